@@ -1,0 +1,44 @@
+// samples/common: the frame loop every sample shares, windowed or headless.
+//
+// A sample supplies setup (materials, grids) and a per-frame callback that
+// draws into the given target; SampleApp handles the command line
+// (--frames N --out DIR --size WxH --seed S), the context (a GLFW window by
+// default, headless EGL when --frames is given), PNG frames, the animated
+// GIF, progress output and a summary. Public SDK API only.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "splatfx/splatfx.hpp"
+
+namespace samples {
+
+struct Options {
+    int frames = 0;                 // > 0: headless, render this many frames then exit
+    std::string out = "out";        // output folder (headless)
+    glm::ivec2 size{640, 480};
+    std::uint32_t seed = 1;
+    float fps = 24.0f;
+    bool traditional = false;       // untextured splats (Fig. 1a)
+    std::string extra;              // sample-specific flag value (see each sample's --help)
+};
+
+// Parses argv; prints usage and returns false on --help or a bad flag.
+bool parseOptions(int argc, char** argv, const char* name, const char* about, Options& options);
+
+struct FrameContext {
+    int index = 0;        // frame number
+    double timeSec = 0.0; // index / fps: animation time never depends on the wall clock
+    glm::ivec2 size{0};
+    splatfx::gl::Target target;
+};
+
+// Runs the loop. frame() draws one frame (the host part: clear, geometry, then splats).
+// Headless: writes DIR/<name>_NNNN.png and DIR/<name>.gif. Returns the process exit code.
+int run(const Options& options, const char* name, const std::function<bool()>& setup,
+        const std::function<void(const FrameContext&)>& frame);
+
+} // namespace samples

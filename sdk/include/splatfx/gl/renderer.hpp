@@ -1,0 +1,78 @@
+// splatfx/gl/renderer.hpp: the OpenGL 4.5 backend that draws a SplatList.
+//
+// Draws sorted splats as instanced quads into a framebuffer the host owns,
+// with premultiplied-alpha "over" compositing, testing (not writing) the
+// host's depth buffer so scene geometry drawn first occludes and cuts through
+// the effect. It never creates a context or a window, and never clears.
+//
+//   auto r = splatfx::gl::Renderer::create();   // a GL 4.5 context must be current
+//   r->upload(materials);                       // when materials change
+//   r->draw(builder.splats(), camera, {.framebuffer = hostFbo, .width = w, .height = h});
+//
+// GL state: draw() saves and restores everything it changes: bound draw
+// framebuffer, viewport, program, vertex array, array buffer, texture
+// bindings on units 0 and 1 (and the active unit), blend enable/func/equation,
+// depth test/func/mask, cull face enable, colour mask. With
+// RendererDesc::restoreState = false it skips the queries (faster on drivers
+// where glGet stalls) and leaves: blend on (ONE, ONE_MINUS_SRC_ALPHA, ADD),
+// depth test on (LEQUAL), depth writes off, culling off, its own program,
+// vertex array and textures bound.
+//
+// Threading: every call on the thread whose context is current. Move-only.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "splatfx/camera.hpp"
+#include "splatfx/materials.hpp"
+#include "splatfx/result.hpp"
+#include "splatfx/splats.hpp"
+
+namespace splatfx::gl {
+
+struct RendererDesc {
+    bool restoreState = true;  // save and restore host GL state around draw(); default true
+    bool depthTest = true;     // test against the host's depth buffer; default true
+    bool linearFilter = true;  // bilinear texture sampling (false: nearest); default true
+    bool trimCorners = true;   // draw octagons that skip the footprint's zero corners; default true
+};
+
+// Where to draw: the host's framebuffer object (0 = default framebuffer) and viewport.
+struct Target {
+    unsigned framebuffer = 0;
+    int x = 0, y = 0;
+    int width = 0, height = 0;
+};
+
+struct DrawStats {
+    std::uint64_t splats = 0;
+    std::uint64_t drawCalls = 0;
+};
+
+class Renderer {
+public:
+    // Compiles shaders and allocates buffers. Fails when no GL 4.5 context is current.
+    static Result<Renderer> create(const RendererDesc& desc = {});
+    Renderer(Renderer&&) noexcept;
+    Renderer& operator=(Renderer&&) noexcept;
+    ~Renderer();
+
+    // Uploads texture layers and colour rows when materials.version() differs
+    // from the last upload (cheap otherwise).
+    Status upload(const Materials& materials);
+    // Draws splats (already sorted back to front) with camera's matrices.
+    // Expects upload() to have been called.
+    void draw(const std::vector<Splat>& splats, const Camera& camera, const Target& target);
+
+    const DrawStats& stats() const;
+    const RendererDesc& desc() const;
+
+private:
+    struct Impl;
+    explicit Renderer(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> mImpl;
+};
+
+} // namespace splatfx::gl

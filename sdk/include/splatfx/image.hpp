@@ -1,0 +1,60 @@
+// splatfx/image.hpp: float images in and out of files (OpenImageIO).
+//
+// Reads anything OpenImageIO reads; writes PNG (8-bit) or EXR/TIFF by
+// extension. Writes are atomic: the file appears complete or not at all.
+// It does not resize or colour-manage.
+//
+//   auto img = splatfx::readImage("photo.jpg");
+//   if (!img) return fail(img.error());
+//   splatfx::writeImage("out/frame.png", *img);
+//
+// Threading: free functions; safe from any thread on distinct files.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "splatfx/result.hpp"
+
+namespace splatfx {
+
+// Row-major, top row first, channels interleaved, values nominally in [0, 1].
+struct Image {
+    int width = 0;
+    int height = 0;
+    int channels = 0;
+    std::vector<float> pixels;
+
+    float& at(int x, int y, int c) { return pixels[(static_cast<size_t>(y) * width + x) * channels + c]; }
+    float at(int x, int y, int c) const { return pixels[(static_cast<size_t>(y) * width + x) * channels + c]; }
+};
+
+// Fails with the file name and the reason: missing, unreadable, zero-size,
+// or more than 16384 pixels on a side.
+Result<Image> readImage(const std::string& path);
+// Values are clamped to [0, 1] for 8-bit formats. Written to a temporary
+// name beside the target and renamed into place.
+Status writeImage(const std::string& path, const Image& image);
+
+} // namespace splatfx
+
+namespace splatfx {
+
+// Writes frames into one animated GIF (looping), through OpenImageIO. Frames
+// are kept in memory and written by finish(), so a run that fails halfway
+// leaves no file behind; the file is written to a temporary name and renamed.
+class AnimationWriter {
+public:
+    explicit AnimationWriter(std::string path, int framesPerSecond = 24);
+    // Expects every frame to have the first frame's size. Uses RGB only.
+    Status add(const Image& frame);
+    Status finish();
+    int frames() const { return static_cast<int>(mFrames.size()); }
+
+private:
+    std::string mPath;
+    int mFps;
+    std::vector<Image> mFrames;
+};
+
+} // namespace splatfx

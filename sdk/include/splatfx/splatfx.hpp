@@ -1,0 +1,15 @@
+// splatfx/splatfx.hpp: everything in the simulation side of the SDK, plus the GL backend.
+// Contexts (EGL, GLFW) are in splatfx/context.hpp and the splatfx::context target.
+#pragma once
+
+#include "splatfx/camera.hpp"
+#include "splatfx/color_table.hpp"
+#include "splatfx/footprint.hpp"
+#include "splatfx/gl/framebuffer.hpp"
+#include "splatfx/gl/renderer.hpp"
+#include "splatfx/grid.hpp"
+#include "splatfx/image.hpp"
+#include "splatfx/materials.hpp"
+#include "splatfx/result.hpp"
+#include "splatfx/splats.hpp"
+#include "splatfx/texture_set.hpp"

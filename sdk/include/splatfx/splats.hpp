@@ -1,0 +1,107 @@
+// splatfx/splats.hpp: voxels to camera-facing splats, sorted back to front.
+//
+// For each voxel the builder computes the ellipse its (possibly anisotropic)
+// kernel projects to for this camera, the optical depth along the ray
+// through its centre, its texture layer(s) and colour coordinate, and fades
+// it out as it nears the near plane (so a camera inside an effect sees no
+// popping). The list is then sorted back to front for composite-every-sample
+// splatting (King et al. 1999, sec. 2 step 4). The resulting SplatList is
+// exactly what the GL renderer draws and the reference renderer integrates.
+// It does no GL and no animation.
+//
+//   splatfx::SplatBuilder builder;
+//   builder.begin(camera);
+//   builder.add(grid, materials, {.textureSet = fireSet, .colorTable = fireLut});
+//   builder.sort();
+//   renderer.draw(builder.splats(), camera, target);
+//
+// Threading: one thread at a time per builder; builders are independent.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "splatfx/camera.hpp"
+#include "splatfx/grid.hpp"
+#include "splatfx/materials.hpp"
+
+namespace splatfx {
+
+// One splat, laid out as the GPU reads it (64 bytes, 16 floats).
+// A fragment at ellipse coordinates (u, v) in [-1, 1]^2, i.e. world position
+// center + u * axisU + v * axisV, gets
+//   texel  = mix(layer[layer](u, v), layer[nextLayer](u, v), blend)
+//   alpha  = 1 - exp2(-density * texel.a)
+//   colour = colourRow[colorRow](colorCoord).rgb * texel.rgb
+// composited with premultiplied "over".
+struct Splat {
+    glm::vec3 center{0.0f};
+    float density = 0.0f;    // optical depth scale, log2 units (already includes the near-plane fade)
+    glm::vec3 axisU{0.0f};   // ellipse half-axis reaching the footprint's support radius
+    float colorCoord = 0.0f;
+    glm::vec3 axisV{0.0f};
+    float colorRow = 0.0f;
+    float layer = 0.0f;
+    float nextLayer = 0.0f;
+    float blend = 0.0f;      // cross-fade weight towards nextLayer
+    float depth = 0.0f;      // distance from the eye (perspective) or along forward (ortho); sort key
+};
+static_assert(sizeof(Splat) == 64, "Splat must match the GPU layout");
+
+// How a grid's voxels become splats.
+struct SplatStyle {
+    std::uint32_t textureSet = 0;  // id from Materials::addTextureSet; default 0
+    std::uint32_t colorTable = 0;  // id from Materials::addColorTable; default 0
+    bool textured = true;          // false: traditional splatting with the plain footprint (Fig. 1a); default true
+    bool crossfade = false;        // blend towards the next texture by the voxel's phase; default false
+    float opacityScale = 1.0f;     // multiplies every voxel's opacity; default 1
+};
+
+enum class SortMode {
+    Exact,    // radix sort on the exact depth key (default)
+    Bucketed, // radix sort on a coarse key (SplatBuilderDesc::buckets bins over the depth range)
+    None,     // grid order: wrong compositing order, cheapest
+};
+
+struct SplatBuilderDesc {
+    float nearFadeStart = 0.25f; // near-plane fade begins at near + nearFadeStart * splat extent; default 0.25
+    float nearFadeEnd = 1.5f;    // ... and is complete (full opacity) at near + nearFadeEnd * extent; default 1.5
+    bool frustumCull = true;     // drop splats wholly outside the view frustum; default true
+    std::uint32_t buckets = 64;  // depth bins for SortMode::Bucketed; default 64
+};
+
+struct SplatStats {
+    std::uint64_t voxelsIn = 0;   // voxels offered
+    std::uint64_t culled = 0;     // outside the frustum, behind the eye or fully faded
+    std::uint64_t rejected = 0;   // non-finite voxel data or a degenerate transform
+};
+
+class SplatBuilder {
+public:
+    explicit SplatBuilder(const SplatBuilderDesc& desc = {}) : mDesc(desc) {}
+
+    // Starts a frame: clears the list (keeping its memory) and the stats.
+    void begin(const Camera& camera);
+    // Appends the grid's voxels. Opacities are clamped to [0, 1]; voxels with
+    // non-finite data are dropped and counted in stats().rejected.
+    void add(const Grid& grid, const Materials& materials, const SplatStyle& style = {});
+    // Orders the list back to front (largest depth first).
+    void sort(SortMode mode = SortMode::Exact);
+
+    const std::vector<Splat>& splats() const { return mSplats; }
+    std::vector<Splat>& splats() { return mSplats; }
+    const SplatStats& stats() const { return mStats; }
+    const Camera& camera() const { return mCamera; }
+
+private:
+    SplatBuilderDesc mDesc;
+    Camera mCamera;
+    std::vector<Splat> mSplats;
+    SplatStats mStats;
+};
+
+// Back-to-front radix sort of splats by their depth field, stable, O(n).
+// Exposed for tests and for hosts that merge lists from several builders.
+void sortBackToFront(std::vector<Splat>& splats, SortMode mode = SortMode::Exact, std::uint32_t buckets = 64);
+
+} // namespace splatfx

@@ -1,0 +1,69 @@
+// splatfx/texture_set.hpp: the detail textures drawn inside the splats.
+//
+// King et al. 1999, sec. 2 step 1: a small set of textures holding the
+// frequencies to model, converted to grayscale and windowed by the footprint
+// (Figure 2), so each textured splat carries detail yet fades out like a
+// footprint. Sets come from Perlin turbulence (deterministic per seed, no
+// files needed) or from a texture-set folder (e.g. made by splatfx-texpick).
+// It does not upload anything: the GL renderer does.
+//
+//   auto raw = splatfx::TextureSet::turbulence({.count = 8, .size = 32, .seed = 7});
+//   auto splats = raw.windowed(splatfx::Footprint{});
+//
+// Texture-set folder: manifest.json {"format": "splatfx-texture-set",
+// "version": 1, "textures": ["t00.png", ...], "color": false, ...} plus the
+// images (all the same square size). Unknown keys are kept for provenance.
+//
+// Threading: a plain value.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "splatfx/footprint.hpp"
+#include "splatfx/image.hpp"
+#include "splatfx/result.hpp"
+
+namespace splatfx {
+
+struct TurbulenceDesc {
+    int count = 8;          // textures in the set; default 8 (the paper's choice)
+    int size = 32;          // texels on a side; default 32 (sec. 5.4)
+    std::uint32_t seed = 1; // default 1
+    int octaves = 4;        // turbulence octaves; default 4
+    float baseFrequency = 3.0f; // lowest octave, cycles per texture; default 3
+    // Textures are slices along a closed loop through 4D noise, so cycling
+    // them in order is smooth and periodic (sec. 3.3 "cyclical pattern").
+    float loopRadius = 0.6f;    // noise units; larger = faster change; default 0.6
+};
+
+class TextureSet {
+public:
+    int size = 0;        // texels on a side (square)
+    bool color = false;  // true: RGB detail kept; false: grayscale (R=G=B=1, detail in A)
+    bool isWindowed = false;
+    // One RGBA float image per texture, size x size, row-major.
+    std::vector<std::vector<float>> layers;
+
+    int count() const { return static_cast<int>(layers.size()); }
+
+    // Perlin turbulence (sum of |noise| octaves), normalized to [0, 1].
+    static TextureSet turbulence(const TurbulenceDesc& desc);
+    // Loads a texture-set folder (see above). Errors name the file.
+    static Result<TextureSet> load(const std::string& folder);
+    // One texture per image file; all must be square and the same size.
+    static Result<TextureSet> fromImages(const std::vector<Image>& images, bool keepColor);
+    // Writes a texture-set folder atomically (temporary folder, then rename).
+    Status save(const std::string& folder, const std::string& provenanceJson = "{}") const;
+
+    // Figure 2: grayscale (unless color), contrast kept, multiplied by the
+    // footprint weight over the texture's extent. Opacity detail ends up in A.
+    TextureSet windowed(const Footprint& footprint) const;
+    // Box-filters or bilinearly resamples every layer to newSize.
+    TextureSet resized(int newSize) const;
+    // The plain footprint as a one-layer set: traditional splatting (Fig. 1a).
+    static TextureSet footprintOnly(const Footprint& footprint, int size);
+};
+
+} // namespace splatfx

@@ -1,0 +1,80 @@
+#include "splatfx/image.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <system_error>
+
+#include <OpenImageIO/imageio.h>
+
+namespace splatfx {
+
+namespace fs = std::filesystem;
+
+Result<Image> readImage(const std::string& path) {
+    std::error_code ec;
+    if (!fs::exists(path, ec)) return makeError("cannot read image '" + path + "': no such file");
+    if (fs::is_directory(path, ec)) return makeError("cannot read image '" + path + "': it is a folder");
+    if (fs::file_size(path, ec) == 0) return makeError("cannot read image '" + path + "': the file is empty");
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) {
+        std::string why = OIIO::geterror();
+        if (why.empty()) why = "unknown format or corrupt data";
+        return makeError("cannot read image '" + path + "': " + why);
+    }
+    const OIIO::ImageSpec& spec = in->spec();
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
+        return makeError("cannot read image '" + path + "': it has no pixels");
+    if (spec.width > 16384 || spec.height > 16384)
+        return makeError("cannot read image '" + path + "': " + std::to_string(spec.width) + "x" +
+                         std::to_string(spec.height) + " is larger than 16384 on a side");
+    Image img;
+    img.width = spec.width;
+    img.height = spec.height;
+    img.channels = std::min(spec.nchannels, 4);
+    std::vector<float> all(size_t(spec.width) * spec.height * spec.nchannels);
+    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) {
+        std::string why = in->geterror();
+        return makeError("cannot read image '" + path + "': " + (why.empty() ? "truncated or corrupt data" : why));
+    }
+    img.pixels.resize(size_t(img.width) * img.height * img.channels);
+    for (size_t p = 0, n = size_t(img.width) * img.height; p < n; ++p)
+        for (int c = 0; c < img.channels; ++c) img.pixels[p * img.channels + c] = all[p * spec.nchannels + c];
+    return img;
+}
+
+Status writeImage(const std::string& path, const Image& image) {
+    if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
+        image.pixels.size() != size_t(image.width) * image.height * image.channels)
+        return makeError("cannot write image '" + path + "': the image is empty or its size does not match its pixels");
+    const fs::path target(path);
+    // Keep the extension on the temporary name so OpenImageIO picks the format.
+    const fs::path tmp = target.parent_path() / (".tmp-" + target.stem().string() + target.extension().string());
+    auto out = OIIO::ImageOutput::create(target.string());
+    if (!out) return makeError("cannot write image '" + path + "': no writer for '" + target.extension().string() + "'");
+    const std::string ext = target.extension().string();
+    const bool eightBit = ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".gif" || ext == ".bmp";
+    OIIO::ImageSpec spec(image.width, image.height, image.channels, eightBit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+    std::vector<float> clamped;
+    const float* data = image.pixels.data();
+    if (eightBit) {
+        clamped = image.pixels;
+        for (float& v : clamped) v = std::clamp(v, 0.0f, 1.0f); // NaN stays NaN only if both compares fail
+        for (float& v : clamped) if (v != v) v = 0.0f;
+        data = clamped.data();
+    }
+    if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, data) || !out->close()) {
+        std::error_code ec;
+        fs::remove(tmp, ec);
+        return makeError("cannot write image '" + path + "': " + out->geterror());
+    }
+    std::error_code ec;
+    fs::rename(tmp, target, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        return makeError("cannot write image '" + path + "': " + ec.message());
+    }
+    return {};
+}
+
+} // namespace splatfx

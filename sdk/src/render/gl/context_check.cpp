@@ -1,0 +1,22 @@
+#include "context_check.hpp"
+
+#include <dlfcn.h>
+
+namespace splatfx::gl::detail {
+
+bool contextIsCurrent() {
+    using GetCurrent = void* (*)();
+    const char* libs[][2] = {{"libEGL.so.1", "eglGetCurrentContext"}, {"libGLX.so.0", "glXGetCurrentContext"},
+                             {"libGL.so.1", "glXGetCurrentContext"}};
+    for (const auto& lib : libs) {
+        void* handle = dlopen(lib[0], RTLD_LAZY | RTLD_NOLOAD);
+        if (!handle) continue;
+        auto fn = reinterpret_cast<GetCurrent>(dlsym(handle, lib[1]));
+        const bool current = fn && fn() != nullptr;
+        dlclose(handle);
+        if (current) return true;
+    }
+    return false;
+}
+
+} // namespace splatfx::gl::detail

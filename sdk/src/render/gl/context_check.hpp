@@ -1,0 +1,11 @@
+// Is an OpenGL context current on this thread? (private to the GL backend)
+#pragma once
+
+namespace splatfx::gl::detail {
+
+// Asks the EGL and GLX libraries already loaded in the process; a context can
+// only be current if one of them made it so. Never loads a library itself,
+// and never calls GL (which would abort inside the loader with no context).
+bool contextIsCurrent();
+
+} // namespace splatfx::gl::detail

@@ -1,0 +1,70 @@
+#include "splatfx/gl/framebuffer.hpp"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <utility>
+
+#include "context_check.hpp"
+
+namespace splatfx::gl {
+
+Result<Framebuffer> Framebuffer::create(const FramebufferDesc& desc) {
+    if (!detail::contextIsCurrent()) return makeError("splatfx::gl::Framebuffer::create: no OpenGL context is current");
+    if (desc.width <= 0 || desc.height <= 0 || desc.width > 16384 || desc.height > 16384)
+        return makeError("FramebufferDesc size " + std::to_string(desc.width) + "x" + std::to_string(desc.height) +
+                         " must be between 1 and 16384 on each side");
+    Framebuffer fb;
+    fb.mDesc = desc;
+    const GLenum format = desc.color == Precision::U8 ? GL_RGBA8 : desc.color == Precision::F16 ? GL_RGBA16F : GL_RGBA32F;
+    glCreateTextures(GL_TEXTURE_2D, 1, &fb.mColor);
+    glTextureStorage2D(fb.mColor, 1, format, desc.width, desc.height);
+    glCreateTextures(GL_TEXTURE_2D, 1, &fb.mDepth);
+    glTextureStorage2D(fb.mDepth, 1, GL_DEPTH_COMPONENT24, desc.width, desc.height);
+    glCreateFramebuffers(1, &fb.mFbo);
+    glNamedFramebufferTexture(fb.mFbo, GL_COLOR_ATTACHMENT0, fb.mColor, 0);
+    glNamedFramebufferTexture(fb.mFbo, GL_DEPTH_ATTACHMENT, fb.mDepth, 0);
+    if (glCheckNamedFramebufferStatus(fb.mFbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        return makeError("offscreen framebuffer is incomplete for this colour format");
+    return fb;
+}
+
+Framebuffer::Framebuffer(Framebuffer&& o) noexcept { *this = std::move(o); }
+Framebuffer& Framebuffer::operator=(Framebuffer&& o) noexcept {
+    std::swap(mDesc, o.mDesc);
+    std::swap(mFbo, o.mFbo);
+    std::swap(mColor, o.mColor);
+    std::swap(mDepth, o.mDepth);
+    return *this;
+}
+Framebuffer::~Framebuffer() {
+    if (!detail::contextIsCurrent()) return; // the context, and our objects with it, are already gone
+    if (mFbo) glDeleteFramebuffers(1, &mFbo);
+    if (mColor) glDeleteTextures(1, &mColor);
+    if (mDepth) glDeleteTextures(1, &mDepth);
+}
+
+void Framebuffer::clear(glm::vec4 color, float depth) {
+    glClearNamedFramebufferfv(mFbo, GL_COLOR, 0, &color.x);
+    glClearNamedFramebufferfv(mFbo, GL_DEPTH, 0, &depth);
+}
+
+namespace {
+Image readBack(GLuint tex, int w, int h, GLenum format, int channels) {
+    Image img;
+    img.width = w;
+    img.height = h;
+    img.channels = channels;
+    std::vector<float> rows(size_t(w) * h * channels);
+    glGetTextureImage(tex, 0, format, GL_FLOAT, GLsizei(rows.size() * sizeof(float)), rows.data());
+    img.pixels.resize(rows.size());
+    const size_t stride = size_t(w) * channels;
+    for (int y = 0; y < h; ++y) std::copy_n(&rows[size_t(h - 1 - y) * stride], stride, &img.pixels[size_t(y) * stride]);
+    return img;
+}
+} // namespace
+
+Image Framebuffer::read() const { return readBack(mColor, mDesc.width, mDesc.height, GL_RGBA, 4); }
+Image Framebuffer::readDepth() const { return readBack(mDepth, mDesc.width, mDesc.height, GL_DEPTH_COMPONENT, 1); }
+
+} // namespace splatfx::gl

@@ -1,0 +1,245 @@
+#include "splatfx/gl/renderer.hpp"
+
+#include <cassert>
+
+#include <epoxy/gl.h>
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include "context_check.hpp"
+#include "shaders.hpp"
+
+namespace splatfx::gl {
+namespace {
+
+GLuint compile(GLenum type, const char* src, std::string& log) {
+    GLuint s = glCreateShader(type);
+    glShaderSource(s, 1, &src, nullptr);
+    glCompileShader(s);
+    GLint ok = 0;
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char buf[4096];
+        glGetShaderInfoLog(s, sizeof buf, nullptr, buf);
+        log = buf;
+        glDeleteShader(s);
+        return 0;
+    }
+    return s;
+}
+
+// Host state draw() changes, captured so it can be put back.
+struct SavedState {
+    GLint drawFbo = 0, program = 0, vao = 0, arrayBuffer = 0, activeTexture = 0;
+    GLint viewport[4] = {};
+    GLint tex0 = 0, tex1 = 0;
+    GLboolean blend = 0, depthTest = 0, depthMask = 0, cull = 0;
+    GLboolean colorMask[4] = {};
+    GLint blendSrcRgb = 0, blendDstRgb = 0, blendSrcA = 0, blendDstA = 0, blendEqRgb = 0, blendEqA = 0, depthFunc = 0;
+
+    void save() {
+        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &drawFbo);
+        glGetIntegerv(GL_CURRENT_PROGRAM, &program);
+        glGetIntegerv(GL_VERTEX_ARRAY_BINDING, &vao);
+        glGetIntegerv(GL_ARRAY_BUFFER_BINDING, &arrayBuffer);
+        glGetIntegerv(GL_ACTIVE_TEXTURE, &activeTexture);
+        glGetIntegerv(GL_VIEWPORT, viewport);
+        glActiveTexture(GL_TEXTURE0);
+        glGetIntegerv(GL_TEXTURE_BINDING_2D_ARRAY, &tex0);
+        glActiveTexture(GL_TEXTURE1);
+        glGetIntegerv(GL_TEXTURE_BINDING_2D, &tex1);
+        blend = glIsEnabled(GL_BLEND);
+        depthTest = glIsEnabled(GL_DEPTH_TEST);
+        cull = glIsEnabled(GL_CULL_FACE);
+        glGetBooleanv(GL_DEPTH_WRITEMASK, &depthMask);
+        glGetBooleanv(GL_COLOR_WRITEMASK, colorMask);
+        glGetIntegerv(GL_BLEND_SRC_RGB, &blendSrcRgb);
+        glGetIntegerv(GL_BLEND_DST_RGB, &blendDstRgb);
+        glGetIntegerv(GL_BLEND_SRC_ALPHA, &blendSrcA);
+        glGetIntegerv(GL_BLEND_DST_ALPHA, &blendDstA);
+        glGetIntegerv(GL_BLEND_EQUATION_RGB, &blendEqRgb);
+        glGetIntegerv(GL_BLEND_EQUATION_ALPHA, &blendEqA);
+        glGetIntegerv(GL_DEPTH_FUNC, &depthFunc);
+    }
+    void restore() const {
+        auto set = [](GLenum cap, GLboolean on) { on ? glEnable(cap) : glDisable(cap); };
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(drawFbo));
+        glUseProgram(GLuint(program));
+        glBindVertexArray(GLuint(vao));
+        glBindBuffer(GL_ARRAY_BUFFER, GLuint(arrayBuffer));
+        glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, GLuint(tex0));
+        glActiveTexture(GL_TEXTURE1);
+        glBindTexture(GL_TEXTURE_2D, GLuint(tex1));
+        glActiveTexture(GLenum(activeTexture));
+        set(GL_BLEND, blend);
+        set(GL_DEPTH_TEST, depthTest);
+        set(GL_CULL_FACE, cull);
+        glDepthMask(depthMask);
+        glColorMask(colorMask[0], colorMask[1], colorMask[2], colorMask[3]);
+        glBlendFuncSeparate(GLenum(blendSrcRgb), GLenum(blendDstRgb), GLenum(blendSrcA), GLenum(blendDstA));
+        glBlendEquationSeparate(GLenum(blendEqRgb), GLenum(blendEqA));
+        glDepthFunc(GLenum(depthFunc));
+    }
+};
+
+} // namespace
+
+struct Renderer::Impl {
+    RendererDesc desc;
+    DrawStats stats;
+    GLuint program = 0, vao = 0, instances = 0, layers = 0, colors = 0;
+    GLint uViewProj = -1, uOctagon = -1, uColorRows = -1;
+    GLsizeiptr capacity = 0;
+    std::uint64_t uploadedVersion = 0;
+    std::uint32_t colorRows = 0;
+
+    ~Impl() {
+        // The context may already be gone at exit; its objects died with it then.
+        if (!detail::contextIsCurrent()) return;
+        if (program) glDeleteProgram(program);
+        if (vao) glDeleteVertexArrays(1, &vao);
+        if (instances) glDeleteBuffers(1, &instances);
+        if (layers) glDeleteTextures(1, &layers);
+        if (colors) glDeleteTextures(1, &colors);
+    }
+};
+
+Renderer::Renderer(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
+Renderer::Renderer(Renderer&&) noexcept = default;
+Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+Renderer::~Renderer() = default;
+const DrawStats& Renderer::stats() const { return mImpl->stats; }
+const RendererDesc& Renderer::desc() const { return mImpl->desc; }
+
+Result<Renderer> Renderer::create(const RendererDesc& desc) {
+    if (!detail::contextIsCurrent()) return makeError("splatfx::gl::Renderer::create: no OpenGL context is current on this thread");
+    if (epoxy_gl_version() < 45)
+        return makeError("splatfx::gl::Renderer::create: OpenGL 4.5 is required, the current context has " +
+                         std::to_string(epoxy_gl_version() / 10) + "." + std::to_string(epoxy_gl_version() % 10));
+    auto impl = std::make_unique<Impl>();
+    impl->desc = desc;
+    std::string log;
+    GLuint vs = compile(GL_VERTEX_SHADER, detail::kSplatVertex, log);
+    if (!vs) return makeError("splat vertex shader failed to compile: " + log);
+    GLuint fs = compile(GL_FRAGMENT_SHADER, detail::kSplatFragment, log);
+    if (!fs) {
+        glDeleteShader(vs);
+        return makeError("splat fragment shader failed to compile: " + log);
+    }
+    impl->program = glCreateProgram();
+    glAttachShader(impl->program, vs);
+    glAttachShader(impl->program, fs);
+    glLinkProgram(impl->program);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = 0;
+    glGetProgramiv(impl->program, GL_LINK_STATUS, &ok);
+    if (!ok) {
+        char buf[4096];
+        glGetProgramInfoLog(impl->program, sizeof buf, nullptr, buf);
+        return makeError(std::string("splat program failed to link: ") + buf);
+    }
+    impl->uViewProj = glGetUniformLocation(impl->program, "uViewProj");
+    impl->uOctagon = glGetUniformLocation(impl->program, "uOctagon");
+    impl->uColorRows = glGetUniformLocation(impl->program, "uColorRows");
+
+    glCreateBuffers(1, &impl->instances);
+    glCreateVertexArrays(1, &impl->vao);
+    glVertexArrayVertexBuffer(impl->vao, 0, impl->instances, 0, sizeof(Splat));
+    glVertexArrayBindingDivisor(impl->vao, 0, 1);
+    for (GLuint a = 0; a < 4; ++a) {
+        glEnableVertexArrayAttrib(impl->vao, a);
+        glVertexArrayAttribFormat(impl->vao, a, 4, GL_FLOAT, GL_FALSE, a * 16);
+        glVertexArrayAttribBinding(impl->vao, a, 0);
+    }
+    return Renderer(std::move(impl));
+}
+
+Status Renderer::upload(const Materials& materials) {
+    Impl& r = *mImpl;
+    if (materials.version() == r.uploadedVersion) return {};
+    if (materials.colorTableCount() == 0) return makeError("splatfx::gl::Renderer::upload: materials hold no colour table");
+    const int n = materials.layerSize();
+    const std::uint32_t count = materials.layerCount();
+    GLint maxLayers = 0;
+    glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &maxLayers);
+    if (GLint(count) > maxLayers)
+        return makeError("materials hold " + std::to_string(count) + " texture layers; this GL allows " + std::to_string(maxLayers));
+    if (r.layers) glDeleteTextures(1, &r.layers);
+    glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &r.layers);
+    glTextureStorage3D(r.layers, 1, GL_RGBA8, n, n, GLsizei(count));
+    for (std::uint32_t i = 0; i < count; ++i)
+        glTextureSubImage3D(r.layers, 0, 0, 0, GLint(i), n, n, 1, GL_RGBA, GL_FLOAT, materials.layer(i).data());
+    const GLint filter = r.desc.linearFilter ? GL_LINEAR : GL_NEAREST;
+    glTextureParameteri(r.layers, GL_TEXTURE_MIN_FILTER, filter);
+    glTextureParameteri(r.layers, GL_TEXTURE_MAG_FILTER, filter);
+    // Clamp to the border texels, which the footprint window has brought to zero.
+    glTextureParameteri(r.layers, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(r.layers, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+
+    const int width = materials.colorTableSize();
+    r.colorRows = materials.colorTableCount();
+    if (r.colors) glDeleteTextures(1, &r.colors);
+    glCreateTextures(GL_TEXTURE_2D, 1, &r.colors);
+    glTextureStorage2D(r.colors, 1, GL_RGBA16F, width, GLsizei(r.colorRows));
+    for (std::uint32_t row = 0; row < r.colorRows; ++row)
+        glTextureSubImage2D(r.colors, 0, 0, GLint(row), width, 1, GL_RGBA, GL_FLOAT, materials.colorRow(row).data());
+    glTextureParameteri(r.colors, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTextureParameteri(r.colors, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTextureParameteri(r.colors, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTextureParameteri(r.colors, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    r.uploadedVersion = materials.version();
+    return {};
+}
+
+void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, const Target& target) {
+    Impl& r = *mImpl;
+    assert(r.layers && "splatfx::gl::Renderer::draw: call upload(materials) first");
+    r.stats.splats = splats.size();
+    r.stats.drawCalls = 0;
+    if (splats.empty() || !r.layers) return;
+
+    const GLsizeiptr bytes = GLsizeiptr(splats.size() * sizeof(Splat));
+    if (bytes > r.capacity) {
+        r.capacity = bytes + bytes / 2;
+        glNamedBufferData(r.instances, r.capacity, nullptr, GL_STREAM_DRAW);
+    } else {
+        // Orphan: the driver hands back fresh storage instead of waiting for the last frame's draw.
+        glInvalidateBufferData(r.instances);
+    }
+    glNamedBufferSubData(r.instances, 0, bytes, splats.data());
+
+    SavedState saved;
+    if (r.desc.restoreState) saved.save();
+
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
+    glViewport(target.x, target.y, target.width, target.height);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    glBlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
+    if (r.desc.depthTest) {
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LEQUAL);
+    } else {
+        glDisable(GL_DEPTH_TEST);
+    }
+    glDepthMask(GL_FALSE);
+    glDisable(GL_CULL_FACE);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glUseProgram(r.program);
+    const glm::mat4 vp = camera.proj * camera.view;
+    glUniformMatrix4fv(r.uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
+    glUniform1i(r.uOctagon, r.desc.trimCorners ? 1 : 0);
+    glUniform1f(r.uColorRows, float(r.colorRows));
+    glBindTextureUnit(0, r.layers);
+    glBindTextureUnit(1, r.colors);
+    glBindVertexArray(r.vao);
+    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, r.desc.trimCorners ? 8 : 4, GLsizei(splats.size()));
+    r.stats.drawCalls = 1;
+
+    if (r.desc.restoreState) saved.restore();
+}
+
+} // namespace splatfx::gl

@@ -1,0 +1,61 @@
+// GLSL for the splat pass (private to the GL backend).
+#pragma once
+
+namespace splatfx::gl::detail {
+
+// Per instance: one Splat (see splats.hpp). Per vertex: a corner of the
+// octagon (or square) circumscribing the unit disc, from gl_VertexID.
+inline constexpr const char* kSplatVertex = R"(#version 450 core
+layout(location = 0) in vec4 aCenterDensity;
+layout(location = 1) in vec4 aAxisUColor;
+layout(location = 2) in vec4 aAxisVRow;
+layout(location = 3) in vec4 aLayers;
+
+uniform mat4 uViewProj;
+uniform int uOctagon;
+uniform float uColorRows;
+layout(binding = 1) uniform sampler2D uColors;
+
+out vec2 vTex;
+flat out float vDensity;
+flat out vec3 vLayers;
+flat out vec3 vColor;
+
+// Octagon circumscribing the unit circle, in triangle-strip order.
+const vec2 kOct[8] = vec2[8](vec2(1.0, -0.41421356), vec2(1.0, 0.41421356), vec2(0.41421356, -1.0), vec2(0.41421356, 1.0),
+                             vec2(-0.41421356, -1.0), vec2(-0.41421356, 1.0), vec2(-1.0, -0.41421356), vec2(-1.0, 0.41421356));
+const vec2 kQuad[4] = vec2[4](vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 1.0), vec2(1.0, 1.0));
+
+void main() {
+    vec2 uv = uOctagon != 0 ? kOct[gl_VertexID] : kQuad[gl_VertexID];
+    vec3 p = aCenterDensity.xyz + uv.x * aAxisUColor.xyz + uv.y * aAxisVRow.xyz;
+    gl_Position = uViewProj * vec4(p, 1.0);
+    // Layer images are stored top row first; +v is the splat's "up".
+    vTex = vec2(0.5 + 0.5 * uv.x, 0.5 - 0.5 * uv.y);
+    vDensity = aCenterDensity.w;
+    vLayers = aLayers.xyz;
+    // Colour is constant over a splat: look it up once per vertex, texel-centre exact.
+    float n = float(textureSize(uColors, 0).x);
+    vec2 tc = vec2((aAxisUColor.w * (n - 1.0) + 0.5) / n, (aAxisVRow.w + 0.5) / uColorRows);
+    vColor = texture(uColors, tc).rgb;
+}
+)";
+
+inline constexpr const char* kSplatFragment = R"(#version 450 core
+layout(binding = 0) uniform sampler2DArray uLayers;
+in vec2 vTex;
+flat in float vDensity;
+flat in vec3 vLayers;
+flat in vec3 vColor;
+layout(location = 0) out vec4 oColor;
+
+void main() {
+    vec4 t = texture(uLayers, vec3(vTex, vLayers.x));
+    if (vLayers.z > 0.0) t = mix(t, texture(uLayers, vec3(vTex, vLayers.y)), vLayers.z);
+    // Opacity from optical depth: alpha = 1 - 2^(-density * detail).
+    float a = 1.0 - exp2(-vDensity * t.a);
+    oColor = vec4(vColor * t.rgb * a, a);
+}
+)";
+
+} // namespace splatfx::gl::detail

@@ -1,0 +1,44 @@
+#include "gl_fixture.hpp"
+
+#include <filesystem>
+#include <memory>
+
+namespace splatfx::test {
+
+namespace {
+struct Shared {
+    std::unique_ptr<HeadlessContext> ctx;
+    std::string error;
+};
+Shared& shared() {
+    // One context per process: creating EGL displays per test is slow on llvmpipe.
+    static Shared s = [] {
+        Shared out;
+        auto c = HeadlessContext::create();
+        if (c) out.ctx = std::make_unique<HeadlessContext>(std::move(*c));
+        else out.error = c.error();
+        return out;
+    }();
+    return s;
+}
+} // namespace
+
+void GLTest::SetUp() {
+    Shared& s = shared();
+    ASSERT_TRUE(s.ctx) << "headless OpenGL 4.5 is required for this test: " << s.error;
+    s.ctx->makeCurrent();
+}
+
+std::string outputDir() {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "unknown";
+    for (char& c : name)
+        if (c == '/') c = '_';
+    const std::string dir = std::string(SPLATFX_TEST_OUTPUT_DIR) + "/" + name;
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
+std::string sourcePath(const std::string& relative) { return std::string(SPLATFX_SOURCE_DIR) + "/" + relative; }
+
+} // namespace splatfx::test
