@@ -3,6 +3,8 @@
 #include <filesystem>
 #include <memory>
 
+#include <epoxy/gl.h>
+
 namespace splatfx::test {
 
 namespace {
@@ -27,6 +29,14 @@ void GLTest::SetUp() {
     Shared& s = shared();
     ASSERT_TRUE(s.ctx) << "headless OpenGL 4.5 is required for this test: " << s.error;
     s.ctx->makeCurrent();
+    while (glGetError() != GL_NO_ERROR) {
+    }
+}
+
+void GLTest::TearDown() {
+    if (!shared().ctx) return;
+    const GLenum e = glGetError();
+    EXPECT_EQ(e, GLenum(GL_NO_ERROR)) << "a GL call in this test raised error 0x" << std::hex << e;
 }
 
 std::string outputDir() {

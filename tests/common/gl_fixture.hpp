@@ -14,7 +14,10 @@ namespace splatfx::test {
 // fails the test with EGL's message when there is none).
 class GLTest : public ::testing::Test {
 protected:
+    // Also clears the GL error flag, so TearDown's check blames this test only.
     void SetUp() override;
+    // Fails the test if any GL call in it raised an error.
+    void TearDown() override;
 };
 
 // Folder for actual/diff images of failing comparisons: <build>/test-output/<suite>.<test>/

@@ -35,7 +35,7 @@ struct TurbulenceDesc {
     float baseFrequency = 3.0f; // lowest octave, cycles per texture; default 3
     // Textures are slices along a closed loop through 4D noise, so cycling
     // them in order is smooth and periodic (sec. 3.3 "cyclical pattern").
-    float loopRadius = 0.6f;    // noise units; larger = faster change; default 0.6
+    float loopRadius = 0.25f;   // noise units; larger = faster change between textures; default 0.25
 };
 
 class TextureSet {

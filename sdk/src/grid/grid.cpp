@@ -1,12 +1,18 @@
 #include "splatfx/grid.hpp"
 
 #include <cmath>
+#include <sstream>
 #include <string>
 
 namespace splatfx {
 namespace {
 
-std::string str(float v) { return std::to_string(v); }
+// Shortest readable form: "0.25", "-1", "nan", "inf".
+std::string str(float v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+}
 
 Status checkSpacing(glm::vec3 spacing) {
     for (int a = 0; a < 3; ++a)
@@ -118,6 +124,8 @@ Result<Grid> Grid::fromDense(glm::ivec3 dims, const std::vector<float>& opacity,
                 v.opacity = o;
                 g.voxels.push_back(v);
             }
+    if (g.voxels.empty())
+        return makeError("fromDense: every opacity is 0; the grid would be empty (nothing to draw)");
     g.colorByHeight();
     return g;
 }

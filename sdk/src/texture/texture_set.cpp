@@ -47,7 +47,9 @@ TextureSet TextureSet::turbulence(const TurbulenceDesc& d) {
                 double sum = 0.0, amp = 1.0, f = d.baseFrequency;
                 for (int o = 0; o < d.octaves; ++o) {
                     // Perlin 1985 turbulence: sum of |noise| over octaves, each half as strong.
-                    sum += amp * std::abs(noise(f * x / d.size, f * y / d.size, z0 * (1 << o), w0 * (1 << o)));
+                    // Each octave walks its own loop (offset, same radius) so fine
+                    // detail stays as coherent from texture to texture as coarse detail.
+                    sum += amp * std::abs(noise(f * x / d.size, f * y / d.size, z0 + 31.7 * o, w0 + 11.3 * o));
                     amp *= 0.5;
                     f *= 2.0;
                 }

@@ -64,9 +64,11 @@ struct SavedState {
     void restore() const {
         auto set = [](GLenum cap, GLboolean on) { on ? glEnable(cap) : glDisable(cap); };
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(drawFbo));
-        glUseProgram(GLuint(program));
-        glBindVertexArray(GLuint(vao));
-        glBindBuffer(GL_ARRAY_BUFFER, GLuint(arrayBuffer));
+        // A host may delete its program or vertex array while still bound; once
+        // ours replaced it, the name is gone and rebinding it would be an error.
+        glUseProgram(glIsProgram(GLuint(program)) ? GLuint(program) : 0);
+        glBindVertexArray(glIsVertexArray(GLuint(vao)) ? GLuint(vao) : 0);
+        glBindBuffer(GL_ARRAY_BUFFER, glIsBuffer(GLuint(arrayBuffer)) ? GLuint(arrayBuffer) : 0);
         glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_2D_ARRAY, GLuint(tex0));

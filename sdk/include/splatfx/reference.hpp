@@ -1,0 +1,173 @@
+// splatfx/reference.hpp: the CPU reference renderer (double precision), two modes.
+//
+// Every accuracy figure splatfx publishes is "GL output vs this reference on
+// the same input". It consumes exactly what the GL renderer consumes (the
+// splat list, the camera, the Materials) and follows GL's rasterization
+// conventions: pixel (x, y) of the output (top row first) is sampled at its
+// centre, x + 0.5, and GL row height - 1 - y + 0.5, through camera.proj * view
+// over a viewport of camera.viewport pixels; fragments outside [near, far]
+// are clipped and a host depth image is tested with LEQUAL.
+//
+//  * Splat-exact (renderSplatExact): the splat model with every approximation
+//    of the real-time path removed. Each splat's footprint is evaluated
+//    analytically (Footprint::exact, no table, no 8-bit texture); textured
+//    detail is sampled like the GPU (bilinear, clamp to edge, texel centres)
+//    in double and multiplied by the exact window; the splats overlapping a
+//    pixel are composited in the order of the depth at which that pixel's ray
+//    meets each splat plane (not the per-splat sort key); accumulation is in
+//    double. Alpha and colour follow the GPU: alpha = 1 - 2^(-density * detail),
+//    colour = colourRow(colorCoord).rgb * texel.rgb, premultiplied "over".
+//  * Volume-exact (VolumeField + renderVolumeExact): untextured splatting's
+//    continuous field, i.e. the sum of the voxel kernels h(|M^-1 (x - c)|)
+//    with the extinction each voxel's splat implies, colour from the same
+//    colour table (extinction-weighted where kernels overlap), integrated
+//    along every pixel ray with the emission-absorption model, halving the
+//    step until two successive results agree to VolumeExactDesc::tolerance.
+//    It measures what splatting itself costs against true volume rendering.
+//
+// It does NOT: draw anything with GL, apply the splat builder's near-plane
+// fade in volume mode (rays simply start at the near plane), model textured
+// detail in volume mode (the field is the traditional, untextured one), or
+// run fast: it is for tests and benchmarks (seconds per frame).
+//
+//   splatfx::Image ref = *splatfx::renderSplatExact(builder.splats(), camera, materials, {.background = bg});
+//   splatfx::VolumeField field(materials);
+//   field.add(grid, {.colorTable = lut});
+//   splatfx::Image vol = *splatfx::renderVolumeExact(field, camera, {.background = bg});
+//
+// Threading: the render functions split rows over `threads` worker threads
+// they own; inputs are read-only during the call. A VolumeField is a plain
+// value (one writer at a time; evaluate() is const and thread-safe).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "splatfx/camera.hpp"
+#include "splatfx/grid.hpp"
+#include "splatfx/image.hpp"
+#include "splatfx/materials.hpp"
+#include "splatfx/result.hpp"
+#include "splatfx/splats.hpp"
+
+namespace splatfx {
+
+// How a textured layer's footprint window is evaluated.
+enum class ReferenceWindow {
+    // The detail is recovered from the stored layer (alpha / the sampled
+    // window it was multiplied by at layerSize) and multiplied by the exact
+    // window F(r) / F(0). Exact when the set was windowed at layerSize (a set
+    // whose size equals MaterialsDesc::layerSize); default.
+    Exact,
+    // The layer's alpha as stored (sampled window included), in double: the
+    // GPU's texture, without 8-bit storage or fixed-point filtering.
+    Stored,
+};
+
+// What the GL frame was drawn over: a constant colour, or the host's image.
+struct ReferenceHost {
+    glm::vec4 background{0.0f};         // premultiplied RGBA under the splats; default transparent black
+    const Image* backgroundImage = nullptr; // optional RGBA, top row first, viewport size; replaces `background`
+    const Image* depth = nullptr;       // optional host depth, window units [0, 1], one channel, top row first
+                                        // (as gl::Framebuffer::readDepth returns); fragments behind it are dropped
+};
+
+struct SplatExactDesc {
+    ReferenceHost host;                             // default: transparent black, no depth
+    ReferenceWindow window = ReferenceWindow::Exact; // default Exact
+    bool trimCorners = true; // match RendererDesc::trimCorners (octagon vs square quad); default true
+    int threads = 0;         // worker threads; 0 = std::thread::hardware_concurrency(); default 0
+};
+
+struct SplatExactStats {
+    std::uint64_t fragments = 0;    // (pixel, splat) pairs composited
+    std::uint64_t maxOverlap = 0;   // most fragments on one pixel
+    std::uint64_t skippedSplats = 0; // non-finite or degenerate splats, or layer/row out of range
+};
+
+// Expects camera.viewport > 0 and materials holding every splat's layer and
+// colour row (others are skipped and counted). Fails with a message on a
+// host image whose size or channel count does not match the viewport.
+Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& camera, const Materials& materials,
+                               const SplatExactDesc& desc = {}, SplatExactStats* stats = nullptr);
+
+// The continuous field that untextured splatting reconstructs.
+//
+// Voxel j, with kernel matrix M_j (grid rotation and scale, lattice spacing,
+// stretch, as SplatBuilder builds it), centre c_j and log2 optical depth
+// tau_j = -log2(1 - opacity * opacityScale * table alpha) (clamped like the
+// builder, at most 24), contributes extinction (natural log, per world unit)
+//   sigma_j(x) = ln 2 * tau_j / (F(0) * |det M_j|^(1/3)) * h(|M_j^-1 (x - c_j)|)
+// with h = Footprint::kernel and F(0) = Footprint::exact(0). Its line
+// integral along any direction d is then ln 2 * tau_j * chord * F(q) / F(0),
+// the splat's own optical depth (splats.cpp), so a lone voxel seen head-on
+// renders identically as a splat and as a volume.
+class VolumeField {
+public:
+    struct Sample {
+        double extinction = 0.0;     // sum of sigma_j(x), per world unit
+        glm::dvec3 color{0.0};       // extinction-weighted mean colour (0 where extinction is 0)
+    };
+    struct VoxelKernel {
+        glm::dvec3 center{0.0};
+        glm::dmat3 inverse{1.0};     // M^-1
+        double scale = 0.0;          // ln 2 * tau / (F(0) |det M|^(1/3))
+        double boundRadius = 0.0;    // world radius of a sphere holding the support
+        glm::dvec3 color{1.0};       // colour row at colorCoord (texel.rgb = 1 for the plain footprint)
+    };
+
+    explicit VolumeField(const Materials& materials);
+
+    // Appends the grid's voxels with the splat builder's rules: opacities
+    // clamped to [0, 1], non-finite voxels or singular kernels dropped and
+    // counted in rejected(), zero-opacity voxels left out. style.textured is
+    // ignored (the field is the untextured one).
+    void add(const Grid& grid, const SplatStyle& style = {});
+
+    Sample evaluate(glm::dvec3 worldPoint) const;
+    // Exact optical depth (natural log) along the whole line origin + t dir,
+    // t in (-inf, inf): the sum of each kernel's footprint (closed form up to
+    // Footprint::exact's quadrature). For tests.
+    double lineOpticalDepth(glm::dvec3 origin, glm::dvec3 dir) const;
+
+    const Materials& materials() const { return *mMaterials; }
+    const std::vector<VoxelKernel>& kernels() const { return mKernels; }
+    std::uint64_t rejected() const { return mRejected; }
+
+private:
+    const Materials* mMaterials;
+    std::vector<VoxelKernel> mKernels;
+    std::uint64_t mRejected = 0;
+    double mCentreFootprint = 1.0; // F(0)
+};
+
+struct VolumeExactDesc {
+    ReferenceHost host;          // default: transparent black, no depth
+    double tolerance = 1e-5;     // stop halving when two results differ by less (max over RGBA); default 1e-5
+    double initialStep = 0.0;    // world units; 0 = a quarter of the smallest kernel support radius; default 0
+    int maxHalvings = 10;        // at most this many halvings per pixel; default 10
+    int minHalvings = 1;         // at least this many (so every pixel has an error estimate); default 1
+    // Fixed step (no refinement) when > 0: for convergence studies. Default 0.
+    double fixedStep = 0.0;
+    int threads = 0;             // 0 = std::thread::hardware_concurrency(); default 0
+};
+
+struct VolumeExactStats {
+    double maxErrorEstimate = 0.0;   // largest |C(h) - C(h/2)| over pixels at the final step
+    int maxHalvingsUsed = 0;
+    std::uint64_t unconverged = 0;   // pixels that hit maxHalvings above tolerance
+    std::uint64_t kernelEvaluations = 0;
+};
+
+// Emission-absorption: C = integral T(t) sigma(t) c(t) dt, T = exp(-integral sigma),
+// from the near plane to the far plane (or the host depth), then
+// C + T * background. The ray is cut at every kernel's support boundary;
+// inside each piece, steps of at most h each contribute
+// (1 - exp(-dtau)) * (extinction-weighted colour) with dtau by 4-point
+// Gauss-Legendre: exact for a constant colour, second order in h otherwise.
+Result<Image> renderVolumeExact(const VolumeField& field, const Camera& camera, const VolumeExactDesc& desc = {},
+                                VolumeExactStats* stats = nullptr);
+
+} // namespace splatfx

@@ -1,0 +1,211 @@
+// Splat-exact reference: the splat model of splats.hpp evaluated without the
+// real-time path's approximations (see reference.hpp).
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <mutex>
+#include <vector>
+
+#include "reference_common.hpp"
+#include "splatfx/reference.hpp"
+
+namespace splatfx {
+namespace {
+
+constexpr double kLn2 = 0.69314718055994530942;
+constexpr int kTile = 16;
+
+bool finite(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// One layer as the reference samples it, in double: RGB as stored, alpha
+// either as stored or with the sampled footprint window divided out.
+struct RefLayer {
+    int size = 0;
+    std::vector<glm::dvec4> texels;
+
+    // GL_LINEAR, GL_CLAMP_TO_EDGE, texel centres at (i + 0.5) / size.
+    glm::dvec4 sample(double s, double t) const {
+        const double fx = s * size - 0.5, fy = t * size - 0.5;
+        const double x0f = std::floor(fx), y0f = std::floor(fy);
+        const double ax = fx - x0f, ay = fy - y0f;
+        auto clampi = [&](double v) { return int(std::clamp(v, 0.0, double(size - 1))); };
+        const int x0 = clampi(x0f), x1 = clampi(x0f + 1.0), y0 = clampi(y0f), y1 = clampi(y0f + 1.0);
+        auto at = [&](int x, int y) { return texels[size_t(y) * size + x]; };
+        return (at(x0, y0) * (1.0 - ax) + at(x1, y0) * ax) * (1.0 - ay) + (at(x0, y1) * (1.0 - ax) + at(x1, y1) * ax) * ay;
+    }
+};
+
+RefLayer makeLayer(const Materials& m, std::uint32_t index, const std::vector<float>& window, bool divideWindow) {
+    RefLayer L;
+    L.size = m.layerSize();
+    const int n = L.size;
+    const std::vector<float>& src = m.layer(index);
+    L.texels.resize(size_t(n) * n);
+    for (size_t p = 0; p < L.texels.size(); ++p) L.texels[p] = glm::dvec4(src[p * 4], src[p * 4 + 1], src[p * 4 + 2], src[p * 4 + 3]);
+    if (!divideWindow) return L;
+    // TextureSet::windowed stored alpha = detail * window(texel centre); undo it.
+    std::vector<char> known(L.texels.size(), 0);
+    for (size_t p = 0; p < L.texels.size(); ++p)
+        if (window[p] > 0.0f) {
+            L.texels[p].a = std::clamp(double(src[p * 4 + 3]) / double(window[p]), 0.0, 1.0);
+            known[p] = 1;
+        }
+    // Texels whose centre lies outside the support carry no detail; extend the
+    // nearest inner texel along the radius so bilinear taps near the rim see
+    // detail, not zero (the exact window is what brings the rim to zero).
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const size_t p = size_t(y) * n + x;
+            if (known[p]) continue;
+            const double cx = x + 0.5 - 0.5 * n, cy = y + 0.5 - 0.5 * n;
+            const double len = std::sqrt(cx * cx + cy * cy);
+            double a = 0.0;
+            for (double k = 1.0; k < len; k += 0.5) {
+                const int xi = int(std::floor(0.5 * n + cx * (1.0 - k / len)));
+                const int yi = int(std::floor(0.5 * n + cy * (1.0 - k / len)));
+                if (xi < 0 || yi < 0 || xi >= n || yi >= n) continue;
+                if (known[size_t(yi) * n + xi]) {
+                    a = L.texels[size_t(yi) * n + xi].a;
+                    break;
+                }
+            }
+            L.texels[p].a = a;
+        }
+    return L;
+}
+
+struct Fragment {
+    double t;
+    double alpha;
+    glm::dvec3 color; // straight (not premultiplied)
+};
+
+} // namespace
+
+Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& camera, const Materials& materials,
+                               const SplatExactDesc& desc, SplatExactStats* statsOut) {
+    if (Status s = reference::checkHost(desc.host, camera, "renderSplatExact"); !s) return makeError(s.error());
+    const int W = camera.viewport.x, H = camera.viewport.y;
+    const Footprint& fp = materials.footprint();
+    const double R = fp.radius();
+    const double F0 = fp.exact(0.0);
+    const bool exactWindow = desc.window == ReferenceWindow::Exact;
+
+    std::vector<RefLayer> layers;
+    {
+        const std::vector<float> window = fp.image(materials.layerSize());
+        for (std::uint32_t i = 0; i < materials.layerCount(); ++i) layers.push_back(makeLayer(materials, i, window, exactWindow));
+    }
+
+    SplatExactStats stats;
+    // Bin splats into screen tiles by the bounding box of their drawn polygon.
+    const int tilesX = (W + kTile - 1) / kTile, tilesY = (H + kTile - 1) / kTile;
+    std::vector<std::vector<std::uint32_t>> tiles(size_t(tilesX) * tilesY);
+    const glm::dmat4 vp = glm::dmat4(camera.proj) * glm::dmat4(camera.view);
+    const double o = 0.41421356; // the octagon of shaders.hpp
+    const double octU[8] = {1, 1, o, o, -o, -o, -1, -1}, octV[8] = {-o, o, -1, 1, -1, 1, -o, o};
+    const double sqU[4] = {-1, 1, -1, 1}, sqV[4] = {-1, -1, 1, 1};
+    for (size_t i = 0; i < splats.size(); ++i) {
+        const Splat& s = splats[i];
+        const std::uint32_t layer = std::uint32_t(std::lround(s.layer)), next = std::uint32_t(std::lround(s.nextLayer));
+        const std::uint32_t row = std::uint32_t(std::lround(s.colorRow));
+        if (!finite(s.center) || !finite(s.axisU) || !finite(s.axisV) || !std::isfinite(s.density) || !std::isfinite(s.blend) ||
+            !(s.layer >= 0.0f) || layer >= materials.layerCount() || (s.blend > 0.0f && (!(s.nextLayer >= 0.0f) || next >= materials.layerCount())) ||
+            !(s.colorRow >= 0.0f) || row >= std::max(materials.colorTableCount(), 1u)) {
+            ++stats.skippedSplats;
+            continue;
+        }
+        double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+        bool behind = false;
+        const int nv = desc.trimCorners ? 8 : 4;
+        for (int k = 0; k < nv; ++k) {
+            const double u = desc.trimCorners ? octU[k] : sqU[k], v = desc.trimCorners ? octV[k] : sqV[k];
+            const glm::dvec4 c = vp * glm::dvec4(glm::dvec3(s.center) + u * glm::dvec3(s.axisU) + v * glm::dvec3(s.axisV), 1.0);
+            if (!(c.w > 1e-12)) {
+                behind = true; // crosses the eye plane: the clipped polygon may cover anything
+                break;
+            }
+            const double px = (c.x / c.w * 0.5 + 0.5) * W, py = (1.0 - (c.y / c.w * 0.5 + 0.5)) * H;
+            x0 = std::min(x0, px), x1 = std::max(x1, px), y0 = std::min(y0, py), y1 = std::max(y1, py);
+        }
+        int tx0 = 0, ty0 = 0, tx1 = tilesX - 1, ty1 = tilesY - 1;
+        if (!behind) {
+            if (x1 < 0.0 || y1 < 0.0 || x0 > W || y0 > H) continue;
+            tx0 = std::clamp(int(std::floor(x0)) / kTile, 0, tilesX - 1);
+            tx1 = std::clamp(int(std::floor(std::min(x1, double(W)))) / kTile, 0, tilesX - 1);
+            ty0 = std::clamp(int(std::floor(y0)) / kTile, 0, tilesY - 1);
+            ty1 = std::clamp(int(std::floor(std::min(y1, double(H)))) / kTile, 0, tilesY - 1);
+        }
+        for (int ty = ty0; ty <= ty1; ++ty)
+            for (int tx = tx0; tx <= tx1; ++tx) tiles[size_t(ty) * tilesX + tx].push_back(std::uint32_t(i));
+    }
+
+    Image out;
+    out.width = W;
+    out.height = H;
+    out.channels = 4;
+    out.pixels.assign(size_t(W) * H * 4, 0.0f);
+    const reference::RayMapper mapper(camera);
+    std::mutex statsMutex;
+
+    reference::parallelRows(H, desc.threads, [&](int y) {
+        std::vector<Fragment> frags;
+        std::uint64_t fragCount = 0, maxOverlap = 0;
+        for (int x = 0; x < W; ++x) {
+            const reference::PixelRay ray = mapper.ray(x, y, reference::hostDepth(desc.host, x, y));
+            frags.clear();
+            for (std::uint32_t idx : tiles[size_t(y / kTile) * tilesX + x / kTile]) {
+                const Splat& s = splats[idx];
+                const glm::dvec3 c(s.center), au(s.axisU), av(s.axisV);
+                const glm::dvec3 n = glm::cross(au, av);
+                const double nLen = glm::length(n);
+                const double denom = glm::dot(ray.dir, n);
+                if (!(nLen > 0.0) || std::abs(denom) <= 1e-12 * nLen) continue; // edge-on: GL rasterizes nothing
+                const double t = glm::dot(c - ray.origin, n) / denom;
+                if (!(t >= 0.0) || t > ray.tLimit) continue; // clipped by near/far or hidden by host depth
+                const glm::dvec3 r = ray.origin + t * ray.dir - c;
+                const double g00 = glm::dot(au, au), g01 = glm::dot(au, av), g11 = glm::dot(av, av);
+                const double b0 = glm::dot(au, r), b1 = glm::dot(av, r);
+                const double det = g00 * g11 - g01 * g01;
+                if (!(det > 0.0)) continue;
+                const double u = (g11 * b0 - g01 * b1) / det, v = (g00 * b1 - g01 * b0) / det;
+                if (std::abs(u) > 1.0 || std::abs(v) > 1.0) continue;
+                if (desc.trimCorners && std::abs(u) + std::abs(v) > 1.0 + o) continue;
+                // The vertex shader's texture coordinates: +v is the layer's top row.
+                const double ts = 0.5 + 0.5 * u, tt = 0.5 - 0.5 * v;
+                glm::dvec4 tex = layers[size_t(std::lround(s.layer))].sample(ts, tt);
+                if (s.blend > 0.0f) {
+                    const glm::dvec4 t2 = layers[size_t(std::lround(s.nextLayer))].sample(ts, tt);
+                    tex = tex * (1.0 - double(s.blend)) + t2 * double(s.blend);
+                }
+                double detail = tex.a;
+                if (exactWindow) {
+                    const double rr = R * std::sqrt(u * u + v * v);
+                    detail *= rr < R ? fp.exact(rr) / F0 : 0.0;
+                }
+                // alpha = 1 - 2^(-density * detail), accurate for tiny products.
+                const double alpha = -std::expm1(-kLn2 * double(s.density) * detail);
+                if (!(alpha > 0.0)) continue;
+                const std::uint32_t row = std::uint32_t(std::lround(s.colorRow));
+                const glm::dvec3 col = (row < materials.colorTableCount() ? reference::rowColor(materials.colorRow(row), s.colorCoord)
+                                                                         : glm::dvec3(1.0)) *
+                                       glm::dvec3(tex);
+                frags.push_back({t, std::min(alpha, 1.0), col});
+            }
+            // Per-pixel exact order: farthest plane crossing first.
+            std::stable_sort(frags.begin(), frags.end(), [](const Fragment& a, const Fragment& b) { return a.t > b.t; });
+            glm::dvec4 acc = reference::background(desc.host, x, y);
+            for (const Fragment& f : frags) acc = glm::dvec4(f.color * f.alpha, f.alpha) + (1.0 - f.alpha) * acc;
+            for (int ch = 0; ch < 4; ++ch) out.at(x, y, ch) = float(acc[ch]);
+            fragCount += frags.size();
+            maxOverlap = std::max<std::uint64_t>(maxOverlap, frags.size());
+        }
+        std::lock_guard<std::mutex> lock(statsMutex);
+        stats.fragments += fragCount;
+        stats.maxOverlap = std::max(stats.maxOverlap, maxOverlap);
+    });
+    if (statsOut) *statsOut = stats;
+    return out;
+}
+
+} // namespace splatfx

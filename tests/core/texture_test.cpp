@@ -1,0 +1,124 @@
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "gl_fixture.hpp"
+#include "splatfx/materials.hpp"
+#include "splatfx/texture_set.hpp"
+
+using splatfx::Footprint;
+using splatfx::TextureSet;
+namespace fs = std::filesystem;
+
+TEST(TextureSet, TurbulenceIsDeterministicPerSeed) {
+    const auto a = TextureSet::turbulence({.seed = 7});
+    const auto b = TextureSet::turbulence({.seed = 7});
+    const auto c = TextureSet::turbulence({.seed = 8});
+    ASSERT_EQ(a.count(), 8);
+    EXPECT_EQ(a.size, 32);
+    EXPECT_EQ(a.layers, b.layers);
+    EXPECT_NE(a.layers, c.layers);
+    for (const auto& layer : a.layers)
+        for (float v : layer) {
+            EXPECT_GE(v, 0.0f);
+            EXPECT_LE(v, 1.0f);
+        }
+}
+
+TEST(TextureSet, ConsecutiveTexturesAreCoherentAndTheCycleCloses) {
+    // Textures lie on a loop through noise space: neighbours (including last
+    // -> first) must differ less than textures half a cycle apart.
+    const auto set = TextureSet::turbulence({.count = 8, .seed = 3});
+    auto dist = [&](int i, int j) {
+        double d = 0.0;
+        for (size_t t = 0; t < set.layers[0].size(); t += 4) d += std::abs(set.layers[size_t(i)][t] - set.layers[size_t(j)][t]);
+        return d;
+    };
+    for (int i = 0; i < 8; ++i) EXPECT_LT(dist(i, (i + 1) % 8), dist(i, (i + 4) % 8)) << "texture " << i;
+}
+
+TEST(TextureSet, WindowingKeepsDetailInsideTheFootprint) {
+    const Footprint fp;
+    const auto raw = TextureSet::turbulence({.size = 32, .seed = 2});
+    const auto win = raw.windowed(fp);
+    const auto w = fp.image(32);
+    int inside = 0;
+    for (int p = 0; p < 32 * 32; ++p) {
+        const float detail = raw.layers[0][size_t(p) * 4]; // grayscale: R = G = B = luminance
+        const float a = win.layers[0][size_t(p) * 4 + 3];
+        if (w[size_t(p)] == 0.0f) {
+            EXPECT_EQ(a, 0.0f); // nothing outside the footprint
+        } else {
+            ++inside;
+            // Figure 2: windowed = detail * footprint, to float rounding of the luminance weights.
+            EXPECT_NEAR(a, detail * w[size_t(p)], 1e-6f);
+        }
+        EXPECT_EQ(win.layers[0][size_t(p) * 4], 1.0f); // grayscale sets carry no colour
+    }
+    EXPECT_GT(inside, 32 * 32 / 2);
+}
+
+TEST(TextureSet, SaveAndLoadRoundTrip) {
+    const std::string dir = splatfx::test::outputDir() + "/set";
+    const auto set = TextureSet::turbulence({.count = 3, .size = 16, .seed = 5});
+    ASSERT_TRUE(set.save(dir, R"({"method": "test"})"));
+    auto back = TextureSet::load(dir);
+    ASSERT_TRUE(back) << back.error();
+    ASSERT_EQ(back->count(), 3);
+    ASSERT_EQ(back->size, 16);
+    // 8-bit PNG: values agree to half a quantization step.
+    for (int k = 0; k < 3; ++k)
+        for (size_t i = 0; i < set.layers[0].size(); i += 4) EXPECT_NEAR(back->layers[size_t(k)][i], set.layers[size_t(k)][i], 0.5 / 255 + 1e-6);
+}
+
+TEST(TextureSetBadInput, MissingTextureFileIsNamed) {
+    const std::string dir = splatfx::test::outputDir() + "/missing";
+    fs::remove_all(dir);
+    ASSERT_TRUE(TextureSet::turbulence({.count = 2, .size = 8}).save(dir));
+    fs::remove(dir + "/t001.png");
+    auto set = TextureSet::load(dir);
+    ASSERT_FALSE(set);
+    EXPECT_NE(set.error().find("t001.png': no such file"), std::string::npos) << set.error();
+}
+
+TEST(TextureSetBadInput, CorruptAndZeroSizeImagesAreNamed) {
+    const std::string dir = splatfx::test::outputDir() + "/corrupt";
+    fs::remove_all(dir);
+    ASSERT_TRUE(TextureSet::turbulence({.count = 2, .size = 8}).save(dir));
+    { std::ofstream(dir + "/t000.png", std::ios::trunc); } // zero bytes
+    auto empty = TextureSet::load(dir);
+    ASSERT_FALSE(empty);
+    EXPECT_NE(empty.error().find("t000.png': the file is empty"), std::string::npos) << empty.error();
+
+    { std::ofstream(dir + "/t000.png", std::ios::trunc) << "\x89PNG\r\n\x1a\n this is not really a png"; }
+    auto corrupt = TextureSet::load(dir);
+    ASSERT_FALSE(corrupt);
+    EXPECT_NE(corrupt.error().find("cannot read image '" + dir + "/t000.png'"), std::string::npos) << corrupt.error();
+}
+
+TEST(TextureSetBadInput, MalformedManifestNamesTheField) {
+    const std::string dir = splatfx::test::outputDir() + "/manifest";
+    fs::create_directories(dir);
+    { std::ofstream(dir + "/manifest.json") << R"({"format": "splatfx-texture-set", "version": 2, "textures": []})"; }
+    auto v = TextureSet::load(dir);
+    ASSERT_FALSE(v);
+    EXPECT_NE(v.error().find("field 'version' must be 1"), std::string::npos) << v.error();
+    { std::ofstream(dir + "/manifest.json") << "{ not json"; }
+    auto j = TextureSet::load(dir);
+    ASSERT_FALSE(j);
+    EXPECT_NE(j.error().find("not valid JSON"), std::string::npos) << j.error();
+}
+
+TEST(Materials, TexturedSetsCarryTheFootprintsMeanOpacity) {
+    splatfx::Materials m{Footprint{}};
+    const auto id = m.addTextureSet(TextureSet::turbulence({}));
+    const auto& r = m.set(id);
+    double plain = 0.0, textured = 0.0;
+    for (size_t t = 3; t < m.layer(0).size(); t += 4) plain += m.layer(0)[t];
+    for (std::uint32_t l = r.first; l < r.first + r.count; ++l)
+        for (size_t t = 3; t < m.layer(l).size(); t += 4) textured += m.layer(l)[t] / r.count;
+    EXPECT_NEAR(textured * r.gain, plain, 1e-3 * plain);
+    EXPECT_GT(r.gain, 1.0f); // detail below 1 somewhere needs a gain above 1
+}

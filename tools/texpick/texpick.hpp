@@ -1,0 +1,231 @@
+// tools/texpick/texpick.hpp: cutting texture sets out of photographs (the library behind splatfx-texpick).
+//
+// King et al. 1999, sec. 4: a set of textures is cut out of one large image,
+// at positions the artist gives, at random, by spectral analysis (patches
+// whose frequencies lie in a band, or a set that varies as much as possible
+// in frequency), or along a linear or piecewise-linear path whose overlapping
+// patches give coherent motion when cycled. The patches are converted to
+// grayscale (sec. 2 step 1), contrast-normalized, optionally ordered for
+// smooth cycling, and written as a texture-set folder splatfx::TextureSet::load
+// reads, with a contact sheet and a preview animation of textured splats.
+// It does not track motion in video, and it does not synthesize texture: every
+// texel comes from the photograph (or from splatfx::TextureSet::turbulence).
+//
+//   auto src = texpick::loadSource("fire.png");
+//   auto pick = texpick::pickRandom(*src, {.count = 8, .patch = 64, .seed = 3});
+//   auto made = texpick::makeSet(*src, pick->patches, {.textureSize = 32});
+//
+// Errors come back as splatfx::Result / Status with a message naming the file,
+// option or value; no exception leaves this library. Threading: plain functions
+// on plain values; previews need a GL context (renderPreview makes its own).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "splatfx/footprint.hpp"
+#include "splatfx/image.hpp"
+#include "splatfx/result.hpp"
+#include "splatfx/texture_set.hpp"
+
+namespace texpick {
+
+inline constexpr const char* kToolName = "splatfx-texpick";
+inline constexpr const char* kToolVersion = "1.0.0";
+// Version of the "provenance" object texpick writes into manifest.json.
+inline constexpr int kProvenanceVersion = 1;
+inline constexpr int kMinPatch = 4; // smallest patch side, source pixels
+
+// [SECTION] Source images
+
+// A photograph ready for cutting: RGB composited over black (an alpha cut-out
+// becomes black, i.e. empty, which the flatness test rejects), its luminance,
+// and its coverage (alpha, 1 where the file has none).
+struct Source {
+    std::string path;   // as given
+    int width = 0, height = 0;
+    int fileChannels = 0;
+    cv::Mat rgb;        // CV_32FC3, [0, 1], premultiplied by coverage
+    cv::Mat luminance;  // CV_32FC1, Rec. 709 weights
+    cv::Mat coverage;   // CV_32FC1, [0, 1]
+};
+
+// Reads any format OpenImageIO reads (falling back to OpenCV). On failure the
+// message names the file and the reason: no such file, a folder, empty,
+// unreadable, corrupt or of an unknown format.
+splatfx::Result<Source> loadSource(const std::string& path);
+// Wraps an image made in memory (tests, turbulence). Expects 1, 3 or 4 channels.
+Source sourceFromImage(const splatfx::Image& image, const std::string& name);
+
+// [SECTION] Patches and their spectra
+
+// A square cut from the source: top-left corner and side, in source pixels.
+struct Patch {
+    int x = 0, y = 0;
+    int size = 0;
+    double centerX() const { return x + 0.5 * size; }
+    double centerY() const { return y + 0.5 * size; }
+    bool operator==(const Patch&) const = default;
+};
+
+// Radial frequency bands, in cycles per source pixel (octaves below Nyquist).
+// The last band also holds the spectrum's corners (radius up to sqrt(2)/2).
+inline const std::vector<double>& bandEdges() {
+    static const std::vector<double> edges{0.0, 1.0 / 32, 1.0 / 16, 1.0 / 8, 1.0 / 4, 0.75};
+    return edges;
+}
+
+// Summary of a patch's luminance power spectrum. The patch's weighted mean is
+// removed and it is multiplied by a separable Hann window first, so the edges
+// of the square do not leak power into every band.
+struct SpectralStats {
+    std::vector<double> bandEnergy; // fraction of (non-DC) power per band of bandEdges(); sums to 1 (all 0 when flat)
+    double power = 0.0;             // total non-DC power per pixel (windowed luminance variance)
+    double centroid = 0.0;          // power-weighted mean radial frequency, cycles per pixel
+    double mean = 0.0;              // luminance mean over the patch
+    double stddev = 0.0;            // luminance standard deviation over the patch
+    double coverage = 1.0;          // mean alpha over the patch
+};
+
+// Expects the patch inside the source.
+SpectralStats analyze(const Source& source, const Patch& patch);
+// Fraction of the patch's non-DC power at radial frequency in [lo, hi) cycles per pixel.
+double bandFraction(const Source& source, const Patch& patch, double lo, double hi);
+
+// [SECTION] Selection
+
+// What makes a patch worth keeping (random and spectral modes).
+struct Acceptance {
+    float minStd = 0.03f;      // luminance standard deviation below this is flat; default 0.03
+    float minMean = 0.03f;     // luminance mean below this is near-empty (black or cut-out); default 0.03
+    float minCoverage = 0.9f;  // mean alpha below this is mostly outside a cut-out; default 0.9
+};
+
+struct Selection {
+    std::vector<Patch> patches;
+    std::vector<SpectralStats> stats; // one per patch
+    int candidates = 0;               // patches considered
+    int rejected = 0;                 // flat, near-empty or too close to a pick
+};
+
+// Each position is a patch centre; size 0 takes `defaultSize`. Errors name
+// the position that leaves the image.
+struct PositionsDesc {
+    std::vector<cv::Point3i> centers; // (x, y, size) in source pixels
+    int defaultSize = 64;             // default 64
+};
+splatfx::Result<Selection> pickPositions(const Source& source, const PositionsDesc& desc);
+
+struct RandomDesc {
+    int count = 8;           // default 8
+    int patch = 64;          // source pixels; default 64
+    std::uint32_t seed = 1;  // default 1
+    Acceptance accept{};
+    float minDistance = 0.0f; // smallest distance between picked centres, pixels; default 0 (overlap allowed)
+    int maxTries = 0;         // default 0 = 2000 per texture
+};
+// Deterministic per seed (std::mt19937, whose sequence the C++ standard fixes).
+splatfx::Result<Selection> pickRandom(const Source& source, const RandomDesc& desc);
+
+struct SpectralDesc {
+    int count = 8;            // default 8
+    int patch = 64;           // default 64
+    int stride = 0;           // candidate grid step, pixels; default 0 = patch / 4
+    // Band mode: keep the patches with the largest share of power in [bandLo, bandHi) cycles per pixel.
+    double bandLo = 0.125, bandHi = 0.75; // default: the upper two octaves
+    // Spread mode (true): greedily maximize the spectral variation across the
+    // set instead (farthest-point selection on band energies).
+    bool spread = false;      // default false
+    float minDistance = -1.0f; // smallest distance between picked centres; default -1 = patch / 2
+    Acceptance accept{};
+};
+splatfx::Result<Selection> pickSpectral(const Source& source, const SpectralDesc& desc);
+
+// Patch centres walk the polyline through `points` by arc length, `step`
+// pixels apart (so consecutive patches overlap by patch - step pixels along
+// the path), rounded to whole pixels so each is an exact cut of the photo.
+struct PathDesc {
+    std::vector<cv::Point2d> points; // at least 2 vertices, source pixels
+    int patch = 64;                  // default 64
+    double step = 4.0;               // pixels along the path between consecutive patches; default 4
+    int count = 0;                   // default 0 = as many as fit on the path
+};
+splatfx::Result<Selection> pickPath(const Source& source, const PathDesc& desc);
+
+// [SECTION] Processing
+
+enum class Contrast {
+    Patch, // each patch's luminance to mean 0.5, std `contrastStd` (default)
+    Set,   // one mean/std for the whole set: keeps relative brightness, no flicker
+    None,  // the photograph's values
+};
+
+struct ProcessDesc {
+    int textureSize = 32;        // texels on a side; default 32
+    bool color = false;          // keep RGB (default false: grayscale, sec. 2 step 1)
+    Contrast contrast = Contrast::Patch; // default Patch
+    float contrastStd = 0.2f;    // target standard deviation; default 0.2
+    bool order = false;          // reorder for smooth cycling; default false
+    bool window = false;         // bake the footprint into the saved set (else the renderer windows it); default false
+    splatfx::FootprintDesc footprint{}; // kernel for the window, the contact sheet and the preview
+};
+
+// The textures, before windowing unless desc.window. `order[k]` is the index
+// (in the input patch list) of texture k.
+struct MadeSet {
+    splatfx::TextureSet set;
+    std::vector<int> order;
+};
+splatfx::Result<MadeSet> makeSet(const Source& source, const std::vector<Patch>& patches, const ProcessDesc& desc);
+
+// A cycle through all textures (starting at 0) with a small total
+// frame-to-frame difference, the last leading back to the first: nearest
+// neighbour then 2-opt on mean squared texel difference. Deterministic.
+std::vector<int> smoothCycle(const splatfx::TextureSet& set);
+// Sum of mean squared differences between consecutive textures of `order`, closing the cycle.
+double cycleCost(const splatfx::TextureSet& set, const std::vector<int>& order);
+
+// [SECTION] Output
+
+struct OutputDesc {
+    bool contactSheet = true;    // write contact.png; default true
+    bool preview = true;         // write preview.gif (needs headless GL); default true
+    int previewFrames = 0;       // default 0 = 3 per texture (one full cycle)
+    int previewFps = 12;         // default 12
+    int previewSize = 192;       // height in pixels; the GIF is twice as wide; default 192
+    std::string previewColors = "smoke"; // fire | smoke | steam | dust | white; default smoke
+    splatfx::FootprintDesc footprint{};
+};
+
+// Writes folder/ (textures, manifest.json with `provenanceJson` under
+// "provenance", contact.png, preview.gif) through a staging folder beside it
+// that is renamed into place only when everything is written. An existing
+// texture-set folder is replaced; any other existing path is refused. On
+// failure nothing is left behind (staging and any parent folders it created
+// are removed) and the message says why.
+splatfx::Status writeOutput(const std::string& folder, const splatfx::TextureSet& set, const std::string& provenanceJson,
+                            const OutputDesc& desc, const Source* source = nullptr,
+                            const std::vector<Patch>* patches = nullptr);
+
+// The contact sheet: the source with numbered patch outlines (when given),
+// then each texture above its windowed splat (Fig. 2). RGB float, top row first.
+splatfx::Image contactSheet(const splatfx::TextureSet& set, const splatfx::FootprintDesc& footprint,
+                            const Source* source = nullptr, const std::vector<Patch>* patches = nullptr);
+
+// Renders the cycling preview headless: one large textured splat (left) and
+// a puff of textured splats (right), cross-fading through the set in order.
+// Fails when no headless GL 4.5 context can be created.
+splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::TextureSet& set, const OutputDesc& desc);
+
+// [SECTION] Helpers shared by the command line and the interactive mode
+
+// Parses "x,y" / "x,y,size" lists and "lo:hi" bands; messages name the option.
+splatfx::Result<cv::Point2d> parsePoint(const std::string& text, const std::string& option);
+splatfx::Result<std::vector<cv::Point2d>> parsePath(const std::string& text, const std::string& option);
+// The file name without its folders, for provenance (no machine-specific paths).
+std::string baseName(const std::string& path);
+
+} // namespace texpick
