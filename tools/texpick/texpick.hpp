@@ -190,6 +190,20 @@ double cycleCost(const splatfx::TextureSet& set, const std::vector<int>& order);
 
 // [SECTION] Output
 
+// What manifest.json's "provenance" records (versioned by kProvenanceVersion).
+struct Provenance {
+    std::string sourceFile;          // file name only (baseName) or an artist-given name
+    std::string credit;              // author / origin of the photograph; default empty
+    std::string license;             // licence of the photograph; default empty
+    int sourceWidth = 0, sourceHeight = 0;
+    std::string method;              // positions | random | spectral | path | turbulence | merge
+    std::string parametersJson = "{}"; // the method's parameters, as given
+    const Selection* selection = nullptr; // patches and their spectra (photo methods)
+    const ProcessDesc* process = nullptr;
+    std::vector<int> order;          // texture k came from patch order[k]
+};
+std::string provenanceJson(const Provenance& p);
+
 struct OutputDesc {
     bool contactSheet = true;    // write contact.png; default true
     bool preview = true;         // write preview.gif (needs headless GL); default true
@@ -219,6 +233,48 @@ splatfx::Image contactSheet(const splatfx::TextureSet& set, const splatfx::Footp
 // a puff of textured splats (right), cross-fading through the set in order.
 // Fails when no headless GL 4.5 context can be created.
 splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::TextureSet& set, const OutputDesc& desc);
+
+// [SECTION] Command line and interactive mode
+
+// Everything the command line can say; defaults match `splatfx-texpick --help`.
+struct Options {
+    std::string mode;             // positions | random | spectral | path | interactive | turbulence | merge
+    std::string input;            // the photograph (merge: unused)
+    std::vector<std::string> sets; // merge: the texture-set folders to concatenate
+    std::string out;              // --out
+    int patch = 64, count = 8;
+    bool countGiven = false;
+    std::uint32_t seed = 1;
+    std::vector<cv::Point3i> at;  // positions
+    Acceptance accept{};
+    float minDistance = -1.0f;    // -1: the mode's default
+    double bandLo = 0.125, bandHi = 0.75;
+    bool spread = false;
+    int stride = 0;
+    std::vector<cv::Point2d> path;
+    double step = 4.0;
+    splatfx::TurbulenceDesc turbulence{};
+    ProcessDesc process{};
+    OutputDesc output{};
+    std::string sourceName, credit, license;
+    bool quiet = false;
+    int autoQuitAfter = 0;        // interactive: close after this many frames (0 = wait for the user)
+    std::string events;           // interactive: scripted input, e.g. "click:120,80;key:s"
+    std::string screenshot;       // interactive: write the window's image here before quitting
+};
+
+// Parses argv into options; on --help prints usage and returns an empty error.
+splatfx::Result<Options> parseOptions(int argc, const char* const* argv);
+// Picks, processes and writes; prints progress and a summary. Returns the exit code.
+int run(const Options& options);
+// The HighGUI window (OpenCV): click positions or draw a path, watch the
+// patches and the cycling preview, press s to write the same output as the
+// command line. Returns the exit code.
+int runInteractive(const Options& options);
+// Builds the set for a selection and writes it: what `run` and the interactive
+// mode's save both do, so their outputs match.
+splatfx::Status produce(const Options& options, const Source& source, const Selection& selection,
+                        const std::string& method, const std::string& parametersJson);
 
 // [SECTION] Helpers shared by the command line and the interactive mode
 

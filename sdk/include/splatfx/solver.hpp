@@ -46,7 +46,9 @@ namespace splatfx {
 // (its Motion): its centre is motion.matrix(t) * offset.
 struct EmitterDesc {
     glm::vec3 offset{0.0f};     // centre in the object's frame, object units; default origin
-    float radius = 1.0f;        // world units, > 0; cells within it are fed, weight (1 - (r/radius)^2)^2; default 1
+    // World units, > 0; cells within it are fed with weight (1 - (r/radius)^2)^2.
+    // Never smaller than half a cell's diagonal, so an emitter always reaches a cell.
+    float radius = 1.0f;        // default 1
     float density = 1.0f;       // target density inside the region, >= 0; default 1
     float temperature = 1.0f;   // target temperature (above ambient), >= 0; default 1
     float rate = 4.0f;          // 1/s: how fast cells relax towards the targets, >= 0; default 4
@@ -62,7 +64,7 @@ struct Emitter {
 };
 
 struct FluidSolverDesc {
-    glm::ivec3 dims{8, 16, 8};      // cells per axis, each >= 2, at most kMaxVoxels in all; default 8x16x8
+    glm::ivec3 dims{8, 16, 8};      // cells per axis, each >= 1, at most kMaxVoxels in all; default 8x16x8
     glm::vec3 spacing{1.0f};        // cell size, grid-local units, > 0; default 1
     glm::mat4 transform{1.0f};      // grid-local to world (same lattice convention as Grid); default identity
     float buoyancy = 4.0f;          // upward acceleration per unit temperature, local units/s^2; default 4
@@ -82,7 +84,6 @@ struct FluidSolverDesc {
     // Rescale density after advection so its total equals the total before
     // (semi-Lagrangian advection is not conservative). Needs every face closed.
     bool conserveMass = false;      // default false
-    std::uint32_t seed = 1;         // reserved for randomised forcing; the solver is deterministic; default 1
 };
 
 // How dense fields become a sparse grid.

@@ -135,6 +135,7 @@ Result<Image> renderVolumeExact(const VolumeField& field, const Camera& camera, 
             } else {
                 double h = h0;
                 RayResult prev = integrate(cs, breaks, fp, h, cutoff, local.kernelEvaluations);
+                res = prev;
                 double err = 0.0;
                 int level = 0;
                 for (level = 1; level <= desc.maxHalvings; ++level) {

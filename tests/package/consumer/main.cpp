@@ -1,0 +1,29 @@
+// Renders one frame of a small fire headless and checks it drew something.
+#include <cstdio>
+
+#include <splatfx/context.hpp>
+#include <splatfx/splatfx.hpp>
+
+int main() {
+    auto ctx = splatfx::HeadlessContext::create();
+    if (!ctx) return std::fprintf(stderr, "consumer: %s\n", ctx.error().c_str()), 1;
+    splatfx::Materials materials{splatfx::Footprint{}};
+    const auto set = materials.addTextureSet(splatfx::TextureSet::turbulence({}));
+    const auto lut = materials.addColorTable(splatfx::ColorTable::fire());
+    auto grid = splatfx::Grid::box({4, 8, 4});
+    auto fb = splatfx::gl::Framebuffer::create({.width = 64, .height = 64});
+    auto renderer = splatfx::gl::Renderer::create();
+    if (!grid || !fb || !renderer || !renderer->upload(materials)) return std::fprintf(stderr, "consumer: setup failed\n"), 1;
+    const auto camera = splatfx::Camera::lookAt({0, 4, 14}, {0, 4, 0}, {0, 1, 0}, 0.8f, {64, 64});
+    splatfx::SplatBuilder builder;
+    builder.begin(camera);
+    builder.add(*grid, materials, {.textureSet = set, .colorTable = lut});
+    builder.sort();
+    fb->clear({0, 0, 0, 1});
+    renderer->draw(builder.splats(), camera, {.framebuffer = fb->handle(), .width = 64, .height = 64});
+    const splatfx::Image img = fb->read();
+    const float centre = img.at(32, 32, 0);
+    if (!(centre > 0.1f)) return std::fprintf(stderr, "consumer: nothing drawn (centre red %f)\n", centre), 1;
+    std::printf("consumer: ok (%zu splats on %s)\n", builder.splats().size(), ctx->renderer().c_str());
+    return 0;
+}

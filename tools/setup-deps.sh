@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# Installs splatfx's build and test dependencies from Debian's archive.
+# Idempotent and fast when everything is present (no apt-get update then).
+# Needs root (or sudo) only when something is missing.
+set -euo pipefail
+
+PACKAGES=(
+  build-essential cmake pkg-config git
+  libglm-dev libglfw3-dev libepoxy-dev libegl-dev libgl-dev
+  libgl1-mesa-dri libegl-mesa0 libegl1
+  libopenimageio-dev libopencv-dev nlohmann-json3-dev libgtest-dev
+  libassimp-dev libimgui-dev
+  gnuplot-nox xvfb xauth
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+  if command -v sudo >/dev/null; then SUDO="sudo"; else
+    echo "setup-deps: missing packages: ${missing[*]}" >&2
+    echo "setup-deps: run as root: apt-get install -y ${missing[*]}" >&2
+    exit 1
+  fi
+fi
+echo "setup-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "setup-deps: done"

@@ -1,0 +1,355 @@
+// texpick: the command line (parsing, the modes, progress and summary).
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "texpick.hpp"
+
+namespace texpick {
+
+using json = nlohmann::json;
+using splatfx::makeError;
+
+namespace {
+
+const char* kUsage = R"(splatfx-texpick: cut a texture set for splatfx out of a photograph (King et al. 1999, sec. 4)
+
+usage:
+  splatfx-texpick positions  IMAGE --out DIR --at X,Y[,SIZE] [--at ...]
+  splatfx-texpick random     IMAGE --out DIR [--count 8] [--seed 1]
+  splatfx-texpick spectral   IMAGE --out DIR [--count 8] (--band LO:HI | --spread)
+  splatfx-texpick path       IMAGE --out DIR --path X,Y:X,Y[:X,Y...] [--step 4] [--count N]
+  splatfx-texpick interactive IMAGE --out DIR [--patch 64]
+  splatfx-texpick turbulence --out DIR [--count 8] [--size 32] [--seed 1]
+  splatfx-texpick merge SET SET... --out DIR
+
+DIR gets t000.png..., manifest.json (provenance: source, method, parameters,
+each patch's position, size and spectrum), contact.png and preview.gif. It is
+written to a temporary folder and moved into place only when complete; an
+existing texture-set folder is replaced, any other existing path is refused.
+Coordinates are source pixels from the top-left corner; X,Y are patch centres.
+
+selection:
+  --patch P            patch side in source pixels (default 64)
+  --count N            textures in the set (default 8; path: as many as fit)
+  --seed S             random seed (default 1)
+  --at X,Y[,SIZE]      positions: one patch centre (and side); repeat
+  --min-std F          reject patches whose luminance std is below F (default 0.03)
+  --min-mean F         reject near-empty patches, mean luminance below F (default 0.03)
+  --min-coverage F     reject patches mostly outside an alpha cut-out (default 0.9)
+  --min-distance D     smallest distance between picked centres (random 0, spectral P/2)
+  --band LO:HI         spectral: frequency band in cycles per pixel (default 0.125:0.75)
+  --spread             spectral: maximize spectral variation across the set instead
+  --stride S           spectral: candidate grid step in pixels (default P/4)
+  --path X,Y:X,Y...    path: polyline of patch centres
+  --step S             path: pixels between consecutive patches (default 4)
+processing:
+  --size S             texture side in texels (default 32)
+  --color              keep colour (default: grayscale, as in the paper)
+  --contrast MODE      patch | set | none (default patch: mean 0.5, std --contrast-std)
+  --contrast-std F     target standard deviation (default 0.2)
+  --order              reorder for smooth cycling (closing the cycle)
+  --window             bake the footprint into the saved textures (default: the renderer windows them)
+  --kernel K           crawfis-max | gaussian footprint (default crawfis-max)
+turbulence:
+  --octaves N --base-frequency F --loop-radius F   (defaults 4, 3, 0.6)
+output:
+  --no-preview         skip preview.gif (it needs headless EGL / GL 4.5)
+  --no-contact         skip contact.png
+  --preview-frames N   (default 3 per texture)  --preview-fps N (default 12)
+  --preview-size N     preview height in pixels (default 192)
+  --preview-colors C   fire | smoke | steam | dust | white (default smoke)
+  --source-name NAME   name recorded for the source (default: its file name)
+  --credit TEXT        author / origin of the photograph, recorded in the manifest
+  --license TEXT       licence of the photograph, recorded in the manifest
+  --quiet              print only errors
+interactive:
+  --auto-quit-after N  close after N frames (smoke tests)
+  --events LIST        scripted input, e.g. "click:120,80;key:p;click:60,60;key:s"
+  --screenshot FILE    write the window's picture to FILE before closing
+)";
+
+template <class T>
+splatfx::Result<T> number(const std::string& opt, const char* text, T lo, T hi) {
+    std::istringstream in(text);
+    T v{};
+    char extra = 0;
+    if (!(in >> v) || (in >> extra) || v < lo || v > hi) {
+        std::ostringstream o;
+        o << opt << " must be a number in [" << lo << ", " << hi << "], got '" << text << "'";
+        return makeError(o.str());
+    }
+    return v;
+}
+
+} // namespace
+
+splatfx::Result<Options> parseOptions(int argc, const char* const* argv) {
+    Options o;
+    if (argc < 2) return makeError(std::string("no mode given\n\n") + kUsage);
+    std::vector<std::string> positional;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        const char* v = nullptr;
+        auto need = [&]() -> bool {
+            if (i + 1 >= argc) return false;
+            v = argv[++i];
+            return true;
+        };
+#define TEXPICK_NUM(field, type, lo, hi)                                                                                  \
+    {                                                                                                                     \
+        if (!need()) return makeError(a + " needs a value");                                                             \
+        auto r = number<type>(a, v, lo, hi);                                                                              \
+        if (!r) return makeError(r.error());                                                                              \
+        field = *r;                                                                                                       \
+        continue;                                                                                                         \
+    }
+        if (a == "--help" || a == "-h") {
+            std::fputs(kUsage, stdout);
+            return makeError("");
+        }
+        if (a == "--out") { if (!need()) return makeError("--out needs a folder"); o.out = v; continue; }
+        if (a == "--patch") TEXPICK_NUM(o.patch, int, 1, 16384)
+        if (a == "--count") { o.countGiven = true; TEXPICK_NUM(o.count, int, 1, 4096) }
+        if (a == "--seed") TEXPICK_NUM(o.seed, std::uint32_t, 0u, 4294967295u)
+        if (a == "--min-std") TEXPICK_NUM(o.accept.minStd, float, 0.0f, 1.0f)
+        if (a == "--min-mean") TEXPICK_NUM(o.accept.minMean, float, 0.0f, 1.0f)
+        if (a == "--min-coverage") TEXPICK_NUM(o.accept.minCoverage, float, 0.0f, 1.0f)
+        if (a == "--min-distance") TEXPICK_NUM(o.minDistance, float, 0.0f, 1e6f)
+        if (a == "--stride") TEXPICK_NUM(o.stride, int, 1, 16384)
+        if (a == "--step") TEXPICK_NUM(o.step, double, 1e-3, 1e6)
+        if (a == "--size") TEXPICK_NUM(o.process.textureSize, int, 4, 1024)
+        if (a == "--contrast-std") TEXPICK_NUM(o.process.contrastStd, float, 1e-3f, 0.5f)
+        if (a == "--octaves") TEXPICK_NUM(o.turbulence.octaves, int, 1, 12)
+        if (a == "--base-frequency") TEXPICK_NUM(o.turbulence.baseFrequency, float, 0.01f, 1000.0f)
+        if (a == "--loop-radius") TEXPICK_NUM(o.turbulence.loopRadius, float, 0.0f, 100.0f)
+        if (a == "--preview-frames") TEXPICK_NUM(o.output.previewFrames, int, 1, 1000)
+        if (a == "--preview-fps") TEXPICK_NUM(o.output.previewFps, int, 1, 100)
+        if (a == "--preview-size") TEXPICK_NUM(o.output.previewSize, int, 32, 2048)
+        if (a == "--auto-quit-after") TEXPICK_NUM(o.autoQuitAfter, int, 1, 1000000)
+#undef TEXPICK_NUM
+        if (a == "--at") {
+            if (!need()) return makeError("--at needs X,Y[,SIZE]");
+            int x = 0, y = 0, s = 0;
+            char c1 = 0, c2 = 0, extra = 0;
+            std::istringstream in(v);
+            if (!(in >> x >> c1 >> y) || c1 != ',' || ((in >> c2) && (c2 != ',' || !(in >> s) || s < 1)) || (in >> extra))
+                return makeError("--at expects X,Y or X,Y,SIZE in whole pixels, got '" + std::string(v) + "'");
+            o.at.emplace_back(x, y, s);
+            continue;
+        }
+        if (a == "--band") {
+            if (!need()) return makeError("--band needs LO:HI");
+            char colon = 0, extra = 0;
+            std::istringstream in(v);
+            if (!(in >> o.bandLo >> colon >> o.bandHi) || colon != ':' || (in >> extra) || !(o.bandLo >= 0.0) ||
+                !(o.bandHi > o.bandLo))
+                return makeError("--band expects LO:HI cycles per pixel with 0 <= LO < HI (e.g. 0.125:0.75), got '" +
+                                 std::string(v) + "'");
+            continue;
+        }
+        if (a == "--path") {
+            if (!need()) return makeError("--path needs X,Y:X,Y[:X,Y...]");
+            auto p = parsePath(v, "--path");
+            if (!p) return makeError(p.error());
+            o.path = *p;
+            continue;
+        }
+        if (a == "--contrast") {
+            if (!need()) return makeError("--contrast needs patch, set or none");
+            const std::string m = v;
+            if (m == "patch") o.process.contrast = Contrast::Patch;
+            else if (m == "set") o.process.contrast = Contrast::Set;
+            else if (m == "none") o.process.contrast = Contrast::None;
+            else return makeError("--contrast must be patch, set or none, got '" + m + "'");
+            continue;
+        }
+        if (a == "--kernel") {
+            if (!need()) return makeError("--kernel needs crawfis-max or gaussian");
+            const std::string k = v;
+            if (k == "crawfis-max") o.process.footprint.kernel = splatfx::Kernel::CrawfisMax;
+            else if (k == "gaussian") o.process.footprint.kernel = splatfx::Kernel::Gaussian;
+            else return makeError("--kernel must be crawfis-max or gaussian, got '" + k + "'");
+            o.output.footprint = o.process.footprint;
+            continue;
+        }
+        if (a == "--preview-colors") {
+            if (!need()) return makeError("--preview-colors needs a name");
+            const std::string c = v;
+            if (c != "fire" && c != "smoke" && c != "steam" && c != "dust" && c != "white")
+                return makeError("--preview-colors must be fire, smoke, steam, dust or white, got '" + c + "'");
+            o.output.previewColors = c;
+            continue;
+        }
+        if (a == "--source-name") { if (!need()) return makeError("--source-name needs a value"); o.sourceName = v; continue; }
+        if (a == "--credit") { if (!need()) return makeError("--credit needs a value"); o.credit = v; continue; }
+        if (a == "--license") { if (!need()) return makeError("--license needs a value"); o.license = v; continue; }
+        if (a == "--events") { if (!need()) return makeError("--events needs a list"); o.events = v; continue; }
+        if (a == "--screenshot") { if (!need()) return makeError("--screenshot needs a file"); o.screenshot = v; continue; }
+        if (a == "--spread") { o.spread = true; continue; }
+        if (a == "--color") { o.process.color = true; continue; }
+        if (a == "--order") { o.process.order = true; continue; }
+        if (a == "--window") { o.process.window = true; continue; }
+        if (a == "--no-preview") { o.output.preview = false; continue; }
+        if (a == "--no-contact") { o.output.contactSheet = false; continue; }
+        if (a == "--quiet") { o.quiet = true; continue; }
+        if (a.size() > 1 && a[0] == '-') return makeError("unknown option '" + a + "' (try --help)");
+        positional.push_back(a);
+    }
+    if (positional.empty()) return makeError("no mode given (try --help)");
+    o.mode = positional[0];
+    static const char* modes[] = {"positions", "random", "spectral", "path", "interactive", "turbulence", "merge"};
+    if (std::find(std::begin(modes), std::end(modes), o.mode) == std::end(modes))
+        return makeError("unknown mode '" + o.mode + "': use positions, random, spectral, path, interactive, turbulence or merge");
+    if (o.mode == "merge") {
+        o.sets.assign(positional.begin() + 1, positional.end());
+        if (o.sets.size() < 2) return makeError("merge: give at least two texture-set folders");
+    } else if (o.mode == "turbulence") {
+        if (positional.size() > 1) return makeError("turbulence takes no image, got '" + positional[1] + "'");
+    } else {
+        if (positional.size() < 2) return makeError(o.mode + ": give the photograph to cut from");
+        if (positional.size() > 2) return makeError(o.mode + ": one photograph only, got '" + positional[2] + "' too");
+        o.input = positional[1];
+    }
+    if (o.out.empty()) return makeError("--out DIR is required: the texture-set folder to write");
+    if (o.mode == "positions" && o.at.empty()) return makeError("positions: give at least one --at X,Y[,SIZE]");
+    if (o.mode == "path" && o.path.empty()) return makeError("path: give --path X,Y:X,Y[:X,Y...]");
+    if (o.spread && o.mode != "spectral") return makeError("--spread only applies to the spectral mode");
+    o.output.footprint = o.process.footprint;
+    return o;
+}
+
+splatfx::Status produce(const Options& o, const Source& src, const Selection& sel, const std::string& method,
+                        const std::string& parametersJson) {
+    auto made = makeSet(src, sel.patches, o.process);
+    if (!made) return makeError(made.error());
+    Provenance p;
+    p.sourceFile = o.sourceName.empty() ? baseName(src.path) : o.sourceName;
+    p.credit = o.credit;
+    p.license = o.license;
+    p.sourceWidth = src.width;
+    p.sourceHeight = src.height;
+    p.method = method;
+    p.parametersJson = parametersJson;
+    p.selection = &sel;
+    p.process = &o.process;
+    p.order = made->order;
+    std::vector<Patch> ordered;
+    for (int k : made->order) ordered.push_back(sel.patches[size_t(k)]);
+    if (!o.quiet) std::printf("%s: writing %s/ (%d textures, %dx%d%s)\n", kToolName, o.out.c_str(), made->set.count(),
+                              made->set.size, made->set.size, o.output.preview ? ", rendering the preview" : "");
+    return writeOutput(o.out, made->set, provenanceJson(p), o.output, &src, &ordered);
+}
+
+namespace {
+
+int fail(const std::string& why) {
+    std::fprintf(stderr, "%s: %s\n", kToolName, why.c_str());
+    return 1;
+}
+
+int runTurbulence(const Options& o) {
+    splatfx::TurbulenceDesc d = o.turbulence;
+    d.count = o.count;
+    d.size = o.process.textureSize;
+    d.seed = o.seed;
+    splatfx::TextureSet set = splatfx::TextureSet::turbulence(d);
+    if (o.process.window) set = set.windowed(splatfx::Footprint(o.process.footprint));
+    json params{{"count", d.count}, {"size", d.size}, {"seed", d.seed}, {"octaves", d.octaves},
+                {"baseFrequency", d.baseFrequency}, {"loopRadius", d.loopRadius}};
+    Provenance p;
+    p.sourceFile = "splatfx::TextureSet::turbulence (procedural, no photograph)";
+    p.method = "turbulence";
+    p.parametersJson = params.dump();
+    if (!o.quiet) std::printf("%s: turbulence: %d textures, %dx%d, seed %u -> %s/\n", kToolName, d.count, d.size, d.size, d.seed, o.out.c_str());
+    json prov = json::parse(provenanceJson(p));
+    prov["processing"] = {{"windowed", o.process.window}, {"ordered", false},
+                          {"note", "turbulence textures are already a closed loop (TurbulenceDesc::loopRadius)"}};
+    if (auto s = writeOutput(o.out, set, prov.dump(), o.output); !s) return fail(s.error());
+    return 0;
+}
+
+int runMerge(const Options& o) {
+    splatfx::TextureSet merged;
+    json parts = json::array();
+    for (const std::string& folder : o.sets) {
+        auto set = splatfx::TextureSet::load(folder);
+        if (!set) return fail("merge: " + set.error());
+        if (merged.layers.empty()) {
+            merged.size = set->size;
+            merged.color = set->color;
+            merged.isWindowed = set->isWindowed;
+        } else if (set->size != merged.size || set->color != merged.color || set->isWindowed != merged.isWindowed) {
+            return fail("merge: '" + folder + "' is " + std::to_string(set->size) + "x" + std::to_string(set->size) +
+                        (set->color ? " colour" : " grayscale") + (set->isWindowed ? " windowed" : "") + " but '" + o.sets[0] +
+                        "' is " + std::to_string(merged.size) + "x" + std::to_string(merged.size) +
+                        (merged.color ? " colour" : " grayscale") + (merged.isWindowed ? " windowed" : "") +
+                        "; merge sets made alike (same --size, --color and --window)");
+        }
+        for (auto& l : set->layers) merged.layers.push_back(std::move(l));
+        json part{{"folder", baseName(folder)}, {"textures", set->count()}};
+        std::ifstream in(folder + "/manifest.json");
+        json m = json::parse(in, nullptr, false);
+        if (!m.is_discarded() && m.contains("provenance")) part["provenance"] = m["provenance"];
+        parts.push_back(part);
+    }
+    Provenance p;
+    p.sourceFile = "(merged sets, see parameters.parts)";
+    p.method = "merge";
+    p.parametersJson = json{{"parts", parts}}.dump();
+    if (!o.quiet) std::printf("%s: merge: %zu sets, %d textures -> %s/\n", kToolName, o.sets.size(), merged.count(), o.out.c_str());
+    if (auto s = writeOutput(o.out, merged, provenanceJson(p), o.output); !s) return fail(s.error());
+    return 0;
+}
+
+} // namespace
+
+int run(const Options& o) {
+    if (o.mode == "turbulence") return runTurbulence(o);
+    if (o.mode == "merge") return runMerge(o);
+    if (o.mode == "interactive") return runInteractive(o);
+    auto src = loadSource(o.input);
+    if (!src) return fail(src.error());
+    if (!o.quiet) std::printf("%s: %s: %s, %dx%d\n", kToolName, o.mode.c_str(), o.input.c_str(), src->width, src->height);
+    splatfx::Result<Selection> sel = makeError("unreachable");
+    json params;
+    if (o.mode == "positions") {
+        sel = pickPositions(*src, {.centers = o.at, .defaultSize = o.patch});
+        json at = json::array();
+        for (const cv::Point3i& c : o.at) at.push_back({c.x, c.y, c.z > 0 ? c.z : o.patch});
+        params = {{"at", at}, {"patch", o.patch}};
+    } else if (o.mode == "random") {
+        const float minDistance = o.minDistance >= 0.0f ? o.minDistance : 0.0f;
+        sel = pickRandom(*src, {.count = o.count, .patch = o.patch, .seed = o.seed, .accept = o.accept, .minDistance = minDistance});
+        params = {{"count", o.count}, {"patch", o.patch}, {"seed", o.seed}, {"minStd", o.accept.minStd},
+                  {"minMean", o.accept.minMean}, {"minCoverage", o.accept.minCoverage}, {"minDistance", minDistance},
+                  {"rng", "std::mt19937, raw words modulo the span"}};
+    } else if (o.mode == "spectral") {
+        SpectralDesc d{.count = o.count, .patch = o.patch, .stride = o.stride, .bandLo = o.bandLo, .bandHi = o.bandHi,
+                       .spread = o.spread, .minDistance = o.minDistance, .accept = o.accept};
+        sel = pickSpectral(*src, d);
+        params = {{"count", o.count}, {"patch", o.patch}, {"stride", o.stride > 0 ? o.stride : std::max(1, o.patch / 4)},
+                  {"minDistance", o.minDistance >= 0.0f ? double(o.minDistance) : 0.5 * o.patch},
+                  {"minStd", o.accept.minStd}, {"minMean", o.accept.minMean}, {"minCoverage", o.accept.minCoverage}};
+        if (o.spread) params["spread"] = true;
+        else params["bandCyclesPerPixel"] = {o.bandLo, o.bandHi};
+    } else if (o.mode == "path") {
+        sel = pickPath(*src, {.points = o.path, .patch = o.patch, .step = o.step, .count = o.countGiven ? o.count : 0});
+        json pts = json::array();
+        for (const cv::Point2d& q : o.path) pts.push_back({q.x, q.y});
+        params = {{"path", pts}, {"patch", o.patch}, {"step", o.step}, {"overlap", o.patch - o.step}};
+        if (o.countGiven) params["count"] = o.count;
+    }
+    if (!sel) return fail(sel.error());
+    if (!o.quiet)
+        std::printf("%s: %s: picked %zu patches of %d px (%d candidates considered, %d rejected)\n", kToolName, o.mode.c_str(),
+                    sel->patches.size(), sel->patches.empty() ? 0 : sel->patches[0].size, sel->candidates, sel->rejected);
+    if (auto s = produce(o, *src, *sel, o.mode, params.dump()); !s) return fail(s.error());
+    if (!o.quiet) std::printf("%s: done: %s/ (manifest.json, t000.png..., contact.png%s)\n", kToolName, o.out.c_str(),
+                              o.output.preview ? ", preview.gif" : "");
+    return 0;
+}
+
+} // namespace texpick
