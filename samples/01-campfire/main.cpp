@@ -1,56 +1,38 @@
 // Sample 01: the paper's campfire (King et al. 1999, Figure 1): a 7x20x5 grid
-// drawn as textured splats, animated by texture cycling with cross-fades.
+// drawn as textured splats, made by splatfx::presets::fire and animated at
+// two scales: global dynamics (sec. 3.2, texture detail propagating upwards
+// one voxel per step) and local dynamics (sec. 3.3, ordered texture cycling
+// with cross-fades). Every frame is computed directly from its time
+// (Effect::update), so frames can be rendered in any order.
 // Headless it also writes campfire_figure1.png: traditional splatting (left,
 // Fig. 1a) beside textured splatting (right, Fig. 1b) of the same grid.
-#include <cmath>
 #include <cstdio>
 #include <optional>
 
 #include <epoxy/gl.h>
-#include <glm/gtc/matrix_transform.hpp>
 
 #include "sample_app.hpp"
 
 namespace {
 
-// A flame-shaped opacity on the box: dense at the base and centre, thinning
-// and narrowing with height.
-void shapeFlame(splatfx::Grid& grid, std::uint32_t seed) {
-    for (splatfx::Voxel& v : grid.voxels) {
-        const float h = v.cell.y / float(grid.dims.y - 1);
-        const float rx = (v.cell.x - 0.5f * (grid.dims.x - 1)) / (0.5f * grid.dims.x);
-        const float rz = (v.cell.z - 0.5f * (grid.dims.z - 1)) / (0.5f * grid.dims.z);
-        const float r = std::sqrt(rx * rx + rz * rz);
-        const float width = 1.0f - 0.75f * h;
-        const float edge = std::clamp((width - r) / 0.35f + 0.3f, 0.0f, 1.0f);
-        v.opacity = 0.55f * (1.0f - 0.6f * h) * edge;
-        // Deterministic per-voxel start texture (sec. 2 step 3: initially random).
-        std::uint32_t x = std::uint32_t(v.cell.x * 73856093) ^ std::uint32_t(v.cell.y * 19349663) ^ std::uint32_t(v.cell.z * 83492791) ^ seed;
-        x ^= x >> 13;
-        x *= 0x5bd1e995u;
-        x ^= x >> 15;
-        v.texture = x;
-    }
-}
-
 struct Campfire {
     samples::Options options;
     splatfx::Materials materials{splatfx::Footprint{}};
-    std::uint32_t fireSet = 0, fireTable = 0;
-    splatfx::Grid base;
-    splatfx::Grid grid;
+    std::optional<splatfx::Effect> fire;
     splatfx::SplatBuilder builder;
     std::optional<splatfx::gl::Renderer> renderer;
     bool figureWritten = false;
 
     bool setup() {
-        fireSet = materials.addTextureSet(splatfx::TextureSet::turbulence({.count = 8, .size = 32, .seed = options.seed}));
-        fireTable = materials.addColorTable(splatfx::ColorTable::fire());
-        auto g = splatfx::Grid::box({7, 20, 5}, glm::vec3(0.5f));
-        if (!g) return fail(g.error());
-        base = std::move(*g);
-        shapeFlame(base, options.seed);
-        grid = base;
+        // The preset registers its turbulence set and fire colour table in materials.
+        auto f = splatfx::presets::fire(materials, {.dims = {7, 20, 5},
+                                                    .spacing = glm::vec3(0.5f),
+                                                    .propagationStepsPerSec = 8.0f,
+                                                    .texturesPerSec = 6.0f,
+                                                    .crossfade = true,
+                                                    .seed = options.seed});
+        if (!f) return fail(f.error());
+        fire = std::move(*f);
         auto r = splatfx::gl::Renderer::create();
         if (!r) return fail(r.error());
         renderer = std::move(*r);
@@ -67,25 +49,15 @@ struct Campfire {
         return splatfx::Camera::lookAt({0.0f, 4.8f, 15.0f}, {0.0f, 4.6f, 0.0f}, {0, 1, 0}, glm::radians(45.0f), size);
     }
 
-    // Local dynamics by texture cycling: 6 textures per second, cross-faded.
-    void animate(double timeSec) {
-        const double steps = timeSec * 6.0;
-        const auto whole = std::uint32_t(std::floor(steps));
-        for (size_t i = 0; i < grid.voxels.size(); ++i) {
-            grid.voxels[i].texture = base.voxels[i].texture + whole;
-            grid.voxels[i].phase = float(steps - std::floor(steps));
-        }
-    }
-
     void draw(const splatfx::Camera& cam, const splatfx::gl::Target& target, bool textured) {
         builder.begin(cam);
-        builder.add(grid, materials, {.textureSet = fireSet, .colorTable = fireTable, .textured = textured, .crossfade = true});
+        fire->emit(builder, materials, {.textured = textured});
         builder.sort();
         renderer->draw(builder.splats(), cam, target);
     }
 
     void frame(const samples::FrameContext& fc) {
-        animate(fc.timeSec);
+        fire->update(fc.timeSec);
         const splatfx::Camera cam = camera(fc.size);
         glBindFramebuffer(GL_FRAMEBUFFER, fc.target.framebuffer);
         glViewport(0, 0, fc.size.x, fc.size.y);

@@ -1,6 +1,8 @@
 // texpick: the command line (parsing, the modes, progress and summary).
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -49,7 +51,7 @@ processing:
   --size S             texture side in texels (default 32)
   --color              keep colour (default: grayscale, as in the paper)
   --contrast MODE      patch | set | none (default patch: mean 0.5, std --contrast-std)
-  --contrast-std F     target standard deviation (default 0.2)
+  --contrast-std F     target standard deviation (default 0.25)
   --order              reorder for smooth cycling (closing the cycle)
   --window             bake the footprint into the saved textures (default: the renderer windows them)
   --kernel K           crawfis-max | gaussian footprint (default crawfis-max)
@@ -245,6 +247,9 @@ splatfx::Status produce(const Options& o, const Source& src, const Selection& se
 
 namespace {
 
+// Floats as the artist typed them (0.03, not 0.029999999329447746).
+double f6(float v) { return std::round(double(v) * 1e6) / 1e6; }
+
 int fail(const std::string& why) {
     std::fprintf(stderr, "%s: %s\n", kToolName, why.c_str());
     return 1;
@@ -258,7 +263,7 @@ int runTurbulence(const Options& o) {
     splatfx::TextureSet set = splatfx::TextureSet::turbulence(d);
     if (o.process.window) set = set.windowed(splatfx::Footprint(o.process.footprint));
     json params{{"count", d.count}, {"size", d.size}, {"seed", d.seed}, {"octaves", d.octaves},
-                {"baseFrequency", d.baseFrequency}, {"loopRadius", d.loopRadius}};
+                {"baseFrequency", f6(d.baseFrequency)}, {"loopRadius", f6(d.loopRadius)}};
     Provenance p;
     p.sourceFile = "splatfx::TextureSet::turbulence (procedural, no photograph)";
     p.method = "turbulence";
@@ -323,16 +328,16 @@ int run(const Options& o) {
     } else if (o.mode == "random") {
         const float minDistance = o.minDistance >= 0.0f ? o.minDistance : 0.0f;
         sel = pickRandom(*src, {.count = o.count, .patch = o.patch, .seed = o.seed, .accept = o.accept, .minDistance = minDistance});
-        params = {{"count", o.count}, {"patch", o.patch}, {"seed", o.seed}, {"minStd", o.accept.minStd},
-                  {"minMean", o.accept.minMean}, {"minCoverage", o.accept.minCoverage}, {"minDistance", minDistance},
+        params = {{"count", o.count}, {"patch", o.patch}, {"seed", o.seed}, {"minStd", f6(o.accept.minStd)},
+                  {"minMean", f6(o.accept.minMean)}, {"minCoverage", f6(o.accept.minCoverage)}, {"minDistance", f6(minDistance)},
                   {"rng", "std::mt19937, raw words modulo the span"}};
     } else if (o.mode == "spectral") {
         SpectralDesc d{.count = o.count, .patch = o.patch, .stride = o.stride, .bandLo = o.bandLo, .bandHi = o.bandHi,
                        .spread = o.spread, .minDistance = o.minDistance, .accept = o.accept};
         sel = pickSpectral(*src, d);
         params = {{"count", o.count}, {"patch", o.patch}, {"stride", o.stride > 0 ? o.stride : std::max(1, o.patch / 4)},
-                  {"minDistance", o.minDistance >= 0.0f ? double(o.minDistance) : 0.5 * o.patch},
-                  {"minStd", o.accept.minStd}, {"minMean", o.accept.minMean}, {"minCoverage", o.accept.minCoverage}};
+                  {"minDistance", o.minDistance >= 0.0f ? f6(o.minDistance) : 0.5 * o.patch},
+                  {"minStd", f6(o.accept.minStd)}, {"minMean", f6(o.accept.minMean)}, {"minCoverage", f6(o.accept.minCoverage)}};
         if (o.spread) params["spread"] = true;
         else params["bandCyclesPerPixel"] = {o.bandLo, o.bandHi};
     } else if (o.mode == "path") {

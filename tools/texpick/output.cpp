@@ -191,7 +191,11 @@ splatfx::Camera frame(const splatfx::Grid& g, float support, glm::ivec2 viewport
         hi = glm::max(hi, g.worldPosition(v.cell));
     }
     const glm::vec3 centre = 0.5f * (lo + hi);
-    const float radius = 0.5f * glm::length(hi - lo) + support * g.spacing.x;
+    // The footprint is faint beyond about half its support radius, so framing
+    // the half-extent plus half the support leaves little empty border; a lone
+    // splat gets its whole support so its edge is visible.
+    const float extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+    const float radius = 0.5f * extent + (extent > 0.0f ? 0.6f : 1.0f) * support * g.spacing.x;
     const float fov = glm::radians(40.0f);
     const float dist = 1.05f * radius / std::sin(0.5f * fov);
     return splatfx::Camera::lookAt(centre + glm::vec3(0.0f, 0.0f, dist), centre, {0, 1, 0}, fov, viewport);
@@ -217,7 +221,8 @@ splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::Textur
     if (auto s = renderer->upload(mat); !s) return makeError("cannot render the preview: " + s.error());
 
     // Left: one big splat, so the artist sees each windowed texture (Fig. 2).
-    auto single = splatfx::Grid::fromDense({1, 1, 1}, {1.0f});
+    // Opacity 0.6 rather than 1: a saturated splat would hide the detail it carries.
+    auto single = splatfx::Grid::fromDense({1, 1, 1}, {0.6f});
     // Right: a puff of splats, each starting at its own texture (sec. 2 step 3).
     const float r = 3.0f;
     auto puff = splatfx::Grid::sphere(r);
@@ -264,6 +269,20 @@ splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::Textur
 
 // [SECTION] Output folder
 
+namespace {
+
+// ".<name><tag><pid>": beside the target, hidden, unique to this process.
+// Appended piecewise: GCC 12 warns falsely (-Wrestrict) on "." + std::string.
+std::string hiddenName(const fs::path& target, const char* tag) {
+    std::string name(1, '.');
+    name += target.filename().string();
+    name += tag;
+    name += std::to_string(getpid());
+    return name;
+}
+
+} // namespace
+
 splatfx::Status writeOutput(const std::string& folder, const splatfx::TextureSet& set, const std::string& provenance,
                             const OutputDesc& d, const Source* source, const std::vector<Patch>* patches) {
     std::error_code ec;
@@ -286,7 +305,7 @@ splatfx::Status writeOutput(const std::string& folder, const splatfx::TextureSet
     }
     fs::create_directories(parent, ec);
     if (ec) return makeError("cannot create the folder '" + parent.string() + "' for '" + folder + "': " + ec.message());
-    const fs::path staging = parent / ("." + target.filename().string() + ".texpick-" + std::to_string(getpid()));
+    const fs::path staging = parent / hiddenName(target, ".texpick-");
     fs::remove_all(staging, ec);
     auto fail = [&](const std::string& why) {
         fs::remove_all(staging, ec);
@@ -310,7 +329,7 @@ splatfx::Status writeOutput(const std::string& folder, const splatfx::TextureSet
     // ...and a check that the SDK reads back what was written, before anything is replaced.
     if (auto back = splatfx::TextureSet::load(staging.string()); !back) return fail("the written set does not load: " + back.error());
     // Finally the swap: the old folder steps aside, the new one takes its name.
-    const fs::path old = parent / ("." + target.filename().string() + ".texpick-old-" + std::to_string(getpid()));
+    const fs::path old = parent / hiddenName(target, ".texpick-old-");
     fs::remove_all(old, ec);
     const bool had = fs::exists(target, ec);
     if (had) {

@@ -136,7 +136,7 @@ struct Spectrum {
 Spectrum spectrum(const Source& s, const Patch& p) {
     assert(inside(s, p) && "patch must lie inside the source");
     const int n = p.size;
-    std::vector<double> w(size_t(n));
+    std::vector<double> w(static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) w[size_t(i)] = 0.5 - 0.5 * std::cos(2.0 * kPi * (i + 0.5) / n);
     cv::Mat lum;
     s.luminance(cv::Rect(p.x, p.y, n, n)).convertTo(lum, CV_64F);

@@ -45,12 +45,16 @@ inline constexpr int kMinPatch = 4; // smallest patch side, source pixels
 // becomes black, i.e. empty, which the flatness test rejects), its luminance,
 // and its coverage (alpha, 1 where the file has none).
 struct Source {
-    std::string path;   // as given
+    
+    std::string path{};   // as given
     int width = 0, height = 0;
     int fileChannels = 0;
-    cv::Mat rgb;        // CV_32FC3, [0, 1], premultiplied by coverage
-    cv::Mat luminance;  // CV_32FC1, Rec. 709 weights
-    cv::Mat coverage;   // CV_32FC1, [0, 1]
+    
+    cv::Mat rgb{};        // CV_32FC3, [0, 1], premultiplied by coverage
+    
+    cv::Mat luminance{};  // CV_32FC1, Rec. 709 weights
+    
+    cv::Mat coverage{};   // CV_32FC1, [0, 1]
 };
 
 // Reads any format OpenImageIO reads (falling back to OpenCV). On failure the
@@ -82,7 +86,8 @@ inline const std::vector<double>& bandEdges() {
 // removed and it is multiplied by a separable Hann window first, so the edges
 // of the square do not leak power into every band.
 struct SpectralStats {
-    std::vector<double> bandEnergy; // fraction of (non-DC) power per band of bandEdges(); sums to 1 (all 0 when flat)
+    
+    std::vector<double> bandEnergy{}; // fraction of (non-DC) power per band of bandEdges(); sums to 1 (all 0 when flat)
     double power = 0.0;             // total non-DC power per pixel (windowed luminance variance)
     double centroid = 0.0;          // power-weighted mean radial frequency, cycles per pixel
     double mean = 0.0;              // luminance mean over the patch
@@ -105,8 +110,10 @@ struct Acceptance {
 };
 
 struct Selection {
-    std::vector<Patch> patches;
-    std::vector<SpectralStats> stats; // one per patch
+    
+    std::vector<Patch> patches{};
+    
+    std::vector<SpectralStats> stats{}; // one per patch
     int candidates = 0;               // patches considered
     int rejected = 0;                 // flat, near-empty or too close to a pick
 };
@@ -114,7 +121,8 @@ struct Selection {
 // Each position is a patch centre; size 0 takes `defaultSize`. Errors name
 // the position that leaves the image.
 struct PositionsDesc {
-    std::vector<cv::Point3i> centers; // (x, y, size) in source pixels
+    
+    std::vector<cv::Point3i> centers{}; // (x, y, size) in source pixels
     int defaultSize = 64;             // default 64
 };
 splatfx::Result<Selection> pickPositions(const Source& source, const PositionsDesc& desc);
@@ -148,7 +156,8 @@ splatfx::Result<Selection> pickSpectral(const Source& source, const SpectralDesc
 // pixels apart (so consecutive patches overlap by patch - step pixels along
 // the path), rounded to whole pixels so each is an exact cut of the photo.
 struct PathDesc {
-    std::vector<cv::Point2d> points; // at least 2 vertices, source pixels
+    
+    std::vector<cv::Point2d> points{}; // at least 2 vertices, source pixels
     int patch = 64;                  // default 64
     double step = 4.0;               // pixels along the path between consecutive patches; default 4
     int count = 0;                   // default 0 = as many as fit on the path
@@ -167,7 +176,7 @@ struct ProcessDesc {
     int textureSize = 32;        // texels on a side; default 32
     bool color = false;          // keep RGB (default false: grayscale, sec. 2 step 1)
     Contrast contrast = Contrast::Patch; // default Patch
-    float contrastStd = 0.2f;    // target standard deviation; default 0.2
+    float contrastStd = 0.25f;   // target standard deviation; default 0.25 (about 2 std either side of 0.5 fit in [0, 1])
     bool order = false;          // reorder for smooth cycling; default false
     bool window = false;         // bake the footprint into the saved set (else the renderer windows it); default false
     splatfx::FootprintDesc footprint{}; // kernel for the window, the contact sheet and the preview
@@ -176,8 +185,10 @@ struct ProcessDesc {
 // The textures, before windowing unless desc.window. `order[k]` is the index
 // (in the input patch list) of texture k.
 struct MadeSet {
-    splatfx::TextureSet set;
-    std::vector<int> order;
+    
+    splatfx::TextureSet set{};
+    
+    std::vector<int> order{};
 };
 splatfx::Result<MadeSet> makeSet(const Source& source, const std::vector<Patch>& patches, const ProcessDesc& desc);
 
@@ -192,15 +203,20 @@ double cycleCost(const splatfx::TextureSet& set, const std::vector<int>& order);
 
 // What manifest.json's "provenance" records (versioned by kProvenanceVersion).
 struct Provenance {
-    std::string sourceFile;          // file name only (baseName) or an artist-given name
-    std::string credit;              // author / origin of the photograph; default empty
-    std::string license;             // licence of the photograph; default empty
+    
+    std::string sourceFile{};          // file name only (baseName) or an artist-given name
+    
+    std::string credit{};              // author / origin of the photograph; default empty
+    
+    std::string license{};             // licence of the photograph; default empty
     int sourceWidth = 0, sourceHeight = 0;
-    std::string method;              // positions | random | spectral | path | turbulence | merge
+    
+    std::string method{};              // positions | random | spectral | path | turbulence | merge
     std::string parametersJson = "{}"; // the method's parameters, as given
     const Selection* selection = nullptr; // patches and their spectra (photo methods)
     const ProcessDesc* process = nullptr;
-    std::vector<int> order;          // texture k came from patch order[k]
+    
+    std::vector<int> order{};          // texture k came from patch order[k]
 };
 std::string provenanceJson(const Provenance& p);
 
@@ -238,29 +254,38 @@ splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::Textur
 
 // Everything the command line can say; defaults match `splatfx-texpick --help`.
 struct Options {
-    std::string mode;             // positions | random | spectral | path | interactive | turbulence | merge
-    std::string input;            // the photograph (merge: unused)
-    std::vector<std::string> sets; // merge: the texture-set folders to concatenate
-    std::string out;              // --out
+    
+    std::string mode{};             // positions | random | spectral | path | interactive | turbulence | merge
+    
+    std::string input{};            // the photograph (merge: unused)
+    
+    std::vector<std::string> sets{}; // merge: the texture-set folders to concatenate
+    
+    std::string out{};              // --out
     int patch = 64, count = 8;
     bool countGiven = false;
     std::uint32_t seed = 1;
-    std::vector<cv::Point3i> at;  // positions
+    
+    std::vector<cv::Point3i> at{};  // positions
     Acceptance accept{};
     float minDistance = -1.0f;    // -1: the mode's default
     double bandLo = 0.125, bandHi = 0.75;
     bool spread = false;
     int stride = 0;
-    std::vector<cv::Point2d> path;
+    
+    std::vector<cv::Point2d> path{};
     double step = 4.0;
     splatfx::TurbulenceDesc turbulence{};
     ProcessDesc process{};
     OutputDesc output{};
-    std::string sourceName, credit, license;
+    
+    std::string sourceName{}, credit{}, license{};
     bool quiet = false;
     int autoQuitAfter = 0;        // interactive: close after this many frames (0 = wait for the user)
-    std::string events;           // interactive: scripted input, e.g. "click:120,80;key:s"
-    std::string screenshot;       // interactive: write the window's image here before quitting
+    
+    std::string events{};           // interactive: scripted input, e.g. "click:120,80;key:s"
+    
+    std::string screenshot{};       // interactive: write the window's image here before quitting
 };
 
 // Parses argv into options; on --help prints usage and returns an empty error.

@@ -89,8 +89,8 @@ struct CyclingDesc {
 };
 
 struct TextureDynamicsDesc {
-    PropagationDesc propagation;
-    CyclingDesc cycling;
+    PropagationDesc propagation{};
+    CyclingDesc cycling{};
     std::uint32_t seed = 1; // every random choice derives from it; default 1
 };
 
@@ -135,7 +135,7 @@ public:
     const TextureDynamicsDesc& desc() const { return mDesc; }
 
 private:
-    TextureDynamicsDesc mDesc;
+    TextureDynamicsDesc mDesc{};
     std::vector<glm::ivec3> mCells;
     std::vector<int> mChain;
     glm::ivec3 mLo{0}, mSize{0};
@@ -163,6 +163,8 @@ public:
                      double dtSec, std::uint32_t offset);
 
     std::uint32_t index(glm::ivec3 cell) const { return mIndex[linear(cell)]; }
+    // Overrides one cell's index (e.g. to mark a texture and watch it travel).
+    void setIndex(glm::ivec3 cell, std::uint32_t value) { mIndex[linear(cell)] = value; }
     const std::vector<std::uint32_t>& indices() const { return mIndex; }
     std::int64_t steps() const { return mSteps; }
     glm::ivec3 dims() const { return mDims; }

@@ -75,7 +75,7 @@ struct ReferenceHost {
 };
 
 struct SplatExactDesc {
-    ReferenceHost host;                             // default: transparent black, no depth
+    ReferenceHost host{};                           // default: transparent black, no depth
     ReferenceWindow window = ReferenceWindow::Exact; // default Exact
     bool trimCorners = true; // match RendererDesc::trimCorners (octagon vs square quad); default true
     int threads = 0;         // worker threads; 0 = std::thread::hardware_concurrency(); default 0
@@ -144,7 +144,7 @@ private:
 };
 
 struct VolumeExactDesc {
-    ReferenceHost host;          // default: transparent black, no depth
+    ReferenceHost host{};        // default: transparent black, no depth
     double tolerance = 1e-5;     // stop halving when two results differ by less (max over RGBA); default 1e-5
     double initialStep = 0.0;    // world units; 0 = a quarter of the smallest kernel support radius; default 0
     int maxHalvings = 10;        // at most this many halvings per pixel; default 10

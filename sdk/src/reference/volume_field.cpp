@@ -43,7 +43,7 @@ void VolumeField::add(const Grid& grid, const SplatStyle& style) {
         const double tableAlpha = hasTable ? std::clamp(double(mat.colorTable(style.colorTable).sample(v.colorCoord).a), 0.0, 1.0) : 1.0;
         const double alpha = opacity * tableAlpha;
         if (!(alpha > 0.0)) continue;
-        const double tau = alpha >= 1.0 ? kMaxTau : std::min(-std::log2(1.0 - alpha), kMaxTau);
+        const double tau = alpha >= 1.0 ? kMaxTau : std::min(-std::log1p(-alpha) / kLn2, kMaxTau);
         VoxelKernel k;
         k.center = c;
         k.inverse = glm::inverse(m);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <optional>
 
 namespace splatfx {
 namespace {
@@ -21,10 +22,10 @@ float smoothstep(float a, float b, float x) {
 // Symmetric square root of a 2x2 symmetric positive definite matrix.
 void sqrt2x2(float a, float b, float c, float out[3]) { // [[a b][b c]]
     const float s = std::sqrt(std::max(a * c - b * b, 0.0f));
-    const float t = std::sqrt(std::max(a + c + 2.0f * s, 1e-30f));
-    out[0] = (a + s) / t;
-    out[1] = b / t;
-    out[2] = (c + s) / t;
+    const float inv = 1.0f / std::sqrt(std::max(a + c + 2.0f * s, 1e-30f));
+    out[0] = (a + s) * inv;
+    out[1] = b * inv;
+    out[2] = (c + s) * inv;
 }
 
 bool finite3(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
@@ -67,27 +68,52 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
     const bool hasTable = style.colorTable < materials.colorTableCount();
     const glm::mat3 rot(grid.transform);
     const float opacityScale = std::isfinite(style.opacityScale) ? std::max(style.opacityScale, 0.0f) : 0.0f;
+    const ColorTable* table = hasTable ? &materials.colorTable(style.colorTable) : nullptr;
 
-    for (const Voxel& v : grid.voxels) {
-        // Kernel shape: grid rotation/scale, lattice spacing, then the voxel's stretch.
-        glm::mat3 m = rot * glm::mat3(glm::vec3(grid.spacing.x, 0, 0), glm::vec3(0, grid.spacing.y, 0), glm::vec3(0, 0, grid.spacing.z));
-        const float stretchLen = glm::length(v.stretch);
-        if (stretchLen > 0.0f && std::isfinite(stretchLen)) {
-            const glm::vec3 s = v.stretch / stretchLen;
-            m = m * (glm::mat3(1.0f) + stretchLen * glm::outerProduct(s, s));
+    // The kernel's shape: grid rotation/scale times lattice spacing, then the
+    // voxel's stretch. Without a stretch it is the same for every voxel, so
+    // its inverse, determinant and extent are computed once per grid.
+    struct Shape {
+        glm::mat3 sigma, sigmaInv; // M M^T and its inverse
+        float cbrtDet = 1.0f, extent = 0.0f;
+        bool ok = false;
+        explicit Shape(const glm::mat3& m, float R) {
+            const float det = glm::determinant(m);
+            ok = std::isfinite(det) && std::abs(det) >= 1e-12f;
+            if (!ok) return;
+            sigma = m * glm::transpose(m);
+            const glm::mat3 mi = glm::inverse(m);
+            sigmaInv = glm::transpose(mi) * mi;
+            cbrtDet = std::cbrt(std::abs(det));
+            // Conservative world extent of the footprint: R times the kernel's largest axis.
+            extent = R * std::sqrt(sigma[0][0] + sigma[1][1] + sigma[2][2]);
         }
-        const float det = glm::determinant(m);
-        const glm::vec3 c = glm::vec3(grid.transform * glm::vec4(grid.localPosition(v.cell), 1.0f));
-        if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord) || !std::isfinite(v.phase) || !finite3(c) ||
-            !std::isfinite(det) || std::abs(det) < 1e-12f) {
+    };
+    const glm::mat3 gridShape = rot * glm::mat3(glm::vec3(grid.spacing.x, 0, 0), glm::vec3(0, grid.spacing.y, 0), glm::vec3(0, 0, grid.spacing.z));
+    const Shape plain(gridShape, R);
+    const glm::vec3 half = glm::vec3(glm::max(grid.dims - 1, glm::ivec3(0))) * 0.5f;
+    const glm::vec3 halfXZ(half.x, 0.0f, half.z);
+
+    if (mSplats.capacity() < mSplats.size() + grid.voxels.size()) mSplats.reserve(mSplats.size() + grid.voxels.size());
+    for (const Voxel& v : grid.voxels) {
+        const float stretchLen = glm::length(v.stretch);
+        const bool stretched = stretchLen > 0.0f;
+        std::optional<Shape> own;
+        if (stretched && std::isfinite(stretchLen)) {
+            const glm::vec3 sd = v.stretch / stretchLen;
+            own.emplace(gridShape * (glm::mat3(1.0f) + stretchLen * glm::outerProduct(sd, sd)), R);
+        }
+        const Shape& shape = own ? *own : plain;
+        const glm::vec3 c = glm::vec3(grid.transform * glm::vec4((glm::vec3(v.cell) - halfXZ) * grid.spacing, 1.0f));
+        if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord) || !std::isfinite(v.phase) || !finite3(c) || !shape.ok ||
+            (stretched && !own)) {
             ++mStats.rejected;
             continue;
         }
         const float opacity = std::clamp(v.opacity * opacityScale, 0.0f, 1.0f);
         const glm::vec3 toC = c - eye;
         const float viewZ = glm::dot(toC, fwd);
-        // Conservative world extent of the footprint: R times the kernel's largest axis.
-        const float extent = R * std::sqrt(glm::dot(m[0], m[0]) + glm::dot(m[1], m[1]) + glm::dot(m[2], m[2]));
+        const float extent = shape.extent;
         bool outside = opacity <= 0.0f;
         if (mDesc.frustumCull)
             for (const auto& p : planes) outside = outside || glm::dot(glm::vec3(p), c) + p.w < -extent;
@@ -107,34 +133,30 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         e1 = e1Len > 1e-6f ? e1 / e1Len : camRight;
         const glm::vec3 e2 = glm::normalize(glm::cross(e1, d));
 
-        // Line integral of h(|M^-1 x|) along d at plane offset q: F(|.|_Q) / |M^-1 d|,
-        // with Q the quadratic form of the distance in kernel space.
-        const glm::mat3 mi = glm::inverse(m);
-        const glm::vec3 a1 = mi * e1, a2 = mi * e2, b = mi * d;
-        const float bLen = glm::length(b);
-        const glm::vec3 bh = b / bLen;
-        const float q00 = glm::dot(a1, a1) - glm::dot(a1, bh) * glm::dot(a1, bh);
-        const float q01 = glm::dot(a1, a2) - glm::dot(a1, bh) * glm::dot(a2, bh);
-        const float q11 = glm::dot(a2, a2) - glm::dot(a2, bh) * glm::dot(a2, bh);
-        // Q^-1 maps the unit disc onto the ellipse; its square root gives the axes.
-        const float qDet = std::max(q00 * q11 - q01 * q01, 1e-30f);
-        float s[3];
-        sqrt2x2(q11 / qDet, -q01 / qDet, q00 / qDet, s);
+        // Line integral of h(|M^-1 x|) along d at plane offset q: F(|q|_Q) / |M^-1 d|.
+        // Q is the Schur complement of Sigma^-1 = (M M^T)^-1 in the frame
+        // (e1, e2, d), so Q^-1 is simply the (e1, e2) block of Sigma: the
+        // ellipse's axes are the square root of that 2x2 block.
+        const glm::vec3 se1 = shape.sigma * e1, se2 = shape.sigma * e2;
+        float sq[3];
+        sqrt2x2(glm::dot(e1, se1), glm::dot(e2, se1), glm::dot(e2, se2), sq);
+        const float bLen = std::sqrt(glm::dot(d, shape.sigmaInv * d));
 
         Splat sp;
         sp.center = c;
-        sp.axisU = R * (s[0] * e1 + s[1] * e2);
-        sp.axisV = R * (s[1] * e1 + s[2] * e2);
+        sp.axisU = R * (sq[0] * e1 + sq[1] * e2);
+        sp.axisV = R * (sq[1] * e1 + sq[2] * e2);
         if (!finite3(sp.axisU) || !finite3(sp.axisV)) {
             ++mStats.rejected;
             continue;
         }
-        const float tableAlpha = hasTable ? std::clamp(materials.colorTable(style.colorTable).sample(v.colorCoord).a, 0.0f, 1.0f) : 1.0f;
+        const float tableAlpha = table ? std::clamp(table->sample(v.colorCoord).a, 0.0f, 1.0f) : 1.0f;
         const float alpha = opacity * tableAlpha;
         // Optical depth through the centre, relative to an isotropic voxel of
         // equal volume: the chord along d (1 / |M^-1 d|) over det(M)^(1/3).
-        const float tau = alpha >= 1.0f ? kMaxTau : std::min(-std::log2(1.0f - alpha), kMaxTau);
-        const float chord = (1.0f / bLen) / std::cbrt(std::abs(det));
+        // log1p: 1.0f - alpha rounds to 1 for alpha < 6e-8, which would lose the voxel entirely.
+        const float tau = alpha >= 1.0f ? kMaxTau : std::min(-std::log1p(-alpha) * 1.44269504f, kMaxTau);
+        const float chord = (1.0f / bLen) / shape.cbrtDet;
         sp.density = tau * std::min(chord, 64.0f) * fade * range.gain;
         sp.colorCoord = std::clamp(v.colorCoord, 0.0f, 1.0f);
         sp.colorRow = hasTable ? float(style.colorTable) : 0.0f;

@@ -1,6 +1,8 @@
 #include "splatfx/gl/renderer.hpp"
 
+#include <algorithm>
 #include <cassert>
+#include <cstring>
 
 #include <epoxy/gl.h>
 
@@ -92,14 +94,42 @@ struct Renderer::Impl {
     RendererDesc desc;
     DrawStats stats;
     GLuint program = 0, vao = 0, instances = 0, layers = 0, colors = 0;
-    GLint uViewProj = -1, uOctagon = -1, uColorRows = -1;
-    GLsizeiptr capacity = 0;
+    GLint uViewProj = -1, uOctagon = -1, uColorRows = -1, uCut = -1;
+    // Instance data streams through a persistently mapped ring of kRing
+    // regions: the CPU writes region i while the GPU may still read the
+    // others; a fence per region says when it is free again. No per-frame
+    // allocation and no implicit synchronisation inside the driver.
+    static constexpr int kRing = 3;
+    std::size_t regionSplats = 0; // capacity of one region, in splats
+    Splat* mapped = nullptr;
+    GLsync fences[kRing] = {};
+    int region = 0;
     std::uint64_t uploadedVersion = 0;
     std::uint32_t colorRows = 0;
+
+    void grow(std::size_t splats) {
+        for (GLsync& f : fences)
+            if (f) {
+                glClientWaitSync(f, GL_SYNC_FLUSH_COMMANDS_BIT, GLuint64(-1));
+                glDeleteSync(f);
+                f = nullptr;
+            }
+        if (instances) glDeleteBuffers(1, &instances);
+        regionSplats = std::max<std::size_t>(splats + splats / 2, 1024);
+        const GLsizeiptr bytes = GLsizeiptr(regionSplats * sizeof(Splat) * kRing);
+        const GLbitfield flags = GL_MAP_WRITE_BIT | GL_MAP_PERSISTENT_BIT | GL_MAP_COHERENT_BIT;
+        glCreateBuffers(1, &instances);
+        glNamedBufferStorage(instances, bytes, nullptr, flags);
+        mapped = static_cast<Splat*>(glMapNamedBufferRange(instances, 0, bytes, flags));
+        glVertexArrayVertexBuffer(vao, 0, instances, 0, sizeof(Splat));
+        region = 0;
+    }
 
     ~Impl() {
         // The context may already be gone at exit; its objects died with it then.
         if (!detail::contextIsCurrent()) return;
+        for (GLsync f : fences)
+            if (f) glDeleteSync(f);
         if (program) glDeleteProgram(program);
         if (vao) glDeleteVertexArrays(1, &vao);
         if (instances) glDeleteBuffers(1, &instances);
@@ -146,10 +176,11 @@ Result<Renderer> Renderer::create(const RendererDesc& desc) {
     impl->uViewProj = glGetUniformLocation(impl->program, "uViewProj");
     impl->uOctagon = glGetUniformLocation(impl->program, "uOctagon");
     impl->uColorRows = glGetUniformLocation(impl->program, "uColorRows");
+    impl->uCut = glGetUniformLocation(impl->program, "uCut");
 
-    glCreateBuffers(1, &impl->instances);
     glCreateVertexArrays(1, &impl->vao);
-    glVertexArrayVertexBuffer(impl->vao, 0, impl->instances, 0, sizeof(Splat));
+    impl->grow(0);
+    if (!impl->mapped) return makeError("splatfx::gl::Renderer::create: cannot map a persistent instance buffer");
     glVertexArrayBindingDivisor(impl->vao, 0, 1);
     for (GLuint a = 0; a < 4; ++a) {
         glEnableVertexArrayAttrib(impl->vao, a);
@@ -203,15 +234,16 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
     r.stats.drawCalls = 0;
     if (splats.empty() || !r.layers) return;
 
-    const GLsizeiptr bytes = GLsizeiptr(splats.size() * sizeof(Splat));
-    if (bytes > r.capacity) {
-        r.capacity = bytes + bytes / 2;
-        glNamedBufferData(r.instances, r.capacity, nullptr, GL_STREAM_DRAW);
-    } else {
-        // Orphan: the driver hands back fresh storage instead of waiting for the last frame's draw.
-        glInvalidateBufferData(r.instances);
+    if (splats.size() > r.regionSplats) r.grow(splats.size());
+    r.region = (r.region + 1) % Impl::kRing;
+    if (GLsync& f = r.fences[r.region]) {
+        // Three frames back: normally long finished, so this does not wait.
+        glClientWaitSync(f, GL_SYNC_FLUSH_COMMANDS_BIT, GLuint64(-1));
+        glDeleteSync(f);
+        f = nullptr;
     }
-    glNamedBufferSubData(r.instances, 0, bytes, splats.data());
+    const std::size_t first = std::size_t(r.region) * r.regionSplats;
+    std::memcpy(r.mapped + first, splats.data(), splats.size() * sizeof(Splat));
 
     SavedState saved;
     if (r.desc.restoreState) saved.save();
@@ -235,10 +267,12 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
     glUniformMatrix4fv(r.uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
     glUniform1i(r.uOctagon, r.desc.trimCorners ? 1 : 0);
     glUniform1f(r.uColorRows, float(r.colorRows));
+    glUniform1f(r.uCut, std::clamp(r.desc.footprintCut, 0.05f, 1.0f));
     glBindTextureUnit(0, r.layers);
     glBindTextureUnit(1, r.colors);
     glBindVertexArray(r.vao);
-    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, r.desc.trimCorners ? 8 : 4, GLsizei(splats.size()));
+    glDrawArraysInstancedBaseInstance(GL_TRIANGLE_STRIP, 0, r.desc.trimCorners ? 8 : 4, GLsizei(splats.size()), GLuint(first));
+    r.fences[r.region] = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
     r.stats.drawCalls = 1;
 
     if (r.desc.restoreState) saved.restore();

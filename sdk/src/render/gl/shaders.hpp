@@ -13,6 +13,7 @@ layout(location = 3) in vec4 aLayers;
 
 uniform mat4 uViewProj;
 uniform int uOctagon;
+uniform float uCut;
 uniform float uColorRows;
 layout(binding = 1) uniform sampler2D uColors;
 
@@ -27,7 +28,7 @@ const vec2 kOct[8] = vec2[8](vec2(1.0, -0.41421356), vec2(1.0, 0.41421356), vec2
 const vec2 kQuad[4] = vec2[4](vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(-1.0, 1.0), vec2(1.0, 1.0));
 
 void main() {
-    vec2 uv = uOctagon != 0 ? kOct[gl_VertexID] : kQuad[gl_VertexID];
+    vec2 uv = (uOctagon != 0 ? kOct[gl_VertexID] : kQuad[gl_VertexID]) * uCut;
     vec3 p = aCenterDensity.xyz + uv.x * aAxisUColor.xyz + uv.y * aAxisVRow.xyz;
     gl_Position = uViewProj * vec4(p, 1.0);
     // Layer images are stored top row first; +v is the splat's "up".

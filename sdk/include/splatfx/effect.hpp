@@ -1,0 +1,159 @@
+// splatfx/effect.hpp: one animated effect: a coarse grid (or a solver) with
+// its three scales of motion and how it is drawn.
+//
+// King et al. 1999, sec. 3: an effect moves at three disjoint scales. An
+// Effect bundles them:
+//   - object dynamics (sec. 3.1): a Motion (keyframes + procedure) and growth
+//     applied to a base grid, or a FluidSolver with emitters on moving objects;
+//   - global dynamics (sec. 3.2): texture propagation (PropagationDesc);
+//   - local dynamics (sec. 3.3): texture cycling (CyclingDesc);
+// plus one or more layers, each a SplatStyle over a height band of the
+// lattice, so one effect can draw with two texture sets and colour tables
+// (fire turning into smoke, sec. 2 step 4: "mixing effects ... with multiple
+// color tables and differing texture sets").
+//
+// Two ways to advance:
+//   - Grid effects are stateless: update(t) computes frame t directly from
+//     (voxel, t, seed), in any order, at no cost for skipped frames. step(dt)
+//     is update(time() + dt).
+//   - Solver effects are stateful: step(dt) simulates; update() asserts.
+// isStateless() tells which; bounds(t0, t1) is a conservative world box of
+// every splat the effect can produce in [t0, t1] (motion and splat extent
+// included), for culling by a scheduler.
+// It does not sort, render or own GPU resources; it does not read files
+// (presets.hpp does, through Materials).
+//
+//   auto fire = splatfx::presets::fire(materials, {.dims = {7, 20, 5}});
+//   fire->update(timeSec);                 // or fire->step(dtSec)
+//   fire->emit(builder, materials);        // after builder.begin(camera)
+//
+// Threading: one thread at a time per effect; effects are independent.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "splatfx/dynamics.hpp"
+#include "splatfx/grid.hpp"
+#include "splatfx/motion.hpp"
+#include "splatfx/result.hpp"
+#include "splatfx/solver.hpp"
+#include "splatfx/splats.hpp"
+
+namespace splatfx {
+
+// One style over a band of the lattice's normalized height (0 = lowest
+// lattice row, 1 = highest). Voxels in [heightFrom, heightTo] are drawn with
+// `style`; with blend > 0 the layer fades in/out over `blend` around an inner
+// edge, so two layers meeting at h overlap and their weights sum to 1.
+struct EffectLayer {
+    SplatStyle style{};           // texture set, colour table, textured, crossfade; default SplatStyle{}
+    float heightFrom = 0.0f;    // [0, 1]; default 0
+    float heightTo = 1.0f;      // [heightFrom, 1]; default 1
+    float blend = 0.0f;         // normalized height of the fade at inner edges, >= 0; default 0 (hard split)
+    bool remapColor = false;    // colour coordinate = position within [heightFrom, heightTo]; default false (keep the voxel's)
+};
+
+// Each scale of motion can be switched off (the viewer's toggles). Off means
+// frozen at its t = 0 state, not removed.
+struct DynamicsToggles {
+    bool object = true; // sec. 3.1: motion, growth, fades, solver; default on
+    bool global = true; // sec. 3.2: texture propagation; default on
+    bool local = true;  // sec. 3.3: texture cycling; default on
+};
+
+struct EffectDesc {
+    std::string name = "effect";     // used in messages; default "effect"
+    Motion motion{};                   // object dynamics of the whole grid (grid effects only); default at rest
+    GrowthDesc growth{};               // how Pose::growth reveals material; default from the lattice centre
+    TextureDynamicsDesc textures{};    // global + local dynamics and their seed; default up, ordered cycling
+    std::vector<EffectLayer> layers{}; // default (empty): one layer with SplatStyle{}
+    SparseOutputDesc sparse{};         // solver effects: dense fields to voxels; default SparseOutputDesc{}
+    DynamicsToggles enabled{};         // default all on
+    // Support radius of the Materials footprint the effect is drawn with, in
+    // voxel units (Footprint::radius()); bounds() depend on it. Presets set it.
+    float footprintRadius = 1.6f;    // default 1.6 (Kernel::CrawfisMax)
+};
+
+struct EffectCounters {
+    std::uint64_t updates = 0;         // update() / step() calls that did work
+    std::uint64_t stepsSimulated = 0;  // solver substeps
+    std::uint64_t voxelsUpdated = 0;   // voxels (grid) or cells (solver) evaluated
+    std::uint64_t propagationSteps = 0; // step-by-step texture propagation steps (solver effects)
+};
+
+struct EmitOptions {
+    bool textured = true;        // false: traditional splats for every layer (Fig. 1a); default true
+    float opacityScale = 1.0f;   // multiplies each layer's style.opacityScale; default 1
+};
+
+class Effect {
+public:
+    // A stateless effect over a base grid (its voxels' cells fix the lattice;
+    // opacities, colour coordinates and stretch are the t = 0 material).
+    // Fails on an invalid grid or desc; the message names the field.
+    static Result<Effect> fromGrid(Grid base, EffectDesc desc);
+    // A stateful effect driven by a solver. desc.motion must be at rest
+    // (attach motion to the emitters instead: the smoke should trail).
+    static Result<Effect> fromSolver(FluidSolver solver, EffectDesc desc);
+
+    bool isStateless() const { return !mSolver.has_value(); }
+    // Stateless path: the effect at timeSec (>= 0), independent of earlier calls.
+    // Expects isStateless().
+    void update(double timeSec);
+    // Advances by dtSec (>= 0): simulates a solver effect, or update(time() + dtSec).
+    void step(double dtSec);
+    double time() const { return mTime; }
+
+    // The whole effect now (every layer's voxels before the height split).
+    const Grid& grid() const { return mGrid; }
+    std::size_t layerCount() const { return mLayerGrids.size(); }
+    const Grid& layerGrid(std::size_t i) const { return mLayerGrids.at(i); }
+    const EffectLayer& layer(std::size_t i) const { return mLayers.at(i); }
+
+    // Adds every layer's (grid, style) to the builder (after builder.begin).
+    // Expects materials with the footprint radius given in the desc and the
+    // layers' texture sets and colour tables. Returns the splats added.
+    std::size_t emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options = {}) const;
+
+    // Conservative world box of every splat over [t0, t1] (seconds): lattice
+    // extent, motion over the interval, and the splat extent (footprint
+    // radius times the kernel's largest axis, stretch included).
+    Aabb bounds(double t0, double t1) const;
+
+    const EffectCounters& counters() const { return mCounters; }
+    const EffectDesc& desc() const { return mDesc; }
+    // Switches scales of motion on or off; takes effect at the next update/step.
+    void setToggles(const DynamicsToggles& toggles);
+    // The solver of a solver effect, for emitters and inspection (nullptr otherwise).
+    FluidSolver* solver() { return mSolver ? &*mSolver : nullptr; }
+    const FluidSolver* solver() const { return mSolver ? &*mSolver : nullptr; }
+    // The stateless texture dynamics of a grid effect.
+    const TextureDynamics& textureDynamics() const { return mTexDyn; }
+
+private:
+    Effect() = default;
+    static Status checkDesc(const EffectDesc& desc);
+    void rebuildTextureDynamics();
+    void splitLayers();
+    float kernelNormBound(const Grid& g, float maxStretch) const;
+
+    EffectDesc mDesc;
+    std::vector<EffectLayer> mLayers{};
+    Grid mBase;                          // grid effects: the t = 0 material
+    std::vector<float> mGrowthDistance;  // per base voxel, cells
+    float mGrowthMax = 0.0f;
+    TextureDynamics mTexDyn;
+    std::optional<FluidSolver> mSolver;
+    TexturePropagator mPropagator;
+    Grid mGrid;
+    std::vector<Grid> mLayerGrids;
+    int mLatticeLoY = 0, mLatticeHiY = 0;
+    double mTime = 0.0;
+    EffectCounters mCounters;
+};
+
+} // namespace splatfx

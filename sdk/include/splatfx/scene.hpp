@@ -1,0 +1,109 @@
+// splatfx/scene.hpp: many effects, and only the ones the camera needs get work.
+//
+// A Scene holds the effects a level declares and, every frame, decides which
+// are needed now: enabled, within range of the camera, alive (emitting, or
+// with material left), and inside the view frustum by conservative bounds
+// that include their motion and the extent of their splats. Only those are
+// simulated and drawn. An effect that was skipped comes back exactly as it
+// would have been: stateless effects are evaluated at the current time
+// directly (Effect::update), solver effects catch up over the skipped
+// interval in at most `maxCatchUpSteps` coarse steps (bounded cost; its
+// error against full simulation is measured in docs/BENCHMARKS.md).
+// It does not render, load files, or own GL resources.
+//
+//   splatfx::Scene scene;
+//   auto id = scene.add(*splatfx::presets::fire(materials), {.name = "campfire", .rangeWorld = 80});
+//   scene.update(timeSec, camera);            // per frame
+//   builder.begin(camera); scene.emit(builder, materials); builder.sort();
+//
+// Threading: one thread at a time.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "splatfx/camera.hpp"
+#include "splatfx/effect.hpp"
+#include "splatfx/materials.hpp"
+#include "splatfx/splats.hpp"
+
+namespace splatfx {
+
+using EffectId = std::uint32_t;
+
+struct EffectOptions {
+    std::string name;                                        // for counters and messages; default empty
+    float rangeWorld = std::numeric_limits<float>::infinity(); // skipped beyond this distance from its bounds; default no limit
+    bool enabled = true;                                     // default true
+    // Solver effects returning after dt unseen seconds catch up in
+    // n = min(ceil(dt / catchUpStepSec), maxCatchUpSteps) steps of dt / n.
+    double catchUpStepSec = 1.0 / 30.0;                      // default 1/30 s
+    int maxCatchUpSteps = 8;                                 // default 8
+    // A solver effect whose emitters are all off and whose total density is
+    // below this is dead: not simulated, not drawn.
+    double deadDensity = 1e-4;                               // default 1e-4
+};
+
+// Why an effect was or was not needed at the last update, and what it cost.
+struct EffectStatus {
+    bool enabled = true;
+    bool inRange = false;
+    bool inView = false;             // in range and inside the frustum
+    bool alive = false;              // in view and with material present (only tested when in view)
+    bool needed = false;             // enabled && inRange && inView && alive
+    std::uint64_t framesNeeded = 0;  // updates where it was needed
+    std::uint64_t framesSkipped = 0; // updates where it was not (no work done)
+    std::uint64_t catchUps = 0;      // returns of a solver effect after being skipped
+    std::uint64_t splatsDrawn = 0;   // splats emitted at the last emit()
+    Aabb bounds;                     // world bounds used for the last decision
+};
+
+struct SceneCounters {
+    std::size_t declared = 0;   // effects in the scene
+    std::size_t needed = 0;     // needed at the last update (= simulated and drawn)
+    std::size_t simulated = 0;  // effects that did dynamics work at the last update
+    std::uint64_t splats = 0;   // splats emitted at the last emit()
+};
+
+class Scene {
+public:
+    EffectId add(Effect effect, EffectOptions options = {});
+    std::size_t size() const { return mEntries.size(); }
+    Effect& effect(EffectId id) { return mEntries.at(id).effect; }
+    const Effect& effect(EffectId id) const { return mEntries.at(id).effect; }
+    const EffectOptions& options(EffectId id) const { return mEntries.at(id).options; }
+    void setEnabled(EffectId id, bool enabled) { mEntries.at(id).options.enabled = enabled; }
+
+    // Decides what is needed for this camera at timeSec (non-decreasing
+    // across calls) and brings exactly those effects to timeSec.
+    void update(double timeSec, const Camera& camera);
+    // Adds the splats of the effects the last update() found needed.
+    std::size_t emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options = {});
+
+    const EffectStatus& status(EffectId id) const { return mEntries.at(id).status; }
+    const SceneCounters& counters() const { return mCounters; }
+    double time() const { return mTime; }
+
+    // True when any part of the box may be inside the camera's frustum
+    // (conservative: boxes near a frustum corner may pass).
+    static bool inFrustum(const Aabb& box, const Camera& camera);
+
+private:
+    struct Entry {
+        Effect effect;
+        EffectOptions options;
+        EffectStatus status;
+        double simulatedTo = 0.0; // solver effects: time the simulation has reached
+    };
+    bool alive(const Entry& e, double t) const;
+    void bringUpToDate(Entry& e, double t, bool wasNeeded);
+
+    std::vector<Entry> mEntries;
+    SceneCounters mCounters;
+    double mTime = 0.0;
+    bool mUpdated = false;
+};
+
+} // namespace splatfx

@@ -1,0 +1,254 @@
+#include "splatfx/gl/scaled_renderer.hpp"
+
+#include <cassert>
+#include <optional>
+#include <string>
+
+#include <epoxy/gl.h>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "context_check.hpp"
+#include "scaled_shaders.hpp"
+
+namespace splatfx::gl {
+namespace {
+
+Result<GLuint> linkProgram(const char* vertex, const char* fragment, const char* what) {
+    GLuint stages[2] = {glCreateShader(GL_VERTEX_SHADER), glCreateShader(GL_FRAGMENT_SHADER)};
+    const char* sources[2] = {vertex, fragment};
+    std::string log;
+    for (int i = 0; i < 2 && log.empty(); ++i) {
+        glShaderSource(stages[i], 1, &sources[i], nullptr);
+        glCompileShader(stages[i]);
+        GLint ok = 0;
+        glGetShaderiv(stages[i], GL_COMPILE_STATUS, &ok);
+        if (!ok) {
+            char buf[4096] = {};
+            glGetShaderInfoLog(stages[i], sizeof buf, nullptr, buf);
+            log = std::string(what) + (i == 0 ? " vertex" : " fragment") + " shader failed to compile: " + buf;
+        }
+    }
+    GLuint program = 0;
+    if (log.empty()) {
+        program = glCreateProgram();
+        glAttachShader(program, stages[0]);
+        glAttachShader(program, stages[1]);
+        glLinkProgram(program);
+        GLint ok = 0;
+        glGetProgramiv(program, GL_LINK_STATUS, &ok);
+        if (!ok) {
+            char buf[4096] = {};
+            glGetProgramInfoLog(program, sizeof buf, nullptr, buf);
+            log = std::string(what) + " program failed to link: " + buf;
+            glDeleteProgram(program);
+        }
+    }
+    glDeleteShader(stages[0]);
+    glDeleteShader(stages[1]);
+    if (!log.empty()) return makeError(log);
+    return program;
+}
+
+// The host state the two extra passes touch, beyond what Renderer documents.
+class HostState {
+public:
+    void capture() {
+        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &mDrawFbo);
+        glGetIntegerv(GL_VIEWPORT, mViewport);
+        glGetIntegerv(GL_CURRENT_PROGRAM, &mProgram);
+        glGetIntegerv(GL_VERTEX_ARRAY_BINDING, &mVao);
+        glGetIntegerv(GL_ARRAY_BUFFER_BINDING, &mArrayBuffer);
+        glGetIntegerv(GL_ACTIVE_TEXTURE, &mActive);
+        for (int u = 0; u < 3; ++u) {
+            glActiveTexture(GLenum(GL_TEXTURE0 + u));
+            glGetIntegerv(GL_TEXTURE_BINDING_2D, &mTex2D[u]);
+        }
+        glActiveTexture(GL_TEXTURE0);
+        glGetIntegerv(GL_TEXTURE_BINDING_2D_ARRAY, &mTexArray0);
+        mCaps[0] = glIsEnabled(GL_BLEND);
+        mCaps[1] = glIsEnabled(GL_DEPTH_TEST);
+        mCaps[2] = glIsEnabled(GL_CULL_FACE);
+        glGetBooleanv(GL_DEPTH_WRITEMASK, &mDepthMask);
+        glGetBooleanv(GL_COLOR_WRITEMASK, mColorMask);
+        const GLenum blendQueries[6] = {GL_BLEND_SRC_RGB, GL_BLEND_DST_RGB, GL_BLEND_SRC_ALPHA, GL_BLEND_DST_ALPHA,
+                                        GL_BLEND_EQUATION_RGB, GL_BLEND_EQUATION_ALPHA};
+        for (int i = 0; i < 6; ++i) glGetIntegerv(blendQueries[i], &mBlend[i]);
+        glGetIntegerv(GL_DEPTH_FUNC, &mDepthFunc);
+    }
+    void apply() const {
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(mDrawFbo));
+        glViewport(mViewport[0], mViewport[1], mViewport[2], mViewport[3]);
+        glUseProgram(GLuint(mProgram));
+        glBindVertexArray(GLuint(mVao));
+        glBindBuffer(GL_ARRAY_BUFFER, GLuint(mArrayBuffer));
+        for (int u = 0; u < 3; ++u) {
+            glActiveTexture(GLenum(GL_TEXTURE0 + u));
+            glBindTexture(GL_TEXTURE_2D, GLuint(mTex2D[u]));
+        }
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D_ARRAY, GLuint(mTexArray0));
+        glActiveTexture(GLenum(mActive));
+        const GLenum caps[3] = {GL_BLEND, GL_DEPTH_TEST, GL_CULL_FACE};
+        for (int i = 0; i < 3; ++i) mCaps[i] ? glEnable(caps[i]) : glDisable(caps[i]);
+        glDepthMask(mDepthMask);
+        glColorMask(mColorMask[0], mColorMask[1], mColorMask[2], mColorMask[3]);
+        glBlendFuncSeparate(GLenum(mBlend[0]), GLenum(mBlend[1]), GLenum(mBlend[2]), GLenum(mBlend[3]));
+        glBlendEquationSeparate(GLenum(mBlend[4]), GLenum(mBlend[5]));
+        glDepthFunc(GLenum(mDepthFunc));
+    }
+
+private:
+    GLint mDrawFbo = 0, mViewport[4] = {}, mProgram = 0, mVao = 0, mArrayBuffer = 0, mActive = 0;
+    GLint mTex2D[3] = {}, mTexArray0 = 0, mBlend[6] = {}, mDepthFunc = 0;
+    GLboolean mCaps[3] = {}, mDepthMask = 0, mColorMask[4] = {};
+};
+
+} // namespace
+
+struct ScaledRenderer::Impl {
+    ScaledRendererDesc desc;
+    std::optional<Renderer> inner;
+    GLuint downsample = 0, composite = 0, emptyVao = 0;
+    GLuint fbo = 0, color = 0, depth = 0;
+    int lowW = 0, lowH = 0;
+
+    ~Impl() {
+        if (!detail::contextIsCurrent()) return; // the context took our objects with it
+        if (downsample) glDeleteProgram(downsample);
+        if (composite) glDeleteProgram(composite);
+        if (emptyVao) glDeleteVertexArrays(1, &emptyVao);
+        releaseTarget();
+    }
+    void releaseTarget() {
+        if (fbo) glDeleteFramebuffers(1, &fbo);
+        if (color) glDeleteTextures(1, &color);
+        if (depth) glDeleteTextures(1, &depth);
+        fbo = color = depth = 0;
+        lowW = lowH = 0;
+    }
+    void ensureTarget(int w, int h) {
+        if (w == lowW && h == lowH && fbo) return;
+        releaseTarget();
+        const GLenum format = desc.precision == Precision::U8 ? GL_RGBA8 : desc.precision == Precision::F16 ? GL_RGBA16F : GL_RGBA32F;
+        glCreateTextures(GL_TEXTURE_2D, 1, &color);
+        glTextureStorage2D(color, 1, format, w, h);
+        glCreateTextures(GL_TEXTURE_2D, 1, &depth);
+        glTextureStorage2D(depth, 1, GL_DEPTH_COMPONENT32F, w, h);
+        for (GLuint t : {color, depth}) {
+            glTextureParameteri(t, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+            glTextureParameteri(t, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        }
+        glCreateFramebuffers(1, &fbo);
+        glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, color, 0);
+        glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, depth, 0);
+        lowW = w;
+        lowH = h;
+    }
+};
+
+ScaledRenderer::ScaledRenderer(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
+ScaledRenderer::ScaledRenderer(ScaledRenderer&&) noexcept = default;
+ScaledRenderer& ScaledRenderer::operator=(ScaledRenderer&&) noexcept = default;
+ScaledRenderer::~ScaledRenderer() = default;
+const ScaledRendererDesc& ScaledRenderer::desc() const { return mImpl->desc; }
+const Renderer& ScaledRenderer::renderer() const { return *mImpl->inner; }
+
+Result<ScaledRenderer> ScaledRenderer::create(const ScaledRendererDesc& desc) {
+    if (desc.scale != 1 && desc.scale != 2 && desc.scale != 4)
+        return makeError("ScaledRendererDesc::scale must be 1, 2 or 4 (got " + std::to_string(desc.scale) + ")");
+    if (!(desc.depthThreshold > 0.0f))
+        return makeError("ScaledRendererDesc::depthThreshold must be positive (got " + std::to_string(desc.depthThreshold) + ")");
+    RendererDesc innerDesc = desc.renderer;
+    innerDesc.restoreState = false; // draw() saves and restores once around all three passes
+    auto inner = Renderer::create(innerDesc);
+    if (!inner) return makeError(inner.error());
+    auto impl = std::make_unique<Impl>();
+    impl->desc = desc;
+    impl->inner = std::move(*inner);
+    auto down = linkProgram(detail::kFullscreenVertex, detail::kDepthDownsampleFragment, "depth downsample");
+    if (!down) return makeError(down.error());
+    impl->downsample = *down;
+    auto comp = linkProgram(detail::kFullscreenVertex, detail::kCompositeFragment, "upsample composite");
+    if (!comp) return makeError(comp.error());
+    impl->composite = *comp;
+    glCreateVertexArrays(1, &impl->emptyVao);
+    return ScaledRenderer(std::move(impl));
+}
+
+Status ScaledRenderer::upload(const Materials& materials) { return mImpl->inner->upload(materials); }
+
+void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera, const ScaledTarget& target) {
+    Impl& r = *mImpl;
+    assert(target.width > 0 && target.height > 0 && "ScaledTarget::width and height must be positive");
+    const bool restore = r.desc.renderer.restoreState;
+    HostState saved;
+    if (restore) saved.capture();
+    if (r.desc.scale == 1) {
+        r.inner->draw(splats, camera, {target.framebuffer, target.x, target.y, target.width, target.height});
+        if (restore) saved.apply();
+        return;
+    }
+    const int s = r.desc.scale;
+    r.ensureTarget((target.width + s - 1) / s, (target.height + s - 1) / s);
+
+    GLuint hostDepth = target.depthTexture;
+    if (hostDepth == 0 && target.framebuffer != 0) {
+        GLint type = GL_NONE, name = 0;
+        glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
+        if (type == GL_TEXTURE) {
+            glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &name);
+            hostDepth = GLuint(name);
+        }
+    }
+    const bool useDepth = hostDepth != 0;
+    const GLint hostRect[4] = {target.x, target.y, target.width, target.height};
+
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, r.fbo);
+    glViewport(0, 0, r.lowW, r.lowH);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthMask(GL_TRUE);
+    const float clear[4] = {0.0f, 0.0f, 0.0f, 0.0f}, farDepth = 1.0f;
+    glClearNamedFramebufferfv(r.fbo, GL_COLOR, 0, clear);
+    glClearNamedFramebufferfv(r.fbo, GL_DEPTH, 0, &farDepth);
+    glBindVertexArray(r.emptyVao);
+    if (useDepth) {
+        glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_ALWAYS);
+        glUseProgram(r.downsample);
+        glUniform4iv(glGetUniformLocation(r.downsample, "uHostRect"), 1, hostRect);
+        glUniform1i(glGetUniformLocation(r.downsample, "uScale"), s);
+        glBindTextureUnit(2, hostDepth);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    }
+    // The splats, into the low-resolution target (transparent black, premultiplied).
+    r.inner->draw(splats, camera, {r.fbo, 0, 0, r.lowW, r.lowH});
+
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
+    glViewport(target.x, target.y, target.width, target.height);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    glBlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    glDisable(GL_CULL_FACE);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glUseProgram(r.composite);
+    glUniform4iv(glGetUniformLocation(r.composite, "uHostRect"), 1, hostRect);
+    glUniform1i(glGetUniformLocation(r.composite, "uScale"), s);
+    glUniform1i(glGetUniformLocation(r.composite, "uUseDepth"), useDepth ? 1 : 0);
+    glUniform1f(glGetUniformLocation(r.composite, "uThreshold"), r.desc.depthThreshold);
+    const glm::mat4 invProj = glm::inverse(camera.proj);
+    glUniformMatrix4fv(glGetUniformLocation(r.composite, "uInvProj"), 1, GL_FALSE, glm::value_ptr(invProj));
+    glBindTextureUnit(0, r.color);
+    glBindTextureUnit(1, r.depth);
+    if (useDepth) glBindTextureUnit(2, hostDepth);
+    glBindVertexArray(r.emptyVao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    if (restore) saved.apply();
+}
+
+} // namespace splatfx::gl

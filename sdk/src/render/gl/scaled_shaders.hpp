@@ -1,0 +1,79 @@
+// GLSL for ScaledRenderer's two passes (private to the GL backend).
+#pragma once
+
+namespace splatfx::gl::detail {
+
+// One triangle covering the viewport, from gl_VertexID; no vertex buffer.
+inline constexpr const char* kFullscreenVertex = R"(#version 450 core
+void main() {
+    vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
+    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}
+)";
+
+// Low-resolution depth: the farthest host depth in each scale x scale block.
+inline constexpr const char* kDepthDownsampleFragment = R"(#version 450 core
+layout(binding = 2) uniform sampler2D uHostDepth;
+uniform ivec4 uHostRect; // x, y, width, height of the host viewport
+uniform int uScale;
+void main() {
+    ivec2 base = ivec2(gl_FragCoord.xy) * uScale;
+    float far = 0.0;
+    for (int j = 0; j < uScale; ++j)
+        for (int i = 0; i < uScale; ++i) {
+            ivec2 p = min(base + ivec2(i, j), uHostRect.zw - 1);
+            far = max(far, texelFetch(uHostDepth, uHostRect.xy + p, 0).r);
+        }
+    gl_FragDepth = far;
+}
+)";
+
+// Nearest-depth upsampling of the premultiplied low-resolution image.
+inline constexpr const char* kCompositeFragment = R"(#version 450 core
+layout(binding = 0) uniform sampler2D uLowColor;
+layout(binding = 1) uniform sampler2D uLowDepth;
+layout(binding = 2) uniform sampler2D uHostDepth;
+uniform ivec4 uHostRect;
+uniform int uScale;
+uniform int uUseDepth;
+uniform float uThreshold;
+uniform mat4 uInvProj;
+layout(location = 0) out vec4 oColor;
+
+float viewDepth(float d) {
+    vec4 v = uInvProj * vec4(0.0, 0.0, 2.0 * d - 1.0, 1.0);
+    return abs(v.z / v.w);
+}
+
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy) - uHostRect.xy;
+    ivec2 lowSize = textureSize(uLowColor, 0);
+    // Low-resolution texel centres sit at (i + 0.5) * scale full-resolution pixels.
+    vec2 q = (vec2(p) + 0.5) / float(uScale) - 0.5;
+    ivec2 b = ivec2(floor(q));
+    vec2 f = q - vec2(b);
+    ivec2 t[4] = ivec2[4](b, b + ivec2(1, 0), b + ivec2(0, 1), b + ivec2(1, 1));
+    float w[4] = float[4]((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    vec4 c[4];
+    for (int k = 0; k < 4; ++k) {
+        t[k] = clamp(t[k], ivec2(0), lowSize - 1);
+        c[k] = texelFetch(uLowColor, t[k], 0);
+    }
+    vec4 bilinear = c[0] * w[0] + c[1] * w[1] + c[2] * w[2] + c[3] * w[3];
+    if (uUseDepth == 0) {
+        oColor = bilinear;
+        return;
+    }
+    float z = viewDepth(texelFetch(uHostDepth, uHostRect.xy + p, 0).r);
+    float worst = 0.0, best = 1e30;
+    int nearest = 0;
+    for (int k = 0; k < 4; ++k) {
+        float dz = abs(viewDepth(texelFetch(uLowDepth, t[k], 0).r) - z);
+        worst = max(worst, dz);
+        if (dz < best) { best = dz; nearest = k; }
+    }
+    oColor = worst <= uThreshold * z ? bilinear : c[nearest];
+}
+)";
+
+} // namespace splatfx::gl::detail

@@ -1,0 +1,19 @@
+// splatfx-bench subcommands. Each lives in its own .cpp in this folder (the
+// CMakeLists globs them); to add one, declare its entry point here and add a
+// row to kCommands. Every command takes the arguments after its name, prints
+// progress and a summary, and returns the process exit code.
+#pragma once
+
+int runAccuracy(int argc, char** argv); // accuracy.cpp: error vs time per quality knob (issue 5)
+int runTable1(int argc, char** argv);   // table1.cpp: the paper's Table I, fill limit, CPU scaling (issue 7)
+
+struct BenchCommand {
+    const char* name;
+    const char* summary;
+    int (*run)(int argc, char** argv);
+};
+
+inline constexpr BenchCommand kCommands[] = {
+    {"accuracy", "error against the exact reference vs time per frame, for every quality knob", runAccuracy},
+    {"table1", "King et al. 1999 Table I on this machine, fill limit, naive baseline, CPU scaling", runTable1},
+};
