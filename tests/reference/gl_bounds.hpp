@@ -42,4 +42,17 @@ inline double windowErrorBound(const Materials& mat, std::uint32_t layerIndex = 
     return worst + 2.0 * step / 256.0;
 }
 
+// |GPU sample - double bilinear sample of the same float layer|: RGBA8
+// storage (half a step of 1/255) plus fixed-point filter weights (as above).
+// What ReferenceWindow::Stored leaves between the two.
+inline double storedErrorBound(const Materials& mat, std::uint32_t layerIndex) {
+    const int n = mat.layerSize();
+    const std::vector<float>& layer = mat.layer(layerIndex);
+    double step = 0.0;
+    auto a = [&](int x, int y) { return double(layer[(size_t(y) * n + x) * 4 + 3]); };
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x + 1 < n; ++x) step = std::max({step, std::abs(a(x + 1, y) - a(x, y)), std::abs(a(y, x + 1) - a(y, x))});
+    return 0.5 / 255.0 + 2.0 * (step + 1.0 / 255.0) / 256.0;
+}
+
 } // namespace splatfx::test

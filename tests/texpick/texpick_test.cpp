@@ -425,18 +425,21 @@ TEST_F(TexpickErrors, CorruptImage) {
     expectNothingLeft();
 }
 
-TEST_F(TexpickErrors, UnreadableImage) {
+TEST_F(TexpickErrors, UnreadableImageAFolder) {
     auto [rc, err] = runCli({"random", dir.string(), "--out", out, "--no-preview"});
     EXPECT_EQ(rc, 1);
     EXPECT_EQ(err, "splatfx-texpick: cannot read image '" + dir.string() + "': it is a folder, not an image file\n");
     expectNothingLeft();
+}
+
+TEST_F(TexpickErrors, UnreadableImageNoPermission) {
     if (geteuid() == 0) GTEST_SKIP() << "running as root: file permissions cannot make a file unreadable";
     const std::string img = (dir / "locked.png").string();
     ASSERT_TRUE(splatfx::writeImage(img, grayImage(64, 64, [](int x, int) { return x / 64.0; })));
     fs::permissions(img, fs::perms::none);
-    auto [rc2, err2] = runCli({"random", img, "--out", out, "--no-preview"});
-    EXPECT_EQ(rc2, 1);
-    EXPECT_EQ(err2, "splatfx-texpick: cannot read image '" + img + "': the file cannot be opened (check its permissions)\n");
+    auto [rc, err] = runCli({"random", img, "--out", out, "--no-preview"});
+    EXPECT_EQ(rc, 1);
+    EXPECT_EQ(err, "splatfx-texpick: cannot read image '" + img + "': the file cannot be opened (check its permissions)\n");
     expectNothingLeft();
 }
 

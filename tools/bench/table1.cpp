@@ -369,7 +369,7 @@ int runTable1(int argc, char** argv) {
     int& frames = settings.frames;
     std::string csvPath = "table1.csv";
     bool quick = false;
-    for (int i = 0; i < argc; ++i) {
+    for (int i = 1; i < argc; ++i) { // argv[0] is the subcommand
         const std::string a = argv[i];
         if (a == "--frames" && i + 1 < argc) frames = std::max(3, std::atoi(argv[++i]));
         else if (a == "--csv" && i + 1 < argc) csvPath = argv[++i];

@@ -91,7 +91,7 @@ struct App {
                 status = "path mode: click at least two points (" + std::to_string(path.size()) + " so far)";
                 return;
             }
-            sel = pickPath(source, {.points = path, .patch = patch, .step = options.step});
+            sel = pickPath(source, {.points = path, .patch = patch, .step = options.step, .count = options.countGiven ? options.count : 0});
         } else {
             if (centers.empty()) return;
             sel = pickPositions(source, {.centers = centers, .defaultSize = patch});
@@ -130,7 +130,7 @@ struct App {
     }
 
     void save() {
-        auto sel = pathMode ? pickPath(source, {.points = path, .patch = patch, .step = options.step})
+        auto sel = pathMode ? pickPath(source, {.points = path, .patch = patch, .step = options.step, .count = options.countGiven ? options.count : 0})
                             : pickPositions(source, {.centers = centers, .defaultSize = patch});
         if (!sel) {
             status = "not saved: " + sel.error();
@@ -198,6 +198,7 @@ struct App {
         cv::Mat photo;
         cv::resize(source.rgb, photo, cv::Size(int(source.width * scale), int(source.height * scale)), 0, 0,
                    scale < 1.0 ? cv::INTER_AREA : cv::INTER_NEAREST);
+        cv::cvtColor(photo, photo, cv::COLOR_RGB2BGR); // HighGUI shows BGR
         const int panel = 400, statusH = 24;
         const int W = photo.cols + panel, H = std::max(photo.rows, 460) + statusH;
         cv::Mat canvas(H, W, CV_32FC3, cv::Scalar(0.1f, 0.1f, 0.12f));
@@ -232,13 +233,18 @@ struct App {
         const int big = 256, by = 130;
         cv::putText(canvas, "cycling preview", cv::Point(x0, by - 6), cv::FONT_HERSHEY_PLAIN, 1.0, white);
         if (n > 0) {
+            // Three frames per texture, cross-faded, as the preview GIF and the samples cycle them.
             const int k0 = (frame / 3) % n, k1 = (k0 + 1) % n;
             const float t = (frame % 3) / 3.0f;
-            for (int y = 0; y < big; ++y)
-                for (int x = 0; x < big; ++x) {
-                    const float u = (x + 0.5f) / big, v = (y + 0.5f) / big;
-                    canvas.at<cv::Vec3f>(by + y, x0 + x) = texel(k0, u, v) * (1.0f - t) + texel(k1, u, v) * t;
+            const int s = windowed.size;
+            cv::Mat small(s, s, CV_32FC3), large;
+            for (int y = 0; y < s; ++y)
+                for (int x = 0; x < s; ++x) {
+                    const float u = (x + 0.5f) / s, v = (y + 0.5f) / s;
+                    small.at<cv::Vec3f>(y, x) = texel(k0, u, v) * (1.0f - t) + texel(k1, u, v) * t;
                 }
+            cv::resize(small, large, cv::Size(big, big), 0, 0, cv::INTER_LINEAR);
+            large.copyTo(canvas(cv::Rect(x0, by, big, big)));
         }
         std::ostringstream info;
         info << (pathMode ? "path" : "positions") << "  patch " << patch << " px  ->  " << options.process.textureSize

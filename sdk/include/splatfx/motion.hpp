@@ -68,7 +68,7 @@ enum class Easing {
 
 struct Keyframe {
     double timeSec = 0.0;          // seconds; keys must be strictly increasing; default 0
-    Pose pose{};                     // default identity pose
+    Pose pose{};                   // default identity pose
     Easing easing = Easing::Linear; // of the segment from this key to the next; default Linear
 };
 

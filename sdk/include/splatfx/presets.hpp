@@ -42,13 +42,13 @@ struct FireDesc {
     glm::ivec3 dims{7, 20, 5};        // lattice cells; default the paper's Fig. 1 grid
     glm::vec3 spacing{0.5f};          // world units between voxels; default 0.5
     glm::vec3 position{0.0f};         // world position of the base centre; default origin
-    std::string textureSetPath{};       // texture-set folder; default empty (procedural turbulence)
+    std::string textureSetPath{};     // texture-set folder; default empty (procedural turbulence)
     int textureCount = 8;             // procedural textures; default 8
     float opacity = 0.55f;            // opacity at the core of the base, (0, 1]; default 0.55
     float propagationStepsPerSec = 8.0f; // global dynamics: cells per second the detail rises; default 8
     float texturesPerSec = 6.0f;      // local dynamics rate; default 6
     bool crossfade = true;            // cross-fade consecutive textures; default true
-    Motion motion{};                    // object dynamics (keyframes, procedure); default at rest
+    Motion motion{};                  // object dynamics (keyframes, procedure); default at rest
     std::uint32_t seed = 1;           // default 1
 };
 Result<Effect> fire(Materials& materials, const FireDesc& desc = {});
@@ -59,10 +59,10 @@ struct SmokeDesc {
     glm::vec3 position{0.0f};         // world position of the domain's base centre; default origin
     glm::vec3 sourceOffset{0.0f, 0.5f, 0.0f}; // emitter centre in the source object's frame; default 0.5 up
     float sourceRadius = 0.75f;       // emitter radius, world units; default 0.75
-    Motion sourceMotion{};              // the object the chimney sits on; default at rest at `position`
+    Motion sourceMotion{};            // the object the chimney sits on; default at rest at `position`
     glm::vec3 windWorld{1.0f, 0.0f, 0.0f}; // world units/s; default 1 along +x
     float dissipation = 0.15f;        // 1/s smoke thinning; default 0.15
-    std::string textureSetPath{};       // default empty (procedural turbulence)
+    std::string textureSetPath{};     // default empty (procedural turbulence)
     int textureCount = 8;             // default 8
     float texturesPerSec = 3.0f;      // local dynamics rate; default 3
     int substeps = 1;                 // solver substeps per step; default 1
@@ -74,12 +74,12 @@ struct SteamDesc {
     glm::ivec3 dims{2, 20, 2};        // lattice; default the paper's Fig. 5 grid
     glm::vec3 spacing{0.25f};         // world units; default 0.25
     glm::vec3 position{0.0f};         // world position of the base (the spout); default origin
-    std::string textureSetPath{};       // default empty (procedural turbulence)
+    std::string textureSetPath{};     // default empty (procedural turbulence)
     int textureCount = 16;            // default 16 (sec. 5.2)
     float opacity = 0.35f;            // at the spout; default 0.35
     float propagationStepsPerSec = 10.0f; // inter-voxel advection rate; default 10
     float texturesPerSec = 4.0f;      // default 4
-    Motion motion{};                    // default at rest
+    Motion motion{};                  // default at rest
     std::uint32_t seed = 1;           // default 1
 };
 Result<Effect> steam(Materials& materials, const SteamDesc& desc = {});
@@ -88,13 +88,13 @@ struct DustDesc {
     glm::ivec3 dims{24, 6, 12};       // solver cells; default 24x6x12
     glm::vec3 spacing{0.5f};          // world units per cell; default 0.5
     glm::vec3 position{0.0f};         // world position of the domain's base centre; default origin
-    Motion sourceMotion{};              // the animal kicking up dust; default at rest at `position`
+    Motion sourceMotion{};            // the animal kicking up dust; default at rest at `position`
     glm::vec3 sourceOffset{0.0f, 0.25f, 0.0f}; // hooves, in the animal's frame; default 0.25 up
     float sourceRadius = 0.8f;        // world units; default 0.8
     glm::vec3 windWorld{0.0f};        // default none
     float settle = 0.6f;              // downward pull per unit density, world units/s^2; default 0.6
     float dissipation = 0.3f;         // 1/s; default 0.3
-    std::string textureSetPath{};       // default empty (procedural turbulence)
+    std::string textureSetPath{};     // default empty (procedural turbulence)
     int textureCount = 8;             // default 8
     std::uint32_t seed = 1;           // default 1
 };
@@ -106,11 +106,11 @@ struct FireToSmokeDesc {
     glm::vec3 position{0.0f};         // default origin
     float split = 0.45f;              // normalized height where smoke takes over, (0, 1); default 0.45
     float blend = 0.15f;              // overlap of the two layers, normalized height; default 0.15
-    std::string fireTextureSetPath{};   // default empty (procedural turbulence)
+    std::string fireTextureSetPath{}; // default empty (procedural turbulence)
     std::string smokeTextureSetPath{};  // default empty (procedural, softer turbulence)
     float propagationStepsPerSec = 8.0f; // default 8
     float texturesPerSec = 5.0f;      // default 5
-    Motion motion{};                    // default at rest
+    Motion motion{};                  // default at rest
     std::uint32_t seed = 1;           // default 1
 };
 Result<Effect> fireToSmoke(Materials& materials, const FireToSmokeDesc& desc = {});
@@ -120,7 +120,7 @@ struct GhostsDesc {
     int plumeCells = 8;               // cells of rising, dissipating faces above it; default 8
     glm::vec3 spacing{0.3f};          // default 0.3
     glm::vec3 position{0.0f};         // world position of the base; default origin
-    std::string textureSetPath{};       // folder of face images; default empty (procedural faces)
+    std::string textureSetPath{};     // folder of face images; default empty (procedural faces)
     int textureCount = 12;            // procedural faces; default 12
     float opacity = 0.4f;             // default 0.4
     float texturesPerSec = 5.0f;      // random selection rate; default 5

@@ -58,7 +58,7 @@ struct EmitterDesc {
 
 struct Emitter {
     EmitterDesc desc{};
-    Motion motion{};              // the object the emitter is attached to; default at rest at the origin
+    Motion motion{};            // the object the emitter is attached to; default at rest at the origin
     // World centre at t.
     glm::vec3 worldCenter(double timeSec) const { return glm::vec3(motion.matrix(timeSec) * glm::vec4(desc.offset, 1.0f)); }
 };

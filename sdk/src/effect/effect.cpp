@@ -73,6 +73,11 @@ Result<Effect> Effect::fromGrid(Grid base, EffectDesc desc) {
         const GrowthDesc& g = e.mDesc.growth;
         const glm::vec3 origin = g.originAtCentre ? glm::vec3(0.5f * (lo.x + hi.x), float(lo.y), 0.5f * (lo.z + hi.z))
                                                   : g.originCells;
+        // The lattice never changes after construction: bounds() reuses this box.
+        for (const Voxel& v : e.mBase.voxels) {
+            e.mBaseBox.extend(e.mBase.localPosition(v.cell));
+            e.mBaseMaxStretch = std::max(e.mBaseMaxStretch, glm::length(v.stretch));
+        }
         for (const Voxel& v : e.mBase.voxels) {
             const float dist = glm::length(glm::vec3(v.cell) - origin);
             e.mGrowthDistance.push_back(dist);
@@ -252,10 +257,8 @@ Aabb Effect::bounds(double t0, double t1) const {
     Grid frame; // spacing and base transform of the lattice
     float maxStretch = 0.0f;
     if (isStateless()) {
-        for (const Voxel& v : mBase.voxels) {
-            local.extend(mBase.localPosition(v.cell));
-            maxStretch = std::max(maxStretch, glm::length(v.stretch));
-        }
+        local = mBaseBox;
+        maxStretch = mBaseMaxStretch;
         frame.spacing = mBase.spacing;
         frame.transform = mBase.transform;
         frame.dims = mBase.dims;

@@ -53,7 +53,11 @@ std::string num(double v) {
     return buf;
 }
 
-std::string range(double lo, double hi) { return "[" + num(lo) + ", " + num(hi) + "]"; }
+std::string range(double lo, double hi) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "[%g, %g]", lo, hi);
+    return buf;
+}
 
 } // namespace
 

@@ -786,7 +786,10 @@ std::optional<Effect> readGridKind(Context& c, ObjectReader& o, const EffectComm
     if (glm::length(colorAxis) < 1e-6f) c.d.error(o.at("colorAxis"), "must be non-zero");
     std::optional<TextureSpec> tex;
     if (const Json* t = o.get("textureSet")) tex = readTextureSpec(c, o.at("textureSet"), *t, 8, e.seed, false);
-    else tex = TextureSpec{.count = 8, .seed = e.seed};
+    else {
+        tex.emplace();
+        tex->seed = e.seed;
+    }
     std::optional<ColorTable> table = ColorTable::fire();
     if (const Json* t = o.get("colorTable")) table = readColorTable(c, o.at("colorTable"), *t);
     EffectDesc desc;

@@ -5,7 +5,6 @@
 #include <string>
 
 #include <epoxy/gl.h>
-#include <glm/gtc/type_ptr.hpp>
 
 #include "context_check.hpp"
 #include "scaled_shaders.hpp"
@@ -111,12 +110,18 @@ struct ScaledRenderer::Impl {
     GLuint downsample = 0, composite = 0, emptyVao = 0;
     GLuint fbo = 0, color = 0, depth = 0;
     int lowW = 0, lowH = 0;
+    // Private copy of the host depth: sampling a texture attached to the
+    // framebuffer being drawn is a feedback loop (undefined, and slow on llvmpipe).
+    GLuint hostCopy = 0;
+    int copyW = 0, copyH = 0;
+    GLenum copyFormat = 0;
 
     ~Impl() {
         if (!detail::contextIsCurrent()) return; // the context took our objects with it
         if (downsample) glDeleteProgram(downsample);
         if (composite) glDeleteProgram(composite);
         if (emptyVao) glDeleteVertexArrays(1, &emptyVao);
+        if (hostCopy) glDeleteTextures(1, &hostCopy);
         releaseTarget();
     }
     void releaseTarget() {
@@ -201,7 +206,20 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
         }
     }
     const bool useDepth = hostDepth != 0;
-    const GLint hostRect[4] = {target.x, target.y, target.width, target.height};
+    if (useDepth) {
+        GLint format = 0;
+        glGetTextureLevelParameteriv(hostDepth, 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
+        if (!r.hostCopy || r.copyW != target.width || r.copyH != target.height || r.copyFormat != GLenum(format)) {
+            if (r.hostCopy) glDeleteTextures(1, &r.hostCopy);
+            glCreateTextures(GL_TEXTURE_2D, 1, &r.hostCopy);
+            glTextureStorage2D(r.hostCopy, 1, GLenum(format), target.width, target.height);
+            r.copyW = target.width, r.copyH = target.height, r.copyFormat = GLenum(format);
+        }
+        glCopyImageSubData(hostDepth, GL_TEXTURE_2D, 0, target.x, target.y, 0, r.hostCopy, GL_TEXTURE_2D, 0, 0, 0, 0, target.width,
+                           target.height, 1);
+    }
+    // The copy starts at the viewport's corner, so the shaders read it at offset 0.
+    const GLint hostRect[4] = {0, 0, target.width, target.height};
 
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, r.fbo);
     glViewport(0, 0, r.lowW, r.lowH);
@@ -220,7 +238,7 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
         glUseProgram(r.downsample);
         glUniform4iv(glGetUniformLocation(r.downsample, "uHostRect"), 1, hostRect);
         glUniform1i(glGetUniformLocation(r.downsample, "uScale"), s);
-        glBindTextureUnit(2, hostDepth);
+        glBindTextureUnit(2, r.hostCopy);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     }
@@ -238,14 +256,15 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glUseProgram(r.composite);
     glUniform4iv(glGetUniformLocation(r.composite, "uHostRect"), 1, hostRect);
+    glUniform2i(glGetUniformLocation(r.composite, "uViewportOrigin"), target.x, target.y);
     glUniform1i(glGetUniformLocation(r.composite, "uScale"), s);
     glUniform1i(glGetUniformLocation(r.composite, "uUseDepth"), useDepth ? 1 : 0);
     glUniform1f(glGetUniformLocation(r.composite, "uThreshold"), r.desc.depthThreshold);
     const glm::mat4 invProj = glm::inverse(camera.proj);
-    glUniformMatrix4fv(glGetUniformLocation(r.composite, "uInvProj"), 1, GL_FALSE, glm::value_ptr(invProj));
+    glUniform4f(glGetUniformLocation(r.composite, "uDepthToView"), invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
     glBindTextureUnit(0, r.color);
     glBindTextureUnit(1, r.depth);
-    if (useDepth) glBindTextureUnit(2, hostDepth);
+    if (useDepth) glBindTextureUnit(2, r.hostCopy);
     glBindVertexArray(r.emptyVao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     if (restore) saved.apply();

@@ -14,7 +14,7 @@ void main() {
 // Low-resolution depth: the farthest host depth in each scale x scale block.
 inline constexpr const char* kDepthDownsampleFragment = R"(#version 450 core
 layout(binding = 2) uniform sampler2D uHostDepth;
-uniform ivec4 uHostRect; // x, y, width, height of the host viewport
+uniform ivec4 uHostRect; // x, y, width, height of the host depth region to read
 uniform int uScale;
 void main() {
     ivec2 base = ivec2(gl_FragCoord.xy) * uScale;
@@ -34,19 +34,20 @@ layout(binding = 0) uniform sampler2D uLowColor;
 layout(binding = 1) uniform sampler2D uLowDepth;
 layout(binding = 2) uniform sampler2D uHostDepth;
 uniform ivec4 uHostRect;
+uniform ivec2 uViewportOrigin; // the host viewport's corner in window pixels
 uniform int uScale;
 uniform int uUseDepth;
 uniform float uThreshold;
-uniform mat4 uInvProj;
+uniform vec4 uDepthToView; // (a, b, c, d): view depth = |(a n + b) / (c n + d)|, n = ndc z (inverse projection's z and w rows)
 layout(location = 0) out vec4 oColor;
 
 float viewDepth(float d) {
-    vec4 v = uInvProj * vec4(0.0, 0.0, 2.0 * d - 1.0, 1.0);
-    return abs(v.z / v.w);
+    float n = 2.0 * d - 1.0;
+    return abs((uDepthToView.x * n + uDepthToView.y) / (uDepthToView.z * n + uDepthToView.w));
 }
 
 void main() {
-    ivec2 p = ivec2(gl_FragCoord.xy) - uHostRect.xy;
+    ivec2 p = ivec2(gl_FragCoord.xy) - uViewportOrigin;
     ivec2 lowSize = textureSize(uLowColor, 0);
     // Low-resolution texel centres sit at (i + 0.5) * scale full-resolution pixels.
     vec2 q = (vec2(p) + 0.5) / float(uScale) - 0.5;
@@ -59,6 +60,8 @@ void main() {
         t[k] = clamp(t[k], ivec2(0), lowSize - 1);
         c[k] = texelFetch(uLowColor, t[k], 0);
     }
+    // Nothing drawn near this pixel: blending zero would leave the host unchanged.
+    if (max(max(c[0].a, c[1].a), max(c[2].a, c[3].a)) <= 0.0) discard;
     vec4 bilinear = c[0] * w[0] + c[1] * w[1] + c[2] * w[2] + c[3] * w[3];
     if (uUseDepth == 0) {
         oColor = bilinear;

@@ -1,0 +1,188 @@
+#include "geometry_renderer.hpp"
+
+#include <map>
+
+#include <epoxy/gl.h>
+#include <glm/gtc/type_ptr.hpp>
+
+namespace scenehost {
+namespace {
+
+const char* kVertex = R"(#version 450 core
+layout(location = 0) in vec3 aPosition;
+layout(location = 1) in vec3 aNormal;
+uniform mat4 uModel;
+uniform mat4 uViewProj;
+out vec3 vNormal;
+out vec3 vWorld;
+void main() {
+    vec4 world = uModel * vec4(aPosition, 1.0);
+    vWorld = world.xyz;
+    vNormal = transpose(inverse(mat3(uModel))) * aNormal;
+    gl_Position = uViewProj * world;
+}
+)";
+
+const char* kFragment = R"(#version 450 core
+in vec3 vNormal;
+in vec3 vWorld;
+uniform vec3 uColor;
+uniform vec3 uEye;
+out vec4 fragColor;
+void main() {
+    vec3 n = normalize(vNormal);
+    // Two-sided: face the normal towards the eye, whatever the mesh's winding.
+    if (dot(n, uEye - vWorld) < 0.0) n = -n;
+    const vec3 toLight = normalize(vec3(0.4, 1.0, 0.6));
+    float diffuse = max(dot(n, toLight), 0.0);
+    vec3 lit = uColor * (0.25 + 0.75 * diffuse);
+    fragColor = vec4(lit, 1.0);
+}
+)";
+
+GLuint compile(GLenum type, const char* src, std::string& log) {
+    GLuint s = glCreateShader(type);
+    glShaderSource(s, 1, &src, nullptr);
+    glCompileShader(s);
+    GLint ok = 0;
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    if (!ok) {
+        char buf[2048];
+        glGetShaderInfoLog(s, sizeof buf, nullptr, buf);
+        log = buf;
+    }
+    return s;
+}
+
+} // namespace
+
+struct GeometryRenderer::Impl {
+    struct Object {
+        splatfx::GeometryDesc desc;
+        GLuint vao = 0, vbo = 0, ibo = 0;
+        GLsizei indexCount = 0;
+        splatfx::Aabb localBounds;
+    };
+    GLuint program = 0;
+    std::vector<Object> objects;
+    GeometryStats stats;
+    ~Impl() {
+        for (Object& o : objects) {
+            glDeleteVertexArrays(1, &o.vao);
+            glDeleteBuffers(1, &o.vbo);
+            glDeleteBuffers(1, &o.ibo);
+        }
+        if (program) glDeleteProgram(program);
+    }
+};
+
+splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<splatfx::GeometryDesc>& geometry) {
+    if (!epoxy_has_gl_extension("GL_ARB_direct_state_access") && epoxy_gl_version() < 45)
+        return splatfx::makeError("GeometryRenderer: needs a current OpenGL 4.5 context");
+    auto impl = std::make_unique<Impl>();
+    std::string log;
+    const GLuint vs = compile(GL_VERTEX_SHADER, kVertex, log);
+    const GLuint fs = compile(GL_FRAGMENT_SHADER, kFragment, log);
+    impl->program = glCreateProgram();
+    glAttachShader(impl->program, vs);
+    glAttachShader(impl->program, fs);
+    glLinkProgram(impl->program);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint linked = 0;
+    glGetProgramiv(impl->program, GL_LINK_STATUS, &linked);
+    if (!log.empty() || !linked) return splatfx::makeError("GeometryRenderer: shader failed: " + log);
+
+    std::map<std::string, Mesh> meshes; // each file loaded once
+    for (const splatfx::GeometryDesc& g : geometry) {
+        Impl::Object o;
+        o.desc = g;
+        Mesh mesh;
+        switch (g.type) {
+        case splatfx::GeometryType::Empty: impl->objects.push_back(std::move(o)); continue;
+        case splatfx::GeometryType::Plane: mesh = planeMesh(g.size); break;
+        case splatfx::GeometryType::Box: mesh = boxMesh(g.size); break;
+        case splatfx::GeometryType::Cylinder: mesh = cylinderMesh(g.size); break;
+        case splatfx::GeometryType::Sphere: mesh = sphereMesh(g.size); break;
+        case splatfx::GeometryType::Mesh: {
+            auto it = meshes.find(g.meshPath);
+            if (it == meshes.end()) {
+                splatfx::Result<Mesh> m = loadMesh(g.meshPath);
+                if (!m) return splatfx::makeError("geometry '" + g.name + "': " + m.error());
+                it = meshes.emplace(g.meshPath, std::move(*m)).first;
+            }
+            mesh = g.fitSize > 0.0f ? fitted(it->second, g.fitSize) : it->second;
+            break;
+        }
+        }
+        o.localBounds = mesh.bounds();
+        std::vector<float> interleaved;
+        interleaved.reserve(mesh.positions.size() * 6);
+        for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+            const glm::vec3 p = mesh.positions[i], n = mesh.normals[i];
+            interleaved.insert(interleaved.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
+        }
+        glCreateVertexArrays(1, &o.vao);
+        glCreateBuffers(1, &o.vbo);
+        glCreateBuffers(1, &o.ibo);
+        glNamedBufferStorage(o.vbo, GLsizeiptr(interleaved.size() * sizeof(float)), interleaved.data(), 0);
+        glNamedBufferStorage(o.ibo, GLsizeiptr(mesh.indices.size() * sizeof(std::uint32_t)), mesh.indices.data(), 0);
+        glVertexArrayVertexBuffer(o.vao, 0, o.vbo, 0, 6 * sizeof(float));
+        glVertexArrayElementBuffer(o.vao, o.ibo);
+        for (GLuint a = 0; a < 2; ++a) {
+            glEnableVertexArrayAttrib(o.vao, a);
+            glVertexArrayAttribFormat(o.vao, a, 3, GL_FLOAT, GL_FALSE, a * 3 * sizeof(float));
+            glVertexArrayAttribBinding(o.vao, a, 0);
+        }
+        o.indexCount = GLsizei(mesh.indices.size());
+        impl->objects.push_back(std::move(o));
+    }
+    return GeometryRenderer(std::move(impl));
+}
+
+GeometryRenderer::GeometryRenderer(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
+GeometryRenderer::GeometryRenderer(GeometryRenderer&&) noexcept = default;
+GeometryRenderer& GeometryRenderer::operator=(GeometryRenderer&&) noexcept = default;
+GeometryRenderer::~GeometryRenderer() = default;
+
+const GeometryStats& GeometryRenderer::stats() const { return mImpl->stats; }
+
+splatfx::Aabb GeometryRenderer::worldBounds(std::size_t i, double t) const {
+    const Impl::Object& o = mImpl->objects.at(i);
+    splatfx::Aabb out;
+    if (o.localBounds.empty()) return out;
+    const glm::mat4 m = o.desc.motion.matrix(t) * o.desc.transform;
+    for (int c = 0; c < 8; ++c) out.extend(glm::vec3(m * glm::vec4(o.localBounds.corner(c), 1.0f)));
+    return out;
+}
+
+void GeometryRenderer::draw(double t, const splatfx::Camera& camera) {
+    Impl& r = *mImpl;
+    r.stats = {};
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(r.program);
+    const glm::mat4 viewProj = camera.proj * camera.view;
+    const glm::vec3 eye = camera.eye();
+    glUniformMatrix4fv(glGetUniformLocation(r.program, "uViewProj"), 1, GL_FALSE, glm::value_ptr(viewProj));
+    glUniform3fv(glGetUniformLocation(r.program, "uEye"), 1, glm::value_ptr(eye));
+    const GLint model = glGetUniformLocation(r.program, "uModel"), color = glGetUniformLocation(r.program, "uColor");
+    for (const Impl::Object& o : r.objects) {
+        if (!o.vao) continue;
+        // Object to world: its motion (own or shared) after its static placement.
+        const glm::mat4 m = o.desc.motion.matrix(t) * o.desc.transform;
+        glUniformMatrix4fv(model, 1, GL_FALSE, glm::value_ptr(m));
+        glUniform3fv(color, 1, glm::value_ptr(o.desc.color));
+        glBindVertexArray(o.vao);
+        glDrawElements(GL_TRIANGLES, o.indexCount, GL_UNSIGNED_INT, nullptr);
+        ++r.stats.objects;
+        r.stats.triangles += std::size_t(o.indexCount) / 3;
+    }
+    glBindVertexArray(0);
+    glUseProgram(0);
+}
+
+} // namespace scenehost

@@ -1,0 +1,55 @@
+// samples/common/geometry_renderer.hpp: draws a scene file's geometry (host side).
+//
+// A tiny OpenGL 4.5 renderer for the ground plane, boxes, cylinders, spheres
+// and meshes of a scene file: one program (two-sided Lambert with a little
+// ambient light, depth test and depth writes on), one vertex array per
+// object. Drawn before the splats, its depth buffer is what makes the splats
+// depth-correct (a cow inside the fire is partly hidden by it, and hides the
+// part behind it). Meshes are loaded once, by path, through mesh.hpp.
+// Not part of the SDK (it is the host's job to draw its own scene).
+//
+//   auto geo = scenehost::GeometryRenderer::create(file.geometry);  // GL context current
+//   geo->draw(timeSec, camera);   // after clearing, before the splats
+//
+// GL state: draw() leaves depth test on (LESS), depth writes on, blending
+// off, and unbinds its program and vertex array.
+// Threading: the GL thread only. Move-only.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "mesh.hpp"
+#include "splatfx/camera.hpp"
+#include "splatfx/result.hpp"
+#include "splatfx/scene_file.hpp"
+
+namespace scenehost {
+
+struct GeometryStats {
+    std::size_t objects = 0;   // objects drawn (Empty ones are not)
+    std::size_t triangles = 0; // triangles drawn
+};
+
+class GeometryRenderer {
+public:
+    // Loads meshes and uploads every object. Errors name the object and file.
+    static splatfx::Result<GeometryRenderer> create(const std::vector<splatfx::GeometryDesc>& geometry);
+    GeometryRenderer(GeometryRenderer&&) noexcept;
+    GeometryRenderer& operator=(GeometryRenderer&&) noexcept;
+    ~GeometryRenderer();
+
+    // Draws every object at timeSec into the bound framebuffer and viewport.
+    void draw(double timeSec, const splatfx::Camera& camera);
+    const GeometryStats& stats() const;
+    // World-space box of object i at timeSec (empty for Empty objects).
+    splatfx::Aabb worldBounds(std::size_t i, double timeSec) const;
+
+private:
+    struct Impl;
+    explicit GeometryRenderer(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> mImpl;
+};
+
+} // namespace scenehost

@@ -1,0 +1,174 @@
+#include "mesh.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+namespace scenehost {
+
+splatfx::Aabb Mesh::bounds() const {
+    splatfx::Aabb b;
+    for (const glm::vec3& p : positions) b.extend(p);
+    return b;
+}
+
+namespace {
+
+void appendNode(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, Mesh& out) {
+    const aiMatrix4x4 m = parent * node->mTransformation;
+    for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+        const aiMesh* mesh = scene->mMeshes[node->mMeshes[i]];
+        const std::uint32_t base = std::uint32_t(out.positions.size());
+        for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+            const aiVector3D p = m * mesh->mVertices[v];
+            out.positions.push_back({p.x, p.y, p.z});
+        }
+        for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+            const aiFace& face = mesh->mFaces[f];
+            if (face.mNumIndices != 3) continue; // points and lines (aiProcess_Triangulate leaves only these)
+            for (int k = 0; k < 3; ++k) out.indices.push_back(base + face.mIndices[k]);
+        }
+    }
+    for (unsigned c = 0; c < node->mNumChildren; ++c) appendNode(scene, node->mChildren[c], m, out);
+}
+
+} // namespace
+
+splatfx::Result<Mesh> loadMesh(const std::string& path) {
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) return splatfx::makeError(path + ": mesh file not found");
+    Assimp::Importer importer;
+    const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+    if (!scene || !scene->mRootNode) return splatfx::makeError(path + ": cannot load mesh: " + importer.GetErrorString());
+    Mesh out;
+    appendNode(scene, scene->mRootNode, aiMatrix4x4(), out);
+    if (out.indices.empty()) return splatfx::makeError(path + ": the file holds no triangles");
+    for (const glm::vec3& p : out.positions)
+        if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+            return splatfx::makeError(path + ": the mesh has non-finite vertex positions");
+    computeNormals(out);
+    return out;
+}
+
+void computeNormals(Mesh& mesh) {
+    mesh.normals.assign(mesh.positions.size(), glm::vec3(0.0f));
+    for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+        const std::uint32_t a = mesh.indices[t], b = mesh.indices[t + 1], c = mesh.indices[t + 2];
+        // The cross product's length is twice the area: area-weighted normals.
+        const glm::vec3 n = glm::cross(mesh.positions[b] - mesh.positions[a], mesh.positions[c] - mesh.positions[a]);
+        mesh.normals[a] += n, mesh.normals[b] += n, mesh.normals[c] += n;
+    }
+    for (glm::vec3& n : mesh.normals) n = glm::length(n) > 0.0f ? glm::normalize(n) : glm::vec3(0, 1, 0);
+}
+
+Mesh fitted(const Mesh& mesh, float size) {
+    Mesh out = mesh;
+    const splatfx::Aabb b = mesh.bounds();
+    if (b.empty() || !(size > 0.0f)) return out;
+    const glm::vec3 ext = b.hi - b.lo;
+    const float s = size / std::max({ext.x, ext.y, ext.z, 1e-12f});
+    const glm::vec3 anchor(0.5f * (b.lo.x + b.hi.x), b.lo.y, 0.5f * (b.lo.z + b.hi.z));
+    for (glm::vec3& p : out.positions) p = (p - anchor) * s;
+    return out;
+}
+
+splatfx::Status saveOff(const std::string& path, const Mesh& mesh, int decimals) {
+    const std::string tmp = path + ".tmp";
+    std::FILE* f = std::fopen(tmp.c_str(), "w");
+    if (!f) return splatfx::makeError(path + ": cannot write");
+    std::fprintf(f, "OFF\n%zu %zu 0\n", mesh.positions.size(), mesh.indices.size() / 3);
+    for (const glm::vec3& p : mesh.positions) std::fprintf(f, "%.*f %.*f %.*f\n", decimals, p.x, decimals, p.y, decimals, p.z);
+    for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3)
+        std::fprintf(f, "3 %u %u %u\n", mesh.indices[t], mesh.indices[t + 1], mesh.indices[t + 2]);
+    const bool ok = std::fclose(f) == 0;
+    std::error_code ec;
+    if (ok) std::filesystem::rename(tmp, path, ec);
+    if (!ok || ec) {
+        std::filesystem::remove(tmp, ec);
+        return splatfx::makeError(path + ": cannot write");
+    }
+    return {};
+}
+
+namespace {
+
+// Flat-shaded quad: its own four vertices so the normals stay sharp.
+void quad(Mesh& m, glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) {
+    const std::uint32_t base = std::uint32_t(m.positions.size());
+    const glm::vec3 n = glm::normalize(glm::cross(b - a, d - a));
+    for (glm::vec3 p : {a, b, c, d}) m.positions.push_back(p), m.normals.push_back(n);
+    for (std::uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + i);
+}
+
+} // namespace
+
+Mesh planeMesh(glm::vec3 size) {
+    Mesh m;
+    const float x = 0.5f * size.x, z = 0.5f * size.z;
+    quad(m, {-x, 0, z}, {x, 0, z}, {x, 0, -z}, {-x, 0, -z});
+    return m;
+}
+
+Mesh boxMesh(glm::vec3 size) {
+    Mesh m;
+    const glm::vec3 h = 0.5f * size;
+    const glm::vec3 p[8] = {{-h.x, -h.y, -h.z}, {h.x, -h.y, -h.z}, {h.x, h.y, -h.z}, {-h.x, h.y, -h.z},
+                            {-h.x, -h.y, h.z},  {h.x, -h.y, h.z},  {h.x, h.y, h.z},  {-h.x, h.y, h.z}};
+    quad(m, p[4], p[5], p[6], p[7]); // +z
+    quad(m, p[1], p[0], p[3], p[2]); // -z
+    quad(m, p[5], p[1], p[2], p[6]); // +x
+    quad(m, p[0], p[4], p[7], p[3]); // -x
+    quad(m, p[7], p[6], p[2], p[3]); // +y
+    quad(m, p[0], p[1], p[5], p[4]); // -y
+    return m;
+}
+
+Mesh cylinderMesh(glm::vec3 size, int segments) {
+    Mesh m;
+    const float r = 0.5f * size.x, h = size.y;
+    const float twoPi = 6.2831853f;
+    for (int i = 0; i < segments; ++i) {
+        const float a0 = twoPi * i / segments, a1 = twoPi * (i + 1) / segments;
+        const glm::vec3 d0(std::cos(a0), 0, -std::sin(a0)), d1(std::cos(a1), 0, -std::sin(a1));
+        const std::uint32_t base = std::uint32_t(m.positions.size());
+        for (glm::vec3 p : {r * d0, r * d1, r * d1 + glm::vec3(0, h, 0), r * d0 + glm::vec3(0, h, 0)}) m.positions.push_back(p);
+        for (glm::vec3 n : {d0, d1, d1, d0}) m.normals.push_back(n);
+        for (std::uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + k);
+        // Caps as fans of their own vertices (flat normals).
+        for (int cap = 0; cap < 2; ++cap) {
+            const float y = cap ? h : 0.0f;
+            const glm::vec3 n(0, cap ? 1.0f : -1.0f, 0);
+            const std::uint32_t c = std::uint32_t(m.positions.size());
+            for (glm::vec3 p : {glm::vec3(0, y, 0), r * d0 + glm::vec3(0, y, 0), r * d1 + glm::vec3(0, y, 0)})
+                m.positions.push_back(p), m.normals.push_back(n);
+            if (cap) m.indices.insert(m.indices.end(), {c, c + 1, c + 2});
+            else m.indices.insert(m.indices.end(), {c, c + 2, c + 1});
+        }
+    }
+    return m;
+}
+
+Mesh sphereMesh(glm::vec3 size, int segments) {
+    Mesh m;
+    const int rings = segments / 2;
+    const float pi = 3.14159265f;
+    for (int j = 0; j <= rings; ++j)
+        for (int i = 0; i <= segments; ++i) {
+            const float th = pi * j / rings, ph = 2.0f * pi * i / segments;
+            const glm::vec3 n(std::sin(th) * std::cos(ph), std::cos(th), -std::sin(th) * std::sin(ph));
+            m.positions.push_back(0.5f * size * n);
+            m.normals.push_back(n);
+        }
+    for (int j = 0; j < rings; ++j)
+        for (int i = 0; i < segments; ++i) {
+            const std::uint32_t a = std::uint32_t(j * (segments + 1) + i), b = a + std::uint32_t(segments + 1);
+            m.indices.insert(m.indices.end(), {a, b, a + 1, a + 1, b, b + 1});
+        }
+    return m;
+}
+
+} // namespace scenehost

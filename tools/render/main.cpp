@@ -1,0 +1,241 @@
+// splatfx-render: renders a scene file headless (EGL) into PNG frames plus one
+// animated GIF, with progress output and a summary.
+//
+//   splatfx-render samples/03-cow-through-fire/scene.json --out out/cow --frames 24 --size 320x240
+//
+// Outputs are staged in DIR/.splatfx-render-<name>.partial/ and moved into DIR
+// only when every frame and the GIF were written (the GIF last), so a failed
+// or interrupted run never leaves a half-written set passed off as complete.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "scene_player.hpp"
+#include "splatfx/context.hpp"
+#include "splatfx/gl/framebuffer.hpp"
+#include "splatfx/image.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Args {
+    std::string scene;
+    std::string out = "out";
+    std::optional<int> frames;
+    std::optional<glm::ivec2> size;
+    std::optional<std::uint32_t> seed;
+    std::optional<float> fps;
+    bool traditional = false;
+    bool quiet = false;
+    int abortAfter = -1; // testing aid: fail after this many frames
+};
+
+void usage() {
+    std::printf(
+        "splatfx-render: render a splatfx scene file headless into PNG frames and an animated GIF\n\n"
+        "usage: splatfx-render SCENE.json [options]\n"
+        "  --out DIR        output folder (default: out); writes DIR/<name>_NNNN.png and DIR/<name>.gif\n"
+        "  --frames N       frames to render (default: the scene's output.frames)\n"
+        "  --size WxH       image size in pixels (default: the scene's output.size)\n"
+        "  --fps F          animation rate; frame i shows time i / F (default: the scene's output.fps)\n"
+        "  --seed S         scene seed (every effect's random choices derive from it; default: the file's)\n"
+        "  --traditional    draw every effect with plain footprints, no textures (the paper's Fig. 1a)\n"
+        "  --quiet          no per-frame progress\n"
+        "  --abort-after N  testing aid: fail on purpose after N frames (checks that nothing partial is left)\n"
+        "<name> is the scene's output.name (default: the scene file's folder name).\n");
+}
+
+bool parse(int argc, char** argv, Args& a) {
+    for (int i = 1; i < argc; ++i) {
+        const std::string s = argv[i];
+        auto value = [&]() -> const char* {
+            if (i + 1 >= argc) {
+                std::fprintf(stderr, "splatfx-render: %s needs a value (try --help)\n", s.c_str());
+                return nullptr;
+            }
+            return argv[++i];
+        };
+        auto integer = [&](const char* v, long lo, long hi, long& out) {
+            char* end = nullptr;
+            out = std::strtol(v, &end, 10);
+            if (!*v || *end || out < lo || out > hi) {
+                std::fprintf(stderr, "splatfx-render: %s expects an integer in [%ld, %ld], got '%s'\n", s.c_str(), lo, hi, v);
+                return false;
+            }
+            return true;
+        };
+        const char* v = nullptr;
+        long n = 0;
+        if (s == "--help" || s == "-h") {
+            usage();
+            std::exit(0);
+        } else if (s == "--traditional") {
+            a.traditional = true;
+        } else if (s == "--quiet") {
+            a.quiet = true;
+        } else if (s == "--out") {
+            if (!(v = value())) return false;
+            a.out = v;
+        } else if (s == "--frames") {
+            if (!(v = value()) || !integer(v, 1, 100000, n)) return false;
+            a.frames = int(n);
+        } else if (s == "--abort-after") {
+            if (!(v = value()) || !integer(v, 0, 100000, n)) return false;
+            a.abortAfter = int(n);
+        } else if (s == "--seed") {
+            if (!(v = value()) || !integer(v, 0, 4294967295L, n)) return false;
+            a.seed = std::uint32_t(n);
+        } else if (s == "--size") {
+            if (!(v = value())) return false;
+            int w = 0, h = 0;
+            char tail = 0;
+            if (std::sscanf(v, "%dx%d%c", &w, &h, &tail) != 2 || w < 16 || h < 16 || w > 8192 || h > 8192) {
+                std::fprintf(stderr, "splatfx-render: --size expects WxH with 16..8192 pixels per side, e.g. 640x480; got '%s'\n", v);
+                return false;
+            }
+            a.size = glm::ivec2(w, h);
+        } else if (s == "--fps") {
+            if (!(v = value())) return false;
+            char* end = nullptr;
+            const float f = std::strtof(v, &end);
+            if (!*v || *end || !(f > 0.0f && f <= 240.0f)) {
+                std::fprintf(stderr, "splatfx-render: --fps expects a number in (0, 240], got '%s'\n", v);
+                return false;
+            }
+            a.fps = f;
+        } else if (!s.empty() && s[0] == '-') {
+            std::fprintf(stderr, "splatfx-render: unknown option '%s' (try --help)\n", s.c_str());
+            return false;
+        } else if (a.scene.empty()) {
+            a.scene = s;
+        } else {
+            std::fprintf(stderr, "splatfx-render: one scene file at a time (got '%s' and '%s')\n", a.scene.c_str(), s.c_str());
+            return false;
+        }
+    }
+    if (a.scene.empty()) {
+        std::fprintf(stderr, "splatfx-render: no scene file given (try --help)\n");
+        return false;
+    }
+    return true;
+}
+
+struct Staging {
+    fs::path dir;
+    bool keep = false;
+    ~Staging() {
+        std::error_code ec;
+        if (!keep && !dir.empty()) fs::remove_all(dir, ec);
+    }
+};
+
+int fail(const std::string& why) {
+    std::fprintf(stderr, "splatfx-render: %s\n", why.c_str());
+    return 1;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    Args a;
+    if (!parse(argc, argv, a)) return 2;
+
+    auto ctx = splatfx::HeadlessContext::create();
+    if (!ctx) return fail(ctx.error());
+    auto player = scenehost::ScenePlayer::load(a.scene, {.seed = a.seed});
+    if (!player) return fail(player.error());
+    const splatfx::SceneFile& file = player->file();
+    const glm::ivec2 size = a.size.value_or(file.output.size);
+    const int frames = a.frames.value_or(file.output.frames);
+    const float fps = a.fps.value_or(file.output.fps);
+    const std::string name = file.output.name;
+
+    std::error_code ec;
+    fs::create_directories(a.out, ec);
+    if (ec) return fail("cannot create output folder '" + a.out + "': " + ec.message());
+    Staging staging;
+    staging.dir = fs::path(a.out) / (".splatfx-render-" + name + ".partial");
+    fs::remove_all(staging.dir, ec);
+    fs::create_directories(staging.dir, ec);
+    if (ec) return fail("cannot create staging folder '" + staging.dir.string() + "': " + ec.message());
+
+    auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
+    if (!fb) return fail(fb.error());
+    std::printf("splatfx-render: %s (%s) on %s\n", a.scene.c_str(), file.title.empty() ? name.c_str() : file.title.c_str(),
+                ctx->renderer().c_str());
+    std::printf("splatfx-render: %d frames at %dx%d, %g fps, seed %u, %s splats -> %s/%s_NNNN.png + %s.gif\n", frames, size.x, size.y,
+                fps, file.seed, a.traditional ? "traditional" : "textured", a.out.c_str(), name.c_str(), name.c_str());
+
+    splatfx::AnimationWriter gif((staging.dir / (name + ".gif")).string(), int(fps + 0.5f));
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
+    double renderMs = 0.0, updateMs = 0.0, buildMs = 0.0;
+    std::uint64_t splatsMin = ~0ull, splatsMax = 0, splatsSum = 0;
+    std::size_t visibleMax = 0, simulatedMax = 0, drawnMax = 0, visibleSum = 0, simulatedSum = 0, drawnSum = 0;
+    std::vector<std::string> pngs;
+    const bool tty = isatty(fileno(stdout)) != 0;
+    for (int i = 0; i < frames; ++i) {
+        if (i == a.abortAfter) return fail("aborted on purpose after " + std::to_string(i) + " frames (--abort-after); no output kept");
+        const double t = i / double(fps);
+        const auto f0 = Clock::now();
+        player->renderFrame(t, player->cameraAt(t, size), {.framebuffer = fb->handle(), .width = size.x, .height = size.y},
+                            {.traditional = a.traditional});
+        splatfx::Image img = fb->read();
+        renderMs += std::chrono::duration<double, std::milli>(Clock::now() - f0).count();
+        const scenehost::FrameStats& s = player->stats();
+        updateMs += s.updateMs, buildMs += s.buildMs;
+        splatsMin = std::min(splatsMin, s.splats), splatsMax = std::max(splatsMax, s.splats), splatsSum += s.splats;
+        visibleMax = std::max(visibleMax, s.visible), simulatedMax = std::max(simulatedMax, s.simulated), drawnMax = std::max(drawnMax, s.drawn);
+        visibleSum += s.visible, simulatedSum += s.simulated, drawnSum += s.drawn;
+        char png[128];
+        std::snprintf(png, sizeof png, "%s_%04d.png", name.c_str(), i);
+        if (auto w = splatfx::writeImage((staging.dir / png).string(), img); !w) return fail(w.error());
+        pngs.push_back(png);
+        if (auto w = gif.add(img); !w) return fail(w.error());
+        // A terminal gets a live line; a log gets about ten lines.
+        if (!a.quiet && (tty || (i + 1) % std::max(1, frames / 10) == 0 || i + 1 == frames)) {
+            std::printf("%ssplatfx-render: frame %d/%d  t=%.2fs  %llu splats  %zu/%zu effects visible", tty ? "\r" : "", i + 1, frames, t,
+                        (unsigned long long)s.splats, s.visible, s.declared);
+            if (!tty) std::printf("\n");
+            std::fflush(stdout);
+        }
+    }
+    if (!a.quiet && tty) std::printf("\n");
+    if (auto w = gif.finish(); !w) return fail(w.error());
+
+    // Replace an earlier run's outputs of the same name, frames first, GIF last.
+    for (const auto& entry : fs::directory_iterator(a.out, ec)) {
+        const std::string f = entry.path().filename().string();
+        if (f.rfind(name + "_", 0) == 0 && f.size() == name.size() + 9 && entry.path().extension() == ".png") fs::remove(entry.path(), ec);
+    }
+    for (const std::string& png : pngs) {
+        fs::rename(staging.dir / png, fs::path(a.out) / png, ec);
+        if (ec) return fail("cannot move " + png + " into '" + a.out + "': " + ec.message());
+    }
+    fs::rename(staging.dir / (name + ".gif"), fs::path(a.out) / (name + ".gif"), ec);
+    if (ec) return fail("cannot move " + name + ".gif into '" + a.out + "': " + ec.message());
+
+    const double sec = std::chrono::duration<double>(Clock::now() - start).count();
+    const scenehost::FrameStats& last = player->stats();
+    std::printf("splatfx-render: summary for %s\n", a.scene.c_str());
+    std::printf("  frames            %d (%dx%d, %.3g s of animation at %g fps)\n", frames, size.x, size.y, frames / double(fps), fps);
+    std::printf("  time              %.2f s in all, %.1f ms per frame (render + readback %.1f ms: update %.2f, splat build %.2f; PNG/GIF the rest)\n",
+                sec, 1000.0 * sec / frames, renderMs / frames, updateMs / frames, buildMs / frames);
+    std::printf("  splats per frame  min %llu, mean %.0f, max %llu\n", (unsigned long long)splatsMin, double(splatsSum) / frames,
+                (unsigned long long)splatsMax);
+    std::printf("  effects           %zu declared; per frame mean/max: %.1f/%zu simulated, %.1f/%zu visible, %.1f/%zu drawn\n", last.declared,
+                double(simulatedSum) / frames, simulatedMax, double(visibleSum) / frames, visibleMax, double(drawnSum) / frames, drawnMax);
+    std::printf("  geometry          %zu objects, %zu triangles\n", player->geometry().stats().objects, player->geometry().stats().triangles);
+    std::printf("  wrote             %s/%s_0000.png .. %s_%04d.png and %s/%s.gif\n", a.out.c_str(), name.c_str(), name.c_str(), frames - 1,
+                a.out.c_str(), name.c_str());
+    return 0;
+}

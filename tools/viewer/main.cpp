@@ -1,0 +1,408 @@
+// splatfx-viewer: interactive viewer for scene files (GLFW + Dear ImGui).
+//
+//   splatfx-viewer samples/03-cow-through-fire/scene.json
+//   xvfb-run -s "-screen 0 1280x720x24" splatfx-viewer SCENE --auto-quit-after 30 --screenshot shot.png
+//
+// Cameras: the scene's path, orbit (left drag rotates, right drag pans, wheel
+// zooms) and fly (WASD, Q/E down/up, right drag looks; "inside effect" puts
+// the eye in an effect's centre). Each scale of dynamics can be switched off
+// per scene (Effect::setToggles), effects enabled one by one, parameters
+// tweaked live (opacity, time rate, field of view, the scene text itself),
+// and the overlay shows frame time and counts from Scene::counters().
+//
+// [SECTION] Command line
+// [SECTION] Viewer state and cameras
+// [SECTION] UI
+// [SECTION] Main loop
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <epoxy/gl.h>
+#include <GLFW/glfw3.h>
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "backends/imgui_impl_glfw.h"
+#include "backends/imgui_impl_opengl3.h"
+#include "imgui.h"
+
+#include "scene_player.hpp"
+#include "splatfx/context.hpp"
+#include "splatfx/image.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// [SECTION] Command line
+
+struct Args {
+    std::string scene;
+    glm::ivec2 size{1280, 720};
+    int autoQuitAfter = 0;     // > 0: quit after this many frames (fixed time step)
+    std::string screenshot;    // written after the last frame (with --auto-quit-after)
+    std::optional<std::uint32_t> seed;
+    std::string camera = "path";
+    bool hideUi = false;
+};
+
+bool parse(int argc, char** argv, Args& a) {
+    for (int i = 1; i < argc; ++i) {
+        const std::string s = argv[i];
+        auto value = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
+        const char* v = nullptr;
+        if (s == "--help" || s == "-h") {
+            std::printf("splatfx-viewer: interactive splatfx scene viewer\n\n"
+                        "usage: splatfx-viewer [SCENE.json] [--size WxH] [--seed S] [--camera path|orbit|fly]\n"
+                        "                      [--auto-quit-after N] [--screenshot FILE] [--hide-ui]\n"
+                        "  --auto-quit-after N  render N frames at the scene's fps (fixed steps), then quit\n"
+                        "  --screenshot FILE    write the last frame (with the UI) to FILE (PNG)\n");
+            std::exit(0);
+        } else if (s == "--size" && (v = value())) {
+            if (std::sscanf(v, "%dx%d", &a.size.x, &a.size.y) != 2 || a.size.x < 64 || a.size.y < 64 || a.size.x > 8192 || a.size.y > 8192) {
+                std::fprintf(stderr, "splatfx-viewer: --size expects WxH (64..8192), got '%s'\n", v);
+                return false;
+            }
+        } else if (s == "--auto-quit-after" && (v = value())) {
+            a.autoQuitAfter = std::atoi(v);
+            if (a.autoQuitAfter < 1) {
+                std::fprintf(stderr, "splatfx-viewer: --auto-quit-after expects a positive frame count, got '%s'\n", v);
+                return false;
+            }
+        } else if (s == "--screenshot" && (v = value())) {
+            a.screenshot = v;
+        } else if (s == "--seed" && (v = value())) {
+            a.seed = std::uint32_t(std::strtoul(v, nullptr, 10));
+        } else if (s == "--camera" && (v = value())) {
+            a.camera = v;
+            if (a.camera != "path" && a.camera != "orbit" && a.camera != "fly") {
+                std::fprintf(stderr, "splatfx-viewer: --camera expects path, orbit or fly, got '%s'\n", v);
+                return false;
+            }
+        } else if (s == "--hide-ui") {
+            a.hideUi = true;
+        } else if (!s.empty() && s[0] != '-' && a.scene.empty()) {
+            a.scene = s;
+        } else {
+            std::fprintf(stderr, "splatfx-viewer: unknown or incomplete option '%s' (try --help)\n", s.c_str());
+            return false;
+        }
+    }
+    return true;
+}
+
+// [SECTION] Viewer state and cameras
+
+enum class CameraMode { Path, Orbit, Fly };
+
+struct Viewer {
+    Args args;
+    std::optional<scenehost::ScenePlayer> player;
+    std::string path;
+    std::string error;
+    std::vector<std::string> catalogue; // scene files next to the current one
+    std::string editorText;
+    double time = 0.0;
+    bool paused = false;
+    float timeRate = 1.0f;
+    CameraMode mode = CameraMode::Path;
+    splatfx::DynamicsToggles toggles;
+    scenehost::FrameOptions frame;
+    float fovDeg = 45.0f;
+    // Orbit
+    glm::vec3 orbitTarget{0, 1, 0};
+    float orbitYaw = 0.0f, orbitPitch = 0.2f, orbitDistance = 10.0f;
+    // Fly
+    glm::vec3 flyPos{0, 2, 10};
+    float flyYaw = -1.5708f, flyPitch = 0.0f;
+    double frameMs = 0.0;
+    char pathInput[1024] = {};
+
+    void load(const std::string& p, const std::string* text = nullptr) {
+        auto r = text ? scenehost::ScenePlayer::fromText(*text, p, {.seed = args.seed}) : scenehost::ScenePlayer::load(p, {.seed = args.seed});
+        if (!r) {
+            error = r.error();
+            std::fprintf(stderr, "splatfx-viewer: %s\n", error.c_str());
+            return;
+        }
+        error.clear();
+        player.emplace(std::move(*r));
+        path = p;
+        std::snprintf(pathInput, sizeof pathInput, "%s", p.c_str());
+        time = 0.0;
+        if (!text) {
+            std::ifstream in(p);
+            std::stringstream ss;
+            ss << in.rdbuf();
+            editorText = ss.str();
+        }
+        applyToggles();
+        // Start orbit and fly cameras where the scene's camera is.
+        const splatfx::CameraKey k = player->file().camera.keys.front();
+        fovDeg = glm::degrees(k.fovYRad);
+        orbitTarget = k.target;
+        const glm::vec3 d = k.position - k.target;
+        orbitDistance = std::max(glm::length(d), 0.1f);
+        orbitYaw = std::atan2(d.x, d.z);
+        orbitPitch = std::asin(std::clamp(d.y / orbitDistance, -1.0f, 1.0f));
+        flyPos = k.position;
+        const glm::vec3 f = glm::normalize(k.target - k.position);
+        flyYaw = std::atan2(f.z, f.x);
+        flyPitch = std::asin(std::clamp(f.y, -1.0f, 1.0f));
+        catalogue.clear();
+        std::error_code ec;
+        const fs::path samples = fs::path(p).parent_path().parent_path();
+        for (const auto& e : fs::directory_iterator(samples.empty() ? "." : samples, ec))
+            if (fs::is_regular_file(e.path() / "scene.json", ec)) catalogue.push_back((e.path() / "scene.json").string());
+        std::sort(catalogue.begin(), catalogue.end());
+    }
+
+    void applyToggles() {
+        if (!player) return;
+        for (const auto& info : player->file().effects) player->file().scene.effect(info.id).setToggles(toggles);
+    }
+
+    splatfx::Camera camera(glm::ivec2 vp) const {
+        const float fov = glm::radians(fovDeg);
+        const splatfx::CameraPath& cp = player->file().camera;
+        if (mode == CameraMode::Orbit) {
+            const glm::vec3 eye = orbitTarget + orbitDistance * glm::vec3(std::cos(orbitPitch) * std::sin(orbitYaw), std::sin(orbitPitch),
+                                                                         std::cos(orbitPitch) * std::cos(orbitYaw));
+            return splatfx::Camera::lookAt(eye, orbitTarget, {0, 1, 0}, fov, vp, cp.nearPlane, cp.farPlane);
+        }
+        if (mode == CameraMode::Fly) {
+            const glm::vec3 f(std::cos(flyPitch) * std::cos(flyYaw), std::sin(flyPitch), std::cos(flyPitch) * std::sin(flyYaw));
+            return splatfx::Camera::lookAt(flyPos, flyPos + f, {0, 1, 0}, fov, vp, cp.nearPlane, cp.farPlane);
+        }
+        splatfx::Camera c = player->cameraAt(time, vp);
+        return c;
+    }
+
+    void handleInput(GLFWwindow* w, float dt) {
+        ImGuiIO& io = ImGui::GetIO();
+        if (io.WantCaptureMouse && io.WantCaptureKeyboard) return;
+        const ImVec2 md = io.MouseDelta;
+        if (!io.WantCaptureMouse) {
+            if (mode == CameraMode::Orbit) {
+                if (ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
+                    orbitYaw -= 0.005f * md.x;
+                    orbitPitch = std::clamp(orbitPitch + 0.005f * md.y, -1.5f, 1.5f);
+                }
+                if (ImGui::IsMouseDown(ImGuiMouseButton_Right)) {
+                    const splatfx::Camera c = camera({1, 1});
+                    orbitTarget += orbitDistance * 0.002f * (-md.x * c.right() + md.y * c.up());
+                }
+                if (io.MouseWheel != 0.0f) orbitDistance = std::clamp(orbitDistance * std::pow(0.9f, io.MouseWheel), 0.05f, 1000.0f);
+            } else if (mode == CameraMode::Fly && ImGui::IsMouseDown(ImGuiMouseButton_Right)) {
+                flyYaw += 0.004f * md.x;
+                flyPitch = std::clamp(flyPitch - 0.004f * md.y, -1.55f, 1.55f);
+            }
+        }
+        if (mode == CameraMode::Fly && !io.WantCaptureKeyboard) {
+            const glm::vec3 f(std::cos(flyPitch) * std::cos(flyYaw), std::sin(flyPitch), std::cos(flyPitch) * std::sin(flyYaw));
+            const glm::vec3 r = glm::normalize(glm::cross(f, glm::vec3(0, 1, 0)));
+            const float speed = (glfwGetKey(w, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS ? 8.0f : 2.5f) * dt;
+            if (glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS) flyPos += speed * f;
+            if (glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS) flyPos -= speed * f;
+            if (glfwGetKey(w, GLFW_KEY_D) == GLFW_PRESS) flyPos += speed * r;
+            if (glfwGetKey(w, GLFW_KEY_A) == GLFW_PRESS) flyPos -= speed * r;
+            if (glfwGetKey(w, GLFW_KEY_E) == GLFW_PRESS) flyPos.y += speed;
+            if (glfwGetKey(w, GLFW_KEY_Q) == GLFW_PRESS) flyPos.y -= speed;
+        }
+    }
+
+    // Puts the fly camera at the centre of effect `id`'s current bounds, looking along the path camera's direction.
+    void jumpInside(splatfx::EffectId id) {
+        const splatfx::Aabb b = player->file().scene.status(id).bounds;
+        if (b.empty()) return;
+        const splatfx::Camera c = camera({1, 1});
+        mode = CameraMode::Fly;
+        flyPos = 0.5f * (b.lo + b.hi);
+        const glm::vec3 f = c.forward();
+        flyYaw = std::atan2(f.z, f.x);
+        flyPitch = std::asin(std::clamp(f.y, -1.0f, 1.0f));
+    }
+
+    // [SECTION] UI
+
+    void ui() {
+        ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
+        ImGui::SetNextWindowSize(ImVec2(380, 0), ImGuiCond_FirstUseEver);
+        ImGui::Begin("splatfx");
+        const scenehost::FrameStats s = player ? player->stats() : scenehost::FrameStats{};
+        ImGui::Text("%.2f ms/frame (%.0f fps)   t = %.2f s", frameMs, frameMs > 0 ? 1000.0 / frameMs : 0.0, time);
+        ImGui::Text("effects: %zu declared, %zu simulated, %zu visible, %zu drawn", s.declared, s.simulated, s.visible, s.drawn);
+        ImGui::Text("voxels: %llu   splats: %llu", (unsigned long long)s.voxels, (unsigned long long)s.splats);
+        ImGui::Text("update %.2f ms  build %.2f ms  draw %.2f ms", s.updateMs, s.buildMs, s.drawMs);
+        if (!error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", error.c_str());
+        ImGui::Separator();
+
+        if (ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) {
+            if (player && !player->file().title.empty()) ImGui::TextWrapped("%s", player->file().title.c_str());
+            if (ImGui::BeginCombo("samples", path.empty() ? "(none)" : fs::path(path).parent_path().filename().string().c_str())) {
+                for (const std::string& c : catalogue)
+                    if (ImGui::Selectable(fs::path(c).parent_path().filename().string().c_str(), c == path)) load(c);
+                ImGui::EndCombo();
+            }
+            ImGui::InputText("file", pathInput, sizeof pathInput);
+            ImGui::SameLine();
+            if (ImGui::Button("Load")) load(pathInput);
+            if (ImGui::Button(paused ? "Play" : "Pause")) paused = !paused;
+            ImGui::SameLine();
+            if (ImGui::Button("Restart") && !path.empty()) load(path, &editorText);
+            ImGui::SliderFloat("time rate", &timeRate, 0.0f, 4.0f);
+        }
+        if (ImGui::CollapsingHeader("Camera", ImGuiTreeNodeFlags_DefaultOpen)) {
+            int m = int(mode);
+            ImGui::RadioButton("path", &m, 0);
+            ImGui::SameLine();
+            ImGui::RadioButton("orbit", &m, 1);
+            ImGui::SameLine();
+            ImGui::RadioButton("fly", &m, 2);
+            mode = CameraMode(m);
+            ImGui::SliderFloat("fov (deg)", &fovDeg, 10.0f, 120.0f);
+            ImGui::TextDisabled(mode == CameraMode::Orbit ? "left drag: rotate, right drag: pan, wheel: zoom"
+                                : mode == CameraMode::Fly  ? "WASD move, Q/E down/up, shift fast, right drag look"
+                                                           : "the scene file's camera path");
+        }
+        if (ImGui::CollapsingHeader("Dynamics and drawing", ImGuiTreeNodeFlags_DefaultOpen)) {
+            bool changed = ImGui::Checkbox("object (sec. 3.1)", &toggles.object);
+            ImGui::SameLine();
+            changed |= ImGui::Checkbox("global (3.2)", &toggles.global);
+            ImGui::SameLine();
+            changed |= ImGui::Checkbox("local (3.3)", &toggles.local);
+            if (changed) applyToggles();
+            ImGui::Checkbox("traditional splats (Fig. 1a)", &frame.traditional);
+            ImGui::Checkbox("geometry", &frame.drawGeometry);
+            ImGui::SliderFloat("opacity scale", &frame.opacityScale, 0.0f, 3.0f);
+        }
+        if (player && ImGui::CollapsingHeader("Effects", ImGuiTreeNodeFlags_DefaultOpen)) {
+            splatfx::Scene& scene = player->file().scene;
+            const auto& perEffect = player->stats().splatsPerEffect;
+            for (std::size_t i = 0; i < player->file().effects.size(); ++i) {
+                const splatfx::SceneEffectInfo& info = player->file().effects[i];
+                ImGui::PushID(int(info.id));
+                bool on = scene.options(info.id).enabled;
+                if (ImGui::Checkbox("##on", &on)) scene.setEnabled(info.id, on);
+                ImGui::SameLine();
+                const splatfx::EffectStatus& st = scene.status(info.id);
+                ImGui::Text("%s (%s)%s %llu splats", info.name.c_str(), info.kind.c_str(), st.needed ? "" : " [skipped]",
+                            (unsigned long long)(i < perEffect.size() ? perEffect[i] : 0));
+                ImGui::SameLine();
+                if (ImGui::SmallButton("inside")) jumpInside(info.id);
+                ImGui::PopID();
+            }
+        }
+        if (ImGui::CollapsingHeader("Scene file (edit, then Apply)")) {
+            static std::vector<char> buf;
+            if (buf.size() < editorText.size() + 65536) buf.resize(editorText.size() + 65536);
+            if (std::strncmp(buf.data(), editorText.c_str(), buf.size()) != 0) std::snprintf(buf.data(), buf.size(), "%s", editorText.c_str());
+            if (ImGui::InputTextMultiline("##text", buf.data(), buf.size(), ImVec2(-1, 300))) editorText = buf.data();
+            if (ImGui::Button("Apply") && !path.empty()) load(path, &editorText);
+        }
+        ImGui::End();
+    }
+};
+
+bool writeScreenshot(const std::string& file, glm::ivec2 size) {
+    splatfx::Image img;
+    img.width = size.x, img.height = size.y, img.channels = 4;
+    std::vector<unsigned char> px(std::size_t(size.x) * size.y * 4);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadBuffer(GL_BACK);
+    glReadPixels(0, 0, size.x, size.y, GL_RGBA, GL_UNSIGNED_BYTE, px.data());
+    img.pixels.resize(px.size());
+    for (int y = 0; y < size.y; ++y) // GL rows are bottom-up
+        for (int x = 0; x < size.x * 4; ++x) img.pixels[std::size_t(y) * size.x * 4 + x] = px[std::size_t(size.y - 1 - y) * size.x * 4 + x] / 255.0f;
+    for (std::size_t i = 3; i < img.pixels.size(); i += 4) img.pixels[i] = 1.0f;
+    if (auto s = splatfx::writeImage(file, img); !s) {
+        std::fprintf(stderr, "splatfx-viewer: %s\n", s.error().c_str());
+        return false;
+    }
+    std::printf("splatfx-viewer: wrote %s\n", file.c_str());
+    return true;
+}
+
+} // namespace
+
+// [SECTION] Main loop
+
+int main(int argc, char** argv) {
+    Viewer v;
+    if (!parse(argc, argv, v.args)) return 2;
+    v.mode = v.args.camera == "orbit" ? CameraMode::Orbit : v.args.camera == "fly" ? CameraMode::Fly : CameraMode::Path;
+    auto window = splatfx::Window::create({.width = v.args.size.x, .height = v.args.size.y, .title = "splatfx viewer", .vsync = v.args.autoQuitAfter == 0});
+    if (!window) {
+        std::fprintf(stderr, "splatfx-viewer: %s\n", window.error().c_str());
+        return 1;
+    }
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr; // no imgui.ini written next to the user's files
+    ImGui::StyleColorsDark();
+    ImGui_ImplGlfw_InitForOpenGL(window->handle(), true);
+    ImGui_ImplOpenGL3_Init("#version 450");
+
+    if (!v.args.scene.empty()) {
+        const CameraMode keep = v.mode;
+        v.load(v.args.scene);
+        v.mode = keep;
+        if (!v.player && v.args.autoQuitAfter > 0) return 1;
+    }
+    const float fixedStep = v.player ? 1.0f / v.player->file().output.fps : 1.0f / 24.0f;
+    using Clock = std::chrono::steady_clock;
+    auto last = Clock::now();
+    int rc = 0;
+    for (int frameIndex = 0; !window->shouldClose(); ++frameIndex) {
+        window->pollEvents();
+        const auto now = Clock::now();
+        const float wallDt = std::chrono::duration<float>(now - last).count();
+        last = now;
+        v.frameMs = 1000.0 * wallDt;
+        // Auto-quit runs step by the scene's fps so screenshots are reproducible.
+        const float dt = v.args.autoQuitAfter > 0 ? fixedStep : std::min(wallDt, 0.1f);
+        if (glfwGetKey(window->handle(), GLFW_KEY_ESCAPE) == GLFW_PRESS) break;
+
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        v.handleInput(window->handle(), dt);
+        if (!v.args.hideUi) v.ui();
+        ImGui::Render();
+
+        const glm::ivec2 fbSize = window->framebufferSize();
+        if (v.player && fbSize.x > 0 && fbSize.y > 0) {
+            if (!v.paused && frameIndex > 0) v.time += double(dt) * v.timeRate;
+            const splatfx::Camera cam = v.camera(fbSize);
+            v.player->renderFrame(v.time, cam, {.framebuffer = 0, .width = fbSize.x, .height = fbSize.y}, v.frame);
+        } else {
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            glViewport(0, 0, fbSize.x, fbSize.y);
+            glClearColor(0.1f, 0.1f, 0.12f, 1.0f);
+            glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        }
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        const bool lastFrame = v.args.autoQuitAfter > 0 && frameIndex + 1 >= v.args.autoQuitAfter;
+        if (lastFrame && !v.args.screenshot.empty() && !writeScreenshot(v.args.screenshot, fbSize)) rc = 1;
+        window->swapBuffers();
+        if (lastFrame) {
+            const scenehost::FrameStats s = v.player ? v.player->stats() : scenehost::FrameStats{};
+            std::printf("splatfx-viewer: %d frames, t = %.2f s, %zu effects declared / %zu simulated / %zu visible, %llu splats\n",
+                        frameIndex + 1, v.time, s.declared, s.simulated, s.visible, (unsigned long long)s.splats);
+            break;
+        }
+    }
+    v.player.reset(); // its GL objects go while the window's context is still current
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    return rc;
+}
