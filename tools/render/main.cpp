@@ -179,7 +179,7 @@ int main(int argc, char** argv) {
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
     double renderMs = 0.0, updateMs = 0.0, buildMs = 0.0;
-    std::uint64_t splatsMin = ~0ull, splatsMax = 0, splatsSum = 0;
+    std::uint64_t splatsMin = ~0ull, splatsMax = 0, splatsSum = 0, voxelsMax = 0;
     std::size_t visibleMax = 0, simulatedMax = 0, drawnMax = 0, visibleSum = 0, simulatedSum = 0, drawnSum = 0;
     std::vector<std::string> pngs;
     const bool tty = isatty(fileno(stdout)) != 0;
@@ -194,6 +194,7 @@ int main(int argc, char** argv) {
         const scenehost::FrameStats& s = player->stats();
         updateMs += s.updateMs, buildMs += s.buildMs;
         splatsMin = std::min(splatsMin, s.splats), splatsMax = std::max(splatsMax, s.splats), splatsSum += s.splats;
+        voxelsMax = std::max(voxelsMax, s.voxels);
         visibleMax = std::max(visibleMax, s.visible), simulatedMax = std::max(simulatedMax, s.simulated), drawnMax = std::max(drawnMax, s.drawn);
         visibleSum += s.visible, simulatedSum += s.simulated, drawnSum += s.drawn;
         char png[128];
@@ -232,6 +233,7 @@ int main(int argc, char** argv) {
                 sec, 1000.0 * sec / frames, renderMs / frames, updateMs / frames, buildMs / frames);
     std::printf("  splats per frame  min %llu, mean %.0f, max %llu\n", (unsigned long long)splatsMin, double(splatsSum) / frames,
                 (unsigned long long)splatsMax);
+    std::printf("  voxels            at most %llu per frame (of the effects needed)\n", (unsigned long long)voxelsMax);
     std::printf("  effects           %zu declared; per frame mean/max: %.1f/%zu simulated, %.1f/%zu visible, %.1f/%zu drawn\n", last.declared,
                 double(simulatedSum) / frames, simulatedMax, double(visibleSum) / frames, visibleMax, double(drawnSum) / frames, drawnMax);
     std::printf("  geometry          %zu objects, %zu triangles\n", player->geometry().stats().objects, player->geometry().stats().triangles);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <optional>
 
 namespace splatfx {
 namespace {
@@ -77,6 +76,7 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         glm::mat3 sigma, sigmaInv; // M M^T and its inverse
         float cbrtDet = 1.0f, extent = 0.0f;
         bool ok = false;
+        Shape() = default;
         explicit Shape(const glm::mat3& m, float R) {
             const float det = glm::determinant(m);
             ok = std::isfinite(det) && std::abs(det) >= 1e-12f;
@@ -94,19 +94,36 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
     const glm::vec3 half = glm::vec3(glm::max(grid.dims - 1, glm::ivec3(0))) * 0.5f;
     const glm::vec3 halfXZ(half.x, 0.0f, half.z);
 
-    if (mSplats.capacity() < mSplats.size() + grid.voxels.size()) mSplats.reserve(mSplats.size() + grid.voxels.size());
+    // Colour-table alpha, read inline: it scales every voxel's opacity.
+    const std::vector<glm::vec4>* entries = table ? &table->entries : nullptr;
+    const float lastEntry = entries ? float(entries->size() - 1) : 0.0f;
+    auto tableAlphaAt = [&](float t) {
+        if (!entries) return 1.0f;
+        const float f = std::clamp(t, 0.0f, 1.0f) * lastEntry;
+        const size_t i = std::min(size_t(f), entries->size() - 2);
+        const float a = glm::mix((*entries)[i].a, (*entries)[i + 1].a, f - float(i));
+        return std::clamp(a, 0.0f, 1.0f);
+    };
+
+    // Written in place (no push_back in the loop); trimmed at the end.
+    const std::size_t first = mSplats.size();
+    mSplats.resize(first + grid.voxels.size());
+    Splat* out = mSplats.data() + first;
     for (const Voxel& v : grid.voxels) {
-        const float stretchLen = glm::length(v.stretch);
-        const bool stretched = stretchLen > 0.0f;
-        std::optional<Shape> own;
-        if (stretched && std::isfinite(stretchLen)) {
+        const float stretch2 = glm::dot(v.stretch, v.stretch);
+        const Shape* shapePtr = &plain;
+        Shape stretchedShape;
+        if (stretch2 > 0.0f) {
+            const float stretchLen = std::sqrt(stretch2);
             const glm::vec3 sd = v.stretch / stretchLen;
-            own.emplace(gridShape * (glm::mat3(1.0f) + stretchLen * glm::outerProduct(sd, sd)), R);
+            stretchedShape = Shape(gridShape * (glm::mat3(1.0f) + stretchLen * glm::outerProduct(sd, sd)), R);
+            stretchedShape.ok = stretchedShape.ok && std::isfinite(stretchLen);
+            shapePtr = &stretchedShape;
         }
-        const Shape& shape = own ? *own : plain;
+        const Shape& shape = *shapePtr;
         const glm::vec3 c = glm::vec3(grid.transform * glm::vec4((glm::vec3(v.cell) - halfXZ) * grid.spacing, 1.0f));
         if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord) || !std::isfinite(v.phase) || !finite3(c) || !shape.ok ||
-            (stretched && !own)) {
+            !std::isfinite(stretch2)) {
             ++mStats.rejected;
             continue;
         }
@@ -131,7 +148,7 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         glm::vec3 e1 = glm::cross(d, camUp);
         const float e1Len = glm::length(e1);
         e1 = e1Len > 1e-6f ? e1 / e1Len : camRight;
-        const glm::vec3 e2 = glm::normalize(glm::cross(e1, d));
+        const glm::vec3 e2 = glm::cross(e1, d); // unit: e1 and d are orthonormal
 
         // Line integral of h(|M^-1 x|) along d at plane offset q: F(|q|_Q) / |M^-1 d|.
         // Q is the Schur complement of Sigma^-1 = (M M^T)^-1 in the frame
@@ -142,7 +159,7 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         sqrt2x2(glm::dot(e1, se1), glm::dot(e2, se1), glm::dot(e2, se2), sq);
         const float bLen = std::sqrt(glm::dot(d, shape.sigmaInv * d));
 
-        Splat sp;
+        Splat& sp = *out;
         sp.center = c;
         sp.axisU = R * (sq[0] * e1 + sq[1] * e2);
         sp.axisV = R * (sq[1] * e1 + sq[2] * e2);
@@ -150,8 +167,7 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
             ++mStats.rejected;
             continue;
         }
-        const float tableAlpha = table ? std::clamp(table->sample(v.colorCoord).a, 0.0f, 1.0f) : 1.0f;
-        const float alpha = opacity * tableAlpha;
+        const float alpha = opacity * tableAlphaAt(v.colorCoord);
         // Optical depth through the centre, relative to an isotropic voxel of
         // equal volume: the chord along d (1 / |M^-1 d|) over det(M)^(1/3).
         // log1p: 1.0f - alpha rounds to 1 for alpha < 6e-8, which would lose the voxel entirely.
@@ -160,12 +176,14 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         sp.density = tau * std::min(chord, 64.0f) * fade * range.gain;
         sp.colorCoord = std::clamp(v.colorCoord, 0.0f, 1.0f);
         sp.colorRow = hasTable ? float(style.colorTable) : 0.0f;
-        sp.layer = float(range.first + v.texture % range.count);
-        sp.nextLayer = float(range.first + (v.texture + 1) % range.count);
+        const std::uint32_t index = v.texture % range.count; // one division per voxel, not two
+        sp.layer = float(range.first + index);
+        sp.nextLayer = float(range.first + (index + 1 == range.count ? 0 : index + 1));
         sp.blend = style.crossfade ? std::clamp(v.phase - std::floor(v.phase), 0.0f, 1.0f) : 0.0f;
         sp.depth = persp ? dist : viewZ;
-        mSplats.push_back(sp);
+        ++out;
     }
+    mSplats.resize(std::size_t(out - mSplats.data()));
 }
 
 void SplatBuilder::sort(SortMode mode) { sortBackToFront(mSplats, mode, mDesc.buckets); }

@@ -13,6 +13,9 @@
 // of its own host depth, and otherwise takes the single texel whose depth is
 // nearest its own (so effects do not bleed onto geometry edges).
 // Without a host depth texture it upsamples bilinearly and tests no depth.
+// The full-resolution passes are scissored to the splats' screen rectangle,
+// and the host depth is copied once per draw (sampling the attached texture
+// while drawing into its framebuffer would be a feedback loop).
 // It does not anti-alias, blur or sharpen, and it never clears the host target.
 // With scale 1 it is exactly the wrapped Renderer drawing into the target.
 //
@@ -22,7 +25,7 @@
 //
 // GL state: with renderer.restoreState (the default) draw() saves and
 // restores what it and the wrapped renderer change (the renderer.hpp list
-// plus texture unit 2's 2D binding); otherwise it leaves blending on
+// plus texture unit 2's 2D binding and the scissor test and box); otherwise it leaves blending on
 // (ONE, ONE_MINUS_SRC_ALPHA), depth test and writes off, its own program,
 // vertex array and textures bound.
 //

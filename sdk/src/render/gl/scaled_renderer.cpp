@@ -1,6 +1,8 @@
 #include "splatfx/gl/scaled_renderer.hpp"
 
+#include <algorithm>
 #include <cassert>
+#include <cmath>
 #include <optional>
 #include <string>
 
@@ -73,6 +75,8 @@ public:
                                         GL_BLEND_EQUATION_RGB, GL_BLEND_EQUATION_ALPHA};
         for (int i = 0; i < 6; ++i) glGetIntegerv(blendQueries[i], &mBlend[i]);
         glGetIntegerv(GL_DEPTH_FUNC, &mDepthFunc);
+        mScissor = glIsEnabled(GL_SCISSOR_TEST);
+        glGetIntegerv(GL_SCISSOR_BOX, mScissorBox);
     }
     void apply() const {
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(mDrawFbo));
@@ -94,13 +98,33 @@ public:
         glBlendFuncSeparate(GLenum(mBlend[0]), GLenum(mBlend[1]), GLenum(mBlend[2]), GLenum(mBlend[3]));
         glBlendEquationSeparate(GLenum(mBlend[4]), GLenum(mBlend[5]));
         glDepthFunc(GLenum(mDepthFunc));
+        mScissor ? glEnable(GL_SCISSOR_TEST) : glDisable(GL_SCISSOR_TEST);
+        glScissor(mScissorBox[0], mScissorBox[1], mScissorBox[2], mScissorBox[3]);
     }
 
 private:
     GLint mDrawFbo = 0, mViewport[4] = {}, mProgram = 0, mVao = 0, mArrayBuffer = 0, mActive = 0;
     GLint mTex2D[3] = {}, mTexArray0 = 0, mBlend[6] = {}, mDepthFunc = 0;
-    GLboolean mCaps[3] = {}, mDepthMask = 0, mColorMask[4] = {};
+    GLboolean mCaps[3] = {}, mDepthMask = 0, mColorMask[4] = {}, mScissor = 0;
+    GLint mScissorBox[4] = {};
 };
+
+// Window-space rectangle (x0, y0, x1, y1), relative to the viewport, that the
+// splats' quads can touch; the whole viewport when one crosses the eye plane.
+glm::ivec4 splatBounds(const std::vector<Splat>& splats, const Camera& camera, int w, int h) {
+    const glm::mat4 vp = camera.proj * camera.view;
+    float x0 = 1e30f, y0 = 1e30f, x1 = -1e30f, y1 = -1e30f;
+    for (const Splat& s : splats)
+        for (int k = 0; k < 4; ++k) {
+            const glm::vec3 p = s.center + ((k & 1) ? 1.0f : -1.0f) * s.axisU + ((k & 2) ? 1.0f : -1.0f) * s.axisV;
+            const glm::vec4 c = vp * glm::vec4(p, 1.0f);
+            if (!(c.w > 1e-6f)) return {0, 0, w, h};
+            const float px = (c.x / c.w * 0.5f + 0.5f) * float(w), py = (c.y / c.w * 0.5f + 0.5f) * float(h);
+            x0 = std::min(x0, px), x1 = std::max(x1, px), y0 = std::min(y0, py), y1 = std::max(y1, py);
+        }
+    auto clampTo = [](float v, int hi) { return int(std::clamp(v, 0.0f, float(hi))); };
+    return {clampTo(std::floor(x0) - 1.0f, w), clampTo(std::floor(y0) - 1.0f, h), clampTo(std::ceil(x1) + 1.0f, w), clampTo(std::ceil(y1) + 1.0f, h)};
+}
 
 } // namespace
 
@@ -195,6 +219,16 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
     }
     const int s = r.desc.scale;
     r.ensureTarget((target.width + s - 1) / s, (target.height + s - 1) / s);
+    // The passes at full resolution only touch the splats' screen rectangle
+    // (grown by a low-resolution texel for the bilinear taps): on a CPU
+    // rasterizer a full-screen pass costs as much as the effect itself.
+    const glm::ivec4 box = splatBounds(splats, camera, target.width, target.height);
+    if (box.z <= box.x || box.w <= box.y) {
+        if (restore) saved.apply();
+        return;
+    }
+    const glm::ivec4 lowBox{std::max(box.x / s - 1, 0), std::max(box.y / s - 1, 0), std::min(box.z / s + 2, r.lowW), std::min(box.w / s + 2, r.lowH)};
+    const glm::ivec4 fullBox{std::max(lowBox.x * s, 0), std::max(lowBox.y * s, 0), std::min(lowBox.z * s, target.width), std::min(lowBox.w * s, target.height)};
 
     GLuint hostDepth = target.depthTexture;
     if (hostDepth == 0 && target.framebuffer != 0) {
@@ -228,9 +262,12 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDepthMask(GL_TRUE);
     const float clear[4] = {0.0f, 0.0f, 0.0f, 0.0f}, farDepth = 1.0f;
+    glDisable(GL_SCISSOR_TEST);
     glClearNamedFramebufferfv(r.fbo, GL_COLOR, 0, clear);
     glClearNamedFramebufferfv(r.fbo, GL_DEPTH, 0, &farDepth);
     glBindVertexArray(r.emptyVao);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(lowBox.x, lowBox.y, lowBox.z - lowBox.x, lowBox.w - lowBox.y);
     if (useDepth) {
         glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         glEnable(GL_DEPTH_TEST);
@@ -243,7 +280,10 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     }
     // The splats, into the low-resolution target (transparent black, premultiplied).
+    glDisable(GL_SCISSOR_TEST);
     r.inner->draw(splats, camera, {r.fbo, 0, 0, r.lowW, r.lowH});
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(target.x + fullBox.x, target.y + fullBox.y, fullBox.z - fullBox.x, fullBox.w - fullBox.y);
 
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
     glViewport(target.x, target.y, target.width, target.height);
@@ -267,6 +307,7 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
     if (useDepth) glBindTextureUnit(2, r.hostCopy);
     glBindVertexArray(r.emptyVao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDisable(GL_SCISSOR_TEST);
     if (restore) saved.apply();
 }
 
