@@ -122,3 +122,26 @@ TEST(Materials, TexturedSetsCarryTheFootprintsMeanOpacity) {
     EXPECT_NEAR(textured * r.gain, plain, 1e-3 * plain);
     EXPECT_GT(r.gain, 1.0f); // detail below 1 somewhere needs a gain above 1
 }
+
+TEST(TextureSet, WindowedColourSetsRoundTrip) {
+    // Windowed colour sets keep colour in RGB and opacity in A (unassociated).
+    const std::string dir = splatfx::test::outputDir() + "/colour";
+    TextureSet set = TextureSet::turbulence({.count = 2, .size = 16, .seed = 9});
+    set.color = true;
+    for (auto& layer : set.layers)
+        for (size_t i = 0; i < layer.size(); i += 4) layer[i + 1] *= 0.5f, layer[i + 2] *= 0.25f; // warm tint
+    const TextureSet win = set.windowed(Footprint{});
+    ASSERT_TRUE(win.save(dir));
+    auto back = TextureSet::load(dir);
+    ASSERT_TRUE(back) << back.error();
+    ASSERT_TRUE(back->color && back->isWindowed);
+    for (int k = 0; k < 2; ++k)
+        for (size_t i = 0; i < win.layers[0].size(); i += 4) {
+            const float a = win.layers[size_t(k)][i + 3];
+            // Straight alpha: colour and alpha are each stored once in 8 bits,
+            // so both come back within half a quantization step.
+            EXPECT_NEAR(back->layers[size_t(k)][i + 3], a, 0.5 / 255 + 1e-6);
+            for (int c = 0; c < 3; ++c)
+                EXPECT_NEAR(back->layers[size_t(k)][i + size_t(c)], win.layers[size_t(k)][i + size_t(c)], 0.5 / 255 + 1e-6);
+        }
+}

@@ -83,6 +83,7 @@ struct Config {
     bool textured = true;
     bool gaussian = false;
     float gaussianRadius = 2.0f;
+    float footprintCut = 1.0f;      // RendererDesc::footprintCut
 };
 
 struct Row {
@@ -274,7 +275,9 @@ struct Bench {
         s->truth = &truth;
         s->extraCpuMs = extraCpuMs;
         auto fb = splatfx::gl::Framebuffer::create({.width = opt.size.x, .height = opt.size.y, .color = c.precision});
-        auto sr = splatfx::gl::ScaledRenderer::create({.scale = c.scale});
+        splatfx::gl::RendererDesc rdesc;
+        rdesc.footprintCut = c.footprintCut;
+        auto sr = splatfx::gl::ScaledRenderer::create({.scale = c.scale, .renderer = rdesc});
         if (!fb || !sr || !sr->upload(*s->mat)) {
             std::fprintf(stderr, "accuracy: cannot set up GL for %s %s\n", knob.c_str(), setting.c_str());
             return;
@@ -507,6 +510,13 @@ int runAccuracy(int argc, char** argv) {
         Config c;
         c.scale = s;
         b.add("render scale", s == 1 ? "full (default)" : s == 2 ? "half" : "quarter", c, onTexture, truth);
+    }
+    for (float cut : {0.6f, 0.7f, 0.81f, 0.9f, 1.0f}) {
+        Config c;
+        c.footprintCut = cut;
+        char label[64];
+        std::snprintf(label, sizeof label, "%.2f of the radius%s", cut, cut == 1.0f ? " (default)" : "");
+        b.add("footprint cut (RendererDesc)", label, c, onTexture, truth);
     }
     for (float radius : {1.05f, 1.4f, 1.75f, 2.0f, 2.8f}) {
         Config c = gaussTruthCfg;

@@ -57,7 +57,7 @@ splatfx::Result<std::vector<Event>> parseEvents(const std::string& text) {
 }
 
 struct App {
-    const Options& options;
+    Options options; // a copy: keys change the processing (o toggles ordering)
     const Source& source;
     bool pathMode = false;
     int patch = 64;
@@ -165,7 +165,7 @@ struct App {
         switch (k) {
         case 'q': case 27: quit = true; break;
         case 'p': pathMode = !pathMode; status = pathMode ? "path mode: click the path's points" : "positions mode: click patch centres"; dirty = true; break;
-        case 'o': const_cast<Options&>(options).process.order = !options.process.order; dirty = true; break;
+        case 'o': options.process.order = !options.process.order; dirty = true; break;
         case 'c': centers.clear(); path.clear(); dirty = true; break;
         case 'u': click({}, true); break;
         case '+': case '=': patch = std::min({patch + 8, source.width, source.height}); resizeCenters(); break;

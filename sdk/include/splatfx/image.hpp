@@ -29,12 +29,18 @@ struct Image {
     float at(int x, int y, int c) const { return pixels[(static_cast<size_t>(y) * width + x) * channels + c]; }
 };
 
+// How the colour of an RGBA image relates to its alpha, in memory.
+enum class Alpha {
+    Premultiplied, // colour already multiplied by alpha (OpenImageIO's convention; photos composite over black)
+    Straight,      // colour independent of alpha (texture sets whose alpha is opacity, not coverage)
+};
+
 // Fails with the file name and the reason: missing, unreadable, zero-size,
 // or more than 16384 pixels on a side.
-Result<Image> readImage(const std::string& path);
+Result<Image> readImage(const std::string& path, Alpha alpha = Alpha::Premultiplied);
 // Values are clamped to [0, 1] for 8-bit formats. Written to a temporary
 // name beside the target and renamed into place.
-Status writeImage(const std::string& path, const Image& image);
+Status writeImage(const std::string& path, const Image& image, Alpha alpha = Alpha::Premultiplied);
 
 } // namespace splatfx
 

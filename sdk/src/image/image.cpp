@@ -11,12 +11,14 @@ namespace splatfx {
 
 namespace fs = std::filesystem;
 
-Result<Image> readImage(const std::string& path) {
+Result<Image> readImage(const std::string& path, Alpha alpha) {
     std::error_code ec;
     if (!fs::exists(path, ec)) return makeError("cannot read image '" + path + "': no such file");
     if (fs::is_directory(path, ec)) return makeError("cannot read image '" + path + "': it is a folder");
     if (fs::file_size(path, ec) == 0) return makeError("cannot read image '" + path + "': the file is empty");
-    auto in = OIIO::ImageInput::open(path);
+    OIIO::ImageSpec config;
+    if (alpha == Alpha::Straight) config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(path, &config);
     if (!in) {
         std::string why = OIIO::geterror();
         if (why.empty()) why = "unknown format or corrupt data";
@@ -43,7 +45,7 @@ Result<Image> readImage(const std::string& path) {
     return img;
 }
 
-Status writeImage(const std::string& path, const Image& image) {
+Status writeImage(const std::string& path, const Image& image, Alpha alpha) {
     if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
         image.pixels.size() != size_t(image.width) * image.height * image.channels)
         return makeError("cannot write image '" + path + "': the image is empty or its size does not match its pixels");
@@ -55,6 +57,7 @@ Status writeImage(const std::string& path, const Image& image) {
     const std::string ext = target.extension().string();
     const bool eightBit = ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".gif" || ext == ".bmp";
     OIIO::ImageSpec spec(image.width, image.height, image.channels, eightBit ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+    if (alpha == Alpha::Straight) spec.attribute("oiio:UnassociatedAlpha", 1);
     std::vector<float> clamped;
     const float* data = image.pixels.data();
     if (eightBit) {

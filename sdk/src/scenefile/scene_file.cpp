@@ -823,9 +823,10 @@ std::optional<Effect> readGridKind(Context& c, ObjectReader& o, const EffectComm
                 const float t = (glm::dot(p, axis) - lo) / span;
                 dense[i] = std::clamp(w * opacity * glm::mix(1.0f, fadeTo, t), 0.0f, 1.0f);
             }
+    if (std::all_of(dense.begin(), dense.end(), [](float o) { return o <= 0.0f; }))
+        return c.d.error(join(e.path, "shapes"), "the shapes cover no cell of the lattice (dims) at non-zero opacity"), std::nullopt;
     Result<Grid> grid = Grid::fromDense(dims, dense, spacing);
     if (!grid) return c.d.error(e.path, grid.error()), std::nullopt;
-    if (grid->voxels.empty()) return c.d.error(join(e.path, "shapes"), "the shapes cover no cell of the lattice (dims) at non-zero opacity"), std::nullopt;
     for (Voxel& v : grid->voxels) v.colorCoord = std::clamp((glm::dot(glm::vec3(v.cell), axis) - lo) / span, 0.0f, 1.0f);
     grid->transform = pl.parent * local;
 
@@ -1012,6 +1013,11 @@ Result<SceneFile> parse(const std::string& text, const std::string& path, Materi
         // e.byte is 1-based: the position of the character that failed.
         const LineCol lc = lineColumn(text, e.byte == 0 ? 0 : e.byte - 1);
         return makeError(path + ":" + std::to_string(lc.line) + ":" + std::to_string(lc.column) + ": syntax error: " + syntaxReason(e.what()));
+    } catch (const Json::out_of_range& e) {
+        // A literal like 1e999: the JSON library refuses it while parsing.
+        std::string what = e.what();
+        const std::size_t p = what.find("] ");
+        return makeError(path + ": " + (p == std::string::npos ? what : what.substr(p + 2)) + " (expected a finite number)");
     }
 
     Diagnostics d(path, options.maxErrors);

@@ -132,7 +132,9 @@ Result<TextureSet> TextureSet::load(const std::string& folder) {
         const json& t = m["textures"][i];
         if (!t.is_string()) return makeError(where + "textures[" + std::to_string(i) + "] must be a file name string");
         const fs::path file = dir / t.get<std::string>();
-        auto img = readImage(file.string());
+        // Windowed sets store straight colour with opacity in alpha; raw sets
+        // made from photos keep alpha as coverage (composited over black).
+        auto img = readImage(file.string(), windowed ? Alpha::Straight : Alpha::Premultiplied);
         if (!img) return makeError("texture set '" + folder + "': " + img.error());
         images.push_back(std::move(*img));
     }
@@ -143,8 +145,12 @@ Result<TextureSet> TextureSet::load(const std::string& folder) {
         for (size_t k = 0; k < images.size(); ++k) {
             const Image& img = images[k];
             for (int p = 0; p < set->size * set->size; ++p) {
-                set->layers[k][size_t(p) * 4 + 3] = img.channels == 4 ? img.pixels[size_t(p) * 4 + 3] : img.pixels[size_t(p) * img.channels];
-                if (!color) set->layers[k][size_t(p) * 4] = set->layers[k][size_t(p) * 4 + 1] = set->layers[k][size_t(p) * 4 + 2] = 1.0f;
+                float* t = &set->layers[k][size_t(p) * 4];
+                const float a = img.channels == 4 ? img.pixels[size_t(p) * 4 + 3] : img.pixels[size_t(p) * img.channels];
+                t[3] = a;
+                // Alpha is opacity here, not coverage: colour stays as stored.
+                for (int c = 0; c < 3; ++c)
+                    t[c] = !color ? 1.0f : std::clamp(img.pixels[size_t(p) * img.channels + size_t(std::min(c, img.channels - 1))], 0.0f, 1.0f);
             }
         }
         set->isWindowed = true;
@@ -186,9 +192,12 @@ Status TextureSet::save(const std::string& folder, const std::string& provenance
         img.channels = isWindowed ? 4 : (color ? 3 : 1);
         img.pixels.resize(size_t(size) * size * img.channels);
         for (int p = 0; p < size * size; ++p)
-            for (int c = 0; c < img.channels; ++c)
-                img.pixels[size_t(p) * img.channels + c] = layers[k][size_t(p) * 4 + size_t(img.channels == 1 ? 0 : c)];
-        if (Status s = writeImage((tmp / name).string(), img); !s) return fail(s.error());
+            for (int c = 0; c < img.channels; ++c) {
+                const float* t = &layers[k][size_t(p) * 4];
+                img.pixels[size_t(p) * img.channels + c] = t[img.channels == 1 ? 0 : c];
+            }
+        // Windowed RGBA: alpha is opacity, colour is independent of it.
+        if (Status s = writeImage((tmp / name).string(), img, Alpha::Straight); !s) return fail(s.error());
         m["textures"].push_back(name);
     }
     m["provenance"] = provenance;

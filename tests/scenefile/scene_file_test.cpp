@@ -1,0 +1,220 @@
+// Scene-file parser tests (CPU): what a valid file builds, and that every kind
+// of bad input is refused with a message naming the file, the field and what
+// was expected.
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "splatfx/scene_file.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+const std::string kHead = R"("format": "splatfx-scene", "version": 1)";
+
+splatfx::Result<splatfx::SceneFile> parse(const std::string& body, const std::string& path = "dir/scene.json") {
+    splatfx::Materials m(splatfx::Footprint{});
+    return splatfx::parseSceneFile("{" + kHead + (body.empty() ? "" : ", " + body) + "}", path, m);
+}
+
+// Expects failure and every fragment in the message.
+void expectError(const std::string& body, std::initializer_list<const char*> fragments, const std::string& path = "dir/scene.json") {
+    auto r = parse(body, path);
+    ASSERT_FALSE(r.ok()) << "accepted: " << body;
+    for (const char* f : fragments) EXPECT_NE(r.error().find(f), std::string::npos) << "missing '" << f << "' in:\n" << r.error();
+}
+
+std::string corpus(const char* name) {
+    std::ifstream in(std::string(SPLATFX_SCENEFILE_CORPUS) + "/" + name);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(SceneFile, MinimalFileHasDefaults) {
+    auto r = parse("");
+    ASSERT_TRUE(r.ok()) << r.error();
+    EXPECT_EQ(r->scene.size(), 0u);
+    EXPECT_EQ(r->output.size, glm::ivec2(640, 480));
+    EXPECT_EQ(r->output.frames, 48);
+    EXPECT_EQ(r->output.name, "dir"); // the scene file's folder
+    ASSERT_EQ(r->camera.keys.size(), 1u);
+}
+
+TEST(SceneFile, FullCorpusFileBuildsEverything) {
+    splatfx::Materials m(splatfx::Footprint{});
+    auto r = splatfx::parseSceneFile(corpus("full.json"), "corpus/full.json", m);
+    ASSERT_TRUE(r.ok()) << r.error();
+    EXPECT_EQ(r->scene.size(), 7u);
+    ASSERT_EQ(r->effects.size(), 7u);
+    EXPECT_EQ(r->effects[0].kind, "fire");
+    EXPECT_EQ(r->effects[0].name, "fire0");
+    EXPECT_EQ(r->effects[6].name, "blob");
+    EXPECT_TRUE(r->effects[6].traditional);
+    EXPECT_FALSE(r->scene.options(r->effects[3].id).enabled);
+    EXPECT_FALSE(r->scene.effect(r->effects[0].id).desc().enabled.global);
+    EXPECT_FALSE(r->scene.effect(r->effects[4].id).isStateless()); // smoke is a solver effect
+    EXPECT_EQ(r->output.size, glm::ivec2(64, 48));
+    EXPECT_EQ(r->camera.keys.size(), 2u);
+    EXPECT_FALSE(r->camera.smooth);
+    EXPECT_NEAR(r->camera.keys[1].fovYRad, glm::radians(50.0f), 1e-6f);
+    ASSERT_EQ(r->geometry.size(), 5u);
+    EXPECT_EQ(r->geometry[1].type, splatfx::GeometryType::Empty);
+}
+
+TEST(SceneFile, AttachedObjectsShareTheRootMotionAndComposePlacements) {
+    auto r = parse(R"("geometry": [
+        {"name": "train", "type": "empty", "position": [0, 1, 0],
+         "motion": {"keys": [{"time": 0, "position": [0, 0, 0]}, {"time": 2, "position": [10, 0, 0]}]}},
+        {"name": "boiler", "type": "box", "attachTo": "train", "position": [1, 0, 0]},
+        {"name": "chimney", "type": "box", "attachTo": "boiler", "position": [0, 2, 0]}],
+      "effects": [{"kind": "fire", "dims": [2, 3, 2], "attachTo": "chimney", "position": [0, 0.5, 0]}])");
+    ASSERT_TRUE(r.ok()) << r.error();
+    const splatfx::GeometryDesc& chimney = r->geometry[2];
+    EXPECT_EQ(chimney.attachedTo, "boiler");
+    // World at t = 1: root motion (5, 0, 0) after train (0, 1, 0), boiler (1, 0, 0), chimney (0, 2, 0).
+    const glm::vec3 p = glm::vec3(chimney.motion.matrix(1.0) * chimney.transform * glm::vec4(0, 0, 0, 1));
+    EXPECT_NEAR(glm::distance(p, glm::vec3(6, 3, 0)), 0.0f, 1e-5f);
+    // The fire rides along: its grid moves with the train (the flame's base sits 0.5 above the chimney).
+    splatfx::Effect& fire = r->scene.effect(r->effects[0].id);
+    fire.update(1.0);
+    const glm::vec3 base = glm::vec3(fire.grid().transform * glm::vec4(0, 0, 0, 1));
+    EXPECT_NEAR(glm::distance(base, glm::vec3(6, 3.5f, 0)), 0.0f, 1e-5f);
+}
+
+TEST(SceneFile, SeedOptionChangesEveryEffectSeed) {
+    splatfx::Materials m(splatfx::Footprint{});
+    const std::string text = "{" + kHead + R"(, "seed": 5, "effects": [{"kind": "fire", "dims": [2, 3, 2]}]})";
+    auto a = splatfx::parseSceneFile(text, "s.json", m);
+    auto b = splatfx::parseSceneFile(text, "s.json", m, {.seed = 6});
+    ASSERT_TRUE(a.ok() && b.ok());
+    EXPECT_EQ(a->seed, 5u);
+    EXPECT_EQ(b->seed, 6u);
+    EXPECT_NE(a->scene.effect(0).desc().textures.seed, b->scene.effect(0).desc().textures.seed);
+}
+
+TEST(SceneFile, SyntaxErrorGivesLineAndColumn) {
+    splatfx::Materials m(splatfx::Footprint{});
+    auto r = splatfx::parseSceneFile("{\n  \"format\": \"splatfx-scene\",\n  \"version\": 1,,\n}", "bad.json", m);
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().find("bad.json:3:"), std::string::npos) << r.error();
+    EXPECT_NE(r.error().find("syntax error"), std::string::npos) << r.error();
+}
+
+TEST(SceneFile, WrongFormatOrVersionIsRefusedFirst) {
+    splatfx::Materials m(splatfx::Footprint{});
+    auto r = splatfx::parseSceneFile(R"({"format": "splatfx-texture-set", "version": 1})", "x.json", m);
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().find("x.json: format: expected \"splatfx-scene\""), std::string::npos) << r.error();
+    r = splatfx::parseSceneFile(R"({"format": "splatfx-scene", "version": 2})", "x.json", m);
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().find("version: expected 1, got 2 (written by a newer splatfx)"), std::string::npos) << r.error();
+}
+
+TEST(SceneFile, WrongTypeNamesTheField) {
+    expectError(R"("effects": [{"kind": "fire", "dims": "big"}])",
+                {"dir/scene.json: effects[0].dims: expected an array of 3 integers", "got a string \"big\""});
+    expectError(R"("output": {"frames": 2.5})", {"output.frames: expected an integer in [1, 100000], got 2.5"});
+    expectError(R"("effects": [{"kind": "fire", "crossfade": 1}])", {"effects[0].crossfade: expected true or false, got a number 1"});
+}
+
+TEST(SceneFile, UnknownEffectKindListsTheKinds) {
+    expectError(R"("effects": [{"kind": "fires"}])", {"effects[0].kind: unknown value \"fires\" (did you mean \"fire\"?)", "ghosts"});
+}
+
+TEST(SceneFile, MissingTextureSetNamesTheFolder) {
+    expectError(R"("effects": [{"kind": "fire"}, {"kind": "steam", "textureSet": "no/such/set"}])",
+                {"effects[1].textureSet: texture set 'no/such/set' not found", "dir/no/such/set/manifest.json"});
+}
+
+TEST(SceneFile, MissingTextureSetFallsBackWhenAskedTo) {
+    auto r = parse(R"("effects": [{"kind": "ghosts", "textureSet": {"folder": "no/faces", "ifMissing": "procedural", "count": 5}}])");
+    ASSERT_TRUE(r.ok()) << r.error();
+}
+
+TEST(SceneFile, AbsurdSizesAreRefusedBeforeAllocating) {
+    expectError(R"("effects": [{"kind": "fire", "dims": [1000, 1000, 1000]}])",
+                {"effects[0].dims: 1000x1000x1000 = 1000000000 cells is too many; expected at most 16777216"});
+    expectError(R"("effects": [{"kind": "smoke", "dims": [100, 100, 100]}])", {"effects[0].dims:", "at most 262144", "solver"});
+    expectError(R"("effects": [{"kind": "grid", "dims": [5, 99999, 5]}])", {"effects[0].dims[1]: expected an integer in [1, 4096], got 99999"});
+    expectError(R"("output": {"size": [100000, 10]})", {"output.size[0]: expected an integer in [16, 8192], got 100000"});
+}
+
+TEST(SceneFile, NonFiniteAndHugeValuesAreRefused) {
+    expectError(R"("effects": [{"kind": "fire", "position": [0, 1e999, 0]}])", {"dir/scene.json: number overflow parsing '1e999' (expected a finite number)"});
+    expectError(R"("effects": [{"kind": "fire", "position": [0, 1e30, 0]}])", {"effects[0].position[1]: expected a number in [-1e+06, 1e+06], got 1e+30"});
+    expectError(R"("camera": {"fovDeg": 0})", {"camera.fovDeg: expected a number in [1, 170], got 0"});
+}
+
+TEST(SceneFile, UnknownKeysAreReportedWithASuggestion) {
+    expectError(R"("effects": [{"kind": "fire", "dimz": [7, 20, 5]}])", {"effects[0].dimz: unknown key (did you mean \"dims\"?)"});
+    expectError(R"("outptu": {})", {"outptu: unknown key (did you mean \"output\"?)"});
+    // Keys of another kind are unknown here: fire has no "split".
+    expectError(R"("effects": [{"kind": "fire", "split": 0.5}])", {"effects[0].split: unknown key"});
+}
+
+TEST(SceneFile, SeveralProblemsAreReportedAtOnce) {
+    auto r = parse(R"("output": {"frames": -1, "fps": "fast"}, "effects": [{"kind": "fire", "opacity": 2}])");
+    ASSERT_FALSE(r.ok());
+    EXPECT_NE(r.error().find("output.frames"), std::string::npos) << r.error();
+    EXPECT_NE(r.error().find("output.fps"), std::string::npos) << r.error();
+    EXPECT_NE(r.error().find("effects[0].opacity"), std::string::npos) << r.error();
+}
+
+TEST(SceneFile, AttachmentErrors) {
+    expectError(R"("geometry": [{"name": "cow", "type": "box"}], "effects": [{"kind": "fire", "attachTo": "cwo"}])",
+                {"effects[0].attachTo: no geometry named 'cwo' (did you mean 'cow'?)"});
+    expectError(R"("geometry": [{"name": "a", "type": "box", "attachTo": "b"}, {"name": "b", "type": "box", "attachTo": "a"}])",
+                {"geometry[0].attachTo: attachment chain through 'b' loops"});
+    expectError(R"("effects": [{"kind": "smoke", "motion": {"velocity": [1, 0, 0]}}])", {"effects[0].motion: solver effects"});
+}
+
+TEST(SceneFile, MotionErrorsNameTheKey) {
+    expectError(R"("geometry": [{"type": "box", "motion": {"keys": [{"time": 1}, {"time": 1}]}}])",
+                {"geometry[0].motion.keys[1].time: key times must increase strictly"});
+    expectError(R"("geometry": [{"type": "box", "motion": {"keys": [{"time": 0, "easing": "bouncy"}]}}])",
+                {"geometry[0].motion.keys[0].easing: unknown value \"bouncy\""});
+}
+
+TEST(SceneFile, MissingMeshNamesTheResolvedPath) {
+    expectError(R"("geometry": [{"type": "mesh", "mesh": "cow.obj"}])", {"geometry[0].mesh: mesh file 'cow.obj' not found", "dir/cow.obj"});
+}
+
+TEST(SceneFile, DeepNestingIsRefused) {
+    std::string deep(200, '[');
+    expectError(R"("title": )" + deep, {"nesting deeper than 64 levels"});
+}
+
+TEST(SceneFile, GridShapesVoxelizeWithinTheLattice) {
+    auto r = parse(R"("effects": [{"kind": "grid", "dims": [9, 9, 9], "shapes": [{"type": "sphere", "center": [4, 4, 4], "radius": 2}]}])");
+    ASSERT_TRUE(r.ok()) << r.error();
+    const splatfx::Grid& g = r->scene.effect(0).grid();
+    // Cells whose centre is within radius + soft edge: about (4/3) pi 2.4^3 = 58; the soft edge keeps it between the 2.0 and 2.8 balls.
+    EXPECT_GT(g.voxels.size(), 33u);
+    EXPECT_LT(g.voxels.size(), 93u);
+    for (const splatfx::Voxel& v : g.voxels) EXPECT_LE(glm::distance(glm::vec3(v.cell), glm::vec3(4)), 2.0f + 0.75f);
+    expectError(R"("effects": [{"kind": "grid", "dims": [3, 3, 3], "shapes": [{"type": "sphere", "center": [40, 40, 40], "radius": 1}]}])",
+                {"effects[0].shapes: the shapes cover no cell"});
+}
+
+TEST(SceneFile, LoadSceneFileReportsAMissingFile) {
+    splatfx::Materials m(splatfx::Footprint{});
+    auto r = splatfx::loadSceneFile("definitely/not/here.json", m);
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error(), "definitely/not/here.json: scene file not found");
+}
+
+TEST(SceneFile, PathsAreRelativeToTheFile) {
+    const fs::path dir = fs::temp_directory_path() / "splatfx_scenefile_paths";
+    fs::create_directories(dir / "meshes");
+    std::ofstream(dir / "meshes" / "m.off") << "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    std::ofstream(dir / "scene.json") << "{" << kHead << R"(, "geometry": [{"type": "mesh", "mesh": "meshes/m.off"}]})";
+    splatfx::Materials m(splatfx::Footprint{});
+    auto r = splatfx::loadSceneFile((dir / "scene.json").string(), m);
+    ASSERT_TRUE(r.ok()) << r.error();
+    EXPECT_EQ(fs::path(r->geometry[0].meshPath), (dir / "meshes" / "m.off").lexically_normal());
+    fs::remove_all(dir);
+}
+
+} // namespace
