@@ -83,7 +83,7 @@ struct Config {
     bool textured = true;
     bool gaussian = false;
     float gaussianRadius = 2.0f;
-    float footprintCut = 1.0f;      // RendererDesc::footprintCut
+    float footprintCut = splatfx::gl::RendererDesc{}.footprintCut; // the SDK default
 };
 
 struct Row {

@@ -259,7 +259,7 @@ struct RowResult {
 
 struct Settings {
     int frames = 30;
-    float footprintCut = 1.0f;
+    float footprintCut = splatfx::gl::RendererDesc{}.footprintCut;
     bool crossfade = false;
     bool octagons = true;
 };
