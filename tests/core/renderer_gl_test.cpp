@@ -1,4 +1,5 @@
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 
 #include <epoxy/gl.h>
@@ -98,6 +99,7 @@ TEST_F(RendererGL, CampfireMatchesGoldenImage) {
     // splats overlapping a pixel, and (b) which edge pixels a triangle covers,
     // which moves a splat's faint rim by up to its edge value. So: mean within
     // one step, at most 2 % of pixels beyond two steps, no pixel beyond 24 steps.
+    std::printf("golden diff: mean %.3f/255 max %.1f/255 over %.2f%%\n", d.meanAbs * 255, d.maxAbs * 255, d.fractionOver * 100);
     const bool ok = d.meanAbs <= 1.0 / 255 && d.fractionOver <= 0.02 && d.maxAbs <= 24.0 / 255;
     EXPECT_TRUE(ok) << "mean " << d.meanAbs * 255 << "/255, max " << d.maxAbs * 255 << "/255, over " << d.fractionOver * 100
                     << "% -- " << test::writeFailureImages(actual, d);

@@ -27,24 +27,28 @@
 
 namespace splatfx {
 
-// One splat, laid out as the GPU reads it (64 bytes, 16 floats).
+// One splat, laid out as the GPU reads it (64 bytes).
 // A fragment at ellipse coordinates (u, v) in [-1, 1]^2, i.e. world position
 // center + u * axisU + v * axisV, gets
 //   texel  = mix(layer[layer](u, v), layer[nextLayer](u, v), blend)
 //   alpha  = 1 - exp2(-density * texel.a)
-//   colour = colourRow[colorRow](colorCoord).rgb * texel.rgb
-// composited with premultiplied "over".
+//   colour = color.rgb * texel.rgb
+// composited with premultiplied "over". `color` is the colour table's entry
+// at colorCoord in row colorRow, quantized to 8 bits per channel by the
+// builder, so the GPU needs no colour lookup; colorCoord and colorRow stay for
+// the reference renderer, which reads the table exactly.
 struct Splat {
     glm::vec3 center{0.0f};
-    float density = 0.0f;    // optical depth scale, log2 units (already includes the near-plane fade)
-    glm::vec3 axisU{0.0f};   // ellipse half-axis reaching the footprint's support radius
+    float density = 0.0f;        // optical depth scale, log2 units (already includes the near-plane fade)
+    glm::vec3 axisU{0.0f};       // ellipse half-axis reaching the footprint's support radius
     float colorCoord = 0.0f;
     glm::vec3 axisV{0.0f};
     float colorRow = 0.0f;
-    float layer = 0.0f;
-    float nextLayer = 0.0f;
-    float blend = 0.0f;      // cross-fade weight towards nextLayer
-    float depth = 0.0f;      // distance from the eye (perspective) or along forward (ortho); sort key
+    std::uint16_t layer = 0;     // texture-array layer (Materials)
+    std::uint16_t nextLayer = 0; // layer cross-faded towards
+    float blend = 0.0f;          // cross-fade weight towards nextLayer
+    std::uint32_t color = 0xffffffffu; // RGBA8, R in the lowest byte
+    float depth = 0.0f;          // distance from the eye (perspective) or along forward (ortho); sort key
 };
 static_assert(sizeof(Splat) == 64, "Splat must match the GPU layout");
 

@@ -94,15 +94,15 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
     const glm::vec3 half = glm::vec3(glm::max(grid.dims - 1, glm::ivec3(0))) * 0.5f;
     const glm::vec3 halfXZ(half.x, 0.0f, half.z);
 
-    // Colour-table alpha, read inline: it scales every voxel's opacity.
+    // Colour-table entry, read inline: its alpha scales the voxel's opacity,
+    // its colour goes into the splat (8 bits per channel).
     const std::vector<glm::vec4>* entries = table ? &table->entries : nullptr;
     const float lastEntry = entries ? float(entries->size() - 1) : 0.0f;
-    auto tableAlphaAt = [&](float t) {
-        if (!entries) return 1.0f;
+    auto tableAt = [&](float t) {
+        if (!entries) return glm::vec4(1.0f);
         const float f = std::clamp(t, 0.0f, 1.0f) * lastEntry;
         const size_t i = std::min(size_t(f), entries->size() - 2);
-        const float a = glm::mix((*entries)[i].a, (*entries)[i + 1].a, f - float(i));
-        return std::clamp(a, 0.0f, 1.0f);
+        return glm::clamp(glm::mix((*entries)[i], (*entries)[i + 1], f - float(i)), glm::vec4(0.0f), glm::vec4(1.0f));
     };
 
     // Written in place (no push_back in the loop); trimmed at the end.
@@ -167,7 +167,8 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
             ++mStats.rejected;
             continue;
         }
-        const float alpha = opacity * tableAlphaAt(v.colorCoord);
+        const glm::vec4 entry = tableAt(v.colorCoord);
+        const float alpha = opacity * entry.a;
         // Optical depth through the centre, relative to an isotropic voxel of
         // equal volume: the chord along d (1 / |M^-1 d|) over det(M)^(1/3).
         // log1p: 1.0f - alpha rounds to 1 for alpha < 6e-8, which would lose the voxel entirely.
@@ -177,8 +178,10 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         sp.colorCoord = std::clamp(v.colorCoord, 0.0f, 1.0f);
         sp.colorRow = hasTable ? float(style.colorTable) : 0.0f;
         const std::uint32_t index = v.texture % range.count; // one division per voxel, not two
-        sp.layer = float(range.first + index);
-        sp.nextLayer = float(range.first + (index + 1 == range.count ? 0 : index + 1));
+        sp.layer = std::uint16_t(range.first + index);
+        sp.nextLayer = std::uint16_t(range.first + (index + 1 == range.count ? 0 : index + 1));
+        sp.color = std::uint32_t(entry.r * 255.0f + 0.5f) | std::uint32_t(entry.g * 255.0f + 0.5f) << 8 |
+                   std::uint32_t(entry.b * 255.0f + 0.5f) << 16 | 0xff000000u;
         sp.blend = style.crossfade ? std::clamp(v.phase - std::floor(v.phase), 0.0f, 1.0f) : 0.0f;
         sp.depth = persp ? dist : viewZ;
         ++out;

@@ -170,7 +170,10 @@ Status TextureSet::save(const std::string& folder, const std::string& provenance
     const fs::path parent = target.parent_path().empty() ? fs::path(".") : target.parent_path();
     std::error_code ec;
     fs::create_directories(parent, ec);
-    const fs::path tmp = parent / ("." + target.filename().string() + ".tmp-" + std::to_string(getpid()));
+    // Built with append() rather than "." + name: GCC 12 warns falsely (-Wrestrict) on the latter.
+    std::string tmpName = ".";
+    tmpName.append(target.filename().string()).append(".tmp-").append(std::to_string(getpid()));
+    const fs::path tmp = parent / tmpName;
     fs::remove_all(tmp, ec);
     if (!fs::create_directory(tmp, ec)) return makeError("cannot create '" + tmp.string() + "': " + ec.message());
     auto fail = [&](const std::string& why) {

@@ -16,7 +16,7 @@
 // RendererDesc::restoreState = false it skips the queries (faster on drivers
 // where glGet stalls) and leaves: blend on (ONE, ONE_MINUS_SRC_ALPHA, ADD),
 // depth test on (LEQUAL), depth writes off, culling off, its own program,
-// vertex array and textures bound.
+// vertex array and texture array (unit 0) bound.
 //
 // Threading: every call on the thread whose context is current. Move-only.
 #pragma once

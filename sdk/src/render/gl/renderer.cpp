@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cstddef>
 #include <cstring>
+#include <initializer_list>
+#include <vector>
 
 #include <epoxy/gl.h>
 
@@ -14,9 +17,10 @@
 namespace splatfx::gl {
 namespace {
 
-GLuint compile(GLenum type, const char* src, std::string& log) {
+GLuint compile(GLenum type, std::initializer_list<const char*> parts, std::string& log) {
     GLuint s = glCreateShader(type);
-    glShaderSource(s, 1, &src, nullptr);
+    const std::vector<const char*> src(parts);
+    glShaderSource(s, GLsizei(src.size()), src.data(), nullptr);
     glCompileShader(s);
     GLint ok = 0;
     glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
@@ -93,8 +97,12 @@ struct SavedState {
 struct Renderer::Impl {
     RendererDesc desc;
     DrawStats stats;
-    GLuint program = 0, vao = 0, instances = 0, layers = 0, colors = 0;
-    GLint uViewProj = -1, uOctagon = -1, uColorRows = -1, uCut = -1;
+    struct Program {
+        GLuint id = 0;
+        GLint uViewProj = -1, uOctagon = -1, uCut = -1;
+    };
+    Program programs[2]; // [0]: no cross-fade in the frame, [1]: with cross-fade
+    GLuint vao = 0, instances = 0, layers = 0;
     // Instance data streams through a persistently mapped ring of kRing
     // regions: the CPU writes region i while the GPU may still read the
     // others; a fence per region says when it is free again. No per-frame
@@ -105,7 +113,6 @@ struct Renderer::Impl {
     GLsync fences[kRing] = {};
     int region = 0;
     std::uint64_t uploadedVersion = 0;
-    std::uint32_t colorRows = 0;
 
     void grow(std::size_t splats) {
         for (GLsync& f : fences)
@@ -130,11 +137,11 @@ struct Renderer::Impl {
         if (!detail::contextIsCurrent()) return;
         for (GLsync f : fences)
             if (f) glDeleteSync(f);
-        if (program) glDeleteProgram(program);
+        for (const Program& p : programs)
+            if (p.id) glDeleteProgram(p.id);
         if (vao) glDeleteVertexArrays(1, &vao);
         if (instances) glDeleteBuffers(1, &instances);
         if (layers) glDeleteTextures(1, &layers);
-        if (colors) glDeleteTextures(1, &colors);
     }
 };
 
@@ -152,39 +159,47 @@ Result<Renderer> Renderer::create(const RendererDesc& desc) {
                          std::to_string(epoxy_gl_version() / 10) + "." + std::to_string(epoxy_gl_version() % 10));
     auto impl = std::make_unique<Impl>();
     impl->desc = desc;
-    std::string log;
-    GLuint vs = compile(GL_VERTEX_SHADER, detail::kSplatVertex, log);
-    if (!vs) return makeError("splat vertex shader failed to compile: " + log);
-    GLuint fs = compile(GL_FRAGMENT_SHADER, detail::kSplatFragment, log);
-    if (!fs) {
+    for (int crossfade = 0; crossfade < 2; ++crossfade) {
+        std::string log;
+        GLuint vs = compile(GL_VERTEX_SHADER, {detail::kSplatVertex}, log);
+        if (!vs) return makeError("splat vertex shader failed to compile: " + log);
+        GLuint fs = compile(GL_FRAGMENT_SHADER,
+                            {"#version 450 core\n", crossfade ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n", detail::kSplatFragment}, log);
+        if (!fs) {
+            glDeleteShader(vs);
+            return makeError("splat fragment shader failed to compile: " + log);
+        }
+        Impl::Program& p = impl->programs[crossfade];
+        p.id = glCreateProgram();
+        glAttachShader(p.id, vs);
+        glAttachShader(p.id, fs);
+        glLinkProgram(p.id);
         glDeleteShader(vs);
-        return makeError("splat fragment shader failed to compile: " + log);
+        glDeleteShader(fs);
+        GLint ok = 0;
+        glGetProgramiv(p.id, GL_LINK_STATUS, &ok);
+        if (!ok) {
+            char buf[4096];
+            glGetProgramInfoLog(p.id, sizeof buf, nullptr, buf);
+            return makeError(std::string("splat program failed to link: ") + buf);
+        }
+        p.uViewProj = glGetUniformLocation(p.id, "uViewProj");
+        p.uOctagon = glGetUniformLocation(p.id, "uOctagon");
+        p.uCut = glGetUniformLocation(p.id, "uCut");
     }
-    impl->program = glCreateProgram();
-    glAttachShader(impl->program, vs);
-    glAttachShader(impl->program, fs);
-    glLinkProgram(impl->program);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    GLint ok = 0;
-    glGetProgramiv(impl->program, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char buf[4096];
-        glGetProgramInfoLog(impl->program, sizeof buf, nullptr, buf);
-        return makeError(std::string("splat program failed to link: ") + buf);
-    }
-    impl->uViewProj = glGetUniformLocation(impl->program, "uViewProj");
-    impl->uOctagon = glGetUniformLocation(impl->program, "uOctagon");
-    impl->uColorRows = glGetUniformLocation(impl->program, "uColorRows");
-    impl->uCut = glGetUniformLocation(impl->program, "uCut");
 
     glCreateVertexArrays(1, &impl->vao);
     impl->grow(0);
     if (!impl->mapped) return makeError("splatfx::gl::Renderer::create: cannot map a persistent instance buffer");
     glVertexArrayBindingDivisor(impl->vao, 0, 1);
-    for (GLuint a = 0; a < 4; ++a) {
+    // The Splat struct as vertex attributes (one per instance):
+    // three vec4s, the layer pair as two u16, blend, and the RGBA8 colour.
+    for (GLuint a = 0; a < 3; ++a) glVertexArrayAttribFormat(impl->vao, a, 4, GL_FLOAT, GL_FALSE, a * 16);
+    glVertexArrayAttribIFormat(impl->vao, 3, 2, GL_UNSIGNED_SHORT, offsetof(Splat, layer));
+    glVertexArrayAttribFormat(impl->vao, 4, 1, GL_FLOAT, GL_FALSE, offsetof(Splat, blend));
+    glVertexArrayAttribFormat(impl->vao, 5, 4, GL_UNSIGNED_BYTE, GL_TRUE, offsetof(Splat, color));
+    for (GLuint a = 0; a < 6; ++a) {
         glEnableVertexArrayAttrib(impl->vao, a);
-        glVertexArrayAttribFormat(impl->vao, a, 4, GL_FLOAT, GL_FALSE, a * 16);
         glVertexArrayAttribBinding(impl->vao, a, 0);
     }
     return Renderer(std::move(impl));
@@ -193,7 +208,6 @@ Result<Renderer> Renderer::create(const RendererDesc& desc) {
 Status Renderer::upload(const Materials& materials) {
     Impl& r = *mImpl;
     if (materials.version() == r.uploadedVersion) return {};
-    if (materials.colorTableCount() == 0) return makeError("splatfx::gl::Renderer::upload: materials hold no colour table");
     const int n = materials.layerSize();
     const std::uint32_t count = materials.layerCount();
     GLint maxLayers = 0;
@@ -212,17 +226,6 @@ Status Renderer::upload(const Materials& materials) {
     glTextureParameteri(r.layers, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTextureParameteri(r.layers, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
 
-    const int width = materials.colorTableSize();
-    r.colorRows = materials.colorTableCount();
-    if (r.colors) glDeleteTextures(1, &r.colors);
-    glCreateTextures(GL_TEXTURE_2D, 1, &r.colors);
-    glTextureStorage2D(r.colors, 1, GL_RGBA16F, width, GLsizei(r.colorRows));
-    for (std::uint32_t row = 0; row < r.colorRows; ++row)
-        glTextureSubImage2D(r.colors, 0, 0, GLint(row), width, 1, GL_RGBA, GL_FLOAT, materials.colorRow(row).data());
-    glTextureParameteri(r.colors, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-    glTextureParameteri(r.colors, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTextureParameteri(r.colors, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTextureParameteri(r.colors, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     r.uploadedVersion = materials.version();
     return {};
 }
@@ -262,14 +265,14 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
     glDepthMask(GL_FALSE);
     glDisable(GL_CULL_FACE);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glUseProgram(r.program);
+    const bool anyCrossfade = std::any_of(splats.begin(), splats.end(), [](const Splat& s) { return s.blend > 0.0f; });
+    const Impl::Program& p = r.programs[anyCrossfade ? 1 : 0];
+    glUseProgram(p.id);
     const glm::mat4 vp = camera.proj * camera.view;
-    glUniformMatrix4fv(r.uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
-    glUniform1i(r.uOctagon, r.desc.trimCorners ? 1 : 0);
-    glUniform1f(r.uColorRows, float(r.colorRows));
-    glUniform1f(r.uCut, std::clamp(r.desc.footprintCut, 0.05f, 1.0f));
+    glUniformMatrix4fv(p.uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
+    glUniform1i(p.uOctagon, r.desc.trimCorners ? 1 : 0);
+    glUniform1f(p.uCut, std::clamp(r.desc.footprintCut, 0.05f, 1.0f));
     glBindTextureUnit(0, r.layers);
-    glBindTextureUnit(1, r.colors);
     glBindVertexArray(r.vao);
     glDrawArraysInstancedBaseInstance(GL_TRIANGLE_STRIP, 0, r.desc.trimCorners ? 8 : 4, GLsizei(splats.size()), GLuint(first));
     r.fences[r.region] = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);

@@ -9,13 +9,13 @@ inline constexpr const char* kSplatVertex = R"(#version 450 core
 layout(location = 0) in vec4 aCenterDensity;
 layout(location = 1) in vec4 aAxisUColor;
 layout(location = 2) in vec4 aAxisVRow;
-layout(location = 3) in vec4 aLayers;
+layout(location = 3) in uvec2 aLayers;
+layout(location = 4) in float aBlend;
+layout(location = 5) in vec4 aColor; // RGBA8, normalized by the vertex fetch
 
 uniform mat4 uViewProj;
 uniform int uOctagon;
 uniform float uCut;
-uniform float uColorRows;
-layout(binding = 1) uniform sampler2D uColors;
 
 out vec2 vTex;
 flat out float vDensity;
@@ -34,15 +34,15 @@ void main() {
     // Layer images are stored top row first; +v is the splat's "up".
     vTex = vec2(0.5 + 0.5 * uv.x, 0.5 - 0.5 * uv.y);
     vDensity = aCenterDensity.w;
-    vLayers = aLayers.xyz;
-    // Colour is constant over a splat: look it up once per vertex, texel-centre exact.
-    float n = float(textureSize(uColors, 0).x);
-    vec2 tc = vec2((aAxisUColor.w * (n - 1.0) + 0.5) / n, (aAxisVRow.w + 0.5) / uColorRows);
-    vColor = texture(uColors, tc).rgb;
+    vLayers = vec3(float(aLayers.x), float(aLayers.y), aBlend);
+    vColor = aColor.rgb;
 }
 )";
 
-inline constexpr const char* kSplatFragment = R"(#version 450 core
+// Compiled twice, after "#version 450 core\n#define CROSSFADE 0|1\n": a draw
+// with no cross-faded splat skips the second fetch and the branch entirely
+// (software rasterizers execute both sides of a per-fragment branch).
+inline constexpr const char* kSplatFragment = R"(
 layout(binding = 0) uniform sampler2DArray uLayers;
 in vec2 vTex;
 flat in float vDensity;
@@ -52,7 +52,9 @@ layout(location = 0) out vec4 oColor;
 
 void main() {
     vec4 t = texture(uLayers, vec3(vTex, vLayers.x));
+#if CROSSFADE
     if (vLayers.z > 0.0) t = mix(t, texture(uLayers, vec3(vTex, vLayers.y)), vLayers.z);
+#endif
     // Opacity from optical depth: alpha = 1 - 2^(-density * detail).
     float a = 1.0 - exp2(-vDensity * t.a);
     oColor = vec4(vColor * t.rgb * a, a);
