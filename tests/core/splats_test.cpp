@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <cstring>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
@@ -188,4 +189,29 @@ TEST(SplatBuilder, ClampsOpacityAndDropsNonFiniteVoxels) {
     EXPECT_EQ(b.stats().rejected, 1u);
     ASSERT_EQ(b.splats().size(), 2u);
     EXPECT_EQ(b.splats()[0].density, b.splats()[1].density); // 7 clamped to 1, like the first
+}
+
+TEST(SplatBuilder, ThreadsGiveTheSameSplatsAsOneThread) {
+    const Materials m = plainMaterials();
+    Grid g = *Grid::box({40, 40, 40}, glm::vec3(0.25f));
+    for (size_t i = 0; i < g.voxels.size(); i += 7) g.voxels[i].opacity = 0.0f;              // some culled
+    for (size_t i = 3; i < g.voxels.size(); i += 11) g.voxels[i].stretch = {0.0f, 0.5f, 0.0f}; // some stretched
+    g.voxels[5].opacity = std::nanf("");                                                     // one rejected
+    const Camera cam = Camera::lookAt({2, 6, 14}, {0, 4, 0}, {0, 1, 0}, 0.9f, {320, 240});
+    auto build = [&](unsigned threads) {
+        SplatBuilder b({.threads = threads});
+        b.begin(cam);
+        b.add(g, m);
+        b.sort();
+        return std::pair(b.splats(), b.stats());
+    };
+    const auto [one, oneStats] = build(1);
+    for (unsigned t : {2u, 3u, 8u}) {
+        const auto [many, manyStats] = build(t);
+        ASSERT_EQ(many.size(), one.size()) << t << " threads";
+        EXPECT_EQ(std::memcmp(many.data(), one.data(), one.size() * sizeof(Splat)), 0) << t << " threads";
+        EXPECT_EQ(manyStats.culled, oneStats.culled);
+        EXPECT_EQ(manyStats.rejected, oneStats.rejected);
+    }
+    EXPECT_EQ(oneStats.rejected, 1u);
 }

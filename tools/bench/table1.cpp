@@ -10,6 +10,7 @@
 #include <numeric>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <epoxy/gl.h>
@@ -360,9 +361,12 @@ RowResult measureRow(const Row& row, const Settings& settings) {
 // CPU work per frame (dynamics + build + sort + copy into the instance
 // stream) at growing voxel counts.
 void cpuScaling(std::FILE* csv) {
-    std::printf("\nCPU work per frame (texture cycling + splat build + radix sort + copy to the instance stream):\n");
-    std::printf("%10s %12s %12s\n", "voxels", "ms/frame", "ns/voxel");
-    std::fprintf(csv, "\nvoxels,ms_per_frame,ns_per_voxel\n");
+    const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+    std::printf("\nCPU work per frame (texture cycling + splat build + radix sort + copy to the instance stream),\n"
+                "SplatBuilderDesc::threads = 1 (default) and = %u (this machine's hardware threads):\n", hw);
+    std::printf("%10s %12s %12s %12s %12s\n", "voxels", "ms/frame", "ns/voxel", "ms/frame", "ns/voxel");
+    std::printf("%10s %25s %25s\n", "", "1 thread", (std::to_string(hw) + " threads").c_str());
+    std::fprintf(csv, "\nvoxels,threads,ms_per_frame,ns_per_voxel\n");
     splatfx::Materials materials{splatfx::Footprint{}};
     const auto set = materials.addTextureSet(splatfx::TextureSet::turbulence({}));
     const auto lut = materials.addColorTable(splatfx::ColorTable::fire());
@@ -370,20 +374,24 @@ void cpuScaling(std::FILE* csv) {
         const int side = std::max(1, int(std::round(std::cbrt(double(n)))));
         splatfx::Grid base = *splatfx::Grid::box({side, side, side}, glm::vec3(10.0f / side));
         splatfx::Grid grid = base;
-        splatfx::SplatBuilder builder({.frustumCull = false});
         std::vector<splatfx::Splat> stream(grid.voxels.size());
         const splatfx::Camera cam = splatfx::Camera::lookAt({3, 8, 30}, {0, 5, 0}, {0, 1, 0}, 0.8f, {640, 480});
         const int frames = n >= 1000000 ? 5 : n >= 100000 ? 15 : 50;
-        const double sec = medianFrame(2, frames, [&](int i) {
-            cycle(base, grid, i / 60.0);
-            builder.begin(cam);
-            builder.add(grid, materials, {.textureSet = set, .colorTable = lut, .crossfade = true});
-            builder.sort();
-            std::memcpy(stream.data(), builder.splats().data(), builder.splats().size() * sizeof(splatfx::Splat));
-        });
-        const double ns = 1e9 * sec / double(grid.voxels.size());
-        std::printf("%10zu %12.3f %12.1f\n", grid.voxels.size(), 1e3 * sec, ns);
-        std::fprintf(csv, "%zu,%.4f,%.2f\n", grid.voxels.size(), 1e3 * sec, ns);
+        std::printf("%10zu", grid.voxels.size());
+        for (unsigned threads : {1u, hw}) {
+            splatfx::SplatBuilder builder({.frustumCull = false, .threads = threads});
+            const double sec = medianFrame(2, frames, [&](int i) {
+                cycle(base, grid, i / 60.0);
+                builder.begin(cam);
+                builder.add(grid, materials, {.textureSet = set, .colorTable = lut, .crossfade = true});
+                builder.sort();
+                std::memcpy(stream.data(), builder.splats().data(), builder.splats().size() * sizeof(splatfx::Splat));
+            });
+            const double ns = 1e9 * sec / double(grid.voxels.size());
+            std::printf(" %12.3f %12.1f", 1e3 * sec, ns);
+            std::fprintf(csv, "%zu,%u,%.4f,%.2f\n", grid.voxels.size(), threads, 1e3 * sec, ns);
+        }
+        std::printf("\n");
     }
 }
 

@@ -72,6 +72,10 @@ struct SplatBuilderDesc {
     float nearFadeEnd = 1.5f;    // ... and is complete (full opacity) at near + nearFadeEnd * extent; default 1.5
     bool frustumCull = true;     // drop splats wholly outside the view frustum; default true
     std::uint32_t buckets = 64;  // depth bins for SortMode::Bucketed; default 64
+    // Threads add() may use on a large grid (one per 8192 voxels at most);
+    // the output is identical for any count. 0: one per hardware thread.
+    // Default 1: the SDK starts no threads unless asked.
+    unsigned threads = 1;
 };
 
 struct SplatStats {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <thread>
+#include <vector>
 
 namespace splatfx {
 namespace {
@@ -76,6 +78,11 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         glm::mat3 sigma, sigmaInv; // M M^T and its inverse
         float cbrtDet = 1.0f, extent = 0.0f;
         bool ok = false;
+        // Sigma = s^2 I (cubic spacing, rotation, uniform scale): every view
+        // sees a circle of radius s and a chord of s, so the 2x2 square root
+        // and |M^-1 d| are known without per-voxel work.
+        bool isotropic = false;
+        float s = 0.0f;
         Shape() = default;
         explicit Shape(const glm::mat3& m, float R) {
             const float det = glm::determinant(m);
@@ -87,6 +94,12 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
             cbrtDet = std::cbrt(std::abs(det));
             // Conservative world extent of the footprint: R times the kernel's largest axis.
             extent = R * std::sqrt(sigma[0][0] + sigma[1][1] + sigma[2][2]);
+            const float s2 = (sigma[0][0] + sigma[1][1] + sigma[2][2]) / 3.0f;
+            float offIso = 0.0f;
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) offIso = std::max(offIso, std::abs(sigma[i][j] - (i == j ? s2 : 0.0f)));
+            isotropic = offIso <= 1e-6f * s2;
+            s = std::sqrt(s2);
         }
     };
     const glm::mat3 gridShape = rot * glm::mat3(glm::vec3(grid.spacing.x, 0, 0), glm::vec3(0, grid.spacing.y, 0), glm::vec3(0, 0, grid.spacing.z));
@@ -105,88 +118,128 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         return glm::clamp(glm::mix((*entries)[i], (*entries)[i + 1], f - float(i)), glm::vec4(0.0f), glm::vec4(1.0f));
     };
 
-    // Written in place (no push_back in the loop); trimmed at the end.
-    const std::size_t first = mSplats.size();
-    mSplats.resize(first + grid.voxels.size());
-    Splat* out = mSplats.data() + first;
-    for (const Voxel& v : grid.voxels) {
-        const float stretch2 = glm::dot(v.stretch, v.stretch);
-        const Shape* shapePtr = &plain;
-        Shape stretchedShape;
-        if (stretch2 > 0.0f) {
-            const float stretchLen = std::sqrt(stretch2);
-            const glm::vec3 sd = v.stretch / stretchLen;
-            stretchedShape = Shape(gridShape * (glm::mat3(1.0f) + stretchLen * glm::outerProduct(sd, sd)), R);
-            stretchedShape.ok = stretchedShape.ok && std::isfinite(stretchLen);
-            shapePtr = &stretchedShape;
-        }
-        const Shape& shape = *shapePtr;
-        const glm::vec3 c = glm::vec3(grid.transform * glm::vec4((glm::vec3(v.cell) - halfXZ) * grid.spacing, 1.0f));
-        if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord) || !std::isfinite(v.phase) || !finite3(c) || !shape.ok ||
-            !std::isfinite(stretch2)) {
-            ++mStats.rejected;
-            continue;
-        }
-        const float opacity = std::clamp(v.opacity * opacityScale, 0.0f, 1.0f);
-        const glm::vec3 toC = c - eye;
-        const float viewZ = glm::dot(toC, fwd);
-        const float extent = shape.extent;
-        bool outside = opacity <= 0.0f;
-        if (mDesc.frustumCull)
-            for (const auto& p : planes) outside = outside || glm::dot(glm::vec3(p), c) + p.w < -extent;
-        const float fade = smoothstep(nearZ + mDesc.nearFadeStart * extent, nearZ + mDesc.nearFadeEnd * extent, viewZ);
-        if (outside || fade <= 0.0f) {
-            ++mStats.culled;
-            continue;
-        }
+    // One pass over a range of voxels, writing splats in place from `out`
+    // (no push_back); returns the end of what it wrote. Reads only shared,
+    // unchanging state, so ranges can run on several threads.
+    auto build = [&](const Voxel* begin, const Voxel* end, Splat* out, SplatStats& stats) {
+        for (const Voxel* vp = begin; vp != end; ++vp) {
+            const Voxel& v = *vp;
+            const float stretch2 = glm::dot(v.stretch, v.stretch);
+            const Shape* shapePtr = &plain;
+            Shape stretchedShape;
+            if (stretch2 > 0.0f) {
+                const float stretchLen = std::sqrt(stretch2);
+                const glm::vec3 sd = v.stretch / stretchLen;
+                stretchedShape = Shape(gridShape * (glm::mat3(1.0f) + stretchLen * glm::outerProduct(sd, sd)), R);
+                stretchedShape.ok = stretchedShape.ok && std::isfinite(stretchLen);
+                shapePtr = &stretchedShape;
+            }
+            const Shape& shape = *shapePtr;
+            const glm::vec3 c = glm::vec3(grid.transform * glm::vec4((glm::vec3(v.cell) - halfXZ) * grid.spacing, 1.0f));
+            if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord) || !std::isfinite(v.phase) || !finite3(c) || !shape.ok ||
+                !std::isfinite(stretch2)) {
+                ++stats.rejected;
+                continue;
+            }
+            const float opacity = std::clamp(v.opacity * opacityScale, 0.0f, 1.0f);
+            const glm::vec3 toC = c - eye;
+            const float viewZ = glm::dot(toC, fwd);
+            const float extent = shape.extent;
+            bool outside = opacity <= 0.0f;
+            if (mDesc.frustumCull)
+                for (const auto& p : planes) outside = outside || glm::dot(glm::vec3(p), c) + p.w < -extent;
+            const float fade = smoothstep(nearZ + mDesc.nearFadeStart * extent, nearZ + mDesc.nearFadeEnd * extent, viewZ);
+            if (outside || fade <= 0.0f) {
+                ++stats.culled;
+                continue;
+            }
 
-        // Screen-plane basis at the splat: perpendicular to the ray through
-        // its centre, "up" as close to the camera's up as possible so
-        // textures stay upright (flames rise on screen).
-        const float dist = glm::length(toC);
-        const glm::vec3 d = persp ? (dist > 1e-20f ? toC / dist : fwd) : fwd;
-        glm::vec3 e1 = glm::cross(d, camUp);
-        const float e1Len = glm::length(e1);
-        e1 = e1Len > 1e-6f ? e1 / e1Len : camRight;
-        const glm::vec3 e2 = glm::cross(e1, d); // unit: e1 and d are orthonormal
+            // Screen-plane basis at the splat: perpendicular to the ray through
+            // its centre, "up" as close to the camera's up as possible so
+            // textures stay upright (flames rise on screen).
+            const float dist = glm::length(toC);
+            const glm::vec3 d = persp ? (dist > 1e-20f ? toC * (1.0f / dist) : fwd) : fwd;
+            glm::vec3 e1 = glm::cross(d, camUp);
+            const float e1Len = glm::length(e1);
+            e1 = e1Len > 1e-6f ? e1 * (1.0f / e1Len) : camRight;
+            const glm::vec3 e2 = glm::cross(e1, d); // unit: e1 and d are orthonormal
 
-        // Line integral of h(|M^-1 x|) along d at plane offset q: F(|q|_Q) / |M^-1 d|.
-        // Q is the Schur complement of Sigma^-1 = (M M^T)^-1 in the frame
-        // (e1, e2, d), so Q^-1 is simply the (e1, e2) block of Sigma: the
-        // ellipse's axes are the square root of that 2x2 block.
-        const glm::vec3 se1 = shape.sigma * e1, se2 = shape.sigma * e2;
-        float sq[3];
-        sqrt2x2(glm::dot(e1, se1), glm::dot(e2, se1), glm::dot(e2, se2), sq);
-        const float bLen = std::sqrt(glm::dot(d, shape.sigmaInv * d));
+            // Line integral of h(|M^-1 x|) along d at plane offset q: F(|q|_Q) / |M^-1 d|.
+            // Q is the Schur complement of Sigma^-1 = (M M^T)^-1 in the frame
+            // (e1, e2, d), so Q^-1 is simply the (e1, e2) block of Sigma: the
+            // ellipse's axes are the square root of that 2x2 block.
+            float sq[3] = {shape.s, 0.0f, shape.s};
+            float bLen = 1.0f / shape.s;
+            if (!shape.isotropic) {
+                const glm::vec3 se1 = shape.sigma * e1, se2 = shape.sigma * e2;
+                sqrt2x2(glm::dot(e1, se1), glm::dot(e2, se1), glm::dot(e2, se2), sq);
+                bLen = std::sqrt(glm::dot(d, shape.sigmaInv * d));
+            }
 
-        Splat& sp = *out;
-        sp.center = c;
-        sp.axisU = R * (sq[0] * e1 + sq[1] * e2);
-        sp.axisV = R * (sq[1] * e1 + sq[2] * e2);
-        if (!finite3(sp.axisU) || !finite3(sp.axisV)) {
-            ++mStats.rejected;
-            continue;
+            Splat& sp = *out;
+            sp.center = c;
+            sp.axisU = R * (sq[0] * e1 + sq[1] * e2);
+            sp.axisV = R * (sq[1] * e1 + sq[2] * e2);
+            if (!finite3(sp.axisU) || !finite3(sp.axisV)) {
+                ++stats.rejected;
+                continue;
+            }
+            const glm::vec4 entry = tableAt(v.colorCoord);
+            const float alpha = opacity * entry.a;
+            // Optical depth through the centre, relative to an isotropic voxel of
+            // equal volume: the chord along d (1 / |M^-1 d|) over det(M)^(1/3).
+            // log1p: 1.0f - alpha rounds to 1 for alpha < 6e-8, which would lose the voxel entirely.
+            const float tau = alpha >= 1.0f ? kMaxTau : std::min(-std::log1p(-alpha) * 1.44269504f, kMaxTau);
+            const float chord = (1.0f / bLen) / shape.cbrtDet;
+            sp.density = tau * std::min(chord, 64.0f) * fade * range.gain;
+            sp.colorCoord = std::clamp(v.colorCoord, 0.0f, 1.0f);
+            sp.colorRow = hasTable ? float(style.colorTable) : 0.0f;
+            const std::uint32_t index = v.texture % range.count; // one division per voxel, not two
+            sp.layer = std::uint16_t(range.first + index);
+            sp.nextLayer = std::uint16_t(range.first + (index + 1 == range.count ? 0 : index + 1));
+            sp.color = std::uint32_t(entry.r * 255.0f + 0.5f) | std::uint32_t(entry.g * 255.0f + 0.5f) << 8 |
+                       std::uint32_t(entry.b * 255.0f + 0.5f) << 16 | 0xff000000u;
+            sp.blend = style.crossfade ? std::clamp(v.phase - std::floor(v.phase), 0.0f, 1.0f) : 0.0f;
+            sp.depth = persp ? dist : viewZ;
+            ++out;
         }
-        const glm::vec4 entry = tableAt(v.colorCoord);
-        const float alpha = opacity * entry.a;
-        // Optical depth through the centre, relative to an isotropic voxel of
-        // equal volume: the chord along d (1 / |M^-1 d|) over det(M)^(1/3).
-        // log1p: 1.0f - alpha rounds to 1 for alpha < 6e-8, which would lose the voxel entirely.
-        const float tau = alpha >= 1.0f ? kMaxTau : std::min(-std::log1p(-alpha) * 1.44269504f, kMaxTau);
-        const float chord = (1.0f / bLen) / shape.cbrtDet;
-        sp.density = tau * std::min(chord, 64.0f) * fade * range.gain;
-        sp.colorCoord = std::clamp(v.colorCoord, 0.0f, 1.0f);
-        sp.colorRow = hasTable ? float(style.colorTable) : 0.0f;
-        const std::uint32_t index = v.texture % range.count; // one division per voxel, not two
-        sp.layer = std::uint16_t(range.first + index);
-        sp.nextLayer = std::uint16_t(range.first + (index + 1 == range.count ? 0 : index + 1));
-        sp.color = std::uint32_t(entry.r * 255.0f + 0.5f) | std::uint32_t(entry.g * 255.0f + 0.5f) << 8 |
-                   std::uint32_t(entry.b * 255.0f + 0.5f) << 16 | 0xff000000u;
-        sp.blend = style.crossfade ? std::clamp(v.phase - std::floor(v.phase), 0.0f, 1.0f) : 0.0f;
-        sp.depth = persp ? dist : viewZ;
-        ++out;
+        return out;
+    };
+
+    const std::size_t first = mSplats.size(), n = grid.voxels.size();
+    mSplats.resize(first + n);
+    const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
+    const unsigned wanted = mDesc.threads == 0 ? hw : mDesc.threads;
+    // Threads only pay off on large grids: below ~8k voxels a thread's start-up costs more than it saves.
+    const unsigned threads = unsigned(std::clamp<std::size_t>(n / 8192, 1, std::max(1u, wanted)));
+    if (threads <= 1) {
+        Splat* out = build(grid.voxels.data(), grid.voxels.data() + n, mSplats.data() + first, mStats);
+        mSplats.resize(std::size_t(out - mSplats.data()));
+        return;
     }
-    mSplats.resize(std::size_t(out - mSplats.data()));
+    // Contiguous chunks keep the output in voxel order, so the result (and
+    // the stable sort after it) is the same for any thread count.
+    std::vector<SplatStats> stats(threads);
+    std::vector<Splat*> ends(threads);
+    std::vector<std::thread> pool;
+    auto chunk = [&](unsigned t) { return first + n * t / threads; };
+    for (unsigned t = 1; t < threads; ++t)
+        pool.emplace_back([&, t] {
+            ends[t] = build(grid.voxels.data() + (chunk(t) - first), grid.voxels.data() + (chunk(t + 1) - first),
+                            mSplats.data() + chunk(t), stats[t]);
+        });
+    ends[0] = build(grid.voxels.data(), grid.voxels.data() + (chunk(1) - first), mSplats.data() + first, stats[0]);
+    for (std::thread& th : pool) th.join();
+    Splat* write = ends[0];
+    for (unsigned t = 0; t < threads; ++t) {
+        if (t > 0) {
+            const Splat* from = mSplats.data() + chunk(t);
+            write = std::copy(from, static_cast<const Splat*>(ends[t]), write);
+        }
+        mStats.rejected += stats[t].rejected;
+        mStats.culled += stats[t].culled;
+    }
+    mSplats.resize(std::size_t(write - mSplats.data()));
 }
 
 void SplatBuilder::sort(SortMode mode) { sortBackToFront(mSplats, mode, mDesc.buckets); }
