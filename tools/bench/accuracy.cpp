@@ -84,6 +84,7 @@ struct Config {
     bool gaussian = false;
     float gaussianRadius = 2.0f;
     float footprintCut = splatfx::gl::RendererDesc{}.footprintCut; // the SDK default
+    bool octagons = splatfx::gl::RendererDesc{}.trimCorners;        // the SDK default
 };
 
 struct Row {
@@ -277,6 +278,7 @@ struct Bench {
         auto fb = splatfx::gl::Framebuffer::create({.width = opt.size.x, .height = opt.size.y, .color = c.precision});
         splatfx::gl::RendererDesc rdesc;
         rdesc.footprintCut = c.footprintCut;
+        rdesc.trimCorners = c.octagons;
         auto sr = splatfx::gl::ScaledRenderer::create({.scale = c.scale, .renderer = rdesc});
         if (!fb || !sr || !sr->upload(*s->mat)) {
             std::fprintf(stderr, "accuracy: cannot set up GL for %s %s\n", knob.c_str(), setting.c_str());
@@ -511,12 +513,20 @@ int runAccuracy(int argc, char** argv) {
         c.scale = s;
         b.add("render scale", s == 1 ? "full (default)" : s == 2 ? "half" : "quarter", c, onTexture, truth);
     }
-    for (float cut : {0.6f, 0.7f, 0.81f, 0.9f, 1.0f}) {
+    const float defaultCut = splatfx::gl::RendererDesc{}.footprintCut;
+    for (float cut : {0.6f, 0.7f, defaultCut, 0.9f, 1.0f}) {
         Config c;
         c.footprintCut = cut;
         char label[64];
-        std::snprintf(label, sizeof label, "%.2f of the radius%s", cut, cut == 1.0f ? " (default)" : "");
+        std::snprintf(label, sizeof label, "%.4g of the radius%s", cut, cut == defaultCut ? " (default)" : "");
         b.add("footprint cut (RendererDesc)", label, c, onTexture, truth);
+    }
+    for (bool octagons : {false, true}) {
+        Config c;
+        c.octagons = octagons;
+        const bool isDefault = octagons == splatfx::gl::RendererDesc{}.trimCorners;
+        b.add("footprint shape (RendererDesc)", std::string(octagons ? "octagon, 6 triangles" : "square, 2 triangles") + (isDefault ? " (default)" : ""),
+              c, onTexture, truth);
     }
     for (float radius : {1.05f, 1.4f, 1.75f, 2.0f, 2.8f}) {
         Config c = gaussTruthCfg;

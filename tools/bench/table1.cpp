@@ -262,7 +262,7 @@ struct Settings {
     int frames = 30;
     float footprintCut = splatfx::gl::RendererDesc{}.footprintCut;
     bool crossfade = false;
-    bool octagons = true;
+    bool octagons = splatfx::gl::RendererDesc{}.trimCorners;
 };
 
 RowResult measureRow(const Row& row, const Settings& settings) {
@@ -410,8 +410,9 @@ int runTable1(int argc, char** argv) {
         else if (a == "--footprint-cut" && i + 1 < argc) settings.footprintCut = float(std::atof(argv[++i]));
         else if (a == "--crossfade") settings.crossfade = true;
         else if (a == "--squares") settings.octagons = false;
+        else if (a == "--octagons") settings.octagons = true;
         else if (a == "--help" || a == "-h") {
-            std::printf("splatfx-bench table1 [--frames N] [--csv FILE] [--quick] [--footprint-cut F] [--crossfade] [--squares]\n"
+            std::printf("splatfx-bench table1 [--frames N] [--csv FILE] [--quick] [--footprint-cut F] [--crossfade] [--squares | --octagons]\n"
                         "  The paper's Table I rows on this machine (headless), with pixels covered, overdraw,\n"
                         "  the splat pass as a fraction of this GL's fill rate, a naive baseline, and CPU scaling.\n");
             return 0;

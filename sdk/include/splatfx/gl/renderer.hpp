@@ -36,7 +36,12 @@ struct RendererDesc {
     bool restoreState = true;  // save and restore host GL state around draw(); default true
     bool depthTest = true;     // test against the host's depth buffer; default true
     bool linearFilter = true;  // bilinear texture sampling (false: nearest); default true
-    bool trimCorners = true;   // draw octagons that skip the footprint's zero corners; default true
+    // Draw octagons (6 triangles) that skip the square's empty corners, or
+    // squares (2 triangles). Octagons save ~17 % of the fragments but cost 3x
+    // the triangles; on Mesa's llvmpipe squares are 1.3-2x faster per frame
+    // (docs/BENCHMARKS.md, Table I), so the default is squares. Fill-bound
+    // GPUs with large splats may prefer octagons. Default false.
+    bool trimCorners = false;
     // Fraction of the footprint's support radius actually drawn. The kernel's
     // outer ring carries little weight (Crawfis-Max: 1.25 % of the centre at
     // 0.8125 of the radius, below one 8-bit step of a typical splat) but 34 %
