@@ -122,6 +122,15 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
     // (no push_back); returns the end of what it wrote. Reads only shared,
     // unchanging state, so ranges can run on several threads.
     auto build = [&](const Voxel* begin, const Voxel* end, Splat* out, SplatStats& stats) {
+        // Local copies: the compiler cannot keep values read through
+        // references in registers across the stores to *out (they might alias).
+        const glm::vec3 eyeL = eye, fwdL = fwd, camUpL = camUp, camRightL = camRight;
+        const float nearZL = nearZ, fadeStart = mDesc.nearFadeStart, fadeEnd = mDesc.nearFadeEnd, RL = R;
+        const bool cull = mDesc.frustumCull, crossfade = style.crossfade, perspL = persp;
+        const float colorRow = hasTable ? float(style.colorTable) : 0.0f, gain = range.gain, scaleL = opacityScale;
+        const std::uint32_t setFirst = range.first, setCount = range.count;
+        const glm::mat4 transform = grid.transform;
+        const glm::vec3 spacing = grid.spacing, halfL = halfXZ;
         for (const Voxel* vp = begin; vp != end; ++vp) {
             const Voxel& v = *vp;
             const float stretch2 = glm::dot(v.stretch, v.stretch);
@@ -135,20 +144,20 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
                 shapePtr = &stretchedShape;
             }
             const Shape& shape = *shapePtr;
-            const glm::vec3 c = glm::vec3(grid.transform * glm::vec4((glm::vec3(v.cell) - halfXZ) * grid.spacing, 1.0f));
+            const glm::vec3 c = glm::vec3(transform * glm::vec4((glm::vec3(v.cell) - halfL) * spacing, 1.0f));
             if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord) || !std::isfinite(v.phase) || !finite3(c) || !shape.ok ||
                 !std::isfinite(stretch2)) {
                 ++stats.rejected;
                 continue;
             }
-            const float opacity = std::clamp(v.opacity * opacityScale, 0.0f, 1.0f);
-            const glm::vec3 toC = c - eye;
-            const float viewZ = glm::dot(toC, fwd);
+            const float opacity = std::clamp(v.opacity * scaleL, 0.0f, 1.0f);
+            const glm::vec3 toC = c - eyeL;
+            const float viewZ = glm::dot(toC, fwdL);
             const float extent = shape.extent;
             bool outside = opacity <= 0.0f;
-            if (mDesc.frustumCull)
+            if (cull)
                 for (const auto& p : planes) outside = outside || glm::dot(glm::vec3(p), c) + p.w < -extent;
-            const float fade = smoothstep(nearZ + mDesc.nearFadeStart * extent, nearZ + mDesc.nearFadeEnd * extent, viewZ);
+            const float fade = smoothstep(nearZL + fadeStart * extent, nearZL + fadeEnd * extent, viewZ);
             if (outside || fade <= 0.0f) {
                 ++stats.culled;
                 continue;
@@ -158,10 +167,10 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
             // its centre, "up" as close to the camera's up as possible so
             // textures stay upright (flames rise on screen).
             const float dist = glm::length(toC);
-            const glm::vec3 d = persp ? (dist > 1e-20f ? toC * (1.0f / dist) : fwd) : fwd;
-            glm::vec3 e1 = glm::cross(d, camUp);
+            const glm::vec3 d = perspL ? (dist > 1e-20f ? toC * (1.0f / dist) : fwdL) : fwdL;
+            glm::vec3 e1 = glm::cross(d, camUpL);
             const float e1Len = glm::length(e1);
-            e1 = e1Len > 1e-6f ? e1 * (1.0f / e1Len) : camRight;
+            e1 = e1Len > 1e-6f ? e1 * (1.0f / e1Len) : camRightL;
             const glm::vec3 e2 = glm::cross(e1, d); // unit: e1 and d are orthonormal
 
             // Line integral of h(|M^-1 x|) along d at plane offset q: F(|q|_Q) / |M^-1 d|.
@@ -178,8 +187,8 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
 
             Splat& sp = *out;
             sp.center = c;
-            sp.axisU = R * (sq[0] * e1 + sq[1] * e2);
-            sp.axisV = R * (sq[1] * e1 + sq[2] * e2);
+            sp.axisU = RL * (sq[0] * e1 + sq[1] * e2);
+            sp.axisV = RL * (sq[1] * e1 + sq[2] * e2);
             if (!finite3(sp.axisU) || !finite3(sp.axisV)) {
                 ++stats.rejected;
                 continue;
@@ -189,18 +198,21 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
             // Optical depth through the centre, relative to an isotropic voxel of
             // equal volume: the chord along d (1 / |M^-1 d|) over det(M)^(1/3).
             // log1p: 1.0f - alpha rounds to 1 for alpha < 6e-8, which would lose the voxel entirely.
-            const float tau = alpha >= 1.0f ? kMaxTau : std::min(-std::log1p(-alpha) * 1.44269504f, kMaxTau);
+            // log2(1 - alpha) loses small alphas (1 - alpha rounds to 1 below 6e-8):
+            // log1p below 2^-10, the cheaper log2 above, where it is exact to 1e-4 relative.
+            const float tau = alpha >= 1.0f ? kMaxTau
+                                            : std::min(alpha < 0x1p-10f ? -std::log1p(-alpha) * 1.44269504f : -std::log2(1.0f - alpha), kMaxTau);
             const float chord = (1.0f / bLen) / shape.cbrtDet;
-            sp.density = tau * std::min(chord, 64.0f) * fade * range.gain;
+            sp.density = tau * std::min(chord, 64.0f) * fade * gain;
             sp.colorCoord = std::clamp(v.colorCoord, 0.0f, 1.0f);
-            sp.colorRow = hasTable ? float(style.colorTable) : 0.0f;
-            const std::uint32_t index = v.texture % range.count; // one division per voxel, not two
-            sp.layer = std::uint16_t(range.first + index);
-            sp.nextLayer = std::uint16_t(range.first + (index + 1 == range.count ? 0 : index + 1));
+            sp.colorRow = colorRow;
+            const std::uint32_t index = v.texture % setCount; // one division per voxel, not two
+            sp.layer = std::uint16_t(setFirst + index);
+            sp.nextLayer = std::uint16_t(setFirst + (index + 1 == setCount ? 0 : index + 1));
             sp.color = std::uint32_t(entry.r * 255.0f + 0.5f) | std::uint32_t(entry.g * 255.0f + 0.5f) << 8 |
                        std::uint32_t(entry.b * 255.0f + 0.5f) << 16 | 0xff000000u;
-            sp.blend = style.crossfade ? std::clamp(v.phase - std::floor(v.phase), 0.0f, 1.0f) : 0.0f;
-            sp.depth = persp ? dist : viewZ;
+            sp.blend = crossfade ? std::clamp(v.phase - std::floor(v.phase), 0.0f, 1.0f) : 0.0f;
+            sp.depth = perspL ? dist : viewZ;
             ++out;
         }
         return out;
