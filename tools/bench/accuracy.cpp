@@ -32,6 +32,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "commands.hpp"
+#include "gl_program.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
 #include "splatfx/reference.hpp"
@@ -162,18 +163,8 @@ public:
         const char* vs = "#version 450 core\nlayout(location=0) in vec3 p; layout(location=1) in vec3 c; uniform mat4 uVP; out vec3 vC;\n"
                          "void main() { vC = c; gl_Position = uVP * vec4(p, 1.0); }\n";
         const char* fs = "#version 450 core\nin vec3 vC; out vec4 o; void main() { o = vec4(vC, 1.0); }\n";
-        mProgram = glCreateProgram();
-        for (auto [type, src] : {std::pair{GL_VERTEX_SHADER, vs}, std::pair{GL_FRAGMENT_SHADER, fs}}) {
-            GLuint s = glCreateShader(type);
-            glShaderSource(s, 1, &src, nullptr);
-            glCompileShader(s);
-            GLint ok = 0;
-            glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-            if (!ok) return (err = "host geometry shader failed to compile"), false;
-            glAttachShader(mProgram, s);
-            glDeleteShader(s);
-        }
-        glLinkProgram(mProgram);
+        mProgram = bench::compileProgram(vs, fs, err);
+        if (!mProgram) return (err = "host geometry shader failed to compile: " + err), false;
         std::vector<float> v;
         auto quad = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec3 col) {
             for (glm::vec3 p : {a, b, c, a, c, d}) v.insert(v.end(), {p.x, p.y, p.z, col.r, col.g, col.b});

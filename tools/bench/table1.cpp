@@ -17,6 +17,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "gl_program.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
 #include "splatfx/splatfx.hpp"
@@ -82,22 +83,9 @@ void cycle(const splatfx::Grid& base, splatfx::Grid& grid, double t) {
 }
 
 GLuint compileProgram(const char* vs, const char* fs) {
-    GLuint p = glCreateProgram();
-    for (auto [type, src] : {std::pair{GL_VERTEX_SHADER, vs}, std::pair{GL_FRAGMENT_SHADER, fs}}) {
-        GLuint s = glCreateShader(type);
-        glShaderSource(s, 1, &src, nullptr);
-        glCompileShader(s);
-        GLint ok = 0;
-        glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-        if (!ok) {
-            char log[2048];
-            glGetShaderInfoLog(s, sizeof log, nullptr, log);
-            std::fprintf(stderr, "bench shader: %s\n", log);
-        }
-        glAttachShader(p, s);
-        glDeleteShader(s);
-    }
-    glLinkProgram(p);
+    std::string error;
+    const GLuint p = bench::compileProgram(vs, fs, error);
+    if (!p) std::fprintf(stderr, "table1: bench shader: %s\n", error.c_str());
     return p;
 }
 
@@ -286,16 +274,18 @@ RowResult measureRow(const Row& row, const Settings& settings) {
 
     // Full frame as an application runs it: dynamics, build, sort, upload,
     // draw, and wait for the pixels (glFinish), at 60 simulated frames/s.
-    auto frame = [&](int i) {
-        cycle(base, grid, i / 60.0);
-        builder.begin(cam);
-        builder.add(grid, materials, style);
-        builder.sort();
-        fb->clear({0, 0, 0, 1});
-        renderer->draw(builder.splats(), cam, target);
-        glFinish();
+    auto fullFrame = [&](const auto& draw) {
+        return [&](int i) {
+            cycle(base, grid, i / 60.0);
+            builder.begin(cam);
+            builder.add(grid, materials, style);
+            builder.sort();
+            fb->clear({0, 0, 0, 1});
+            draw(builder.splats());
+            glFinish();
+        };
     };
-    out.hz = 1.0 / medianFrame(5, frames, frame);
+    out.hz = 1.0 / medianFrame(5, frames, fullFrame([&](const std::vector<splatfx::Splat>& s) { renderer->draw(s, cam, target); }));
 
     // Coverage and overdraw: samples that reached the blender / pixels touched.
     GLuint query = 0;
@@ -335,15 +325,7 @@ RowResult measureRow(const Row& row, const Settings& settings) {
                 {.scale = scale, .renderer = {.trimCorners = settings.octagons, .footprintCut = settings.footprintCut}});
             if (!scaled || !scaled->upload(materials)) break;
             const splatfx::gl::ScaledTarget st{.framebuffer = fb->handle(), .width = row.window.x, .height = row.window.y};
-            out.scaledHz = 1.0 / medianFrame(5, frames, [&](int i) {
-                cycle(base, grid, i / 60.0);
-                builder.begin(cam);
-                builder.add(grid, materials, style);
-                builder.sort();
-                fb->clear({0, 0, 0, 1});
-                scaled->draw(builder.splats(), cam, st);
-                glFinish();
-            });
+            out.scaledHz = 1.0 / medianFrame(5, frames, fullFrame([&](const std::vector<splatfx::Splat>& s) { scaled->draw(s, cam, st); }));
             out.scale = scale;
             if (out.scaledHz >= row.onyx2) break;
         }

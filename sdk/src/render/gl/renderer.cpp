@@ -12,27 +12,11 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "context_check.hpp"
+#include "program.hpp"
 #include "shaders.hpp"
 
 namespace splatfx::gl {
 namespace {
-
-GLuint compile(GLenum type, std::initializer_list<const char*> parts, std::string& log) {
-    GLuint s = glCreateShader(type);
-    const std::vector<const char*> src(parts);
-    glShaderSource(s, GLsizei(src.size()), src.data(), nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char buf[4096];
-        glGetShaderInfoLog(s, sizeof buf, nullptr, buf);
-        log = buf;
-        glDeleteShader(s);
-        return 0;
-    }
-    return s;
-}
 
 // Host state draw() changes, captured so it can be put back.
 struct SavedState {
@@ -160,29 +144,12 @@ Result<Renderer> Renderer::create(const RendererDesc& desc) {
     auto impl = std::make_unique<Impl>();
     impl->desc = desc;
     for (int crossfade = 0; crossfade < 2; ++crossfade) {
-        std::string log;
-        GLuint vs = compile(GL_VERTEX_SHADER, {detail::kSplatVertex}, log);
-        if (!vs) return makeError("splat vertex shader failed to compile: " + log);
-        GLuint fs = compile(GL_FRAGMENT_SHADER,
-                            {"#version 450 core\n", crossfade ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n", detail::kSplatFragment}, log);
-        if (!fs) {
-            glDeleteShader(vs);
-            return makeError("splat fragment shader failed to compile: " + log);
-        }
+        auto linked = detail::linkProgram({detail::kSplatVertex},
+                                          {"#version 450 core\n", crossfade ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n", detail::kSplatFragment},
+                                          "splat");
+        if (!linked) return makeError(linked.error());
         Impl::Program& p = impl->programs[crossfade];
-        p.id = glCreateProgram();
-        glAttachShader(p.id, vs);
-        glAttachShader(p.id, fs);
-        glLinkProgram(p.id);
-        glDeleteShader(vs);
-        glDeleteShader(fs);
-        GLint ok = 0;
-        glGetProgramiv(p.id, GL_LINK_STATUS, &ok);
-        if (!ok) {
-            char buf[4096];
-            glGetProgramInfoLog(p.id, sizeof buf, nullptr, buf);
-            return makeError(std::string("splat program failed to link: ") + buf);
-        }
+        p.id = *linked;
         p.uViewProj = glGetUniformLocation(p.id, "uViewProj");
         p.uOctagon = glGetUniformLocation(p.id, "uOctagon");
         p.uCut = glGetUniformLocation(p.id, "uCut");

@@ -9,46 +9,11 @@
 #include <epoxy/gl.h>
 
 #include "context_check.hpp"
+#include "program.hpp"
 #include "scaled_shaders.hpp"
 
 namespace splatfx::gl {
 namespace {
-
-Result<GLuint> linkProgram(const char* vertex, const char* fragment, const char* what) {
-    GLuint stages[2] = {glCreateShader(GL_VERTEX_SHADER), glCreateShader(GL_FRAGMENT_SHADER)};
-    const char* sources[2] = {vertex, fragment};
-    std::string log;
-    for (int i = 0; i < 2 && log.empty(); ++i) {
-        glShaderSource(stages[i], 1, &sources[i], nullptr);
-        glCompileShader(stages[i]);
-        GLint ok = 0;
-        glGetShaderiv(stages[i], GL_COMPILE_STATUS, &ok);
-        if (!ok) {
-            char buf[4096] = {};
-            glGetShaderInfoLog(stages[i], sizeof buf, nullptr, buf);
-            log = std::string(what) + (i == 0 ? " vertex" : " fragment") + " shader failed to compile: " + buf;
-        }
-    }
-    GLuint program = 0;
-    if (log.empty()) {
-        program = glCreateProgram();
-        glAttachShader(program, stages[0]);
-        glAttachShader(program, stages[1]);
-        glLinkProgram(program);
-        GLint ok = 0;
-        glGetProgramiv(program, GL_LINK_STATUS, &ok);
-        if (!ok) {
-            char buf[4096] = {};
-            glGetProgramInfoLog(program, sizeof buf, nullptr, buf);
-            log = std::string(what) + " program failed to link: " + buf;
-            glDeleteProgram(program);
-        }
-    }
-    glDeleteShader(stages[0]);
-    glDeleteShader(stages[1]);
-    if (!log.empty()) return makeError(log);
-    return program;
-}
 
 // The host state the two extra passes touch, beyond what Renderer documents.
 class HostState {
@@ -194,10 +159,10 @@ Result<ScaledRenderer> ScaledRenderer::create(const ScaledRendererDesc& desc) {
     auto impl = std::make_unique<Impl>();
     impl->desc = desc;
     impl->inner = std::move(*inner);
-    auto down = linkProgram(detail::kFullscreenVertex, detail::kDepthDownsampleFragment, "depth downsample");
+    auto down = detail::linkProgram({detail::kFullscreenVertex}, {detail::kDepthDownsampleFragment}, "depth downsample");
     if (!down) return makeError(down.error());
     impl->downsample = *down;
-    auto comp = linkProgram(detail::kFullscreenVertex, detail::kCompositeFragment, "upsample composite");
+    auto comp = detail::linkProgram({detail::kFullscreenVertex}, {detail::kCompositeFragment}, "upsample composite");
     if (!comp) return makeError(comp.error());
     impl->composite = *comp;
     glCreateVertexArrays(1, &impl->emptyVao);
