@@ -509,8 +509,12 @@ std::string presetPath(const std::optional<TextureSpec>& t) {
     return t && t->kind == TextureSpec::Kind::Folder ? t->folder : std::string();
 }
 
-std::optional<Effect> readFire(Context& c, ObjectReader& o, const EffectCommon& e, const Placement& pl) {
-    presets::FireDesc d;
+// Fire and steam share their fields: a lattice, textures, opacity and the
+// two rates; `extra` reads what only one of them has.
+template <class Desc, class Extra>
+std::optional<Effect> readLatticePreset(Context& c, ObjectReader& o, const EffectCommon& e, const Placement& pl, Extra extra,
+                                        Result<Effect> (*make)(Materials&, const Desc&)) {
+    Desc d;
     readDims(c, o, d.dims, kMaxVoxels, "grid effects");
     o.vec3("spacing", d.spacing, 1e-4, 1e3, true);
     o.vec3("position", d.position, -kMaxCoord, kMaxCoord);
@@ -520,36 +524,24 @@ std::optional<Effect> readFire(Context& c, ObjectReader& o, const EffectCommon& 
     o.number("opacity", d.opacity, 1e-6, 1.0);
     o.number("propagationStepsPerSec", d.propagationStepsPerSec, 1e-3, 1e3);
     o.number("texturesPerSec", d.texturesPerSec, 0.0, 1e3);
-    o.boolean("crossfade", d.crossfade);
+    extra(d);
     if (!c.d.ok()) return std::nullopt;
     d.textureSetPath = presetPath(tex);
     d.position = applyPoint(pl.parent, d.position);
     d.motion = pl.motion;
     d.seed = e.seed;
-    Result<Effect> r = presets::fire(c.materials, d);
+    Result<Effect> r = make(c.materials, d);
     if (!r) return c.d.error(e.path, r.error()), std::nullopt;
     return std::move(*r);
 }
 
+std::optional<Effect> readFire(Context& c, ObjectReader& o, const EffectCommon& e, const Placement& pl) {
+    return readLatticePreset<presets::FireDesc>(c, o, e, pl, [&](presets::FireDesc& d) { o.boolean("crossfade", d.crossfade); },
+                                                &presets::fire);
+}
+
 std::optional<Effect> readSteam(Context& c, ObjectReader& o, const EffectCommon& e, const Placement& pl) {
-    presets::SteamDesc d;
-    readDims(c, o, d.dims, kMaxVoxels, "grid effects");
-    o.vec3("spacing", d.spacing, 1e-4, 1e3, true);
-    o.vec3("position", d.position, -kMaxCoord, kMaxCoord);
-    std::optional<TextureSpec> tex;
-    if (const Json* t = o.get("textureSet")) tex = readTextureSpec(c, o.at("textureSet"), *t, d.textureCount, e.seed, true);
-    if (tex) d.textureCount = tex->count;
-    o.number("opacity", d.opacity, 1e-6, 1.0);
-    o.number("propagationStepsPerSec", d.propagationStepsPerSec, 1e-3, 1e3);
-    o.number("texturesPerSec", d.texturesPerSec, 0.0, 1e3);
-    if (!c.d.ok()) return std::nullopt;
-    d.textureSetPath = presetPath(tex);
-    d.position = applyPoint(pl.parent, d.position);
-    d.motion = pl.motion;
-    d.seed = e.seed;
-    Result<Effect> r = presets::steam(c.materials, d);
-    if (!r) return c.d.error(e.path, r.error()), std::nullopt;
-    return std::move(*r);
+    return readLatticePreset<presets::SteamDesc>(c, o, e, pl, [](presets::SteamDesc&) {}, &presets::steam);
 }
 
 std::optional<Effect> readFireToSmoke(Context& c, ObjectReader& o, const EffectCommon& e, const Placement& pl) {
