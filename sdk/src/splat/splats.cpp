@@ -121,12 +121,27 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
     // One pass over a range of voxels, writing splats in place from `out`
     // (no push_back); returns the end of what it wrote. Reads only shared,
     // unchanging state, so ranges can run on several threads.
+    // A lattice wholly inside the frustum needs no per-voxel plane tests: a
+    // voxel is culled only when a whole plane's distance is below -extent, and
+    // the lattice's corners bound that distance for every voxel inside it.
+    // (A voxel outside its grid's dims is then merely not culled: harmless.)
+    bool cullEach = mDesc.frustumCull;
+    if (cullEach && plain.ok && glm::all(glm::greaterThan(grid.dims, glm::ivec3(0)))) {
+        bool inside = true;
+        for (int k = 0; k < 8 && inside; ++k) {
+            const glm::ivec3 cell((k & 1) ? grid.dims.x - 1 : 0, (k & 2) ? grid.dims.y - 1 : 0, (k & 4) ? grid.dims.z - 1 : 0);
+            const glm::vec3 corner = glm::vec3(grid.transform * glm::vec4((glm::vec3(cell) - halfXZ) * grid.spacing, 1.0f));
+            for (const auto& p : planes) inside = inside && glm::dot(glm::vec3(p), corner) + p.w >= -plain.extent;
+        }
+        cullEach = !inside;
+    }
+
     auto build = [&](const Voxel* begin, const Voxel* end, Splat* out, SplatStats& stats) {
         // Local copies: the compiler cannot keep values read through
         // references in registers across the stores to *out (they might alias).
         const glm::vec3 eyeL = eye, fwdL = fwd, camUpL = camUp, camRightL = camRight;
         const float nearZL = nearZ, fadeStart = mDesc.nearFadeStart, fadeEnd = mDesc.nearFadeEnd, RL = R;
-        const bool cull = mDesc.frustumCull, crossfade = style.crossfade, perspL = persp;
+        const bool cull = cullEach, crossfade = style.crossfade, perspL = persp;
         const float colorRow = hasTable ? float(style.colorTable) : 0.0f, gain = range.gain, scaleL = opacityScale;
         const std::uint32_t setFirst = range.first, setCount = range.count;
         const glm::mat4 transform = grid.transform;
@@ -157,7 +172,8 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
             bool outside = opacity <= 0.0f;
             if (cull)
                 for (const auto& p : planes) outside = outside || glm::dot(glm::vec3(p), c) + p.w < -extent;
-            const float fade = smoothstep(nearZL + fadeStart * extent, nearZL + fadeEnd * extent, viewZ);
+            const float fadeFrom = nearZL + fadeStart * extent, fadeTo = nearZL + fadeEnd * extent;
+            const float fade = viewZ >= fadeTo ? 1.0f : smoothstep(fadeFrom, fadeTo, viewZ);
             if (outside || fade <= 0.0f) {
                 ++stats.culled;
                 continue;
