@@ -36,6 +36,10 @@ struct TurbulenceDesc {
     // Textures are slices along a closed loop through 4D noise, so cycling
     // them in order is smooth and periodic (sec. 3.3 "cyclical pattern").
     float loopRadius = 0.25f;   // noise units; larger = faster change between textures; default 0.25
+    // Exponent applied after normalization: above 1 the detail gets sparser
+    // and sharper, which survives the averaging of many overlapping splats
+    // (fire: 2.5). Default 1 (plain turbulence).
+    float contrast = 1.0f;
 };
 
 class TextureSet {

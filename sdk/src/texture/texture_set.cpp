@@ -30,7 +30,7 @@ std::vector<float> blankLayer(int size) { return std::vector<float>(size_t(size)
 } // namespace
 
 TextureSet TextureSet::turbulence(const TurbulenceDesc& d) {
-    assert(d.count >= 1 && d.size >= kMinSize && d.octaves >= 1);
+    assert(d.count >= 1 && d.size >= kMinSize && d.octaves >= 1 && d.contrast > 0.0f);
     detail::Noise4 noise(d.seed);
     TextureSet set;
     set.size = d.size;
@@ -63,7 +63,7 @@ TextureSet TextureSet::turbulence(const TurbulenceDesc& d) {
     for (int k = 0; k < d.count; ++k) {
         std::vector<float> layer = blankLayer(d.size);
         for (size_t i = 0; i < raw[size_t(k)].size(); ++i) {
-            const float v = float((raw[size_t(k)][i] - lo) * scale);
+            const float v = float(std::pow((raw[size_t(k)][i] - lo) * scale, double(d.contrast)));
             layer[i * 4 + 0] = layer[i * 4 + 1] = layer[i * 4 + 2] = v;
         }
         set.layers.push_back(std::move(layer));
