@@ -146,6 +146,10 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         const std::uint32_t setFirst = range.first, setCount = range.count;
         const glm::mat4 transform = grid.transform;
         const glm::vec3 spacing = grid.spacing, halfL = halfXZ;
+        bool haveEntry = false;
+        float lastCoord = 0.0f, lastAlpha = -1.0f, lastTau = 0.0f;
+        glm::vec4 entry(1.0f);
+        std::uint32_t packedColor = 0xffffffffu;
         for (const Voxel* vp = begin; vp != end; ++vp) {
             const Voxel& v = *vp;
             const float stretch2 = glm::dot(v.stretch, v.stretch);
@@ -209,15 +213,26 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
                 ++stats.rejected;
                 continue;
             }
-            const glm::vec4 entry = tableAt(v.colorCoord);
+            // Neighbouring voxels usually share a colour coordinate (one layer of
+            // the lattice) and an opacity: reuse the last lookup and logarithm.
+            if (!haveEntry || v.colorCoord != lastCoord) {
+                entry = tableAt(v.colorCoord);
+                packedColor = std::uint32_t(entry.r * 255.0f + 0.5f) | std::uint32_t(entry.g * 255.0f + 0.5f) << 8 |
+                              std::uint32_t(entry.b * 255.0f + 0.5f) << 16 | 0xff000000u;
+                lastCoord = v.colorCoord;
+                haveEntry = true;
+            }
             const float alpha = opacity * entry.a;
             // Optical depth through the centre, relative to an isotropic voxel of
             // equal volume: the chord along d (1 / |M^-1 d|) over det(M)^(1/3).
-            // log1p: 1.0f - alpha rounds to 1 for alpha < 6e-8, which would lose the voxel entirely.
             // log2(1 - alpha) loses small alphas (1 - alpha rounds to 1 below 6e-8):
             // log1p below 2^-10, the cheaper log2 above, where it is exact to 1e-4 relative.
-            const float tau = alpha >= 1.0f ? kMaxTau
-                                            : std::min(alpha < 0x1p-10f ? -std::log1p(-alpha) * 1.44269504f : -std::log2(1.0f - alpha), kMaxTau);
+            if (alpha != lastAlpha) {
+                lastTau = alpha >= 1.0f ? kMaxTau
+                                        : std::min(alpha < 0x1p-10f ? -std::log1p(-alpha) * 1.44269504f : -std::log2(1.0f - alpha), kMaxTau);
+                lastAlpha = alpha;
+            }
+            const float tau = lastTau;
             const float chord = (1.0f / bLen) / shape.cbrtDet;
             sp.density = tau * std::min(chord, 64.0f) * fade * gain;
             sp.colorCoord = std::clamp(v.colorCoord, 0.0f, 1.0f);
@@ -225,8 +240,7 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
             const std::uint32_t index = v.texture % setCount; // one division per voxel, not two
             sp.layer = std::uint16_t(setFirst + index);
             sp.nextLayer = std::uint16_t(setFirst + (index + 1 == setCount ? 0 : index + 1));
-            sp.color = std::uint32_t(entry.r * 255.0f + 0.5f) | std::uint32_t(entry.g * 255.0f + 0.5f) << 8 |
-                       std::uint32_t(entry.b * 255.0f + 0.5f) << 16 | 0xff000000u;
+            sp.color = packedColor;
             sp.blend = crossfade ? std::clamp(v.phase - std::floor(v.phase), 0.0f, 1.0f) : 0.0f;
             sp.depth = perspL ? dist : viewZ;
             ++out;
