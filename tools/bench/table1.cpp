@@ -89,6 +89,16 @@ GLuint compileProgram(const char* vs, const char* fs) {
     return p;
 }
 
+// Draw state both probes share: the target, premultiplied "over", no depth test.
+void beginOver(GLuint fbo, glm::ivec2 size, GLuint program) {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glViewport(0, 0, size.x, size.y);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    glDisable(GL_DEPTH_TEST);
+    glUseProgram(program);
+}
+
 // The fill limit: full-screen quads doing the splat fragment's work (one
 // texture-array fetch, exp2, colour multiply, premultiplied "over" blend into
 // the same RGBA8 target). Nothing else can make splat fragments cheaper.
@@ -113,12 +123,7 @@ public:
     }
     // Fragments per second for `quads` full-screen quads.
     double rate(GLuint fbo, glm::ivec2 size, GLuint layers, int quads) {
-        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-        glViewport(0, 0, size.x, size.y);
-        glEnable(GL_BLEND);
-        glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-        glDisable(GL_DEPTH_TEST);
-        glUseProgram(program);
+        beginOver(fbo, size, program);
         glBindTextureUnit(0, layers);
         glBindVertexArray(vao);
         glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, 4); // warm up
@@ -183,12 +188,7 @@ public:
             instances.push_back({glm::vec4(grid.worldPosition(v.cell), half),
                                  glm::vec4(v.opacity, float(1 + v.texture % 8), v.colorCoord, 0.0f)});
         glNamedBufferData(buffer, GLsizeiptr(instances.size() * sizeof(Instance)), instances.data(), GL_STREAM_DRAW);
-        glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-        glViewport(0, 0, size.x, size.y);
-        glEnable(GL_BLEND);
-        glBlendFunc(GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-        glDisable(GL_DEPTH_TEST);
-        glUseProgram(program);
+        beginOver(fbo, size, program);
         const glm::mat4 vp = cam.proj * cam.view;
         glUniformMatrix4fv(glGetUniformLocation(program, "uViewProj"), 1, GL_FALSE, glm::value_ptr(vp));
         glUniform3fv(glGetUniformLocation(program, "uRight"), 1, glm::value_ptr(cam.right()));

@@ -157,6 +157,8 @@ private:
     void substep(float dt);
     void applyEmitters(float dt);
     void applyForces(float dt);
+    // Whether face f of axis a lies on a boundary the desc closes.
+    bool closedFace(int axis, glm::ivec3 f) const;
     void project();
     void advectScalars(float dt);
     void advectVelocity(float dt);

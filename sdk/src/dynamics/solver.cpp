@@ -233,18 +233,22 @@ void FluidSolver::applyEmitters(float dt) {
     }
 }
 
+bool FluidSolver::closedFace(int a, glm::ivec3 f) const {
+    const bool closedLo = a == 1 ? mDesc.closedFloor : mDesc.closedWalls;
+    const bool closedHi = a == 1 ? mDesc.closedCeiling : mDesc.closedWalls;
+    return (f[a] == 0 && closedLo) || (f[a] == mDims[a] && closedHi);
+}
+
 void FluidSolver::applyForces(float dt) {
     const float relax = dt * (mDesc.windCoupling + mDesc.velocityDamping);
     for (int a = 0; a < 3; ++a) {
         const glm::ivec3 fd = faceDims(mDims, a);
-        const bool closedLo = a == 1 ? mDesc.closedFloor : mDesc.closedWalls;
-        const bool closedHi = a == 1 ? mDesc.closedCeiling : mDesc.closedWalls;
         for (int k = 0; k < fd.z; ++k)
             for (int j = 0; j < fd.y; ++j)
                 for (int i = 0; i < fd.x; ++i) {
                     const glm::ivec3 f{i, j, k};
                     float& u = mU[a][lin(f, fd)];
-                    if ((f[a] == 0 && closedLo) || (f[a] == mDims[a] && closedHi)) {
+                    if (closedFace(a, f)) {
                         u = 0.0f;
                         continue;
                     }
@@ -307,14 +311,10 @@ void FluidSolver::advectVelocity(float dt) {
         mU[a].swap(mUScratch[a]);
         // Closed faces stay closed.
         const glm::ivec3 fd = faceDims(mDims, a);
-        const bool closedLo = a == 1 ? mDesc.closedFloor : mDesc.closedWalls;
-        const bool closedHi = a == 1 ? mDesc.closedCeiling : mDesc.closedWalls;
         for (int k = 0; k < fd.z; ++k)
             for (int j = 0; j < fd.y; ++j)
-                for (int i = 0; i < fd.x; ++i) {
-                    const glm::ivec3 f{i, j, k};
-                    if ((f[a] == 0 && closedLo) || (f[a] == mDims[a] && closedHi)) mU[a][lin(f, fd)] = 0.0f;
-                }
+                for (int i = 0; i < fd.x; ++i)
+                    if (closedFace(a, {i, j, k})) mU[a][lin({i, j, k}, fd)] = 0.0f;
     }
 }
 
@@ -426,7 +426,7 @@ void FluidSolver::project() {
             for (int j = 0; j < fd.y; ++j)
                 for (int i = 0; i < fd.x; ++i) {
                     const glm::ivec3 f{i, j, k};
-                    if ((f[a] == 0 && closedLo[a]) || (f[a] == mDims[a] && closedHi[a])) continue;
+                    if (closedFace(a, f)) continue;
                     glm::ivec3 lo = f;
                     lo[a] -= 1;
                     const double pHi = f[a] < mDims[a] ? mP[lin(f, mDims)] : 0.0;

@@ -213,7 +213,13 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
         f = nullptr;
     }
     const std::size_t first = std::size_t(r.region) * r.regionSplats;
-    std::memcpy(r.mapped + first, splats.data(), splats.size() * sizeof(Splat));
+    // One pass over the splats: copy into the ring and note whether any cross-fades.
+    Splat* dst = r.mapped + first;
+    bool anyCrossfade = false;
+    for (std::size_t i = 0; i < splats.size(); ++i) {
+        dst[i] = splats[i];
+        anyCrossfade |= splats[i].blend > 0.0f;
+    }
 
     SavedState saved;
     if (r.desc.restoreState) saved.save();
@@ -232,7 +238,6 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
     glDepthMask(GL_FALSE);
     glDisable(GL_CULL_FACE);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    const bool anyCrossfade = std::any_of(splats.begin(), splats.end(), [](const Splat& s) { return s.blend > 0.0f; });
     const Impl::Program& p = r.programs[anyCrossfade ? 1 : 0];
     glUseProgram(p.id);
     const glm::mat4 vp = camera.proj * camera.view;
