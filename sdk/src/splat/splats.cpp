@@ -20,21 +20,163 @@ float smoothstep(float a, float b, float x) {
     return t * t * (3.0f - 2.0f * t);
 }
 
-// Symmetric square root of a 2x2 symmetric positive definite matrix.
-void sqrt2x2(float a, float b, float c, float out[3]) { // [[a b][b c]]
-    const float s = std::sqrt(std::max(a * c - b * b, 0.0f));
-    const float inv = 1.0f / std::sqrt(std::max(a + c + 2.0f * s, 1e-30f));
-    out[0] = (a + s) * inv;
-    out[1] = b * inv;
-    out[2] = (c + s) * inv;
-}
-
 bool finite3(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 std::uint32_t orderedBits(float f) {
     std::uint32_t u;
     std::memcpy(&u, &f, 4);
     return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+}
+
+// The kernel's shape: grid rotation/scale times lattice spacing, then the
+// voxel's stretch. Without a stretch it is the same for every voxel, so
+// its inverse, determinant and extent are computed once per grid.
+struct Shape {
+    glm::mat3 sigma, sigmaInv; // M M^T and its inverse
+    float cbrtDet = 1.0f, extent = 0.0f;
+    bool ok = false;
+    // Sigma = s^2 I (cubic spacing, rotation, uniform scale): every view
+    // sees a circle of radius s and a chord of s, so the 2x2 square root
+    // and |M^-1 d| are known without per-voxel work.
+    bool isotropic = false;
+    float s = 0.0f;
+    Shape() = default;
+    explicit Shape(const glm::mat3& m, float R) {
+        const float det = glm::determinant(m);
+        ok = std::isfinite(det) && std::abs(det) >= 1e-12f;
+        if (!ok) return;
+        sigma = m * glm::transpose(m);
+        const glm::mat3 mi = glm::inverse(m);
+        sigmaInv = glm::transpose(mi) * mi;
+        cbrtDet = std::cbrt(std::abs(det));
+        // Conservative world extent of the footprint: R times the kernel's largest axis.
+        extent = R * std::sqrt(sigma[0][0] + sigma[1][1] + sigma[2][2]);
+        const float s2 = (sigma[0][0] + sigma[1][1] + sigma[2][2]) / 3.0f;
+        float offIso = 0.0f;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) offIso = std::max(offIso, std::abs(sigma[i][j] - (i == j ? s2 : 0.0f)));
+        isotropic = offIso <= 1e-6f * s2;
+        s = std::sqrt(s2);
+    }
+};
+
+// FastMod: x % d without a division (Lemire, Kaser & Kurz 2019), exact for
+// every 32-bit x and d >= 1.
+struct FastMod {
+    std::uint32_t d;
+    std::uint64_t m;
+    explicit FastMod(std::uint32_t divisor) : d(std::max(divisor, 1u)), m(~std::uint64_t(0) / d + 1) {}
+    std::uint32_t mod(std::uint32_t x) const {
+        const std::uint64_t low = m * x;
+        return std::uint32_t((static_cast<unsigned __int128>(low) * d) >> 64);
+    }
+};
+
+// What a splat's geometry depends on besides its voxel and kernel shape.
+struct Frame {
+    glm::mat4 transform;
+    glm::vec3 spacing, half;
+    glm::vec3 eye, forward, up, right;
+    float radius;
+    bool perspective;
+};
+
+struct Geometry {
+    glm::vec3 center{0.0f};
+    float viewZ = 0.0f, dist = 0.0f;
+    glm::vec3 axisU{0.0f}, axisV{0.0f};
+    float chord = 0.0f; // optical-depth scale of the ray through the centre
+};
+
+constexpr int kBatch = 64;
+
+// Geometry of kBatch voxels as structure of arrays, so computeGeometry's
+// loop has no branches and vectorizes.
+struct GeometryBatch {
+    float cx[kBatch], cy[kBatch], cz[kBatch], viewZ[kBatch], dist[kBatch];
+    float ux[kBatch], uy[kBatch], uz[kBatch], vx[kBatch], vy[kBatch], vz[kBatch], chord[kBatch];
+    Geometry at(int i) const {
+        return {{cx[i], cy[i], cz[i]}, viewZ[i], dist[i], {ux[i], uy[i], uz[i]}, {vx[i], vy[i], vz[i]}, chord[i]};
+    }
+};
+
+// The projected ellipse and centre chord of `count` voxels sharing one shape.
+//
+// Screen-plane basis at each splat: perpendicular to the ray d through its
+// centre, "up" as close to the camera's up as possible so textures stay
+// upright (flames rise on screen). The line integral of h(|M^-1 x|) along d
+// at plane offset q is F(|q|_Q) / |M^-1 d|, where Q is the Schur complement
+// of Sigma^-1 = (M M^T)^-1 in the frame (e1, e2, d); Q^-1 is simply the
+// (e1, e2) block of Sigma, so the ellipse's axes are that 2x2 block's square
+// root. Isotropic kernels see a circle of radius s and a chord of s.
+template <bool Isotropic>
+void computeGeometry(const Frame& f, const Shape& shape, const Voxel* voxels, int count, GeometryBatch& out) {
+    // Plain floats rather than glm vectors: GCC vectorizes the loop only
+    // when no 3-vector aggregates are copied inside it (and, for the
+    // selects, with -fno-trapping-math; see sdk/CMakeLists.txt).
+    const glm::mat4& t = f.transform;
+    const float t00 = t[0][0], t01 = t[0][1], t02 = t[0][2], t10 = t[1][0], t11 = t[1][1], t12 = t[1][2];
+    const float t20 = t[2][0], t21 = t[2][1], t22 = t[2][2];
+    const float ox = t[3][0] - f.eye.x, oy = t[3][1] - f.eye.y, oz = t[3][2] - f.eye.z; // grid origin from the eye
+    const float ex = f.eye.x, ey = f.eye.y, ez = f.eye.z;
+    const float sx = f.spacing.x, sy = f.spacing.y, sz = f.spacing.z, hx = f.half.x, hy = f.half.y, hz = f.half.z;
+    const float fx = f.forward.x, fy = f.forward.y, fz = f.forward.z, ux = f.up.x, uy = f.up.y, uz = f.up.z;
+    const float rx = f.right.x, ry = f.right.y, rz = f.right.z;
+    const float perspW = f.perspective ? 1.0f : 0.0f;
+    const float R = f.radius, isoAxis = f.radius * shape.s, isoChord = shape.s / shape.cbrtDet, invCbrtDet = 1.0f / shape.cbrtDet;
+    const glm::mat3& S = shape.sigma;
+    const glm::mat3& Si = shape.sigmaInv;
+    const float s00 = S[0][0], s01 = S[0][1], s02 = S[0][2], s11 = S[1][1], s12 = S[1][2], s22 = S[2][2]; // symmetric
+    const float i00 = Si[0][0], i01 = Si[0][1], i02 = Si[0][2], i11 = Si[1][1], i12 = Si[1][2], i22 = Si[2][2];
+    // The cells first, into arrays: strided loads from the 40-byte voxels
+    // would keep the loop below scalar.
+    float cellX[kBatch], cellY[kBatch], cellZ[kBatch];
+    for (int i = 0; i < count; ++i) {
+        cellX[i] = float(voxels[i].cell.x);
+        cellY[i] = float(voxels[i].cell.y);
+        cellZ[i] = float(voxels[i].cell.z);
+    }
+    for (int i = 0; i < count; ++i) {
+        const float lx = (cellX[i] - hx) * sx, ly = (cellY[i] - hy) * sy, lz = (cellZ[i] - hz) * sz;
+        // Eye-relative centre.
+        const float cx = t00 * lx + t10 * ly + t20 * lz + ox, cy = t01 * lx + t11 * ly + t21 * lz + oy,
+                    cz = t02 * lx + t12 * ly + t22 * lz + oz;
+        const float dist = std::sqrt(cx * cx + cy * cy + cz * cz);
+        // Selections as arithmetic on 0/1 weights: vector selects, no branches.
+        const float ray = dist > 1e-20f ? perspW : 0.0f;
+        const float k = ray / (ray > 0.0f ? dist : 1.0f), kf = 1.0f - ray;
+        const float dx = cx * k + fx * kf, dy = cy * k + fy * kf, dz = cz * k + fz * kf;
+        // e1 = normalize(d x up), or the camera's right when d is parallel to up.
+        float e1x = dy * uz - dz * uy, e1y = dz * ux - dx * uz, e1z = dx * uy - dy * ux;
+        const float len = std::sqrt(e1x * e1x + e1y * e1y + e1z * e1z);
+        const float ok = len > 1e-6f ? 1.0f : 0.0f;
+        const float ke = ok / (ok > 0.0f ? len : 1.0f), kr = 1.0f - ok;
+        e1x = e1x * ke + rx * kr, e1y = e1y * ke + ry * kr, e1z = e1z * ke + rz * kr;
+        // e2 = e1 x d, unit since e1 and d are orthonormal.
+        const float e2x = e1y * dz - e1z * dy, e2y = e1z * dx - e1x * dz, e2z = e1x * dy - e1y * dx;
+        float q0 = isoAxis, q1 = 0.0f, q2 = isoAxis, chord = isoChord;
+        if constexpr (!Isotropic) {
+            const float a1 = s00 * e1x + s01 * e1y + s02 * e1z, b1 = s01 * e1x + s11 * e1y + s12 * e1z,
+                        c1 = s02 * e1x + s12 * e1y + s22 * e1z; // Sigma e1
+            const float a = e1x * a1 + e1y * b1 + e1z * c1, b = e2x * a1 + e2y * b1 + e2z * c1;
+            const float a2 = s00 * e2x + s01 * e2y + s02 * e2z, b2 = s01 * e2x + s11 * e2y + s12 * e2z,
+                        c2 = s02 * e2x + s12 * e2y + s22 * e2z; // Sigma e2
+            const float c = e2x * a2 + e2y * b2 + e2z * c2;
+            // Symmetric square root of [[a b][b c]], scaled to the footprint's radius.
+            const float root = std::sqrt(std::max(a * c - b * b, 0.0f));
+            const float inv = R / std::sqrt(std::max(a + c + 2.0f * root, 1e-30f));
+            q0 = (a + root) * inv, q1 = b * inv, q2 = (c + root) * inv;
+            const float id = (i00 * dx + i01 * dy + i02 * dz) * dx + (i01 * dx + i11 * dy + i12 * dz) * dy +
+                             (i02 * dx + i12 * dy + i22 * dz) * dz; // |M^-1 d|^2
+            chord = invCbrtDet / std::sqrt(id);
+        }
+        out.cx[i] = cx + ex, out.cy[i] = cy + ey, out.cz[i] = cz + ez;
+        out.viewZ[i] = cx * fx + cy * fy + cz * fz;
+        out.dist[i] = dist;
+        out.ux[i] = q0 * e1x + q1 * e2x, out.uy[i] = q0 * e1y + q1 * e2y, out.uz[i] = q0 * e1z + q1 * e2z;
+        out.vx[i] = q1 * e1x + q2 * e2x, out.vy[i] = q1 * e1y + q2 * e2y, out.vz[i] = q1 * e1z + q2 * e2z;
+        out.chord[i] = chord;
+    }
 }
 
 } // namespace
@@ -71,37 +213,6 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
     const float opacityScale = std::isfinite(style.opacityScale) ? std::max(style.opacityScale, 0.0f) : 0.0f;
     const ColorTable* table = hasTable ? &materials.colorTable(style.colorTable) : nullptr;
 
-    // The kernel's shape: grid rotation/scale times lattice spacing, then the
-    // voxel's stretch. Without a stretch it is the same for every voxel, so
-    // its inverse, determinant and extent are computed once per grid.
-    struct Shape {
-        glm::mat3 sigma, sigmaInv; // M M^T and its inverse
-        float cbrtDet = 1.0f, extent = 0.0f;
-        bool ok = false;
-        // Sigma = s^2 I (cubic spacing, rotation, uniform scale): every view
-        // sees a circle of radius s and a chord of s, so the 2x2 square root
-        // and |M^-1 d| are known without per-voxel work.
-        bool isotropic = false;
-        float s = 0.0f;
-        Shape() = default;
-        explicit Shape(const glm::mat3& m, float R) {
-            const float det = glm::determinant(m);
-            ok = std::isfinite(det) && std::abs(det) >= 1e-12f;
-            if (!ok) return;
-            sigma = m * glm::transpose(m);
-            const glm::mat3 mi = glm::inverse(m);
-            sigmaInv = glm::transpose(mi) * mi;
-            cbrtDet = std::cbrt(std::abs(det));
-            // Conservative world extent of the footprint: R times the kernel's largest axis.
-            extent = R * std::sqrt(sigma[0][0] + sigma[1][1] + sigma[2][2]);
-            const float s2 = (sigma[0][0] + sigma[1][1] + sigma[2][2]) / 3.0f;
-            float offIso = 0.0f;
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j) offIso = std::max(offIso, std::abs(sigma[i][j] - (i == j ? s2 : 0.0f)));
-            isotropic = offIso <= 1e-6f * s2;
-            s = std::sqrt(s2);
-        }
-    };
     const glm::mat3 gridShape = rot * glm::mat3(glm::vec3(grid.spacing.x, 0, 0), glm::vec3(0, grid.spacing.y, 0), glm::vec3(0, 0, grid.spacing.z));
     const Shape plain(gridShape, R);
     const glm::vec3 half = glm::vec3(glm::max(grid.dims - 1, glm::ivec3(0))) * 0.5f;
@@ -136,114 +247,105 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         cullEach = !inside;
     }
 
+    // Everything the geometry of one splat depends on besides its voxel.
+    const Frame frame{grid.transform, grid.spacing, halfXZ, eye, fwd, camUp, camRight, R, persp};
+
     auto build = [&](const Voxel* begin, const Voxel* end, Splat* out, SplatStats& stats) {
         // Local copies: the compiler cannot keep values read through
         // references in registers across the stores to *out (they might alias).
-        const glm::vec3 eyeL = eye, fwdL = fwd, camUpL = camUp, camRightL = camRight;
-        const float nearZL = nearZ, fadeStart = mDesc.nearFadeStart, fadeEnd = mDesc.nearFadeEnd, RL = R;
+        const float nearZL = nearZ, fadeStart = mDesc.nearFadeStart, fadeEnd = mDesc.nearFadeEnd;
         const bool cull = cullEach, crossfade = style.crossfade, perspL = persp;
         const float colorRow = hasTable ? float(style.colorTable) : 0.0f, gain = range.gain, scaleL = opacityScale;
-        const std::uint32_t setFirst = range.first, setCount = range.count;
-        const glm::mat4 transform = grid.transform;
-        const glm::vec3 spacing = grid.spacing, halfL = halfXZ;
+        const std::uint32_t setFirst = range.first;
+        const FastMod setCount(range.count);
         bool haveEntry = false;
         float lastCoord = 0.0f, lastAlpha = -1.0f, lastTau = 0.0f;
         glm::vec4 entry(1.0f);
         std::uint32_t packedColor = 0xffffffffu;
-        for (const Voxel* vp = begin; vp != end; ++vp) {
-            const Voxel& v = *vp;
-            const float stretch2 = glm::dot(v.stretch, v.stretch);
-            const Shape* shapePtr = &plain;
-            Shape stretchedShape;
-            if (stretch2 > 0.0f) {
-                const float stretchLen = std::sqrt(stretch2);
-                const glm::vec3 sd = v.stretch / stretchLen;
-                stretchedShape = Shape(gridShape * (glm::mat3(1.0f) + stretchLen * glm::outerProduct(sd, sd)), R);
-                stretchedShape.ok = stretchedShape.ok && std::isfinite(stretchLen);
-                shapePtr = &stretchedShape;
+        // Geometry is computed kBatch voxels at a time by a branch-free loop
+        // the compiler vectorizes; the per-voxel rest below is scalar.
+        GeometryBatch batch;
+        for (const Voxel* first = begin; first < end; first += kBatch) {
+            const int count = int(std::min<std::ptrdiff_t>(kBatch, end - first));
+            if (plain.ok) {
+                if (plain.isotropic) computeGeometry<true>(frame, plain, first, count, batch);
+                else computeGeometry<false>(frame, plain, first, count, batch);
             }
-            const Shape& shape = *shapePtr;
-            const glm::vec3 c = glm::vec3(transform * glm::vec4((glm::vec3(v.cell) - halfL) * spacing, 1.0f));
-            if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord) || !std::isfinite(v.phase) || !finite3(c) || !shape.ok ||
-                !std::isfinite(stretch2)) {
-                ++stats.rejected;
-                continue;
+            for (int i = 0; i < count; ++i) {
+                const Voxel& v = first[i];
+                const float stretch2 = glm::dot(v.stretch, v.stretch);
+                Geometry g;
+                float extent = plain.extent;
+                bool shapeOk = plain.ok;
+                if (stretch2 > 0.0f) {
+                    // A stretched kernel has its own shape: the same math, one voxel.
+                    const float stretchLen = std::sqrt(stretch2);
+                    const glm::vec3 sd = v.stretch / stretchLen;
+                    const Shape shape(gridShape * (glm::mat3(1.0f) + stretchLen * glm::outerProduct(sd, sd)), R);
+                    shapeOk = shape.ok && std::isfinite(stretchLen);
+                    extent = shape.extent;
+                    if (shapeOk) {
+                        GeometryBatch one;
+                        if (shape.isotropic) computeGeometry<true>(frame, shape, &v, 1, one);
+                        else computeGeometry<false>(frame, shape, &v, 1, one);
+                        g = one.at(0);
+                    }
+                } else if (shapeOk) {
+                    g = batch.at(i);
+                }
+                if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord) || !std::isfinite(v.phase) || !shapeOk ||
+                    !std::isfinite(stretch2) || !finite3(g.center)) {
+                    ++stats.rejected;
+                    continue;
+                }
+                const float opacity = std::clamp(v.opacity * scaleL, 0.0f, 1.0f);
+                bool outside = opacity <= 0.0f;
+                if (cull)
+                    for (const auto& p : planes) outside = outside || glm::dot(glm::vec3(p), g.center) + p.w < -extent;
+                const float fadeFrom = nearZL + fadeStart * extent, fadeTo = nearZL + fadeEnd * extent;
+                const float fade = g.viewZ >= fadeTo ? 1.0f : smoothstep(fadeFrom, fadeTo, g.viewZ);
+                if (outside || fade <= 0.0f) {
+                    ++stats.culled;
+                    continue;
+                }
+                if (!finite3(g.axisU) || !finite3(g.axisV)) {
+                    ++stats.rejected;
+                    continue;
+                }
+                Splat& sp = *out;
+                sp.center = g.center;
+                sp.axisU = g.axisU;
+                sp.axisV = g.axisV;
+                // Neighbouring voxels usually share a colour coordinate (one layer of
+                // the lattice) and an opacity: reuse the last lookup and logarithm.
+                if (!haveEntry || v.colorCoord != lastCoord) {
+                    entry = tableAt(v.colorCoord);
+                    packedColor = std::uint32_t(entry.r * 255.0f + 0.5f) | std::uint32_t(entry.g * 255.0f + 0.5f) << 8 |
+                                  std::uint32_t(entry.b * 255.0f + 0.5f) << 16 | 0xff000000u;
+                    lastCoord = v.colorCoord;
+                    haveEntry = true;
+                }
+                const float alpha = opacity * entry.a;
+                // Optical depth through the centre: -log2(1 - alpha) times the
+                // chord relative to an isotropic voxel of equal volume.
+                // log2(1 - alpha) loses small alphas (1 - alpha rounds to 1 below 6e-8):
+                // log1p below 2^-10, the cheaper log2 above, where it is exact to 1e-4 relative.
+                if (alpha != lastAlpha) {
+                    lastTau = alpha >= 1.0f ? kMaxTau
+                                            : std::min(alpha < 0x1p-10f ? -std::log1p(-alpha) * 1.44269504f : -std::log2(1.0f - alpha), kMaxTau);
+                    lastAlpha = alpha;
+                }
+                sp.density = lastTau * std::min(g.chord, 64.0f) * fade * gain;
+                sp.colorCoord = std::clamp(v.colorCoord, 0.0f, 1.0f);
+                sp.colorRow = colorRow;
+                const std::uint32_t index = setCount.mod(v.texture);
+                sp.layer = std::uint16_t(setFirst + index);
+                sp.nextLayer = std::uint16_t(setFirst + (index + 1 == setCount.d ? 0 : index + 1));
+                sp.color = packedColor;
+                sp.blend = crossfade ? std::clamp(v.phase - std::floor(v.phase), 0.0f, 1.0f) : 0.0f;
+                sp.depth = perspL ? g.dist : g.viewZ;
+                ++out;
             }
-            const float opacity = std::clamp(v.opacity * scaleL, 0.0f, 1.0f);
-            const glm::vec3 toC = c - eyeL;
-            const float viewZ = glm::dot(toC, fwdL);
-            const float extent = shape.extent;
-            bool outside = opacity <= 0.0f;
-            if (cull)
-                for (const auto& p : planes) outside = outside || glm::dot(glm::vec3(p), c) + p.w < -extent;
-            const float fadeFrom = nearZL + fadeStart * extent, fadeTo = nearZL + fadeEnd * extent;
-            const float fade = viewZ >= fadeTo ? 1.0f : smoothstep(fadeFrom, fadeTo, viewZ);
-            if (outside || fade <= 0.0f) {
-                ++stats.culled;
-                continue;
-            }
-
-            // Screen-plane basis at the splat: perpendicular to the ray through
-            // its centre, "up" as close to the camera's up as possible so
-            // textures stay upright (flames rise on screen).
-            const float dist = glm::length(toC);
-            const glm::vec3 d = perspL ? (dist > 1e-20f ? toC * (1.0f / dist) : fwdL) : fwdL;
-            glm::vec3 e1 = glm::cross(d, camUpL);
-            const float e1Len = glm::length(e1);
-            e1 = e1Len > 1e-6f ? e1 * (1.0f / e1Len) : camRightL;
-            const glm::vec3 e2 = glm::cross(e1, d); // unit: e1 and d are orthonormal
-
-            // Line integral of h(|M^-1 x|) along d at plane offset q: F(|q|_Q) / |M^-1 d|.
-            // Q is the Schur complement of Sigma^-1 = (M M^T)^-1 in the frame
-            // (e1, e2, d), so Q^-1 is simply the (e1, e2) block of Sigma: the
-            // ellipse's axes are the square root of that 2x2 block.
-            float sq[3] = {shape.s, 0.0f, shape.s};
-            float bLen = 1.0f / shape.s;
-            if (!shape.isotropic) {
-                const glm::vec3 se1 = shape.sigma * e1, se2 = shape.sigma * e2;
-                sqrt2x2(glm::dot(e1, se1), glm::dot(e2, se1), glm::dot(e2, se2), sq);
-                bLen = std::sqrt(glm::dot(d, shape.sigmaInv * d));
-            }
-
-            Splat& sp = *out;
-            sp.center = c;
-            sp.axisU = RL * (sq[0] * e1 + sq[1] * e2);
-            sp.axisV = RL * (sq[1] * e1 + sq[2] * e2);
-            if (!finite3(sp.axisU) || !finite3(sp.axisV)) {
-                ++stats.rejected;
-                continue;
-            }
-            // Neighbouring voxels usually share a colour coordinate (one layer of
-            // the lattice) and an opacity: reuse the last lookup and logarithm.
-            if (!haveEntry || v.colorCoord != lastCoord) {
-                entry = tableAt(v.colorCoord);
-                packedColor = std::uint32_t(entry.r * 255.0f + 0.5f) | std::uint32_t(entry.g * 255.0f + 0.5f) << 8 |
-                              std::uint32_t(entry.b * 255.0f + 0.5f) << 16 | 0xff000000u;
-                lastCoord = v.colorCoord;
-                haveEntry = true;
-            }
-            const float alpha = opacity * entry.a;
-            // Optical depth through the centre, relative to an isotropic voxel of
-            // equal volume: the chord along d (1 / |M^-1 d|) over det(M)^(1/3).
-            // log2(1 - alpha) loses small alphas (1 - alpha rounds to 1 below 6e-8):
-            // log1p below 2^-10, the cheaper log2 above, where it is exact to 1e-4 relative.
-            if (alpha != lastAlpha) {
-                lastTau = alpha >= 1.0f ? kMaxTau
-                                        : std::min(alpha < 0x1p-10f ? -std::log1p(-alpha) * 1.44269504f : -std::log2(1.0f - alpha), kMaxTau);
-                lastAlpha = alpha;
-            }
-            const float tau = lastTau;
-            const float chord = (1.0f / bLen) / shape.cbrtDet;
-            sp.density = tau * std::min(chord, 64.0f) * fade * gain;
-            sp.colorCoord = std::clamp(v.colorCoord, 0.0f, 1.0f);
-            sp.colorRow = colorRow;
-            const std::uint32_t index = v.texture % setCount; // one division per voxel, not two
-            sp.layer = std::uint16_t(setFirst + index);
-            sp.nextLayer = std::uint16_t(setFirst + (index + 1 == setCount ? 0 : index + 1));
-            sp.color = packedColor;
-            sp.blend = crossfade ? std::clamp(v.phase - std::floor(v.phase), 0.0f, 1.0f) : 0.0f;
-            sp.depth = perspL ? dist : viewZ;
-            ++out;
         }
         return out;
     };
