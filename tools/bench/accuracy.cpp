@@ -86,6 +86,8 @@ struct Config {
     float gaussianRadius = 2.0f;
     float footprintCut = splatfx::gl::RendererDesc{}.footprintCut; // the SDK default
     bool octagons = splatfx::gl::RendererDesc{}.trimCorners;        // the SDK default
+    splatfx::gl::TextureSampling sampling = splatfx::gl::RendererDesc{}.sampling; // the SDK default
+    int upsample = splatfx::gl::RendererDesc{}.upsample;
 };
 
 struct Row {
@@ -270,6 +272,8 @@ struct Bench {
         splatfx::gl::RendererDesc rdesc;
         rdesc.footprintCut = c.footprintCut;
         rdesc.trimCorners = c.octagons;
+        rdesc.sampling = c.sampling;
+        rdesc.upsample = c.upsample;
         auto sr = splatfx::gl::ScaledRenderer::create({.scale = c.scale, .renderer = rdesc});
         if (!fb || !sr || !sr->upload(*s->mat)) {
             std::fprintf(stderr, "accuracy: cannot set up GL for %s %s\n", knob.c_str(), setting.c_str());
@@ -518,6 +522,20 @@ int runAccuracy(int argc, char** argv) {
         const bool isDefault = octagons == splatfx::gl::RendererDesc{}.trimCorners;
         b.add("footprint shape (RendererDesc)", std::string(octagons ? "octagon, 6 triangles" : "square, 2 triangles") + (isDefault ? " (default)" : ""),
               c, onTexture, truth);
+    }
+    {
+        using splatfx::gl::TextureSampling;
+        const splatfx::gl::RendererDesc defaults;
+        auto sampled = [&](TextureSampling s, int factor, const std::string& label) {
+            Config c;
+            c.sampling = s;
+            c.upsample = factor;
+            const bool isDefault = s == defaults.sampling && (s != TextureSampling::Upsampled || factor == defaults.upsample);
+            b.add("texture sampling (RendererDesc)", label + (isDefault ? " (default)" : ""), c, onTexture, truth);
+        };
+        sampled(TextureSampling::Bilinear, 1, "bilinear");
+        sampled(TextureSampling::Nearest, 1, "nearest");
+        for (int factor : {2, 4, 8}) sampled(TextureSampling::Upsampled, factor, "upsampled " + std::to_string(factor) + "x, nearest");
     }
     for (float radius : {1.05f, 1.4f, 1.75f, 2.0f, 2.8f}) {
         Config c = gaussTruthCfg;

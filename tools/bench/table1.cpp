@@ -100,8 +100,9 @@ void beginOver(GLuint fbo, glm::ivec2 size, GLuint program) {
 }
 
 // The fill limit: full-screen quads doing the splat fragment's work (one
-// texture-array fetch, exp2, colour multiply, premultiplied "over" blend into
-// the same RGBA8 target). Nothing else can make splat fragments cheaper.
+// fetch from the renderer's own texture array with its sampling, exp2, colour
+// multiply, premultiplied "over" blend into the same RGBA8 target). Nothing
+// else can make splat fragments cheaper.
 class FillProbe {
 public:
     FillProbe() {
@@ -313,7 +314,8 @@ RowResult measureRow(const Row& row, const Settings& settings) {
     FillProbe fill;
     // At least 64 screens of fragments so the timing is not dominated by one draw's fixed cost.
     const int quads = std::max(64, int(samples / (double(row.window.x) * row.window.y)));
-    out.fillRate = fill.rate(fb->handle(), row.window, gpu.layers, quads);
+    // The renderer's own layer texture: the same texels, size and sampling per fragment.
+    out.fillRate = fill.rate(fb->handle(), row.window, renderer->layerTexture(), quads);
     out.fillFraction = out.splatFragsPerSec / out.fillRate;
 
     // Where full resolution misses the Onyx2 rate, the same full frame with

@@ -32,10 +32,25 @@
 
 namespace splatfx::gl {
 
+// How splats sample their texture layers.
+enum class TextureSampling {
+    Bilinear,  // the layers as stored, bilinear filtering
+    Nearest,   // the layers as stored, nearest texel: blocky where splats magnify their textures
+    // The layers resampled bilinearly by RendererDesc::upsample on upload,
+    // then sampled nearest: within 1/(2 upsample) texel of bilinear, at
+    // nearest's cost per fragment. On Mesa's llvmpipe filtering dominates a
+    // splat fragment, and this is 1.3-1.4x faster than Bilinear at the same
+    // error against the exact reference (docs/BENCHMARKS.md); on a GPU both
+    // are free and this costs upsample^2 the texture memory (a 16-layer set
+    // of 64^2 textures: 4 MiB at 4x).
+    Upsampled,
+};
+
 struct RendererDesc {
     bool restoreState = true;  // save and restore host GL state around draw(); default true
     bool depthTest = true;     // test against the host's depth buffer; default true
-    bool linearFilter = true;  // bilinear texture sampling (false: nearest); default true
+    TextureSampling sampling = TextureSampling::Upsampled; // default Upsampled
+    int upsample = 4;          // Upsampled's factor, clamped to [1, 16]; default 4
     // Draw octagons (6 triangles) that skip the square's empty corners, or
     // squares (2 triangles). Octagons save ~17 % of the fragments but cost 3x
     // the triangles; on Mesa's llvmpipe squares are 1.3-2x faster per frame
@@ -80,6 +95,9 @@ public:
 
     const DrawStats& stats() const;
     const RendererDesc& desc() const;
+    // The GL texture array holding the uploaded layers (0 before upload), for
+    // tools and debug views; the renderer owns it.
+    unsigned layerTexture() const;
 
 private:
     struct Impl;

@@ -76,6 +76,33 @@ struct SavedState {
     }
 };
 
+// An n x n RGBA layer resampled to (factor n)^2 with GL's bilinear rule
+// (texel centres at (i + 0.5) / size, clamped at the edges), so that
+// nearest sampling of the result reproduces bilinear sampling of the
+// original to within half a new texel.
+const float* upsampleBilinear(const float* src, int n, int factor, std::vector<float>& out) {
+    const int m = n * factor;
+    out.resize(std::size_t(m) * m * 4);
+    for (int y = 0; y < m; ++y) {
+        const float fy = std::clamp((float(y) + 0.5f) / float(factor) - 0.5f, 0.0f, float(n - 1));
+        const int y0 = std::min(int(fy), n - 1), y1 = std::min(y0 + 1, n - 1);
+        const float ay = fy - float(y0);
+        for (int x = 0; x < m; ++x) {
+            const float fx = std::clamp((float(x) + 0.5f) / float(factor) - 0.5f, 0.0f, float(n - 1));
+            const int x0 = std::min(int(fx), n - 1), x1 = std::min(x0 + 1, n - 1);
+            const float ax = fx - float(x0);
+            const float* a = src + (std::size_t(y0) * n + x0) * 4;
+            const float* b = src + (std::size_t(y0) * n + x1) * 4;
+            const float* c = src + (std::size_t(y1) * n + x0) * 4;
+            const float* d = src + (std::size_t(y1) * n + x1) * 4;
+            float* o = out.data() + (std::size_t(y) * m + x) * 4;
+            for (int k = 0; k < 4; ++k)
+                o[k] = (1.0f - ay) * ((1.0f - ax) * a[k] + ax * b[k]) + ay * ((1.0f - ax) * c[k] + ax * d[k]);
+        }
+    }
+    return out.data();
+}
+
 } // namespace
 
 struct Renderer::Impl {
@@ -135,6 +162,7 @@ Renderer& Renderer::operator=(Renderer&&) noexcept = default;
 Renderer::~Renderer() = default;
 const DrawStats& Renderer::stats() const { return mImpl->stats; }
 const RendererDesc& Renderer::desc() const { return mImpl->desc; }
+unsigned Renderer::layerTexture() const { return mImpl->layers; }
 
 Result<Renderer> Renderer::create(const RendererDesc& desc) {
     if (!detail::contextIsCurrent()) return makeError("splatfx::gl::Renderer::create: no OpenGL context is current on this thread");
@@ -181,12 +209,23 @@ Status Renderer::upload(const Materials& materials) {
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &maxLayers);
     if (GLint(count) > maxLayers)
         return makeError("materials hold " + std::to_string(count) + " texture layers; this GL allows " + std::to_string(maxLayers));
+    const bool upsampled = r.desc.sampling == TextureSampling::Upsampled;
+    const int factor = upsampled ? std::clamp(r.desc.upsample, 1, 16) : 1;
+    GLint maxSize = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
+    if (n * factor > maxSize)
+        return makeError("texture layers of " + std::to_string(n) + "^2 upsampled " + std::to_string(factor) + "x exceed this GL's " +
+                         std::to_string(maxSize) + " texels; use a smaller RendererDesc::upsample");
     if (r.layers) glDeleteTextures(1, &r.layers);
     glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &r.layers);
-    glTextureStorage3D(r.layers, 1, GL_RGBA8, n, n, GLsizei(count));
-    for (std::uint32_t i = 0; i < count; ++i)
-        glTextureSubImage3D(r.layers, 0, 0, 0, GLint(i), n, n, 1, GL_RGBA, GL_FLOAT, materials.layer(i).data());
-    const GLint filter = r.desc.linearFilter ? GL_LINEAR : GL_NEAREST;
+    glTextureStorage3D(r.layers, 1, GL_RGBA8, n * factor, n * factor, GLsizei(count));
+    std::vector<float> resampled;
+    for (std::uint32_t i = 0; i < count; ++i) {
+        const float* texels = materials.layer(i).data();
+        if (factor > 1) texels = upsampleBilinear(texels, n, factor, resampled);
+        glTextureSubImage3D(r.layers, 0, 0, 0, GLint(i), n * factor, n * factor, 1, GL_RGBA, GL_FLOAT, texels);
+    }
+    const GLint filter = r.desc.sampling == TextureSampling::Bilinear ? GL_LINEAR : GL_NEAREST;
     glTextureParameteri(r.layers, GL_TEXTURE_MIN_FILTER, filter);
     glTextureParameteri(r.layers, GL_TEXTURE_MAG_FILTER, filter);
     // Clamp to the border texels, which the footprint window has brought to zero.
