@@ -24,11 +24,11 @@ struct Frame {
     }
 };
 
-Image renderCampfire(std::uint32_t seed, glm::ivec2 size, gl::Precision precision = gl::Precision::U8) {
+Image renderCampfire(std::uint32_t seed, glm::ivec2 size, const gl::RendererDesc& desc = {}) {
     Frame f(seed);
-    auto fb = gl::Framebuffer::create({.width = size.x, .height = size.y, .color = precision});
+    auto fb = gl::Framebuffer::create({.width = size.x, .height = size.y});
     EXPECT_TRUE(fb) << fb.error();
-    auto r = gl::Renderer::create();
+    auto r = gl::Renderer::create(desc);
     EXPECT_TRUE(r) << r.error();
     EXPECT_TRUE(r->upload(f.materials));
     fb->clear({0.02f, 0.02f, 0.04f, 1.0f});
@@ -84,7 +84,8 @@ public:
 class RendererGL : public test::GLTest {};
 
 TEST_F(RendererGL, CampfireMatchesGoldenImage) {
-    const Image actual = renderCampfire(1, {160, 120});
+    // Bilinear sampling, named: the default (Auto) depends on the GL.
+    const Image actual = renderCampfire(1, {160, 120}, {.sampling = gl::TextureSampling::Bilinear});
     const std::string goldenPath = test::sourcePath("tests/golden/campfire_160x120.png");
     if (std::getenv("SPLATFX_UPDATE_GOLDEN")) {
         ASSERT_TRUE(writeImage(goldenPath, actual));
@@ -103,6 +104,48 @@ TEST_F(RendererGL, CampfireMatchesGoldenImage) {
     const bool ok = d.meanAbs <= 1.0 / 255 && d.fractionOver <= 0.02 && d.maxAbs <= 24.0 / 255;
     EXPECT_TRUE(ok) << "mean " << d.meanAbs * 255 << "/255, max " << d.maxAbs * 255 << "/255, over " << d.fractionOver * 100
                     << "% -- " << test::writeFailureImages(actual, d);
+}
+
+// Upsampled layers sampled nearest stand in for bilinear sampling: the same
+// picture to within a fraction of an 8-bit step on average, and closer the
+// finer the resampling.
+TEST_F(RendererGL, UpsampledSamplingApproachesBilinear) {
+    const glm::ivec2 size{160, 120};
+    const Image bilinear = renderCampfire(1, size, {.sampling = gl::TextureSampling::Bilinear});
+    const Image nearest = renderCampfire(1, size, {.sampling = gl::TextureSampling::Nearest});
+    double previous = 1.0;
+    for (int factor : {2, 4, 8}) {
+        const Image up = renderCampfire(1, size, {.sampling = gl::TextureSampling::Upsampled, .upsample = factor});
+        const double mean = test::compareImages(up, bilinear, 2.0 / 255.0).meanAbs;
+        std::printf("upsampled %dx vs bilinear: mean %.3f/255\n", factor, mean * 255);
+        EXPECT_LT(mean, 0.5 / 255) << factor << "x";
+        EXPECT_LT(mean, previous) << factor << "x";
+        previous = mean;
+    }
+    const double nearestMean = test::compareImages(nearest, bilinear, 2.0 / 255.0).meanAbs;
+    std::printf("nearest vs bilinear: mean %.3f/255\n", nearestMean * 255);
+    EXPECT_LT(previous, nearestMean);
+}
+
+// Auto: upsampled on CPU rasterizers, by 4x or 2x within the memory budget,
+// bilinear on GPUs and for layers too large to upsample within it.
+TEST_F(RendererGL, AutoSamplingFollowsTheRasterizerAndTheBudget) {
+    const std::string name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    const bool cpu = name.find("llvmpipe") != std::string::npos || name.find("softpipe") != std::string::npos;
+    struct Case {
+        int layerSize, count, factor; // factor expected on a CPU rasterizer (1: bilinear)
+    };
+    // Layers = the set plus the plain footprint (layer 0).
+    for (const Case c : {Case{16, 8, 4}, Case{32, 7, 4}, Case{32, 8, 2}, Case{64, 7, 2}, Case{64, 8, 1}}) {
+        Materials m{Footprint{}, {.layerSize = c.layerSize}};
+        m.addTextureSet(TextureSet::turbulence({.count = c.count, .size = c.layerSize}));
+        auto r = gl::Renderer::create();
+        ASSERT_TRUE(r) << r.error();
+        ASSERT_TRUE(r->upload(m));
+        const int expected = cpu ? c.factor : 1;
+        EXPECT_EQ(r->upsampleFactor(), expected) << c.layerSize << "^2 x " << c.count;
+        EXPECT_EQ(r->sampling(), expected > 1 ? gl::TextureSampling::Upsampled : gl::TextureSampling::Bilinear);
+    }
 }
 
 TEST_F(RendererGL, SameSeedGivesIdenticalPixels) {

@@ -525,17 +525,24 @@ int runAccuracy(int argc, char** argv) {
     }
     {
         using splatfx::gl::TextureSampling;
-        const splatfx::gl::RendererDesc defaults;
         auto sampled = [&](TextureSampling s, int factor, const std::string& label) {
             Config c;
             c.sampling = s;
             c.upsample = factor;
-            const bool isDefault = s == defaults.sampling && (s != TextureSampling::Upsampled || factor == defaults.upsample);
-            b.add("texture sampling (RendererDesc)", label + (isDefault ? " (default)" : ""), c, onTexture, truth);
+            b.add("texture sampling (RendererDesc)", label, c, onTexture, truth);
         };
-        sampled(TextureSampling::Bilinear, 1, "bilinear");
-        sampled(TextureSampling::Nearest, 1, "nearest");
+        sampled(TextureSampling::Bilinear, 0, "bilinear");
+        sampled(TextureSampling::Nearest, 0, "nearest");
         for (int factor : {2, 4, 8}) sampled(TextureSampling::Upsampled, factor, "upsampled " + std::to_string(factor) + "x, nearest");
+        // The default, labelled with what it resolved to on this GL.
+        Config c;
+        b.add("texture sampling (RendererDesc)", "auto", c, onTexture, truth);
+        if (!b.settings.empty()) {
+            const splatfx::gl::Renderer& r = b.settings.back()->sr->renderer();
+            b.settings.back()->row.setting = r.sampling() == TextureSampling::Upsampled
+                                                 ? "auto: upsampled " + std::to_string(r.upsampleFactor()) + "x (default)"
+                                                 : "auto: bilinear (default)";
+        }
     }
     for (float radius : {1.05f, 1.4f, 1.75f, 2.0f, 2.8f}) {
         Config c = gaussTruthCfg;

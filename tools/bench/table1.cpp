@@ -120,6 +120,7 @@ public:
     }
     ~FillProbe() {
         glDeleteProgram(program);
+        glDeleteProgram(squares);
         glDeleteVertexArrays(1, &vao);
     }
     // Fragments per second for `quads` full-screen quads.
@@ -140,7 +141,54 @@ public:
         glDisable(GL_BLEND);
         return double(quads) * size.x * size.y / t[t.size() / 2];
     }
-    GLuint program = 0, vao = 0;
+    // Fragments per second for `count` screen-aligned squares of `side`
+    // pixels scattered over `region` (x0, y0, x1, y1 in pixels), one draw:
+    // the fill rate this rasterizer reaches for primitives of the splats'
+    // size, with the same per-fragment work.
+    double rateSquares(GLuint fbo, glm::ivec2 size, GLuint layers, int count, float side, glm::vec4 region) {
+        if (!squares)
+            squares = compileProgram(R"(#version 450 core
+                const vec2 k[4] = vec2[4](vec2(0,0), vec2(1,0), vec2(0,1), vec2(1,1));
+                uniform vec2 uViewport; uniform float uSide; uniform vec4 uRegion;
+                out vec2 vTex; flat out float vLayer;
+                float hash(uint x) { x ^= x >> 16; x *= 0x7feb352du; x ^= x >> 15; x *= 0x846ca68bu; x ^= x >> 16; return float(x) / 4294967296.0; }
+                void main() {
+                    uint i = uint(gl_InstanceID);
+                    vec2 at = uRegion.xy + vec2(hash(2u * i), hash(2u * i + 1u)) * max(uRegion.zw - uRegion.xy - uSide, vec2(0.0));
+                    vec2 p = at + k[gl_VertexID] * uSide;
+                    vTex = k[gl_VertexID]; vLayer = float(gl_InstanceID % 8 + 1);
+                    gl_Position = vec4(p / uViewport * 2.0 - 1.0, 0.5, 1.0); })",
+                                     R"(#version 450 core
+                layout(binding = 0) uniform sampler2DArray uLayers;
+                in vec2 vTex; flat in float vLayer; out vec4 o;
+                void main() { vec4 t = texture(uLayers, vec3(vTex, vLayer));
+                              float a = 1.0 - exp2(-0.05 * t.a); o = vec4(vec3(1.0, 0.6, 0.2) * t.rgb * a, a); })");
+        beginOver(fbo, size, squares);
+        glUniform2f(glGetUniformLocation(squares, "uViewport"), float(size.x), float(size.y));
+        glUniform1f(glGetUniformLocation(squares, "uSide"), side);
+        glUniform4fv(glGetUniformLocation(squares, "uRegion"), 1, glm::value_ptr(region));
+        glBindTextureUnit(0, layers);
+        glBindVertexArray(vao);
+        GLuint query = 0;
+        glGenQueries(1, &query);
+        glBeginQuery(GL_SAMPLES_PASSED, query);
+        glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, count);
+        glEndQuery(GL_SAMPLES_PASSED);
+        GLuint64 samples = 0;
+        glGetQueryObjectui64v(query, GL_QUERY_RESULT, &samples);
+        glDeleteQueries(1, &query);
+        std::vector<double> t;
+        for (int rep = 0; rep < 15; ++rep) {
+            const auto a = Clock::now();
+            glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, count);
+            glFinish();
+            t.push_back(seconds(a, Clock::now()));
+        }
+        std::sort(t.begin(), t.end());
+        glDisable(GL_BLEND);
+        return double(samples) / t[t.size() / 2];
+    }
+    GLuint program = 0, squares = 0, vao = 0;
 };
 
 // What a user might write in an afternoon: instanced square billboards, no
@@ -245,6 +293,7 @@ double medianFrame(int warm, int frames, F f) {
 struct RowResult {
     double scaledHz = 0; int scale = 1;  // reduced-resolution result where full resolution misses the Onyx2 rate
     double hz = 0, naiveHz = 0, fillFraction = 0, splatFragsPerSec = 0, fillRate = 0, covered = 0, overdraw = 0;
+    double sizedRate = 0, side = 0; // fill rate of screen-aligned squares of the splats' mean size, and that size
 };
 
 struct Settings {
@@ -300,7 +349,13 @@ RowResult measureRow(const Row& row, const Settings& settings) {
     glDeleteQueries(1, &query);
     const splatfx::Image img = fb->read();
     size_t covered = 0;
-    for (size_t p = 3; p < img.pixels.size(); p += 4) covered += img.pixels[p] > 0.0f;
+    glm::vec4 region(float(row.window.x), float(row.window.y), 0.0f, 0.0f); // covered pixels' bounds
+    for (size_t p = 3; p < img.pixels.size(); p += 4)
+        if (img.pixels[p] > 0.0f) {
+            ++covered;
+            const float x = float((p / 4) % size_t(img.width)), y = float((p / 4) / size_t(img.width));
+            region = glm::vec4(std::min(region.x, x), std::min(region.y, y), std::max(region.z, x + 1), std::max(region.w, y + 1));
+        }
     out.covered = double(covered);
     out.overdraw = covered ? double(samples) / double(covered) : 0.0;
 
@@ -317,6 +372,11 @@ RowResult measureRow(const Row& row, const Settings& settings) {
     // The renderer's own layer texture: the same texels, size and sampling per fragment.
     out.fillRate = fill.rate(fb->handle(), row.window, renderer->layerTexture(), quads);
     out.fillFraction = out.splatFragsPerSec / out.fillRate;
+    // The same fragments as squares of the splats' mean size: what limits small splats.
+    const int splats = int(builder.splats().size());
+    const float side = std::sqrt(float(samples) / float(std::max(splats, 1)));
+    out.sizedRate = fill.rateSquares(fb->handle(), row.window, renderer->layerTexture(), splats, side, region);
+    out.side = side;
 
     // Where full resolution misses the Onyx2 rate, the same full frame with
     // the splat pass at half, then quarter resolution (depth-aware upsampling;
@@ -427,25 +487,28 @@ int runTable1(int argc, char** argv) {
         return 1;
     }
     std::printf("Table I on %s (median of %d frames per row; paper columns in Hz)\n\n", ctx->renderer().c_str(), frames);
-    std::printf("%-9s %6s | %6s %6s %7s %6s | %9s %9s %13s | %8s %8s %8s %6s | %8s %6s\n", "window", "voxels", "O2", "Indy", "Octane",
-                "Onyx2", "splatfx", "vs Onyx2", "reduced res", "covered", "overdraw", "Mfrag/s", "fill", "naive Hz", "ratio");
+    std::printf("%-9s %6s | %6s %6s %7s %6s | %9s %9s %13s | %8s %8s %8s %6s | %6s %8s | %8s %6s\n", "window", "voxels", "O2", "Indy",
+                "Octane", "Onyx2", "splatfx", "vs Onyx2", "reduced res", "covered", "overdraw", "Mfrag/s", "fill", "side", "vs sized",
+                "naive Hz", "ratio");
     std::fprintf(csv, "window,voxels,o2_hz,indy_hz,octane_hz,onyx2_hz,splatfx_hz,pixels_covered,overdraw,splat_mfrag_s,fill_mfrag_s,"
-                      "fill_fraction,naive_hz,speedup_vs_naive,reduced_scale,reduced_hz\n");
+                      "fill_fraction,mean_splat_side_px,sized_fill_mfrag_s,fraction_of_sized_fill,naive_hz,speedup_vs_naive,reduced_scale,reduced_hz\n");
     for (const Row& row : kRows) {
         const RowResult r = measureRow(row, settings);
         char win[16];
         std::snprintf(win, sizeof win, "%dx%d", row.window.x, row.window.y);
         char reduced[32] = "-";
         if (r.scale > 1) std::snprintf(reduced, sizeof reduced, "%.1f Hz @1/%d", r.scaledHz, r.scale);
-        std::printf("%-9s %6d | %6.0f %6.3g %7.0f %6.0f | %9.1f %8.2fx %13s | %8.0f %8.1f %8.0f %5.0f%% | %8.1f %5.2fx\n", win, row.voxels,
-                    row.o2, row.indy, row.octane, row.onyx2, r.hz, r.hz / row.onyx2, reduced, r.covered, r.overdraw, r.splatFragsPerSec / 1e6,
-                    100 * r.fillFraction, r.naiveHz, r.hz / r.naiveHz);
-        std::fprintf(csv, "%s,%d,%g,%g,%g,%g,%.2f,%.0f,%.2f,%.1f,%.1f,%.3f,%.2f,%.3f,%d,%.2f\n", win, row.voxels, row.o2, row.indy,
-                     row.octane, row.onyx2, r.hz, r.covered, r.overdraw, r.splatFragsPerSec / 1e6, r.fillRate / 1e6, r.fillFraction,
-                     r.naiveHz, r.hz / r.naiveHz, r.scale, r.scaledHz);
+        std::printf("%-9s %6d | %6.0f %6.3g %7.0f %6.0f | %9.1f %8.2fx %13s | %8.0f %8.1f %8.0f %5.0f%% | %6.1f %7.0f%% | %8.1f %5.2fx\n", win,
+                    row.voxels, row.o2, row.indy, row.octane, row.onyx2, r.hz, r.hz / row.onyx2, reduced, r.covered, r.overdraw,
+                    r.splatFragsPerSec / 1e6, 100 * r.fillFraction, r.side, 100 * r.splatFragsPerSec / r.sizedRate, r.naiveHz, r.hz / r.naiveHz);
+        std::fprintf(csv, "%s,%d,%g,%g,%g,%g,%.2f,%.0f,%.2f,%.1f,%.1f,%.3f,%.1f,%.1f,%.3f,%.2f,%.3f,%d,%.2f\n", win, row.voxels, row.o2,
+                     row.indy, row.octane, row.onyx2, r.hz, r.covered, r.overdraw, r.splatFragsPerSec / 1e6, r.fillRate / 1e6, r.fillFraction,
+                     r.side, r.sizedRate / 1e6, r.splatFragsPerSec / r.sizedRate, r.naiveHz, r.hz / r.naiveHz, r.scale, r.scaledHz);
         std::fflush(stdout);
     }
     std::printf("\nfill = splat-pass fragments/s as a fraction of full-screen quads doing the same per-fragment work\n"
+                "side = the splats' mean size in pixels (sqrt of fragments per splat); vs sized = splat-pass fragments/s as a\n"
+                "  fraction of screen-aligned squares of that size doing the same work (the rasterizer's limit at that size)\n"
                 "ratio = splatfx full frame (dynamics, sort, upload, draw) vs the naive baseline's frame (no sort, no footprint math)\n");
     cpuScaling(csv);
     std::fclose(csv);

@@ -21,6 +21,7 @@
 // Threading: every call on the thread whose context is current. Move-only.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -34,23 +35,31 @@ namespace splatfx::gl {
 
 // How splats sample their texture layers.
 enum class TextureSampling {
-    Bilinear,  // the layers as stored, bilinear filtering
-    Nearest,   // the layers as stored, nearest texel: blocky where splats magnify their textures
-    // The layers resampled bilinearly by RendererDesc::upsample on upload,
-    // then sampled nearest: within 1/(2 upsample) texel of bilinear, at
-    // nearest's cost per fragment. On Mesa's llvmpipe filtering dominates a
-    // splat fragment, and this is 1.3-1.4x faster than Bilinear at the same
-    // error against the exact reference (docs/BENCHMARKS.md); on a GPU both
-    // are free and this costs upsample^2 the texture memory (a 16-layer set
-    // of 64^2 textures: 4 MiB at 4x).
+    // Upsampled on software rasterizers (Mesa's llvmpipe, softpipe), where
+    // filtering dominates a splat fragment; Bilinear on GPUs, where it is free.
+    Auto,
+    Bilinear, // the layers as stored, bilinear filtering
+    Nearest,  // the layers as stored, nearest texel: blocky where splats magnify their textures
+    // The layers resampled bilinearly on upload by an integer factor, then
+    // sampled nearest: within half a new texel of bilinear, at nearest's cost
+    // per fragment. On llvmpipe: 1.5x the fill rate of Bilinear where splats
+    // magnify their textures, at the same error against the exact reference
+    // (docs/BENCHMARKS.md). Costs factor^2 the texture memory, so with
+    // RendererDesc::upsample = 0 the factor is 4 or 2, whichever keeps all
+    // layers within kUpsampleBudgetBytes (larger layers thrash a CPU's
+    // caches where splats are small); Bilinear where neither fits.
     Upsampled,
 };
+
+// Texture memory Upsampled may use with an automatic factor: half the L2
+// cache of a typical desktop core, leaving room for framebuffer tiles.
+inline constexpr std::size_t kUpsampleBudgetBytes = 512 * 1024;
 
 struct RendererDesc {
     bool restoreState = true;  // save and restore host GL state around draw(); default true
     bool depthTest = true;     // test against the host's depth buffer; default true
-    TextureSampling sampling = TextureSampling::Upsampled; // default Upsampled
-    int upsample = 4;          // Upsampled's factor, clamped to [1, 16]; default 4
+    TextureSampling sampling = TextureSampling::Auto; // default Auto
+    int upsample = 0;          // Upsampled's factor, 2 to 16; 0 (default): automatic (see Upsampled)
     // Draw octagons (6 triangles) that skip the square's empty corners, or
     // squares (2 triangles). Octagons save ~17 % of the fragments but cost 3x
     // the triangles; on Mesa's llvmpipe squares are 1.3-2x faster per frame
@@ -98,6 +107,10 @@ public:
     // The GL texture array holding the uploaded layers (0 before upload), for
     // tools and debug views; the renderer owns it.
     unsigned layerTexture() const;
+    // What the last upload() chose: never Auto; Upsampled with its factor
+    // (1 for the other modes).
+    TextureSampling sampling() const;
+    int upsampleFactor() const;
 
 private:
     struct Impl;

@@ -1,6 +1,10 @@
 #include "context_check.hpp"
 
+#include <cstring>
+#include <initializer_list>
+
 #include <dlfcn.h>
+#include <epoxy/gl.h>
 
 namespace splatfx::gl::detail {
 
@@ -16,6 +20,14 @@ bool contextIsCurrent() {
         dlclose(handle);
         if (current) return true;
     }
+    return false;
+}
+
+bool softwareRasterizer() {
+    const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    if (!name) return false;
+    for (const char* cpu : {"llvmpipe", "softpipe", "swrast"})
+        if (std::strstr(name, cpu)) return true;
     return false;
 }
 

@@ -1,4 +1,4 @@
-// Is an OpenGL context current on this thread? (private to the GL backend)
+// What kind of OpenGL context is current on this thread (private to the GL backend).
 #pragma once
 
 namespace splatfx::gl::detail {
@@ -7,5 +7,9 @@ namespace splatfx::gl::detail {
 // only be current if one of them made it so. Never loads a library itself,
 // and never calls GL (which would abort inside the loader with no context).
 bool contextIsCurrent();
+
+// Whether the current context renders on the CPU (Mesa's llvmpipe, softpipe,
+// swrast), by its GL_RENDERER string. Needs a current context.
+bool softwareRasterizer();
 
 } // namespace splatfx::gl::detail

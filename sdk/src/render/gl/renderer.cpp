@@ -124,6 +124,8 @@ struct Renderer::Impl {
     GLsync fences[kRing] = {};
     int region = 0;
     std::uint64_t uploadedVersion = 0;
+    TextureSampling sampling = TextureSampling::Bilinear; // resolved at upload
+    int upsample = 1;
 
     void grow(std::size_t splats) {
         for (GLsync& f : fences)
@@ -163,6 +165,8 @@ Renderer::~Renderer() = default;
 const DrawStats& Renderer::stats() const { return mImpl->stats; }
 const RendererDesc& Renderer::desc() const { return mImpl->desc; }
 unsigned Renderer::layerTexture() const { return mImpl->layers; }
+TextureSampling Renderer::sampling() const { return mImpl->sampling; }
+int Renderer::upsampleFactor() const { return mImpl->upsample; }
 
 Result<Renderer> Renderer::create(const RendererDesc& desc) {
     if (!detail::contextIsCurrent()) return makeError("splatfx::gl::Renderer::create: no OpenGL context is current on this thread");
@@ -209,8 +213,19 @@ Status Renderer::upload(const Materials& materials) {
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &maxLayers);
     if (GLint(count) > maxLayers)
         return makeError("materials hold " + std::to_string(count) + " texture layers; this GL allows " + std::to_string(maxLayers));
-    const bool upsampled = r.desc.sampling == TextureSampling::Upsampled;
-    const int factor = upsampled ? std::clamp(r.desc.upsample, 1, 16) : 1;
+    // Resolve Auto and the automatic factor for these layers.
+    TextureSampling mode = r.desc.sampling;
+    if (mode == TextureSampling::Auto) mode = detail::softwareRasterizer() ? TextureSampling::Upsampled : TextureSampling::Bilinear;
+    int factor = 1;
+    if (mode == TextureSampling::Upsampled) {
+        factor = std::clamp(r.desc.upsample, 0, 16);
+        const auto bytes = [&](int f) { return std::size_t(count) * std::size_t(n * f) * std::size_t(n * f) * 4; };
+        if (factor == 0) factor = bytes(4) <= kUpsampleBudgetBytes ? 4 : bytes(2) <= kUpsampleBudgetBytes ? 2 : 1;
+        if (factor < 2) {
+            mode = TextureSampling::Bilinear;
+            factor = 1;
+        }
+    }
     GLint maxSize = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &maxSize);
     if (n * factor > maxSize)
@@ -225,13 +240,15 @@ Status Renderer::upload(const Materials& materials) {
         if (factor > 1) texels = upsampleBilinear(texels, n, factor, resampled);
         glTextureSubImage3D(r.layers, 0, 0, 0, GLint(i), n * factor, n * factor, 1, GL_RGBA, GL_FLOAT, texels);
     }
-    const GLint filter = r.desc.sampling == TextureSampling::Bilinear ? GL_LINEAR : GL_NEAREST;
+    const GLint filter = mode == TextureSampling::Bilinear ? GL_LINEAR : GL_NEAREST;
     glTextureParameteri(r.layers, GL_TEXTURE_MIN_FILTER, filter);
     glTextureParameteri(r.layers, GL_TEXTURE_MAG_FILTER, filter);
     // Clamp to the border texels, which the footprint window has brought to zero.
     glTextureParameteri(r.layers, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTextureParameteri(r.layers, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
 
+    r.sampling = mode;
+    r.upsample = factor;
     r.uploadedVersion = materials.version();
     return {};
 }
