@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <thread>
+#include <utility>
 #include <vector>
 
 namespace splatfx {
@@ -407,24 +408,37 @@ void sortBackToFront(std::vector<Splat>& splats, SortMode mode, std::uint32_t bu
         for (size_t i = 0; i < n; ++i)
             keys[i] = last - std::min(last, std::uint32_t((splats[i].depth - lo) * scale));
     }
-    // LSD radix sort, 8 bits per pass on indices; skip passes where all digits agree.
+    // LSD radix sort on indices, 8 bits per pass. The four digit histograms
+    // come from one read of the keys; a pass whose digit is the same for every
+    // key is skipped; the first pass that runs reads no index array.
     thread_local std::vector<std::uint32_t> idx, idx2;
     idx.resize(n);
     idx2.resize(n);
-    for (size_t i = 0; i < n; ++i) idx[i] = std::uint32_t(i);
-    for (int shift = 0; shift < 32; shift += 8) {
-        size_t count[257] = {};
-        for (size_t i = 0; i < n; ++i) ++count[((keys[i] >> shift) & 255u) + 1];
-        if (count[((keys[0] >> shift) & 255u) + 1] == n) continue;
-        for (int b = 0; b < 256; ++b) count[b + 1] += count[b];
+    std::uint32_t count[4][256] = {};
+    for (size_t i = 0; i < n; ++i) {
+        const std::uint32_t k = keys[i];
+        ++count[0][k & 255u];
+        ++count[1][(k >> 8) & 255u];
+        ++count[2][(k >> 16) & 255u];
+        ++count[3][k >> 24];
+    }
+    bool sorted = false; // idx holds a permutation
+    for (int pass = 0; pass < 4; ++pass) {
+        const int shift = 8 * pass;
+        std::uint32_t* offset = count[pass];
+        if (offset[(keys[0] >> shift) & 255u] == n) continue;
+        std::uint32_t sum = 0;
+        for (std::uint32_t& c : count[pass]) sum += std::exchange(c, sum);
         for (size_t i = 0; i < n; ++i) {
-            const size_t dst = count[(keys[i] >> shift) & 255u]++;
+            const std::uint32_t dst = offset[(keys[i] >> shift) & 255u]++;
             keys2[dst] = keys[i];
-            idx2[dst] = idx[i];
+            idx2[dst] = sorted ? idx[i] : std::uint32_t(i);
         }
         keys.swap(keys2);
         idx.swap(idx2);
+        sorted = true;
     }
+    if (!sorted) return; // every key equal: already in (stable) order
     for (size_t i = 0; i < n; ++i) tmp[i] = splats[idx[i]];
     splats.swap(tmp);
 }
