@@ -103,19 +103,22 @@ void beginOver(GLuint fbo, glm::ivec2 size, GLuint program) {
 // fetch from the renderer's own texture array with its sampling, exp2, colour
 // multiply, premultiplied "over" blend into the same RGBA8 target). Nothing
 // else can make splat fragments cheaper.
+// The splat fragment's work: one texture-array fetch, exp2, colour multiply.
+const char* kSplatWork = R"(#version 450 core
+    layout(binding = 0) uniform sampler2DArray uLayers;
+    in vec2 vTex; flat in float vLayer; out vec4 o;
+    void main() { vec4 t = texture(uLayers, vec3(vTex, vLayer));
+                  float a = 1.0 - exp2(-0.05 * t.a); o = vec4(vec3(1.0, 0.6, 0.2) * t.rgb * a, a); })";
+
 class FillProbe {
 public:
-    FillProbe() {
+    explicit FillProbe(const char* fragment = kSplatWork) {
         program = compileProgram(R"(#version 450 core
             const vec2 k[4] = vec2[4](vec2(-1,-1), vec2(1,-1), vec2(-1,1), vec2(1,1));
             out vec2 vTex; flat out float vLayer;
             void main() { vTex = k[gl_VertexID] * 0.5 + 0.5; vLayer = float(gl_InstanceID % 8 + 1);
                           gl_Position = vec4(k[gl_VertexID], 0.5, 1.0); })",
-                                 R"(#version 450 core
-            layout(binding = 0) uniform sampler2DArray uLayers;
-            in vec2 vTex; flat in float vLayer; out vec4 o;
-            void main() { vec4 t = texture(uLayers, vec3(vTex, vLayer));
-                          float a = 1.0 - exp2(-0.05 * t.a); o = vec4(vec3(1.0, 0.6, 0.2) * t.rgb * a, a); })");
+                                 fragment);
         glCreateVertexArrays(1, &vao);
     }
     ~FillProbe() {
@@ -124,8 +127,9 @@ public:
         glDeleteVertexArrays(1, &vao);
     }
     // Fragments per second for `quads` full-screen quads.
-    double rate(GLuint fbo, glm::ivec2 size, GLuint layers, int quads) {
+    double rate(GLuint fbo, glm::ivec2 size, GLuint layers, int quads, bool blend = true) {
         beginOver(fbo, size, program);
+        if (!blend) glDisable(GL_BLEND);
         glBindTextureUnit(0, layers);
         glBindVertexArray(vao);
         glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, 4); // warm up
@@ -158,11 +162,7 @@ public:
                     vec2 p = at + k[gl_VertexID] * uSide;
                     vTex = k[gl_VertexID]; vLayer = float(gl_InstanceID % 8 + 1);
                     gl_Position = vec4(p / uViewport * 2.0 - 1.0, 0.5, 1.0); })",
-                                     R"(#version 450 core
-                layout(binding = 0) uniform sampler2DArray uLayers;
-                in vec2 vTex; flat in float vLayer; out vec4 o;
-                void main() { vec4 t = texture(uLayers, vec3(vTex, vLayer));
-                              float a = 1.0 - exp2(-0.05 * t.a); o = vec4(vec3(1.0, 0.6, 0.2) * t.rgb * a, a); })");
+                                     kSplatWork);
         beginOver(fbo, size, squares);
         glUniform2f(glGetUniformLocation(squares, "uViewport"), float(size.x), float(size.y));
         glUniform1f(glGetUniformLocation(squares, "uSide"), side);
@@ -293,14 +293,14 @@ double medianFrame(int warm, int frames, F f) {
 struct RowResult {
     double scaledHz = 0; int scale = 1;  // reduced-resolution result where full resolution misses the Onyx2 rate
     double hz = 0, naiveHz = 0, fillFraction = 0, splatFragsPerSec = 0, fillRate = 0, covered = 0, overdraw = 0;
+    double naiveFragsPerSec = 0;
     double sizedRate = 0, side = 0; // fill rate of screen-aligned squares of the splats' mean size, and that size
 };
 
 struct Settings {
     int frames = 30;
-    float footprintCut = splatfx::gl::RendererDesc{}.footprintCut;
+    splatfx::gl::RendererDesc renderer; // the SDK defaults unless an option says otherwise
     bool crossfade = false;
-    bool octagons = splatfx::gl::RendererDesc{}.trimCorners;
 };
 
 RowResult measureRow(const Row& row, const Settings& settings) {
@@ -310,7 +310,7 @@ RowResult measureRow(const Row& row, const Settings& settings) {
     const auto set = materials.addTextureSet(splatfx::TextureSet::turbulence({.count = 8, .size = 32, .seed = 1}));
     const auto lut = materials.addColorTable(splatfx::ColorTable::fire());
     auto fb = splatfx::gl::Framebuffer::create({.width = row.window.x, .height = row.window.y});
-    auto renderer = splatfx::gl::Renderer::create({.trimCorners = settings.octagons, .footprintCut = settings.footprintCut});
+    auto renderer = splatfx::gl::Renderer::create(settings.renderer);
     if (!fb || !renderer || !renderer->upload(materials)) {
         std::fprintf(stderr, "table1: GL setup failed\n");
         return out;
@@ -384,7 +384,7 @@ RowResult measureRow(const Row& row, const Settings& settings) {
     if (out.hz < row.onyx2) {
         for (int scale : {2, 4}) {
             auto scaled = splatfx::gl::ScaledRenderer::create(
-                {.scale = scale, .renderer = {.trimCorners = settings.octagons, .footprintCut = settings.footprintCut}});
+                {.scale = scale, .renderer = settings.renderer});
             if (!scaled || !scaled->upload(materials)) break;
             const splatfx::gl::ScaledTarget st{.framebuffer = fb->handle(), .width = row.window.x, .height = row.window.y};
             out.scaledHz = 1.0 / medianFrame(5, frames, fullFrame([&](const std::vector<splatfx::Splat>& s) { scaled->draw(s, cam, st); }));
@@ -400,7 +400,66 @@ RowResult measureRow(const Row& row, const Settings& settings) {
         naive.draw(grid, materials, cam, fb->handle(), row.window, gpu.layers, gpu.colors);
         glFinish();
     });
+    // The naive pass's own fragment rate (its draw alone, instance upload included).
+    GLuint naiveQuery = 0;
+    glGenQueries(1, &naiveQuery);
+    glBeginQuery(GL_SAMPLES_PASSED, naiveQuery);
+    naive.draw(grid, materials, cam, fb->handle(), row.window, gpu.layers, gpu.colors);
+    glEndQuery(GL_SAMPLES_PASSED);
+    GLuint64 naiveSamples = 0;
+    glGetQueryObjectui64v(naiveQuery, GL_QUERY_RESULT, &naiveSamples);
+    glDeleteQueries(1, &naiveQuery);
+    const double naiveSec = medianFrame(3, frames, [&](int) {
+        naive.draw(grid, materials, cam, fb->handle(), row.window, gpu.layers, gpu.colors);
+        glFinish();
+    });
+    out.naiveFragsPerSec = double(naiveSamples) / naiveSec;
     return out;
+}
+
+// What one fragment costs on this GL: full-screen quads from the simplest
+// fragment up to the splat's, so the fill fraction's reference is in view.
+void fragmentCosts(std::FILE* csv) {
+    const glm::ivec2 size{640, 480};
+    splatfx::Materials materials{splatfx::Footprint{}};
+    materials.addTextureSet(splatfx::TextureSet::turbulence({.count = 8, .size = 32, .seed = 1}));
+    materials.addColorTable(splatfx::ColorTable::fire());
+    auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
+    auto renderer = splatfx::gl::Renderer::create();
+    if (!fb || !renderer || !renderer->upload(materials)) return;
+    GpuMaterials bilinear(materials);
+    const char* flat = "#version 450 core\nout vec4 o; void main() { o = vec4(0.5, 0.3, 0.2, 0.5); }";
+    const char* fetch = R"(#version 450 core
+        layout(binding = 0) uniform sampler2DArray uLayers; in vec2 vTex; flat in float vLayer; out vec4 o;
+        void main() { o = texture(uLayers, vec3(vTex, vLayer)); })";
+    struct Probe {
+        const char *name, *fragment;
+        bool blend;
+        GLuint layers;
+    };
+    const std::string upsampled =
+        "splat fragment, " +
+        std::string(renderer->sampling() == splatfx::gl::TextureSampling::Upsampled
+                        ? "upsampled " + std::to_string(renderer->upsampleFactor()) + "x, nearest"
+                        : "bilinear") +
+        " (default)";
+    const Probe probes[] = {
+        {"flat colour, no blend", flat, false, 0},
+        {"flat colour, over blend", flat, true, 0},
+        {"bilinear texture fetch, over blend", fetch, true, bilinear.layers},
+        {"splat fragment (fetch, exp2, colour), bilinear", kSplatWork, true, bilinear.layers},
+        {upsampled.c_str(), kSplatWork, true, renderer->layerTexture()},
+    };
+    std::printf("Fragment cost on this GL: full-screen quads at %dx%d into RGBA8, 64 screens per draw\n", size.x, size.y);
+    std::fprintf(csv, "fragment_probe,mfrag_s\n");
+    for (const Probe& p : probes) {
+        FillProbe probe(p.fragment);
+        const double rate = probe.rate(fb->handle(), size, p.layers, 64, p.blend);
+        std::printf("  %-50s %8.0f Mfrag/s\n", p.name, rate / 1e6);
+        std::fprintf(csv, "\"%s\",%.1f\n", p.name, rate / 1e6);
+    }
+    std::printf("\n");
+    std::fprintf(csv, "\n");
 }
 
 // CPU work per frame (dynamics + build + sort + copy into the instance
@@ -461,14 +520,30 @@ int runTable1(int argc, char** argv) {
         if (a == "--frames" && i + 1 < argc) frames = std::max(3, std::atoi(argv[++i]));
         else if (a == "--csv" && i + 1 < argc) csvPath = argv[++i];
         else if (a == "--quick") quick = true;
-        else if (a == "--footprint-cut" && i + 1 < argc) settings.footprintCut = float(std::atof(argv[++i]));
+        else if (a == "--footprint-cut" && i + 1 < argc) settings.renderer.footprintCut = float(std::atof(argv[++i]));
+        else if (a == "--sampling" && i + 1 < argc) {
+            using splatfx::gl::TextureSampling;
+            const std::string v = argv[++i];
+            if (v == "auto") settings.renderer.sampling = TextureSampling::Auto;
+            else if (v == "bilinear") settings.renderer.sampling = TextureSampling::Bilinear;
+            else if (v == "nearest") settings.renderer.sampling = TextureSampling::Nearest;
+            else if (v.rfind("upsampled", 0) == 0) {
+                settings.renderer.sampling = TextureSampling::Upsampled;
+                settings.renderer.upsample = v.size() > 9 ? std::atoi(v.c_str() + 9) : 0; // "upsampled4" -> 4
+            } else {
+                std::fprintf(stderr, "table1: --sampling takes auto, bilinear, nearest, upsampled or upsampledN\n");
+                return 2;
+            }
+        }
         else if (a == "--crossfade") settings.crossfade = true;
-        else if (a == "--squares") settings.octagons = false;
-        else if (a == "--octagons") settings.octagons = true;
+        else if (a == "--squares") settings.renderer.trimCorners = false;
+        else if (a == "--octagons") settings.renderer.trimCorners = true;
         else if (a == "--help" || a == "-h") {
             std::printf("splatfx-bench table1 [--frames N] [--csv FILE] [--quick] [--footprint-cut F] [--crossfade] [--squares | --octagons]\n"
-                        "  The paper's Table I rows on this machine (headless), with pixels covered, overdraw,\n"
-                        "  the splat pass as a fraction of this GL's fill rate, a naive baseline, and CPU scaling.\n");
+                        "                     [--sampling auto|bilinear|nearest|upsampled|upsampledN]\n"
+                        "  What a fragment costs on this GL, then the paper's Table I rows on this machine (headless), with\n"
+                        "  pixels covered, overdraw, the splat pass as a fraction of this GL's fill rate and of its rate for\n"
+                        "  squares of the splats' size, a naive baseline, and CPU scaling. Renderer options default to the SDK's.\n");
             return 0;
         } else {
             std::fprintf(stderr, "table1: unknown option '%s'\n", a.c_str());
@@ -486,24 +561,28 @@ int runTable1(int argc, char** argv) {
         std::fprintf(stderr, "table1: cannot write '%s'\n", csvPath.c_str());
         return 1;
     }
+    fragmentCosts(csv);
     std::printf("Table I on %s (median of %d frames per row; paper columns in Hz)\n\n", ctx->renderer().c_str(), frames);
-    std::printf("%-9s %6s | %6s %6s %7s %6s | %9s %9s %13s | %8s %8s %8s %6s | %6s %8s | %8s %6s\n", "window", "voxels", "O2", "Indy",
+    std::printf("%-9s %6s | %6s %6s %7s %6s | %9s %9s %13s | %8s %8s %8s %6s | %6s %8s | %8s %8s %6s\n", "window", "voxels", "O2", "Indy",
                 "Octane", "Onyx2", "splatfx", "vs Onyx2", "reduced res", "covered", "overdraw", "Mfrag/s", "fill", "side", "vs sized",
-                "naive Hz", "ratio");
+                "naive Hz", "Mfrag/s", "ratio");
     std::fprintf(csv, "window,voxels,o2_hz,indy_hz,octane_hz,onyx2_hz,splatfx_hz,pixels_covered,overdraw,splat_mfrag_s,fill_mfrag_s,"
-                      "fill_fraction,mean_splat_side_px,sized_fill_mfrag_s,fraction_of_sized_fill,naive_hz,speedup_vs_naive,reduced_scale,reduced_hz\n");
+                      "fill_fraction,mean_splat_side_px,sized_fill_mfrag_s,fraction_of_sized_fill,naive_hz,naive_mfrag_s,speedup_vs_naive,reduced_scale,"
+                      "reduced_hz\n");
     for (const Row& row : kRows) {
         const RowResult r = measureRow(row, settings);
         char win[16];
         std::snprintf(win, sizeof win, "%dx%d", row.window.x, row.window.y);
         char reduced[32] = "-";
         if (r.scale > 1) std::snprintf(reduced, sizeof reduced, "%.1f Hz @1/%d", r.scaledHz, r.scale);
-        std::printf("%-9s %6d | %6.0f %6.3g %7.0f %6.0f | %9.1f %8.2fx %13s | %8.0f %8.1f %8.0f %5.0f%% | %6.1f %7.0f%% | %8.1f %5.2fx\n", win,
+        std::printf("%-9s %6d | %6.0f %6.3g %7.0f %6.0f | %9.1f %8.2fx %13s | %8.0f %8.1f %8.0f %5.0f%% | %6.1f %7.0f%% | %8.1f %8.0f %5.2fx\n", win,
                     row.voxels, row.o2, row.indy, row.octane, row.onyx2, r.hz, r.hz / row.onyx2, reduced, r.covered, r.overdraw,
-                    r.splatFragsPerSec / 1e6, 100 * r.fillFraction, r.side, 100 * r.splatFragsPerSec / r.sizedRate, r.naiveHz, r.hz / r.naiveHz);
-        std::fprintf(csv, "%s,%d,%g,%g,%g,%g,%.2f,%.0f,%.2f,%.1f,%.1f,%.3f,%.1f,%.1f,%.3f,%.2f,%.3f,%d,%.2f\n", win, row.voxels, row.o2,
+                    r.splatFragsPerSec / 1e6, 100 * r.fillFraction, r.side, 100 * r.splatFragsPerSec / r.sizedRate, r.naiveHz,
+                    r.naiveFragsPerSec / 1e6, r.hz / r.naiveHz);
+        std::fprintf(csv, "%s,%d,%g,%g,%g,%g,%.2f,%.0f,%.2f,%.1f,%.1f,%.3f,%.1f,%.1f,%.3f,%.2f,%.1f,%.3f,%d,%.2f\n", win, row.voxels, row.o2,
                      row.indy, row.octane, row.onyx2, r.hz, r.covered, r.overdraw, r.splatFragsPerSec / 1e6, r.fillRate / 1e6, r.fillFraction,
-                     r.side, r.sizedRate / 1e6, r.splatFragsPerSec / r.sizedRate, r.naiveHz, r.hz / r.naiveHz, r.scale, r.scaledHz);
+                     r.side, r.sizedRate / 1e6, r.splatFragsPerSec / r.sizedRate, r.naiveHz, r.naiveFragsPerSec / 1e6, r.hz / r.naiveHz, r.scale,
+                     r.scaledHz);
         std::fflush(stdout);
     }
     std::printf("\nfill = splat-pass fragments/s as a fraction of full-screen quads doing the same per-fragment work\n"
