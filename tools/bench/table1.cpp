@@ -468,9 +468,10 @@ void cpuScaling(std::FILE* csv) {
     const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
     std::printf("\nCPU work per frame (texture cycling + splat build + radix sort + copy to the instance stream),\n"
                 "SplatBuilderDesc::threads = 1 (default) and = %u (this machine's hardware threads):\n", hw);
-    std::printf("%10s %12s %12s %12s %12s\n", "voxels", "ms/frame", "ns/voxel", "ms/frame", "ns/voxel");
-    std::printf("%10s %25s %25s\n", "", "1 thread", (std::to_string(hw) + " threads").c_str());
-    std::fprintf(csv, "\nvoxels,threads,ms_per_frame,ns_per_voxel\n");
+    std::printf("%10s %12s %12s %12s %12s | %8s %8s %8s\n", "voxels", "ms/frame", "ns/voxel", "ms/frame", "ns/voxel", "build", "sort",
+                "other");
+    std::printf("%10s %25s %25s | %26s\n", "", "1 thread", (std::to_string(hw) + " threads").c_str(), "1 thread, ns/voxel (median)");
+    std::fprintf(csv, "\nvoxels,threads,ms_per_frame,ns_per_voxel,build_ns,sort_ns,other_ns\n");
     splatfx::Materials materials{splatfx::Footprint{}};
     const auto set = materials.addTextureSet(splatfx::TextureSet::turbulence({}));
     const auto lut = materials.addColorTable(splatfx::ColorTable::fire());
@@ -487,24 +488,40 @@ void cpuScaling(std::FILE* csv) {
         // ever adds time, and alternating spreads it over both settings.
         const unsigned counts[2] = {1u, hw};
         double best[2] = {1e30, 1e30};
+        std::vector<double> phases[3]; // single thread: build, sort, cycling + copy, seconds per frame
         for (int round = 0; round < 3; ++round)
             for (int k = 0; k < 2; ++k) {
                 splatfx::SplatBuilder builder({.threads = counts[k]}); // defaults: culling on (the grid is in view)
                 const double sec = medianFrame(2, frames, [&](int i) {
+                    const auto t0 = Clock::now();
                     cycle(base, grid, i / 60.0);
+                    const auto t1 = Clock::now();
                     builder.begin(cam);
                     builder.add(grid, materials, {.textureSet = set, .colorTable = lut, .crossfade = true});
+                    const auto t2 = Clock::now();
                     builder.sort();
+                    const auto t3 = Clock::now();
                     std::memcpy(stream.data(), builder.splats().data(), builder.splats().size() * sizeof(splatfx::Splat));
+                    if (k == 0) {
+                        phases[0].push_back(seconds(t1, t2));
+                        phases[1].push_back(seconds(t2, t3));
+                        phases[2].push_back(seconds(t0, t1) + seconds(t3, Clock::now()));
+                    }
                 });
                 best[k] = std::min(best[k], sec);
             }
+        double split[3];
+        for (int p = 0; p < 3; ++p) {
+            std::sort(phases[p].begin(), phases[p].end());
+            split[p] = 1e9 * phases[p][phases[p].size() / 2] / double(grid.voxels.size());
+        }
         for (int k = 0; k < 2; ++k) {
             const double ns = 1e9 * best[k] / double(grid.voxels.size());
             std::printf(" %12.3f %12.1f", 1e3 * best[k], ns);
-            std::fprintf(csv, "%zu,%u,%.4f,%.2f\n", grid.voxels.size(), counts[k], 1e3 * best[k], ns);
+            std::fprintf(csv, "%zu,%u,%.4f,%.2f,%.2f,%.2f,%.2f\n", grid.voxels.size(), counts[k], 1e3 * best[k], ns, split[0], split[1],
+                         split[2]);
         }
-        std::printf("\n");
+        std::printf(" | %8.1f %8.1f %8.1f\n", split[0], split[1], split[2]);
     }
 }
 
