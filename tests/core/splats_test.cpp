@@ -250,3 +250,31 @@ TEST(SplatBuilder, BatchedGeometryMatchesOneVoxelAtATime) {
         EXPECT_EQ(a.layer, b.layer) << i;
     }
 }
+
+// A voxel's texture index wraps around its set (any 32-bit index, any set
+// size), and the cross-fade partner is the next texture, wrapping at the end.
+TEST(SplatBuilder, TextureIndexWrapsAroundItsSet) {
+    Materials m{Footprint{}};
+    m.addTextureSet(TextureSet::turbulence({.count = 2, .size = 16}));
+    const std::uint32_t set = m.addTextureSet(TextureSet::turbulence({.count = 7, .size = 16}));
+    const Materials::SetRange range = m.set(set);
+    ASSERT_EQ(range.count, 7u);
+    Grid g;
+    const std::uint32_t textures[] = {0u, 6u, 7u, 13u, 12345678u, 0x7fffffffu, 0xfffffffeu, 0xffffffffu};
+    for (std::uint32_t t : textures) {
+        Voxel v;
+        v.cell = {int(g.voxels.size()), 0, 0};
+        v.texture = t;
+        g.voxels.push_back(v);
+    }
+    g.dims = {int(g.voxels.size()), 1, 1};
+    SplatBuilder b;
+    b.begin(Camera::lookAt({0, 0, 20}, {0, 0, 0}, {0, 1, 0}, 1.0f, {64, 64}));
+    b.add(g, m, {.textureSet = set});
+    ASSERT_EQ(b.splats().size(), g.voxels.size());
+    for (size_t i = 0; i < g.voxels.size(); ++i) {
+        const std::uint32_t index = textures[i] % 7u;
+        EXPECT_EQ(b.splats()[i].layer, range.first + index) << textures[i];
+        EXPECT_EQ(b.splats()[i].nextLayer, range.first + (index + 1) % 7u) << textures[i];
+    }
+}

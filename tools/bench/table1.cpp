@@ -99,10 +99,6 @@ void beginOver(GLuint fbo, glm::ivec2 size, GLuint program) {
     glUseProgram(program);
 }
 
-// The fill limit: full-screen quads doing the splat fragment's work (one
-// fetch from the renderer's own texture array with its sampling, exp2, colour
-// multiply, premultiplied "over" blend into the same RGBA8 target). Nothing
-// else can make splat fragments cheaper.
 // The splat fragment's work: one texture-array fetch, exp2, colour multiply.
 const char* kSplatWork = R"(#version 450 core
     layout(binding = 0) uniform sampler2DArray uLayers;
@@ -110,6 +106,10 @@ const char* kSplatWork = R"(#version 450 core
     void main() { vec4 t = texture(uLayers, vec3(vTex, vLayer));
                   float a = 1.0 - exp2(-0.05 * t.a); o = vec4(vec3(1.0, 0.6, 0.2) * t.rgb * a, a); })";
 
+// The fill limit: full-screen quads doing a fragment's work (by default the
+// splat's, fetching from the renderer's own texture array with its sampling,
+// premultiplied "over" into the same RGBA8 target). Nothing else can make
+// splat fragments cheaper.
 class FillProbe {
 public:
     explicit FillProbe(const char* fragment = kSplatWork) {
@@ -353,7 +353,8 @@ RowResult measureRow(const Row& row, const Settings& settings) {
     for (size_t p = 3; p < img.pixels.size(); p += 4)
         if (img.pixels[p] > 0.0f) {
             ++covered;
-            const float x = float((p / 4) % size_t(img.width)), y = float((p / 4) / size_t(img.width));
+            // Image rows run top down; GL's window y runs bottom up.
+            const float x = float((p / 4) % size_t(img.width)), y = float(img.height - 1 - int((p / 4) / size_t(img.width)));
             region = glm::vec4(std::min(region.x, x), std::min(region.y, y), std::max(region.z, x + 1), std::max(region.w, y + 1));
         }
     out.covered = double(covered);

@@ -61,15 +61,15 @@ struct Shape {
     }
 };
 
-// FastMod: x % d without a division (Lemire, Kaser & Kurz 2019), exact for
-// every 32-bit x and d >= 1.
+// x % d without a division (Lemire, Kaser & Kurz 2019), exact for every
+// 32-bit x and d >= 1. The 64x32-bit high product is done in two 32x32 halves.
 struct FastMod {
     std::uint32_t d;
     std::uint64_t m;
     explicit FastMod(std::uint32_t divisor) : d(std::max(divisor, 1u)), m(~std::uint64_t(0) / d + 1) {}
     std::uint32_t mod(std::uint32_t x) const {
-        const std::uint64_t low = m * x;
-        return std::uint32_t((static_cast<unsigned __int128>(low) * d) >> 64);
+        const std::uint64_t low = m * x; // the fraction x / d, in 64 bits
+        return std::uint32_t(((low >> 32) * d + (((low & 0xffffffffu) * d) >> 32)) >> 32);
     }
 };
 
