@@ -50,7 +50,8 @@ protected:
         b.add(grid, mat, style);
         b.sort();
         r.splats = b.splats().size();
-        auto renderer = gl::Renderer::create();
+        // The bounds are derived for bilinear sampling (gl_bounds.hpp), so name it.
+        auto renderer = gl::Renderer::create({.sampling = gl::TextureSampling::Bilinear});
         EXPECT_TRUE(renderer && renderer->upload(mat));
         auto fb = gl::Framebuffer::create({.width = cam.viewport.x, .height = cam.viewport.y, .color = precision});
         EXPECT_TRUE(fb);
