@@ -25,17 +25,27 @@ double msSince(Clock::time_point t0) { return std::chrono::duration<double, std:
 } // namespace
 
 // Geometry and the splat renderer, once the scene file is read.
-splatfx::Status ScenePlayer::setupGl(Impl& impl, const std::string& path) {
+splatfx::Status ScenePlayer::setupGl(Impl& impl, const std::string& path, const splatfx::gl::RendererDesc& desc) {
     auto geo = GeometryRenderer::create(impl.file->geometry);
     if (!geo) return splatfx::makeError(path + ": " + geo.error());
     impl.geometry.emplace(std::move(*geo));
-    auto r = splatfx::gl::Renderer::create();
-    if (!r) return splatfx::makeError(r.error());
-    impl.splats.emplace(std::move(*r));
     // A scene of geometry only still needs one row for the renderer to upload.
     if (impl.materials.colorTableCount() == 0) impl.materials.addColorTable(splatfx::ColorTable::constant(glm::vec4(1.0f)));
-    return impl.splats->upload(impl.materials);
+    return installRenderer(impl, desc);
 }
+
+// A splat renderer with these settings and the materials uploaded; on failure
+// the previous renderer stays.
+splatfx::Status ScenePlayer::installRenderer(Impl& impl, const splatfx::gl::RendererDesc& desc) {
+    auto r = splatfx::gl::Renderer::create(desc);
+    if (!r) return splatfx::makeError(r.error());
+    if (auto s = r->upload(impl.materials); !s) return s;
+    impl.splats.emplace(std::move(*r));
+    return {};
+}
+
+splatfx::Status ScenePlayer::setRenderer(const splatfx::gl::RendererDesc& desc) { return installRenderer(*mImpl, desc); }
+const splatfx::gl::Renderer& ScenePlayer::renderer() const { return *mImpl->splats; }
 
 splatfx::Result<ScenePlayer> ScenePlayer::load(const std::string& path, const PlayerOptions& options) {
     auto impl = std::make_unique<Impl>();
@@ -44,7 +54,7 @@ splatfx::Result<ScenePlayer> ScenePlayer::load(const std::string& path, const Pl
     auto file = splatfx::loadSceneFile(path, impl->materials, so);
     if (!file) return splatfx::makeError(file.error());
     impl->file.emplace(std::move(*file));
-    if (auto s = setupGl(*impl, path); !s) return splatfx::makeError(s.error());
+    if (auto s = setupGl(*impl, path, options.renderer); !s) return splatfx::makeError(s.error());
     return ScenePlayer(std::move(impl));
 }
 
@@ -55,7 +65,7 @@ splatfx::Result<ScenePlayer> ScenePlayer::fromText(const std::string& text, cons
     auto file = splatfx::parseSceneFile(text, path, impl->materials, so);
     if (!file) return splatfx::makeError(file.error());
     impl->file.emplace(std::move(*file));
-    if (auto s = setupGl(*impl, path); !s) return splatfx::makeError(s.error());
+    if (auto s = setupGl(*impl, path, options.renderer); !s) return splatfx::makeError(s.error());
     return ScenePlayer(std::move(impl));
 }
 

@@ -30,6 +30,7 @@ namespace scenehost {
 
 struct PlayerOptions {
     std::optional<std::uint32_t> seed; // replaces the file's seed; default the file's
+    splatfx::gl::RendererDesc renderer{}; // the splat renderer's settings; default the SDK's
 };
 
 struct FrameOptions {
@@ -70,11 +71,15 @@ public:
     const splatfx::Materials& materials() const;
     const FrameStats& stats() const;
     GeometryRenderer& geometry();
+    // The splat renderer, and a new one with other settings (materials re-uploaded).
+    const splatfx::gl::Renderer& renderer() const;
+    splatfx::Status setRenderer(const splatfx::gl::RendererDesc& desc);
 
 private:
     struct Impl;
     explicit ScenePlayer(std::unique_ptr<Impl> impl);
-    static splatfx::Status setupGl(Impl& impl, const std::string& path);
+    static splatfx::Status setupGl(Impl& impl, const std::string& path, const splatfx::gl::RendererDesc& desc);
+    static splatfx::Status installRenderer(Impl& impl, const splatfx::gl::RendererDesc& desc);
     std::unique_ptr<Impl> mImpl;
 };
 

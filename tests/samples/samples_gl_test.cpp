@@ -115,3 +115,25 @@ TEST_F(SamplesGL, CowInFrontHidesTheFireAndFireInFrontVeilsTheCow) {
 }
 
 } // namespace
+
+// The host can change the splat renderer's settings on a loaded scene (the
+// viewer's texture-sampling choice): the new renderer reports what it uses,
+// and the frame it draws differs from the old one only in sampling detail.
+TEST_F(SamplesGL, RendererSettingsChangeOnALoadedScene) {
+    auto player = scenehost::ScenePlayer::load(splatfx::test::sourcePath("samples/02-fire-figure1/scene.json"),
+                                               {.seed = {}, .renderer = {.sampling = splatfx::gl::TextureSampling::Bilinear}});
+    ASSERT_TRUE(player.ok()) << player.error();
+    EXPECT_EQ(player->renderer().sampling(), splatfx::gl::TextureSampling::Bilinear);
+    const splatfx::Image bilinear = render(*player, {1.0}, {160, 120});
+    ASSERT_TRUE(player->setRenderer({.sampling = splatfx::gl::TextureSampling::Nearest}));
+    EXPECT_EQ(player->renderer().sampling(), splatfx::gl::TextureSampling::Nearest);
+    const splatfx::Image nearest = render(*player, {1.0}, {160, 120});
+    double sum = 0.0, peak = 0.0;
+    for (std::size_t i = 0; i < bilinear.pixels.size(); ++i) {
+        const double d = std::fabs(bilinear.pixels[i] - nearest.pixels[i]);
+        sum += d;
+        peak = std::max(peak, d);
+    }
+    EXPECT_GT(peak, 0.0) << "the new settings must take effect";
+    EXPECT_LT(sum / double(bilinear.pixels.size()), 2.0 / 255.0) << "same scene, same frame";
+}

@@ -21,6 +21,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -103,6 +104,20 @@ bool parse(int argc, char** argv, Args& a) {
 
 enum class CameraMode { Path, Orbit, Fly };
 
+// Texture sampling choices offered in the panel: compare quality and cost live.
+struct SamplingChoice {
+    const char* label;
+    splatfx::gl::TextureSampling mode;
+    int upsample;
+};
+constexpr SamplingChoice kSamplings[] = {
+    {"auto (SDK default)", splatfx::gl::TextureSampling::Auto, 0},
+    {"bilinear", splatfx::gl::TextureSampling::Bilinear, 0},
+    {"nearest", splatfx::gl::TextureSampling::Nearest, 0},
+    {"upsampled 2x", splatfx::gl::TextureSampling::Upsampled, 2},
+    {"upsampled 4x", splatfx::gl::TextureSampling::Upsampled, 4},
+};
+
 struct Viewer {
     Args args;
     std::optional<scenehost::ScenePlayer> player;
@@ -116,6 +131,7 @@ struct Viewer {
     CameraMode mode = CameraMode::Path;
     splatfx::DynamicsToggles toggles;
     scenehost::FrameOptions frame;
+    int sampling = 0; // index into kSamplings
     float fovDeg = 45.0f;
     // Orbit
     glm::vec3 orbitTarget{0, 1, 0};
@@ -126,8 +142,13 @@ struct Viewer {
     double frameMs = 0.0;
     char pathInput[1024] = {};
 
+    splatfx::gl::RendererDesc rendererDesc() const {
+        return {.sampling = kSamplings[sampling].mode, .upsample = kSamplings[sampling].upsample};
+    }
+
     void load(const std::string& p, const std::string* text = nullptr) {
-        auto r = text ? scenehost::ScenePlayer::fromText(*text, p, {.seed = args.seed}) : scenehost::ScenePlayer::load(p, {.seed = args.seed});
+        const scenehost::PlayerOptions options{.seed = args.seed, .renderer = rendererDesc()};
+        auto r = text ? scenehost::ScenePlayer::fromText(*text, p, options) : scenehost::ScenePlayer::load(p, options);
         if (!r) {
             error = r.error();
             std::fprintf(stderr, "splatfx-viewer: %s\n", error.c_str());
@@ -283,6 +304,20 @@ struct Viewer {
             ImGui::Checkbox("traditional splats (Fig. 1a)", &frame.traditional);
             ImGui::Checkbox("geometry", &frame.drawGeometry);
             ImGui::SliderFloat("opacity scale", &frame.opacityScale, 0.0f, 3.0f);
+            if (ImGui::BeginCombo("texture sampling", kSamplings[sampling].label)) {
+                for (int i = 0; i < int(std::size(kSamplings)); ++i)
+                    if (ImGui::Selectable(kSamplings[i].label, i == sampling) && i != sampling) {
+                        sampling = i;
+                        if (player)
+                            if (auto st = player->setRenderer(rendererDesc()); !st) error = st.error();
+                    }
+                ImGui::EndCombo();
+            }
+            if (player) {
+                const splatfx::gl::Renderer& r = player->renderer();
+                if (r.sampling() == splatfx::gl::TextureSampling::Upsampled) ImGui::TextDisabled("in use: layers upsampled %dx, nearest", r.upsampleFactor());
+                else ImGui::TextDisabled("in use: %s", r.sampling() == splatfx::gl::TextureSampling::Bilinear ? "bilinear" : "nearest");
+            }
         }
         if (player && ImGui::CollapsingHeader("Effects", ImGuiTreeNodeFlags_DefaultOpen)) {
             splatfx::Scene& scene = player->file().scene;
