@@ -536,8 +536,9 @@ int runAccuracy(int argc, char** argv) {
         for (int factor : {2, 4, 8}) sampled(TextureSampling::Upsampled, factor, "upsampled " + std::to_string(factor) + "x, nearest");
         // The default, labelled with what it resolved to on this GL.
         Config c;
+        const std::size_t before = b.settings.size();
         b.add("texture sampling (RendererDesc)", "auto", c, onTexture, truth);
-        if (!b.settings.empty()) {
+        if (b.settings.size() > before) { // add() keeps nothing when GL setup fails
             const splatfx::gl::Renderer& r = b.settings.back()->sr->renderer();
             b.settings.back()->row.setting = r.sampling() == TextureSampling::Upsampled
                                                  ? "auto: upsampled " + std::to_string(r.upsampleFactor()) + "x (default)"

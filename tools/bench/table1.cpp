@@ -99,6 +99,34 @@ void beginOver(GLuint fbo, glm::ivec2 size, GLuint program) {
     glUseProgram(program);
 }
 
+// Median seconds per call of f over `frames` frames, after `warm` untimed ones.
+template <class F>
+double medianFrame(int warm, int frames, F f) {
+    for (int i = 0; i < warm; ++i) f(i);
+    std::vector<double> t;
+    for (int i = 0; i < frames; ++i) {
+        const auto a = Clock::now();
+        f(warm + i);
+        t.push_back(seconds(a, Clock::now()));
+    }
+    std::sort(t.begin(), t.end());
+    return t[t.size() / 2];
+}
+
+// Fragments that reached the blender in what draw() submits (GL_SAMPLES_PASSED).
+template <class F>
+GLuint64 samplesPassed(F draw) {
+    GLuint query = 0;
+    glGenQueries(1, &query);
+    glBeginQuery(GL_SAMPLES_PASSED, query);
+    draw();
+    glEndQuery(GL_SAMPLES_PASSED);
+    GLuint64 samples = 0;
+    glGetQueryObjectui64v(query, GL_QUERY_RESULT, &samples);
+    glDeleteQueries(1, &query);
+    return samples;
+}
+
 // The splat fragment's work: one texture-array fetch, exp2, colour multiply.
 const char* kSplatWork = R"(#version 450 core
     layout(binding = 0) uniform sampler2DArray uLayers;
@@ -132,18 +160,12 @@ public:
         if (!blend) glDisable(GL_BLEND);
         glBindTextureUnit(0, layers);
         glBindVertexArray(vao);
-        glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, 4); // warm up
-        glFinish();
-        std::vector<double> t;
-        for (int rep = 0; rep < 5; ++rep) {
-            const auto a = Clock::now();
+        const double sec = medianFrame(1, 5, [&](int) {
             glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, quads);
             glFinish();
-            t.push_back(seconds(a, Clock::now()));
-        }
-        std::sort(t.begin(), t.end());
+        });
         glDisable(GL_BLEND);
-        return double(quads) * size.x * size.y / t[t.size() / 2];
+        return double(quads) * size.x * size.y / sec;
     }
     // Fragments per second for `count` screen-aligned squares of `side`
     // pixels scattered over `region` (x0, y0, x1, y1 in pixels), one draw:
@@ -169,24 +191,14 @@ public:
         glUniform4fv(glGetUniformLocation(squares, "uRegion"), 1, glm::value_ptr(region));
         glBindTextureUnit(0, layers);
         glBindVertexArray(vao);
-        GLuint query = 0;
-        glGenQueries(1, &query);
-        glBeginQuery(GL_SAMPLES_PASSED, query);
-        glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, count);
-        glEndQuery(GL_SAMPLES_PASSED);
-        GLuint64 samples = 0;
-        glGetQueryObjectui64v(query, GL_QUERY_RESULT, &samples);
-        glDeleteQueries(1, &query);
-        std::vector<double> t;
-        for (int rep = 0; rep < 15; ++rep) {
-            const auto a = Clock::now();
-            glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, count);
+        const auto draw = [&] { glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, count); };
+        const GLuint64 samples = samplesPassed(draw); // also the warm-up
+        const double sec = medianFrame(0, 15, [&](int) {
+            draw();
             glFinish();
-            t.push_back(seconds(a, Clock::now()));
-        }
-        std::sort(t.begin(), t.end());
+        });
         glDisable(GL_BLEND);
-        return double(samples) / t[t.size() / 2];
+        return double(samples) / sec;
     }
     GLuint program = 0, squares = 0, vao = 0;
 };
@@ -276,20 +288,6 @@ struct GpuMaterials {
     }
 };
 
-// Median seconds per call of f over `frames` frames, after `warm` untimed ones.
-template <class F>
-double medianFrame(int warm, int frames, F f) {
-    for (int i = 0; i < warm; ++i) f(i);
-    std::vector<double> t;
-    for (int i = 0; i < frames; ++i) {
-        const auto a = Clock::now();
-        f(warm + i);
-        t.push_back(seconds(a, Clock::now()));
-    }
-    std::sort(t.begin(), t.end());
-    return t[t.size() / 2];
-}
-
 struct RowResult {
     double scaledHz = 0; int scale = 1;  // reduced-resolution result where full resolution misses the Onyx2 rate
     double hz = 0, naiveHz = 0, fillFraction = 0, splatFragsPerSec = 0, fillRate = 0, covered = 0, overdraw = 0;
@@ -338,15 +336,8 @@ RowResult measureRow(const Row& row, const Settings& settings) {
     out.hz = 1.0 / medianFrame(5, frames, fullFrame([&](const std::vector<splatfx::Splat>& s) { renderer->draw(s, cam, target); }));
 
     // Coverage and overdraw: samples that reached the blender / pixels touched.
-    GLuint query = 0;
-    glGenQueries(1, &query);
     fb->clear({0, 0, 0, 0});
-    glBeginQuery(GL_SAMPLES_PASSED, query);
-    renderer->draw(builder.splats(), cam, target);
-    glEndQuery(GL_SAMPLES_PASSED);
-    GLuint64 samples = 0;
-    glGetQueryObjectui64v(query, GL_QUERY_RESULT, &samples);
-    glDeleteQueries(1, &query);
+    const GLuint64 samples = samplesPassed([&] { renderer->draw(builder.splats(), cam, target); });
     const splatfx::Image img = fb->read();
     size_t covered = 0;
     glm::vec4 region(float(row.window.x), float(row.window.y), 0.0f, 0.0f); // covered pixels' bounds
@@ -402,14 +393,7 @@ RowResult measureRow(const Row& row, const Settings& settings) {
         glFinish();
     });
     // The naive pass's own fragment rate (its draw alone, instance upload included).
-    GLuint naiveQuery = 0;
-    glGenQueries(1, &naiveQuery);
-    glBeginQuery(GL_SAMPLES_PASSED, naiveQuery);
-    naive.draw(grid, materials, cam, fb->handle(), row.window, gpu.layers, gpu.colors);
-    glEndQuery(GL_SAMPLES_PASSED);
-    GLuint64 naiveSamples = 0;
-    glGetQueryObjectui64v(naiveQuery, GL_QUERY_RESULT, &naiveSamples);
-    glDeleteQueries(1, &naiveQuery);
+    const GLuint64 naiveSamples = samplesPassed([&] { naive.draw(grid, materials, cam, fb->handle(), row.window, gpu.layers, gpu.colors); });
     const double naiveSec = medianFrame(3, frames, [&](int) {
         naive.draw(grid, materials, cam, fb->handle(), row.window, gpu.layers, gpu.colors);
         glFinish();
