@@ -9,15 +9,23 @@ cd "$(dirname "$0")/.."
 BUILD_DIR="${BUILD_DIR:-build}"
 JOBS="${JOBS:-$(nproc)}"
 
+# Each step is announced so that a failure says where it happened (tools/clean-room.sh reports
+# the last one announced).
+step() { echo "quickstart: $*"; }
+
 build() {
+  step "installing dependencies (tools/setup-deps.sh)"
   tools/setup-deps.sh
+  step "configuring ($BUILD_DIR)"
   cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DSPLATFX_BUILD_TESTS=ON -DSPLATFX_BUILD_SAMPLES=ON -DSPLATFX_BUILD_TOOLS=ON >/dev/null
+  step "building with $JOBS jobs"
   cmake --build "$BUILD_DIR" -j"$JOBS"
 }
 
 case "${1:-}" in
   demo)
     build
+    step "rendering the campfire into out/"
     "$BUILD_DIR"/samples/01-campfire/campfire --frames 48 --out out --size 640x480
     echo
     echo "Open out/campfire.gif (the animation), out/campfire_figure1.png (traditional vs textured splats)"
@@ -25,6 +33,7 @@ case "${1:-}" in
     ;;
   test)
     build
+    step "running the test suite"
     ctest --test-dir "$BUILD_DIR" --output-on-failure -j"$JOBS" --timeout 600
     ;;
   *)

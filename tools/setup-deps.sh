@@ -8,7 +8,7 @@ PACKAGES=(
   build-essential cmake pkg-config git
   libglm-dev libglfw3-dev libepoxy-dev libegl-dev libgl-dev
   libgl1-mesa-dri libegl-mesa0 libegl1
-  libopenimageio-dev libopencv-dev nlohmann-json3-dev libgtest-dev
+  libopenimageio-dev openimageio-tools python3-imath libopencv-dev nlohmann-json3-dev libgtest-dev
   libassimp-dev libimgui-dev
   gnuplot-nox xvfb xauth
 )

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdarg>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -404,6 +405,15 @@ RowResult measureRow(const Row& row, const Settings& settings) {
 
 // What one fragment costs on this GL: full-screen quads from the simplest
 // fragment up to the splat's, so the fill fraction's reference is in view.
+// The CSV is optional: a null file means the table is only printed.
+[[gnu::format(printf, 2, 3)]] void csvPrintf(std::FILE* csv, const char* format, ...) {
+    if (!csv) return;
+    va_list args;
+    va_start(args, format);
+    std::vfprintf(csv, format, args);
+    va_end(args);
+}
+
 void fragmentCosts(std::FILE* csv) {
     const glm::ivec2 size{640, 480};
     splatfx::Materials materials{splatfx::Footprint{}};
@@ -436,15 +446,15 @@ void fragmentCosts(std::FILE* csv) {
         {upsampled.c_str(), kSplatWork, true, renderer->layerTexture()},
     };
     std::printf("Fragment cost on this GL: full-screen quads at %dx%d into RGBA8, 64 screens per draw\n", size.x, size.y);
-    std::fprintf(csv, "fragment_probe,mfrag_s\n");
+    csvPrintf(csv, "fragment_probe,mfrag_s\n");
     for (const Probe& p : probes) {
         FillProbe probe(p.fragment);
         const double rate = probe.rate(fb->handle(), size, p.layers, 64, p.blend);
         std::printf("  %-50s %8.0f Mfrag/s\n", p.name, rate / 1e6);
-        std::fprintf(csv, "\"%s\",%.1f\n", p.name, rate / 1e6);
+        csvPrintf(csv, "\"%s\",%.1f\n", p.name, rate / 1e6);
     }
     std::printf("\n");
-    std::fprintf(csv, "\n");
+    csvPrintf(csv, "\n");
 }
 
 // CPU work per frame (dynamics + build + sort + copy into the instance
@@ -456,7 +466,7 @@ void cpuScaling(std::FILE* csv) {
     std::printf("%10s %12s %12s %12s %12s | %8s %8s %8s\n", "voxels", "ms/frame", "ns/voxel", "ms/frame", "ns/voxel", "build", "sort",
                 "other");
     std::printf("%10s %25s %25s | %26s\n", "", "1 thread", (std::to_string(hw) + " threads").c_str(), "1 thread, ns/voxel (median)");
-    std::fprintf(csv, "\nvoxels,threads,ms_per_frame,ns_per_voxel,build_ns,sort_ns,other_ns\n");
+    csvPrintf(csv, "\nvoxels,threads,ms_per_frame,ns_per_voxel,build_ns,sort_ns,other_ns\n");
     splatfx::Materials materials{splatfx::Footprint{}};
     const auto set = materials.addTextureSet(splatfx::TextureSet::turbulence({}));
     const auto lut = materials.addColorTable(splatfx::ColorTable::fire());
@@ -503,7 +513,7 @@ void cpuScaling(std::FILE* csv) {
         for (int k = 0; k < 2; ++k) {
             const double ns = 1e9 * best[k] / double(grid.voxels.size());
             std::printf(" %12.3f %12.1f", 1e3 * best[k], ns);
-            std::fprintf(csv, "%zu,%u,%.4f,%.2f,%.2f,%.2f,%.2f\n", grid.voxels.size(), counts[k], 1e3 * best[k], ns, split[0], split[1],
+            csvPrintf(csv, "%zu,%u,%.4f,%.2f,%.2f,%.2f,%.2f\n", grid.voxels.size(), counts[k], 1e3 * best[k], ns, split[0], split[1],
                          split[2]);
         }
         std::printf(" | %8.1f %8.1f %8.1f\n", split[0], split[1], split[2]);
@@ -515,7 +525,7 @@ void cpuScaling(std::FILE* csv) {
 int runTable1(int argc, char** argv) {
     Settings settings;
     int& frames = settings.frames;
-    std::string csvPath = "table1.csv";
+    std::string csvPath; // no CSV unless --csv names one
     bool quick = false;
     for (int i = 1; i < argc; ++i) { // argv[0] is the subcommand
         const std::string a = argv[i];
@@ -545,7 +555,8 @@ int runTable1(int argc, char** argv) {
                         "                     [--sampling auto|bilinear|nearest|upsampled|upsampledN]\n"
                         "  What a fragment costs on this GL, then the paper's Table I rows on this machine (headless), with\n"
                         "  pixels covered, overdraw, the splat pass as a fraction of this GL's fill rate and of its rate for\n"
-                        "  squares of the splats' size, a naive baseline, and CPU scaling. Renderer options default to the SDK's.\n");
+                        "  squares of the splats' size, a naive baseline, and CPU scaling. Renderer options default to the SDK's.\n"
+                        "  --csv FILE writes the same figures as CSV (nothing is written without it).\n");
             return 0;
         } else {
             std::fprintf(stderr, "table1: unknown option '%s'\n", a.c_str());
@@ -558,8 +569,8 @@ int runTable1(int argc, char** argv) {
         std::fprintf(stderr, "table1: %s\n", ctx.error().c_str());
         return 1;
     }
-    std::FILE* csv = std::fopen(csvPath.c_str(), "w");
-    if (!csv) {
+    std::FILE* csv = csvPath.empty() ? nullptr : std::fopen(csvPath.c_str(), "w");
+    if (!csvPath.empty() && !csv) {
         std::fprintf(stderr, "table1: cannot write '%s'\n", csvPath.c_str());
         return 1;
     }
@@ -568,7 +579,7 @@ int runTable1(int argc, char** argv) {
     std::printf("%-9s %6s | %6s %6s %7s %6s | %9s %9s %13s | %8s %8s %8s %6s | %6s %8s | %8s %8s %6s\n", "window", "voxels", "O2", "Indy",
                 "Octane", "Onyx2", "splatfx", "vs Onyx2", "reduced res", "covered", "overdraw", "Mfrag/s", "fill", "side", "vs sized",
                 "naive Hz", "Mfrag/s", "ratio");
-    std::fprintf(csv, "window,voxels,o2_hz,indy_hz,octane_hz,onyx2_hz,splatfx_hz,pixels_covered,overdraw,splat_mfrag_s,fill_mfrag_s,"
+    csvPrintf(csv, "window,voxels,o2_hz,indy_hz,octane_hz,onyx2_hz,splatfx_hz,pixels_covered,overdraw,splat_mfrag_s,fill_mfrag_s,"
                       "fill_fraction,mean_splat_side_px,sized_fill_mfrag_s,fraction_of_sized_fill,naive_hz,naive_mfrag_s,speedup_vs_naive,reduced_scale,"
                       "reduced_hz\n");
     for (const Row& row : kRows) {
@@ -581,7 +592,7 @@ int runTable1(int argc, char** argv) {
                     row.voxels, row.o2, row.indy, row.octane, row.onyx2, r.hz, r.hz / row.onyx2, reduced, r.covered, r.overdraw,
                     r.splatFragsPerSec / 1e6, 100 * r.fillFraction, r.side, 100 * r.splatFragsPerSec / r.sizedRate, r.naiveHz,
                     r.naiveFragsPerSec / 1e6, r.hz / r.naiveHz);
-        std::fprintf(csv, "%s,%d,%g,%g,%g,%g,%.2f,%.0f,%.2f,%.1f,%.1f,%.3f,%.1f,%.1f,%.3f,%.2f,%.1f,%.3f,%d,%.2f\n", win, row.voxels, row.o2,
+        csvPrintf(csv, "%s,%d,%g,%g,%g,%g,%.2f,%.0f,%.2f,%.1f,%.1f,%.3f,%.1f,%.1f,%.3f,%.2f,%.1f,%.3f,%d,%.2f\n", win, row.voxels, row.o2,
                      row.indy, row.octane, row.onyx2, r.hz, r.covered, r.overdraw, r.splatFragsPerSec / 1e6, r.fillRate / 1e6, r.fillFraction,
                      r.side, r.sizedRate / 1e6, r.splatFragsPerSec / r.sizedRate, r.naiveHz, r.naiveFragsPerSec / 1e6, r.hz / r.naiveHz, r.scale,
                      r.scaledHz);
@@ -592,7 +603,13 @@ int runTable1(int argc, char** argv) {
                 "  fraction of screen-aligned squares of that size doing the same work (the rasterizer's limit at that size)\n"
                 "ratio = splatfx full frame (dynamics, sort, upload, draw) vs the naive baseline's frame (no sort, no footprint math)\n");
     cpuScaling(csv);
-    std::fclose(csv);
-    std::printf("\nCSV: %s\n", csvPath.c_str());
+    if (csv) {
+        const bool ok = std::ferror(csv) == 0;
+        if (std::fclose(csv) != 0 || !ok) {
+            std::fprintf(stderr, "table1: writing '%s' failed\n", csvPath.c_str());
+            return 1;
+        }
+        std::printf("\nCSV: %s\n", csvPath.c_str());
+    }
     return 0;
 }
