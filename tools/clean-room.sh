@@ -72,6 +72,7 @@ echo "clean-room: minimal Debian 12 root, then: $steps"
 start=$(date +%s)
 set +e
 mmdebstrap --variant=minbase --mode=root --quiet \
+  --customize-hook='mkdir -p "$1/root/splatfx"' \
   --customize-hook="sync-in $work/src /root/splatfx" \
   --customize-hook="chroot \"\$1\" /bin/bash -c '$inner' > '$log' 2>&1" \
   bookworm "$work/root" "${sources[@]}"
