@@ -13,8 +13,11 @@
 //
 //   splatfx::Scene scene;
 //   auto id = scene.add(*splatfx::presets::fire(materials), {.name = "campfire", .rangeWorld = 80});
-//   scene.update(timeSec, camera);            // per frame
-//   builder.begin(camera); scene.emit(builder, materials); builder.sort();
+//   scene.prepare(timeSec, camera, materials, frame);   // per frame: decide, simulate, emit, sort
+//   frameRenderer->render(frame, hostTarget);            // gl/frame_renderer.hpp
+//
+// prepare() is update() + emit() into a Frame + the sort; the two halves stay
+// public for hosts that feed their own SplatBuilder.
 //
 // Threading: one thread at a time.
 #pragma once
@@ -26,6 +29,7 @@
 
 #include "splatfx/camera.hpp"
 #include "splatfx/effect.hpp"
+#include "splatfx/frame.hpp"
 #include "splatfx/materials.hpp"
 #include "splatfx/splats.hpp"
 
@@ -44,6 +48,9 @@ struct EffectOptions {
     // A solver effect whose emitters are all off and whose total density is
     // below this is dead: not simulated, not drawn.
     double deadDensity = 1e-4;                               // default 1e-4
+    // How the effect is drawn (textured or traditional, opacity scale);
+    // combined with the options given to prepare()/emit(). Default EmitOptions{}.
+    EmitOptions draw{};
 };
 
 // Why an effect was or was not needed at the last update, and what it cost.
@@ -79,8 +86,13 @@ public:
     // Decides what is needed for this camera at timeSec (non-decreasing
     // across calls) and brings exactly those effects to timeSec.
     void update(double timeSec, const Camera& camera);
-    // Adds the splats of the effects the last update() found needed.
+    // Adds the splats of the effects the last update() found needed, each
+    // drawn with its EffectOptions::draw combined with `options` (textured
+    // only if both are; opacity scales multiply).
     std::size_t emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options = {});
+    // One frame: update(timeSec, camera), then frame.begin, emit into it,
+    // frame.end (one back-to-front sort), and the frame's counters.
+    void prepare(double timeSec, const Camera& camera, const Materials& materials, Frame& frame, const EmitOptions& options = {});
 
     const EffectStatus& status(EffectId id) const { return mEntries.at(id).status; }
     const SceneCounters& counters() const { return mCounters; }

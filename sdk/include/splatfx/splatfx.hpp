@@ -7,6 +7,8 @@
 #include "splatfx/dynamics.hpp"
 #include "splatfx/effect.hpp"
 #include "splatfx/footprint.hpp"
+#include "splatfx/frame.hpp"
+#include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/gl/framebuffer.hpp"
 #include "splatfx/gl/renderer.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"

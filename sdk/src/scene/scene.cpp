@@ -94,11 +94,26 @@ void Scene::update(double timeSec, const Camera& camera) {
 std::size_t Scene::emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options) {
     std::size_t total = 0;
     for (Entry& e : mEntries) {
-        e.status.splatsDrawn = e.status.needed ? e.effect.emit(builder, materials, options) : 0;
+        const EmitOptions draw{.textured = e.options.draw.textured && options.textured,
+                               .opacityScale = e.options.draw.opacityScale * options.opacityScale};
+        e.status.splatsDrawn = e.status.needed ? e.effect.emit(builder, materials, draw) : 0;
         total += e.status.splatsDrawn;
     }
     mCounters.splats = total;
     return total;
+}
+
+void Scene::prepare(double timeSec, const Camera& camera, const Materials& materials, Frame& frame, const EmitOptions& options) {
+    update(timeSec, camera);
+    frame.begin(timeSec, camera);
+    emit(frame.builder(), materials, options);
+    frame.end();
+    FrameCounters& c = frame.counters();
+    c.declared = mCounters.declared;
+    c.needed = mCounters.needed;
+    c.simulated = mCounters.simulated;
+    c.drawn = 0;
+    for (const Entry& e : mEntries) c.drawn += e.status.splatsDrawn > 0 ? 1 : 0;
 }
 
 } // namespace splatfx

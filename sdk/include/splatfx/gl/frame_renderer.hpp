@@ -1,0 +1,104 @@
+// splatfx/gl/frame_renderer.hpp: draws a Frame into the host's framebuffer, owning the order of passes.
+//
+// This is the one place that knows the order in which a frame's passes run.
+// The host hands over, once per frame, everything it owns (framebuffer, host
+// depth texture, and hooks for its own opaque and transparent geometry), and
+// render() runs:
+//   1. the host's opaque pass   (HostTarget::drawOpaque; its depth is what cuts the volumes)
+//   2. the volumes: the frame's splats, back to front, premultiplied "over",
+//      tested against the host depth, at full resolution or at 1/2 or 1/4 per
+//      axis with depth-aware upsampling (FrameRendererDesc::resolutionScale)
+//   3. the host's transparent pass (HostTarget::drawTransparent), blended over
+// The passes of the systems still being built (fog of the host image, shadow
+// tables before the opaque pass, exact ordering among transparent surfaces,
+// projected tetrahedra) join this list here, not in callers.
+// It never creates a context, never clears, and writes no depth.
+//
+//   auto fr = splatfx::gl::FrameRenderer::create();       // a GL 4.5 context must be current
+//   fr->upload(materials);                                // when materials change
+//   scene.prepare(t, camera, materials, frame);           // GL-free (scene.hpp)
+//   fr->render(frame, {.framebuffer = fbo, .depthTexture = depth, .drawOpaque = [&] { drawMyScene(); }});
+//
+// The viewport is the frame camera's (Camera::viewport), at HostTarget's x, y.
+// Engines that want the bare splat pass can still use gl::Renderer (or
+// gl::ScaledRenderer) with a SplatBuilder directly; FrameRenderer is built
+// from them.
+//
+// GL state: as gl::Renderer / gl::ScaledRenderer (restored with
+// RendererDesc::restoreState, the default). The hooks run with the host's
+// framebuffer bound and the viewport set; what they change is theirs.
+//
+// Threading: every call on the thread whose context is current. Move-only.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+
+#include "splatfx/frame.hpp"
+#include "splatfx/gl/framebuffer.hpp"
+#include "splatfx/gl/renderer.hpp"
+#include "splatfx/materials.hpp"
+#include "splatfx/result.hpp"
+
+namespace splatfx::gl {
+
+struct FrameRendererDesc {
+    RendererDesc splats{};                // the splat pass's settings; default RendererDesc{}
+    // 1: splats at full resolution; 2 or 4: at 1/scale per axis, composited
+    // with depth-aware upsampling (gl::ScaledRenderer). Default 1.
+    int resolutionScale = 1;
+    Precision reducedPrecision = Precision::F16; // reduced-resolution colour format; default F16
+    float depthThreshold = 0.1f;          // reduced resolution: relative view depth still one surface; default 0.1
+};
+
+// What the host owns, handed over for one frame.
+struct HostTarget {
+    unsigned framebuffer = 0;  // the host's framebuffer object (0: the default framebuffer); default 0
+    int x = 0, y = 0;          // viewport origin; its size is the frame camera's viewport; default 0, 0
+    // The host's depth as a texture (GL name). Reduced resolution reads it
+    // (0: the framebuffer's depth attachment when it is a texture); at full
+    // resolution the framebuffer's own depth buffer tests the splats. Default 0.
+    unsigned depthTexture = 0;
+    // The host's opaque geometry, drawn with depth writes before the volumes.
+    // Empty: the host drew it before render(). Default empty.
+    std::function<void()> drawOpaque{};
+    // The host's transparent surfaces, blended after the volumes (ordered
+    // blend; exact interleaving with the volumes is issue 15's pass). Default empty.
+    std::function<void()> drawTransparent{};
+};
+
+struct FrameRenderStats {
+    std::uint64_t splats = 0;    // splats drawn
+    std::uint64_t drawCalls = 0; // draw calls of the volume passes
+    int resolutionScale = 1;     // the scale the splats were drawn at
+};
+
+class FrameRenderer {
+public:
+    // Compiles the passes. Fails when no GL 4.5 context is current or
+    // desc.resolutionScale is not 1, 2 or 4 (the message names the field).
+    static Result<FrameRenderer> create(const FrameRendererDesc& desc = {});
+    FrameRenderer(FrameRenderer&&) noexcept;
+    FrameRenderer& operator=(FrameRenderer&&) noexcept;
+    ~FrameRenderer();
+
+    // Uploads texture layers and colour rows when materials changed (cheap otherwise).
+    Status upload(const Materials& materials);
+    // Runs the frame's passes into the host target. Expects upload() first and
+    // a frame camera with a positive viewport.
+    void render(const Frame& frame, const HostTarget& target);
+
+    const FrameRendererDesc& desc() const;
+    const FrameRenderStats& stats() const;
+    // The splat pass's renderer: what texture sampling upload() chose, its
+    // layer texture (for tools and debug views).
+    const Renderer& splatRenderer() const;
+
+private:
+    struct Impl;
+    explicit FrameRenderer(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> mImpl;
+};
+
+} // namespace splatfx::gl

@@ -1,0 +1,17 @@
+#include "splatfx/frame.hpp"
+
+namespace splatfx {
+
+void Frame::begin(double timeSec, const Camera& camera) {
+    mTime = timeSec;
+    mCounters = {};
+    mBuilder.begin(camera);
+}
+
+void Frame::end(SortMode mode) {
+    mBuilder.sort(mode);
+    mCounters.splats = mBuilder.splats().size();
+    mCounters.voxels = mBuilder.stats().voxelsIn;
+}
+
+} // namespace splatfx

@@ -1,0 +1,89 @@
+// The frame's passes in their order (frame_renderer.hpp lists them).
+#include "splatfx/gl/frame_renderer.hpp"
+
+#include <cassert>
+#include <optional>
+#include <string>
+
+#include <epoxy/gl.h>
+
+#include "splatfx/gl/scaled_renderer.hpp"
+
+namespace splatfx::gl {
+
+struct FrameRenderer::Impl {
+    FrameRendererDesc desc;
+    // Exactly one of the two splat passes: the reduced-resolution one wraps its own Renderer.
+    std::optional<Renderer> full;
+    std::optional<ScaledRenderer> reduced;
+    FrameRenderStats stats;
+};
+
+Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
+    if (desc.resolutionScale != 1 && desc.resolutionScale != 2 && desc.resolutionScale != 4)
+        return makeError("FrameRendererDesc::resolutionScale must be 1, 2 or 4, got " + std::to_string(desc.resolutionScale));
+    auto impl = std::make_unique<Impl>();
+    impl->desc = desc;
+    impl->stats.resolutionScale = desc.resolutionScale;
+    if (desc.resolutionScale == 1) {
+        auto r = Renderer::create(desc.splats);
+        if (!r) return makeError(r.error());
+        impl->full.emplace(std::move(*r));
+    } else {
+        auto r = ScaledRenderer::create({.scale = desc.resolutionScale,
+                                         .renderer = desc.splats,
+                                         .precision = desc.reducedPrecision,
+                                         .depthThreshold = desc.depthThreshold});
+        if (!r) return makeError(r.error());
+        impl->reduced.emplace(std::move(*r));
+    }
+    return FrameRenderer(std::move(impl));
+}
+
+FrameRenderer::FrameRenderer(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
+FrameRenderer::FrameRenderer(FrameRenderer&&) noexcept = default;
+FrameRenderer& FrameRenderer::operator=(FrameRenderer&&) noexcept = default;
+FrameRenderer::~FrameRenderer() = default;
+
+Status FrameRenderer::upload(const Materials& materials) {
+    return mImpl->full ? mImpl->full->upload(materials) : mImpl->reduced->upload(materials);
+}
+
+const FrameRendererDesc& FrameRenderer::desc() const { return mImpl->desc; }
+const FrameRenderStats& FrameRenderer::stats() const { return mImpl->stats; }
+const Renderer& FrameRenderer::splatRenderer() const { return mImpl->full ? *mImpl->full : mImpl->reduced->renderer(); }
+
+void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
+    Impl& r = *mImpl;
+    const Camera& camera = frame.camera();
+    assert(camera.viewport.x > 0 && camera.viewport.y > 0 && "FrameRenderer::render: the frame camera's viewport must be positive");
+    const int w = camera.viewport.x, h = camera.viewport.y;
+
+    // 1. The host's opaque pass: its depth is what the volumes are tested against.
+    if (target.drawOpaque) {
+        glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+        glViewport(target.x, target.y, w, h);
+        target.drawOpaque();
+    }
+
+    // 2. The volumes, back to front.
+    if (r.full) {
+        r.full->draw(frame.splats(), camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h});
+        r.stats.drawCalls = r.full->stats().drawCalls;
+    } else {
+        r.reduced->draw(frame.splats(), camera,
+                        {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
+                         .depthTexture = target.depthTexture});
+        r.stats.drawCalls = r.reduced->renderer().stats().drawCalls;
+    }
+    r.stats.splats = frame.splats().size();
+
+    // 3. The host's transparent surfaces, over the volumes.
+    if (target.drawTransparent) {
+        glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+        glViewport(target.x, target.y, w, h);
+        target.drawTransparent();
+    }
+}
+
+} // namespace splatfx::gl
