@@ -2,8 +2,10 @@
 // drawn as textured splats, made by splatfx::presets::fire and animated at
 // two scales: global dynamics (sec. 3.2, texture detail propagating upwards
 // one voxel per step) and local dynamics (sec. 3.3, ordered texture cycling
-// with cross-fades). Every frame is computed directly from its time
-// (Effect::update), so frames can be rendered in any order.
+// with cross-fades). Every frame is computed directly from its time (the
+// fire is stateless), so frames can be rendered in any order. The frame is
+// the SDK's: Scene::prepare, then gl::FrameRenderer with the clear as the
+// host's opaque pass.
 // Headless it also writes campfire_figure1.png: traditional splatting (left,
 // Fig. 1a) beside textured splatting (right, Fig. 1b) of the same grid.
 #include <cstdio>
@@ -18,9 +20,9 @@ namespace {
 struct Campfire {
     samples::Options options;
     splatfx::Materials materials{splatfx::Footprint{}};
-    std::optional<splatfx::Effect> fire;
-    splatfx::SplatBuilder builder;
-    std::optional<splatfx::gl::Renderer> renderer;
+    splatfx::Scene scene;
+    splatfx::Frame splatFrame;
+    std::optional<splatfx::gl::FrameRenderer> renderer;
     bool figureWritten = false;
 
     bool setup() {
@@ -32,8 +34,8 @@ struct Campfire {
                                                     .crossfade = true,
                                                     .seed = options.seed});
         if (!f) return fail(f.error());
-        fire = std::move(*f);
-        auto r = splatfx::gl::Renderer::create();
+        scene.add(std::move(*f), {.name = "campfire"});
+        auto r = splatfx::gl::FrameRenderer::create();
         if (!r) return fail(r.error());
         renderer = std::move(*r);
         if (auto s = renderer->upload(materials); !s) return fail(s.error());
@@ -49,22 +51,21 @@ struct Campfire {
         return splatfx::Camera::lookAt({0.0f, 4.8f, 15.0f}, {0.0f, 4.6f, 0.0f}, {0, 1, 0}, glm::radians(45.0f), size);
     }
 
-    void draw(const splatfx::Camera& cam, const splatfx::gl::Target& target, bool textured) {
-        builder.begin(cam);
-        fire->emit(builder, materials, {.textured = textured});
-        builder.sort();
-        renderer->draw(builder.splats(), cam, target);
+    // The host's opaque pass: this sample has no geometry, only a background.
+    static void clearBackground() {
+        glClearColor(0.02f, 0.02f, 0.04f, 1.0f);
+        glClearDepth(1.0);
+        glDepthMask(GL_TRUE);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    }
+
+    void draw(double timeSec, glm::ivec2 size, unsigned framebuffer, bool textured) {
+        scene.prepare(timeSec, camera(size), materials, splatFrame, {.textured = textured});
+        renderer->render(splatFrame, {.framebuffer = framebuffer, .drawOpaque = clearBackground});
     }
 
     void frame(const samples::FrameContext& fc) {
-        fire->update(fc.timeSec);
-        const splatfx::Camera cam = camera(fc.size);
-        glBindFramebuffer(GL_FRAMEBUFFER, fc.target.framebuffer);
-        glViewport(0, 0, fc.size.x, fc.size.y);
-        glClearColor(0.02f, 0.02f, 0.04f, 1.0f);
-        glClearDepth(1.0);
-        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-        draw(cam, fc.target, !options.traditional);
+        draw(fc.timeSec, fc.size, fc.target.framebuffer, !options.traditional);
         if (options.frames > 0 && !figureWritten) writeFigure1(fc);
     }
 
@@ -75,8 +76,7 @@ struct Campfire {
         for (int textured = 0; textured < 2; ++textured) {
             auto fb = splatfx::gl::Framebuffer::create({.width = fc.size.x, .height = fc.size.y});
             if (!fb) return void(fail(fb.error()));
-            fb->clear({0.02f, 0.02f, 0.04f, 1.0f});
-            draw(camera(fc.size), {.framebuffer = fb->handle(), .width = fc.size.x, .height = fc.size.y}, textured == 1);
+            draw(fc.timeSec, fc.size, fb->handle(), textured == 1);
             halves[textured] = fb->read();
         }
         splatfx::Image both;

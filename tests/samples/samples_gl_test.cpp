@@ -20,7 +20,7 @@ splatfx::Image render(scenehost::ScenePlayer& player, const std::vector<double>&
     auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
     EXPECT_TRUE(fb.ok());
     for (double t : times)
-        player.renderFrame(t, player.cameraAt(t, size), {.framebuffer = fb->handle(), .width = size.x, .height = size.y});
+        player.renderFrame(t, player.cameraAt(t, size), fb->handle());
     return fb->read();
 }
 
@@ -47,8 +47,8 @@ TEST_F(SamplesGL, EverySampleLoadsAndRendersAFrame) {
         ASSERT_TRUE(player.ok()) << player.error();
         // A few frames up to 1.5 s, so solver effects have emitted and moving objects are in view.
         const splatfx::Image img = render(*player, {0.0, 0.5, 1.0, 1.5}, {160, 120});
-        EXPECT_GT(player->stats().splats, 0u);
-        EXPECT_GT(player->stats().visible, 0u);
+        EXPECT_GT(player->stats().counters.splats, 0u);
+        EXPECT_GT(player->stats().counters.needed, 0u);
         // Not empty: a good part of the frame is not the clear colour (8/255 ignores rounding noise).
         EXPECT_GT(fractionUnlike(img, player->file().output.background), 0.03);
     }
@@ -121,12 +121,12 @@ TEST_F(SamplesGL, CowInFrontHidesTheFireAndFireInFrontVeilsTheCow) {
 // and the frame it draws differs from the old one only in sampling detail.
 TEST_F(SamplesGL, RendererSettingsChangeOnALoadedScene) {
     auto player = scenehost::ScenePlayer::load(splatfx::test::sourcePath("samples/02-fire-figure1/scene.json"),
-                                               {.seed = {}, .renderer = {.sampling = splatfx::gl::TextureSampling::Bilinear}});
+                                               {.seed = {}, .renderer = {.splats = {.sampling = splatfx::gl::TextureSampling::Bilinear}}});
     ASSERT_TRUE(player.ok()) << player.error();
-    EXPECT_EQ(player->renderer().sampling(), splatfx::gl::TextureSampling::Bilinear);
+    EXPECT_EQ(player->renderer().splatRenderer().sampling(), splatfx::gl::TextureSampling::Bilinear);
     const splatfx::Image bilinear = render(*player, {1.0}, {160, 120});
-    ASSERT_TRUE(player->setRenderer({.sampling = splatfx::gl::TextureSampling::Nearest}));
-    EXPECT_EQ(player->renderer().sampling(), splatfx::gl::TextureSampling::Nearest);
+    ASSERT_TRUE(player->setRenderer({.splats = {.sampling = splatfx::gl::TextureSampling::Nearest}}));
+    EXPECT_EQ(player->renderer().splatRenderer().sampling(), splatfx::gl::TextureSampling::Nearest);
     const splatfx::Image nearest = render(*player, {1.0}, {160, 120});
     double sum = 0.0, peak = 0.0;
     for (std::size_t i = 0; i < bilinear.pixels.size(); ++i) {

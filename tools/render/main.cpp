@@ -36,6 +36,7 @@ struct Args {
     std::optional<float> fps;
     bool traditional = false;
     bool quiet = false;
+    splatfx::gl::FrameRendererDesc renderer{}; // --scale, --sampling
     int abortAfter = -1; // testing aid: fail after this many frames
 };
 
@@ -49,6 +50,8 @@ void usage() {
         "  --fps F          animation rate; frame i shows time i / F (default: the scene's output.fps)\n"
         "  --seed S         scene seed (every effect's random choices derive from it; default: the file's)\n"
         "  --traditional    draw every effect with plain footprints, no textures (the paper's Fig. 1a)\n"
+        "  --scale N        draw the effects at 1/N resolution per axis (1, 2 or 4; default 1) with depth-aware upsampling\n"
+        "  --sampling M     texture sampling: auto (default), bilinear, nearest, upsampled, upsampledN (N = 2..16)\n"
         "  --quiet          no per-frame progress\n"
         "  --abort-after N  testing aid: fail on purpose after N frames (checks that nothing partial is left)\n"
         "<name> is the scene's output.name (default: the scene file's folder name).\n");
@@ -88,6 +91,28 @@ bool parse(int argc, char** argv, Args& a) {
         } else if (s == "--frames") {
             if (!(v = value()) || !integer(v, 1, 100000, n)) return false;
             a.frames = int(n);
+        } else if (s == "--scale") {
+            if (!(v = value()) || !integer(v, 1, 4, n)) return false;
+            if (n == 3) {
+                std::fprintf(stderr, "splatfx-render: --scale expects 1, 2 or 4, got '%s'\n", v);
+                return false;
+            }
+            a.renderer.resolutionScale = int(n);
+        } else if (s == "--sampling") {
+            if (!(v = value())) return false;
+            using splatfx::gl::TextureSampling;
+            const std::string m = v;
+            if (m == "auto") a.renderer.splats.sampling = TextureSampling::Auto;
+            else if (m == "bilinear") a.renderer.splats.sampling = TextureSampling::Bilinear;
+            else if (m == "nearest") a.renderer.splats.sampling = TextureSampling::Nearest;
+            else if (m.rfind("upsampled", 0) == 0) {
+                a.renderer.splats.sampling = TextureSampling::Upsampled;
+                if (m.size() > 9 && !integer(m.c_str() + 9, 2, 16, n)) return false;
+                a.renderer.splats.upsample = m.size() > 9 ? int(n) : 0;
+            } else {
+                std::fprintf(stderr, "splatfx-render: --sampling expects auto, bilinear, nearest, upsampled or upsampledN, got '%s'\n", v);
+                return false;
+            }
         } else if (s == "--abort-after") {
             if (!(v = value()) || !integer(v, 0, 100000, n)) return false;
             a.abortAfter = int(n);
@@ -151,7 +176,7 @@ int main(int argc, char** argv) {
 
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) return fail(ctx.error());
-    auto player = scenehost::ScenePlayer::load(a.scene, {.seed = a.seed});
+    auto player = scenehost::ScenePlayer::load(a.scene, {.seed = a.seed, .renderer = a.renderer});
     if (!player) return fail(player.error());
     const splatfx::SceneFile& file = player->file();
     const glm::ivec2 size = a.size.value_or(file.output.size);
@@ -178,7 +203,7 @@ int main(int argc, char** argv) {
     splatfx::AnimationWriter gif((staging.dir / (name + ".gif")).string(), int(fps + 0.5f));
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
-    double renderMs = 0.0, updateMs = 0.0, buildMs = 0.0;
+    double renderMs = 0.0, prepareMs = 0.0, submitMs = 0.0;
     std::uint64_t splatsMin = ~0ull, splatsMax = 0, splatsSum = 0, voxelsMax = 0;
     std::size_t visibleMax = 0, simulatedMax = 0, drawnMax = 0, visibleSum = 0, simulatedSum = 0, drawnSum = 0;
     std::vector<std::string> pngs;
@@ -187,16 +212,15 @@ int main(int argc, char** argv) {
         if (i == a.abortAfter) return fail("aborted on purpose after " + std::to_string(i) + " frames (--abort-after); no output kept");
         const double t = i / double(fps);
         const auto f0 = Clock::now();
-        player->renderFrame(t, player->cameraAt(t, size), {.framebuffer = fb->handle(), .width = size.x, .height = size.y},
-                            {.traditional = a.traditional});
+        player->renderFrame(t, player->cameraAt(t, size), fb->handle(), {.traditional = a.traditional});
         splatfx::Image img = fb->read();
         renderMs += std::chrono::duration<double, std::milli>(Clock::now() - f0).count();
-        const scenehost::FrameStats& s = player->stats();
-        updateMs += s.updateMs, buildMs += s.buildMs;
+        const splatfx::FrameCounters& s = player->stats().counters;
+        prepareMs += player->stats().prepareMs, submitMs += player->stats().renderMs;
         splatsMin = std::min(splatsMin, s.splats), splatsMax = std::max(splatsMax, s.splats), splatsSum += s.splats;
         voxelsMax = std::max(voxelsMax, s.voxels);
-        visibleMax = std::max(visibleMax, s.visible), simulatedMax = std::max(simulatedMax, s.simulated), drawnMax = std::max(drawnMax, s.drawn);
-        visibleSum += s.visible, simulatedSum += s.simulated, drawnSum += s.drawn;
+        visibleMax = std::max(visibleMax, s.needed), simulatedMax = std::max(simulatedMax, s.simulated), drawnMax = std::max(drawnMax, s.drawn);
+        visibleSum += s.needed, simulatedSum += s.simulated, drawnSum += s.drawn;
         char png[128];
         std::snprintf(png, sizeof png, "%s_%04d.png", name.c_str(), i);
         if (auto w = splatfx::writeImage((staging.dir / png).string(), img); !w) return fail(w.error());
@@ -205,7 +229,7 @@ int main(int argc, char** argv) {
         // A terminal gets a live line; a log gets about ten lines.
         if (!a.quiet && (tty || (i + 1) % std::max(1, frames / 10) == 0 || i + 1 == frames)) {
             std::printf("%ssplatfx-render: frame %d/%d  t=%.2fs  %llu splats  %zu/%zu effects visible", tty ? "\r" : "", i + 1, frames, t,
-                        (unsigned long long)s.splats, s.visible, s.declared);
+                        (unsigned long long)s.splats, s.needed, s.declared);
             if (!tty) std::printf("\n");
             std::fflush(stdout);
         }
@@ -226,11 +250,11 @@ int main(int argc, char** argv) {
     if (ec) return fail("cannot move " + name + ".gif into '" + a.out + "': " + ec.message());
 
     const double sec = std::chrono::duration<double>(Clock::now() - start).count();
-    const scenehost::FrameStats& last = player->stats();
+    const splatfx::FrameCounters& last = player->stats().counters;
     std::printf("splatfx-render: summary for %s\n", a.scene.c_str());
     std::printf("  frames            %d (%dx%d, %.3g s of animation at %g fps)\n", frames, size.x, size.y, frames / double(fps), fps);
-    std::printf("  time              %.2f s in all, %.1f ms per frame (render + readback %.1f ms: update %.2f, splat build %.2f; PNG/GIF the rest)\n",
-                sec, 1000.0 * sec / frames, renderMs / frames, updateMs / frames, buildMs / frames);
+    std::printf("  time              %.2f s in all, %.1f ms per frame (frame + readback %.1f ms: prepare %.2f, GL submission %.2f; PNG/GIF the rest)\n",
+                sec, 1000.0 * sec / frames, renderMs / frames, prepareMs / frames, submitMs / frames);
     std::printf("  splats per frame  min %llu, mean %.0f, max %llu\n", (unsigned long long)splatsMin, double(splatsSum) / frames,
                 (unsigned long long)splatsMax);
     std::printf("  voxels            at most %llu per frame (of the effects needed)\n", (unsigned long long)voxelsMax);

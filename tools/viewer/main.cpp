@@ -132,6 +132,7 @@ struct Viewer {
     splatfx::DynamicsToggles toggles;
     scenehost::FrameOptions frame;
     int sampling = 0; // index into kSamplings
+    int resolutionScale = 1; // 1, 2 or 4
     float fovDeg = 45.0f;
     // Orbit
     glm::vec3 orbitTarget{0, 1, 0};
@@ -142,8 +143,9 @@ struct Viewer {
     double frameMs = 0.0;
     char pathInput[1024] = {};
 
-    splatfx::gl::RendererDesc rendererDesc() const {
-        return {.sampling = kSamplings[sampling].mode, .upsample = kSamplings[sampling].upsample};
+    splatfx::gl::FrameRendererDesc rendererDesc() const {
+        return {.splats = {.sampling = kSamplings[sampling].mode, .upsample = kSamplings[sampling].upsample},
+                .resolutionScale = resolutionScale};
     }
 
     void load(const std::string& p, const std::string* text = nullptr) {
@@ -258,11 +260,12 @@ struct Viewer {
         ImGui::SetNextWindowPos(ImVec2(8, 8), ImGuiCond_FirstUseEver);
         ImGui::SetNextWindowSize(ImVec2(380, 0), ImGuiCond_FirstUseEver);
         ImGui::Begin("splatfx");
-        const scenehost::FrameStats s = player ? player->stats() : scenehost::FrameStats{};
+        const scenehost::FrameStats fs = player ? player->stats() : scenehost::FrameStats{};
+        const splatfx::FrameCounters& s = fs.counters;
         ImGui::Text("%.2f ms/frame (%.0f fps)   t = %.2f s", frameMs, frameMs > 0 ? 1000.0 / frameMs : 0.0, time);
-        ImGui::Text("effects: %zu declared, %zu simulated, %zu visible, %zu drawn", s.declared, s.simulated, s.visible, s.drawn);
+        ImGui::Text("effects: %zu declared, %zu simulated, %zu visible, %zu drawn", s.declared, s.simulated, s.needed, s.drawn);
         ImGui::Text("voxels: %llu   splats: %llu", (unsigned long long)s.voxels, (unsigned long long)s.splats);
-        ImGui::Text("update %.2f ms  build %.2f ms  draw %.2f ms", s.updateMs, s.buildMs, s.drawMs);
+        ImGui::Text("prepare %.2f ms  render %.2f ms", fs.prepareMs, fs.renderMs);
         if (!error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", error.c_str());
         ImGui::Separator();
 
@@ -313,8 +316,15 @@ struct Viewer {
                     }
                 ImGui::EndCombo();
             }
+            static const char* kScales[] = {"full resolution", "1/2 resolution", "1/4 resolution"};
+            int scaleIndex = resolutionScale == 4 ? 2 : resolutionScale - 1;
+            if (ImGui::Combo("effects drawn at", &scaleIndex, kScales, 3)) {
+                resolutionScale = scaleIndex == 2 ? 4 : scaleIndex + 1;
+                if (player)
+                    if (auto st = player->setRenderer(rendererDesc()); !st) error = st.error();
+            }
             if (player) {
-                const splatfx::gl::Renderer& r = player->renderer();
+                const splatfx::gl::Renderer& r = player->renderer().splatRenderer();
                 if (r.sampling() == splatfx::gl::TextureSampling::Upsampled) ImGui::TextDisabled("in use: layers upsampled %dx, nearest", r.upsampleFactor());
                 else ImGui::TextDisabled("in use: %s", r.sampling() == splatfx::gl::TextureSampling::Bilinear ? "bilinear" : "nearest");
             }
@@ -417,7 +427,7 @@ int main(int argc, char** argv) {
         if (v.player && fbSize.x > 0 && fbSize.y > 0) {
             if (!v.paused && frameIndex > 0) v.time += double(dt) * v.timeRate;
             const splatfx::Camera cam = v.camera(fbSize);
-            v.player->renderFrame(v.time, cam, {.framebuffer = 0, .width = fbSize.x, .height = fbSize.y}, v.frame);
+            v.player->renderFrame(v.time, cam, 0, v.frame);
         } else {
             glBindFramebuffer(GL_FRAMEBUFFER, 0);
             glViewport(0, 0, fbSize.x, fbSize.y);
@@ -429,9 +439,9 @@ int main(int argc, char** argv) {
         if (lastFrame && !v.args.screenshot.empty() && !writeScreenshot(v.args.screenshot, fbSize)) rc = 1;
         window->swapBuffers();
         if (lastFrame) {
-            const scenehost::FrameStats s = v.player ? v.player->stats() : scenehost::FrameStats{};
+            const splatfx::FrameCounters s = v.player ? v.player->stats().counters : splatfx::FrameCounters{};
             std::printf("splatfx-viewer: %d frames, t = %.2f s, %zu effects declared / %zu simulated / %zu visible, %llu splats\n",
-                        frameIndex + 1, v.time, s.declared, s.simulated, s.visible, (unsigned long long)s.splats);
+                        frameIndex + 1, v.time, s.declared, s.simulated, s.needed, (unsigned long long)s.splats);
             break;
         }
     }

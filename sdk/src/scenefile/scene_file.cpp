@@ -903,6 +903,7 @@ void readEffects(Context& c, const std::string& path, const Json& v, const std::
         }
         effect->setToggles(e.toggles);
         e.options.name = e.name;
+        e.options.draw.textured = !e.traditional; // the Scene owns how each effect is drawn
         SceneEffectInfo info;
         info.name = e.name;
         info.kind = e.kind;

@@ -1,4 +1,4 @@
-// samples/common/geometry_renderer.hpp: draws a scene file's geometry (host side).
+// tools/scenehost/geometry_renderer.hpp: draws a scene file's geometry (host side).
 //
 // A tiny OpenGL 4.5 renderer for the ground plane, boxes, cylinders, spheres
 // and meshes of a scene file: one program (two-sided Lambert with a little

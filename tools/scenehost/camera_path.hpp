@@ -1,4 +1,4 @@
-// samples/common/camera_path.hpp: evaluating a scene file's camera path (host side).
+// tools/scenehost/camera_path.hpp: evaluating a scene file's camera path (host side).
 //
 // Interpolates position, target and field of view between keys (linear or
 // smoothstep per CameraPath::smooth), holding the first and last key

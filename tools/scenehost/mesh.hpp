@@ -1,4 +1,4 @@
-// samples/common/mesh.hpp: triangle meshes for scene geometry (host side).
+// tools/scenehost/mesh.hpp: triangle meshes for scene geometry (host side).
 //
 // Loads any format assimp reads (OBJ, OFF, Collada, glTF, PLY, ...) into one
 // indexed triangle list with smooth normals, builds the primitive shapes a

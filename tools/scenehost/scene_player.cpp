@@ -12,8 +12,8 @@ struct ScenePlayer::Impl {
     splatfx::Materials materials{splatfx::Footprint{}};
     std::optional<splatfx::SceneFile> file;
     std::optional<GeometryRenderer> geometry;
-    std::optional<splatfx::gl::Renderer> splats;
-    splatfx::SplatBuilder builder;
+    std::optional<splatfx::gl::FrameRenderer> renderer;
+    splatfx::Frame frame;
     FrameStats stats;
 };
 
@@ -25,7 +25,7 @@ double msSince(Clock::time_point t0) { return std::chrono::duration<double, std:
 } // namespace
 
 // Geometry and the splat renderer, once the scene file is read.
-splatfx::Status ScenePlayer::setupGl(Impl& impl, const std::string& path, const splatfx::gl::RendererDesc& desc) {
+splatfx::Status ScenePlayer::setupGl(Impl& impl, const std::string& path, const splatfx::gl::FrameRendererDesc& desc) {
     auto geo = GeometryRenderer::create(impl.file->geometry);
     if (!geo) return splatfx::makeError(path + ": " + geo.error());
     impl.geometry.emplace(std::move(*geo));
@@ -36,16 +36,16 @@ splatfx::Status ScenePlayer::setupGl(Impl& impl, const std::string& path, const 
 
 // A splat renderer with these settings and the materials uploaded; on failure
 // the previous renderer stays.
-splatfx::Status ScenePlayer::installRenderer(Impl& impl, const splatfx::gl::RendererDesc& desc) {
-    auto r = splatfx::gl::Renderer::create(desc);
+splatfx::Status ScenePlayer::installRenderer(Impl& impl, const splatfx::gl::FrameRendererDesc& desc) {
+    auto r = splatfx::gl::FrameRenderer::create(desc);
     if (!r) return splatfx::makeError(r.error());
     if (auto s = r->upload(impl.materials); !s) return s;
-    impl.splats.emplace(std::move(*r));
+    impl.renderer.emplace(std::move(*r));
     return {};
 }
 
-splatfx::Status ScenePlayer::setRenderer(const splatfx::gl::RendererDesc& desc) { return installRenderer(*mImpl, desc); }
-const splatfx::gl::Renderer& ScenePlayer::renderer() const { return *mImpl->splats; }
+splatfx::Status ScenePlayer::setRenderer(const splatfx::gl::FrameRendererDesc& desc) { return installRenderer(*mImpl, desc); }
+const splatfx::gl::FrameRenderer& ScenePlayer::renderer() const { return *mImpl->renderer; }
 
 splatfx::Result<ScenePlayer> ScenePlayer::load(const std::string& path, const PlayerOptions& options) {
     auto impl = std::make_unique<Impl>();
@@ -82,50 +82,31 @@ GeometryRenderer& ScenePlayer::geometry() { return *mImpl->geometry; }
 
 splatfx::Camera ScenePlayer::cameraAt(double t, glm::ivec2 viewport) const { return evaluate(mImpl->file->camera, t, viewport); }
 
-void ScenePlayer::renderFrame(double t, const splatfx::Camera& camera, const splatfx::gl::Target& target, const FrameOptions& options) {
+void ScenePlayer::renderFrame(double t, const splatfx::Camera& camera, unsigned framebuffer, const FrameOptions& options) {
     Impl& p = *mImpl;
     splatfx::SceneFile& f = *p.file;
     FrameStats& s = p.stats;
-    s = {};
-    glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
-    glViewport(target.x, target.y, target.width, target.height);
-    if (options.clear) {
-        glClearColor(f.output.background.r, f.output.background.g, f.output.background.b, 1.0f);
-        glClearDepth(1.0);
-        glDepthMask(GL_TRUE);
-        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    }
-    // Opaque geometry first: its depth is what the splats are tested against.
-    if (options.drawGeometry) p.geometry->draw(t, camera);
 
     auto t0 = Clock::now();
-    f.scene.update(t, camera);
-    s.updateMs = msSince(t0);
-
-    t0 = Clock::now();
-    p.builder.begin(camera);
+    f.scene.prepare(t, camera, p.materials, p.frame, {.textured = !options.traditional, .opacityScale = options.opacityScale});
+    s.prepareMs = msSince(t0);
+    s.counters = p.frame.counters();
     s.splatsPerEffect.assign(f.effects.size(), 0);
-    for (std::size_t i = 0; i < f.effects.size(); ++i) {
-        const splatfx::SceneEffectInfo& info = f.effects[i];
-        if (!f.scene.status(info.id).needed) continue;
-        const splatfx::Effect& e = f.scene.effect(info.id);
-        s.voxels += e.grid().voxels.size();
-        const std::size_t n = e.emit(p.builder, p.materials,
-                                     {.textured = !(options.traditional || info.traditional), .opacityScale = options.opacityScale});
-        s.splatsPerEffect[i] = n;
-        s.drawn += n > 0 ? 1 : 0;
-    }
-    p.builder.sort();
-    s.buildMs = msSince(t0);
-    s.splats = p.builder.splats().size();
-    const splatfx::SceneCounters& c = f.scene.counters();
-    s.declared = c.declared;
-    s.visible = c.needed;
-    s.simulated = c.simulated;
+    for (std::size_t i = 0; i < f.effects.size(); ++i) s.splatsPerEffect[i] = f.scene.status(f.effects[i].id).splatsDrawn;
 
+    // This host's opaque pass: background, then geometry with depth writes.
+    auto drawOpaque = [&] {
+        if (options.clear) {
+            glClearColor(f.output.background.r, f.output.background.g, f.output.background.b, 1.0f);
+            glClearDepth(1.0);
+            glDepthMask(GL_TRUE);
+            glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        }
+        if (options.drawGeometry) p.geometry->draw(t, camera);
+    };
     t0 = Clock::now();
-    p.splats->draw(p.builder.splats(), camera, target);
-    s.drawMs = msSince(t0);
+    p.renderer->render(p.frame, {.framebuffer = framebuffer, .drawOpaque = drawOpaque});
+    s.renderMs = msSince(t0);
 }
 
 } // namespace scenehost
