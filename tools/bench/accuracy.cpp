@@ -239,19 +239,19 @@ struct Bench {
         Config config;
         std::unique_ptr<splatfx::Materials> mat;
         splatfx::Grid grid;
-        splatfx::SplatBuilder builder;
+        std::optional<splatfx::Frame> frame;
         std::uint32_t setId = 0;
         std::optional<splatfx::gl::Framebuffer> fb;
-        std::optional<splatfx::gl::ScaledRenderer> sr;
+        std::optional<splatfx::gl::FrameRenderer> sr;
         const splatfx::Image* truth = nullptr;
         double extraCpuMs = 0.0;
         std::vector<double> cpu, total;
 
-        const std::vector<splatfx::Splat>& frame(const splatfx::Camera& cam) {
-            builder.begin(cam);
-            builder.add(grid, *mat, {.textureSet = setId, .colorTable = 0, .textured = config.textured, .crossfade = true});
-            builder.sort(config.sort);
-            return builder.splats();
+        const splatfx::Frame& prepare(const splatfx::Camera& cam) {
+            frame->begin(0.0, cam);
+            frame->builder().add(grid, *mat, {.textureSet = setId, .colorTable = 0, .textured = config.textured, .crossfade = true});
+            frame->end(config.sort);
+            return *frame;
         }
     };
     std::vector<std::unique_ptr<Setting>> settings;
@@ -265,7 +265,7 @@ struct Bench {
         s->config = c;
         s->mat = std::make_unique<splatfx::Materials>(materials(c, subset(truthSet, c.count), s->setId));
         s->grid = remapTextures ? forCount(truthGrid, c.count) : truthGrid;
-        s->builder = splatfx::SplatBuilder({.buckets = c.buckets});
+        s->frame.emplace(splatfx::SplatBuilderDesc{.buckets = c.buckets});
         s->truth = &truth;
         s->extraCpuMs = extraCpuMs;
         auto fb = splatfx::gl::Framebuffer::create({.width = opt.size.x, .height = opt.size.y, .color = c.precision});
@@ -274,7 +274,7 @@ struct Bench {
         rdesc.trimCorners = c.octagons;
         rdesc.sampling = c.sampling;
         rdesc.upsample = c.upsample;
-        auto sr = splatfx::gl::ScaledRenderer::create({.scale = c.scale, .renderer = rdesc});
+        auto sr = splatfx::gl::FrameRenderer::create({.splats = rdesc, .resolutionScale = c.scale});
         if (!fb || !sr || !sr->upload(*s->mat)) {
             std::fprintf(stderr, "accuracy: cannot set up GL for %s %s\n", knob.c_str(), setting.c_str());
             return;
@@ -290,12 +290,11 @@ struct Bench {
     void measureAll() {
         for (int r = -2; r < opt.reps; ++r) { // two warm-up rounds
             for (auto& s : settings) {
-                const splatfx::gl::ScaledTarget target{.framebuffer = s->fb->handle(), .width = opt.size.x, .height = opt.size.y};
                 restoreHost(*s->fb);
                 glFinish();
                 const double c0 = processCpuMs();
                 const auto t0 = Clock::now();
-                s->sr->draw(s->frame(cam), cam, target);
+                s->sr->render(s->prepare(cam), {.framebuffer = s->fb->handle()});
                 glFinish();
                 const auto t2 = Clock::now();
                 const double c2 = processCpuMs();
@@ -306,9 +305,8 @@ struct Bench {
         }
         std::printf("\n");
         for (auto& s : settings) {
-            const splatfx::gl::ScaledTarget target{.framebuffer = s->fb->handle(), .width = opt.size.x, .height = opt.size.y};
             restoreHost(*s->fb);
-            s->sr->draw(s->frame(cam), cam, target);
+            s->sr->render(s->prepare(cam), {.framebuffer = s->fb->handle()});
             const Error e = compare(s->fb->read(), *s->truth);
             Row& row = s->row;
             row.cpuMs = median(s->cpu) + s->extraCpuMs;
@@ -539,7 +537,7 @@ int runAccuracy(int argc, char** argv) {
         const std::size_t before = b.settings.size();
         b.add("texture sampling (RendererDesc)", "auto", c, onTexture, truth);
         if (b.settings.size() > before) { // add() keeps nothing when GL setup fails
-            const splatfx::gl::Renderer& r = b.settings.back()->sr->renderer();
+            const splatfx::gl::Renderer& r = b.settings.back()->sr->splatRenderer();
             b.settings.back()->row.setting = r.sampling() == TextureSampling::Upsampled
                                                  ? "auto: upsampled " + std::to_string(r.upsampleFactor()) + "x (default)"
                                                  : "auto: bilinear (default)";

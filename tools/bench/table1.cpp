@@ -309,7 +309,7 @@ RowResult measureRow(const Row& row, const Settings& settings) {
     const auto set = materials.addTextureSet(splatfx::TextureSet::turbulence({.count = 8, .size = 32, .seed = 1}));
     const auto lut = materials.addColorTable(splatfx::ColorTable::fire());
     auto fb = splatfx::gl::Framebuffer::create({.width = row.window.x, .height = row.window.y});
-    auto renderer = splatfx::gl::Renderer::create(settings.renderer);
+    auto renderer = splatfx::gl::FrameRenderer::create({.splats = settings.renderer});
     if (!fb || !renderer || !renderer->upload(materials)) {
         std::fprintf(stderr, "table1: GL setup failed\n");
         return out;
@@ -317,28 +317,28 @@ RowResult measureRow(const Row& row, const Settings& settings) {
     const splatfx::Grid base = fireGrid(row.voxels, 1);
     splatfx::Grid grid = base;
     const splatfx::Camera cam = fireCamera(row.window);
-    splatfx::SplatBuilder builder;
-    const splatfx::gl::Target target{.framebuffer = fb->handle(), .width = row.window.x, .height = row.window.y};
+    splatfx::Frame frame;
+    const splatfx::gl::HostTarget target{.framebuffer = fb->handle()};
     const splatfx::SplatStyle style{.textureSet = set, .colorTable = lut, .crossfade = settings.crossfade};
 
     // Full frame as an application runs it: dynamics, build, sort, upload,
     // draw, and wait for the pixels (glFinish), at 60 simulated frames/s.
-    auto fullFrame = [&](const auto& draw) {
+    auto fullFrame = [&](splatfx::gl::FrameRenderer& r) {
         return [&](int i) {
             cycle(base, grid, i / 60.0);
-            builder.begin(cam);
-            builder.add(grid, materials, style);
-            builder.sort();
+            frame.begin(i / 60.0, cam);
+            frame.builder().add(grid, materials, style);
+            frame.end();
             fb->clear({0, 0, 0, 1});
-            draw(builder.splats());
+            r.render(frame, target);
             glFinish();
         };
     };
-    out.hz = 1.0 / medianFrame(5, frames, fullFrame([&](const std::vector<splatfx::Splat>& s) { renderer->draw(s, cam, target); }));
+    out.hz = 1.0 / medianFrame(5, frames, fullFrame(*renderer));
 
     // Coverage and overdraw: samples that reached the blender / pixels touched.
     fb->clear({0, 0, 0, 0});
-    const GLuint64 samples = samplesPassed([&] { renderer->draw(builder.splats(), cam, target); });
+    const GLuint64 samples = samplesPassed([&] { renderer->render(frame, target); });
     const splatfx::Image img = fb->read();
     size_t covered = 0;
     glm::vec4 region(float(row.window.x), float(row.window.y), 0.0f, 0.0f); // covered pixels' bounds
@@ -354,7 +354,7 @@ RowResult measureRow(const Row& row, const Settings& settings) {
 
     // The splat pass alone (splats already built), as fragments per second.
     const double drawSec = medianFrame(3, frames, [&](int) {
-        renderer->draw(builder.splats(), cam, target);
+        renderer->render(frame, target);
         glFinish();
     });
     out.splatFragsPerSec = double(samples) / drawSec;
@@ -363,12 +363,12 @@ RowResult measureRow(const Row& row, const Settings& settings) {
     // At least 64 screens of fragments so the timing is not dominated by one draw's fixed cost.
     const int quads = std::max(64, int(samples / (double(row.window.x) * row.window.y)));
     // The renderer's own layer texture: the same texels, size and sampling per fragment.
-    out.fillRate = fill.rate(fb->handle(), row.window, renderer->layerTexture(), quads);
+    out.fillRate = fill.rate(fb->handle(), row.window, renderer->splatRenderer().layerTexture(), quads);
     out.fillFraction = out.splatFragsPerSec / out.fillRate;
     // The same fragments as squares of the splats' mean size: what limits small splats.
-    const int splats = int(builder.splats().size());
+    const int splats = int(frame.splats().size());
     const float side = std::sqrt(float(samples) / float(std::max(splats, 1)));
-    out.sizedRate = fill.rateSquares(fb->handle(), row.window, renderer->layerTexture(), splats, side, region);
+    out.sizedRate = fill.rateSquares(fb->handle(), row.window, renderer->splatRenderer().layerTexture(), splats, side, region);
     out.side = side;
 
     // Where full resolution misses the Onyx2 rate, the same full frame with
@@ -376,11 +376,9 @@ RowResult measureRow(const Row& row, const Settings& settings) {
     // its accuracy cost is in the accuracy benchmark's render-scale rows).
     if (out.hz < row.onyx2) {
         for (int scale : {2, 4}) {
-            auto scaled = splatfx::gl::ScaledRenderer::create(
-                {.scale = scale, .renderer = settings.renderer});
+            auto scaled = splatfx::gl::FrameRenderer::create({.splats = settings.renderer, .resolutionScale = scale});
             if (!scaled || !scaled->upload(materials)) break;
-            const splatfx::gl::ScaledTarget st{.framebuffer = fb->handle(), .width = row.window.x, .height = row.window.y};
-            out.scaledHz = 1.0 / medianFrame(5, frames, fullFrame([&](const std::vector<splatfx::Splat>& s) { scaled->draw(s, cam, st); }));
+            out.scaledHz = 1.0 / medianFrame(5, frames, fullFrame(*scaled));
             out.scale = scale;
             if (out.scaledHz >= row.onyx2) break;
         }

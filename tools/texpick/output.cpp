@@ -216,7 +216,7 @@ splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::Textur
     splatfx::Materials mat(fp, {.layerSize = set.size});
     const std::uint32_t setId = mat.addTextureSet(set);
     const std::uint32_t tableId = mat.addColorTable(previewTable(d.previewColors));
-    auto renderer = splatfx::gl::Renderer::create();
+    auto renderer = splatfx::gl::FrameRenderer::create();
     if (!renderer) return makeError("cannot render the preview: " + renderer.error());
     if (auto s = renderer->upload(mat); !s) return makeError("cannot render the preview: " + s.error());
 
@@ -240,7 +240,7 @@ splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::Textur
 
     const int frames = d.previewFrames > 0 ? d.previewFrames : 3 * set.count();
     std::vector<splatfx::Image> out;
-    splatfx::SplatBuilder builder;
+    splatfx::Frame singleFrame, puffFrame; // one frame per view, drawn side by side
     for (int f = 0; f < frames; ++f) {
         // Three frames per texture with cross-fades: one full cycle, so the GIF loops seamlessly.
         const double steps = f / 3.0;
@@ -254,14 +254,14 @@ splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::Textur
         }
         fb->clear({0.02f, 0.02f, 0.04f, 1.0f});
         const splatfx::SplatStyle style{.textureSet = setId, .colorTable = tableId, .crossfade = true};
-        builder.begin(camSingle);
-        builder.add(*single, mat, style);
-        builder.sort();
-        renderer->draw(builder.splats(), camSingle, {.framebuffer = fb->handle(), .x = 0, .y = 0, .width = h, .height = h});
-        builder.begin(camPuff);
-        builder.add(*puff, mat, style);
-        builder.sort();
-        renderer->draw(builder.splats(), camPuff, {.framebuffer = fb->handle(), .x = h, .y = 0, .width = h, .height = h});
+        singleFrame.begin(f, camSingle);
+        singleFrame.builder().add(*single, mat, style);
+        singleFrame.end();
+        renderer->render(singleFrame, {.framebuffer = fb->handle(), .x = 0, .y = 0});
+        puffFrame.begin(f, camPuff);
+        puffFrame.builder().add(*puff, mat, style);
+        puffFrame.end();
+        renderer->render(puffFrame, {.framebuffer = fb->handle(), .x = h, .y = 0});
         out.push_back(fb->read());
     }
     return out;
