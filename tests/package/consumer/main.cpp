@@ -1,5 +1,6 @@
 // Renders a small fire headless through the README's two snippets (the bare
 // core, then a preset in a Scene) and checks each drew something.
+#include <algorithm>
 #include <cstdio>
 
 #include <splatfx/context.hpp>
@@ -25,19 +26,26 @@ int main() {
     const splatfx::Image img = fb->read();
     const float centre = img.at(32, 32, 0);
     if (!(centre > 0.1f)) return std::fprintf(stderr, "consumer: nothing drawn (centre red %f)\n", centre), 1;
-    // The README's second snippet: a preset effect in a scheduling Scene.
+    // The README's second snippet: a preset effect in a Scene, drawn as one frame.
     splatfx::Scene scene;
     auto fire = splatfx::presets::fire(materials, {.dims = {7, 20, 5}});
     if (!fire) return std::fprintf(stderr, "consumer: %s\n", fire.error().c_str()), 1;
     scene.add(std::move(*fire), {.name = "campfire", .rangeWorld = 80});
-    if (!renderer->upload(materials)) return std::fprintf(stderr, "consumer: upload failed\n"), 1;
-    scene.update(0.5, camera);
-    builder.begin(camera);
-    scene.emit(builder, materials);
-    builder.sort();
-    renderer->draw(builder.splats(), camera, {.framebuffer = fb->handle(), .width = 64, .height = 64});
-    if (scene.counters().needed != 1 || builder.splats().empty())
+    auto frameRenderer = splatfx::gl::FrameRenderer::create();
+    if (!frameRenderer || !frameRenderer->upload(materials)) return std::fprintf(stderr, "consumer: frame renderer setup failed\n"), 1;
+    splatfx::Frame frame;
+    bool opaqueDrawn = false;
+    scene.prepare(0.5, camera, materials, frame);
+    frameRenderer->render(frame, {.framebuffer = fb->handle(), .drawOpaque = [&] {
+                                      fb->clear({0, 0, 0, 1});
+                                      opaqueDrawn = true;
+                                  }});
+    const splatfx::Image lit = fb->read();
+    float brightest = 0.0f;
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) brightest = std::max(brightest, lit.at(x, y, 0));
+    if (!opaqueDrawn || frame.counters().needed != 1 || frame.splats().empty() || !(brightest > 0.1f))
         return std::fprintf(stderr, "consumer: the scene drew nothing\n"), 1;
-    std::printf("consumer: ok (%zu splats on %s)\n", builder.splats().size(), ctx->renderer().c_str());
+    std::printf("consumer: ok (%zu splats on %s)\n", frame.splats().size(), ctx->renderer().c_str());
     return 0;
 }
