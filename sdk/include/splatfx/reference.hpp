@@ -77,7 +77,7 @@ struct ReferenceHost {
 struct SplatExactDesc {
     ReferenceHost host{};                           // default: transparent black, no depth
     ReferenceWindow window = ReferenceWindow::Exact; // default Exact
-    bool trimCorners = true; // match RendererDesc::trimCorners (octagon vs square quad); default true
+    bool trimCorners = false; // match RendererDesc::trimCorners (octagon vs square quad); default false, as the renderer's
     int threads = 0;         // worker threads; 0 = std::thread::hardware_concurrency(); default 0
 };
 

@@ -84,6 +84,14 @@ struct SplatStats {
     std::uint64_t rejected = 0;   // non-finite voxel data or a degenerate transform
 };
 
+// Memory the back-to-front sort reuses between frames (keys, indices, a copy
+// of the splats). Each builder owns one; pass your own to sortBackToFront to
+// keep a host-side sort free of allocation too.
+struct SortScratch {
+    std::vector<std::uint32_t> keys, keys2, index, index2;
+    std::vector<Splat> splats;
+};
+
 class SplatBuilder {
 public:
     explicit SplatBuilder(const SplatBuilderDesc& desc = {}) : mDesc(desc) {}
@@ -106,10 +114,13 @@ private:
     Camera mCamera;
     std::vector<Splat> mSplats;
     SplatStats mStats;
+    SortScratch mScratch;
 };
 
 // Back-to-front radix sort of splats by their depth field, stable, O(n).
 // Exposed for tests and for hosts that merge lists from several builders.
+void sortBackToFront(std::vector<Splat>& splats, SortScratch& scratch, SortMode mode = SortMode::Exact, std::uint32_t buckets = 64);
+// Same, with scratch memory allocated for this call.
 void sortBackToFront(std::vector<Splat>& splats, SortMode mode = SortMode::Exact, std::uint32_t buckets = 64);
 
 } // namespace splatfx

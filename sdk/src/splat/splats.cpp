@@ -387,14 +387,20 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
     mSplats.resize(std::size_t(write - mSplats.data()));
 }
 
-void SplatBuilder::sort(SortMode mode) { sortBackToFront(mSplats, mode, mDesc.buckets); }
+void SplatBuilder::sort(SortMode mode) { sortBackToFront(mSplats, mScratch, mode, mDesc.buckets); }
 
 void sortBackToFront(std::vector<Splat>& splats, SortMode mode, std::uint32_t buckets) {
+    SortScratch scratch;
+    sortBackToFront(splats, scratch, mode, buckets);
+}
+
+void sortBackToFront(std::vector<Splat>& splats, SortScratch& scratch, SortMode mode, std::uint32_t buckets) {
     if (mode == SortMode::None || splats.size() < 2) return;
     const size_t n = splats.size();
     // Keys ascending = depth descending: back to front.
-    thread_local std::vector<std::uint32_t> keys, keys2;
-    thread_local std::vector<Splat> tmp;
+    std::vector<std::uint32_t>& keys = scratch.keys;
+    std::vector<std::uint32_t>& keys2 = scratch.keys2;
+    std::vector<Splat>& tmp = scratch.splats;
     keys.resize(n);
     keys2.resize(n);
     tmp.resize(n);
@@ -411,7 +417,8 @@ void sortBackToFront(std::vector<Splat>& splats, SortMode mode, std::uint32_t bu
     // LSD radix sort on indices, 8 bits per pass. The four digit histograms
     // come from one read of the keys; a pass whose digit is the same for every
     // key is skipped; the first pass that runs reads no index array.
-    thread_local std::vector<std::uint32_t> idx, idx2;
+    std::vector<std::uint32_t>& idx = scratch.index;
+    std::vector<std::uint32_t>& idx2 = scratch.index2;
     idx.resize(n);
     idx2.resize(n);
     std::uint32_t count[4][256] = {};
