@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
 
 #include "gl_fixture.hpp"
 
@@ -37,6 +40,25 @@ std::string writeFailureImages(const Image& actual, const ImageDiff& diff) {
     (void)writeImage(dir + "/actual.png", actual);
     if (diff.sameSize) (void)writeImage(dir + "/diff.png", diff.diff);
     return "actual and diff images written to " + dir;
+}
+
+Result<GoldenThresholds> loadGoldenThresholds(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) return makeError(path + ": cannot open the golden thresholds");
+    const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded() || !j.is_object()) return makeError(path + ": not a JSON object");
+    for (const char* key : {"pixelThreshold255", "meanMax255", "fractionOverMax", "maxAbs255", "why"})
+        if (!j.contains(key)) return makeError(path + ": missing \"" + key + "\"");
+    GoldenThresholds t;
+    t.pixelThreshold = j["pixelThreshold255"].get<double>() / 255.0;
+    t.meanMax = j["meanMax255"].get<double>() / 255.0;
+    t.fractionOverMax = j["fractionOverMax"].get<double>();
+    t.maxAbs = j["maxAbs255"].get<double>() / 255.0;
+    return t;
+}
+
+bool withinThresholds(const ImageDiff& d, const GoldenThresholds& t) {
+    return d.sameSize && d.meanAbs <= t.meanMax && d.fractionOver <= t.fractionOverMax && d.maxAbs <= t.maxAbs;
 }
 
 } // namespace splatfx::test
