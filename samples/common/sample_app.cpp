@@ -89,7 +89,7 @@ int runHeadless(const Options& o, const char* name, const std::function<bool()>&
         std::fprintf(stderr, "%s: cannot create output folder '%s': %s\n", name, o.out.c_str(), ec.message().c_str());
         return 1;
     }
-    splatfx::AnimationWriter gif(o.out + "/" + name + ".gif", int(o.fps + 0.5f));
+    splatfx::AnimationWriter gif(o.out + "/" + name + ".gif", o.fps);
     const auto start = std::chrono::steady_clock::now();
     for (int i = 0; i < o.frames; ++i) {
         FrameContext fc;

@@ -200,7 +200,7 @@ int main(int argc, char** argv) {
     std::printf("splatfx-render: %d frames at %dx%d, %g fps, seed %u, %s splats -> %s/%s_NNNN.png + %s.gif\n", frames, size.x, size.y,
                 fps, file.seed, a.traditional ? "traditional" : "textured", a.out.c_str(), name.c_str(), name.c_str());
 
-    splatfx::AnimationWriter gif((staging.dir / (name + ".gif")).string(), int(fps + 0.5f));
+    splatfx::AnimationWriter gif((staging.dir / (name + ".gif")).string(), fps);
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
     double renderMs = 0.0, prepareMs = 0.0, submitMs = 0.0;

@@ -1,8 +1,11 @@
 // splatfx/image.hpp: float images in and out of files (OpenImageIO).
 //
 // Reads anything OpenImageIO reads; writes PNG (8-bit) or EXR/TIFF by
-// extension. Writes are atomic: the file appears complete or not at all.
-// It does not resize or colour-manage.
+// extension. Writes are checked and atomic: every write, the fsync and the
+// close are checked (a full disk is an error, not a truncated file), the file
+// is written under a temporary name beside the target and renamed into place
+// only when complete, so it appears complete or not at all and a previous
+// file of that name survives a failure. It does not resize or colour-manage.
 //
 //   auto img = splatfx::readImage("photo.jpg");
 //   if (!img) return fail(img.error());
@@ -11,6 +14,7 @@
 // Threading: free functions; safe from any thread on distinct files.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -38,29 +42,37 @@ enum class Alpha {
 // Fails with the file name and the reason: missing, unreadable, zero-size,
 // or more than 16384 pixels on a side.
 Result<Image> readImage(const std::string& path, Alpha alpha = Alpha::Premultiplied);
-// Values are clamped to [0, 1] for 8-bit formats. Written to a temporary
-// name beside the target and renamed into place.
+// Values are clamped to [0, 1] for 8-bit formats (NaN becomes 0).
 Status writeImage(const std::string& path, const Image& image, Alpha alpha = Alpha::Premultiplied);
+// Any other file (a manifest, a record of outputs) with the same guarantees.
+Status writeFileAtomically(const std::string& path, const std::string& bytes);
 
 } // namespace splatfx
 
 namespace splatfx {
 
-// Writes frames into one animated GIF (looping), through OpenImageIO. Frames
-// are kept in memory and written by finish(), so a run that fails halfway
-// leaves no file behind; the file is written to a temporary name and renamed.
+// Writes frames into one animated GIF (looping), through OpenImageIO,
+// streamed: each frame is encoded as it is added (8-bit RGB), so memory does
+// not grow with the number of frames. The file is written under a temporary
+// name and renamed into place by finish(); a writer destroyed before finish()
+// (a failed run) removes it, so no partial GIF is ever left at the target.
+// Move-only.
 class AnimationWriter {
 public:
-    explicit AnimationWriter(std::string path, int framesPerSecond = 24);
+    // framesPerSecond in [1/600, 100]: a GIF's frame delay is a whole number of
+    // hundredths of a second, from 1 to 65535 (add() reports a rate outside).
+    explicit AnimationWriter(std::string path, double framesPerSecond = 24.0);
+    AnimationWriter(AnimationWriter&&) noexcept;
+    AnimationWriter& operator=(AnimationWriter&&) noexcept;
+    ~AnimationWriter();
     // Expects every frame to have the first frame's size. Uses RGB only.
     Status add(const Image& frame);
     Status finish();
-    int frames() const { return static_cast<int>(mFrames.size()); }
+    int frames() const;
 
 private:
-    std::string mPath;
-    int mFps;
-    std::vector<Image> mFrames;
+    struct Impl;
+    std::unique_ptr<Impl> mImpl;
 };
 
 } // namespace splatfx

@@ -7,6 +7,8 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "checked_file.hpp"
+
 namespace splatfx {
 
 namespace fs = std::filesystem;
@@ -50,8 +52,6 @@ Status writeImage(const std::string& path, const Image& image, Alpha alpha) {
         image.pixels.size() != size_t(image.width) * image.height * image.channels)
         return makeError("cannot write image '" + path + "': the image is empty or its size does not match its pixels");
     const fs::path target(path);
-    // Keep the extension on the temporary name so OpenImageIO picks the format.
-    const fs::path tmp = target.parent_path() / (".tmp-" + target.stem().string() + target.extension().string());
     auto out = OIIO::ImageOutput::create(target.string());
     if (!out) return makeError("cannot write image '" + path + "': no writer for '" + target.extension().string() + "'");
     const std::string ext = target.extension().string();
@@ -62,22 +62,35 @@ Status writeImage(const std::string& path, const Image& image, Alpha alpha) {
     const float* data = image.pixels.data();
     if (eightBit) {
         clamped = image.pixels;
-        for (float& v : clamped) v = std::clamp(v, 0.0f, 1.0f); // NaN stays NaN only if both compares fail
-        for (float& v : clamped) if (v != v) v = 0.0f;
+        for (float& v : clamped) v = v == v ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
         data = clamped.data();
     }
-    if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, data) || !out->close()) {
+    const std::string tmp = detail::temporaryNameFor(path);
+    std::string why;
+    auto file = detail::CheckedFile::create(tmp, why);
+    if (!file) return makeError("cannot write image '" + path + "': " + why);
+    const bool encoded = out->set_ioproxy(file.get()) && out->open(tmp, spec) && out->write_image(OIIO::TypeDesc::FLOAT, data) && out->close();
+    const Status written = file->finish();
+    if (!encoded || !written) {
         std::error_code ec;
         fs::remove(tmp, ec);
-        return makeError("cannot write image '" + path + "': " + out->geterror());
+        return makeError("cannot write image '" + path + "': " + (!written ? written.error() : out->geterror()));
     }
-    std::error_code ec;
-    fs::rename(tmp, target, ec);
-    if (ec) {
+    return detail::publishTemporary(tmp, path);
+}
+
+Status writeFileAtomically(const std::string& path, const std::string& bytes) {
+    const std::string tmp = detail::temporaryNameFor(path);
+    std::string why;
+    auto file = detail::CheckedFile::create(tmp, why);
+    if (!file) return makeError("cannot write '" + path + "': " + why);
+    file->write(bytes.data(), bytes.size());
+    if (Status s = file->finish(); !s) {
+        std::error_code ec;
         fs::remove(tmp, ec);
-        return makeError("cannot write image '" + path + "': " + ec.message());
+        return makeError("cannot write '" + path + "': " + s.error());
     }
-    return {};
+    return detail::publishTemporary(tmp, path);
 }
 
 } // namespace splatfx
