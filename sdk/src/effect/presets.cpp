@@ -38,7 +38,7 @@ std::string turbulenceKey(const TurbulenceDesc& t) {
 // manifest cannot be read; loading then reports why.
 std::string folderKey(const std::string& folder, bool keepColor) {
     std::error_code ec;
-    const std::filesystem::path full = std::filesystem::weakly_canonical(folder, ec);
+    const std::filesystem::path full = std::filesystem::canonical(folder, ec);
     std::ifstream in(std::filesystem::path(folder) / "manifest.json", std::ios::binary);
     if (ec || !in) return {};
     std::uint64_t h = 1469598103934665603ull;

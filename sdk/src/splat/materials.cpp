@@ -186,7 +186,7 @@ Status Materials::checkLayerLimit(std::uint32_t maxLayers) const {
     if (order.size() > kNamed)
         msg += " and " + std::to_string(order.size() - kNamed) + " more sets with " + std::to_string(rest) + " layers.";
     msg += " Equal sets are registered once, so share them: give presets the same textureSeed and texture parameters, "
-           "reuse one set id across effects, use fewer textures per set (textureCount), or split the level across several Materials.";
+           "reuse one set id across effects, use fewer textures per set (textureCount), or split the level across several Materials (one renderer each).";
     return makeError(msg);
 }
 
