@@ -27,8 +27,9 @@
 // dynamics per effect (each voxel's texture and phase), which is what tells
 // two effects apart; give `textureSeed` different values only when effects
 // must also use different texture images (each value is one more set).
-// A folder is read once per Materials: edits to its images after the first
-// preset loaded it are seen by a new Materials.
+// A folder is read once per Materials while its manifest.json keeps its size
+// and time (a folder saved again by texpick is read again); images edited in
+// place without touching the manifest are seen by a new Materials.
 // It does not render or schedule anything.
 //
 //   splatfx::Materials materials(splatfx::Footprint{});

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -26,26 +25,32 @@ Result<TextureSet> loadOrTurbulence(const std::string& path, const TurbulenceDes
 // significant digits round-trip binary32), so distinct parameters give
 // distinct keys.
 std::string turbulenceKey(const TurbulenceDesc& t) {
+    // A field added to TurbulenceDesc must be added to the key too, or sets
+    // that differ in it would be taken for one another.
+    static_assert(sizeof(TurbulenceDesc) == 7 * 4, "turbulenceKey must name every TurbulenceDesc field");
     char buf[256];
     std::snprintf(buf, sizeof buf, "turbulence(count=%d,size=%d,seed=%u,octaves=%d,baseFrequency=%.9g,loopRadius=%.9g,contrast=%.9g)", t.count,
                   t.size, t.seed, t.octaves, double(t.baseFrequency), double(t.loopRadius), double(t.contrast));
     return buf;
 }
 
-// A folder by its full path and its manifest's bytes (FNV-1a), so a folder
-// rewritten in place under the same path (a new manifest) is a new set.
-// Empty (no key: the set is loaded and shared by content only) when the
-// manifest cannot be read; loading then reports why.
+// A folder by its full path and its manifest's size and modification time,
+// so a folder rewritten under the same path (texpick saves into a temporary
+// folder and renames it) is a new set. Empty (no key: the set is loaded and
+// shared by content only) when the manifest cannot be found; loading then
+// reports why.
 std::string folderKey(const std::string& folder, bool keepColor) {
+    namespace fs = std::filesystem;
     std::error_code ec;
-    const std::filesystem::path full = std::filesystem::canonical(folder, ec);
-    std::ifstream in(std::filesystem::path(folder) / "manifest.json", std::ios::binary);
-    if (ec || !in) return {};
-    std::uint64_t h = 1469598103934665603ull;
-    for (char c; in.get(c);) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
-    char buf[40];
-    std::snprintf(buf, sizeof buf, ",manifest=%016llx", static_cast<unsigned long long>(h));
-    return "folder(" + full.string() + (keepColor ? ",color" : ",gray") + buf + ")";
+    const fs::path full = fs::canonical(folder, ec);
+    if (ec) return {};
+    const std::uintmax_t bytes = fs::file_size(full / "manifest.json", ec);
+    if (ec) return {};
+    const auto written = fs::last_write_time(full / "manifest.json", ec);
+    if (ec) return {};
+    const long long ticks = static_cast<long long>(written.time_since_epoch().count());
+    return "folder(" + full.string() + (keepColor ? ",color" : ",gray") + ",manifest=" + std::to_string(bytes) + "B@" +
+           std::to_string(ticks) + ")";
 }
 
 // A preset's texture set before it is registered: found in Materials by its
