@@ -212,7 +212,7 @@ Status Renderer::upload(const Materials& materials) {
     GLint maxLayers = 0;
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &maxLayers);
     if (Status s = materials.checkLayerLimit(std::uint32_t(std::max(maxLayers, 0))); !s)
-        return makeError("splatfx::gl::Renderer::upload: " + s.error() + " (the limit is this GL's GL_MAX_ARRAY_TEXTURE_LAYERS)");
+        return makeError("splatfx::gl::Renderer::upload (limit: this GL's GL_MAX_ARRAY_TEXTURE_LAYERS): " + s.error());
     // Resolve Auto and the automatic factor for these layers.
     TextureSampling mode = r.desc.sampling;
     if (mode == TextureSampling::Auto) mode = detail::softwareRasterizer() ? TextureSampling::Upsampled : TextureSampling::Bilinear;
