@@ -19,6 +19,17 @@
 //                texture-set folder is given
 // A preset fails only when a texture-set folder cannot be loaded or a field
 // is out of range; the message names the file or field.
+// Sharing: a preset registers its sets and tables by content (see
+// materials.hpp), keyed by what makes them (the turbulence parameters and
+// textureSeed, or the folder's path and manifest), so presets with equal
+// texture parameters share one set and skip regenerating it: a level of 1000
+// fires with different `seed`s holds one fire set. `seed` varies the texture
+// dynamics per effect (each voxel's texture and phase), which is what tells
+// two effects apart; give `textureSeed` different values only when effects
+// must also use different texture images (each value is one more set).
+// A folder is read once per Materials while its manifest.json keeps its size
+// and time (a folder saved again by texpick is read again); images edited in
+// place without touching the manifest are seen by a new Materials.
 // It does not render or schedule anything.
 //
 //   splatfx::Materials materials(splatfx::Footprint{});
@@ -49,7 +60,8 @@ struct FireDesc {
     float texturesPerSec = 6.0f;      // local dynamics rate; default 6
     bool crossfade = true;            // cross-fade consecutive textures; default true
     Motion motion{};                  // object dynamics (keyframes, procedure); default at rest
-    std::uint32_t seed = 1;           // default 1
+    std::uint32_t seed = 1;           // texture dynamics (which texture each voxel shows when); default 1
+    std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> fire(Materials& materials, const FireDesc& desc = {});
 
@@ -66,7 +78,8 @@ struct SmokeDesc {
     int textureCount = 8;             // default 8
     float texturesPerSec = 3.0f;      // local dynamics rate; default 3
     int substeps = 1;                 // solver substeps per step; default 1
-    std::uint32_t seed = 1;           // default 1
+    std::uint32_t seed = 1;           // texture dynamics (which texture each voxel shows when); default 1
+    std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> smoke(Materials& materials, const SmokeDesc& desc = {});
 
@@ -80,7 +93,8 @@ struct SteamDesc {
     float propagationStepsPerSec = 10.0f; // inter-voxel advection rate; default 10
     float texturesPerSec = 4.0f;      // default 4
     Motion motion{};                  // default at rest
-    std::uint32_t seed = 1;           // default 1
+    std::uint32_t seed = 1;           // texture dynamics (which texture each voxel shows when); default 1
+    std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> steam(Materials& materials, const SteamDesc& desc = {});
 
@@ -96,7 +110,8 @@ struct DustDesc {
     float dissipation = 0.3f;         // 1/s; default 0.3
     std::string textureSetPath{};     // default empty (procedural turbulence)
     int textureCount = 8;             // default 8
-    std::uint32_t seed = 1;           // default 1
+    std::uint32_t seed = 1;           // texture dynamics (which texture each voxel shows when); default 1
+    std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> dust(Materials& materials, const DustDesc& desc = {});
 
@@ -111,7 +126,8 @@ struct FireToSmokeDesc {
     float propagationStepsPerSec = 8.0f; // default 8
     float texturesPerSec = 5.0f;      // default 5
     Motion motion{};                  // default at rest
-    std::uint32_t seed = 1;           // default 1
+    std::uint32_t seed = 1;           // texture dynamics (which texture each voxel shows when); default 1
+    std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> fireToSmoke(Materials& materials, const FireToSmokeDesc& desc = {});
 
@@ -125,7 +141,8 @@ struct GhostsDesc {
     float opacity = 0.4f;             // default 0.4
     float texturesPerSec = 5.0f;      // random selection rate; default 5
     float propagationStepsPerSec = 4.0f; // faces drifting upwards; default 4
-    std::uint32_t seed = 1;           // default 1
+    std::uint32_t seed = 1;           // texture dynamics (which texture each voxel shows when); default 1
+    std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> ghosts(Materials& materials, const GhostsDesc& desc = {});
 

@@ -3,18 +3,80 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
 
 #include <glm/gtc/matrix_transform.hpp>
 
 namespace splatfx::presets {
 namespace {
 
-Result<TextureSet> loadOrTurbulence(const std::string& path, const TurbulenceDesc& fallback, bool keepColor = false) {
+Result<TextureSet> loadOrTurbulence(const std::string& path, const TurbulenceDesc& fallback, bool keepColor) {
     if (path.empty()) return TextureSet::turbulence(fallback);
     Result<TextureSet> set = TextureSet::load(path);
     if (!set) return set;
     if (!keepColor) set->color = false;
     return set;
+}
+
+// Keys name a set by what makes it, so a preset finds a set an earlier one
+// registered without building it again. %.9g prints a float exactly (9
+// significant digits round-trip binary32), so distinct parameters give
+// distinct keys.
+std::string turbulenceKey(const TurbulenceDesc& t) {
+    // A field added to TurbulenceDesc must be added to the key too, or sets
+    // that differ in it would be taken for one another.
+    static_assert(sizeof(TurbulenceDesc) == 7 * 4, "turbulenceKey must name every TurbulenceDesc field");
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "turbulence(count=%d,size=%d,seed=%u,octaves=%d,baseFrequency=%.9g,loopRadius=%.9g,contrast=%.9g)", t.count,
+                  t.size, t.seed, t.octaves, double(t.baseFrequency), double(t.loopRadius), double(t.contrast));
+    return buf;
+}
+
+// A folder by its full path and its manifest's size and modification time,
+// so a folder rewritten under the same path (texpick saves into a temporary
+// folder and renames it) is a new set. Empty (no key: the set is loaded and
+// shared by content only) when the manifest cannot be found; loading then
+// reports why.
+std::string folderKey(const std::string& folder, bool keepColor) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::path full = fs::canonical(folder, ec);
+    if (ec) return {};
+    const std::uintmax_t bytes = fs::file_size(full / "manifest.json", ec);
+    if (ec) return {};
+    const auto written = fs::last_write_time(full / "manifest.json", ec);
+    if (ec) return {};
+    const long long ticks = static_cast<long long>(written.time_since_epoch().count());
+    return "folder(" + full.string() + (keepColor ? ",color" : ",gray") + ",manifest=" + std::to_string(bytes) + "B@" +
+           std::to_string(ticks) + ")";
+}
+
+// A preset's texture set before it is registered: found in Materials by its
+// key, or built and waiting for registerSet (so a preset that fails later
+// registers nothing).
+struct PendingSet {
+    std::optional<std::uint32_t> id;
+    TextureSet set;
+    std::string key;
+};
+
+Result<PendingSet> resolveSet(const Materials& m, const std::string& path, const TurbulenceDesc& fallback, bool keepColor = false) {
+    PendingSet p;
+    p.key = path.empty() ? turbulenceKey(fallback) : folderKey(path, keepColor);
+    if (!p.key.empty()) p.id = m.findTextureSet(p.key);
+    if (p.id) return p;
+    Result<TextureSet> set = loadOrTurbulence(path, fallback, keepColor);
+    if (!set) return makeError(set.error());
+    p.set = std::move(*set);
+    return p;
+}
+
+Result<std::uint32_t> registerSet(Materials& m, const PendingSet& p) {
+    if (p.id) return *p.id;
+    if (p.key.empty()) return m.addTextureSet(p.set);
+    return m.addTextureSet(p.set, p.key);
 }
 
 Status checkCount(const char* field, int n) {
@@ -70,8 +132,8 @@ Result<Effect> fire(Materials& materials, const FireDesc& d) {
     if (!grid) return makeError("FireDesc.dims/spacing: " + grid.error());
     // Sparse, sharp detail (contrast 2.5) reads as licking flames through the
     // ~20 splats that overlap on each pixel; plain turbulence averages to a haze.
-    Result<TextureSet> set =
-        loadOrTurbulence(d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.seed, .contrast = 2.5f});
+    Result<PendingSet> set =
+        resolveSet(materials, d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .contrast = 2.5f});
     if (!set) return makeError("FireDesc.textureSetPath: " + set.error());
 
     for (Voxel& v : grid->voxels) v.opacity = d.opacity * flameOpacity(v.cell, grid->dims, 1.0f);
@@ -81,9 +143,10 @@ Result<Effect> fire(Materials& materials, const FireDesc& d) {
     EffectDesc e = gridDesc("fire", materials, d.motion, d.seed);
     e.textures.propagation = {.mode = Propagation::Fixed, .direction = {0, 1, 0}, .stepsPerSec = d.propagationStepsPerSec, .offset = 1};
     e.textures.cycling = {.mode = Cycling::Ordered, .texturesPerSec = d.texturesPerSec, .rateJitter = 0.2f};
-    const std::uint32_t setId = materials.addTextureSet(*set);
+    const Result<std::uint32_t> setId = registerSet(materials, *set);
+    if (!setId) return makeError("FireDesc.textureSetPath: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::fire());
-    e.layers = {{.style = {.textureSet = setId, .colorTable = tableId, .textured = true, .crossfade = d.crossfade}}};
+    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = d.crossfade}}};
     return Effect::fromGrid(std::move(*grid), std::move(e));
 }
 
@@ -104,8 +167,8 @@ Result<Effect> smoke(Materials& materials, const SmokeDesc& d) {
                        .substeps = d.substeps};
     Result<FluidSolver> solver = FluidSolver::create(sd);
     if (!solver) return makeError("SmokeDesc: " + solver.error());
-    Result<TextureSet> set =
-        loadOrTurbulence(d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.seed, .baseFrequency = 2.0f});
+    Result<PendingSet> set =
+        resolveSet(materials, d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .baseFrequency = 2.0f});
     if (!set) return makeError("SmokeDesc.textureSetPath: " + set.error());
     solver->addEmitter({.desc = {.offset = d.sourceOffset, .radius = d.sourceRadius, .density = 1.0f, .temperature = 1.0f, .rate = 6.0f},
                         .motion = restingAt(d.sourceMotion, d.position)});
@@ -114,9 +177,10 @@ Result<Effect> smoke(Materials& materials, const SmokeDesc& d) {
     e.textures.propagation = {.mode = Propagation::Velocity, .offset = 1};
     e.textures.cycling = {.mode = Cycling::Ordered, .texturesPerSec = d.texturesPerSec, .rateJitter = 0.3f};
     e.sparse = {.opacityPerDensity = 0.5f, .minOpacity = 0.02f, .color = ColorSource::Height, .stretchPerSpeed = 0.15f, .maxStretch = 0.8f};
-    const std::uint32_t setId = materials.addTextureSet(*set);
+    const Result<std::uint32_t> setId = registerSet(materials, *set);
+    if (!setId) return makeError("SmokeDesc.textureSetPath: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::smoke());
-    e.layers = {{.style = {.textureSet = setId, .colorTable = tableId, .textured = true, .crossfade = true}}};
+    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true}}};
     return Effect::fromSolver(std::move(*solver), std::move(e));
 }
 
@@ -126,7 +190,7 @@ Result<Effect> steam(Materials& materials, const SteamDesc& d) {
     if (Status s = checkRate("SteamDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
     Result<Grid> grid = Grid::box(d.dims, d.spacing);
     if (!grid) return makeError("SteamDesc.dims/spacing: " + grid.error());
-    Result<TextureSet> set = loadOrTurbulence(d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.seed});
+    Result<PendingSet> set = resolveSet(materials, d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.textureSeed});
     if (!set) return makeError("SteamDesc.textureSetPath: " + set.error());
     for (Voxel& v : grid->voxels) {
         const float h = v.cell.y / float(std::max(d.dims.y - 1, 1));
@@ -137,9 +201,10 @@ Result<Effect> steam(Materials& materials, const SteamDesc& d) {
     EffectDesc e = gridDesc("steam", materials, d.motion, d.seed);
     e.textures.propagation = {.mode = Propagation::Fixed, .direction = {0, 1, 0}, .stepsPerSec = d.propagationStepsPerSec, .offset = 1};
     e.textures.cycling = {.mode = Cycling::Ordered, .texturesPerSec = d.texturesPerSec, .rateJitter = 0.25f};
-    const std::uint32_t setId = materials.addTextureSet(*set);
+    const Result<std::uint32_t> setId = registerSet(materials, *set);
+    if (!setId) return makeError("SteamDesc.textureSetPath: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::steam());
-    e.layers = {{.style = {.textureSet = setId, .colorTable = tableId, .textured = true, .crossfade = true}}};
+    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true}}};
     return Effect::fromGrid(std::move(*grid), std::move(e));
 }
 
@@ -160,8 +225,8 @@ Result<Effect> dust(Materials& materials, const DustDesc& d) {
                        .temperatureDissipation = 1.5f};
     Result<FluidSolver> solver = FluidSolver::create(sd);
     if (!solver) return makeError("DustDesc: " + solver.error());
-    Result<TextureSet> set =
-        loadOrTurbulence(d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.seed, .baseFrequency = 2.5f});
+    Result<PendingSet> set =
+        resolveSet(materials, d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .baseFrequency = 2.5f});
     if (!set) return makeError("DustDesc.textureSetPath: " + set.error());
     solver->addEmitter({.desc = {.offset = d.sourceOffset, .radius = d.sourceRadius, .density = 1.0f, .temperature = 0.6f, .rate = 5.0f},
                         .motion = restingAt(d.sourceMotion, d.position)});
@@ -170,9 +235,10 @@ Result<Effect> dust(Materials& materials, const DustDesc& d) {
     e.textures.propagation = {.mode = Propagation::Velocity, .offset = 1};
     e.textures.cycling = {.mode = Cycling::Ordered, .texturesPerSec = 3.0f, .rateJitter = 0.3f};
     e.sparse = {.opacityPerDensity = 0.5f, .minOpacity = 0.02f, .color = ColorSource::Density};
-    const std::uint32_t setId = materials.addTextureSet(*set);
+    const Result<std::uint32_t> setId = registerSet(materials, *set);
+    if (!setId) return makeError("DustDesc.textureSetPath: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::dust());
-    e.layers = {{.style = {.textureSet = setId, .colorTable = tableId, .textured = true, .crossfade = true}}};
+    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true}}};
     return Effect::fromSolver(std::move(*solver), std::move(e));
 }
 
@@ -182,10 +248,10 @@ Result<Effect> fireToSmoke(Materials& materials, const FireToSmokeDesc& d) {
     if (Status s = checkRate("FireToSmokeDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
     Result<Grid> grid = Grid::box(d.dims, d.spacing);
     if (!grid) return makeError("FireToSmokeDesc.dims/spacing: " + grid.error());
-    Result<TextureSet> fireSet = loadOrTurbulence(d.fireTextureSetPath, {.count = 8, .size = 32, .seed = d.seed});
+    Result<PendingSet> fireSet = resolveSet(materials, d.fireTextureSetPath, {.count = 8, .size = 32, .seed = d.textureSeed});
     if (!fireSet) return makeError("FireToSmokeDesc.fireTextureSetPath: " + fireSet.error());
-    Result<TextureSet> smokeSet =
-        loadOrTurbulence(d.smokeTextureSetPath, {.count = 8, .size = 32, .seed = d.seed + 1, .baseFrequency = 2.0f});
+    Result<PendingSet> smokeSet =
+        resolveSet(materials, d.smokeTextureSetPath, {.count = 8, .size = 32, .seed = d.textureSeed + 1, .baseFrequency = 2.0f});
     if (!smokeSet) return makeError("FireToSmokeDesc.smokeTextureSetPath: " + smokeSet.error());
 
     // Flame below the split; above it a plume that widens and thins.
@@ -209,14 +275,16 @@ Result<Effect> fireToSmoke(Materials& materials, const FireToSmokeDesc& d) {
     e.textures.cycling = {.mode = Cycling::Ordered, .texturesPerSec = d.texturesPerSec, .rateJitter = 0.2f};
     // sec. 2 step 4: "mixing effects, such as smoke and fire, can be achieved
     // with multiple color tables and differing texture sets".
-    const std::uint32_t fireId = materials.addTextureSet(*fireSet);
-    const std::uint32_t smokeId = materials.addTextureSet(*smokeSet);
+    const Result<std::uint32_t> fireId = registerSet(materials, *fireSet);
+    if (!fireId) return makeError("FireToSmokeDesc.fireTextureSetPath: " + fireId.error());
+    const Result<std::uint32_t> smokeId = registerSet(materials, *smokeSet);
+    if (!smokeId) return makeError("FireToSmokeDesc.smokeTextureSetPath: " + smokeId.error());
     const std::uint32_t fireLut = materials.addColorTable(ColorTable::fire());
     const std::uint32_t smokeLut = materials.addColorTable(ColorTable::smoke());
     e.layers = {
-        {.style = {.textureSet = fireId, .colorTable = fireLut, .textured = true, .crossfade = true},
+        {.style = {.textureSet = *fireId, .colorTable = fireLut, .textured = true, .crossfade = true},
          .heightFrom = 0.0f, .heightTo = d.split, .blend = d.blend, .remapColor = true},
-        {.style = {.textureSet = smokeId, .colorTable = smokeLut, .textured = true, .crossfade = true},
+        {.style = {.textureSet = *smokeId, .colorTable = smokeLut, .textured = true, .crossfade = true},
          .heightFrom = d.split, .heightTo = 1.0f, .blend = d.blend, .remapColor = true},
     };
     return Effect::fromGrid(std::move(*grid), std::move(e));
@@ -262,9 +330,21 @@ Result<Effect> ghosts(Materials& materials, const GhostsDesc& d) {
     if (Status s = checkCount("GhostsDesc.textureCount", d.textureCount); !s) return makeError(s.error());
     if (Status s = checkUnit("GhostsDesc.opacity", d.opacity); !s) return makeError(s.error());
     if (Status s = checkRate("GhostsDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
-    Result<TextureSet> set = d.textureSetPath.empty() ? Result<TextureSet>(proceduralFaces(d.textureCount, 32, d.seed))
-                                                      : TextureSet::load(d.textureSetPath);
-    if (!set) return makeError("GhostsDesc.textureSetPath: " + set.error());
+    PendingSet set;
+    if (d.textureSetPath.empty()) {
+        set.key = "faces(count=" + std::to_string(d.textureCount) + ",size=32,seed=" + std::to_string(d.textureSeed) + ")";
+        set.id = materials.findTextureSet(set.key);
+        if (!set.id) set.set = proceduralFaces(d.textureCount, 32, d.textureSeed);
+    } else {
+        // A face folder keeps its colour, as TextureSet::load reads it.
+        set.key = folderKey(d.textureSetPath, true);
+        if (!set.key.empty()) set.id = materials.findTextureSet(set.key);
+        if (!set.id) {
+            Result<TextureSet> loaded = TextureSet::load(d.textureSetPath);
+            if (!loaded) return makeError("GhostsDesc.textureSetPath: " + loaded.error());
+            set.set = std::move(*loaded);
+        }
+    }
 
     // A head-sized ball of voxels with a thinning column of faces above it.
     const int r = int(std::floor(d.headRadiusCells));
@@ -292,10 +372,11 @@ Result<Effect> ghosts(Materials& materials, const GhostsDesc& d) {
     e.textures.propagation = {.mode = Propagation::Fixed, .direction = {0, 1, 0}, .stepsPerSec = d.propagationStepsPerSec, .offset = 1};
     // sec. 5.3 / Fig. 10: faces chosen at random (sec. 3.3's surprising result).
     e.textures.cycling = {.mode = Cycling::Random, .texturesPerSec = d.texturesPerSec, .rateJitter = 0.4f};
-    const std::uint32_t setId = materials.addTextureSet(*set);
+    const Result<std::uint32_t> setId = registerSet(materials, set);
+    if (!setId) return makeError("GhostsDesc.textureSetPath: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::gradient(
         {{0.0f, {0.75f, 0.85f, 1.0f, 1.0f}}, {0.6f, {0.7f, 0.8f, 1.0f, 0.8f}}, {1.0f, {0.6f, 0.7f, 0.9f, 0.0f}}}));
-    e.layers = {{.style = {.textureSet = setId, .colorTable = tableId, .textured = true, .crossfade = false}}};
+    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = false}}};
     return Effect::fromGrid(std::move(*grid), std::move(e));
 }
 

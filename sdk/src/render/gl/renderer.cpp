@@ -211,8 +211,8 @@ Status Renderer::upload(const Materials& materials) {
     const std::uint32_t count = materials.layerCount();
     GLint maxLayers = 0;
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &maxLayers);
-    if (GLint(count) > maxLayers)
-        return makeError("materials hold " + std::to_string(count) + " texture layers; this GL allows " + std::to_string(maxLayers));
+    if (Status s = materials.checkLayerLimit(std::uint32_t(std::max(maxLayers, 0))); !s)
+        return makeError("splatfx::gl::Renderer::upload (limit: this GL's GL_MAX_ARRAY_TEXTURE_LAYERS): " + s.error());
     // Resolve Auto and the automatic factor for these layers.
     TextureSampling mode = r.desc.sampling;
     if (mode == TextureSampling::Auto) mode = detail::softwareRasterizer() ? TextureSampling::Upsampled : TextureSampling::Bilinear;
