@@ -222,10 +222,10 @@ int runScheduling(int argc, char** argv) {
         for (int i = 0; i < int(warm * 60); ++i) a->step(1.0 / 60), b->step(1.0 / 60), c->step(1.0 / 60);
         for (int i = 0; i < int(std::round(gap * 60)); ++i) b->step(1.0 / 60);
         const splatfx::EffectOptions opts;
+        // The kind's own catch-up (what Scene runs on re-entry), with the step cap varied.
         auto catchUp = [&](splatfx::Effect& e, int maxSteps) {
-            const int n = std::clamp(int(std::ceil(gap / opts.catchUpStepSec)), 1, maxSteps);
-            for (int i = 0; i < n; ++i) e.step(gap / n);
-            return n;
+            const splatfx::AdvanceContext ctx{.catchUpStepSec = opts.catchUpStepSec, .maxCatchUpSteps = maxSteps, .resumed = true};
+            return e.advanceTo(e.time() + gap, ctx).steps;
         };
         const int n = catchUp(*a, opts.maxCatchUpSteps);
         catchUp(*c, 32);

@@ -12,14 +12,18 @@
 // (fire turning into smoke, sec. 2 step 4: "mixing effects ... with multiple
 // color tables and differing texture sets").
 //
-// Two ways to advance:
-//   - Grid effects are stateless: update(t) computes frame t directly from
-//     (voxel, t, seed), in any order, at no cost for skipped frames. step(dt)
-//     is update(time() + dt).
-//   - Solver effects are stateful: step(dt) simulates; update() asserts.
+// An Effect is an EffectKind (effect_kind.hpp), the interface Scene schedules
+// by; it is a copyable value that owns one of the SDK's two kinds:
+//   - grid effects (fromGrid) are stateless: update(t) computes frame t
+//     directly from (voxel, t, seed), in any order, at no cost for skipped
+//     frames. step(dt) is update(time() + dt); advanceTo(t) is update(t).
+//   - solver effects (fromSolver) are stateful: step(dt) simulates; update()
+//     asserts; advanceTo(t) steps to t, catching up after a gap in a bounded
+//     number of coarse steps (AdvanceContext).
 // isStateless() tells which; bounds(t0, t1) is a conservative world box of
 // every splat the effect can produce in [t0, t1] (motion and splat extent
-// included), for culling by a scheduler.
+// included), for culling by a scheduler. Other kinds implement EffectKind
+// directly and are added to a Scene without being an Effect.
 // It does not sort, render or own GPU resources; it does not read files
 // (presets.hpp does, through Materials).
 //
@@ -32,11 +36,11 @@
 
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
 #include "splatfx/dynamics.hpp"
+#include "splatfx/effect_kind.hpp"
 #include "splatfx/grid.hpp"
 #include "splatfx/motion.hpp"
 #include "splatfx/result.hpp"
@@ -85,12 +89,11 @@ struct EffectCounters {
     std::uint64_t propagationSteps = 0; // step-by-step texture propagation steps (solver effects)
 };
 
-struct EmitOptions {
-    bool textured = true;        // false: traditional splats for every layer (Fig. 1a); default true
-    float opacityScale = 1.0f;   // multiplies each layer's style.opacityScale; default 1
-};
+namespace detail {
+class EffectBody; // the kind's state and code: sdk/src/effect/{grid,solver}_effect.cpp
+}
 
-class Effect {
+class Effect final : public EffectKind {
 public:
     // A stateless effect over a base grid (its voxels' cells fix the lattice;
     // opacities, colour coordinates and stretch are the t = 0 material).
@@ -100,62 +103,61 @@ public:
     // (attach motion to the emitters instead: the smoke should trail).
     static Result<Effect> fromSolver(FluidSolver solver, EffectDesc desc);
 
-    bool isStateless() const { return !mSolver.has_value(); }
+    Effect(const Effect& other);
+    Effect& operator=(const Effect& other);
+    Effect(Effect&&) noexcept;
+    Effect& operator=(Effect&&) noexcept;
+    ~Effect() override;
+
+    bool isStateless() const;
     // Stateless path: the effect at timeSec (>= 0), independent of earlier calls.
     // Expects isStateless().
     void update(double timeSec);
     // Advances by dtSec (>= 0): simulates a solver effect, or update(time() + dtSec).
     void step(double dtSec);
-    double time() const { return mTime; }
+    double time() const override;
 
     // The whole effect now (every layer's voxels before the height split).
-    const Grid& grid() const { return mGrid; }
-    std::size_t layerCount() const { return mLayerGrids.size(); }
-    const Grid& layerGrid(std::size_t i) const { return mLayerGrids.at(i); }
-    const EffectLayer& layer(std::size_t i) const { return mLayers.at(i); }
+    const Grid& grid() const;
+    std::size_t layerCount() const;
+    const Grid& layerGrid(std::size_t i) const;
+    const EffectLayer& layer(std::size_t i) const;
 
     // Adds every layer's (grid, style) to the builder (after builder.begin).
     // Expects materials with the footprint radius given in the desc and the
     // layers' texture sets and colour tables. Returns the splats added.
-    std::size_t emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options = {}) const;
+    std::size_t emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options = {}) const override;
 
     // Conservative world box of every splat over [t0, t1] (seconds): lattice
     // extent, motion over the interval, and the splat extent (footprint
     // radius times the kernel's largest axis, stretch included).
-    Aabb bounds(double t0, double t1) const;
+    Aabb bounds(double t0, double t1) const override;
 
-    const EffectCounters& counters() const { return mCounters; }
-    const EffectDesc& desc() const { return mDesc; }
+    // EffectKind: grid effects are alive unless the motion's fade or growth
+    // is at zero at timeSec; solver effects while an emitter is on or their
+    // total density exceeds hints.deadDensity.
+    bool alive(double timeSec, const AliveHints& hints) const override;
+    // EffectKind: grid effects update(timeSec); solver effects step from the
+    // time they were last brought to (by advanceTo or step) to timeSec in
+    // n = min(ceil(gap / context.catchUpStepSec), context.maxCatchUpSteps)
+    // equal steps, and do nothing when timeSec is not later.
+    AdvanceResult advanceTo(double timeSec, const AdvanceContext& context) override;
+    // EffectKind: base voxels (grid effects) or solver cells evaluated per advance.
+    std::uint64_t costCells() const override;
+
+    const EffectCounters& counters() const;
+    const EffectDesc& desc() const;
     // Switches scales of motion on or off; takes effect at the next update/step.
     void setToggles(const DynamicsToggles& toggles);
     // The solver of a solver effect, for emitters and inspection (nullptr otherwise).
-    FluidSolver* solver() { return mSolver ? &*mSolver : nullptr; }
-    const FluidSolver* solver() const { return mSolver ? &*mSolver : nullptr; }
-    // The stateless texture dynamics of a grid effect.
-    const TextureDynamics& textureDynamics() const { return mTexDyn; }
+    FluidSolver* solver();
+    const FluidSolver* solver() const;
+    // The stateless texture dynamics of a grid effect (empty for a solver effect).
+    const TextureDynamics& textureDynamics() const;
 
 private:
-    Effect() = default;
-    static Status checkDesc(const EffectDesc& desc);
-    void rebuildTextureDynamics();
-    void splitLayers();
-    float kernelNormBound(const Grid& g, float maxStretch) const;
-
-    EffectDesc mDesc;
-    std::vector<EffectLayer> mLayers{};
-    Grid mBase;                          // grid effects: the t = 0 material
-    Aabb mBaseBox;                       // grid effects: local box of the lattice points
-    float mBaseMaxStretch = 0.0f;        // grid effects: largest voxel stretch
-    std::vector<float> mGrowthDistance;  // per base voxel, cells
-    float mGrowthMax = 0.0f;
-    TextureDynamics mTexDyn;
-    std::optional<FluidSolver> mSolver;
-    TexturePropagator mPropagator;
-    Grid mGrid;
-    std::vector<Grid> mLayerGrids;
-    int mLatticeLoY = 0, mLatticeHiY = 0;
-    double mTime = 0.0;
-    EffectCounters mCounters;
+    explicit Effect(std::unique_ptr<detail::EffectBody> body);
+    std::unique_ptr<detail::EffectBody> mBody; // never null (moved-from Effects excepted)
 };
 
 } // namespace splatfx

@@ -4,11 +4,13 @@
 // are needed now: enabled, within range of the camera, alive (emitting, or
 // with material left), and inside the view frustum by conservative bounds
 // that include their motion and the extent of their splats. Only those are
-// simulated and drawn. An effect that was skipped comes back exactly as it
-// would have been: stateless effects are evaluated at the current time
-// directly (Effect::update), solver effects catch up over the skipped
-// interval in at most `maxCatchUpSteps` coarse steps (bounded cost; its
-// error against full simulation is measured in docs/BENCHMARKS.md).
+// simulated and drawn. It sees every effect through EffectKind
+// (effect_kind.hpp: bounds, alive, advanceTo, emit), so new kinds are added
+// with add(std::unique_ptr<EffectKind>) and no change here. An effect that
+// was skipped comes back exactly as it would have been: stateless effects
+// are evaluated at the current time directly, solver effects catch up over
+// the skipped interval in at most `maxCatchUpSteps` coarse steps (bounded
+// cost; its error against full simulation is measured in docs/BENCHMARKS.md).
 // It does not render, load files, or own GL resources.
 //
 //   splatfx::Scene scene;
@@ -24,11 +26,13 @@
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "splatfx/camera.hpp"
 #include "splatfx/effect.hpp"
+#include "splatfx/effect_kind.hpp"
 #include "splatfx/frame.hpp"
 #include "splatfx/materials.hpp"
 #include "splatfx/splats.hpp"
@@ -41,12 +45,14 @@ struct EffectOptions {
     std::string name;                                        // for counters and messages; default empty
     float rangeWorld = std::numeric_limits<float>::infinity(); // skipped beyond this distance from its bounds; default no limit
     bool enabled = true;                                     // default true
-    // Solver effects returning after dt unseen seconds catch up in
+    // Passed to the kind's advanceTo (AdvanceContext): solver effects
+    // returning after dt unseen seconds catch up in
     // n = min(ceil(dt / catchUpStepSec), maxCatchUpSteps) steps of dt / n.
     double catchUpStepSec = 1.0 / 30.0;                      // default 1/30 s
     int maxCatchUpSteps = 8;                                 // default 8
-    // A solver effect whose emitters are all off and whose total density is
-    // below this is dead: not simulated, not drawn.
+    // Passed to the kind's alive (AliveHints): a solver effect whose emitters
+    // are all off and whose total density is below this is dead: not
+    // simulated, not drawn.
     double deadDensity = 1e-4;                               // default 1e-4
     // How the effect is drawn (textured or traditional, opacity scale);
     // combined with the options given to prepare()/emit(). Default EmitOptions{}.
@@ -62,7 +68,7 @@ struct EffectStatus {
     bool needed = false;             // enabled && inRange && inView && alive
     std::uint64_t framesNeeded = 0;  // updates where it was needed
     std::uint64_t framesSkipped = 0; // updates where it was not (no work done)
-    std::uint64_t catchUps = 0;      // returns of a solver effect after being skipped
+    std::uint64_t catchUps = 0;      // returns of a stateful kind after being skipped (AdvanceResult::caughtUp)
     std::uint64_t splatsDrawn = 0;   // splats emitted at the last emit()
     Aabb bounds;                     // world bounds used for the last decision
 };
@@ -76,10 +82,21 @@ struct SceneCounters {
 
 class Scene {
 public:
+    // An Effect (grid or solver); effect(id) returns it.
     EffectId add(Effect effect, EffectOptions options = {});
+    // Any other kind (effect_kind.hpp). Expects kind != nullptr.
+    EffectId add(std::unique_ptr<EffectKind> kind, EffectOptions options = {});
     std::size_t size() const { return mEntries.size(); }
-    Effect& effect(EffectId id) { return mEntries.at(id).effect; }
-    const Effect& effect(EffectId id) const { return mEntries.at(id).effect; }
+    // Every entry through the interface the Scene schedules by.
+    EffectKind& kind(EffectId id) { return *mEntries.at(id).kind; }
+    const EffectKind& kind(EffectId id) const { return *mEntries.at(id).kind; }
+    // The Effect of an entry added as an Effect; nullptr for other kinds.
+    Effect* findEffect(EffectId id) { return mEntries.at(id).effect; }
+    const Effect* findEffect(EffectId id) const { return mEntries.at(id).effect; }
+    // Expects an entry added as an Effect (asserts otherwise; use findEffect
+    // or kind for other kinds).
+    Effect& effect(EffectId id);
+    const Effect& effect(EffectId id) const;
     const EffectOptions& options(EffectId id) const { return mEntries.at(id).options; }
     void setEnabled(EffectId id, bool enabled) { mEntries.at(id).options.enabled = enabled; }
 
@@ -104,13 +121,12 @@ public:
 
 private:
     struct Entry {
-        Effect effect;
+        std::unique_ptr<EffectKind> kind; // never null
+        Effect* effect = nullptr;         // kind as an Effect, if it was added as one
         EffectOptions options;
         EffectStatus status;
-        double simulatedTo = 0.0; // solver effects: time the simulation has reached
     };
-    bool alive(const Entry& e, double t) const;
-    void bringUpToDate(Entry& e, double t, bool wasNeeded);
+    EffectId push(Entry entry);
 
     std::vector<Entry> mEntries;
     SceneCounters mCounters;

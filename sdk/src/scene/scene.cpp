@@ -1,16 +1,40 @@
 #include "splatfx/scene.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 
 namespace splatfx {
 
 EffectId Scene::add(Effect effect, EffectOptions options) {
-    Entry e{std::move(effect), std::move(options), {}, 0.0};
-    e.simulatedTo = e.effect.time();
-    mEntries.push_back(std::move(e));
+    auto owned = std::make_unique<Effect>(std::move(effect));
+    Effect* asEffect = owned.get();
+    return push(Entry{std::move(owned), asEffect, std::move(options), {}});
+}
+
+EffectId Scene::add(std::unique_ptr<EffectKind> kind, EffectOptions options) {
+    assert(kind && "Scene::add: kind must not be null");
+    // An Effect handed over as a kind is still one: effect(id) should find it.
+    Effect* asEffect = dynamic_cast<Effect*>(kind.get());
+    return push(Entry{std::move(kind), asEffect, std::move(options), {}});
+}
+
+EffectId Scene::push(Entry entry) {
+    mEntries.push_back(std::move(entry));
     mCounters.declared = mEntries.size();
     return EffectId(mEntries.size() - 1);
+}
+
+Effect& Scene::effect(EffectId id) {
+    Effect* e = mEntries.at(id).effect;
+    assert(e && "Scene::effect: this entry is not an Effect; use Scene::kind or Scene::findEffect");
+    return *e;
+}
+
+const Effect& Scene::effect(EffectId id) const {
+    const Effect* e = mEntries.at(id).effect;
+    assert(e && "Scene::effect: this entry is not an Effect; use Scene::kind or Scene::findEffect");
+    return *e;
 }
 
 bool Scene::inFrustum(const Aabb& box, const Camera& camera) {
@@ -29,34 +53,6 @@ bool Scene::inFrustum(const Aabb& box, const Camera& camera) {
     return true;
 }
 
-bool Scene::alive(const Entry& e, double t) const {
-    if (e.effect.isStateless()) {
-        // Material is present unless the object's fade or growth is at zero now.
-        const Pose pose = e.effect.desc().motion.sample(t);
-        return pose.opacity > 0.0f && pose.growth > 0.0f;
-    }
-    const FluidSolver* s = e.effect.solver();
-    for (const Emitter& em : s->emitters())
-        if (em.desc.density > 0.0f && em.desc.rate > 0.0f) return true;
-    return s->totalDensity() > e.options.deadDensity;
-}
-
-void Scene::bringUpToDate(Entry& e, double t, bool wasNeeded) {
-    if (e.effect.isStateless()) {
-        e.effect.update(t); // a pure function of time: nothing to catch up
-        e.simulatedTo = t;
-        return;
-    }
-    const double gap = t - e.simulatedTo;
-    if (gap <= 0.0) return;
-    // Seen last frame: ordinary steps. Returning from a gap: a bounded number
-    // of coarse steps (the solver is unconditionally stable).
-    if (!wasNeeded && e.status.framesNeeded > 0) ++e.status.catchUps;
-    const int n = std::clamp(int(std::ceil(gap / std::max(e.options.catchUpStepSec, 1e-6))), 1, std::max(e.options.maxCatchUpSteps, 1));
-    for (int i = 0; i < n; ++i) e.effect.step(gap / n);
-    e.simulatedTo = t;
-}
-
 void Scene::update(double timeSec, const Camera& camera) {
     const double previous = mUpdated ? std::min(mTime, timeSec) : timeSec;
     mTime = timeSec;
@@ -73,17 +69,21 @@ void Scene::update(double timeSec, const Camera& camera) {
             continue;
         }
         // Bounds over the interval since the last update: motion between frames is covered.
-        s.bounds = e.effect.bounds(std::max(0.0, previous), timeSec);
+        s.bounds = e.kind->bounds(std::max(0.0, previous), timeSec);
         const glm::vec3 nearest = glm::clamp(eye, s.bounds.lo, s.bounds.hi);
         s.inRange = !s.bounds.empty() && glm::length(eye - nearest) <= e.options.rangeWorld;
         // Cheapest tests first: a hidden effect costs one bounds query and a frustum test.
         s.inView = s.inRange && inFrustum(s.bounds, camera);
-        s.alive = s.inView && alive(e, timeSec);
+        s.alive = s.inView && e.kind->alive(timeSec, AliveHints{.deadDensity = e.options.deadDensity});
         if (!s.alive) {
             ++s.framesSkipped;
             continue;
         }
-        bringUpToDate(e, timeSec, wasNeeded);
+        // Resumed: advanced before, skipped since; the kind decides what catching up costs.
+        const AdvanceContext context{.catchUpStepSec = e.options.catchUpStepSec,
+                                     .maxCatchUpSteps = e.options.maxCatchUpSteps,
+                                     .resumed = !wasNeeded && s.framesNeeded > 0};
+        if (e.kind->advanceTo(timeSec, context).caughtUp) ++s.catchUps;
         s.needed = true;
         ++s.framesNeeded;
         ++mCounters.needed;
@@ -96,7 +96,7 @@ std::size_t Scene::emit(SplatBuilder& builder, const Materials& materials, const
     for (Entry& e : mEntries) {
         const EmitOptions draw{.textured = e.options.draw.textured && options.textured,
                                .opacityScale = e.options.draw.opacityScale * options.opacityScale};
-        e.status.splatsDrawn = e.status.needed ? e.effect.emit(builder, materials, draw) : 0;
+        e.status.splatsDrawn = e.status.needed ? e.kind->emit(builder, materials, draw) : 0;
         total += e.status.splatsDrawn;
     }
     mCounters.splats = total;

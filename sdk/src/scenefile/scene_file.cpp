@@ -896,7 +896,7 @@ void readEffects(Context& c, const std::string& path, const Json& v, const std::
         else effect = readSolverKind(c, o, e, pl, e.kind == "dust");
         o.finish();
         if (!effect || c.d.count() != before) continue;
-        totalCells += effect->isStateless() ? effect->grid().voxels.size() : cells(effect->solver()->dims());
+        totalCells += effect->costCells(); // EffectKind: cells or voxels one advance evaluates
         if (totalCells > kMaxVoxels) {
             c.d.error(e.path, "the scene's effects hold more than " + std::to_string(kMaxVoxels) + " voxels/cells in all");
             return;

@@ -1,0 +1,60 @@
+// The inside of an Effect: what both shipped kinds share (desc, layers, the
+// current grid and its height split into layers, emit, the splat-extent part
+// of bounds) and the virtual functions each kind implements
+// (grid_effect.cpp: stateless; solver_effect.cpp: stateful).
+// Private to the SDK: the public extension point is EffectKind.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "splatfx/effect.hpp"
+
+namespace splatfx::detail {
+
+class EffectBody {
+public:
+    virtual ~EffectBody() = default;
+    virtual std::unique_ptr<EffectBody> clone() const = 0;
+
+    virtual bool stateless() const = 0;
+    virtual void update(double timeSec) = 0;
+    virtual void step(double dtSec) = 0;
+    virtual AdvanceResult advanceTo(double timeSec, const AdvanceContext& context) = 0;
+    virtual bool alive(double timeSec, const AliveHints& hints) const = 0;
+    virtual Aabb bounds(double t0, double t1) const = 0;
+    virtual std::uint64_t costCells() const = 0;
+    // After desc.enabled changed.
+    virtual void togglesChanged() {}
+    virtual FluidSolver* solver() { return nullptr; }
+    virtual const TextureDynamics& textureDynamics() const = 0;
+
+    // Shared by both kinds.
+    static Status checkDesc(const EffectDesc& desc);
+    // Takes the desc, its layers (one default layer when none) and the
+    // lattice rows the height bands are measured over.
+    void init(EffectDesc d, int latticeLoY, int latticeHiY);
+    // grid -> layerGrids by the layers' height bands (EffectLayer).
+    void splitLayers();
+    std::size_t emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options) const;
+    // The world box `world` (lattice points, motion included) grown by the
+    // largest splat: footprint radius times the kernel's largest axis for a
+    // lattice with this transform and spacing, scaled by `motionScale`.
+    Aabb withSplatExtent(const Aabb& world, float motionScale, const glm::mat4& transform, glm::vec3 spacing,
+                         float maxStretch) const;
+    // The corners of `box` through `m`.
+    static Aabb transformBox(const Aabb& box, const glm::mat4& m);
+
+    EffectDesc desc;
+    std::vector<EffectLayer> layers;
+    Grid grid;                     // the whole effect now
+    std::vector<Grid> layerGrids;  // grid split by layers
+    int latticeLoY = 0, latticeHiY = 0;
+    double time = 0.0;
+    EffectCounters counters;
+};
+
+std::unique_ptr<EffectBody> makeGridBody(Grid base, EffectDesc desc);
+Result<std::unique_ptr<EffectBody>> makeSolverBody(FluidSolver solver, EffectDesc desc);
+
+} // namespace splatfx::detail
