@@ -2,8 +2,8 @@
 //
 // Each preset takes a descriptor (every field defaulted, so `{}` is valid),
 // registers the texture sets and colour tables it needs in the caller's
-// Materials (procedural Perlin turbulence when no texture-set folder is
-// given, King et al. 1999 sec. 4), and returns an Effect:
+// Materials (procedural Perlin turbulence when no texture set is given,
+// King et al. 1999 sec. 4), and returns an Effect:
 //   fire         Fig. 1: 7x20x5 grid, colour by height (sec. 2 step 4),
 //                upward propagation (sec. 3.2) + ordered cycling (sec. 3.3)
 //   smoke        solver plume from an emitter (which can ride a moving
@@ -16,9 +16,12 @@
 //                smoke (its own set + table) above (sec. 2 step 4)
 //   ghosts       Fig. 10: faces flashing across a head and dissipating above
 //                it (random selection, sec. 3.3); procedural faces if no
-//                texture-set folder is given
-// A preset fails only when a texture-set folder cannot be loaded or a field
-// is out of range; the message names the file or field.
+//                texture set is given
+// A preset fails only when a given texture set is empty or a field is out of
+// range; the message names the field. Presets are GL-free and file-free
+// (splatfx::core): to use a texture-set folder, load it first with
+// TextureSet::load (splatfx::io) and pass the set, e.g.
+// `.textureSet = *TextureSet::load("textures/fire8")`.
 // It does not render or schedule anything.
 //
 //   splatfx::Materials materials(splatfx::Footprint{});
@@ -29,12 +32,14 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include <glm/glm.hpp>
 
 #include "splatfx/effect.hpp"
 #include "splatfx/materials.hpp"
+#include "splatfx/texture_set.hpp"
 
 namespace splatfx::presets {
 
@@ -42,7 +47,7 @@ struct FireDesc {
     glm::ivec3 dims{7, 20, 5};        // lattice cells; default the paper's Fig. 1 grid
     glm::vec3 spacing{0.5f};          // world units between voxels; default 0.5
     glm::vec3 position{0.0f};         // world position of the base centre; default origin
-    std::string textureSetPath{};     // texture-set folder; default empty (procedural turbulence)
+    std::optional<TextureSet> textureSet{}; // detail textures (e.g. a loaded folder); default none (procedural turbulence)
     int textureCount = 8;             // procedural textures; default 8
     float opacity = 0.55f;            // opacity at the core of the base, (0, 1]; default 0.55
     float propagationStepsPerSec = 8.0f; // global dynamics: cells per second the detail rises; default 8
@@ -62,7 +67,7 @@ struct SmokeDesc {
     Motion sourceMotion{};            // the object the chimney sits on; default at rest at `position`
     glm::vec3 windWorld{1.0f, 0.0f, 0.0f}; // world units/s; default 1 along +x
     float dissipation = 0.15f;        // 1/s smoke thinning; default 0.15
-    std::string textureSetPath{};     // default empty (procedural turbulence)
+    std::optional<TextureSet> textureSet{}; // default none (procedural turbulence)
     int textureCount = 8;             // default 8
     float texturesPerSec = 3.0f;      // local dynamics rate; default 3
     int substeps = 1;                 // solver substeps per step; default 1
@@ -74,7 +79,7 @@ struct SteamDesc {
     glm::ivec3 dims{2, 20, 2};        // lattice; default the paper's Fig. 5 grid
     glm::vec3 spacing{0.25f};         // world units; default 0.25
     glm::vec3 position{0.0f};         // world position of the base (the spout); default origin
-    std::string textureSetPath{};     // default empty (procedural turbulence)
+    std::optional<TextureSet> textureSet{}; // default none (procedural turbulence)
     int textureCount = 16;            // default 16 (sec. 5.2)
     float opacity = 0.35f;            // at the spout; default 0.35
     float propagationStepsPerSec = 10.0f; // inter-voxel advection rate; default 10
@@ -94,7 +99,7 @@ struct DustDesc {
     glm::vec3 windWorld{0.0f};        // default none
     float settle = 0.6f;              // downward pull per unit density, world units/s^2; default 0.6
     float dissipation = 0.3f;         // 1/s; default 0.3
-    std::string textureSetPath{};     // default empty (procedural turbulence)
+    std::optional<TextureSet> textureSet{}; // default none (procedural turbulence)
     int textureCount = 8;             // default 8
     std::uint32_t seed = 1;           // default 1
 };
@@ -106,8 +111,8 @@ struct FireToSmokeDesc {
     glm::vec3 position{0.0f};         // default origin
     float split = 0.45f;              // normalized height where smoke takes over, (0, 1); default 0.45
     float blend = 0.15f;              // overlap of the two layers, normalized height; default 0.15
-    std::string fireTextureSetPath{}; // default empty (procedural turbulence)
-    std::string smokeTextureSetPath{};  // default empty (procedural, softer turbulence)
+    std::optional<TextureSet> fireTextureSet{};  // default none (procedural turbulence)
+    std::optional<TextureSet> smokeTextureSet{}; // default none (procedural, softer turbulence)
     float propagationStepsPerSec = 8.0f; // default 8
     float texturesPerSec = 5.0f;      // default 5
     Motion motion{};                  // default at rest
@@ -120,7 +125,7 @@ struct GhostsDesc {
     int plumeCells = 8;               // cells of rising, dissipating faces above it; default 8
     glm::vec3 spacing{0.3f};          // default 0.3
     glm::vec3 position{0.0f};         // world position of the base; default origin
-    std::string textureSetPath{};     // folder of face images; default empty (procedural faces)
+    std::optional<TextureSet> textureSet{}; // face images; default none (procedural faces)
     int textureCount = 12;            // procedural faces; default 12
     float opacity = 0.4f;             // default 0.4
     float texturesPerSec = 5.0f;      // random selection rate; default 5

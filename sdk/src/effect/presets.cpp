@@ -9,11 +9,12 @@
 namespace splatfx::presets {
 namespace {
 
-Result<TextureSet> loadOrTurbulence(const std::string& path, const TurbulenceDesc& fallback, bool keepColor = false) {
-    if (path.empty()) return TextureSet::turbulence(fallback);
-    Result<TextureSet> set = TextureSet::load(path);
-    if (!set) return set;
-    if (!keepColor) set->color = false;
+// The caller's set (loaded by the caller: presets read no files), or turbulence.
+Result<TextureSet> setOrTurbulence(const std::optional<TextureSet>& given, const TurbulenceDesc& fallback, bool keepColor = false) {
+    if (!given) return TextureSet::turbulence(fallback);
+    if (given->layers.empty() || given->size < 1) return makeError("the texture set has no textures");
+    TextureSet set = *given;
+    if (!keepColor) set.color = false;
     return set;
 }
 
@@ -71,8 +72,8 @@ Result<Effect> fire(Materials& materials, const FireDesc& d) {
     // Sparse, sharp detail (contrast 2.5) reads as licking flames through the
     // ~20 splats that overlap on each pixel; plain turbulence averages to a haze.
     Result<TextureSet> set =
-        loadOrTurbulence(d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.seed, .contrast = 2.5f});
-    if (!set) return makeError("FireDesc.textureSetPath: " + set.error());
+        setOrTurbulence(d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.seed, .contrast = 2.5f});
+    if (!set) return makeError("FireDesc.textureSet: " + set.error());
 
     for (Voxel& v : grid->voxels) v.opacity = d.opacity * flameOpacity(v.cell, grid->dims, 1.0f);
     grid->colorByHeight(); // sec. 2 step 4: height stands in for temperature
@@ -105,8 +106,8 @@ Result<Effect> smoke(Materials& materials, const SmokeDesc& d) {
     Result<FluidSolver> solver = FluidSolver::create(sd);
     if (!solver) return makeError("SmokeDesc: " + solver.error());
     Result<TextureSet> set =
-        loadOrTurbulence(d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.seed, .baseFrequency = 2.0f});
-    if (!set) return makeError("SmokeDesc.textureSetPath: " + set.error());
+        setOrTurbulence(d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.seed, .baseFrequency = 2.0f});
+    if (!set) return makeError("SmokeDesc.textureSet: " + set.error());
     solver->addEmitter({.desc = {.offset = d.sourceOffset, .radius = d.sourceRadius, .density = 1.0f, .temperature = 1.0f, .rate = 6.0f},
                         .motion = restingAt(d.sourceMotion, d.position)});
 
@@ -126,8 +127,8 @@ Result<Effect> steam(Materials& materials, const SteamDesc& d) {
     if (Status s = checkRate("SteamDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
     Result<Grid> grid = Grid::box(d.dims, d.spacing);
     if (!grid) return makeError("SteamDesc.dims/spacing: " + grid.error());
-    Result<TextureSet> set = loadOrTurbulence(d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.seed});
-    if (!set) return makeError("SteamDesc.textureSetPath: " + set.error());
+    Result<TextureSet> set = setOrTurbulence(d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.seed});
+    if (!set) return makeError("SteamDesc.textureSet: " + set.error());
     for (Voxel& v : grid->voxels) {
         const float h = v.cell.y / float(std::max(d.dims.y - 1, 1));
         v.opacity = d.opacity * (1.0f - h) * (1.0f - h) + 0.02f * (1.0f - h);
@@ -161,8 +162,8 @@ Result<Effect> dust(Materials& materials, const DustDesc& d) {
     Result<FluidSolver> solver = FluidSolver::create(sd);
     if (!solver) return makeError("DustDesc: " + solver.error());
     Result<TextureSet> set =
-        loadOrTurbulence(d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.seed, .baseFrequency = 2.5f});
-    if (!set) return makeError("DustDesc.textureSetPath: " + set.error());
+        setOrTurbulence(d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.seed, .baseFrequency = 2.5f});
+    if (!set) return makeError("DustDesc.textureSet: " + set.error());
     solver->addEmitter({.desc = {.offset = d.sourceOffset, .radius = d.sourceRadius, .density = 1.0f, .temperature = 0.6f, .rate = 5.0f},
                         .motion = restingAt(d.sourceMotion, d.position)});
 
@@ -182,11 +183,11 @@ Result<Effect> fireToSmoke(Materials& materials, const FireToSmokeDesc& d) {
     if (Status s = checkRate("FireToSmokeDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
     Result<Grid> grid = Grid::box(d.dims, d.spacing);
     if (!grid) return makeError("FireToSmokeDesc.dims/spacing: " + grid.error());
-    Result<TextureSet> fireSet = loadOrTurbulence(d.fireTextureSetPath, {.count = 8, .size = 32, .seed = d.seed});
-    if (!fireSet) return makeError("FireToSmokeDesc.fireTextureSetPath: " + fireSet.error());
+    Result<TextureSet> fireSet = setOrTurbulence(d.fireTextureSet, {.count = 8, .size = 32, .seed = d.seed});
+    if (!fireSet) return makeError("FireToSmokeDesc.fireTextureSet: " + fireSet.error());
     Result<TextureSet> smokeSet =
-        loadOrTurbulence(d.smokeTextureSetPath, {.count = 8, .size = 32, .seed = d.seed + 1, .baseFrequency = 2.0f});
-    if (!smokeSet) return makeError("FireToSmokeDesc.smokeTextureSetPath: " + smokeSet.error());
+        setOrTurbulence(d.smokeTextureSet, {.count = 8, .size = 32, .seed = d.seed + 1, .baseFrequency = 2.0f});
+    if (!smokeSet) return makeError("FireToSmokeDesc.smokeTextureSet: " + smokeSet.error());
 
     // Flame below the split; above it a plume that widens and thins.
     for (Voxel& v : grid->voxels) {
@@ -262,9 +263,10 @@ Result<Effect> ghosts(Materials& materials, const GhostsDesc& d) {
     if (Status s = checkCount("GhostsDesc.textureCount", d.textureCount); !s) return makeError(s.error());
     if (Status s = checkUnit("GhostsDesc.opacity", d.opacity); !s) return makeError(s.error());
     if (Status s = checkRate("GhostsDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
-    Result<TextureSet> set = d.textureSetPath.empty() ? Result<TextureSet>(proceduralFaces(d.textureCount, 32, d.seed))
-                                                      : TextureSet::load(d.textureSetPath);
-    if (!set) return makeError("GhostsDesc.textureSetPath: " + set.error());
+    Result<TextureSet> set = !d.textureSet ? Result<TextureSet>(proceduralFaces(d.textureCount, 32, d.seed))
+                             : d.textureSet->layers.empty() ? Result<TextureSet>(makeError("the texture set has no textures"))
+                                                            : Result<TextureSet>(*d.textureSet);
+    if (!set) return makeError("GhostsDesc.textureSet: " + set.error());
 
     // A head-sized ball of voxels with a thinning column of faces above it.
     const int r = int(std::floor(d.headRadiusCells));
