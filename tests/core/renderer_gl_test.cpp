@@ -10,6 +10,7 @@
 #include "gl_fixture.hpp"
 #include "image_compare.hpp"
 #include "scenes.hpp"
+#include "splatfx/gl/program.hpp"
 
 using namespace splatfx;
 
@@ -48,15 +49,9 @@ public:
         const char* vs = "#version 450 core\nuniform mat4 uMvp; const vec2 k[4] = vec2[4](vec2(0,-4),vec2(4,-4),vec2(0,12),vec2(4,12));\n"
                          "uniform float uZ; void main(){ gl_Position = uMvp * vec4(k[gl_VertexID], uZ, 1.0); }";
         const char* fs = "#version 450 core\nout vec4 o; void main(){ o = vec4(0.1, 0.5, 0.9, 1.0); }";
-        program = glCreateProgram();
-        for (auto [type, src] : {std::pair{GL_VERTEX_SHADER, vs}, std::pair{GL_FRAGMENT_SHADER, fs}}) {
-            GLuint s = glCreateShader(type);
-            glShaderSource(s, 1, &src, nullptr);
-            glCompileShader(s);
-            glAttachShader(program, s);
-            glDeleteShader(s);
-        }
-        glLinkProgram(program);
+        auto linked = gl::linkProgram({vs}, {fs}, "HostQuad");
+        if (linked) program = *linked;
+        else ADD_FAILURE() << linked.error(); // the stand-in host must draw, or the depth tests prove nothing
         glCreateVertexArrays(1, &vao);
     }
     ~HostQuad() {

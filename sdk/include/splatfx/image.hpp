@@ -3,6 +3,8 @@
 // Reads anything OpenImageIO reads; writes PNG (8-bit) or EXR/TIFF by
 // extension. Writes are atomic: the file appears complete or not at all.
 // It does not resize or colour-manage.
+// Targets: the Image struct and Alpha are plain data used throughout
+// splatfx::core; readImage, writeImage and AnimationWriter are splatfx::io.
 //
 //   auto img = splatfx::readImage("photo.jpg");
 //   if (!img) return fail(img.error());

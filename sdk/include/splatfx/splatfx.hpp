@@ -8,6 +8,7 @@
 #include "splatfx/effect.hpp"
 #include "splatfx/footprint.hpp"
 #include "splatfx/gl/framebuffer.hpp"
+#include "splatfx/gl/program.hpp"
 #include "splatfx/gl/renderer.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
 #include "splatfx/grid.hpp"
