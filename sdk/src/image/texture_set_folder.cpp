@@ -123,7 +123,9 @@ Status TextureSet::save(const std::string& folder, const std::string& provenance
         out << m.dump(2) << "\n";
         if (!out) return fail("cannot write manifest.json");
     }
-    const fs::path old = parent / ("." + target.filename().string() + ".old-" + std::to_string(getpid()));
+    std::string oldName = "."; // append(), not "." + name: the same false GCC 12 -Wrestrict as above
+    oldName.append(target.filename().string()).append(".old-").append(std::to_string(getpid()));
+    const fs::path old = parent / oldName;
     if (fs::exists(target, ec)) {
         fs::rename(target, old, ec);
         if (ec) return fail("cannot replace the existing folder: " + ec.message());
