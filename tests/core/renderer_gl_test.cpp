@@ -1,6 +1,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 
 #include <epoxy/gl.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -262,6 +263,29 @@ TEST_F(RendererGL, CameraInsideTheVolumeGivesFiniteInRangePixels) {
             for (size_t p = 3; p < img.pixels.size(); p += 4) visible += img.pixels[p] > 0.01f;
         }
     EXPECT_GT(visible, 100); // the fire is seen from inside, not culled away
+}
+
+// A program the host deleted while bound lives only until draw() replaces
+// it; restoring must not rebind the dead name (GL_INVALID_VALUE).
+TEST_F(RendererGL, RestoringSurvivesAProgramTheHostDeleted) {
+    Frame f(1);
+    auto fb = gl::Framebuffer::create({.width = 32, .height = 32});
+    auto r = gl::Renderer::create();
+    ASSERT_TRUE(fb && r && r->upload(f.materials));
+    std::optional<HostQuad> quad{std::in_place};
+    glUseProgram(quad->program);
+    quad.reset(); // deletes its program (flagged, still current) and vertex array
+    ASSERT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+    const Camera cam = test::campfireCamera({32, 32});
+    SplatBuilder b;
+    b.begin(cam);
+    b.add(test::campfireGrid(1), f.materials, {.textureSet = f.set, .colorTable = f.table});
+    b.sort();
+    r->draw(b.splats(), cam, {.framebuffer = fb->handle(), .width = 32, .height = 32});
+    EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+    GLint current = -1;
+    glGetIntegerv(GL_CURRENT_PROGRAM, &current);
+    EXPECT_EQ(current, 0);
 }
 
 TEST_F(RendererGL, HostStateIsUnchangedAfterDraw) {
