@@ -1,6 +1,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 
 #include <epoxy/gl.h>
 #include <glm/gtc/matrix_transform.hpp>
@@ -10,6 +11,7 @@
 #include "gl_fixture.hpp"
 #include "image_compare.hpp"
 #include "scenes.hpp"
+#include "splatfx/gl/program.hpp"
 
 using namespace splatfx;
 
@@ -48,15 +50,9 @@ public:
         const char* vs = "#version 450 core\nuniform mat4 uMvp; const vec2 k[4] = vec2[4](vec2(0,-4),vec2(4,-4),vec2(0,12),vec2(4,12));\n"
                          "uniform float uZ; void main(){ gl_Position = uMvp * vec4(k[gl_VertexID], uZ, 1.0); }";
         const char* fs = "#version 450 core\nout vec4 o; void main(){ o = vec4(0.1, 0.5, 0.9, 1.0); }";
-        program = glCreateProgram();
-        for (auto [type, src] : {std::pair{GL_VERTEX_SHADER, vs}, std::pair{GL_FRAGMENT_SHADER, fs}}) {
-            GLuint s = glCreateShader(type);
-            glShaderSource(s, 1, &src, nullptr);
-            glCompileShader(s);
-            glAttachShader(program, s);
-            glDeleteShader(s);
-        }
-        glLinkProgram(program);
+        auto linked = gl::linkProgram({vs}, {fs}, "HostQuad");
+        if (linked) program = *linked;
+        else ADD_FAILURE() << linked.error(); // the stand-in host must draw, or the depth tests prove nothing
         glCreateVertexArrays(1, &vao);
     }
     ~HostQuad() {
@@ -264,6 +260,29 @@ TEST_F(RendererGL, CameraInsideTheVolumeGivesFiniteInRangePixels) {
             for (size_t p = 3; p < img.pixels.size(); p += 4) visible += img.pixels[p] > 0.01f;
         }
     EXPECT_GT(visible, 100); // the fire is seen from inside, not culled away
+}
+
+// A program the host deleted while bound lives only until draw() replaces
+// it; restoring must not rebind the dead name (GL_INVALID_VALUE).
+TEST_F(RendererGL, RestoringSurvivesAProgramTheHostDeleted) {
+    FireMaterials f(1);
+    auto fb = gl::Framebuffer::create({.width = 32, .height = 32});
+    auto r = gl::Renderer::create();
+    ASSERT_TRUE(fb && r && r->upload(f.materials));
+    std::optional<HostQuad> quad{std::in_place};
+    glUseProgram(quad->program);
+    quad.reset(); // deletes its program (flagged, still current) and vertex array
+    ASSERT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+    const Camera cam = test::campfireCamera({32, 32});
+    SplatBuilder b;
+    b.begin(cam);
+    b.add(test::campfireGrid(1), f.materials, {.textureSet = f.set, .colorTable = f.table});
+    b.sort();
+    r->draw(b.splats(), cam, {.framebuffer = fb->handle(), .width = 32, .height = 32});
+    EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+    GLint current = -1;
+    glGetIntegerv(GL_CURRENT_PROGRAM, &current);
+    EXPECT_EQ(current, 0);
 }
 
 TEST_F(RendererGL, HostStateIsUnchangedAfterDraw) {

@@ -73,6 +73,12 @@ TEST(TextureSet, SaveAndLoadRoundTrip) {
         for (size_t i = 0; i < set.layers[0].size(); i += 4) EXPECT_NEAR(back->layers[size_t(k)][i], set.layers[size_t(k)][i], 0.5 / 255 + 1e-6);
 }
 
+TEST(TextureSetBadInput, MissingFolderIsNamed) {
+    auto set = TextureSet::load("/nonexistent/fire-set");
+    ASSERT_FALSE(set);
+    EXPECT_EQ(set.error(), "texture set '/nonexistent/fire-set': no such folder");
+}
+
 TEST(TextureSetBadInput, MissingTextureFileIsNamed) {
     const std::string dir = splatfx::test::outputDir() + "/missing";
     fs::remove_all(dir);

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "gl_fixture.hpp"
+#include "splatfx/gl/program.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
 
 namespace splatfx {
@@ -136,6 +137,29 @@ TEST_F(ScaledRendererTest, RestoresTheHostState) {
     EXPECT_FALSE(glIsEnabled(GL_BLEND));
     EXPECT_TRUE(glIsEnabled(GL_DEPTH_TEST));
     EXPECT_TRUE(mask);
+}
+
+// A host may delete its program while it is still bound: GL keeps it alive
+// only until another program replaces it, which draw() does. Putting the old
+// name back would then be GL_INVALID_VALUE (the fixture's TearDown fails the
+// test on any GL error); the shared state guard binds 0 instead.
+TEST_F(ScaledRendererTest, RestoringSurvivesAProgramTheHostDeleted) {
+    for (int scale : {1, 2}) {
+        auto sr = gl::ScaledRenderer::create({.scale = scale});
+        ASSERT_TRUE(sr && sr->upload(mat));
+        gl::Framebuffer fb = makeTarget();
+        auto host = gl::linkProgram({"#version 450 core\nvoid main() { gl_Position = vec4(0, 0, 0, 1); }\n"},
+                                    {"#version 450 core\nout vec4 o; void main() { o = vec4(1); }\n"}, "host");
+        ASSERT_TRUE(host) << host.error();
+        glUseProgram(*host);
+        glDeleteProgram(*host); // flagged; still current
+        ASSERT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+        sr->draw(builder.splats(), cam, {.framebuffer = fb.handle(), .width = size.x, .height = size.y});
+        EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR)) << "scale " << scale;
+        GLint current = -1;
+        glGetIntegerv(GL_CURRENT_PROGRAM, &current);
+        EXPECT_EQ(current, 0) << "scale " << scale << ": the deleted program's name must not be rebound";
+    }
 }
 
 TEST_F(ScaledRendererTest, RejectsAScaleItDoesNotSupport) {

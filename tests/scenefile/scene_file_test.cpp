@@ -133,6 +133,38 @@ TEST(SceneFile, MissingTextureSetFallsBackWhenAskedTo) {
     ASSERT_TRUE(r.ok()) << r.error();
 }
 
+// Presets take texture sets in memory (splatfx::core reads no files): the
+// reader loads a preset's folder itself, so the preset gets exactly that set,
+// and a folder that exists but does not load is an error at the effect.
+TEST(SceneFile, PresetTextureFoldersAreLoadedByTheReader) {
+    const std::string set = std::string(SPLATFX_SOURCE_DIR) + "/textures/photo-fire-8x32";
+    splatfx::Materials m(splatfx::Footprint{});
+    const std::uint32_t sets = m.setCount(), layers = m.layerCount();
+    auto r = splatfx::parseSceneFile("{" + kHead + R"(, "effects": [{"kind": "fire", "textureSet": {"folder": ")" + set + R"("}}]})",
+                                     "dir/scene.json", m);
+    ASSERT_TRUE(r.ok()) << r.error();
+    auto direct = splatfx::TextureSet::load(set);
+    ASSERT_TRUE(direct) << direct.error();
+    ASSERT_EQ(m.setCount(), sets + 1);
+    ASSERT_EQ(m.layerCount() - layers, std::uint32_t(direct->count()));
+    // The same set registered by hand gives the same layers, texel for texel
+    // (procedural turbulence of the same count would not).
+    splatfx::TextureSet grey = *direct;
+    grey.color = false; // what the fire preset does with a set it is given
+    splatfx::Materials expected(splatfx::Footprint{});
+    const std::uint32_t first = expected.layerCount();
+    expected.addTextureSet(grey);
+    for (std::uint32_t k = 0; k < std::uint32_t(direct->count()); ++k)
+        EXPECT_EQ(m.layer(layers + k), expected.layer(first + k)) << "layer " << k << " is not the folder's";
+
+    const fs::path broken = fs::temp_directory_path() / ("splatfx-broken-set-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()));
+    fs::create_directories(broken);
+    std::ofstream(broken / "manifest.json") << R"({"format": "splatfx-texture-set", "version": 1, "textures": ["t000.png"]})";
+    expectError(R"("effects": [{"kind": "steam"}, {"kind": "fire", "textureSet": {"folder": ")" + broken.string() + R"("}}])",
+                {"effects[1]", "t000.png"});
+    fs::remove_all(broken);
+}
+
 TEST(SceneFile, AbsurdSizesAreRefusedBeforeAllocating) {
     expectError(R"("effects": [{"kind": "fire", "dims": [1000, 1000, 1000]}])",
                 {"effects[0].dims: 1000x1000x1000 = 1000000000 cells is too many; expected at most 16777216"});

@@ -32,8 +32,8 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "commands.hpp"
-#include "gl_program.hpp"
 #include "splatfx/context.hpp"
+#include "splatfx/gl/program.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
 #include "splatfx/reference.hpp"
 #include "splatfx/solver.hpp"
@@ -165,8 +165,9 @@ public:
         const char* vs = "#version 450 core\nlayout(location=0) in vec3 p; layout(location=1) in vec3 c; uniform mat4 uVP; out vec3 vC;\n"
                          "void main() { vC = c; gl_Position = uVP * vec4(p, 1.0); }\n";
         const char* fs = "#version 450 core\nin vec3 vC; out vec4 o; void main() { o = vec4(vC, 1.0); }\n";
-        mProgram = bench::compileProgram(vs, fs, err);
-        if (!mProgram) return (err = "host geometry shader failed to compile: " + err), false;
+        const splatfx::Result<GLuint> program = splatfx::gl::linkProgram({vs}, {fs}, "host geometry");
+        if (!program) return (err = program.error()), false;
+        mProgram = *program;
         std::vector<float> v;
         auto quad = [&](glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d, glm::vec3 col) {
             for (glm::vec3 p : {a, b, c, a, c, d}) v.insert(v.end(), {p.x, p.y, p.z, col.r, col.g, col.b});

@@ -18,8 +18,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
-#include "gl_program.hpp"
 #include "splatfx/context.hpp"
+#include "splatfx/gl/program.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
 #include "splatfx/splatfx.hpp"
 
@@ -83,11 +83,11 @@ void cycle(const splatfx::Grid& base, splatfx::Grid& grid, double t) {
     }
 }
 
+// The probes' programs; a failure is printed and leaves 0 (the probe then reports nothing).
 GLuint compileProgram(const char* vs, const char* fs) {
-    std::string error;
-    const GLuint p = bench::compileProgram(vs, fs, error);
-    if (!p) std::fprintf(stderr, "table1: bench shader: %s\n", error.c_str());
-    return p;
+    const splatfx::Result<GLuint> p = splatfx::gl::linkProgram({vs}, {fs}, "table1 bench");
+    if (!p) std::fprintf(stderr, "table1: %s\n", p.error().c_str());
+    return p ? *p : 0;
 }
 
 // Draw state both probes share: the target, premultiplied "over", no depth test.

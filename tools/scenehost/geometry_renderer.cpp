@@ -5,6 +5,8 @@
 #include <epoxy/gl.h>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "splatfx/gl/program.hpp"
+
 namespace scenehost {
 namespace {
 
@@ -40,19 +42,6 @@ void main() {
 }
 )";
 
-GLuint compile(GLenum type, const char* src, std::string& log) {
-    GLuint s = glCreateShader(type);
-    glShaderSource(s, 1, &src, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char buf[2048];
-        glGetShaderInfoLog(s, sizeof buf, nullptr, buf);
-        log = buf;
-    }
-    return s;
-}
 
 } // namespace
 
@@ -80,18 +69,9 @@ splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<spl
     if (!epoxy_has_gl_extension("GL_ARB_direct_state_access") && epoxy_gl_version() < 45)
         return splatfx::makeError("GeometryRenderer: needs a current OpenGL 4.5 context");
     auto impl = std::make_unique<Impl>();
-    std::string log;
-    const GLuint vs = compile(GL_VERTEX_SHADER, kVertex, log);
-    const GLuint fs = compile(GL_FRAGMENT_SHADER, kFragment, log);
-    impl->program = glCreateProgram();
-    glAttachShader(impl->program, vs);
-    glAttachShader(impl->program, fs);
-    glLinkProgram(impl->program);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    GLint linked = 0;
-    glGetProgramiv(impl->program, GL_LINK_STATUS, &linked);
-    if (!log.empty() || !linked) return splatfx::makeError("GeometryRenderer: shader failed: " + log);
+    splatfx::Result<GLuint> program = splatfx::gl::linkProgram({kVertex}, {kFragment}, "GeometryRenderer");
+    if (!program) return splatfx::makeError(program.error());
+    impl->program = *program;
 
     std::map<std::string, Mesh> meshes; // each file loaded once
     for (const splatfx::GeometryDesc& g : geometry) {

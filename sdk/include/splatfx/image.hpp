@@ -6,6 +6,9 @@
 // is written under a temporary name beside the target and renamed into place
 // only when complete, so it appears complete or not at all and a previous
 // file of that name survives a failure. It does not resize or colour-manage.
+// Targets: the Image struct and Alpha are plain data used throughout
+// splatfx::core; readImage, writeImage, writeFileAtomically and
+// AnimationWriter are splatfx::io.
 //
 //   auto img = splatfx::readImage("photo.jpg");
 //   if (!img) return fail(img.error());

@@ -16,20 +16,21 @@
 //                smoke (its own set + table) above (sec. 2 step 4)
 //   ghosts       Fig. 10: faces flashing across a head and dissipating above
 //                it (random selection, sec. 3.3); procedural faces if no
-//                texture-set folder is given
-// A preset fails only when a texture-set folder cannot be loaded or a field
-// is out of range; the message names the file or field.
+//                texture set is given
+// A preset fails only when a given texture set is empty or a field is out of
+// range; the message names the field. Presets are GL-free and file-free
+// (splatfx::core): to use a texture-set folder, load it first with
+// TextureSet::load (splatfx::io) and pass the set, e.g.
+// `.textureSet = *TextureSet::load("textures/fire8")`.
 // Sharing: a preset registers its sets and tables by content (see
-// materials.hpp), keyed by what makes them (the turbulence parameters and
-// textureSeed, or the folder's path and manifest), so presets with equal
-// texture parameters share one set and skip regenerating it: a level of 1000
-// fires with different `seed`s holds one fire set. `seed` varies the texture
-// dynamics per effect (each voxel's texture and phase), which is what tells
-// two effects apart; give `textureSeed` different values only when effects
-// must also use different texture images (each value is one more set).
-// A folder is read once per Materials while its manifest.json keeps its size
-// and time (a folder saved again by texpick is read again); images edited in
-// place without touching the manifest are seen by a new Materials.
+// materials.hpp); a procedural set is keyed by what makes it (the turbulence
+// parameters and textureSeed), so presets with equal texture parameters share
+// one set and skip regenerating it: a level of 1000 fires with different
+// `seed`s holds one fire set. `seed` varies the texture dynamics per effect
+// (each voxel's texture and phase), which is what tells two effects apart;
+// give `textureSeed` different values only when effects must also use
+// different texture images (each value is one more set). A given set equal
+// to one already registered is shared the same way.
 // It does not render or schedule anything.
 //
 //   splatfx::Materials materials(splatfx::Footprint{});
@@ -40,6 +41,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -53,7 +55,7 @@ struct FireDesc {
     glm::ivec3 dims{7, 20, 5};        // lattice cells; default the paper's Fig. 1 grid
     glm::vec3 spacing{0.5f};          // world units between voxels; default 0.5
     glm::vec3 position{0.0f};         // world position of the base centre; default origin
-    std::string textureSetPath{};     // texture-set folder; default empty (procedural turbulence)
+    std::optional<TextureSet> textureSet{}; // detail textures (e.g. a loaded folder); default none (procedural turbulence)
     int textureCount = 8;             // procedural textures; default 8
     float opacity = 0.55f;            // opacity at the core of the base, (0, 1]; default 0.55
     float propagationStepsPerSec = 8.0f; // global dynamics: cells per second the detail rises; default 8
@@ -74,7 +76,7 @@ struct SmokeDesc {
     Motion sourceMotion{};            // the object the chimney sits on; default at rest at `position`
     glm::vec3 windWorld{1.0f, 0.0f, 0.0f}; // world units/s; default 1 along +x
     float dissipation = 0.15f;        // 1/s smoke thinning; default 0.15
-    std::string textureSetPath{};     // default empty (procedural turbulence)
+    std::optional<TextureSet> textureSet{}; // default none (procedural turbulence)
     int textureCount = 8;             // default 8
     float texturesPerSec = 3.0f;      // local dynamics rate; default 3
     int substeps = 1;                 // solver substeps per step; default 1
@@ -87,7 +89,7 @@ struct SteamDesc {
     glm::ivec3 dims{2, 20, 2};        // lattice; default the paper's Fig. 5 grid
     glm::vec3 spacing{0.25f};         // world units; default 0.25
     glm::vec3 position{0.0f};         // world position of the base (the spout); default origin
-    std::string textureSetPath{};     // default empty (procedural turbulence)
+    std::optional<TextureSet> textureSet{}; // default none (procedural turbulence)
     int textureCount = 16;            // default 16 (sec. 5.2)
     float opacity = 0.35f;            // at the spout; default 0.35
     float propagationStepsPerSec = 10.0f; // inter-voxel advection rate; default 10
@@ -108,7 +110,7 @@ struct DustDesc {
     glm::vec3 windWorld{0.0f};        // default none
     float settle = 0.6f;              // downward pull per unit density, world units/s^2; default 0.6
     float dissipation = 0.3f;         // 1/s; default 0.3
-    std::string textureSetPath{};     // default empty (procedural turbulence)
+    std::optional<TextureSet> textureSet{}; // default none (procedural turbulence)
     int textureCount = 8;             // default 8
     std::uint32_t seed = 1;           // texture dynamics (which texture each voxel shows when); default 1
     std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
@@ -121,8 +123,8 @@ struct FireToSmokeDesc {
     glm::vec3 position{0.0f};         // default origin
     float split = 0.45f;              // normalized height where smoke takes over, (0, 1); default 0.45
     float blend = 0.15f;              // overlap of the two layers, normalized height; default 0.15
-    std::string fireTextureSetPath{}; // default empty (procedural turbulence)
-    std::string smokeTextureSetPath{};  // default empty (procedural, softer turbulence)
+    std::optional<TextureSet> fireTextureSet{};  // default none (procedural turbulence)
+    std::optional<TextureSet> smokeTextureSet{}; // default none (procedural, softer turbulence)
     float propagationStepsPerSec = 8.0f; // default 8
     float texturesPerSec = 5.0f;      // default 5
     Motion motion{};                  // default at rest
@@ -136,7 +138,7 @@ struct GhostsDesc {
     int plumeCells = 8;               // cells of rising, dissipating faces above it; default 8
     glm::vec3 spacing{0.3f};          // default 0.3
     glm::vec3 position{0.0f};         // world position of the base; default origin
-    std::string textureSetPath{};     // folder of face images; default empty (procedural faces)
+    std::optional<TextureSet> textureSet{}; // face images; default none (procedural faces)
     int textureCount = 12;            // procedural faces; default 12
     float opacity = 0.4f;             // default 0.4
     float texturesPerSec = 5.0f;      // random selection rate; default 5

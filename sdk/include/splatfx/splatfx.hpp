@@ -11,6 +11,7 @@
 #include "splatfx/frame.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/gl/framebuffer.hpp"
+#include "splatfx/gl/program.hpp"
 #include "splatfx/gl/renderer.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
 #include "splatfx/grid.hpp"

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <optional>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -12,11 +11,12 @@
 namespace splatfx::presets {
 namespace {
 
-Result<TextureSet> loadOrTurbulence(const std::string& path, const TurbulenceDesc& fallback, bool keepColor) {
-    if (path.empty()) return TextureSet::turbulence(fallback);
-    Result<TextureSet> set = TextureSet::load(path);
-    if (!set) return set;
-    if (!keepColor) set->color = false;
+// The caller's set (loaded by the caller: presets read no files), or turbulence.
+Result<TextureSet> setOrTurbulence(const std::optional<TextureSet>& given, const TurbulenceDesc& fallback, bool keepColor) {
+    if (!given) return TextureSet::turbulence(fallback);
+    if (given->layers.empty() || given->size < 1) return makeError("the texture set has no textures");
+    TextureSet set = *given;
+    if (!keepColor) set.color = false;
     return set;
 }
 
@@ -34,25 +34,6 @@ std::string turbulenceKey(const TurbulenceDesc& t) {
     return buf;
 }
 
-// A folder by its full path and its manifest's size and modification time,
-// so a folder rewritten under the same path (texpick saves into a temporary
-// folder and renames it) is a new set. Empty (no key: the set is loaded and
-// shared by content only) when the manifest cannot be found; loading then
-// reports why.
-std::string folderKey(const std::string& folder, bool keepColor) {
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    const fs::path full = fs::canonical(folder, ec);
-    if (ec) return {};
-    const std::uintmax_t bytes = fs::file_size(full / "manifest.json", ec);
-    if (ec) return {};
-    const auto written = fs::last_write_time(full / "manifest.json", ec);
-    if (ec) return {};
-    const long long ticks = static_cast<long long>(written.time_since_epoch().count());
-    return "folder(" + full.string() + (keepColor ? ",color" : ",gray") + ",manifest=" + std::to_string(bytes) + "B@" +
-           std::to_string(ticks) + ")";
-}
-
 // A preset's texture set before it is registered: found in Materials by its
 // key, or built and waiting for registerSet (so a preset that fails later
 // registers nothing).
@@ -62,12 +43,14 @@ struct PendingSet {
     std::string key;
 };
 
-Result<PendingSet> resolveSet(const Materials& m, const std::string& path, const TurbulenceDesc& fallback, bool keepColor = false) {
+// A given set is shared by content (no key); a procedural one by its parameters.
+Result<PendingSet> resolveSet(const Materials& m, const std::optional<TextureSet>& given, const TurbulenceDesc& fallback,
+                              bool keepColor = false) {
     PendingSet p;
-    p.key = path.empty() ? turbulenceKey(fallback) : folderKey(path, keepColor);
+    if (!given) p.key = turbulenceKey(fallback);
     if (!p.key.empty()) p.id = m.findTextureSet(p.key);
     if (p.id) return p;
-    Result<TextureSet> set = loadOrTurbulence(path, fallback, keepColor);
+    Result<TextureSet> set = setOrTurbulence(given, fallback, keepColor);
     if (!set) return makeError(set.error());
     p.set = std::move(*set);
     return p;
@@ -133,8 +116,8 @@ Result<Effect> fire(Materials& materials, const FireDesc& d) {
     // Sparse, sharp detail (contrast 2.5) reads as licking flames through the
     // ~20 splats that overlap on each pixel; plain turbulence averages to a haze.
     Result<PendingSet> set =
-        resolveSet(materials, d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .contrast = 2.5f});
-    if (!set) return makeError("FireDesc.textureSetPath: " + set.error());
+        resolveSet(materials, d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .contrast = 2.5f});
+    if (!set) return makeError("FireDesc.textureSet: " + set.error());
 
     for (Voxel& v : grid->voxels) v.opacity = d.opacity * flameOpacity(v.cell, grid->dims, 1.0f);
     grid->colorByHeight(); // sec. 2 step 4: height stands in for temperature
@@ -144,7 +127,7 @@ Result<Effect> fire(Materials& materials, const FireDesc& d) {
     e.textures.propagation = {.mode = Propagation::Fixed, .direction = {0, 1, 0}, .stepsPerSec = d.propagationStepsPerSec, .offset = 1};
     e.textures.cycling = {.mode = Cycling::Ordered, .texturesPerSec = d.texturesPerSec, .rateJitter = 0.2f};
     const Result<std::uint32_t> setId = registerSet(materials, *set);
-    if (!setId) return makeError("FireDesc.textureSetPath: " + setId.error());
+    if (!setId) return makeError("FireDesc.textureSet: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::fire());
     e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = d.crossfade}}};
     return Effect::fromGrid(std::move(*grid), std::move(e));
@@ -168,8 +151,8 @@ Result<Effect> smoke(Materials& materials, const SmokeDesc& d) {
     Result<FluidSolver> solver = FluidSolver::create(sd);
     if (!solver) return makeError("SmokeDesc: " + solver.error());
     Result<PendingSet> set =
-        resolveSet(materials, d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .baseFrequency = 2.0f});
-    if (!set) return makeError("SmokeDesc.textureSetPath: " + set.error());
+        resolveSet(materials, d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .baseFrequency = 2.0f});
+    if (!set) return makeError("SmokeDesc.textureSet: " + set.error());
     solver->addEmitter({.desc = {.offset = d.sourceOffset, .radius = d.sourceRadius, .density = 1.0f, .temperature = 1.0f, .rate = 6.0f},
                         .motion = restingAt(d.sourceMotion, d.position)});
 
@@ -178,7 +161,7 @@ Result<Effect> smoke(Materials& materials, const SmokeDesc& d) {
     e.textures.cycling = {.mode = Cycling::Ordered, .texturesPerSec = d.texturesPerSec, .rateJitter = 0.3f};
     e.sparse = {.opacityPerDensity = 0.5f, .minOpacity = 0.02f, .color = ColorSource::Height, .stretchPerSpeed = 0.15f, .maxStretch = 0.8f};
     const Result<std::uint32_t> setId = registerSet(materials, *set);
-    if (!setId) return makeError("SmokeDesc.textureSetPath: " + setId.error());
+    if (!setId) return makeError("SmokeDesc.textureSet: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::smoke());
     e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true}}};
     return Effect::fromSolver(std::move(*solver), std::move(e));
@@ -190,8 +173,8 @@ Result<Effect> steam(Materials& materials, const SteamDesc& d) {
     if (Status s = checkRate("SteamDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
     Result<Grid> grid = Grid::box(d.dims, d.spacing);
     if (!grid) return makeError("SteamDesc.dims/spacing: " + grid.error());
-    Result<PendingSet> set = resolveSet(materials, d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.textureSeed});
-    if (!set) return makeError("SteamDesc.textureSetPath: " + set.error());
+    Result<PendingSet> set = resolveSet(materials, d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.textureSeed});
+    if (!set) return makeError("SteamDesc.textureSet: " + set.error());
     for (Voxel& v : grid->voxels) {
         const float h = v.cell.y / float(std::max(d.dims.y - 1, 1));
         v.opacity = d.opacity * (1.0f - h) * (1.0f - h) + 0.02f * (1.0f - h);
@@ -202,7 +185,7 @@ Result<Effect> steam(Materials& materials, const SteamDesc& d) {
     e.textures.propagation = {.mode = Propagation::Fixed, .direction = {0, 1, 0}, .stepsPerSec = d.propagationStepsPerSec, .offset = 1};
     e.textures.cycling = {.mode = Cycling::Ordered, .texturesPerSec = d.texturesPerSec, .rateJitter = 0.25f};
     const Result<std::uint32_t> setId = registerSet(materials, *set);
-    if (!setId) return makeError("SteamDesc.textureSetPath: " + setId.error());
+    if (!setId) return makeError("SteamDesc.textureSet: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::steam());
     e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true}}};
     return Effect::fromGrid(std::move(*grid), std::move(e));
@@ -226,8 +209,8 @@ Result<Effect> dust(Materials& materials, const DustDesc& d) {
     Result<FluidSolver> solver = FluidSolver::create(sd);
     if (!solver) return makeError("DustDesc: " + solver.error());
     Result<PendingSet> set =
-        resolveSet(materials, d.textureSetPath, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .baseFrequency = 2.5f});
-    if (!set) return makeError("DustDesc.textureSetPath: " + set.error());
+        resolveSet(materials, d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .baseFrequency = 2.5f});
+    if (!set) return makeError("DustDesc.textureSet: " + set.error());
     solver->addEmitter({.desc = {.offset = d.sourceOffset, .radius = d.sourceRadius, .density = 1.0f, .temperature = 0.6f, .rate = 5.0f},
                         .motion = restingAt(d.sourceMotion, d.position)});
 
@@ -236,7 +219,7 @@ Result<Effect> dust(Materials& materials, const DustDesc& d) {
     e.textures.cycling = {.mode = Cycling::Ordered, .texturesPerSec = 3.0f, .rateJitter = 0.3f};
     e.sparse = {.opacityPerDensity = 0.5f, .minOpacity = 0.02f, .color = ColorSource::Density};
     const Result<std::uint32_t> setId = registerSet(materials, *set);
-    if (!setId) return makeError("DustDesc.textureSetPath: " + setId.error());
+    if (!setId) return makeError("DustDesc.textureSet: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::dust());
     e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true}}};
     return Effect::fromSolver(std::move(*solver), std::move(e));
@@ -248,11 +231,11 @@ Result<Effect> fireToSmoke(Materials& materials, const FireToSmokeDesc& d) {
     if (Status s = checkRate("FireToSmokeDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
     Result<Grid> grid = Grid::box(d.dims, d.spacing);
     if (!grid) return makeError("FireToSmokeDesc.dims/spacing: " + grid.error());
-    Result<PendingSet> fireSet = resolveSet(materials, d.fireTextureSetPath, {.count = 8, .size = 32, .seed = d.textureSeed});
-    if (!fireSet) return makeError("FireToSmokeDesc.fireTextureSetPath: " + fireSet.error());
+    Result<PendingSet> fireSet = resolveSet(materials, d.fireTextureSet, {.count = 8, .size = 32, .seed = d.textureSeed});
+    if (!fireSet) return makeError("FireToSmokeDesc.fireTextureSet: " + fireSet.error());
     Result<PendingSet> smokeSet =
-        resolveSet(materials, d.smokeTextureSetPath, {.count = 8, .size = 32, .seed = d.textureSeed + 1, .baseFrequency = 2.0f});
-    if (!smokeSet) return makeError("FireToSmokeDesc.smokeTextureSetPath: " + smokeSet.error());
+        resolveSet(materials, d.smokeTextureSet, {.count = 8, .size = 32, .seed = d.textureSeed + 1, .baseFrequency = 2.0f});
+    if (!smokeSet) return makeError("FireToSmokeDesc.smokeTextureSet: " + smokeSet.error());
 
     // Flame below the split; above it a plume that widens and thins.
     for (Voxel& v : grid->voxels) {
@@ -276,9 +259,9 @@ Result<Effect> fireToSmoke(Materials& materials, const FireToSmokeDesc& d) {
     // sec. 2 step 4: "mixing effects, such as smoke and fire, can be achieved
     // with multiple color tables and differing texture sets".
     const Result<std::uint32_t> fireId = registerSet(materials, *fireSet);
-    if (!fireId) return makeError("FireToSmokeDesc.fireTextureSetPath: " + fireId.error());
+    if (!fireId) return makeError("FireToSmokeDesc.fireTextureSet: " + fireId.error());
     const Result<std::uint32_t> smokeId = registerSet(materials, *smokeSet);
-    if (!smokeId) return makeError("FireToSmokeDesc.smokeTextureSetPath: " + smokeId.error());
+    if (!smokeId) return makeError("FireToSmokeDesc.smokeTextureSet: " + smokeId.error());
     const std::uint32_t fireLut = materials.addColorTable(ColorTable::fire());
     const std::uint32_t smokeLut = materials.addColorTable(ColorTable::smoke());
     e.layers = {
@@ -331,19 +314,14 @@ Result<Effect> ghosts(Materials& materials, const GhostsDesc& d) {
     if (Status s = checkUnit("GhostsDesc.opacity", d.opacity); !s) return makeError(s.error());
     if (Status s = checkRate("GhostsDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
     PendingSet set;
-    if (d.textureSetPath.empty()) {
+    if (!d.textureSet) {
         set.key = "faces(count=" + std::to_string(d.textureCount) + ",size=32,seed=" + std::to_string(d.textureSeed) + ")";
         set.id = materials.findTextureSet(set.key);
         if (!set.id) set.set = proceduralFaces(d.textureCount, 32, d.textureSeed);
     } else {
-        // A face folder keeps its colour, as TextureSet::load reads it.
-        set.key = folderKey(d.textureSetPath, true);
-        if (!set.key.empty()) set.id = materials.findTextureSet(set.key);
-        if (!set.id) {
-            Result<TextureSet> loaded = TextureSet::load(d.textureSetPath);
-            if (!loaded) return makeError("GhostsDesc.textureSetPath: " + loaded.error());
-            set.set = std::move(*loaded);
-        }
+        // Faces keep their colour; the set is shared by content.
+        if (d.textureSet->layers.empty() || d.textureSet->size < 1) return makeError("GhostsDesc.textureSet: the texture set has no textures");
+        set.set = *d.textureSet;
     }
 
     // A head-sized ball of voxels with a thinning column of faces above it.
@@ -373,7 +351,7 @@ Result<Effect> ghosts(Materials& materials, const GhostsDesc& d) {
     // sec. 5.3 / Fig. 10: faces chosen at random (sec. 3.3's surprising result).
     e.textures.cycling = {.mode = Cycling::Random, .texturesPerSec = d.texturesPerSec, .rateJitter = 0.4f};
     const Result<std::uint32_t> setId = registerSet(materials, set);
-    if (!setId) return makeError("GhostsDesc.textureSetPath: " + setId.error());
+    if (!setId) return makeError("GhostsDesc.textureSet: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::gradient(
         {{0.0f, {0.75f, 0.85f, 1.0f, 1.0f}}, {0.6f, {0.7f, 0.8f, 1.0f, 0.8f}}, {1.0f, {0.6f, 0.7f, 0.9f, 0.0f}}}));
     e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = false}}};

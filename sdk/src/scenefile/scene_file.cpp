@@ -505,8 +505,14 @@ struct Placement {
 glm::vec3 applyPoint(const glm::mat4& m, glm::vec3 p) { return glm::vec3(m * glm::vec4(p, 1.0f)); }
 
 // Turns a texture spec into a preset's path (a folder or empty for procedural).
-std::string presetPath(const std::optional<TextureSpec>& t) {
-    return t && t->kind == TextureSpec::Kind::Folder ? t->folder : std::string();
+// A texture-set folder named for a preset, loaded here: the presets are in
+// the file-free core and take the set in memory. Errors go to the
+// diagnostics at the effect's path; callers check c.d.ok() afterwards.
+std::optional<TextureSet> presetSet(Context& c, const EffectCommon& e, const std::optional<TextureSpec>& t) {
+    if (!t || t->kind != TextureSpec::Kind::Folder) return std::nullopt;
+    Result<TextureSet> set = TextureSet::load(t->folder);
+    if (!set) return c.d.error(e.path, set.error()), std::nullopt;
+    return std::move(*set);
 }
 
 // Fire and steam share their fields: a lattice, textures, opacity and the
@@ -526,7 +532,8 @@ std::optional<Effect> readLatticePreset(Context& c, ObjectReader& o, const Effec
     o.number("texturesPerSec", d.texturesPerSec, 0.0, 1e3);
     extra(d);
     if (!c.d.ok()) return std::nullopt;
-    d.textureSetPath = presetPath(tex);
+    d.textureSet = presetSet(c, e, tex);
+    if (!c.d.ok()) return std::nullopt;
     d.position = applyPoint(pl.parent, d.position);
     d.motion = pl.motion;
     d.seed = e.seed;
@@ -557,8 +564,9 @@ std::optional<Effect> readFireToSmoke(Context& c, ObjectReader& o, const EffectC
     o.number("propagationStepsPerSec", d.propagationStepsPerSec, 1e-3, 1e3);
     o.number("texturesPerSec", d.texturesPerSec, 0.0, 1e3);
     if (!c.d.ok()) return std::nullopt;
-    d.fireTextureSetPath = presetPath(fireTex);
-    d.smokeTextureSetPath = presetPath(smokeTex);
+    d.fireTextureSet = presetSet(c, e, fireTex);
+    d.smokeTextureSet = presetSet(c, e, smokeTex);
+    if (!c.d.ok()) return std::nullopt;
     d.position = applyPoint(pl.parent, d.position);
     d.motion = pl.motion;
     d.seed = e.seed;
@@ -582,7 +590,8 @@ std::optional<Effect> readGhosts(Context& c, ObjectReader& o, const EffectCommon
     if (!e.attachTo.empty() || e.motion)
         c.d.error(e.path, "kind \"ghosts\" stays where it is put: it takes no \"motion\" or \"attachTo\" (place it with \"position\")");
     if (!c.d.ok()) return std::nullopt;
-    d.textureSetPath = presetPath(tex);
+    d.textureSet = presetSet(c, e, tex);
+    if (!c.d.ok()) return std::nullopt;
     d.position = applyPoint(pl.parent, d.position);
     d.seed = e.seed;
     Result<Effect> r = presets::ghosts(c.materials, d);
@@ -614,7 +623,8 @@ std::optional<Effect> readSolverKind(Context& c, ObjectReader& o, const EffectCo
         if (const Json* t = o.get("textureSet")) tex = readTextureSpec(c, o.at("textureSet"), *t, d.textureCount, e.seed, true);
         if (tex) d.textureCount = tex->count;
         if (!c.d.ok()) return std::nullopt;
-        d.textureSetPath = presetPath(tex);
+        d.textureSet = presetSet(c, e, tex);
+        if (!c.d.ok()) return std::nullopt;
         d.sourceMotion = sourceMotion ? *sourceMotion : pl.motion;
         d.sourceOffset = applyPoint(pl.parent, d.sourceOffset);
         d.seed = e.seed;
@@ -635,7 +645,8 @@ std::optional<Effect> readSolverKind(Context& c, ObjectReader& o, const EffectCo
     o.number("texturesPerSec", d.texturesPerSec, 0.0, 1e3);
     o.integer("substeps", d.substeps, 1, 16);
     if (!c.d.ok()) return std::nullopt;
-    d.textureSetPath = presetPath(tex);
+    d.textureSet = presetSet(c, e, tex);
+    if (!c.d.ok()) return std::nullopt;
     d.sourceMotion = sourceMotion ? *sourceMotion : pl.motion;
     d.sourceOffset = applyPoint(pl.parent, d.sourceOffset);
     d.seed = e.seed;

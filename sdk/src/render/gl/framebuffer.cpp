@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "context_check.hpp"
+#include "formats.hpp"
 
 namespace splatfx::gl {
 
@@ -16,7 +17,7 @@ Result<Framebuffer> Framebuffer::create(const FramebufferDesc& desc) {
                          " must be between 1 and 16384 on each side");
     Framebuffer fb;
     fb.mDesc = desc;
-    const GLenum format = desc.color == Precision::U8 ? GL_RGBA8 : desc.color == Precision::F16 ? GL_RGBA16F : GL_RGBA32F;
+    const GLenum format = detail::colorFormat(desc.color);
     glCreateTextures(GL_TEXTURE_2D, 1, &fb.mColor);
     glTextureStorage2D(fb.mColor, 1, format, desc.width, desc.height);
     glCreateTextures(GL_TEXTURE_2D, 1, &fb.mDepth);

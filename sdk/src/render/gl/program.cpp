@@ -1,11 +1,16 @@
-#include "program.hpp"
+#include "splatfx/gl/program.hpp"
 
 #include <string>
+#include <type_traits>
 #include <vector>
 
-namespace splatfx::gl::detail {
+#include <epoxy/gl.h>
 
-Result<GLuint> linkProgram(std::initializer_list<const char*> vertex, std::initializer_list<const char*> fragment, const char* what) {
+namespace splatfx::gl {
+
+static_assert(std::is_same_v<GLuint, unsigned>, "splatfx/gl/program.hpp hands out GL names as unsigned");
+
+Result<unsigned> linkProgram(std::initializer_list<const char*> vertex, std::initializer_list<const char*> fragment, const char* what) {
     const std::vector<const char*> sources[2] = {vertex, fragment};
     GLuint stages[2] = {glCreateShader(GL_VERTEX_SHADER), glCreateShader(GL_FRAGMENT_SHADER)};
     std::string log;
@@ -41,4 +46,4 @@ Result<GLuint> linkProgram(std::initializer_list<const char*> vertex, std::initi
     return program;
 }
 
-} // namespace splatfx::gl::detail
+} // namespace splatfx::gl

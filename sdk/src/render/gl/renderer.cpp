@@ -12,69 +12,12 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "context_check.hpp"
-#include "program.hpp"
+#include "saved_state.hpp"
+#include "splatfx/gl/program.hpp"
 #include "shaders.hpp"
 
 namespace splatfx::gl {
 namespace {
-
-// Host state draw() changes, captured so it can be put back.
-struct SavedState {
-    GLint drawFbo = 0, program = 0, vao = 0, arrayBuffer = 0, activeTexture = 0;
-    GLint viewport[4] = {};
-    GLint tex0 = 0, tex1 = 0;
-    GLboolean blend = 0, depthTest = 0, depthMask = 0, cull = 0;
-    GLboolean colorMask[4] = {};
-    GLint blendSrcRgb = 0, blendDstRgb = 0, blendSrcA = 0, blendDstA = 0, blendEqRgb = 0, blendEqA = 0, depthFunc = 0;
-
-    void save() {
-        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &drawFbo);
-        glGetIntegerv(GL_CURRENT_PROGRAM, &program);
-        glGetIntegerv(GL_VERTEX_ARRAY_BINDING, &vao);
-        glGetIntegerv(GL_ARRAY_BUFFER_BINDING, &arrayBuffer);
-        glGetIntegerv(GL_ACTIVE_TEXTURE, &activeTexture);
-        glGetIntegerv(GL_VIEWPORT, viewport);
-        glActiveTexture(GL_TEXTURE0);
-        glGetIntegerv(GL_TEXTURE_BINDING_2D_ARRAY, &tex0);
-        glActiveTexture(GL_TEXTURE1);
-        glGetIntegerv(GL_TEXTURE_BINDING_2D, &tex1);
-        blend = glIsEnabled(GL_BLEND);
-        depthTest = glIsEnabled(GL_DEPTH_TEST);
-        cull = glIsEnabled(GL_CULL_FACE);
-        glGetBooleanv(GL_DEPTH_WRITEMASK, &depthMask);
-        glGetBooleanv(GL_COLOR_WRITEMASK, colorMask);
-        glGetIntegerv(GL_BLEND_SRC_RGB, &blendSrcRgb);
-        glGetIntegerv(GL_BLEND_DST_RGB, &blendDstRgb);
-        glGetIntegerv(GL_BLEND_SRC_ALPHA, &blendSrcA);
-        glGetIntegerv(GL_BLEND_DST_ALPHA, &blendDstA);
-        glGetIntegerv(GL_BLEND_EQUATION_RGB, &blendEqRgb);
-        glGetIntegerv(GL_BLEND_EQUATION_ALPHA, &blendEqA);
-        glGetIntegerv(GL_DEPTH_FUNC, &depthFunc);
-    }
-    void restore() const {
-        auto set = [](GLenum cap, GLboolean on) { on ? glEnable(cap) : glDisable(cap); };
-        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(drawFbo));
-        // A host may delete its program or vertex array while still bound; once
-        // ours replaced it, the name is gone and rebinding it would be an error.
-        glUseProgram(glIsProgram(GLuint(program)) ? GLuint(program) : 0);
-        glBindVertexArray(glIsVertexArray(GLuint(vao)) ? GLuint(vao) : 0);
-        glBindBuffer(GL_ARRAY_BUFFER, glIsBuffer(GLuint(arrayBuffer)) ? GLuint(arrayBuffer) : 0);
-        glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D_ARRAY, GLuint(tex0));
-        glActiveTexture(GL_TEXTURE1);
-        glBindTexture(GL_TEXTURE_2D, GLuint(tex1));
-        glActiveTexture(GLenum(activeTexture));
-        set(GL_BLEND, blend);
-        set(GL_DEPTH_TEST, depthTest);
-        set(GL_CULL_FACE, cull);
-        glDepthMask(depthMask);
-        glColorMask(colorMask[0], colorMask[1], colorMask[2], colorMask[3]);
-        glBlendFuncSeparate(GLenum(blendSrcRgb), GLenum(blendDstRgb), GLenum(blendSrcA), GLenum(blendDstA));
-        glBlendEquationSeparate(GLenum(blendEqRgb), GLenum(blendEqA));
-        glDepthFunc(GLenum(depthFunc));
-    }
-};
 
 // An n x n RGBA layer resampled to (factor n)^2 with GL's bilinear rule
 // (texel centres at (i + 0.5) / size, clamped at the edges), so that
@@ -176,7 +119,7 @@ Result<Renderer> Renderer::create(const RendererDesc& desc) {
     auto impl = std::make_unique<Impl>();
     impl->desc = desc;
     for (int crossfade = 0; crossfade < 2; ++crossfade) {
-        auto linked = detail::linkProgram({detail::kSplatVertex},
+        auto linked = linkProgram({detail::kSplatVertex},
                                           {"#version 450 core\n", crossfade ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n", detail::kSplatFragment},
                                           "splat");
         if (!linked) return makeError(linked.error());
@@ -277,8 +220,9 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
         anyCrossfade |= splats[i].blend > 0.0f;
     }
 
-    SavedState saved;
-    if (r.desc.restoreState) saved.save();
+    // draw() binds only unit 0's texture array (no GL_TEXTURE_2D, no scissor).
+    detail::SavedState saved;
+    if (r.desc.restoreState) saved.save({.texture2DUnits = 0, .scissor = false});
 
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
     glViewport(target.x, target.y, target.width, target.height);

@@ -9,70 +9,13 @@
 #include <epoxy/gl.h>
 
 #include "context_check.hpp"
-#include "program.hpp"
+#include "formats.hpp"
+#include "saved_state.hpp"
+#include "splatfx/gl/program.hpp"
 #include "scaled_shaders.hpp"
 
 namespace splatfx::gl {
 namespace {
-
-// The host state the two extra passes touch, beyond what Renderer documents.
-class HostState {
-public:
-    void capture() {
-        glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &mDrawFbo);
-        glGetIntegerv(GL_VIEWPORT, mViewport);
-        glGetIntegerv(GL_CURRENT_PROGRAM, &mProgram);
-        glGetIntegerv(GL_VERTEX_ARRAY_BINDING, &mVao);
-        glGetIntegerv(GL_ARRAY_BUFFER_BINDING, &mArrayBuffer);
-        glGetIntegerv(GL_ACTIVE_TEXTURE, &mActive);
-        for (int u = 0; u < 3; ++u) {
-            glActiveTexture(GLenum(GL_TEXTURE0 + u));
-            glGetIntegerv(GL_TEXTURE_BINDING_2D, &mTex2D[u]);
-        }
-        glActiveTexture(GL_TEXTURE0);
-        glGetIntegerv(GL_TEXTURE_BINDING_2D_ARRAY, &mTexArray0);
-        mCaps[0] = glIsEnabled(GL_BLEND);
-        mCaps[1] = glIsEnabled(GL_DEPTH_TEST);
-        mCaps[2] = glIsEnabled(GL_CULL_FACE);
-        glGetBooleanv(GL_DEPTH_WRITEMASK, &mDepthMask);
-        glGetBooleanv(GL_COLOR_WRITEMASK, mColorMask);
-        const GLenum blendQueries[6] = {GL_BLEND_SRC_RGB, GL_BLEND_DST_RGB, GL_BLEND_SRC_ALPHA, GL_BLEND_DST_ALPHA,
-                                        GL_BLEND_EQUATION_RGB, GL_BLEND_EQUATION_ALPHA};
-        for (int i = 0; i < 6; ++i) glGetIntegerv(blendQueries[i], &mBlend[i]);
-        glGetIntegerv(GL_DEPTH_FUNC, &mDepthFunc);
-        mScissor = glIsEnabled(GL_SCISSOR_TEST);
-        glGetIntegerv(GL_SCISSOR_BOX, mScissorBox);
-    }
-    void apply() const {
-        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(mDrawFbo));
-        glViewport(mViewport[0], mViewport[1], mViewport[2], mViewport[3]);
-        glUseProgram(GLuint(mProgram));
-        glBindVertexArray(GLuint(mVao));
-        glBindBuffer(GL_ARRAY_BUFFER, GLuint(mArrayBuffer));
-        for (int u = 0; u < 3; ++u) {
-            glActiveTexture(GLenum(GL_TEXTURE0 + u));
-            glBindTexture(GL_TEXTURE_2D, GLuint(mTex2D[u]));
-        }
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D_ARRAY, GLuint(mTexArray0));
-        glActiveTexture(GLenum(mActive));
-        const GLenum caps[3] = {GL_BLEND, GL_DEPTH_TEST, GL_CULL_FACE};
-        for (int i = 0; i < 3; ++i) mCaps[i] ? glEnable(caps[i]) : glDisable(caps[i]);
-        glDepthMask(mDepthMask);
-        glColorMask(mColorMask[0], mColorMask[1], mColorMask[2], mColorMask[3]);
-        glBlendFuncSeparate(GLenum(mBlend[0]), GLenum(mBlend[1]), GLenum(mBlend[2]), GLenum(mBlend[3]));
-        glBlendEquationSeparate(GLenum(mBlend[4]), GLenum(mBlend[5]));
-        glDepthFunc(GLenum(mDepthFunc));
-        mScissor ? glEnable(GL_SCISSOR_TEST) : glDisable(GL_SCISSOR_TEST);
-        glScissor(mScissorBox[0], mScissorBox[1], mScissorBox[2], mScissorBox[3]);
-    }
-
-private:
-    GLint mDrawFbo = 0, mViewport[4] = {}, mProgram = 0, mVao = 0, mArrayBuffer = 0, mActive = 0;
-    GLint mTex2D[3] = {}, mTexArray0 = 0, mBlend[6] = {}, mDepthFunc = 0;
-    GLboolean mCaps[3] = {}, mDepthMask = 0, mColorMask[4] = {}, mScissor = 0;
-    GLint mScissorBox[4] = {};
-};
 
 // Window-space rectangle (x0, y0, x1, y1), relative to the viewport, that the
 // splats' quads can touch; the whole viewport when one crosses the eye plane.
@@ -123,7 +66,7 @@ struct ScaledRenderer::Impl {
     void ensureTarget(int w, int h) {
         if (w == lowW && h == lowH && fbo) return;
         releaseTarget();
-        const GLenum format = desc.precision == Precision::U8 ? GL_RGBA8 : desc.precision == Precision::F16 ? GL_RGBA16F : GL_RGBA32F;
+        const GLenum format = detail::colorFormat(desc.precision);
         glCreateTextures(GL_TEXTURE_2D, 1, &color);
         glTextureStorage2D(color, 1, format, w, h);
         glCreateTextures(GL_TEXTURE_2D, 1, &depth);
@@ -159,10 +102,10 @@ Result<ScaledRenderer> ScaledRenderer::create(const ScaledRendererDesc& desc) {
     auto impl = std::make_unique<Impl>();
     impl->desc = desc;
     impl->inner = std::move(*inner);
-    auto down = detail::linkProgram({detail::kFullscreenVertex}, {detail::kDepthDownsampleFragment}, "depth downsample");
+    auto down = linkProgram({detail::kFullscreenVertex}, {detail::kDepthDownsampleFragment}, "depth downsample");
     if (!down) return makeError(down.error());
     impl->downsample = *down;
-    auto comp = detail::linkProgram({detail::kFullscreenVertex}, {detail::kCompositeFragment}, "upsample composite");
+    auto comp = linkProgram({detail::kFullscreenVertex}, {detail::kCompositeFragment}, "upsample composite");
     if (!comp) return makeError(comp.error());
     impl->composite = *comp;
     glCreateVertexArrays(1, &impl->emptyVao);
@@ -175,11 +118,13 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
     Impl& r = *mImpl;
     assert(target.width > 0 && target.height > 0 && "ScaledTarget::width and height must be positive");
     const bool restore = r.desc.renderer.restoreState;
-    HostState saved;
-    if (restore) saved.capture();
+    // The three passes bind GL_TEXTURE_2D on units 0-2 (colour, depth, host
+    // depth copy), the texture array on unit 0, and scissor to the splats.
+    detail::SavedState saved;
+    if (restore) saved.save({.texture2DUnits = 3, .scissor = true});
     if (r.desc.scale == 1) {
         r.inner->draw(splats, camera, {target.framebuffer, target.x, target.y, target.width, target.height});
-        if (restore) saved.apply();
+        if (restore) saved.restore();
         return;
     }
     const int s = r.desc.scale;
@@ -189,7 +134,7 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
     // rasterizer a full-screen pass costs as much as the effect itself.
     const glm::ivec4 box = splatBounds(splats, camera, target.width, target.height);
     if (box.z <= box.x || box.w <= box.y) {
-        if (restore) saved.apply();
+        if (restore) saved.restore();
         return;
     }
     const glm::ivec4 lowBox{std::max(box.x / s - 1, 0), std::max(box.y / s - 1, 0), std::min(box.z / s + 2, r.lowW), std::min(box.w / s + 2, r.lowH)};
@@ -273,7 +218,7 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
     glBindVertexArray(r.emptyVao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glDisable(GL_SCISSOR_TEST);
-    if (restore) saved.apply();
+    if (restore) saved.restore();
 }
 
 } // namespace splatfx::gl
