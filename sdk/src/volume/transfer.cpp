@@ -100,8 +100,12 @@ bool TransferFunction::zeroOpacity(double lo, double hi) const {
     return true;
 }
 
-glm::dvec4 integrateSegment(const TransferFunction& transfer, double sf, double sb, double length, double mf,
-                            double mb) {
+namespace {
+
+// The integral with its two accuracy knobs: the optical depth per Gauss-Legendre
+// step and the transmittance at which the rest is dropped.
+glm::dvec4 integrateSegmentWith(const TransferFunction& transfer, double sf, double sb, double length, double mf,
+                                double mb, double maxStepDepth, double minTransmittance) {
     if (std::isnan(sf) || std::isnan(sb) || std::isnan(mf) || std::isnan(mb) || std::isnan(length) || !(length > 0.0))
         return glm::dvec4(0.0);
     length = std::min(length, 1e30); // beyond this the transmittance is 0 in double for any extinction > 1e-28
@@ -134,7 +138,7 @@ glm::dvec4 integrateSegment(const TransferFunction& transfer, double sf, double 
 
     glm::dvec3 color(0.0);
     double T = 1.0;
-    for (int piece = 0; piece + 1 < nu && T > kMinTransmittance; ++piece) {
+    for (int piece = 0; piece + 1 < nu && T > minTransmittance; ++piece) {
         const double ua = u[piece], ub = u[piece + 1];
         if (!(ub > ua)) continue;
         const double sMid = sf + (sb - sf) * (0.5 * (ua + ub));
@@ -163,10 +167,10 @@ glm::dvec4 integrateSegment(const TransferFunction& transfer, double sf, double 
             return m;
         };
         double x = ua, h = ub - ua;
-        while (x < ub && T > kMinTransmittance) {
+        while (x < ub && T > minTransmittance) {
             h = std::min(ub - x, 2.0 * h);
             const double km = kMax(x, x + h);
-            if (km * h > kMaxStepDepth) h = kMaxStepDepth / km; // k's max cannot grow as h shrinks
+            if (km * h > maxStepDepth) h = maxStepDepth / km; // k's max cannot grow as h shrinks
             if (x + h <= x) {
                 // The extinction is so large that the step underflows: the rest is opaque here.
                 color += T * cAt(x);
@@ -187,6 +191,18 @@ glm::dvec4 integrateSegment(const TransferFunction& transfer, double sf, double 
     return glm::dvec4(color, 1.0 - T);
 }
 
+// For the float table: steps of optical depth 1 (the 5-point rule then errs
+// ~1e-9 relative, below float's 6e-8) and a cut at transmittance 1e-9.
+constexpr double kTableStepDepth = 1.0;
+constexpr double kTableMinTransmittance = 1e-9;
+
+} // namespace
+
+glm::dvec4 integrateSegment(const TransferFunction& transfer, double sf, double sb, double length, double mf,
+                            double mb) {
+    return integrateSegmentWith(transfer, sf, sb, length, mf, mb, kMaxStepDepth, kMinTransmittance);
+}
+
 Result<PreIntegrationTable> PreIntegrationTable::create(const TransferFunction& transfer,
                                                         const PreIntegrationDesc& desc) {
     if (desc.scalarResolution < 2 || desc.scalarResolution > 1024)
@@ -204,7 +220,8 @@ Result<PreIntegrationTable> PreIntegrationTable::create(const TransferFunction& 
         const double l = double(k) / double(m - 1) * double(desc.maxLengthWorld);
         for (int j = 0; j < n; ++j)
             for (int i = 0; i < n; ++i) {
-                const glm::dvec4 v = integrateSegment(transfer, double(i) / (n - 1), double(j) / (n - 1), l);
+                const glm::dvec4 v = integrateSegmentWith(transfer, double(i) / (n - 1), double(j) / (n - 1), l, 1.0, 1.0,
+                                                          kTableStepDepth, kTableMinTransmittance);
                 float* o = &t.mData[4 * (std::size_t(i) + std::size_t(n) * (std::size_t(j) + std::size_t(n) * std::size_t(k)))];
                 o[0] = float(v.r);
                 o[1] = float(v.g);
