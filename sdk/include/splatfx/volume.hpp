@@ -279,6 +279,13 @@ private:
     std::vector<std::pair<int, std::uint32_t>> mMorphWritten; // nodes whose e' was set last frame
 };
 
+// The same emission-absorption integral through an emitted (LOD) mesh, e.g.
+// LodFrame::tets: every tetrahedron the ray crosses gives one linear piece,
+// integrated by integrateSegment, composited front to back in ray order (not
+// list order). Brute force, O(tets) per ray: for references and tests.
+glm::dvec4 integrateRay(const std::vector<Tetrahedron>& tets, const TransferFunction& transfer, glm::dvec3 originWorld,
+                        glm::dvec3 dir, double tNear, double tFar);
+
 // Clip a tetrahedron to the visible side of a plane (dot(normal, x) >= offset)
 // as a volume (sec. 4.3): 0 (all outside), 1 (a tetrahedron: untouched, or the
 // tip left by three outside vertices) or 3 (a prism) tetrahedra are appended

@@ -154,3 +154,61 @@ glm::dvec4 LodVolume::integrateRay(const TransferFunction& transfer, glm::dvec3 
 }
 
 } // namespace splatfx
+
+namespace splatfx {
+
+glm::dvec4 integrateRay(const std::vector<Tetrahedron>& tets, const TransferFunction& transfer, glm::dvec3 o,
+                        glm::dvec3 d, double tNear, double tFar) {
+    const double speed = glm::length(d);
+    if (!(speed > 0.0) || !std::isfinite(speed) || std::isnan(tNear) || std::isnan(tFar)) return glm::dvec4(0.0);
+    struct Piece {
+        double t0, t1;
+        std::size_t tet;
+    };
+    std::vector<Piece> pieces;
+    static constexpr int kFaces[4][4] = {{1, 2, 3, 0}, {0, 2, 3, 1}, {0, 1, 3, 2}, {0, 1, 2, 3}};
+    for (std::size_t i = 0; i < tets.size(); ++i) {
+        const Tetrahedron& t = tets[i];
+        double lo = tNear, hi = tFar;
+        for (const auto& f : kFaces) {
+            const glm::dvec3 a(t.position[std::size_t(f[0])]), b(t.position[std::size_t(f[1])]),
+                c(t.position[std::size_t(f[2])]), q(t.position[std::size_t(f[3])]);
+            glm::dvec3 n = glm::cross(b - a, c - a);
+            if (glm::dot(n, q - a) < 0.0) n = -n; // inward
+            const double num = glm::dot(n, o - a), den = glm::dot(n, d);
+            if (den == 0.0) {
+                if (num < 0.0) hi = lo - 1.0;
+                continue;
+            }
+            const double tc = -num / den;
+            if (den > 0.0) lo = std::max(lo, tc);
+            else hi = std::min(hi, tc);
+        }
+        if (hi > lo) pieces.push_back({lo, hi, i});
+    }
+    std::sort(pieces.begin(), pieces.end(), [](const Piece& a, const Piece& b) { return a.t0 < b.t0; });
+    glm::dvec3 color(0.0);
+    double T = 1.0, reached = tNear;
+    for (const Piece& p : pieces) {
+        const double t0 = std::max(p.t0, reached); // shared faces: each stretch of the ray once
+        if (!(p.t1 > t0)) continue;
+        const Tetrahedron& t = tets[p.tet];
+        // Barycentric coordinates of the two ends (double).
+        const glm::dvec3 p0(t.position[0]);
+        const glm::dmat3 m(glm::dvec3(t.position[1]) - p0, glm::dvec3(t.position[2]) - p0, glm::dvec3(t.position[3]) - p0);
+        const glm::dmat3 inv = glm::inverse(m);
+        auto at = [&](double tt, const std::array<float, 4>& v) {
+            const glm::dvec3 l = inv * (o + d * tt - p0);
+            return (1.0 - l.x - l.y - l.z) * v[0] + l.x * v[1] + l.y * v[2] + l.z * v[3];
+        };
+        const glm::dvec4 seg = integrateSegment(transfer, at(t0, t.scalar), at(p.t1, t.scalar), (p.t1 - t0) * speed,
+                                                at(t0, t.lengthScale), at(p.t1, t.lengthScale));
+        color += T * glm::dvec3(seg);
+        T *= 1.0 - seg.a;
+        reached = p.t1;
+        if (T < 1e-18) break;
+    }
+    return glm::dvec4(color, 1.0 - T);
+}
+
+} // namespace splatfx
