@@ -420,10 +420,14 @@ TEST(LodVolumeHardCases, SmallestVolumeNIsOne) {
 }
 
 TEST(LodVolumeHardCases, LargestNUnderTheMemoryBudgetAndAClearErrorBeyond) {
-    const std::size_t budget = std::size_t(64) << 20; // 64 MiB
+    // A small budget keeps the test light; the rule is the same for the 1 GiB default
+    // (largest cube n = 9, 231 MB with one field).
+    const std::size_t budget = std::size_t(1) << 20; // 1 MiB
     int largest = 1;
     while (LodVolume::bytesFor(glm::ivec3((1 << (largest + 1)) + 1), false) <= budget) ++largest;
-    EXPECT_EQ(largest, 8); // 257^3 points at ~1.71 bytes each = 29 MB; 513^3 would be 231 MB
+    EXPECT_EQ(largest, 6); // 65^3 points at ~1.71 bytes each = 470 kB; 129^3 would be 3.7 MB
+    EXPECT_LE(LodVolume::bytesFor(glm::ivec3(513), false), std::size_t(1) << 30);
+    EXPECT_GT(LodVolume::bytesFor(glm::ivec3(1025), false), std::size_t(1) << 30);
     const int side = (1 << largest) + 1;
     auto v = LodVolume::create(voltest::constantField(glm::ivec3(side), 0.25f), {.memoryBudgetBytes = budget});
     ASSERT_TRUE(v) << v.error();

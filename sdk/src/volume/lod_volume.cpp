@@ -230,6 +230,12 @@ Result<LodVolume> LodVolume::create(const ScalarVolume& field, const LodVolumeDe
         return makeError("LodVolumeDesc.rootLevel must be 0 (auto) or in [1, " + std::to_string(kMaxRootLevel) + "]");
     if (!std::isfinite(desc.padValue) || desc.padValue < 0.0f || desc.padValue > 1.0f)
         return makeError("LodVolumeDesc.padValue must be in [0, 1]");
+    const std::size_t need = bytesFor(d, !field.lengthScale.empty(), desc.rootLevel);
+    if (need > desc.memoryBudgetBytes)
+        return makeError("LodVolume: a " + std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z) +
+                         " field needs " + std::to_string(need) + " bytes, above LodVolumeDesc.memoryBudgetBytes = " +
+                         std::to_string(desc.memoryBudgetBytes));
+
     for (std::size_t i = 0; i < field.scalar.size(); ++i) {
         const float v = field.scalar[i];
         if (!std::isfinite(v) || v < 0.0f || v > 1.0f)
@@ -240,12 +246,6 @@ Result<LodVolume> LodVolume::create(const ScalarVolume& field, const LodVolumeDe
         if (!std::isfinite(v) || v < 0.0f || v > 1.0f)
             return makeError("ScalarVolume.lengthScale[" + std::to_string(i) + "] must be finite and in [0, 1]");
     }
-    const std::size_t need = bytesFor(d, !field.lengthScale.empty(), desc.rootLevel);
-    if (need > desc.memoryBudgetBytes)
-        return makeError("LodVolume: a " + std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z) +
-                         " field needs " + std::to_string(need) + " bytes, above LodVolumeDesc.memoryBudgetBytes = " +
-                         std::to_string(desc.memoryBudgetBytes));
-
     LodVolume v;
     v.mRootLevel = desc.rootLevel > 0 ? desc.rootLevel : autoRootLevel(d);
     v.mRoots = rootsFor(d, v.mRootLevel);
