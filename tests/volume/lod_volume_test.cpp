@@ -334,6 +334,29 @@ TEST(LodVolume, EmittedTetrahedraAreInBackToFrontOrder) {
     EXPECT_GT(overlaps, 1000);
 }
 
+TEST(LodVolume, OrthographicViewsAreOrderedAlongTheViewDirection) {
+    auto v = LodVolume::create(voltest::randomField({17, 17, 17}, 19), {});
+    ASSERT_TRUE(v) << v.error();
+    const glm::vec3 eye(-10, 30, 25), target(8, 8, 8);
+    const Camera cam = Camera::fromMatrices(glm::lookAt(eye, target, glm::vec3(0, 0, 1)),
+                                            glm::ortho(-15.0f, 15.0f, -12.0f, 12.0f, 0.5f, 200.0f), {64, 48});
+    ASSERT_FALSE(cam.perspective());
+    LodRefineDesc r;
+    r.detailC = 2.0f;
+    r.zeroOpacityTest = false;
+    LodFrame f;
+    ASSERT_TRUE(v->update(cam, r, nullptr, f));
+    ASSERT_FALSE(f.tets.empty());
+    // Parallel rays along the view direction from a grid of points on the near plane.
+    int overlaps = 0;
+    for (int i = 0; i < 30; ++i) {
+        const glm::dvec3 o = glm::dvec3(eye) + double((i % 6) - 2.5) * 2.0 * glm::dvec3(cam.right()) +
+                             double((i / 6) - 2.0) * 2.0 * glm::dvec3(cam.up());
+        expectBackToFront(f.tets, o, {glm::dvec3(cam.forward())}, overlaps);
+    }
+    EXPECT_GT(overlaps, 200);
+}
+
 TEST(LodVolume, RootForestIsOrderedBackToFrontToo) {
     // 33x33x9 points: 4x4x1 roots of n = 3.
     auto v = LodVolume::create(voltest::randomField({33, 33, 9}, 10), {});

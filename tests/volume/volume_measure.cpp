@@ -17,7 +17,7 @@
 
 int main(int argc, char** argv) {
     glm::ivec3 dims(257, 257, 33);
-    float detailC = 100.0f, minC = 4.0f;
+    float detailC = 10.0f, minC = 4.0f;
     int frames = 120;
     bool average = false;
     for (int i = 1; i < argc; ++i) {

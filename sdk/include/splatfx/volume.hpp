@@ -17,7 +17,7 @@
 //
 //   auto vol = splatfx::LodVolume::create(*splatfx::makeCloudVolume({}), {});
 //   splatfx::LodFrame frame;
-//   vol->update(camera, {.detailC = 200}, &transfer, frame); // frame.tets back to front
+//   vol->update(camera, {.detailC = 10}, &transfer, frame); // frame.tets back to front
 //
 // Threading: TransferFunction, PreIntegrationTable and ScalarVolume are plain
 // values (const methods thread-safe). A LodVolume is used by one thread at a
@@ -157,7 +157,7 @@ struct LodVolumeDesc {
 
 // Per-frame refinement settings.
 struct LodRefineDesc {
-    float detailC = 100.0f;      // default 100: c of eq. 1 (per unit scalar deviation); higher is finer
+    float detailC = 10.0f;       // default 10: c of eq. 1 (per unit scalar deviation); higher is finer (docs/volume.md: count vs error)
     bool morph = true;           // default true: volumetric morphing (sec. 3); false pops between levels
     bool frustumCull = true;     // default true: hierarchical view-frustum culling (sec. 4.2)
     bool zeroOpacityTest = true; // default true: drop nodes and tetrahedra of zero opacity (sec. 4.1); needs a transfer function
