@@ -568,3 +568,17 @@ TEST(LodVolume, RayThroughTheEmittedFinestMeshEqualsTheGridReference) {
         for (int ch = 0; ch < 4; ++ch) EXPECT_NEAR(a[ch], b[ch], 1e-6) << "ray " << i << " channel " << ch;
     }
 }
+
+TEST(LodVolumeHardCases, NonFiniteRaysAndPointsGiveZero) {
+    auto v = LodVolume::create(voltest::randomField({5, 5, 5}, 20), {});
+    ASSERT_TRUE(v);
+    auto tf = makeCloudTransfer({});
+    ASSERT_TRUE(tf);
+    const double nan = std::nan(""), inf = std::numeric_limits<double>::infinity();
+    EXPECT_EQ(v->integrateRay(*tf, {nan, 1, 1}, {1, 0, 0}, 0.0, 10.0), glm::dvec4(0.0));
+    EXPECT_EQ(v->integrateRay(*tf, {-1, 1, 1}, {inf, 0, 0}, 0.0, 10.0), glm::dvec4(0.0));
+    EXPECT_EQ(v->integrateRay(*tf, {-1, 1, 1}, {0, 0, 0}, 0.0, 10.0), glm::dvec4(0.0));
+    EXPECT_EQ(v->sampleFinest({nan, 0, 0}), glm::dvec2(0.0));
+    const glm::dvec4 r = v->integrateRay(*tf, {-1, 1.5, 1.5}, {1, 0, 0}, 0.0, inf); // to infinity: the grid ends it
+    EXPECT_TRUE(std::isfinite(r.a));
+}

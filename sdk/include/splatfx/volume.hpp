@@ -243,12 +243,14 @@ public:
     static unsigned centreTetCorners(glm::ivec3 node);
 
     // The finest-level piecewise-linear field at a world point: (scalar,
-    // length scale); points outside the grid are clamped onto it.
+    // length scale); points outside the grid are clamped onto it; a
+    // non-finite point gives (0, 0).
     glm::dvec2 sampleFinest(glm::dvec3 pointWorld) const;
     // Emission-absorption integral along origin + t dir, t in [tNear, tFar],
     // through the finest tetrahedral mesh (no LOD, no table: every linear piece
     // is integrated by integrateSegment). Premultiplied RGBA, front to back.
-    // `dir` need not be unit; lengths are world lengths.
+    // `dir` need not be unit; lengths are world lengths. Non-finite origin or
+    // direction give 0.
     glm::dvec4 integrateRay(const TransferFunction& transfer, glm::dvec3 originWorld, glm::dvec3 dir, double tNear,
                             double tFar) const;
 
@@ -276,7 +278,7 @@ private:
     DeltaMode mDeltaMode = DeltaMode::Max;
     std::vector<std::uint8_t> mScalar, mLength;
     std::vector<Level> mLevels; // index = level; level 0 (unit cells) has no node storage
-    std::vector<std::pair<int, std::uint32_t>> mMorphWritten; // nodes whose e' was set last frame
+    std::vector<std::pair<int, std::size_t>> mMorphWritten; // nodes whose e' was set last frame
 };
 
 // The same emission-absorption integral through an emitted (LOD) mesh, e.g.

@@ -664,7 +664,7 @@ Status LodVolume::update(const Camera& camera, const LodRefineDesc& refine, cons
         const double e = errorMetric(level, n, eye, refine.detailC);
         if (!(e > 1.0)) continue;
         const double ePrime = std::min(std::max(e - 1.0, 0.0), 1.0);
-        const std::uint32_t idx = std::uint32_t(nodeIndex(level, n));
+        const std::size_t idx = nodeIndex(level, n);
         mLevels[std::size_t(level)].morph[idx] = std::uint8_t(1 + std::lround(ePrime * double(kMorphSteps)));
         mMorphWritten.push_back({level, idx});
         ++out.stats.nodesRefined;

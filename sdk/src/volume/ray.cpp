@@ -37,6 +37,7 @@ double cellValue(const double (&v)[8], bool odd, glm::dvec3 where, glm::dvec3 u)
 } // namespace
 
 glm::dvec2 LodVolume::sampleFinest(glm::dvec3 pw) const {
+    if (!std::isfinite(pw.x) || !std::isfinite(pw.y) || !std::isfinite(pw.z)) return glm::dvec2(0.0);
     glm::dvec3 g = (pw - glm::dvec3(mOrigin)) / double(mSpacing);
     const glm::dvec3 hi = glm::dvec3(mDims - 1);
     g = glm::clamp(g, glm::dvec3(0.0), hi);
@@ -56,6 +57,7 @@ glm::dvec4 LodVolume::integrateRay(const TransferFunction& transfer, glm::dvec3 
                                    double tFar) const {
     const double speed = glm::length(dir); // world length per unit t
     if (!(speed > 0.0) || !std::isfinite(speed) || std::isnan(tNear) || std::isnan(tFar)) return glm::dvec4(0.0);
+    if (!std::isfinite(origin.x) || !std::isfinite(origin.y) || !std::isfinite(origin.z)) return glm::dvec4(0.0);
     // Grid space: one unit per cell.
     const glm::dvec3 o = (origin - glm::dvec3(mOrigin)) / double(mSpacing);
     const glm::dvec3 d = dir / double(mSpacing);
@@ -161,6 +163,7 @@ glm::dvec4 integrateRay(const std::vector<Tetrahedron>& tets, const TransferFunc
                         glm::dvec3 d, double tNear, double tFar) {
     const double speed = glm::length(d);
     if (!(speed > 0.0) || !std::isfinite(speed) || std::isnan(tNear) || std::isnan(tFar)) return glm::dvec4(0.0);
+    if (!std::isfinite(o.x) || !std::isfinite(o.y) || !std::isfinite(o.z)) return glm::dvec4(0.0);
     struct Piece {
         double t0, t1;
         std::size_t tet;
