@@ -26,3 +26,4 @@
 #include "splatfx/solver.hpp"
 #include "splatfx/splats.hpp"
 #include "splatfx/texture_set.hpp"
+#include "splatfx/volume.hpp"
