@@ -4,17 +4,14 @@
 #include <cassert>
 #include <cmath>
 #include <cstdint>
-#include <sstream>
 #include <string>
+
+#include "grid/number_text.hpp"
 
 namespace splatfx {
 namespace {
 
-std::string str(float v) {
-    std::ostringstream os;
-    os << v;
-    return os.str();
-}
+using grid_detail::str;
 
 bool finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 

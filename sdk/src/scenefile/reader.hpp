@@ -52,6 +52,20 @@ struct Context {
 
 // [SECTION] Shared pieces
 
+// An object read by body(c, o, value) into a default T; nullopt when v is not
+// an object or anything was reported while reading it (unknown keys included).
+template <class T, class Body>
+std::optional<T> readObject(Context& c, const std::string& path, const Json& v, Body body) {
+    ObjectReader o(c.d, path, v);
+    if (!o.valid()) return std::nullopt;
+    const std::size_t before = c.d.count();
+    T value{};
+    body(c, o, value);
+    o.finish();
+    if (c.d.count() != before) return std::nullopt;
+    return value;
+}
+
 // A path from the file, resolved against the scene file's folder.
 std::string resolvePath(const Context& c, const std::string& p);
 
@@ -82,6 +96,10 @@ std::optional<TextureSpec> readTextureSpec(Context& c, const std::string& path, 
 Result<TextureSet> buildTextureSet(const TextureSpec& t);
 // A preset's texture-set path: the folder, or empty for procedural.
 std::string presetPath(const std::optional<TextureSpec>& t);
+
+// A preset's "textureSet" (a folder or a procedural count) when given;
+// `count` becomes its count.
+std::optional<TextureSpec> readPresetTextureSet(Context& c, ObjectReader& o, std::uint32_t seed, int& count);
 
 std::optional<ColorTable> readColorTable(Context& c, const std::string& path, const Json& v);
 

@@ -232,6 +232,13 @@ std::string presetPath(const std::optional<TextureSpec>& t) {
     return t && t->kind == TextureSpec::Kind::Folder ? t->folder : std::string();
 }
 
+std::optional<TextureSpec> readPresetTextureSet(Context& c, ObjectReader& o, std::uint32_t seed, int& count) {
+    std::optional<TextureSpec> tex;
+    if (const Json* t = o.get("textureSet")) tex = readTextureSpec(c, o.at("textureSet"), *t, count, seed, true);
+    if (tex) count = tex->count;
+    return tex;
+}
+
 std::optional<ColorTable> readColorTable(Context& c, const std::string& path, const Json& v) {
     if (v.is_string()) {
         auto s = readChoice(c.d, path, v, {"fire", "smoke", "steam", "dust"});

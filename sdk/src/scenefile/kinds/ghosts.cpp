@@ -10,9 +10,7 @@ std::optional<Effect> readGhosts(Context& c, ObjectReader& o, const EffectCommon
     o.integer("plumeCells", d.plumeCells, 0, 256);
     o.vec3("spacing", d.spacing, 1e-4, 1e3, true);
     o.vec3("position", d.position, -kMaxCoord, kMaxCoord);
-    std::optional<TextureSpec> tex;
-    if (const Json* t = o.get("textureSet")) tex = readTextureSpec(c, o.at("textureSet"), *t, d.textureCount, e.seed, true);
-    if (tex) d.textureCount = tex->count;
+    const std::optional<TextureSpec> tex = readPresetTextureSet(c, o, e.seed, d.textureCount);
     o.number("opacity", d.opacity, 1e-6, 1.0);
     o.number("texturesPerSec", d.texturesPerSec, 0.0, 1e3);
     o.number("propagationStepsPerSec", d.propagationStepsPerSec, 1e-3, 1e3);

@@ -7,11 +7,9 @@
 namespace splatfx::scenefile {
 namespace {
 
-std::optional<Shape> readShape(Context& c, const std::string& path, const Json& v) {
-    ObjectReader o(c.d, path, v);
-    if (!o.valid()) return std::nullopt;
-    const std::size_t before = c.d.count();
-    Shape s;
+// One entry of "shapes", in lattice cells.
+void readShape(Context& c, ObjectReader& o, Shape& s) {
+    const std::string& path = o.path();
     std::string type;
     if (const Json* t = o.get("type")) {
         if (auto x = readChoice(c.d, o.at("type"), *t, {"box", "sphere", "cylinder", "cone"})) type = *x;
@@ -49,16 +47,9 @@ std::optional<Shape> readShape(Context& c, const std::string& path, const Json& 
     }
     o.number("opacity", s.opacity, 0.0, 1.0);
     o.number("softCells", s.softCells, 0.05, L);
-    o.finish();
-    if (c.d.count() != before) return std::nullopt;
-    return s;
 }
 
-std::optional<PropagationDesc> readPropagation(Context& c, const std::string& path, const Json& v) {
-    ObjectReader o(c.d, path, v);
-    if (!o.valid()) return std::nullopt;
-    const std::size_t before = c.d.count();
-    PropagationDesc p;
+void readPropagation(Context& c, ObjectReader& o, PropagationDesc& p) {
     if (const Json* m = o.get("mode"))
         if (auto s = readChoice(c.d, o.at("mode"), *m, {"none", "fixed"})) p.mode = *s == "none" ? Propagation::None : Propagation::Fixed;
     o.ivec3("direction", p.direction, -8, 8);
@@ -67,25 +58,15 @@ std::optional<PropagationDesc> readPropagation(Context& c, const std::string& pa
     o.integer("offset", offset, 0, 1 << 20);
     p.offset = std::uint32_t(offset);
     if (p.mode == Propagation::Fixed && p.direction == glm::ivec3(0)) c.d.error(o.at("direction"), "must be non-zero for mode \"fixed\"");
-    o.finish();
-    if (c.d.count() != before) return std::nullopt;
-    return p;
 }
 
-std::optional<CyclingDesc> readCycling(Context& c, const std::string& path, const Json& v) {
-    ObjectReader o(c.d, path, v);
-    if (!o.valid()) return std::nullopt;
-    const std::size_t before = c.d.count();
-    CyclingDesc cy;
+void readCycling(Context& c, ObjectReader& o, CyclingDesc& cy) {
     if (const Json* m = o.get("mode"))
         if (auto s = readChoice(c.d, o.at("mode"), *m, {"none", "ordered", "random"}))
             cy.mode = *s == "none" ? Cycling::None : *s == "ordered" ? Cycling::Ordered : Cycling::Random;
     o.number("texturesPerSec", cy.texturesPerSec, 0.0, 1e3);
     o.number("rateJitter", cy.rateJitter, 0.0, 0.99);
     o.boolean("randomStart", cy.randomStart);
-    o.finish();
-    if (c.d.count() != before) return std::nullopt;
-    return cy;
 }
 
 } // namespace
@@ -103,7 +84,7 @@ std::optional<Effect> readGridKind(Context& c, ObjectReader& o, const EffectComm
         if (!s->is_array() || s->size() > 256) c.d.error(o.at("shapes"), "expected an array of at most 256 shapes, got " + brief(*s));
         else
             for (std::size_t i = 0; i < s->size(); ++i)
-                if (auto sh = readShape(c, index(o.at("shapes"), i), (*s)[i])) shapes.push_back(*sh);
+                if (auto sh = readObject<Shape>(c, index(o.at("shapes"), i), (*s)[i], readShape)) shapes.push_back(*sh);
     }
     float opacity = 0.5f, fadeTo = 1.0f;
     glm::vec3 colorAxis(0, 1, 0);
@@ -122,9 +103,9 @@ std::optional<Effect> readGridKind(Context& c, ObjectReader& o, const EffectComm
     EffectDesc desc;
     desc.textures.seed = e.seed;
     if (const Json* p = o.get("propagation"))
-        if (auto x = readPropagation(c, o.at("propagation"), *p)) desc.textures.propagation = *x;
+        if (auto x = readObject<PropagationDesc>(c, o.at("propagation"), *p, readPropagation)) desc.textures.propagation = *x;
     if (const Json* p = o.get("cycling"))
-        if (auto x = readCycling(c, o.at("cycling"), *p)) desc.textures.cycling = *x;
+        if (auto x = readObject<CyclingDesc>(c, o.at("cycling"), *p, readCycling)) desc.textures.cycling = *x;
     bool crossfade = true;
     o.boolean("crossfade", crossfade);
     if (!c.d.ok() || !tex || !table) return std::nullopt;

@@ -15,9 +15,7 @@ std::optional<Effect> readLatticePreset(Context& c, ObjectReader& o, const Effec
     readDims(c, o, d.dims, kMaxVoxels, "grid effects");
     o.vec3("spacing", d.spacing, 1e-4, 1e3, true);
     o.vec3("position", d.position, -kMaxCoord, kMaxCoord);
-    std::optional<TextureSpec> tex;
-    if (const Json* t = o.get("textureSet")) tex = readTextureSpec(c, o.at("textureSet"), *t, d.textureCount, e.seed, true);
-    if (tex) d.textureCount = tex->count;
+    const std::optional<TextureSpec> tex = readPresetTextureSet(c, o, e.seed, d.textureCount);
     o.number("opacity", d.opacity, 1e-6, 1.0);
     o.number("propagationStepsPerSec", d.propagationStepsPerSec, 1e-3, 1e3);
     o.number("texturesPerSec", d.texturesPerSec, 0.0, 1e3);

@@ -31,9 +31,7 @@ std::optional<Effect> readSolverEffect(Context& c, ObjectReader& o, const Effect
     o.vec3("windWorld", d.windWorld, -1e3, 1e3);
     if constexpr (requires { d.settle; }) o.number("settle", d.settle, 0.0, 1e3);
     o.number("dissipation", d.dissipation, 0.0, 1e3);
-    std::optional<TextureSpec> tex;
-    if (const Json* t = o.get("textureSet")) tex = readTextureSpec(c, o.at("textureSet"), *t, d.textureCount, e.seed, true);
-    if (tex) d.textureCount = tex->count;
+    const std::optional<TextureSpec> tex = readPresetTextureSet(c, o, e.seed, d.textureCount);
     if constexpr (requires { d.texturesPerSec; }) o.number("texturesPerSec", d.texturesPerSec, 0.0, 1e3);
     if constexpr (requires { d.substeps; }) o.integer("substeps", d.substeps, 1, 16);
     if (!c.d.ok()) return std::nullopt;
