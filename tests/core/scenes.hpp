@@ -1,9 +1,9 @@
 // Small scenes shared by the core GL tests.
 #pragma once
 
-#include <cmath>
 #include <cstdint>
 
+#include "splatfx/shapes.hpp"
 #include "splatfx/splatfx.hpp"
 
 namespace splatfx::test {
@@ -13,10 +13,7 @@ namespace splatfx::test {
 inline Grid campfireGrid(std::uint32_t seed) {
     Grid g = *Grid::box({7, 20, 5}, glm::vec3(0.5f));
     for (Voxel& v : g.voxels) {
-        const float h = v.cell.y / 19.0f;
-        const float rx = (v.cell.x - 3.0f) / 3.5f, rz = (v.cell.z - 2.0f) / 2.5f;
-        const float edge = std::fmin(std::fmax(((1.0f - 0.75f * h) - std::sqrt(rx * rx + rz * rz)) / 0.35f + 0.3f, 0.0f), 1.0f);
-        v.opacity = 0.55f * (1.0f - 0.6f * h) * edge;
+        v.opacity = 0.55f * flameOpacity(v.cell, g.dims);
         std::uint32_t x = std::uint32_t(v.cell.x * 73856093) ^ std::uint32_t(v.cell.y * 19349663) ^ std::uint32_t(v.cell.z * 83492791) ^ seed;
         x ^= x >> 13;
         x *= 0x5bd1e995u;

@@ -123,10 +123,7 @@ Error compare(const splatfx::Image& a, const splatfx::Image& b) {
 splatfx::Grid fireGrid(int quantum) {
     splatfx::Grid g = *splatfx::Grid::box({7, 20, 5}, glm::vec3(0.5f));
     for (splatfx::Voxel& v : g.voxels) {
-        const float h = v.cell.y / 19.0f;
-        const float rx = (v.cell.x - 3.0f) / 3.5f, rz = (v.cell.z - 2.0f) / 2.5f;
-        const float edge = std::clamp((1.0f - 0.75f * h - std::sqrt(rx * rx + rz * rz)) / 0.35f + 0.3f, 0.0f, 1.0f);
-        v.opacity = 0.55f * (1.0f - 0.6f * h) * edge;
+        v.opacity = 0.55f * splatfx::flameOpacity(v.cell, g.dims);
         const std::uint32_t j = splatfx::hashCell(v.cell, kSeed, 7) % kTruthCount;
         v.texture = j - j % std::uint32_t(quantum); // loop position, in truth-set textures
     }

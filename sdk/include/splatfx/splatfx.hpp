@@ -23,6 +23,7 @@
 #include "splatfx/result.hpp"
 #include "splatfx/scene.hpp"
 #include "splatfx/scene_file.hpp"
+#include "splatfx/shapes.hpp"
 #include "splatfx/solver.hpp"
 #include "splatfx/splats.hpp"
 #include "splatfx/texture_set.hpp"

@@ -45,6 +45,16 @@ struct TurbulenceDesc {
     float contrast = 1.0f;
 };
 
+// Windows cut from one larger image (King et al. 1999, sec. 4 / Fig. 11:
+// textures taken at random positions from a photograph).
+struct ImageSampleDesc {
+    int count = 16;           // windows cut, >= 1; default 16
+    int size = 32;            // window side in pixels (the set's texture size), >= 1; default 32
+    std::uint32_t seed = 1;   // picks the window positions; default 1
+    bool keepColor = false;   // keep RGB detail (else grayscale); default false
+    std::string sourceName = "the image"; // names the image in messages (e.g. "image 'wood.jpg'"); default "the image"
+};
+
 class TextureSet {
 public:
     int size = 0;        // texels on a side (square)
@@ -61,6 +71,12 @@ public:
     static Result<TextureSet> load(const std::string& folder);
     // One texture per image file; all must be square and the same size.
     static Result<TextureSet> fromImages(const std::vector<Image>& images, bool keepColor);
+    // desc.count square windows of desc.size pixels at seeded positions
+    // inside `source` (each window lies wholly inside it), as fromImages
+    // makes them. Fails when the image is smaller than a window (the message
+    // names it with desc.sourceName), when its pixels do not match its size,
+    // or as fromImages fails. Pure: reading the file is the caller's part.
+    static Result<TextureSet> sampleImage(const Image& source, const ImageSampleDesc& desc);
     // Writes a texture-set folder atomically (temporary folder, then rename). splatfx::io.
     Status save(const std::string& folder, const std::string& provenanceJson = "{}") const;
 

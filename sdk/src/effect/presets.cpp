@@ -8,6 +8,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "splatfx/shapes.hpp"
+
 namespace splatfx::presets {
 namespace {
 
@@ -75,18 +77,6 @@ Status checkUnit(const char* field, float v) {
 Status checkRate(const char* field, float v) {
     if (!(v >= 0.0f && std::isfinite(v))) return makeError(std::string(field) + " must be finite and >= 0, got " + std::to_string(v));
     return {};
-}
-
-// A flame: dense at the base and along the axis, narrowing and thinning
-// with height (the gross shape; the detail lives in the textures, sec. 2).
-float flameOpacity(glm::ivec3 cell, glm::ivec3 dims, float topHeight) {
-    const float h = cell.y / float(std::max(dims.y - 1, 1)) / topHeight;
-    const float rx = (cell.x - 0.5f * (dims.x - 1)) / (0.5f * dims.x);
-    const float rz = (cell.z - 0.5f * (dims.z - 1)) / (0.5f * dims.z);
-    const float r = std::sqrt(rx * rx + rz * rz);
-    const float width = 1.0f - 0.75f * std::min(h, 1.0f);
-    const float edge = std::clamp((width - r) / 0.35f + 0.3f, 0.0f, 1.0f);
-    return std::max(1.0f - 0.6f * h, 0.0f) * edge;
 }
 
 EffectDesc gridDesc(const char* name, const Materials& m, const Motion& motion, std::uint32_t seed) {

@@ -1,18 +1,14 @@
 #include "splatfx/grid.hpp"
 
 #include <cmath>
-#include <sstream>
 #include <string>
+
+#include "grid/number_text.hpp"
 
 namespace splatfx {
 namespace {
 
-// Shortest readable form: "0.25", "-1", "nan", "inf".
-std::string str(float v) {
-    std::ostringstream os;
-    os << v;
-    return os.str();
-}
+using grid_detail::str;
 
 Status checkSpacing(glm::vec3 spacing) {
     for (int a = 0; a < 3; ++a)

@@ -1,0 +1,81 @@
+// Scene files: the effects list. The keys every kind takes are read here;
+// the rest by the kind's reader, found in the table in kinds.cpp.
+#include "scenefile/kinds.hpp"
+#include "scenefile/reader.hpp"
+
+namespace splatfx::scenefile {
+
+void readEffects(Context& c, const std::string& path, const Json& v, const std::vector<RawGeometry>& geo,
+                 const std::map<std::string, std::size_t>& geoByName, SceneFile& out) {
+    if (!v.is_array() || v.size() > kMaxEffects) {
+        c.d.error(path, "expected an array of at most " + std::to_string(kMaxEffects) + " effects, got " + typeName(v) + " " + brief(v));
+        return;
+    }
+    const std::vector<std::string> kinds = effectKindNames();
+    std::string kindList; // "fire, smoke, ..."
+    for (std::size_t k = 0; k < kinds.size(); ++k) kindList += (k ? ", " : "") + kinds[k];
+    std::uint64_t totalCells = 0;
+    std::map<std::string, std::size_t> names;
+    for (std::size_t i = 0; i < v.size() && !c.d.full(); ++i) {
+        EffectCommon e;
+        e.path = index(path, i);
+        ObjectReader o(c.d, e.path, v[i]);
+        if (!o.valid()) continue;
+        if (const Json* k = o.get("kind")) {
+            if (auto s = readChoice(c.d, o.at("kind"), *k, kinds)) e.kind = *s;
+        } else {
+            c.d.error(e.path, "missing \"kind\" (one of " + kindList + ")");
+        }
+        if (e.kind.empty()) continue; // kind-specific keys cannot be checked without it
+        e.name = e.kind + std::to_string(i);
+        o.string("name", e.name);
+        if (names.count(e.name)) c.d.error(o.at("name"), "duplicate effect name '" + e.name + "'");
+        names[e.name] = i;
+        std::uint32_t localSeed = std::uint32_t(i);
+        o.seed("seed", localSeed);
+        // Every effect's seed derives from the scene seed (so --seed changes them all).
+        e.seed = c.sceneSeed * 1000003u + localSeed;
+        o.boolean("enabled", e.options.enabled);
+        o.number("rangeWorld", e.options.rangeWorld, 0.0, 1e9);
+        o.boolean("traditional", e.traditional);
+        if (const Json* t = o.get("toggles")) {
+            ObjectReader to(c.d, o.at("toggles"), *t);
+            to.boolean("object", e.toggles.object);
+            to.boolean("global", e.toggles.global);
+            to.boolean("local", e.toggles.local);
+            to.finish();
+        }
+        o.string("attachTo", e.attachTo);
+        if (const Json* m = o.get("motion")) {
+            if (!e.attachTo.empty()) c.d.error(o.at("motion"), "an effect either has its own \"motion\" or is attached to geometry; not both");
+            e.motion = readMotion(c, o.at("motion"), *m);
+        }
+        Placement pl;
+        if (!e.attachTo.empty()) {
+            if (auto a = resolveAnchor(c, geo, geoByName, e.attachTo, o.at("attachTo"))) pl.motion = a->motion, pl.parent = a->transform;
+        } else if (e.motion) {
+            pl.motion = *e.motion; // kinds that stay put (solver effects, ghosts) refuse it themselves
+        }
+        const std::size_t before = c.d.count();
+        std::optional<Effect> effect = findEffectKind(e.kind)->read(c, o, e, pl);
+        o.finish();
+        if (!effect || c.d.count() != before) continue;
+        totalCells += effect->costCells(); // EffectKind: cells or voxels one advance evaluates
+        if (totalCells > kMaxVoxels) {
+            c.d.error(e.path, "the scene's effects hold more than " + std::to_string(kMaxVoxels) + " voxels/cells in all");
+            return;
+        }
+        effect->setToggles(e.toggles);
+        e.options.name = e.name;
+        e.options.draw.textured = !e.traditional; // the Scene owns how each effect is drawn
+        SceneEffectInfo info;
+        info.name = e.name;
+        info.kind = e.kind;
+        info.attachedTo = e.attachTo;
+        info.traditional = e.traditional;
+        info.id = out.scene.add(std::move(*effect), e.options);
+        out.effects.push_back(info);
+    }
+}
+
+} // namespace splatfx::scenefile

@@ -1,0 +1,108 @@
+// The registry of scene-file kinds (sdk/src/scenefile/kinds.cpp), CPU only:
+// the table, the messages that list it and the readers behind it agree, so a
+// kind added with one file and one table row is offered, named and built.
+#include <algorithm>
+#include <set>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "scenefile/kinds.hpp"
+#include "splatfx/scene_file.hpp"
+
+namespace {
+
+const std::string kHead = R"("format": "splatfx-scene", "version": 1)";
+
+splatfx::Result<splatfx::SceneFile> parse(const std::string& body) {
+    splatfx::Materials m(splatfx::Footprint{});
+    return splatfx::parseSceneFile("{" + kHead + ", " + body + "}", "dir/scene.json", m);
+}
+
+// The smallest entry each kind builds from (grid needs its lattice; solver
+// kinds a small domain so the test stays fast).
+std::string minimalEffect(const std::string& kind) {
+    if (kind == "grid") return R"({"kind": "grid", "dims": [3, 3, 3]})";
+    if (kind == "smoke" || kind == "dust") return R"({"kind": ")" + kind + R"(", "dims": [4, 4, 4]})";
+    return R"({"kind": ")" + kind + R"("})";
+}
+
+} // namespace
+
+TEST(SceneFileKinds, TablesHaveUniqueNamesAndEveryEffectKindAReader) {
+    std::set<std::string_view> names;
+    for (const auto& k : splatfx::scenefile::effectKinds()) {
+        EXPECT_TRUE(names.insert(k.name).second) << "effect kind listed twice: " << k.name;
+        EXPECT_NE(k.read, nullptr) << k.name;
+        EXPECT_EQ(splatfx::scenefile::findEffectKind(k.name), &k);
+    }
+    EXPECT_EQ(splatfx::scenefile::findEffectKind("fog"), nullptr);
+    std::set<std::string_view> types;
+    for (const auto& g : splatfx::scenefile::geometryKinds()) {
+        EXPECT_TRUE(types.insert(g.name).second) << "geometry type listed twice: " << g.name;
+        EXPECT_EQ(splatfx::scenefile::findGeometryKind(g.name), &g);
+    }
+    EXPECT_EQ(splatfx::scenefile::findGeometryKind("torus"), nullptr);
+    // A missing type is read on as a box, so the table must have one.
+    ASSERT_NE(splatfx::scenefile::findGeometryKind("box"), nullptr);
+}
+
+TEST(SceneFileKinds, AnUnknownKindNamesEveryKnownKind) {
+    auto r = parse(R"("effects": [{"kind": "fgo"}])");
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().find("dir/scene.json: effects[0].kind: unknown value \"fgo\""), std::string::npos) << r.error();
+    std::string listed;
+    for (const std::string& k : splatfx::scenefile::effectKindNames()) listed += (listed.empty() ? "" : ", ") + ("\"" + k + "\"");
+    EXPECT_NE(r.error().find("expected one of " + listed), std::string::npos) << r.error();
+    // The list is the documented one (docs/scene-format.md), in its order.
+    EXPECT_EQ(listed, R"("fire", "smoke", "steam", "dust", "fireToSmoke", "ghosts", "grid")");
+    auto missing = parse(R"("effects": [{"name": "a"}])");
+    ASSERT_FALSE(missing);
+    EXPECT_NE(missing.error().find("missing \"kind\" (one of fire, smoke, steam, dust, fireToSmoke, ghosts, grid)"), std::string::npos)
+        << missing.error();
+}
+
+TEST(SceneFileKinds, AnUnknownGeometryTypeNamesEveryKnownType) {
+    auto r = parse(R"("geometry": [{"type": "torus"}])");
+    ASSERT_FALSE(r);
+    for (const std::string& t : splatfx::scenefile::geometryKindNames())
+        EXPECT_NE(r.error().find("\"" + t + "\""), std::string::npos) << t << " not offered in:\n" << r.error();
+    auto missing = parse(R"("geometry": [{}])");
+    ASSERT_FALSE(missing);
+    EXPECT_NE(missing.error().find(R"(missing "type" ("plane", "box", "cylinder", "sphere", "mesh" or "empty"))"), std::string::npos)
+        << missing.error();
+}
+
+TEST(SceneFileKinds, EveryRegisteredKindBuildsFromItsSmallestEntry) {
+    for (const std::string& kind : splatfx::scenefile::effectKindNames()) {
+        auto r = parse(R"("effects": [)" + minimalEffect(kind) + "]");
+        ASSERT_TRUE(r) << kind << ": " << r.error();
+        ASSERT_EQ(r->effects.size(), 1u) << kind;
+        EXPECT_EQ(r->effects[0].kind, kind);
+        EXPECT_EQ(r->effects[0].name, kind + "0");
+    }
+    for (const auto& g : splatfx::scenefile::geometryKinds()) {
+        if (g.read) continue; // types with keys of their own (mesh) need a file; scene_file_test covers them
+        auto r = parse(R"("geometry": [{"type": ")" + std::string(g.name) + R"("}])");
+        ASSERT_TRUE(r) << g.name << ": " << r.error();
+        EXPECT_EQ(r->geometry.at(0).type, g.type) << g.name;
+    }
+}
+
+TEST(SceneFileKinds, SmokeAndDustShareOneReaderButKeepTheirOwnKeys) {
+    // settle is dust's, substeps and texturesPerSec smoke's: each is unknown to the other.
+    auto smoke = parse(R"("effects": [{"kind": "smoke", "dims": [4, 4, 4], "settle": 1}])");
+    ASSERT_FALSE(smoke);
+    EXPECT_NE(smoke.error().find("effects[0].settle: unknown key"), std::string::npos) << smoke.error();
+    auto dust = parse(R"("effects": [{"kind": "dust", "dims": [4, 4, 4], "substeps": 2}])");
+    ASSERT_FALSE(dust);
+    EXPECT_NE(dust.error().find("effects[0].substeps: unknown key"), std::string::npos) << dust.error();
+    EXPECT_TRUE(parse(R"("effects": [{"kind": "smoke", "dims": [4, 4, 4], "substeps": 2, "texturesPerSec": 1}])"));
+    EXPECT_TRUE(parse(R"("effects": [{"kind": "dust", "dims": [4, 4, 4], "settle": 1}])"));
+    // Both refuse their own motion with the kind named.
+    for (const char* kind : {"smoke", "dust"}) {
+        auto moved = parse(std::string(R"("effects": [{"kind": ")") + kind + R"(", "dims": [4, 4, 4], "motion": {"velocity": [1, 0, 0]}}])");
+        ASSERT_FALSE(moved) << kind;
+        EXPECT_NE(moved.error().find(std::string("solver effects (\"") + kind + "\") stay put"), std::string::npos) << moved.error();
+    }
+}
