@@ -6,6 +6,7 @@
 #include "splatfx/color_table.hpp"
 #include "splatfx/dynamics.hpp"
 #include "splatfx/effect.hpp"
+#include "splatfx/fog.hpp"
 #include "splatfx/footprint.hpp"
 #include "splatfx/gl/framebuffer.hpp"
 #include "splatfx/gl/renderer.hpp"
