@@ -141,10 +141,10 @@ Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& opt) {
         // does not subtract two large cell coordinates in float.
         s += "float " + P + "_poly" + id + "_piece(float la, float lb, float uAnchor, float lAnchor, float dU, float L) {\n"
              "    if (lb <= la) return 0.0;\n"
-             "    float mid = 0.5 * (la + lb), half = 0.5 * (lb - la), sum = 0.0;\n"
+             "    float mid = 0.5 * (la + lb), hw = 0.5 * (lb - la), sum = 0.0;\n"
              "    for (int j = 0; j < 5; ++j) sum += " + P + "_GW[j] * " + P + "_poly" + id +
-             "(uAnchor + (mid + half * " + P + "_GX[j] - lAnchor) * dU);\n"
-             "    return sum * half * L;\n"
+             "(uAnchor + (mid + hw * " + P + "_GX[j] - lAnchor) * dU);\n"
+             "    return sum * hw * L;\n"
              "}\n";
         const std::string pv = P + "_params[" + std::to_string(base) + "]";
         const char axisChar = "xyz"[std::max(p.usedAxis, 0)];
