@@ -82,7 +82,7 @@ enum class FogTermKind {
 
 enum class FogCellMode {
     Periodic,    // the reference cell repeats over all space (Biri et al. Fig. 3)
-    ZeroOutside, // the polynomial is zero outside its cell
+    ZeroOutside, // the polynomial is zero outside its cell (on the axes it depends on)
 };
 
 // One monomial coeff * u^px * v^py * w^pz of a polynomial in cell coordinates.
