@@ -154,16 +154,25 @@ double errorBound(const Fog& fog, const Seg& s, glm::dvec3 ref, double tSec, con
                 sumA += std::abs(m.coeff);
                 sumNA += std::abs(m.coeff) * (m.px + m.py + m.pz);
             }
-            int a = 0;
-            for (const FogMonomial& m : t.monomials) a = m.py > 0 ? 1 : m.pz > 0 ? 2 : m.px > 0 ? 0 : a;
-            const double h = t.cellHalfSize[a];
-            const double U = (glm::length(oR) + glm::length(pR)) / h + 4.0;
+            bool used[3] = {false, false, false};
+            for (const FogMonomial& m : t.monomials) {
+                used[0] = used[0] || m.px > 0;
+                used[1] = used[1] || m.py > 0;
+                used[2] = used[2] || m.pz > 0;
+            }
+            const int nUsed = int(used[0]) + int(used[1]) + int(used[2]);
+            const int a = used[0] ? 0 : used[1] ? 1 : 2;
+            double h = 1e300;
+            for (int b = 0; b < 3; ++b)
+                if (used[b]) h = std::min(h, t.cellHalfSize[b]);
+            const double U = (glm::length(oR) + glm::length(pR)) / std::min(h, 1e300) + 4.0;
             bound += w * L * sumA * 64 * kEps;
-            // The two partial cells are placed with an error eps U (in cell units); together they
-            // span at most 4 cell half-sizes along the axis, i.e. a path of min(L, 4 h / |e_a|),
-            // over which the slope is at most sum n |a_n|.
+            // Cell coordinates carry an error eps U (cell units) and the slope is at most
+            // sum n |a_n|: in 1D only the two partial cells see it, together at most 4 half-sizes
+            // along the axis (a path of min(L, 4 h / |e_a|)); a multi-variable walk, the whole L.
             const double ea = L > 0.0 ? std::abs((s.p - s.o)[a]) / L : 0.0;
-            bound += w * sumNA * kEps * U * (ea > 0.0 ? std::min(L, 4.0 * h / ea) : L);
+            const double path = nUsed > 1 || ea == 0.0 ? L : std::min(L, 4.0 * h / ea);
+            bound += w * sumNA * kEps * U * path;
             break;
         }
         case FogTermKind::Point:
@@ -203,6 +212,10 @@ std::vector<Seg> segmentsFrom(glm::dvec3 eye, int n, unsigned seed) {
         }
     }
     out.push_back({eye, eye}); // zero length
+    // Axis-aligned rays (a polynomial's other variables stay fixed: the O(1) cell count).
+    out.push_back({eye, eye + glm::dvec3(3.7e4, 0, 0)});
+    out.push_back({eye, eye + glm::dvec3(0, 0, -6.1e4)});
+    out.push_back({eye, eye + glm::dvec3(0, 2.2e3, 0)});
     return out;
 }
 
@@ -265,17 +278,31 @@ TEST_F(FogGlslGL, EveryTermKindWithWind) {
 
 TEST_F(FogGlslGL, ZeroTermsCompiles) { check(FogDesc{}, {1, 2, 3}, 0.0, "no terms"); }
 
-TEST_F(FogGlslGL, MultiVariablePolynomialIsRefusedWithAMessage) {
-    FogDesc d;
+TEST_F(FogGlslGL, PolynomialsInThreeVariables) {
+    // Periodic: cells large enough that no test ray crosses more than maxPolynomialCells (1024):
+    // a 1e5 ray crosses at most 1e5 (1/400 + 1/300 + 1/500) < 800 cells.
     FogTerm t;
     t.kind = FogTermKind::Polynomial;
-    t.monomials = {{1.0, 0, 0, 0}, {0.1, 1, 1, 0}};
+    t.cellHalfSize = {200.0, 150.0, 250.0};
+    t.monomials = {{0.02, 0, 0, 0}, {-0.005, 2, 1, 0}, {0.003, 1, 1, 1}, {0.002, 0, 0, 4}, {0.001, 3, 0, 2}};
+    FogDesc d;
     d.terms.push_back(t);
-    auto fog = Fog::create(d);
-    ASSERT_TRUE(fog.ok()) << fog.error();
-    auto glsl = fogGlsl(*fog);
+    check(d, {10.0, 1.7, -30.0}, 0.0, "3-variable periodic");
+    // Zero outside, small cell around the eye, with wind.
+    t.cellMode = FogCellMode::ZeroOutside;
+    t.cellHalfSize = {20.0, 10.0, 30.0};
+    FogDesc z;
+    z.terms.push_back(t);
+    z.wind = FogWind::constant({0.7, 0.0, -0.4});
+    check(z, {3.0, 1.7, -5.0}, 4.0, "3-variable zero outside");
+}
+
+TEST_F(FogGlslGL, BadOptionsAreNamed) {
+    auto fog = Fog::create(paperFig6Fog());
+    ASSERT_TRUE(fog.ok());
+    auto glsl = fogGlsl(*fog, {.maxPolynomialCells = 0});
     ASSERT_FALSE(glsl.ok());
-    EXPECT_NE(glsl.error().find("terms[0]"), std::string::npos) << glsl.error();
+    EXPECT_NE(glsl.error().find("maxPolynomialCells"), std::string::npos) << glsl.error();
 }
 
 } // namespace

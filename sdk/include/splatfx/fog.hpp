@@ -194,6 +194,11 @@ private:
 struct FogGlslOptions {
     std::string prefix = "splatfx_fog";  // prefix of every emitted name; default "splatfx_fog"
     int uniformLocation = -1;            // explicit layout(location) of the parameter array; default -1 (none)
+    // A multi-variable periodic polynomial on a general ray is a walk over the
+    // cells it crosses; past this many cells the rest of the ray is taken at
+    // the cell's mean density (an approximation, docs/fog.md). 1D polynomials
+    // and rays moving along one variable count cells in O(1). Default 1024.
+    int maxPolynomialCells = 1024;
 };
 
 // GLSL 4.50 source (no #version line: include it in any stage) defining
@@ -208,8 +213,7 @@ struct FogGlsl {
     std::string uniformName;  // "<prefix>_params"
     int vec4Count = 0;        // N (at least 1)
 };
-// Fails (naming the term) for a polynomial in more than one variable: the
-// CPU integrates those, the generator does not yet.
+// Fails only for invalid options.
 Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& options = {});
 
 // Adaptive Gauss-Kronrod (7/15) quadrature of the density along [o, p] at

@@ -22,7 +22,118 @@ int polyDegree(const Poly& p) {
 }
 
 // vec4 count of each part of the layout (must match glslParameters' packing).
-int polyVec4s(const Poly& p) { return 1 + (polyDegree(p) + 1 + 3) / 4; }
+bool multi(const Poly& p) { return p.usedCount > 1; }
+int polyVec4s(const Poly& p) {
+    if (multi(p)) return 2 + (int(p.mono.size()) + 3) / 4; // uRef + mean, 1/halfSize, coefficients
+    return 1 + (polyDegree(p) + 1 + 3) / 4;               // uRef, 1/h, cell integral; dense coefficients
+}
+
+// Mean of a polynomial over its reference cell (used axes), by tensor Gauss (exact).
+double cellMean(const Poly& p) {
+    static constexpr double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
+    static constexpr double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
+                                    0.2369268850561891};
+    const int nu = p.used[0] ? 5 : 1, nv = p.used[1] ? 5 : 1, nw = p.used[2] ? 5 : 1;
+    double mean = 0.0;
+    for (int i = 0; i < nu; ++i)
+        for (int j = 0; j < nv; ++j)
+            for (int k = 0; k < nw; ++k)
+                mean += (nu > 1 ? w[i] / 2 : 1.0) * (nv > 1 ? w[j] / 2 : 1.0) * (nw > 1 ? w[k] / 2 : 1.0) *
+                        fogdetail::evalPoly(p, {nu > 1 ? x[i] : 0.0, nv > 1 ? x[j] : 0.0, nw > 1 ? x[k] : 0.0});
+    return mean;
+}
+
+} // namespace
+
+namespace {
+
+// A polynomial in two or three variables: evaluation, Gauss piece, and the
+// integral (O(1) when the ray moves along one variable only, else a cell walk
+// of at most maxCells cells, the rest at the cell's mean density: docs/fog.md).
+std::string multiPolySource(const Poly& p, const std::string& P, const std::string& id, int base, int maxCells) {
+    const std::string fn = P + "_poly" + id;
+    auto prm = [&](int i) { return P + "_params[" + std::to_string(i) + "]"; };
+    const std::string used = std::string("vec3(") + (p.used[0] ? "1.0" : "0.0") + ", " + (p.used[1] ? "1.0" : "0.0") +
+                             ", " + (p.used[2] ? "1.0" : "0.0") + ")";
+    int maxPow[3] = {0, 0, 0};
+    for (const FogMonomial& m : p.mono) {
+        maxPow[0] = std::max(maxPow[0], m.px);
+        maxPow[1] = std::max(maxPow[1], m.py);
+        maxPow[2] = std::max(maxPow[2], m.pz);
+    }
+    std::string s = "float " + fn + "(vec3 u) {\n";
+    const char* names = "xyz";
+    for (int a = 0; a < 3; ++a) {
+        const std::string A(1, char('X' + a));
+        s += "    float " + A + "[" + std::to_string(maxPow[a] + 1) + "];\n    " + A + "[0] = 1.0;\n";
+        for (int n = 1; n <= maxPow[a]; ++n)
+            s += "    " + A + "[" + std::to_string(n) + "] = " + A + "[" + std::to_string(n - 1) + "] * u." + names[a] + ";\n";
+    }
+    s += "    float r = 0.0;\n";
+    for (size_t n = 0; n < p.mono.size(); ++n) {
+        const FogMonomial& m = p.mono[n];
+        s += "    r += " + prm(base + 2 + int(n / 4)) + "[" + std::to_string(n % 4) + "] * X[" + std::to_string(m.px) +
+             "] * Y[" + std::to_string(m.py) + "] * Z[" + std::to_string(m.pz) + "];\n";
+    }
+    s += "    return r;\n}\n";
+    const bool periodic = p.mode == FogCellMode::Periodic;
+    s += "float " + fn + "_piece(float la, float lb, vec3 U0, vec3 dU, float L) {\n"
+         "    if (lb <= la) return 0.0;\n"
+         "    float mid = 0.5 * (la + lb), hw = 0.5 * (lb - la), sum = 0.0;\n";
+    s += periodic ? "    vec3 shift = 2.0 * floor((U0 + mid * dU + 1.0) * 0.5);\n" : "    vec3 shift = vec3(0.0);\n";
+    s += "    for (int j = 0; j < 5; ++j) sum += " + P + "_GW[j] * " + fn + "(U0 + (mid + hw * " + P +
+         "_GX[j]) * dU - shift);\n"
+         "    return sum * hw * L;\n}\n";
+    s += "float " + fn + "_integral(vec3 oRel, vec3 pRel, float L) {\n"
+         "    const vec3 used = " + used + ";\n"
+         "    vec3 U0 = (" + prm(base) + ".xyz + oRel * " + prm(base + 1) + ".xyz) * used;\n"
+         "    vec3 dU = (pRel - oRel) * " + prm(base + 1) + ".xyz * used;\n";
+    if (!periodic) {
+        s += "    float la = 0.0, lb = 1.0;\n"
+             "    for (int a = 0; a < 3; ++a) {\n"
+             "        if (used[a] == 0.0) continue;\n"
+             "        if (dU[a] == 0.0) { if (abs(U0[a]) > 1.0) return 0.0; continue; }\n"
+             "        float l0 = (-1.0 - U0[a]) / dU[a], l1 = (1.0 - U0[a]) / dU[a];\n"
+             "        la = max(la, min(l0, l1));\n"
+             "        lb = min(lb, max(l0, l1));\n"
+             "    }\n"
+             "    return " + fn + "_piece(la, lb, U0, dU, L);\n}\n";
+        return s;
+    }
+    s += "    vec3 n0 = floor((U0 + 1.0) * 0.5), n1 = floor((U0 + dU + 1.0) * 0.5);\n"
+         "    bvec3 moving = notEqual(n0, n1);\n"
+         "    int nMoving = int(moving.x) + int(moving.y) + int(moving.z);\n"
+         "    if (nMoving == 0) return " + fn + "_piece(0.0, 1.0, U0, dU, L);\n"
+         "    bvec3 varies = notEqual(dU, vec3(0.0));\n"
+         "    if (nMoving == 1 && int(varies.x) + int(varies.y) + int(varies.z) == 1) {\n"
+         "        int a = moving.x ? 0 : (moving.y ? 1 : 2);\n"
+         "        float dir = dU[a] > 0.0 ? 1.0 : -1.0;\n"
+         "        float a0 = U0[a] - 2.0 * n0[a], a1 = U0[a] + dU[a] - 2.0 * n1[a];\n"
+         "        float l1 = clamp((dir - a0) / dU[a], 0.0, 1.0);\n"
+         "        float lk = clamp(1.0 - (a1 + dir) / dU[a], 0.0, 1.0);\n"
+         "        float whole = abs(n1[a] - n0[a]) - 1.0;\n"
+         "        vec3 u = U0 - 2.0 * n0;\n"
+         "        float cell = 0.0;\n"
+         "        for (int j = 0; j < 5; ++j) { u[a] = " + P + "_GX[j]; cell += " + P + "_GW[j] * " + fn + "(u); }\n"
+         "        return " + fn + "_piece(0.0, l1, U0, dU, L) + " + fn + "_piece(lk, 1.0, U0, dU, L)\n"
+         "             + whole * cell * (L / abs(dU[a]));\n"
+         "    }\n"
+         "    vec3 dir = sign(dU);\n"
+         "    vec3 nb = 2.0 * n0 + dir;\n"
+         "    vec3 nx = vec3(2.0);\n"
+         "    for (int a = 0; a < 3; ++a) if (dU[a] != 0.0) nx[a] = (nb[a] - U0[a]) / dU[a];\n"
+         "    float lam = 0.0, total = 0.0;\n"
+         "    for (int i = 0; i < " + std::to_string(maxCells) + "; ++i) {\n"
+         "        float ln = min(min(min(nx.x, nx.y), nx.z), 1.0);\n"
+         "        total += " + fn + "_piece(lam, ln, U0, dU, L);\n"
+         "        lam = ln;\n"
+         "        if (lam >= 1.0) return total;\n"
+         "        for (int a = 0; a < 3; ++a)\n"
+         "            if (dU[a] != 0.0 && nx[a] <= lam) { nb[a] += 2.0 * dir[a]; nx[a] = (nb[a] - U0[a]) / dU[a]; }\n"
+         "    }\n"
+         "    return total + (1.0 - lam) * L * " + prm(base) + ".w;\n}\n";
+    return s;
+}
 
 } // namespace
 
@@ -35,6 +146,15 @@ std::vector<glm::vec4> Fog::glslParameters(double tSec, glm::dvec3 reference) co
         out.push_back({float(w.amp), 0.0f, 0.0f, 0.0f});
     }
     for (const Poly& p : fr.polys) {
+        if (multi(p)) {
+            out.push_back({glm::vec3(p.uRef), float(cellMean(p))});
+            out.push_back({glm::vec3(1.0 / p.halfSize), 0.0f});
+            for (size_t n = 0; n < p.mono.size(); n += 4)
+                out.push_back({float(p.mono[n].coeff), n + 1 < p.mono.size() ? float(p.mono[n + 1].coeff) : 0.0f,
+                               n + 2 < p.mono.size() ? float(p.mono[n + 2].coeff) : 0.0f,
+                               n + 3 < p.mono.size() ? float(p.mono[n + 3].coeff) : 0.0f});
+            continue;
+        }
         const int a = std::max(p.usedAxis, 0);
         const int deg = polyDegree(p);
         std::vector<double> dense(size_t(deg + 1), 0.0);
@@ -57,13 +177,7 @@ std::vector<glm::vec4> Fog::glslParameters(double tSec, glm::dvec3 reference) co
 
 Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& opt) {
     const Frozen fr = fogdetail::freeze(fog.desc(), 0.0, glm::dvec3(0.0));
-    for (size_t i = 0, pi = 0; i < fog.desc().terms.size(); ++i) {
-        if (fog.desc().terms[i].kind != FogTermKind::Polynomial) continue;
-        if (fr.polys[pi++].usedCount > 1)
-            return makeError("fogGlsl: terms[" + std::to_string(i) +
-                             "] is a polynomial in more than one variable, which the GLSL generator does not "
-                             "support yet (the CPU integrals do)");
-    }
+    if (opt.maxPolynomialCells < 1) return makeError("FogGlslOptions.maxPolynomialCells must be >= 1");
     const std::string P = opt.prefix;
     int count = 1 + int(fr.waves.size()) * 2 + int(fr.pots.size()) * 3;
     for (const Poly& p : fr.polys) count += polyVec4s(p);
@@ -130,6 +244,11 @@ Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& opt) {
         const int deg = polyDegree(p);
         const std::string id = std::to_string(j);
         polyBase.push_back(base);
+        if (multi(p)) {
+            s += multiPolySource(p, P, id, base, opt.maxPolynomialCells);
+            base += polyVec4s(p);
+            continue;
+        }
         s += "float " + P + "_poly" + id + "(float u) {\n    float r = 0.0;\n";
         for (int n = deg; n >= 0; --n) {
             const int idx = base + 1 + n / 4;
