@@ -227,6 +227,35 @@ TEST(FogTime, WeightAndPhaseCurves) {
     EXPECT_NEAR(fog.density({0.3, 0, 0}, 9.0), 1.0 + 0.6 * std::cos(0.3 + kPi), 1e-14);
 }
 
+TEST(FogTime, WaveScaleOwnMotionAndPotentialParameters) {
+    // Sec. 5: "modifications of coefficients k will shrink or expand the function"; potentials'
+    // c, d and positions may change too.
+    FogDesc d;
+    d.terms.push_back(FogTerm::constant(1.0));
+    FogTerm c = FogTerm::cosine(0.5, 1.0, {1, 0, 0});
+    c.waveScaleOverTime.keys = {{0.0, 1.0}, {1.0, 3.0}};
+    d.terms.push_back(c);
+    FogTerm p = FogTerm::point(0.8, {0, 0, 0}, 1.0, 1.0);
+    p.motion = FogWind::constant({0, 2, 0});
+    p.cOverTime.keys = {{0.0, 1.0}, {2.0, 2.0}};
+    p.dOverTime.keys = {{0.0, 1.0}, {2.0, 0.5}};
+    d.terms.push_back(p);
+    const Fog fog = make(d);
+    // t = 0.5: k = 2; the point is at (0, 1, 0) with c = 1.25, d = 0.875.
+    const glm::dvec3 x{0.3, 1.4, 0.2};
+    const double r2 = 0.3 * 0.3 + 0.4 * 0.4 + 0.2 * 0.2;
+    EXPECT_NEAR(fog.density(x, 0.5), 1.0 + 0.5 * std::cos(2.0 * 0.3) + 0.8 / (1.25 + 0.875 * r2), 1e-14);
+    // The integrals follow: closed form against quadrature at that time.
+    const glm::dvec3 o{-2, 0.5, 0.1}, q{3, 1.5, -0.4};
+    const FogQuadrature num = integrateFogNumerically(fog, o, q, 0.5, 1e-11);
+    EXPECT_NEAR(fog.opticalDepth(o, q, 0.5), num.value, 1e-11 + 1e-13 * num.value);
+    FogDesc bad = d;
+    bad.terms[2].cOverTime.keys = {{0.0, 1.0}, {2.0, 0.0}};
+    auto f = Fog::create(bad);
+    ASSERT_FALSE(f.ok());
+    EXPECT_NE(f.error().find("terms[2].cOverTime.keys[1] value must be > 0"), std::string::npos) << f.error();
+}
+
 TEST(FogTime, PolynomialBlendIsLinearInTheCoefficients) {
     // Sec. 5: interpolating the coefficients of two shapes; the integral is linear in them.
     FogTerm t = FogTerm::polynomial1D(1.0, 0, {0.8, -1, 0, 0, 1}, 2.0);

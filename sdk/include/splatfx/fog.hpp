@@ -100,11 +100,13 @@ struct FogTerm {
     double weight = 1.0;          // c_i, extinction per world unit; default 1
     FogCurve weightOverTime;      // replaces weight when not empty; default empty
     double windFactor = 1.0;      // the term moves by windFactor * D(t) (0 = not sensitive to wind); default 1
+    FogWind motion;               // the term's own motion, added to the wind's (e.g. a drifting potential); default none
 
     // Cosine, CosineProduct
     glm::dvec3 wave{1.0, 0.0, 0.0};  // k * direction, rad per world unit; default (1, 0, 0)
     double phase = 0.0;              // rad; default 0
-    FogCurve phaseOverTime;          // replaces phase when not empty; default empty
+    FogCurve phaseOverTime;          // replaces phase (of the first factor) when not empty; default empty
+    FogCurve waveScaleOverTime;      // multiplies wave and wave2 (shrink / expand, sec. 5); empty = 1; default empty
     glm::dvec3 wave2{0.0, 0.0, 1.0}; // second factor (CosineProduct); default (0, 0, 1)
     double phase2 = 0.0;             // rad; default 0
 
@@ -122,6 +124,8 @@ struct FogTerm {
     double radius = 0.0;            // Sphere radius, world units; default 0
     double c = 1.0;                 // > 0 (finite density at r = 0); default 1
     double d = 1.0;                 // >= 0, per world unit^2; default 1
+    FogCurve cOverTime;             // replaces c when not empty (every key > 0); default empty
+    FogCurve dOverTime;             // replaces d when not empty (every key >= 0); default empty
 
     static FogTerm constant(double weight);
     // weight * cos(k * dot(direction, x) + phase); direction is normalized.

@@ -69,6 +69,12 @@ Status checkTerm(FogTerm& t, const std::string& n) {
     if (!finite(t.weight)) return makeError(n + ".weight must be finite");
     if (!finite(t.windFactor)) return makeError(n + ".windFactor must be finite");
     if (Status s = checkCurve(t.weightOverTime, n + ".weightOverTime"); !s) return s;
+    for (size_t i = 0; i < t.motion.keys.size(); ++i) {
+        if (!finite(t.motion.keys[i].timeSec) || !finite(t.motion.keys[i].velocity))
+            return makeError(n + ".motion.keys[" + std::to_string(i) + "] must be finite");
+        if (i > 0 && t.motion.keys[i].timeSec < t.motion.keys[i - 1].timeSec)
+            return makeError(n + ".motion.keys must be sorted by timeSec");
+    }
     switch (t.kind) {
     case FogTermKind::Constant: break;
     case FogTermKind::CosineProduct:
@@ -79,6 +85,7 @@ Status checkTerm(FogTerm& t, const std::string& n) {
         if (!finite(t.wave)) return makeError(n + ".wave must be finite");
         if (!finite(t.phase)) return makeError(n + ".phase must be finite");
         if (Status s = checkCurve(t.phaseOverTime, n + ".phaseOverTime"); !s) return s;
+        if (Status s = checkCurve(t.waveScaleOverTime, n + ".waveScaleOverTime"); !s) return s;
         break;
     case FogTermKind::Polynomial:
         if (Status s = checkMonomials(t.monomials, n + ".monomials"); !s) return s;
@@ -103,6 +110,15 @@ Status checkTerm(FogTerm& t, const std::string& n) {
                              fmt(t.c) + ")");
         if (!finite(t.d) || t.d < 0.0) return makeError(n + ".d must be finite and >= 0 (got " + fmt(t.d) + ")");
         if (!finite(t.radius) || t.radius < 0.0) return makeError(n + ".radius must be finite and >= 0");
+        if (Status s = checkCurve(t.cOverTime, n + ".cOverTime"); !s) return s;
+        if (Status s = checkCurve(t.dOverTime, n + ".dOverTime"); !s) return s;
+        // Piecewise linear: positive at every key is positive everywhere.
+        for (size_t i = 0; i < t.cOverTime.keys.size(); ++i)
+            if (t.cOverTime.keys[i].y <= 0.0)
+                return makeError(n + ".cOverTime.keys[" + std::to_string(i) + "] value must be > 0");
+        for (size_t i = 0; i < t.dOverTime.keys.size(); ++i)
+            if (t.dOverTime.keys[i].y < 0.0)
+                return makeError(n + ".dOverTime.keys[" + std::to_string(i) + "] value must be >= 0");
         break;
     }
     return {};
@@ -150,13 +166,16 @@ double polyMinimum(const fogdetail::Poly& p, glm::dvec3& where) {
 
 // Times at which the lower bound must be checked: every key of every curve
 // (between keys, constants and -|cosine amplitudes| are linear / concave in
-// t, so their sum is smallest at keys), plus interior points for polynomial
-// terms whose weight and blend may both change on an interval.
+// t, so their sum is smallest at keys), plus interior points for terms
+// whose bound is not concave between keys (a polynomial whose weight and
+// blend both move, a negative potential whose weight and c both move).
 std::vector<double> checkTimes(const FogDesc& d) {
     std::set<double> keys;
     for (const FogTerm& t : d.terms) {
         for (const auto& k : t.weightOverTime.keys) keys.insert(k.x);
         for (const auto& k : t.blendOverTime.keys) keys.insert(k.x);
+        for (const auto& k : t.cOverTime.keys) keys.insert(k.x);
+        for (const auto& k : t.dOverTime.keys) keys.insert(k.x);
     }
     if (keys.empty()) return {0.0};
     std::vector<double> out(keys.begin(), keys.end());
@@ -198,8 +217,9 @@ Status checkNonNegative(const FogDesc& d) {
             case FogTermKind::Point:
             case FogTermKind::Line:
             case FogTermKind::Sphere:
-                low = term.d == 0.0 ? w / term.c : std::min(0.0, w / term.c);
-                where = "at its centre " + fmt(term.centre) + ", value " + fmt(w / term.c);
+                const double c = term.cOverTime.at(t, term.c), dd = term.dOverTime.at(t, term.d);
+                low = dd == 0.0 ? w / c : std::min(0.0, w / c);
+                where = "at its centre " + fmt(term.centre) + ", value " + fmt(w / c);
                 break;
             }
             total += low;

@@ -253,20 +253,23 @@ Frozen freeze(const FogDesc& desc, double tSec, glm::dvec3 ref) {
     const glm::dvec3 D = desc.wind.displacement(tSec);
     for (const FogTerm& term : desc.terms) {
         const double w = term.weightOverTime.at(tSec, term.weight);
-        const glm::dvec3 Dt = term.windFactor * D;
+        const glm::dvec3 Dt = term.windFactor * D + term.motion.displacement(tSec);
+        const double waveScale = term.waveScaleOverTime.at(tSec, 1.0);
         switch (term.kind) {
         case FogTermKind::Constant: fr.constant += w; break;
         case FogTermKind::Cosine: {
             const double phase = term.phaseOverTime.at(tSec, term.phase);
-            fr.waves.push_back({term.wave, reduceAngle(glm::dot(term.wave, ref - Dt) + phase), w});
+            const glm::dvec3 wave = waveScale * term.wave;
+            fr.waves.push_back({wave, reduceAngle(glm::dot(wave, ref - Dt) + phase), w});
             break;
         }
         case FogTermKind::CosineProduct: {
             // cos a cos b = (cos(a + b) + cos(a - b)) / 2
-            const double a1 = reduceAngle(glm::dot(term.wave, ref - Dt) + term.phaseOverTime.at(tSec, term.phase));
-            const double a2 = reduceAngle(glm::dot(term.wave2, ref - Dt) + term.phase2);
-            fr.waves.push_back({term.wave + term.wave2, reduceAngle(a1 + a2), 0.5 * w});
-            fr.waves.push_back({term.wave - term.wave2, reduceAngle(a1 - a2), 0.5 * w});
+            const glm::dvec3 w1 = waveScale * term.wave, w2 = waveScale * term.wave2;
+            const double a1 = reduceAngle(glm::dot(w1, ref - Dt) + term.phaseOverTime.at(tSec, term.phase));
+            const double a2 = reduceAngle(glm::dot(w2, ref - Dt) + term.phase2);
+            fr.waves.push_back({w1 + w2, reduceAngle(a1 + a2), 0.5 * w});
+            fr.waves.push_back({w1 - w2, reduceAngle(a1 - a2), 0.5 * w});
             break;
         }
         case FogTermKind::Polynomial: {
@@ -299,7 +302,8 @@ Frozen freeze(const FogDesc& desc, double tSec, glm::dvec3 ref) {
         case FogTermKind::Point:
         case FogTermKind::Line:
         case FogTermKind::Sphere:
-            fr.pots.push_back({term.kind, term.centre + Dt - ref, term.axis, term.radius * term.radius, term.c, term.d, w});
+            fr.pots.push_back({term.kind, term.centre + Dt - ref, term.axis, term.radius * term.radius,
+                               term.cOverTime.at(tSec, term.c), term.dOverTime.at(tSec, term.d), w});
             break;
         }
     }
