@@ -3,9 +3,7 @@
 // says which numerical hazard each branch avoids.
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <numbers>
-#include <tuple>
 
 #include "fog/frozen.hpp"
 
@@ -277,16 +275,22 @@ Frozen freeze(const FogDesc& desc, double tSec, glm::dvec3 ref) {
             p.mode = term.cellMode;
             p.halfSize = term.cellHalfSize;
             const double s = term.monomialsB.empty() ? 0.0 : term.blendOverTime.at(tSec, 0.0);
-            // One fixed exponent set (A and B merged) so the structure does not change with time.
-            std::map<std::tuple<int, int, int>, double> coeffs;
-            for (const FogMonomial& m : term.monomials) coeffs[{m.px, m.py, m.pz}] += w * (1.0 - s) * m.coeff;
-            for (const FogMonomial& m : term.monomialsB) coeffs[{m.px, m.py, m.pz}] += w * s * m.coeff;
-            for (const auto& [k, v] : coeffs) {
-                p.mono.push_back({v, std::get<0>(k), std::get<1>(k), std::get<2>(k)});
-                if (std::get<0>(k) > 0) p.used[0] = true;
-                if (std::get<1>(k) > 0) p.used[1] = true;
-                if (std::get<2>(k) > 0) p.used[2] = true;
-            }
+            // One fixed exponent set (A's order, then B's new ones) so the structure, hence the
+            // generated GLSL, does not change with time. A few monomials: a linear search.
+            p.mono.reserve(term.monomials.size() + term.monomialsB.size());
+            auto add = [&p](const FogMonomial& m, double scale) {
+                for (FogMonomial& q : p.mono)
+                    if (q.px == m.px && q.py == m.py && q.pz == m.pz) {
+                        q.coeff += scale * m.coeff;
+                        return;
+                    }
+                p.mono.push_back({scale * m.coeff, m.px, m.py, m.pz});
+                if (m.px > 0) p.used[0] = true;
+                if (m.py > 0) p.used[1] = true;
+                if (m.pz > 0) p.used[2] = true;
+            };
+            for (const FogMonomial& m : term.monomials) add(m, w * (1.0 - s));
+            for (const FogMonomial& m : term.monomialsB) add(m, w * s);
             for (int a = 0; a < 3; ++a)
                 if (p.used[a]) {
                     ++p.usedCount;
