@@ -303,6 +303,20 @@ TEST_F(FogGlslGL, BadOptionsAreNamed) {
     auto glsl = fogGlsl(*fog, {.maxPolynomialCells = 0});
     ASSERT_FALSE(glsl.ok());
     EXPECT_NE(glsl.error().find("maxPolynomialCells"), std::string::npos) << glsl.error();
+    auto bad = fogGlsl(*fog, {.prefix = "my fog"});
+    ASSERT_FALSE(bad.ok());
+    EXPECT_NE(bad.error().find("FogGlslOptions.prefix must be a GLSL identifier"), std::string::npos) << bad.error();
+    // A custom prefix compiles: every emitted name carries it.
+    auto custom = fogGlsl(*fog, {.prefix = "hostfog", .uniformLocation = 3});
+    ASSERT_TRUE(custom.ok());
+    EXPECT_EQ(custom->uniformName, "hostfog_params");
+    std::string log;
+    const GLuint prog = compile("#version 450\nlayout(local_size_x = 1) in;\n" + custom->source +
+                                    "layout(std430, binding = 0) buffer O { float o[]; };\n"
+                                    "void main() { o[0] = hostfog_transmittance(vec3(0.0), vec3(1.0, 2.0, 3.0)); }\n",
+                                log);
+    EXPECT_NE(prog, 0u) << log;
+    if (prog) glDeleteProgram(prog);
 }
 
 } // namespace

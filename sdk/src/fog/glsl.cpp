@@ -2,6 +2,7 @@
 // that feed it (computed in double relative to a reference point).
 // The code mirrors integrals.cpp branch for branch; docs/fog.md explains each.
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <string>
 
@@ -178,6 +179,11 @@ std::vector<glm::vec4> Fog::glslParameters(double tSec, glm::dvec3 reference) co
 Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& opt) {
     const Frozen fr = fogdetail::freeze(fog.desc(), 0.0, glm::dvec3(0.0));
     if (opt.maxPolynomialCells < 1) return makeError("FogGlslOptions.maxPolynomialCells must be >= 1");
+    bool identifier = !opt.prefix.empty() && !std::isdigit((unsigned char)opt.prefix[0]) && opt.prefix.rfind("gl_", 0) != 0;
+    for (char ch : opt.prefix) identifier = identifier && (std::isalnum((unsigned char)ch) || ch == '_');
+    if (!identifier)
+        return makeError("FogGlslOptions.prefix must be a GLSL identifier ([A-Za-z_][A-Za-z0-9_]*, not starting with gl_); got \"" +
+                         opt.prefix + "\"");
     const std::string P = opt.prefix;
     int count = 1 + int(fr.waves.size()) * 2 + int(fr.pots.size()) * 3;
     for (const Poly& p : fr.polys) count += polyVec4s(p);
