@@ -7,6 +7,7 @@
 #include "splatfx/dynamics.hpp"
 #include "splatfx/effect.hpp"
 #include "splatfx/effect_kind.hpp"
+#include "splatfx/fog.hpp"
 #include "splatfx/footprint.hpp"
 #include "splatfx/frame.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
