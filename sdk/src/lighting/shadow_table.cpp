@@ -108,8 +108,9 @@ Status ShadowTable::update(const DensityField& field, const Light& light) {
     // along its direction). It depends only on the light and the box, so it
     // is kept while they stay the same and only the density changes.
     const glm::vec3 orderKey = directional ? dir : L;
-    if (mOrder.size() != n || mOrderType != int(light.type == LightType::Directional) || mOrderKey != orderKey ||
-        mOrderBoxMin != lo || mOrderBoxMax != hi || dims != mBuiltDims) {
+    const glm::vec3 w0 = -dir; // towards a directional light
+    if (!directional && (mOrder.size() != n || mOrderType != int(light.type == LightType::Directional) || mOrderKey != orderKey ||
+        mOrderBoxMin != lo || mOrderBoxMax != hi || dims != mBuiltDims)) {
         mOrder.resize(n);
         for (int k = 0; k < dims.z; ++k)
             for (int j = 0; j < dims.y; ++j)
@@ -133,9 +134,7 @@ Status ShadowTable::update(const DensityField& field, const Light& light) {
     const float nearDist = kNearSteps * std::min({h.x, h.y, h.z});
     mNearTraced = 0;
     const std::size_t stride[3] = {1, nx, nx * ny};
-    for (const std::uint64_t key : mOrder) {
-        const std::size_t idx = std::size_t(key & 0xffffffffu);
-        const int ijk[3] = {int(idx % nx), int((idx / nx) % ny), int(idx / (nx * ny))};
+    auto fillNode = [&](std::size_t idx, const int ijk[3]) {
         const glm::vec3 p = node(ijk[0], ijk[1], ijk[2]);
         const float rhoP = mRho[idx];
         glm::vec3 w;
@@ -147,7 +146,7 @@ Status ShadowTable::update(const DensityField& field, const Light& light) {
             D = glm::length(v);
             if (!(D > 0.0f)) { // the light sits on this node
                 mFilled[idx] = 1;
-                continue;
+                return;
             }
             w = v / D;
         }
@@ -160,7 +159,7 @@ Status ShadowTable::update(const DensityField& field, const Light& light) {
         if (D <= t) { // light inside this cube: integrate straight to it (trapezoid)
             mDepth[idx] = D * 0.5f * (rhoP + rhoLight);
             mFilled[idx] = 1;
-            continue;
+            return;
         }
         // Close to a point light the depth changes fastest across rays, so
         // the face interpolation errs most there, and every farther node
@@ -171,7 +170,7 @@ Status ShadowTable::update(const DensityField& field, const Light& light) {
             mDepth[idx] = field.opticalDepth(p, L);
             mFilled[idx] = 1;
             ++mNearTraced;
-            continue;
+            return;
         }
         // The other two axes: where the ray meets the face, as a fraction of
         // a node step towards the light's side.
@@ -208,6 +207,31 @@ Status ShadowTable::update(const DensityField& field, const Light& light) {
         // far end's density times the step; the trapezoid is second order).
         mDepth[idx] = faceS + t * 0.5f * (rhoP + faceRho);
         mFilled[idx] = 1;
+    };
+    if (directional) {
+        // Every node depends only on nodes one step towards the light on each
+        // axis (or level with it), so sweeping each axis from the light's side
+        // is already an order of increasing distance from the light, as the
+        // sort would give; it needs no sort and walks memory in order.
+        const int from[3] = {w0[0] > 0.0f ? dims.x - 1 : 0, w0[1] > 0.0f ? dims.y - 1 : 0, w0[2] > 0.0f ? dims.z - 1 : 0};
+        const int step[3] = {w0[0] > 0.0f ? -1 : 1, w0[1] > 0.0f ? -1 : 1, w0[2] > 0.0f ? -1 : 1};
+        int ijk[3];
+        for (int kk = 0; kk < dims.z; ++kk) {
+            ijk[2] = from[2] + step[2] * kk;
+            for (int jj = 0; jj < dims.y; ++jj) {
+                ijk[1] = from[1] + step[1] * jj;
+                for (int ii = 0; ii < dims.x; ++ii) {
+                    ijk[0] = from[0] + step[0] * ii;
+                    fillNode(std::size_t(ijk[0]) + nx * (std::size_t(ijk[1]) + ny * std::size_t(ijk[2])), ijk);
+                }
+            }
+        }
+    } else {
+        for (const std::uint64_t key : mOrder) {
+            const std::size_t idx = std::size_t(key & 0xffffffffu);
+            const int ijk[3] = {int(idx % nx), int((idx / nx) % ny), int(idx / (nx * ny))};
+            fillNode(idx, ijk);
+        }
     }
 
     mDims = dims;
