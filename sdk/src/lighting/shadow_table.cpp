@@ -130,7 +130,7 @@ Status ShadowTable::update(const DensityField& field, const Light& light) {
     mDepth.assign(n, 0.0f);
     mFilled.assign(n, 0);
     const float rhoLight = directional ? 0.0f : field.at(L);
-    constexpr float kNearSteps = 3.0f;
+    constexpr float kNearSteps = 8.0f;
     const float nearDist = kNearSteps * std::min({h.x, h.y, h.z});
     mNearTraced = 0;
     const std::size_t stride[3] = {1, nx, nx * ny};
@@ -161,11 +161,14 @@ Status ShadowTable::update(const DensityField& field, const Light& light) {
             mFilled[idx] = 1;
             return;
         }
-        // Close to a point light the depth changes fastest across rays, so
-        // the face interpolation errs most there, and every farther node
-        // inherits that error. Nodes within kNearSteps node steps of the
-        // light are therefore traced straight to it through the field (a
-        // few hundred nodes at most, each a short segment).
+        // Close to a point light the depth changes fastest across rays (one
+        // node step spans a wide angle), so the face interpolation errs most
+        // there, and every farther node inherits that error. Nodes within
+        // kNearSteps node steps, where a step subtends more than 1/8 radian,
+        // are therefore traced straight to the light through the field:
+        // about 2000 nodes, each a segment of at most 8 steps. (Measured on
+        // the 1560-voxel effect at 64^3: mean error 1.6/255 without, 0.85
+        // with; see docs/lighting.md.)
         if (D <= nearDist) {
             mDepth[idx] = field.opticalDepth(p, L);
             mFilled[idx] = 1;
