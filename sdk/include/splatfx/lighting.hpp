@@ -209,7 +209,13 @@ struct ShadowTableDesc {
 // the bilinear interpolation of the already-filled nodes on the face of its
 // neighbour cube that the ray to the light pierces, plus the depth of that
 // step (trapezoid rule on the sampled density). A light inside the table is
-// allowed: a node nearer the light than the face integrates straight to it.
+// allowed: nodes within 8 node steps of a point light are traced straight
+// to it through the field, where one step spans too wide an angle for the
+// face interpolation. For a directional light an axis sweep from the
+// light's side replaces the sort (it is already a valid distance order); a
+// point light's sorted order is kept while the light and box stay put.
+// The error is first order in the node spacing (docs/lighting.md has the
+// figures): match the table to the effect's grid, 2x finer for 1/255.
 //
 // Lookups are trilinear. A point outside the table is first moved along its
 // ray to the light to where the ray meets the table (there is no material in

@@ -34,7 +34,7 @@ enum class GasKind {
     Cloud, // an ellipsoid of turbulent density drifting with the wind
 };
 
-struct TurbulenceDesc {
+struct GasTurbulenceDesc {
     std::uint32_t seed = 1;     // noise permutation; default 1
     int octaves = 4;            // |noise| octaves summed, [1, 12]; default 4
     float frequency = 1.0f;     // noise cycles per world unit at the first octave, > 0; default 1
@@ -85,7 +85,7 @@ struct CloudDesc {
 
 struct ProceduralGasDesc {
     GasKind kind = GasKind::Steam; // default Steam
-    TurbulenceDesc turbulence{};
+    GasTurbulenceDesc turbulence{};
     SteamDesc steam{};
     FogDesc fog{};
     CloudDesc cloud{};
@@ -98,7 +98,7 @@ Status validateProceduralGas(const ProceduralGasDesc& desc);
 
 // Perlin 1985 turbulence, sum over octaves of |noise(2^i f p)| / 2^i, about [0, 1].
 // Expects a valid desc (see validateProceduralGas).
-float turbulence(const TurbulenceDesc& desc, glm::vec3 p);
+float gasTurbulence(const GasTurbulenceDesc& desc, glm::vec3 p);
 
 // Density in [0, 1] at a world point and time, the gas's opacity there.
 // Expects a valid desc; non-finite input gives 0.

@@ -30,7 +30,7 @@ Status finite(float v, const std::string& field) {
 }
 
 // Perlin 1985: turbulence(p) = sum_i |noise(2^i p)| / 2^i.
-float turb(const detail::Noise4& noise, const TurbulenceDesc& d, glm::vec3 p) {
+float turb(const detail::Noise4& noise, const GasTurbulenceDesc& d, glm::vec3 p) {
     double sum = 0.0, scale = 1.0;
     const glm::dvec3 q = glm::dvec3(p) * double(d.frequency);
     for (int i = 0; i < d.octaves; ++i) {
@@ -152,7 +152,7 @@ Status validateProceduralGas(const ProceduralGasDesc& g) {
     return {};
 }
 
-float turbulence(const TurbulenceDesc& desc, glm::vec3 p) {
+float gasTurbulence(const GasTurbulenceDesc& desc, glm::vec3 p) {
     const detail::Noise4 noise(desc.seed);
     return finite3(p) ? turb(noise, desc, p) : 0.0f;
 }
