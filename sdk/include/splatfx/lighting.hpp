@@ -214,8 +214,8 @@ struct ShadowTableDesc {
 // face interpolation. For a directional light an axis sweep from the
 // light's side replaces the sort (it is already a valid distance order); a
 // point light's sorted order is kept while the light and box stay put.
-// The error is first order in the node spacing (docs/lighting.md has the
-// figures): match the table to the effect's grid, 2x finer for 1/255.
+// The error is first order in the node spacing; docs/lighting.md gives it
+// against tracing for 16^3 to 128^3 tables.
 //
 // Lookups are trilinear. A point outside the table is first moved along its
 // ray to the light to where the ray meets the table (there is no material in
