@@ -215,9 +215,26 @@ Status ShadowTable::update(const DensityField& field, const Light& light) {
         // Every node depends only on nodes one step towards the light on each
         // axis (or level with it), so sweeping each axis from the light's side
         // is already an order of increasing distance from the light, as the
-        // sort would give; it needs no sort and walks memory in order.
-        const int from[3] = {w0[0] > 0.0f ? dims.x - 1 : 0, w0[1] > 0.0f ? dims.y - 1 : 0, w0[2] > 0.0f ? dims.z - 1 : 0};
-        const int step[3] = {w0[0] > 0.0f ? -1 : 1, w0[1] > 0.0f ? -1 : 1, w0[2] > 0.0f ? -1 : 1};
+        // sort would give; it needs no sort and walks memory in order. The
+        // ray direction is the same for every node, so the pierced face and
+        // the four bilinear weights are computed once.
+        const glm::vec3 w = w0;
+        int a = 0;
+        float t = std::numeric_limits<float>::infinity();
+        for (int k = 0; k < 3; ++k)
+            if (w[k] != 0.0f && h[k] / std::abs(w[k]) < t) t = h[k] / std::abs(w[k]), a = k;
+        const int b = (a + 1) % 3, c = (a + 2) % 3;
+        const float fb = std::min(t * std::abs(w[b]) / h[b], 1.0f), fc = std::min(t * std::abs(w[c]) / h[c], 1.0f);
+        int off[4][3];
+        float wgt[4];
+        for (int corner = 0; corner < 4; ++corner) {
+            off[corner][a] = w[a] > 0.0f ? 1 : -1;
+            off[corner][b] = (corner & 1) ? (w[b] > 0.0f ? 1 : -1) : 0;
+            off[corner][c] = (corner & 2) ? (w[c] > 0.0f ? 1 : -1) : 0;
+            wgt[corner] = ((corner & 1) ? fb : 1.0f - fb) * ((corner & 2) ? fc : 1.0f - fc);
+        }
+        const int from[3] = {w[0] > 0.0f ? dims.x - 1 : 0, w[1] > 0.0f ? dims.y - 1 : 0, w[2] > 0.0f ? dims.z - 1 : 0};
+        const int step[3] = {w[0] > 0.0f ? -1 : 1, w[1] > 0.0f ? -1 : 1, w[2] > 0.0f ? -1 : 1};
         int ijk[3];
         for (int kk = 0; kk < dims.z; ++kk) {
             ijk[2] = from[2] + step[2] * kk;
@@ -225,7 +242,21 @@ Status ShadowTable::update(const DensityField& field, const Light& light) {
                 ijk[1] = from[1] + step[1] * jj;
                 for (int ii = 0; ii < dims.x; ++ii) {
                     ijk[0] = from[0] + step[0] * ii;
-                    fillNode(std::size_t(ijk[0]) + nx * (std::size_t(ijk[1]) + ny * std::size_t(ijk[2])), ijk);
+                    const std::size_t idx = std::size_t(ijk[0]) + nx * (std::size_t(ijk[1]) + ny * std::size_t(ijk[2]));
+                    double sumS = 0.0, sumRho = 0.0, sumW = 0.0;
+                    for (int corner = 0; corner < 4; ++corner) {
+                        if (wgt[corner] <= 0.0f) continue;
+                        const int qx = ijk[0] + off[corner][0], qy = ijk[1] + off[corner][1], qz = ijk[2] + off[corner][2];
+                        sumW += wgt[corner];
+                        if (qx < 0 || qy < 0 || qz < 0 || qx >= dims.x || qy >= dims.y || qz >= dims.z) continue; // beyond: 0, 0
+                        const std::size_t qi = std::size_t(qx) + nx * (std::size_t(qy) + ny * std::size_t(qz));
+                        sumS += wgt[corner] * mDepth[qi];
+                        sumRho += wgt[corner] * mRho[qi];
+                    }
+                    const float faceS = sumW > 0.0 ? float(sumS / sumW) : 0.0f;
+                    const float faceRho = sumW > 0.0 ? float(sumRho / sumW) : mRho[idx];
+                    mDepth[idx] = faceS + t * 0.5f * (mRho[idx] + faceRho);
+                    mFilled[idx] = 1;
                 }
             }
         }
