@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <vector>
 
 #include "splatfx/lighting.hpp"
@@ -20,16 +21,24 @@ namespace {
 
 double ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
 
+// Median wall time, and median process CPU time (std::clock): on a shared
+// machine the CPU time is the steadier of the two.
+struct Timing {
+    double wallMs, cpuMs;
+};
 template <class F>
-double medianMs(int repeats, F&& f) {
-    std::vector<double> t;
+Timing medianMs(int repeats, F&& f) {
+    std::vector<double> wall, cpu;
     for (int r = 0; r < repeats; ++r) {
         const auto a = Clock::now();
+        const std::clock_t c = std::clock();
         f();
-        t.push_back(ms(Clock::now() - a));
+        cpu.push_back(1000.0 * double(std::clock() - c) / CLOCKS_PER_SEC);
+        wall.push_back(ms(Clock::now() - a));
     }
-    std::sort(t.begin(), t.end());
-    return t[t.size() / 2];
+    std::sort(wall.begin(), wall.end());
+    std::sort(cpu.begin(), cpu.end());
+    return {wall[wall.size() / 2], cpu[cpu.size() / 2]};
 }
 
 } // namespace
@@ -53,16 +62,15 @@ int main(int argc, char** argv) {
     std::printf("shadows for a %zu-voxel effect (12x26x5, spacing 0.25), median of %d runs\n", grid.voxels.size(), repeats);
     for (const Case& k : cases) {
         std::vector<float> traced(grid.voxels.size());
-        const double traceMs = medianMs(repeats, [&] {
+        const Timing traceMs = medianMs(repeats, [&] {
             for (std::size_t i = 0; i < grid.voxels.size(); ++i)
                 traced[i] = std::exp2(-field->opticalDepthToLight(grid.worldPosition(grid.voxels[i].cell), k.light));
         });
-        std::printf("\n%s: tracing every voxel %.2f ms\n", k.name, traceMs);
-        std::printf("  table   build ms  lookups ms  build/trace  mean err (1/255)  max err (1/255)\n");
+        std::printf("\n%s: tracing every voxel %.2f ms wall, %.2f ms CPU\n", k.name, traceMs.wallMs, traceMs.cpuMs);
+        std::printf("  table  build wall ms  build CPU ms  lookups ms  (build+lookups)/trace (CPU)  mean err (1/255)  max err (1/255)\n");
         for (int n : {16, 32, 64, 128}) {
-            double buildMs = 0.0;
             ShadowTable table({.dims = glm::ivec3(n)});
-            buildMs = medianMs(repeats, [&] {
+            const Timing buildMs = medianMs(repeats, [&] {
                 ShadowTable fresh({.dims = glm::ivec3(n)}); // a new object: no reuse, sorts its order too
                 (void)fresh.update(*field, k.light);
             });
@@ -71,7 +79,7 @@ int main(int argc, char** argv) {
                 continue;
             }
             std::vector<float> fromTable(grid.voxels.size());
-            const double lookMs = medianMs(repeats, [&] {
+            const Timing lookMs = medianMs(repeats, [&] {
                 for (std::size_t i = 0; i < grid.voxels.size(); ++i)
                     fromTable[i] = table.transmittance(grid.worldPosition(grid.voxels[i].cell));
             });
@@ -82,7 +90,8 @@ int main(int argc, char** argv) {
                 mx = std::max(mx, e);
             }
             mean /= double(traced.size());
-            std::printf("  %4d^3 %10.2f %11.3f %12.2f %17.3f %16.3f\n", n, buildMs, lookMs, (buildMs + lookMs) / traceMs, mean, mx);
+            std::printf("  %4d^3 %14.2f %13.2f %11.3f %28.2f %17.3f %16.3f\n", n, buildMs.wallMs, buildMs.cpuMs, lookMs.wallMs,
+                        (buildMs.cpuMs + lookMs.cpuMs) / std::max(traceMs.cpuMs, 1e-3), mean, mx);
         }
     }
     return 0;
