@@ -40,7 +40,7 @@ struct GasTurbulenceDesc {
     float frequency = 1.0f;     // noise cycles per world unit at the first octave, > 0; default 1
 };
 
-struct SteamDesc {
+struct GasSteamDesc {
     glm::vec3 source{0.0f};     // world centre of the source disc (a glass's rim); default origin
     float sourceRadius = 0.3f;  // world radius of the plume at the source, > 0; default 0.3
     float spread = 1.5f;        // the plume's radius grows by this factor over `height`, >= 0; default 1.5
@@ -58,7 +58,7 @@ struct SteamDesc {
 // FULL_FOG, 1) is min(t / fullDensitySec, 1). The front f = frontStart +
 // frontSpeed * t, deformed by turbulence; density is zero beyond it (x > f)
 // and grows to full over thickenDistance behind it.
-struct FogDesc {
+struct GasFogDesc {
     float swirlPeriodSec = 8.0f;  // one turn of the ellipse in the y-z plane, > 0; default 8
     // The ellipse's axes along y and z (ELLIPSE1, ELLIPSE2; the paper calls
     // them diameters, its code multiplies cos and sin by them), world units, >= 0.
@@ -74,7 +74,7 @@ struct FogDesc {
     float thickenDistance = 1.0f; // world distance behind the front to full density, > 0; default 1
 };
 
-struct CloudDesc {
+struct GasCloudDesc {
     glm::vec3 center{0.0f};       // world centre at t = 0; default origin
     glm::vec3 radii{2.0f, 1.0f, 1.5f}; // world semi-axes, each > 0; default (2, 1, 1.5)
     glm::vec3 windPerSec{0.2f, 0.0f, 0.0f}; // the cloud drifts with the wind, through turbulent space; default (0.2, 0, 0)
@@ -86,9 +86,9 @@ struct CloudDesc {
 struct ProceduralGasDesc {
     GasKind kind = GasKind::Steam; // default Steam
     GasTurbulenceDesc turbulence{};
-    SteamDesc steam{};
-    FogDesc fog{};
-    CloudDesc cloud{};
+    GasSteamDesc steam{};
+    GasFogDesc fog{};
+    GasCloudDesc cloud{};
     // Cells whose density is at most this are left out of the grid (sparse). [0, 1); default 0.01.
     float threshold = 0.01f;
 };

@@ -42,7 +42,7 @@ float turb(const detail::Noise4& noise, const GasTurbulenceDesc& d, glm::vec3 p)
 }
 
 float steam(const detail::Noise4& noise, const ProceduralGasDesc& g, glm::vec3 p, float t) {
-    const SteamDesc& s = g.steam;
+    const GasSteamDesc& s = g.steam;
     const float h = p.y - s.source.y;
     if (!(h >= 0.0f) || h >= s.height) return 0.0f;
     const float hn = h / s.height;
@@ -60,7 +60,7 @@ float steam(const detail::Noise4& noise, const ProceduralGasDesc& g, glm::vec3 p
 }
 
 float fog(const detail::Noise4& noise, const ProceduralGasDesc& g, glm::vec3 p, float t) {
-    const FogDesc& f = g.fog;
+    const GasFogDesc& f = g.fog;
     // chess_fog (1): turbulence applied to the point "so that it appears more random".
     const float tmp = turb(noise, g.turbulence, p);
     // The front: a plane x = f advancing with time, deformed by the point's
@@ -81,7 +81,7 @@ float fog(const detail::Noise4& noise, const ProceduralGasDesc& g, glm::vec3 p, 
 }
 
 float cloud(const detail::Noise4& noise, const ProceduralGasDesc& g, glm::vec3 p, float t) {
-    const CloudDesc& c = g.cloud;
+    const GasCloudDesc& c = g.cloud;
     // The ellipsoid drifts with the wind; density falls to 0 at its surface so
     // the defining solid is not seen (the paper: "decreasing the density
     // based on the location within the volume").
@@ -118,7 +118,7 @@ Status validateProceduralGas(const ProceduralGasDesc& g) {
         return makeError("turbulence.octaves must be in [1, 12], got " + std::to_string(g.turbulence.octaves));
     if (Status s = positive(g.turbulence.frequency, "turbulence.frequency"); !s) return s;
     if (!(g.threshold >= 0.0f && g.threshold < 1.0f)) return makeError("threshold must be in [0, 1)");
-    const SteamDesc& st = g.steam;
+    const GasSteamDesc& st = g.steam;
     for (int a = 0; a < 3; ++a) if (Status s = finite(st.source[a], "steam.source"); !s) return s;
     if (Status s = positive(st.sourceRadius, "steam.sourceRadius"); !s) return s;
     if (Status s = nonNegative(st.spread, "steam.spread"); !s) return s;
@@ -128,7 +128,7 @@ Status validateProceduralGas(const ProceduralGasDesc& g) {
     if (Status s = nonNegative(st.swirlRadius, "steam.swirlRadius"); !s) return s;
     if (Status s = nonNegative(st.opaque, "steam.opaque"); !s) return s;
     if (Status s = positive(st.power, "steam.power"); !s) return s;
-    const FogDesc& f = g.fog;
+    const GasFogDesc& f = g.fog;
     if (Status s = positive(f.swirlPeriodSec, "fog.swirlPeriodSec"); !s) return s;
     if (Status s = nonNegative(f.ellipse1, "fog.ellipse1"); !s) return s;
     if (Status s = nonNegative(f.ellipse2, "fog.ellipse2"); !s) return s;
@@ -140,7 +140,7 @@ Status validateProceduralGas(const ProceduralGasDesc& g) {
     if (Status s = finite(f.frontSpeed, "fog.frontSpeed"); !s) return s;
     if (Status s = nonNegative(f.frontTurbulence, "fog.frontTurbulence"); !s) return s;
     if (Status s = positive(f.thickenDistance, "fog.thickenDistance"); !s) return s;
-    const CloudDesc& c = g.cloud;
+    const GasCloudDesc& c = g.cloud;
     for (int a = 0; a < 3; ++a) {
         if (Status s = finite(c.center[a], "cloud.center"); !s) return s;
         if (Status s = positive(c.radii[a], std::string("cloud.radii.") + "xyz"[a]); !s) return s;
