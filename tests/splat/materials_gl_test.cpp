@@ -37,14 +37,10 @@ Result<Effect> levelEffect(Materials& m, int i) {
     }
 }
 
-Image drawFrame(Scene& scene, const Materials& m, gl::Renderer& r, gl::Framebuffer& fb, const Camera& cam, double t) {
-    scene.update(t, cam);
-    SplatBuilder b;
-    b.begin(cam);
-    scene.emit(b, m);
-    b.sort();
-    fb.clear({0, 0, 0, 1});
-    r.draw(b.splats(), cam, {.framebuffer = fb.handle(), .width = fb.width(), .height = fb.height()});
+Image drawFrame(Scene& scene, const Materials& m, gl::FrameRenderer& r, gl::Framebuffer& fb, const Camera& cam, double t) {
+    Frame frame;
+    scene.prepare(t, cam, m, frame);
+    r.render(frame, {.framebuffer = fb.handle(), .drawOpaque = [&] { fb.clear({0, 0, 0, 1}); }});
     return fb.read();
 }
 
@@ -66,7 +62,7 @@ TEST_F(MaterialsGL, ThousandEffectLevelDrawsWithOnlyItsDistinctSets) {
     EXPECT_EQ(m.layerCount(), 1u + 8u + 16u + 8u + 8u + 8u);
     EXPECT_EQ(m.colorTableCount(), 3u);
 
-    auto r = gl::Renderer::create();
+    auto r = gl::FrameRenderer::create();
     ASSERT_TRUE(r) << r.error();
     const Status up = r->upload(m);
     ASSERT_TRUE(up) << up.error();

@@ -14,6 +14,7 @@
 #include <epoxy/gl.h>
 
 #include "splatfx/context.hpp"
+#include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/gl/framebuffer.hpp"
 #include "splatfx/gl/renderer.hpp"
 #include "splatfx/presets.hpp"
@@ -35,24 +36,19 @@ splatfx::Result<splatfx::Effect> makeEffect(splatfx::Materials& m, int kind, glm
     }
 }
 
-// What a drawn frame needs from the host: a target and the bare SDK path
-// (SplatBuilder + gl::Renderer). drawFrame is the only place this bench
-// draws, so a frame renderer can take its place.
+// What a drawn frame needs from the host: a target, the SDK's frame and its renderer.
 struct FrameDraw {
     splatfx::gl::Framebuffer& fb;
-    splatfx::gl::Renderer& renderer;
-    splatfx::SplatBuilder builder;
+    splatfx::gl::FrameRenderer& renderer;
+    splatfx::Frame frame;
 };
 
-// One full frame as a game runs it: schedule and simulate, emit, sort,
-// clear, draw, and wait for the pixels (glFinish), so the time is CPU + GL.
+// One full frame as a game runs it: Scene::prepare (schedule, simulate, emit,
+// sort), then the frame renderer with the clear as the host's opaque pass,
+// and wait for the pixels (glFinish), so the time is CPU + GL.
 void drawFrame(splatfx::Scene& scene, const splatfx::Materials& m, FrameDraw& d, const splatfx::Camera& cam, double timeSec) {
-    scene.update(timeSec, cam);
-    d.builder.begin(cam);
-    scene.emit(d.builder, m);
-    d.builder.sort();
-    d.fb.clear({0.02f, 0.02f, 0.04f, 1.0f});
-    d.renderer.draw(d.builder.splats(), cam, {.framebuffer = d.fb.handle(), .width = d.fb.width(), .height = d.fb.height()});
+    scene.prepare(timeSec, cam, m, d.frame);
+    d.renderer.render(d.frame, {.framebuffer = d.fb.handle(), .drawOpaque = [&] { d.fb.clear({0.02f, 0.02f, 0.04f, 1.0f}); }});
     glFinish();
 }
 
@@ -144,7 +140,7 @@ int runScheduling(int argc, char** argv) {
                 double(m.texelBytes()) / 1e6);
 
     auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
-    auto renderer = splatfx::gl::Renderer::create();
+    auto renderer = splatfx::gl::FrameRenderer::create();
     if (!fb || !renderer) {
         std::fprintf(stderr, "scheduling: %s\n", (fb ? renderer.error() : fb.error()).c_str());
         return 1;
@@ -153,7 +149,7 @@ int runScheduling(int argc, char** argv) {
         std::fprintf(stderr, "scheduling: %s\n", s.error().c_str());
         return 1;
     }
-    FrameDraw draw{*fb, *renderer, splatfx::SplatBuilder{}};
+    FrameDraw draw{*fb, *renderer, splatfx::Frame{}};
     std::printf("drawing at %dx%d on %s\n\n", size.x, size.y, ctx->renderer().c_str());
 
     const auto fixed = [&](int) {
