@@ -3,9 +3,11 @@
 //
 //   splatfx-render samples/03-cow-through-fire/scene.json --out out/cow --frames 24 --size 320x240
 //
-// Outputs are staged in DIR/.splatfx-render-<name>.partial/ and moved into DIR
-// only when every frame and the GIF were written (the GIF last), so a failed
-// or interrupted run never leaves a half-written set passed off as complete.
+// Frames and GIF are one output set (splatfx/output_set.hpp): staged in
+// DIR/.<name>.partial/, every write checked, moved into DIR only when all were
+// written; DIR/.<name>.outputs records them, so only files this tool wrote
+// are ever replaced or removed, and a run killed while publishing is
+// finished by the next one.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -22,6 +24,7 @@
 #include "splatfx/context.hpp"
 #include "splatfx/gl/framebuffer.hpp"
 #include "splatfx/image.hpp"
+#include "splatfx/output_set.hpp"
 
 namespace fs = std::filesystem;
 
@@ -154,15 +157,6 @@ bool parse(int argc, char** argv, Args& a) {
     return true;
 }
 
-struct Staging {
-    fs::path dir;
-    bool keep = false;
-    ~Staging() {
-        std::error_code ec;
-        if (!keep && !dir.empty()) fs::remove_all(dir, ec);
-    }
-};
-
 int fail(const std::string& why) {
     std::fprintf(stderr, "splatfx-render: %s\n", why.c_str());
     return 1;
@@ -184,14 +178,9 @@ int main(int argc, char** argv) {
     const float fps = a.fps.value_or(file.output.fps);
     const std::string name = file.output.name;
 
-    std::error_code ec;
-    fs::create_directories(a.out, ec);
-    if (ec) return fail("cannot create output folder '" + a.out + "': " + ec.message());
-    Staging staging;
-    staging.dir = fs::path(a.out) / (".splatfx-render-" + name + ".partial");
-    fs::remove_all(staging.dir, ec);
-    fs::create_directories(staging.dir, ec);
-    if (ec) return fail("cannot create staging folder '" + staging.dir.string() + "': " + ec.message());
+    // Frames and GIF are one set: staged, then published together (output_set.hpp).
+    auto outputs = splatfx::OutputSet::begin(a.out, name);
+    if (!outputs) return fail(outputs.error());
 
     auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
     if (!fb) return fail(fb.error());
@@ -200,13 +189,12 @@ int main(int argc, char** argv) {
     std::printf("splatfx-render: %d frames at %dx%d, %g fps, seed %u, %s splats -> %s/%s_NNNN.png + %s.gif\n", frames, size.x, size.y,
                 fps, file.seed, a.traditional ? "traditional" : "textured", a.out.c_str(), name.c_str(), name.c_str());
 
-    splatfx::AnimationWriter gif((staging.dir / (name + ".gif")).string(), fps);
+    splatfx::AnimationWriter gif(outputs->path(name + ".gif"), fps);
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
     double renderMs = 0.0, prepareMs = 0.0, submitMs = 0.0;
     std::uint64_t splatsMin = ~0ull, splatsMax = 0, splatsSum = 0, voxelsMax = 0;
     std::size_t visibleMax = 0, simulatedMax = 0, drawnMax = 0, visibleSum = 0, simulatedSum = 0, drawnSum = 0;
-    std::vector<std::string> pngs;
     const bool tty = isatty(fileno(stdout)) != 0;
     for (int i = 0; i < frames; ++i) {
         if (i == a.abortAfter) return fail("aborted on purpose after " + std::to_string(i) + " frames (--abort-after); no output kept");
@@ -223,8 +211,8 @@ int main(int argc, char** argv) {
         visibleSum += s.needed, simulatedSum += s.simulated, drawnSum += s.drawn;
         char png[128];
         std::snprintf(png, sizeof png, "%s_%04d.png", name.c_str(), i);
-        if (auto w = splatfx::writeImage((staging.dir / png).string(), img); !w) return fail(w.error());
-        pngs.push_back(png);
+        if (auto w = splatfx::writeImage(outputs->path(png), img); !w) return fail(w.error());
+        outputs->add(png);
         if (auto w = gif.add(img); !w) return fail(w.error());
         // A terminal gets a live line; a log gets about ten lines.
         if (!a.quiet && (tty || (i + 1) % std::max(1, frames / 10) == 0 || i + 1 == frames)) {
@@ -236,18 +224,8 @@ int main(int argc, char** argv) {
     }
     if (!a.quiet && tty) std::printf("\n");
     if (auto w = gif.finish(); !w) return fail(w.error());
-
-    // Replace an earlier run's outputs of the same name, frames first, GIF last.
-    for (const auto& entry : fs::directory_iterator(a.out, ec)) {
-        const std::string f = entry.path().filename().string();
-        if (f.rfind(name + "_", 0) == 0 && f.size() == name.size() + 9 && entry.path().extension() == ".png") fs::remove(entry.path(), ec);
-    }
-    for (const std::string& png : pngs) {
-        fs::rename(staging.dir / png, fs::path(a.out) / png, ec);
-        if (ec) return fail("cannot move " + png + " into '" + a.out + "': " + ec.message());
-    }
-    fs::rename(staging.dir / (name + ".gif"), fs::path(a.out) / (name + ".gif"), ec);
-    if (ec) return fail("cannot move " + name + ".gif into '" + a.out + "': " + ec.message());
+    outputs->add(name + ".gif");
+    if (auto w = outputs->publish(); !w) return fail(w.error());
 
     const double sec = std::chrono::duration<double>(Clock::now() - start).count();
     const splatfx::FrameCounters& last = player->stats().counters;
