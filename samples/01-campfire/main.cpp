@@ -64,18 +64,18 @@ struct Campfire {
         renderer->render(splatFrame, {.framebuffer = framebuffer, .drawOpaque = clearBackground});
     }
 
-    void frame(const samples::FrameContext& fc) {
+    bool frame(const samples::FrameContext& fc) {
         draw(fc.timeSec, fc.size, fc.target.framebuffer, !options.traditional);
-        if (options.frames > 0 && !figureWritten) writeFigure1(fc);
+        return figureWritten || !fc.outputs || writeFigure1(fc);
     }
 
     // Fig. 1a vs 1b: the same grid and frame, traditional then textured.
-    void writeFigure1(const samples::FrameContext& fc) {
+    bool writeFigure1(const samples::FrameContext& fc) {
         figureWritten = true;
         splatfx::Image halves[2];
         for (int textured = 0; textured < 2; ++textured) {
             auto fb = splatfx::gl::Framebuffer::create({.width = fc.size.x, .height = fc.size.y});
-            if (!fb) return void(fail(fb.error()));
+            if (!fb) return fail(fb.error());
             draw(fc.timeSec, fc.size, fb->handle(), textured == 1);
             halves[textured] = fb->read();
         }
@@ -88,9 +88,10 @@ struct Campfire {
             for (int x = 0; x < both.width; ++x)
                 for (int c = 0; c < 4; ++c)
                     both.at(x, y, c) = halves[x / fc.size.x].at(x % fc.size.x, y, c);
-        const std::string path = options.out + "/campfire_figure1.png";
-        if (auto s = splatfx::writeImage(path, both); !s) return void(fail(s.error()));
-        std::printf("campfire: wrote %s (left: traditional splats, right: textured splats)\n", path.c_str());
+        if (auto s = splatfx::writeImage(fc.outputs->path("campfire_figure1.png"), both); !s) return fail(s.error());
+        fc.outputs->add("campfire_figure1.png");
+        std::printf("campfire: %s/campfire_figure1.png (left: traditional splats, right: textured splats)\n", options.out.c_str());
+        return true;
     }
 };
 
@@ -101,5 +102,5 @@ int main(int argc, char** argv) {
     if (!samples::parseOptions(argc, argv, "campfire", "the paper's 7x20x5 fire as textured splats (Figure 1)", app.options))
         return 2;
     return samples::run(
-        app.options, "campfire", [&] { return app.setup(); }, [&](const samples::FrameContext& fc) { app.frame(fc); });
+        app.options, "campfire", [&] { return app.setup(); }, [&](const samples::FrameContext& fc) { return app.frame(fc); });
 }

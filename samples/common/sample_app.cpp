@@ -1,5 +1,7 @@
 #include "sample_app.hpp"
 
+#include "splatfx/output_set.hpp"
+
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -69,7 +71,7 @@ bool parseOptions(int argc, char** argv, const char* name, const char* about, Op
 namespace {
 
 int runHeadless(const Options& o, const char* name, const std::function<bool()>& setup,
-                const std::function<void(const FrameContext&)>& frame) {
+                const std::function<bool(const FrameContext&)>& frame) {
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) {
         std::fprintf(stderr, "%s: %s\n", name, ctx.error().c_str());
@@ -83,13 +85,13 @@ int runHeadless(const Options& o, const char* name, const std::function<bool()>&
         return 1;
     }
     if (!setup()) return 1;
-    std::error_code ec;
-    std::filesystem::create_directories(o.out, ec);
-    if (ec) {
-        std::fprintf(stderr, "%s: cannot create output folder '%s': %s\n", name, o.out.c_str(), ec.message().c_str());
+    // Frames, GIF and any extra output are one set, published when all are written.
+    auto outputs = splatfx::OutputSet::begin(o.out, name);
+    if (!outputs) {
+        std::fprintf(stderr, "%s: %s\n", name, outputs.error().c_str());
         return 1;
     }
-    splatfx::AnimationWriter gif(o.out + "/" + name + ".gif", o.fps);
+    splatfx::AnimationWriter gif(outputs->path(std::string(name) + ".gif"), o.fps);
     const auto start = std::chrono::steady_clock::now();
     for (int i = 0; i < o.frames; ++i) {
         FrameContext fc;
@@ -97,15 +99,17 @@ int runHeadless(const Options& o, const char* name, const std::function<bool()>&
         fc.timeSec = i / double(o.fps);
         fc.size = o.size;
         fc.target = {.framebuffer = fb->handle(), .width = o.size.x, .height = o.size.y};
+        fc.outputs = &*outputs;
         glBindFramebuffer(GL_FRAMEBUFFER, fb->handle());
-        frame(fc);
+        if (!frame(fc)) return 1;
         splatfx::Image img = fb->read();
         char file[64];
-        std::snprintf(file, sizeof file, "/%s_%04d.png", name, i);
-        if (auto s = splatfx::writeImage(o.out + file, img); !s) {
+        std::snprintf(file, sizeof file, "%s_%04d.png", name, i);
+        if (auto s = splatfx::writeImage(outputs->path(file), img); !s) {
             std::fprintf(stderr, "%s: %s\n", name, s.error().c_str());
             return 1;
         }
+        outputs->add(file);
         if (auto s = gif.add(img); !s) {
             std::fprintf(stderr, "%s: %s\n", name, s.error().c_str());
             return 1;
@@ -119,12 +123,17 @@ int runHeadless(const Options& o, const char* name, const std::function<bool()>&
         std::fprintf(stderr, "%s: %s\n", name, s.error().c_str());
         return 1;
     }
+    outputs->add(std::string(name) + ".gif");
+    if (auto s = outputs->publish(); !s) {
+        std::fprintf(stderr, "%s: %s\n", name, s.error().c_str());
+        return 1;
+    }
     std::printf("%s: %d frames in %.2f s (%.1f ms per frame including PNG writes)\n", name, o.frames, sec, 1000.0 * sec / o.frames);
     return 0;
 }
 
 int runWindowed(const Options& o, const char* name, const std::function<bool()>& setup,
-                const std::function<void(const FrameContext&)>& frame) {
+                const std::function<bool(const FrameContext&)>& frame) {
     auto window = splatfx::Window::create({.width = o.size.x, .height = o.size.y, .title = std::string("splatfx: ") + name});
     if (!window) {
         std::fprintf(stderr, "%s: %s\n", name, window.error().c_str());
@@ -141,7 +150,7 @@ int runWindowed(const Options& o, const char* name, const std::function<bool()>&
         fc.size = window->framebufferSize();
         fc.target = {.framebuffer = 0, .width = fc.size.x, .height = fc.size.y};
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
-        frame(fc);
+        if (!frame(fc)) return 1;
         window->swapBuffers();
         window->pollEvents();
     }
@@ -151,7 +160,7 @@ int runWindowed(const Options& o, const char* name, const std::function<bool()>&
 } // namespace
 
 int run(const Options& o, const char* name, const std::function<bool()>& setup,
-        const std::function<void(const FrameContext&)>& frame) {
+        const std::function<bool(const FrameContext&)>& frame) {
     return o.frames > 0 ? runHeadless(o, name, setup, frame) : runWindowed(o, name, setup, frame);
 }
 

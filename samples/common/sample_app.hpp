@@ -12,6 +12,7 @@
 
 #include <glm/glm.hpp>
 
+#include "splatfx/output_set.hpp"
 #include "splatfx/splatfx.hpp"
 
 namespace samples {
@@ -34,11 +35,16 @@ struct FrameContext {
     double timeSec = 0.0; // index / fps: animation time never depends on the wall clock
     glm::ivec2 size{0};
     splatfx::gl::Target target;
+    // Headless: the run's output set, for extra files beside the frames
+    // (write at outputs->path(f), then outputs->add(f)); null when windowed.
+    splatfx::OutputSet* outputs = nullptr;
 };
 
-// Runs the loop. frame() draws one frame (the host part: clear, geometry, then splats).
-// Headless: writes DIR/<name>_NNNN.png and DIR/<name>.gif. Returns the process exit code.
+// Runs the loop. frame() draws one frame (the host part: clear, geometry, then
+// splats) and returns false to stop with an error it has printed.
+// Headless: writes DIR/<name>_NNNN.png and DIR/<name>.gif as one output set
+// (splatfx/output_set.hpp). Returns the process exit code.
 int run(const Options& options, const char* name, const std::function<bool()>& setup,
-        const std::function<void(const FrameContext&)>& frame);
+        const std::function<bool(const FrameContext&)>& frame);
 
 } // namespace samples
