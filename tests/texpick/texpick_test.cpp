@@ -586,3 +586,23 @@ TEST(TexpickSets, ShippedTurbulenceRegenerates) {
     for (int k = 0; k < ref.count(); ++k)
         for (size_t i = 0; i < ref.layers[size_t(k)].size(); ++i) ASSERT_NEAR(set->layers[size_t(k)][i], ref.layers[size_t(k)][i], kEightBit);
 }
+
+// A run killed at the swap leaves the previous set moved aside under a hidden
+// name (its process gone); the next run puts it back before anything else, so
+// even a next run that fails leaves the user with the old set, and a killed
+// run's staging folder is removed. 4194305 is above Linux's largest pid.
+TEST(TexpickOutput, KilledRunsAreRecoveredByTheNextRun) {
+    const fs::path dir = fs::path(splatfx::test::outputDir()) / "recover";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const auto set = splatfx::TextureSet::turbulence({.count = 2, .size = 16, .seed = 4});
+    ASSERT_TRUE(set.save((dir / ".fire.texpick-old-4194305").string(), "{}"));
+    fs::create_directories(dir / ".fire.texpick-4194306");
+    std::ofstream(dir / ".fire.texpick-4194306" / "t000.png") << "half written";
+    const splatfx::Status s = texpick::writeOutput((dir / "fire").string(), splatfx::TextureSet{}, "{}", {.contactSheet = false, .preview = false});
+    ASSERT_FALSE(s) << "an empty set must fail to save";
+    EXPECT_TRUE(fs::exists(dir / "fire" / "manifest.json")) << "the previous set must be back under its name";
+    EXPECT_TRUE(splatfx::TextureSet::load((dir / "fire").string()));
+    EXPECT_FALSE(fs::exists(dir / ".fire.texpick-4194306")) << "the killed run's staging folder must be gone";
+    EXPECT_FALSE(fs::exists(dir / ".fire.texpick-old-4194305"));
+}

@@ -5,8 +5,13 @@
 // [SECTION] Preview
 // [SECTION] Output folder
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
+#include <functional>
+
+#include <signal.h>
 #include <unistd.h>
 
 #include <nlohmann/json.hpp>
@@ -203,7 +208,8 @@ splatfx::Camera frame(const splatfx::Grid& g, float support, glm::ivec2 viewport
 
 } // namespace
 
-splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::TextureSet& set, const OutputDesc& d) {
+splatfx::Status renderPreview(const splatfx::TextureSet& set, const OutputDesc& d,
+                              const std::function<splatfx::Status(const splatfx::Image&)>& sink) {
     if (set.count() < 1) return makeError("preview: the set has no textures");
     if (d.previewSize < 32 || d.previewSize > 2048)
         return makeError("--preview-size must be between 32 and 2048 pixels, got " + std::to_string(d.previewSize));
@@ -239,7 +245,6 @@ splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::Textur
     const splatfx::Camera camSingle = frame(*single, fp.radius(), vp), camPuff = frame(*puff, fp.radius(), vp);
 
     const int frames = d.previewFrames > 0 ? d.previewFrames : 3 * set.count();
-    std::vector<splatfx::Image> out;
     splatfx::Frame singleFrame, puffFrame; // one frame per view, drawn side by side
     for (int f = 0; f < frames; ++f) {
         // Three frames per texture with cross-fades: one full cycle, so the GIF loops seamlessly.
@@ -262,9 +267,21 @@ splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::Textur
         puffFrame.builder().add(*puff, mat, style);
         puffFrame.end();
         renderer->render(puffFrame, {.framebuffer = fb->handle(), .x = h, .y = 0});
-        out.push_back(fb->read());
+        // One frame at a time to the sink: memory stays one frame whatever the preview's length.
+        if (auto s = sink(fb->read()); !s) return s;
     }
-    return out;
+    return {};
+}
+
+splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::TextureSet& set, const OutputDesc& d) {
+    std::vector<splatfx::Image> frames;
+    if (auto s = renderPreview(set, d, [&](const splatfx::Image& f) {
+            frames.push_back(f);
+            return splatfx::Status{};
+        });
+        !s)
+        return makeError(s.error());
+    return frames;
 }
 
 // [SECTION] Output folder
@@ -279,6 +296,35 @@ std::string hiddenName(const fs::path& target, const char* tag) {
     name += tag;
     name += std::to_string(getpid());
     return name;
+}
+
+// What a killed run left beside `target`, named by hiddenName with a process
+// id that is no longer running: a staging folder (removed), or the previous
+// set moved aside at the swap (put back when the new one never arrived,
+// removed when it did).
+splatfx::Status recoverKilledRuns(const fs::path& parent, const fs::path& target) {
+    std::error_code ec;
+    std::string stem(1, '.'); // piecewise, as hiddenName (GCC 12's false -Wrestrict)
+    stem += target.filename().string();
+    stem += ".texpick-";
+    for (const auto& entry : fs::directory_iterator(parent, ec)) {
+        const std::string n = entry.path().filename().string();
+        if (n.rfind(stem, 0) != 0) continue;
+        const bool old = n.compare(stem.size(), 4, "old-") == 0;
+        const std::string pidText = n.substr(stem.size() + (old ? 4 : 0));
+        if (pidText.empty() || pidText.find_first_not_of("0123456789") != std::string::npos) continue;
+        const long pid = std::strtol(pidText.c_str(), nullptr, 10);
+        if (pid == long(getpid()) || ::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue; // its owner is still running
+        std::error_code e2;
+        if (old && !fs::exists(target, e2)) {
+            fs::rename(entry.path(), target, e2);
+            if (e2) return makeError("a killed run left the previous '" + target.string() + "' at '" + entry.path().string() +
+                                     "' and it cannot be put back: " + e2.message());
+        } else {
+            fs::remove_all(entry.path(), e2);
+        }
+    }
+    return {};
 }
 
 } // namespace
@@ -305,6 +351,7 @@ splatfx::Status writeOutput(const std::string& folder, const splatfx::TextureSet
     }
     fs::create_directories(parent, ec);
     if (ec) return makeError("cannot create the folder '" + parent.string() + "' for '" + folder + "': " + ec.message());
+    if (auto s = recoverKilledRuns(parent, target); !s) return s;
     const fs::path staging = parent / hiddenName(target, ".texpick-");
     fs::remove_all(staging, ec);
     auto fail = [&](const std::string& why) {
@@ -319,11 +366,8 @@ splatfx::Status writeOutput(const std::string& folder, const splatfx::TextureSet
         if (auto s = splatfx::writeImage((staging / "contact.png").string(), contactSheet(set, d.footprint, source, patches)); !s)
             return fail(s.error());
     if (d.preview) {
-        auto frames = renderPreview(set, d);
-        if (!frames) return fail(frames.error());
         splatfx::AnimationWriter gif((staging / "preview.gif").string(), d.previewFps);
-        for (const splatfx::Image& f : *frames)
-            if (auto s = gif.add(f); !s) return fail(s.error());
+        if (auto s = renderPreview(set, d, [&](const splatfx::Image& f) { return gif.add(f); }); !s) return fail(s.error());
         if (auto s = gif.finish(); !s) return fail(s.error());
     }
     // ...and a check that the SDK reads back what was written, before anything is replaced.

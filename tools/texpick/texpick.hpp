@@ -21,6 +21,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -247,7 +248,11 @@ splatfx::Image contactSheet(const splatfx::TextureSet& set, const splatfx::Footp
 
 // Renders the cycling preview headless: one large textured splat (left) and
 // a puff of textured splats (right), cross-fading through the set in order.
-// Fails when no headless GL 4.5 context can be created.
+// Fails when no headless GL 4.5 context can be created. Each frame goes to
+// `sink` as it is drawn (memory: one frame); the sink's failure stops it.
+splatfx::Status renderPreview(const splatfx::TextureSet& set, const OutputDesc& desc,
+                              const std::function<splatfx::Status(const splatfx::Image&)>& sink);
+// The same, collected (small previews and tests).
 splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::TextureSet& set, const OutputDesc& desc);
 
 // [SECTION] Command line and interactive mode
