@@ -1,8 +1,12 @@
 #include "mesh.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -18,6 +22,60 @@ splatfx::Aabb Mesh::bounds() const {
 
 namespace {
 
+// Budgets for meshes a scene file names, checked before assimp allocates:
+// a crafted header can claim billions of elements in a few bytes.
+constexpr std::uintmax_t kMaxMeshFileBytes = 512ull << 20; // 512 MiB
+constexpr std::uint64_t kMaxMeshElements = 20'000'000;     // vertices or faces
+
+// PLY and OFF state their element counts in a text header. A count is
+// refused when it exceeds the budget, or when the file is too short to hold
+// that many elements at their smallest encoding (ASCII "0 0 0\n" is 6 bytes a
+// vertex, binary is 12; a face is at least 4 bytes either way).
+splatfx::Status checkHeaderCounts(const std::string& path, std::uintmax_t fileBytes) {
+    std::ifstream in(path, std::ios::binary);
+    std::string line;
+    if (!std::getline(in, line)) return {};
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    struct Claim {
+        const char* what;
+        std::uint64_t count;
+        std::uint64_t minBytes;
+    };
+    std::vector<Claim> claims;
+    if (line == "ply") {
+        bool binary = false;
+        for (int n = 0; n < 200 && std::getline(in, line); ++n) {
+            if (!line.empty() && line.back() == '\r') line.pop_back();
+            if (line.rfind("format ", 0) == 0) binary = line.find("binary") != std::string::npos;
+            unsigned long long count = 0;
+            char name[32] = {};
+            if (std::sscanf(line.c_str(), "element %31s %llu", name, &count) == 2) {
+                const bool vertex = std::string(name) == "vertex";
+                claims.push_back({vertex ? "vertices" : "faces", count, vertex ? (binary ? 12u : 6u) : 4u});
+            }
+            if (line == "end_header") break;
+        }
+    } else if (line.rfind("OFF", 0) == 0) {
+        unsigned long long nv = 0, nf = 0;
+        std::string counts = line.substr(3);
+        while (counts.find_first_not_of(" \t") == std::string::npos || counts[counts.find_first_not_of(" \t")] == '#')
+            if (!std::getline(in, counts)) return {};
+        if (std::sscanf(counts.c_str(), "%llu %llu", &nv, &nf) == 2) {
+            claims.push_back({"vertices", nv, 6});
+            claims.push_back({"faces", nf, 8});
+        }
+    }
+    for (const Claim& c : claims) {
+        if (c.count > kMaxMeshElements)
+            return splatfx::makeError(path + ": the header claims " + std::to_string(c.count) + " " + c.what + ", over the mesh budget of " +
+                                      std::to_string(kMaxMeshElements));
+        if (c.count * c.minBytes > fileBytes)
+            return splatfx::makeError(path + ": the header claims " + std::to_string(c.count) + " " + c.what + " but the file has only " +
+                                      std::to_string(fileBytes) + " bytes (truncated or crafted)");
+    }
+    return {};
+}
+
 void appendNode(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, Mesh& out) {
     const aiMatrix4x4 m = parent * node->mTransformation;
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
@@ -30,6 +88,10 @@ void appendNode(const aiScene* scene, const aiNode* node, const aiMatrix4x4& par
         for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
             const aiFace& face = mesh->mFaces[f];
             if (face.mNumIndices != 3) continue; // points and lines (aiProcess_Triangulate leaves only these)
+            // aiProcess_ValidateDataStructure has checked the indices; a face that still points
+            // past its mesh is dropped rather than read out of bounds.
+            if (face.mIndices[0] >= mesh->mNumVertices || face.mIndices[1] >= mesh->mNumVertices || face.mIndices[2] >= mesh->mNumVertices)
+                continue;
             for (int k = 0; k < 3; ++k) out.indices.push_back(base + face.mIndices[k]);
         }
     }
@@ -40,9 +102,17 @@ void appendNode(const aiScene* scene, const aiNode* node, const aiMatrix4x4& par
 
 splatfx::Result<Mesh> loadMesh(const std::string& path) {
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) return splatfx::makeError(path + ": mesh file not found");
+    if (!std::filesystem::exists(path, ec)) return splatfx::makeError(path + ": mesh file not found");
+    if (!std::filesystem::is_regular_file(path, ec)) return splatfx::makeError(path + ": not a regular file (a folder, FIFO or device is never read as a mesh)");
+    const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+    if (ec) return splatfx::makeError(path + ": cannot read its size: " + ec.message());
+    if (bytes > kMaxMeshFileBytes)
+        return splatfx::makeError(path + ": " + std::to_string(bytes) + " bytes, over the mesh budget of " + std::to_string(kMaxMeshFileBytes) + " bytes");
+    if (auto s = checkHeaderCounts(path, bytes); !s) return splatfx::makeError(s.error());
     Assimp::Importer importer;
-    const aiScene* scene = importer.ReadFile(path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+    // Validation makes assimp refuse out-of-range indices and other broken structure instead of handing them on.
+    const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                                                       aiProcess_SortByPType);
     if (!scene || !scene->mRootNode) return splatfx::makeError(path + ": cannot load mesh: " + importer.GetErrorString());
     Mesh out;
     appendNode(scene, scene->mRootNode, aiMatrix4x4(), out);

@@ -84,6 +84,8 @@ splatfx::Result<Source> loadSource(const std::string& path) {
     const std::string what = "cannot read image '" + path + "': ";
     if (!fs::exists(path, ec)) return makeError(what + "no such file");
     if (fs::is_directory(path, ec)) return makeError(what + "it is a folder, not an image file");
+    // Opening a FIFO would block forever and a device never ends: regular files only.
+    if (!fs::is_regular_file(path, ec)) return makeError(what + "not a regular file (a FIFO, device or socket is never read as an image)");
     {
         std::ifstream probe(path, std::ios::binary);
         if (!probe) return makeError(what + "the file cannot be opened (check its permissions)");
@@ -91,7 +93,10 @@ splatfx::Result<Source> loadSource(const std::string& path) {
     }
     auto img = splatfx::readImage(path);
     if (!img) {
-        // OpenImageIO first (it knows EXR, HDR, DPX...), OpenCV for what it lacks.
+        // OpenImageIO first (it knows EXR, HDR, DPX...), OpenCV only for what it
+        // cannot open at all: a file whose header OpenImageIO read was refused
+        // on its merits (a budget, corrupt data), and OpenCV must not bypass that.
+        if (splatfx::readImageInfo(path)) return makeError(img.error());
         cv::Mat m = cv::imread(path, cv::IMREAD_UNCHANGED);
         if (m.empty()) return makeError(img.error() + " (OpenCV cannot decode it either)");
         cv::Mat f;

@@ -42,9 +42,22 @@ enum class Alpha {
     Straight,      // colour independent of alpha (texture sets whose alpha is opacity, not coverage)
 };
 
-// Fails with the file name and the reason: missing, unreadable, zero-size,
-// or more than 16384 pixels on a side.
+// Budgets checked before anything is decoded.
+inline constexpr int kMaxImageSide = 16384;                        // pixels on a side
+inline constexpr unsigned long long kMaxImageFileBytes = 1ull << 30; // 1 GiB of file
+
+// Fails with the file name and the reason: missing, a symbolic-link loop, not
+// a regular file (FIFOs and devices are never read: they could block or never
+// end), empty, over kMaxImageFileBytes, unreadable, or more than
+// kMaxImageSide pixels on a side.
 Result<Image> readImage(const std::string& path, Alpha alpha = Alpha::Premultiplied);
+
+// What an image file says about itself, from its header alone (nothing is
+// decoded): to check a budget before reading. Same file checks as readImage.
+struct ImageInfo {
+    int width = 0, height = 0, channels = 0;
+};
+Result<ImageInfo> readImageInfo(const std::string& path);
 // Values are clamped to [0, 1] for 8-bit formats (NaN becomes 0).
 Status writeImage(const std::string& path, const Image& image, Alpha alpha = Alpha::Premultiplied);
 // Any other file (a manifest, a record of outputs) with the same guarantees.

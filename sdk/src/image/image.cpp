@@ -1,6 +1,7 @@
 #include "splatfx/image.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <filesystem>
 #include <system_error>
@@ -13,11 +14,40 @@ namespace splatfx {
 
 namespace fs = std::filesystem;
 
-Result<Image> readImage(const std::string& path, Alpha alpha) {
+namespace {
+
+// The checks every read makes before a decoder sees the file.
+Status checkImageFile(const std::string& path) {
+    const std::string what = "cannot read image '" + path + "': ";
     std::error_code ec;
-    if (!fs::exists(path, ec)) return makeError("cannot read image '" + path + "': no such file");
-    if (fs::is_directory(path, ec)) return makeError("cannot read image '" + path + "': it is a folder");
-    if (fs::file_size(path, ec) == 0) return makeError("cannot read image '" + path + "': the file is empty");
+    const fs::file_status st = fs::status(path, ec);
+    if (ec && ec.value() == ELOOP) return makeError(what + "its symbolic links form a loop");
+    if (ec || !fs::exists(st)) return makeError(what + "no such file");
+    if (fs::is_directory(st)) return makeError(what + "it is a folder");
+    // Only regular files: a FIFO would block forever, a device (a link to /dev/zero) never ends.
+    if (!fs::is_regular_file(st)) return makeError(what + "not a regular file (a FIFO, device or socket is never read as an image)");
+    const std::uintmax_t bytes = fs::file_size(path, ec);
+    if (ec) return makeError(what + ec.message());
+    if (bytes == 0) return makeError(what + "the file is empty");
+    if (bytes > kMaxImageFileBytes)
+        return makeError(what + std::to_string(bytes) + " bytes, over the image-file budget of " + std::to_string(kMaxImageFileBytes) + " bytes");
+    return {};
+}
+
+} // namespace
+
+Result<ImageInfo> readImageInfo(const std::string& path) {
+    if (Status s = checkImageFile(path); !s) return makeError(s.error());
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) {
+        std::string why = OIIO::geterror();
+        return makeError("cannot read image '" + path + "': " + (why.empty() ? "unknown format or corrupt data" : why));
+    }
+    return ImageInfo{in->spec().width, in->spec().height, in->spec().nchannels};
+}
+
+Result<Image> readImage(const std::string& path, Alpha alpha) {
+    if (Status s = checkImageFile(path); !s) return makeError(s.error());
     OIIO::ImageSpec config;
     if (alpha == Alpha::Straight) config.attribute("oiio:UnassociatedAlpha", 1);
     auto in = OIIO::ImageInput::open(path, &config);
@@ -29,9 +59,9 @@ Result<Image> readImage(const std::string& path, Alpha alpha) {
     const OIIO::ImageSpec& spec = in->spec();
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
         return makeError("cannot read image '" + path + "': it has no pixels");
-    if (spec.width > 16384 || spec.height > 16384)
+    if (spec.width > kMaxImageSide || spec.height > kMaxImageSide)
         return makeError("cannot read image '" + path + "': " + std::to_string(spec.width) + "x" +
-                         std::to_string(spec.height) + " is larger than 16384 on a side");
+                         std::to_string(spec.height) + " is larger than " + std::to_string(kMaxImageSide) + " on a side");
     Image img;
     img.width = spec.width;
     img.height = spec.height;
