@@ -80,15 +80,33 @@ TextureDynamics::TextureDynamics(const Grid& lattice, const TextureDynamicsDesc&
         const glm::ivec3 r = c - mLo;
         mOccupied[(std::size_t(r.z) * mSize.y + r.y) * mSize.x + r.x] = 1;
     }
-    // Chain lengths: K(c) = K(c - d) + 1 if c - d is occupied. Walked per voxel;
-    // a chain cannot be longer than the lattice's extent along d.
+    // Chain lengths: K(c) = K(c - d) + 1 if c - d is occupied, else 0. Walking
+    // each chain from every voxel costs O(voxels x extent along d) (a
+    // 4096x4096x1 fire never finished loading); memoized over the dense box,
+    // each voxel is settled once: O(voxels) in all.
     mChain.assign(mCells.size(), 0);
-    if (desc.propagation.mode == Propagation::Fixed)
-        for (std::size_t i = 0; i < mCells.size(); ++i) {
-            int k = 0;
-            while (occupied(mCells[i] - (k + 1) * desc.propagation.direction)) ++k;
-            mChain[i] = k;
+    if (desc.propagation.mode != Propagation::Fixed) return;
+    const glm::ivec3 d = desc.propagation.direction;
+    auto dense = [&](glm::ivec3 c) {
+        const glm::ivec3 r = c - mLo;
+        return (std::size_t(r.z) * mSize.y + r.y) * mSize.x + r.x;
+    };
+    std::vector<int> chainAt(mOccupied.size(), -1); // -1: not settled yet (or not occupied)
+    std::vector<glm::ivec3> pending;
+    for (std::size_t i = 0; i < mCells.size(); ++i) {
+        // Walk upwind until a settled cell or the chain's source, then settle the walk back down.
+        glm::ivec3 c = mCells[i];
+        pending.clear();
+        int k = -1; // chain length of the cell upwind of the last pending one (-1: none, a source)
+        while (chainAt[dense(c)] < 0) {
+            pending.push_back(c);
+            if (!occupied(c - d)) break;
+            c -= d;
         }
+        if (chainAt[dense(c)] >= 0) k = chainAt[dense(c)];
+        for (auto it = pending.rbegin(); it != pending.rend(); ++it) chainAt[dense(*it)] = ++k;
+        mChain[i] = chainAt[dense(mCells[i])];
+    }
 }
 
 bool TextureDynamics::occupied(glm::ivec3 c) const {
