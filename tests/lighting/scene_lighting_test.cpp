@@ -188,3 +188,18 @@ TEST(SceneLighting, BadOptionsNameTheFieldAndLeaveTheEffectUnlit) {
     EXPECT_NE(r.error().find("lights[1].intensity"), std::string::npos) << r.error();
     EXPECT_FALSE(s.scene.setLight(7, Light{}));
 }
+
+TEST(SceneLighting, OneCasterWithTheSceneShadowsDimsSharesItsTable) {
+    LitScene s({.enabled = true, .selfShadow = SelfShadow::Table, .tableDims = glm::ivec3(40)});
+    const Light sun = Light::directional({0.4f, -1.0f, 0.1f});
+    ASSERT_TRUE(s.scene.addLight(sun));
+    s.scene.setSceneShadow({.dims = glm::ivec3(40)});
+    s.prepare(0.0);
+    EXPECT_EQ(s.frame.counters().shadowTableBuilds, 1u) << "the self-shadow table is the scene shadow";
+    EXPECT_EQ(s.scene.counters().sceneShadowBuilds, 0u);
+    ASSERT_TRUE(s.frame.shadow().valid);
+    ShadowTable reference({.dims = glm::ivec3(40)});
+    auto field = DensityField::fromGrid(s.scene.effect(s.id).grid());
+    ASSERT_TRUE(field && reference.update(*field, sun));
+    ASSERT_EQ(s.frame.shadow().depth, reference.data());
+}

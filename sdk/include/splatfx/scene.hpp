@@ -68,7 +68,9 @@ struct EffectLighting {
 };
 
 // The shadow the lit effects cast on the scene: one table for one light over
-// every needed, lit, shadow-casting effect, put into Frame::shadow().
+// every needed, lit, shadow-casting effect, put into Frame::shadow(). When
+// exactly one effect casts and its self-shadowing table for that light has
+// these dims, that table is used (no second build).
 struct SceneShadowDesc {
     bool enabled = true;        // default true (when a light exists)
     std::size_t light = 0;      // index into Scene::lights(); default 0 (the first)
@@ -211,7 +213,7 @@ private:
     ShadowTableDesc mSceneShadowTableDesc; // what mSceneShadow was made with
     std::uint64_t mSceneShadowVersion = 0; // bumped whenever the scene shadow's contents change
     std::uint64_t mSceneShadowLastBuilds = 0;
-    bool mSceneShadowValid = false;
+    const ShadowTable* mSceneShadowSource = nullptr; // mSceneShadow, or a lit effect's own table it shares
     std::string mLightingError;
 };
 

@@ -134,44 +134,65 @@ void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& mater
 void Scene::shadeScene(Frame& frame) {
     const SceneShadowDesc& d = mSceneShadowDesc;
     std::vector<const DensityField*> fields;
+    const Entry* only = nullptr; // the one casting effect, when there is one
     if (d.enabled && d.light < mLights.size())
         for (const Entry& e : mEntries)
-            if (e.status.lit && e.options.lighting.castsShadow && e.lit && !e.lit->field.empty()) fields.push_back(&e.lit->field);
-    bool valid = false;
-    if (!fields.empty()) {
+            if (e.status.lit && e.options.lighting.castsShadow && e.lit && !e.lit->field.empty()) {
+                fields.push_back(&e.lit->field);
+                only = &e;
+            }
+    if (fields.size() != 1) only = nullptr;
+    // One casting effect whose self-shadowing table for this light has the
+    // scene shadow's dims: that table is the scene shadow (the paper's one
+    // table serves both), so nothing more is built.
+    const ShadowTable* shared = nullptr;
+    if (only && only->options.lighting.selfShadow == SelfShadow::Table && only->options.lighting.tableDims == d.dims &&
+        d.light < only->lit->tables.tables().size())
+        shared = &only->lit->tables.tables()[d.light];
+    const ShadowTable* src = nullptr;
+    if (shared) {
+        src = shared;
+        if (shared != mSceneShadowSource || shared->builds() != mSceneShadowLastBuilds) {
+            mSceneShadowSource = shared;
+            mSceneShadowLastBuilds = shared->builds();
+            ++mSceneShadowVersion;
+        }
+    } else if (!fields.empty()) {
         const ShadowTableDesc td{.dims = d.dims, .memoryBudgetBytes = d.memoryBudgetBytes};
         if (td.dims != mSceneShadowTableDesc.dims || td.memoryBudgetBytes != mSceneShadowTableDesc.memoryBudgetBytes) {
             mSceneShadow = ShadowTable(td);
             mSceneShadowTableDesc = td;
-            mSceneShadowLastBuilds = 0;
         }
         const std::uint64_t reuses = mSceneShadow.reuses();
         if (Status s = mSceneShadow.update(fields, mLights[d.light]); !s) {
             mLightingError = "sceneShadow: " + s.error();
         } else {
-            valid = true;
-            if (mSceneShadow.builds() != mSceneShadowLastBuilds) {
+            src = &mSceneShadow;
+            if (mSceneShadowSource != &mSceneShadow || mSceneShadow.builds() != mSceneShadowLastBuilds) {
+                if (mSceneShadow.builds() != mSceneShadowLastBuilds) {
+                    ++mCounters.shadowTableBuilds;
+                    ++mCounters.sceneShadowBuilds;
+                }
+                mSceneShadowSource = &mSceneShadow;
                 mSceneShadowLastBuilds = mSceneShadow.builds();
                 ++mSceneShadowVersion;
-                ++mCounters.shadowTableBuilds;
-                ++mCounters.sceneShadowBuilds;
             }
             mCounters.shadowTableReuses += mSceneShadow.reuses() - reuses;
         }
     }
-    if (valid != mSceneShadowValid) {
-        mSceneShadowValid = valid;
+    if (!src && mSceneShadowSource) {
+        mSceneShadowSource = nullptr;
         ++mSceneShadowVersion;
     }
     FrameShadow& out = frame.shadow();
     if (out.version == mSceneShadowVersion && mSceneShadowVersion != 0) return; // unchanged: nothing to copy
-    out.valid = valid;
+    out.valid = src != nullptr;
     out.version = mSceneShadowVersion;
-    if (valid) {
-        out.depth = mSceneShadow.data();
-        out.dims = mSceneShadow.dims();
-        out.worldToTable = mSceneShadow.worldToTable();
-        out.lightInTable = mSceneShadow.lightInTable();
+    if (src) {
+        out.depth = src->data();
+        out.dims = src->dims();
+        out.worldToTable = src->worldToTable();
+        out.lightInTable = src->lightInTable();
     } else {
         out.depth.clear();
         out.dims = glm::ivec3(0);
