@@ -6,6 +6,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
+#include "splatfx/reference.hpp"
 #include "splatfx/scene.hpp"
 #include "test_scenes.hpp"
 
@@ -202,4 +203,26 @@ TEST(SceneLighting, OneCasterWithTheSceneShadowsDimsSharesItsTable) {
     auto field = DensityField::fromGrid(s.scene.effect(s.id).grid());
     ASSERT_TRUE(field && reference.update(*field, sun));
     ASSERT_EQ(s.frame.shadow().depth, reference.data());
+}
+
+TEST(SceneLighting, ReferenceRendererIntegratesTheLitColours) {
+    // Lighting scales every splat's colour by albedo 0.5 here (closed form above); compositing is
+    // linear in the splat colours at fixed alphas, so the reference image with the packed (lit)
+    // colours is 0.5 x the one read from the table, up to the 8-bit packing: at most half a level
+    // per splat, and "over" weights sum to at most 1, so 0.5/255 per pixel (plus double rounding).
+    LitScene s({.enabled = true, .gas = {.albedo = 0.5f}, .selfShadow = SelfShadow::Off});
+    s.camera = Camera::lookAt({0.0f, 3.0f, 12.0f}, {0.0f, 3.0f, 0.0f}, {0, 1, 0}, glm::radians(50.0f), {48, 36}, 0.1f, 100.0f);
+    ASSERT_TRUE(s.scene.addLight(Light::directional({0.3f, -1, 0.2f})));
+    s.prepare(0.0);
+    auto lit = renderSplatExact(s.frame.splats(), s.camera, s.materials, {.threads = 1, .packedColor = true});
+    auto table = renderSplatExact(s.frame.splats(), s.camera, s.materials, {.threads = 1});
+    ASSERT_TRUE(lit && table);
+    double brightest = 0.0;
+    for (int y = 0; y < lit->height; ++y)
+        for (int x = 0; x < lit->width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                ASSERT_NEAR(lit->at(x, y, c), 0.5f * table->at(x, y, c), 0.5f / 255.0f + 1e-6f) << x << "," << y;
+                brightest = std::max(brightest, double(table->at(x, y, c)));
+            }
+    EXPECT_GT(brightest, 0.2) << "the gas should cover some pixels";
 }

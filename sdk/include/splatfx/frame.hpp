@@ -7,8 +7,9 @@
 // same Frame can be drawn by the GL backend and integrated by the CPU
 // reference, which is how the backend is measured.
 // It does not simulate (Scene does), render (gl::FrameRenderer does) or own
-// GPU resources. Later passes (fog, lights and shadow tables, volume
-// primitives) join it as further plain-data members.
+// GPU resources. Later passes join it as further plain-data members: the
+// gas's shadow on the scene (shadow(), FrameShadow: issue 16); fog and volume
+// primitives to come.
 //
 //   splatfx::Frame frame;                          // keep it: it reuses its memory
 //   scene.prepare(timeSec, camera, materials, frame);

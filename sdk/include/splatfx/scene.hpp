@@ -11,6 +11,10 @@
 // are evaluated at the current time directly, solver effects catch up over
 // the skipped interval in at most `maxCatchUpSteps` coarse steps (bounded
 // cost; its error against full simulation is measured in docs/BENCHMARKS.md).
+// It also holds lights (addLight) and lights the effects that opt in
+// (EffectOptions::lighting): their splat colours follow Ebert & Parent's
+// low-albedo model with self-shadowing, and prepare() puts the gas's shadow
+// on the scene into Frame::shadow() (docs/lighting.md, "In a Scene").
 // It does not render, load files, or own GL resources.
 //
 //   splatfx::Scene scene;
