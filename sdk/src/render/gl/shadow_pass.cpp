@@ -25,8 +25,12 @@ bool ShadowPass::upload(const FrameShadow& shadow) {
         mDims = dims;
     }
     const float zero = 0.0f;
+    // Floats are 4-byte rows whatever the host's unpack alignment; keep the host's setting.
+    GLint alignment = 4;
+    glGetIntegerv(GL_UNPACK_ALIGNMENT, &alignment);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glTextureSubImage3D(mTexture, 0, 0, 0, 0, dims.x, dims.y, dims.z, GL_RED, GL_FLOAT, valid ? shadow.depth.data() : &zero);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, alignment);
     mValid = valid;
     mWorldToTable = valid ? shadow.worldToTable : glm::mat4(1.0f);
     mLight = valid ? shadow.lightInTable : glm::vec4(0.0f, -1.0f, 0.0f, 0.0f);
