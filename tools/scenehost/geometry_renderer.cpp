@@ -1,11 +1,13 @@
 #include "geometry_renderer.hpp"
 
 #include <map>
+#include <string>
 
 #include <epoxy/gl.h>
 #include <glm/gtc/type_ptr.hpp>
 
 #include "splatfx/gl/program.hpp"
+#include "splatfx/lighting.hpp"
 
 namespace scenehost {
 namespace {
@@ -25,23 +27,27 @@ void main() {
 }
 )";
 
-const char* kFragment = R"(#version 450 core
+// The host's surface shader with the SDK's shadow include (shadowGlsl(),
+// lighting.hpp): the gas's shadow table, bound by gl::FrameRenderer for the
+// opaque hook, darkens the direct light on the ground and the objects.
+const char* kFragmentBody = R"(
 in vec3 vNormal;
 in vec3 vWorld;
 uniform vec3 uColor;
 uniform vec3 uEye;
+uniform vec4 uLight;      // xyz: direction towards the light (w = 0) or its position (w = 1)
+uniform vec3 uLightColor;
 out vec4 fragColor;
 void main() {
     vec3 n = normalize(vNormal);
     // Two-sided: face the normal towards the eye, whatever the mesh's winding.
     if (dot(n, uEye - vWorld) < 0.0) n = -n;
-    const vec3 toLight = normalize(vec3(0.4, 1.0, 0.6));
-    float diffuse = max(dot(n, toLight), 0.0);
-    vec3 lit = uColor * (0.25 + 0.75 * diffuse);
+    vec3 toLight = normalize(uLight.w == 0.0 ? uLight.xyz : uLight.xyz - vWorld);
+    float diffuse = max(dot(n, toLight), 0.0) * splatfx_shadow(vWorld);
+    vec3 lit = uColor * (0.25 + 0.75 * diffuse * uLightColor);
     fragColor = vec4(lit, 1.0);
 }
 )";
-
 
 } // namespace
 
@@ -69,7 +75,9 @@ splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<spl
     if (!epoxy_has_gl_extension("GL_ARB_direct_state_access") && epoxy_gl_version() < 45)
         return splatfx::makeError("GeometryRenderer: needs a current OpenGL 4.5 context");
     auto impl = std::make_unique<Impl>();
-    splatfx::Result<GLuint> program = splatfx::gl::linkProgram({kVertex}, {kFragment}, "GeometryRenderer");
+    const std::string shadow = splatfx::shadowGlsl();
+    splatfx::Result<GLuint> program =
+        splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n", shadow.c_str(), kFragmentBody}, "GeometryRenderer");
     if (!program) return splatfx::makeError(program.error());
     impl->program = *program;
 
@@ -136,7 +144,7 @@ splatfx::Aabb GeometryRenderer::worldBounds(std::size_t i, double t) const {
     return out;
 }
 
-void GeometryRenderer::draw(double t, const splatfx::Camera& camera) {
+void GeometryRenderer::draw(double t, const splatfx::Camera& camera, const GeometryLighting& lighting) {
     Impl& r = *mImpl;
     r.stats = {};
     glEnable(GL_DEPTH_TEST);
@@ -149,6 +157,9 @@ void GeometryRenderer::draw(double t, const splatfx::Camera& camera) {
     const glm::vec3 eye = camera.eye();
     glUniformMatrix4fv(glGetUniformLocation(r.program, "uViewProj"), 1, GL_FALSE, glm::value_ptr(viewProj));
     glUniform3fv(glGetUniformLocation(r.program, "uEye"), 1, glm::value_ptr(eye));
+    glUniform4fv(glGetUniformLocation(r.program, "uLight"), 1, glm::value_ptr(lighting.light));
+    glUniform3fv(glGetUniformLocation(r.program, "uLightColor"), 1, glm::value_ptr(lighting.lightColor));
+    splatfx::gl::setShadowUniforms(r.program, lighting.shadow);
     const GLint model = glGetUniformLocation(r.program, "uModel"), color = glGetUniformLocation(r.program, "uColor");
     for (const Impl::Object& o : r.objects) {
         if (!o.vao) continue;

@@ -3,7 +3,9 @@
 // A tiny OpenGL 4.5 renderer for the ground plane, boxes, cylinders, spheres
 // and meshes of a scene file: one program (two-sided Lambert with a little
 // ambient light, depth test and depth writes on), one vertex array per
-// object. Drawn before the splats, its depth buffer is what makes the splats
+// object. Its surface shader includes the SDK's shadowGlsl(): with the
+// shadow binding of gl::FrameRenderer (GeometryLighting::shadow), smoke
+// darkens the ground and the objects under it. Drawn before the splats, its depth buffer is what makes the splats
 // depth-correct (a cow inside the fire is partly hidden by it, and hides the
 // part behind it). Meshes are loaded once, by path, through mesh.hpp.
 // Not part of the SDK (it is the host's job to draw its own scene).
@@ -22,6 +24,7 @@
 
 #include "mesh.hpp"
 #include "splatfx/camera.hpp"
+#include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/result.hpp"
 #include "splatfx/scene_file.hpp"
 
@@ -30,6 +33,13 @@ namespace scenehost {
 struct GeometryStats {
     std::size_t objects = 0;   // objects drawn (Empty ones are not)
     std::size_t triangles = 0; // triangles drawn
+};
+
+// The light the geometry is lit by, and the gas's shadow on it.
+struct GeometryLighting {
+    glm::vec4 light{0.4f, 1.0f, 0.6f, 0.0f}; // direction towards the light (w = 0) or position (w = 1); default a sun
+    glm::vec3 lightColor{1.0f};              // default white
+    splatfx::gl::ShadowBinding shadow{};     // FrameRenderer::shadowBinding(); default none (unshadowed)
 };
 
 class GeometryRenderer {
@@ -41,7 +51,9 @@ public:
     ~GeometryRenderer();
 
     // Draws every object at timeSec into the bound framebuffer and viewport.
-    void draw(double timeSec, const splatfx::Camera& camera);
+    // Call it inside FrameRenderer's opaque hook when `lighting.shadow` is set
+    // (the table is bound to its unit only there).
+    void draw(double timeSec, const splatfx::Camera& camera, const GeometryLighting& lighting = {});
     const GeometryStats& stats() const;
     // World-space box of object i at timeSec (empty for Empty objects).
     splatfx::Aabb worldBounds(std::size_t i, double timeSec) const;

@@ -1,5 +1,6 @@
 #include "scene_player.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include <epoxy/gl.h>
@@ -20,6 +21,20 @@ struct ScenePlayer::Impl {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// The geometry's light: the scene's shadow light (its first by default), so
+// the gas's shadow on the ground falls where that light puts it.
+GeometryLighting geometryLighting(const splatfx::Scene& scene, const splatfx::gl::FrameRenderer& renderer) {
+    GeometryLighting g;
+    g.shadow = renderer.shadowBinding();
+    const std::size_t i = scene.sceneShadow().light;
+    if (i < scene.lights().size()) {
+        const splatfx::Light& l = scene.lights()[i];
+        g.light = l.type == splatfx::LightType::Directional ? glm::vec4(-glm::normalize(l.direction), 0.0f) : glm::vec4(l.position, 1.0f);
+        g.lightColor = l.color * std::min(l.type == splatfx::LightType::Directional ? l.intensity : 1.0f, 1.0f);
+    }
+    return g;
+}
 double msSince(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 } // namespace
@@ -102,7 +117,7 @@ void ScenePlayer::renderFrame(double t, const splatfx::Camera& camera, unsigned 
             glDepthMask(GL_TRUE);
             glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
         }
-        if (options.drawGeometry) p.geometry->draw(t, camera);
+        if (options.drawGeometry) p.geometry->draw(t, camera, geometryLighting(f.scene, *p.renderer));
     };
     t0 = Clock::now();
     p.renderer->render(p.frame, {.framebuffer = framebuffer, .drawOpaque = drawOpaque});

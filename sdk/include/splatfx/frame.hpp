@@ -7,8 +7,9 @@
 // same Frame can be drawn by the GL backend and integrated by the CPU
 // reference, which is how the backend is measured.
 // It does not simulate (Scene does), render (gl::FrameRenderer does) or own
-// GPU resources. Later passes (fog, lights and shadow tables, volume
-// primitives) join it as further plain-data members.
+// GPU resources. Later passes join it as further plain-data members: the
+// gas's shadow on the scene (shadow(), FrameShadow: issue 16); fog and volume
+// primitives to come.
 //
 //   splatfx::Frame frame;                          // keep it: it reuses its memory
 //   scene.prepare(timeSec, camera, materials, frame);
@@ -24,6 +25,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <glm/glm.hpp>
+
 #include "splatfx/camera.hpp"
 #include "splatfx/splats.hpp"
 
@@ -37,6 +40,25 @@ struct FrameCounters {
     std::size_t drawn = 0;     // effects that emitted at least one splat
     std::uint64_t voxels = 0;  // voxels offered to the splat builder
     std::uint64_t splats = 0;  // splats in the frame
+    // ---- lighting (issue 16; Scene fills them)
+    std::size_t litEffects = 0;             // needed effects lit by the scene's lights
+    std::uint64_t shadowTableBuilds = 0;    // shadow tables (self-shadowing and the scene's) rebuilt for this frame
+    std::uint64_t shadowTableReuses = 0;    // ... and reused because density and light had not changed
+};
+
+// ---- lighting (issue 16): the shadow the frame's gas casts on the scene.
+// One shadow table (lighting.hpp, ShadowTable) for one light, covering every
+// needed effect that casts shadows, as plain data: what gl::FrameRenderer
+// uploads as a 3D texture before the host's opaque pass, and what the GLSL
+// of shadowGlsl() samples. Empty (valid = false): nothing is shadowed.
+struct FrameShadow {
+    bool valid = false;                 // default false: no shadow this frame
+    std::vector<float> depth;           // dims.x * dims.y * dims.z optical depths (log2), x fastest
+    glm::ivec3 dims{0};
+    glm::mat4 worldToTable{1.0f};       // world to the table's [0, 1]^3 (ShadowTable::worldToTable)
+    glm::vec4 lightInTable{0.0f, -1.0f, 0.0f, 0.0f}; // ShadowTable::lightInTable
+    // Changes whenever the contents do (a renderer re-uploads only then); 0 when never filled.
+    std::uint64_t version = 0;
 };
 
 class Frame {
@@ -58,10 +80,14 @@ public:
     const SplatStats& splatStats() const { return mBuilder.stats(); }
     const FrameCounters& counters() const { return mCounters; }
     FrameCounters& counters() { return mCounters; }
+    // ---- lighting (issue 16): kept across begin() (its version says when it changed).
+    const FrameShadow& shadow() const { return mShadow; }
+    FrameShadow& shadow() { return mShadow; }
 
 private:
     SplatBuilder mBuilder;
     FrameCounters mCounters;
+    FrameShadow mShadow; // lighting (issue 16)
     double mTime = 0.0;
 };
 

@@ -230,6 +230,11 @@ public:
     // Fails on a bad desc (the message names the field), a bad light, or a
     // table whose memoryBytes exceed the budget; the table is then emptied.
     Status update(const DensityField& field, const Light& light);
+    // The same for several fields seen as one (their extinctions add; the
+    // table covers the union of their supports): one table per light for
+    // every effect of a frame, for shadows on the scene. Fails on a null
+    // pointer. The fingerprint combines the fields' in order.
+    Status update(std::span<const DensityField* const> fields, const Light& light);
 
     // Accumulated optical depth towards the light (log2 units), and exp2(-depth).
     float opticalDepth(glm::vec3 world) const;
@@ -334,5 +339,14 @@ struct GasLightingDesc {
 // Fails (out untouched) on a bad light or desc; the message names the field.
 Status lightVoxels(const Grid& grid, glm::vec3 eyeWorld, std::span<const Light> lights, const ShadowProvider* shadows,
                    const GasLightingDesc& desc, std::vector<glm::vec3>& out);
+
+// The same model at arbitrary world points (a frame's splat centres): the
+// base colour is white (desc.colorTable is ignored), so out[i] is the factor
+// to multiply point i's colour by. voxelSizeWorld (>= 0) is the size of the
+// voxel each point stands for: a point or spot light closer than half of it
+// lights the point isotropically, as in lightVoxels. Scene uses it to light
+// the splats of lit effects (scene.hpp, EffectLighting).
+Status lightPoints(std::span<const glm::vec3> worldPoints, float voxelSizeWorld, glm::vec3 eyeWorld, std::span<const Light> lights,
+                   const ShadowProvider* shadows, const GasLightingDesc& desc, std::vector<glm::vec3>& out);
 
 } // namespace splatfx

@@ -79,6 +79,11 @@ struct SplatExactDesc {
     ReferenceWindow window = ReferenceWindow::Exact; // default Exact
     bool trimCorners = false; // match RendererDesc::trimCorners (octagon vs square quad); default false, as the renderer's
     int threads = 0;         // worker threads; 0 = std::thread::hardware_concurrency(); default 0
+    // Lighting (issue 16): false reads each splat's colour table exactly at its
+    // colour coordinate (unlit splats); true uses the splat's RGBA8 colour,
+    // which is what the GL pass draws and where a Scene puts lit colours
+    // (docs/lighting.md, "In a Scene"). Default false.
+    bool packedColor = false;
 };
 
 struct SplatExactStats {

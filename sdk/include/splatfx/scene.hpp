@@ -11,6 +11,10 @@
 // are evaluated at the current time directly, solver effects catch up over
 // the skipped interval in at most `maxCatchUpSteps` coarse steps (bounded
 // cost; its error against full simulation is measured in docs/BENCHMARKS.md).
+// It also holds lights (addLight) and lights the effects that opt in
+// (EffectOptions::lighting): their splat colours follow Ebert & Parent's
+// low-albedo model with self-shadowing, and prepare() puts the gas's shadow
+// on the scene into Frame::shadow() (docs/lighting.md, "In a Scene").
 // It does not render, load files, or own GL resources.
 //
 //   splatfx::Scene scene;
@@ -27,6 +31,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -34,12 +39,48 @@
 #include "splatfx/effect.hpp"
 #include "splatfx/effect_kind.hpp"
 #include "splatfx/frame.hpp"
+#include "splatfx/lighting.hpp"
 #include "splatfx/materials.hpp"
 #include "splatfx/splats.hpp"
 
 namespace splatfx {
 
 using EffectId = std::uint32_t;
+
+// ---- lighting (issue 16; docs/lighting.md, "In a Scene")
+enum class SelfShadow {
+    Off,    // every voxel sees the lights unattenuated
+    Traced, // each splat traces to each light through the effect's field (the reference)
+    Table,  // each light's shadow table of the effect (Ebert & Parent 1990), rebuilt only on change
+};
+
+// How an effect is lit by the scene's lights. Off by default: an unlit
+// effect draws its colour tables' colours and costs nothing more.
+// A lit effect's splats get colour = table colour * lightPoints(...) factor
+// at each splat's centre (per splat, on the CPU; the GL pass is unchanged).
+// Only effects added as an Effect are lit (other kinds stay unlit).
+struct EffectLighting {
+    bool enabled = false;                      // default false (unlit)
+    // Albedo, phase lobes, emission, ambient, multipleScattering; its
+    // colorTable is ignored (each layer's own table is the base colour).
+    GasLightingDesc gas{};                     // default GasLightingDesc{} (albedo 0.5, isotropic)
+    SelfShadow selfShadow = SelfShadow::Table; // default Table
+    glm::ivec3 tableDims{32};                  // self-shadowing table entries per axis, each in [1, 1024]; default 32^3
+    // Whether the effect's gas is in the frame's shadow on the scene
+    // (FrameShadow, Scene::setSceneShadow). Default true.
+    bool castsShadow = true;
+};
+
+// The shadow the lit effects cast on the scene: one table for one light over
+// every needed, lit, shadow-casting effect, put into Frame::shadow(). When
+// exactly one effect casts and its self-shadowing table for that light has
+// these dims, that table is used (no second build).
+struct SceneShadowDesc {
+    bool enabled = true;        // default true (when a light exists)
+    std::size_t light = 0;      // index into Scene::lights(); default 0 (the first)
+    glm::ivec3 dims{64};        // entries per axis, each in [1, 1024]; default 64^3
+    std::uint64_t memoryBudgetBytes = 64ull << 20; // as ShadowTableDesc; default 64 MiB
+};
 
 struct EffectOptions {
     std::string name;                                        // for counters and messages; default empty
@@ -57,6 +98,7 @@ struct EffectOptions {
     // How the effect is drawn (textured or traditional, opacity scale);
     // combined with the options given to prepare()/emit(). Default EmitOptions{}.
     EmitOptions draw{};
+    EffectLighting lighting{};                               // lighting (issue 16); default unlit
 };
 
 // Why an effect was or was not needed at the last update, and what it cost.
@@ -71,6 +113,10 @@ struct EffectStatus {
     std::uint64_t catchUps = 0;      // returns of a stateful kind after being skipped (AdvanceResult::caughtUp)
     std::uint64_t splatsDrawn = 0;   // splats emitted at the last emit()
     Aabb bounds;                     // world bounds used for the last decision
+    // ---- lighting (issue 16)
+    bool lit = false;                    // lit at the last emit()
+    std::uint64_t shadowTableBuilds = 0; // self-shadowing tables built (cumulative)
+    std::uint64_t shadowTableReuses = 0; // ... and reused unchanged (cumulative)
 };
 
 struct SceneCounters {
@@ -78,6 +124,11 @@ struct SceneCounters {
     std::size_t needed = 0;     // needed at the last update (= simulated and drawn)
     std::size_t simulated = 0;  // effects that did dynamics work at the last update
     std::uint64_t splats = 0;   // splats emitted at the last emit()
+    // ---- lighting (issue 16)
+    std::size_t litEffects = 0;               // effects lit at the last emit()
+    std::uint64_t shadowTableBuilds = 0;      // self-shadowing and scene-shadow tables built at the last emit()
+    std::uint64_t shadowTableReuses = 0;      // ... reused unchanged at the last emit()
+    std::uint64_t sceneShadowBuilds = 0;      // scene-shadow table builds (cumulative)
 };
 
 class Scene {
@@ -111,6 +162,21 @@ public:
     // frame.end (one back-to-front sort), and the frame's counters.
     void prepare(double timeSec, const Camera& camera, const Materials& materials, Frame& frame, const EmitOptions& options = {});
 
+    // ---- lighting (issue 16; docs/lighting.md, "In a Scene")
+    // Adds a light; fails on an invalid light (the message names the field).
+    Result<std::size_t> addLight(const Light& light);
+    // Replaces light i (expects i < lights().size()); fails as addLight.
+    Status setLight(std::size_t i, const Light& light);
+    std::span<const Light> lights() const { return mLights; }
+    void clearLights() { mLights.clear(); }
+    // Per-effect lighting (also settable through EffectOptions::lighting at add()).
+    void setLighting(EffectId id, const EffectLighting& lighting) { mEntries.at(id).options.lighting = lighting; }
+    void setSceneShadow(const SceneShadowDesc& desc) { mSceneShadowDesc = desc; }
+    const SceneShadowDesc& sceneShadow() const { return mSceneShadowDesc; }
+    // The last lighting failure (a bad EffectLighting or SceneShadowDesc: the
+    // effect is drawn unlit, or no scene shadow); empty when the last emit() had none.
+    const std::string& lightingError() const { return mLightingError; }
+
     const EffectStatus& status(EffectId id) const { return mEntries.at(id).status; }
     const SceneCounters& counters() const { return mCounters; }
     double time() const { return mTime; }
@@ -120,18 +186,39 @@ public:
     static bool inFrustum(const Aabb& box, const Camera& camera);
 
 private:
+    // ---- lighting (issue 16): what a lit effect keeps between frames (scene_lighting.cpp).
+    struct LitState {
+        Grid densityGrid;           // the layers' voxels, opacity as the splats draw it (scratch)
+        DensityField field;         // what the light sees; its fingerprint says when it changed
+        ShadowTables tables;        // self-shadowing, one per light
+        glm::ivec3 tableDims{0};    // what `tables` was made with
+        std::vector<glm::vec3> points, factors; // scratch: splat centres and their light factors
+    };
     struct Entry {
         std::unique_ptr<EffectKind> kind; // never null
         Effect* effect = nullptr;         // kind as an Effect, if it was added as one
         EffectOptions options;
         EffectStatus status;
+        std::unique_ptr<LitState> lit;    // lighting (issue 16): made when first lit
     };
     EffectId push(Entry entry);
+    // lighting (issue 16): lights the splats [first, end) the entry just emitted.
+    void lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first, const EmitOptions& draw);
+    void shadeScene(Frame& frame); // fills frame.shadow()
 
     std::vector<Entry> mEntries;
     SceneCounters mCounters;
     double mTime = 0.0;
     bool mUpdated = false;
+    // ---- lighting (issue 16)
+    std::vector<Light> mLights;
+    SceneShadowDesc mSceneShadowDesc;
+    ShadowTable mSceneShadow;
+    ShadowTableDesc mSceneShadowTableDesc; // what mSceneShadow was made with
+    std::uint64_t mSceneShadowVersion = 0; // bumped whenever the scene shadow's contents change
+    std::uint64_t mSceneShadowLastBuilds = 0;
+    const ShadowTable* mSceneShadowSource = nullptr; // mSceneShadow, or a lit effect's own table it shares
+    std::string mLightingError;
 };
 
 } // namespace splatfx

@@ -36,10 +36,7 @@ struct PreparedLight {
     float minDist;
 };
 
-} // namespace
-
-Status lightVoxels(const Grid& grid, glm::vec3 eyeWorld, std::span<const Light> lights, const ShadowProvider* shadows,
-                   const GasLightingDesc& desc, std::vector<glm::vec3>& out) {
+Status checkInputs(glm::vec3 eyeWorld, std::span<const Light> lights, const GasLightingDesc& desc) {
     if (!finite3(eyeWorld)) return makeError("eyeWorld must be finite");
     if (!std::isfinite(desc.albedo) || desc.albedo < 0.0f || desc.albedo > 1.0f)
         return makeError("GasLightingDesc.albedo must be in [0, 1]");
@@ -50,11 +47,14 @@ Status lightVoxels(const Grid& grid, glm::vec3 eyeWorld, std::span<const Light> 
             return makeError(std::string("GasLightingDesc.ambient.") + "rgb"[a] + " must be a finite number >= 0");
     for (std::size_t i = 0; i < lights.size(); ++i)
         if (Status s = validateLight(lights[i], "lights[" + std::to_string(i) + "]"); !s) return s;
+    return {};
+}
 
-    const glm::mat3 shape = glm::mat3(grid.transform) * glm::mat3(glm::vec3(grid.spacing.x, 0, 0), glm::vec3(0, grid.spacing.y, 0),
-                                                                 glm::vec3(0, 0, grid.spacing.z));
-    const float det = std::abs(glm::determinant(shape));
-    const float voxelSize = std::isfinite(det) ? std::cbrt(det) : 0.0f;
+// The model for `count` points: point(v) gives the world position (and
+// false for data that is not finite), base(v) the base colour.
+template <class PointFn, class BaseFn>
+void lightImpl(std::size_t count, PointFn point, BaseFn base, float voxelSize, glm::vec3 eyeWorld, std::span<const Light> lights,
+               const ShadowProvider* shadows, const GasLightingDesc& desc, std::vector<glm::vec3>& out) {
 
     // Up to this many lights are prepared on the stack; more are prepared per voxel (still no allocation).
     constexpr std::size_t kStackLights = 16;
@@ -75,17 +75,14 @@ Status lightVoxels(const Grid& grid, glm::vec3 eyeWorld, std::span<const Light> 
     };
     for (std::size_t i = 0; i < std::min(lights.size(), kStackLights); ++i) stackLights[i] = prepare(lights[i]);
 
-    const bool hasTable = desc.colorTable && desc.colorTable->entries.size() >= 2;
     const float isotropic = 1.0f / kFourPi;
-    out.resize(grid.voxels.size());
-    for (std::size_t v = 0; v < grid.voxels.size(); ++v) {
-        const Voxel& vox = grid.voxels[v];
-        const glm::vec3 x = grid.worldPosition(vox.cell);
-        if (!finite3(x) || !std::isfinite(vox.opacity) || !std::isfinite(vox.colorCoord)) {
+    out.resize(count);
+    for (std::size_t v = 0; v < count; ++v) {
+        glm::vec3 x;
+        if (!point(v, x) || !finite3(x)) {
             out[v] = glm::vec3(0.0f);
             continue;
         }
-        const glm::vec3 base = hasTable ? glm::clamp(glm::vec3(desc.colorTable->sample(vox.colorCoord)), 0.0f, 1.0f) : glm::vec3(1.0f);
         const glm::vec3 toEyeV = eyeWorld - x;
         const float eyeDist = glm::length(toEyeV);
         const glm::vec3 toEye = eyeDist > 0.0f ? toEyeV / eyeDist : glm::vec3(0.0f);
@@ -111,8 +108,42 @@ Status lightVoxels(const Grid& grid, glm::vec3 eyeWorld, std::span<const Light> 
             T = std::isfinite(T) ? std::clamp(T, 0.0f, 1.0f) : 0.0f;
             scattered += l.color * (irradiance * (kFourPi * phase * T + desc.multipleScattering));
         }
-        out[v] = base * (desc.emission + desc.albedo * scattered);
+        out[v] = base(v) * (desc.emission + desc.albedo * scattered);
     }
+}
+
+} // namespace
+
+Status lightVoxels(const Grid& grid, glm::vec3 eyeWorld, std::span<const Light> lights, const ShadowProvider* shadows,
+                   const GasLightingDesc& desc, std::vector<glm::vec3>& out) {
+    if (Status s = checkInputs(eyeWorld, lights, desc); !s) return s;
+    const glm::mat3 shape = glm::mat3(grid.transform) * glm::mat3(glm::vec3(grid.spacing.x, 0, 0), glm::vec3(0, grid.spacing.y, 0),
+                                                                 glm::vec3(0, 0, grid.spacing.z));
+    const float det = std::abs(glm::determinant(shape));
+    const float voxelSize = std::isfinite(det) ? std::cbrt(det) : 0.0f;
+    const bool hasTable = desc.colorTable && desc.colorTable->entries.size() >= 2;
+    auto point = [&](std::size_t v, glm::vec3& x) {
+        const Voxel& vox = grid.voxels[v];
+        x = grid.worldPosition(vox.cell);
+        return std::isfinite(vox.opacity) && std::isfinite(vox.colorCoord);
+    };
+    auto base = [&](std::size_t v) {
+        return hasTable ? glm::clamp(glm::vec3(desc.colorTable->sample(grid.voxels[v].colorCoord)), 0.0f, 1.0f) : glm::vec3(1.0f);
+    };
+    lightImpl(grid.voxels.size(), point, base, voxelSize, eyeWorld, lights, shadows, desc, out);
+    return {};
+}
+
+Status lightPoints(std::span<const glm::vec3> worldPoints, float voxelSizeWorld, glm::vec3 eyeWorld, std::span<const Light> lights,
+                   const ShadowProvider* shadows, const GasLightingDesc& desc, std::vector<glm::vec3>& out) {
+    if (Status s = checkInputs(eyeWorld, lights, desc); !s) return s;
+    if (!std::isfinite(voxelSizeWorld) || voxelSizeWorld < 0.0f) return makeError("voxelSizeWorld must be a finite number >= 0");
+    auto point = [&](std::size_t v, glm::vec3& x) {
+        x = worldPoints[v];
+        return true;
+    };
+    auto base = [](std::size_t) { return glm::vec3(1.0f); };
+    lightImpl(worldPoints.size(), point, base, voxelSizeWorld, eyeWorld, lights, shadows, desc, out);
     return {};
 }
 

@@ -187,9 +187,11 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                 const double alpha = -std::expm1(-kLn2 * double(s.density) * detail);
                 if (!(alpha > 0.0)) continue;
                 const std::uint32_t row = std::uint32_t(std::lround(s.colorRow));
-                const glm::dvec3 col = (row < materials.colorTableCount() ? reference::rowColor(materials.colorRow(row), s.colorCoord)
-                                                                         : glm::dvec3(1.0)) *
-                                       glm::dvec3(tex);
+                const glm::dvec3 base = desc.packedColor
+                                            ? glm::dvec3(double(s.color & 255u), double((s.color >> 8) & 255u), double((s.color >> 16) & 255u)) / 255.0
+                                        : row < materials.colorTableCount() ? reference::rowColor(materials.colorRow(row), s.colorCoord)
+                                                                            : glm::dvec3(1.0);
+                const glm::dvec3 col = base * glm::dvec3(tex);
                 frags.push_back({t, std::min(alpha, 1.0), col});
             }
             // Per-pixel exact order: farthest plane crossing first.

@@ -9,14 +9,14 @@ namespace splatfx {
 EffectId Scene::add(Effect effect, EffectOptions options) {
     auto owned = std::make_unique<Effect>(std::move(effect));
     Effect* asEffect = owned.get();
-    return push(Entry{std::move(owned), asEffect, std::move(options), {}});
+    return push(Entry{std::move(owned), asEffect, std::move(options), {}, nullptr});
 }
 
 EffectId Scene::add(std::unique_ptr<EffectKind> kind, EffectOptions options) {
     assert(kind && "Scene::add: kind must not be null");
     // An Effect handed over as a kind is still one: effect(id) should find it.
     Effect* asEffect = dynamic_cast<Effect*>(kind.get());
-    return push(Entry{std::move(kind), asEffect, std::move(options), {}});
+    return push(Entry{std::move(kind), asEffect, std::move(options), {}, nullptr});
 }
 
 EffectId Scene::push(Entry entry) {
@@ -93,11 +93,19 @@ void Scene::update(double timeSec, const Camera& camera) {
 
 std::size_t Scene::emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options) {
     std::size_t total = 0;
+    // ---- lighting (issue 16): per-emit counters (scene_lighting.cpp)
+    mLightingError.clear();
+    mCounters.litEffects = 0;
+    mCounters.shadowTableBuilds = mCounters.shadowTableReuses = 0;
     for (Entry& e : mEntries) {
         const EmitOptions draw{.textured = e.options.draw.textured && options.textured,
                                .opacityScale = e.options.draw.opacityScale * options.opacityScale};
+        const std::size_t first = builder.splats().size();
         e.status.splatsDrawn = e.status.needed ? e.kind->emit(builder, materials, draw) : 0;
         total += e.status.splatsDrawn;
+        // ---- lighting (issue 16): colour the splats just emitted; unlit effects skip this.
+        e.status.lit = false;
+        if (e.status.needed && e.options.lighting.enabled && !mLights.empty()) lightEmitted(e, builder, materials, first, draw);
     }
     mCounters.splats = total;
     return total;
@@ -107,8 +115,13 @@ void Scene::prepare(double timeSec, const Camera& camera, const Materials& mater
     update(timeSec, camera);
     frame.begin(timeSec, camera);
     emit(frame.builder(), materials, options);
+    shadeScene(frame); // lighting (issue 16): the shadow on the scene, into frame.shadow()
     frame.end();
     FrameCounters& c = frame.counters();
+    // ---- lighting (issue 16)
+    c.litEffects = mCounters.litEffects;
+    c.shadowTableBuilds = mCounters.shadowTableBuilds;
+    c.shadowTableReuses = mCounters.shadowTableReuses;
     c.declared = mCounters.declared;
     c.needed = mCounters.needed;
     c.simulated = mCounters.simulated;

@@ -45,6 +45,7 @@ void readEffects(Context& c, const std::string& path, const Json& v, const std::
             to.boolean("local", e.toggles.local);
             to.finish();
         }
+        if (const Json* l = o.get("lighting")) readEffectLighting(c, o.at("lighting"), *l, e.options.lighting); // issue 16
         o.string("attachTo", e.attachTo);
         if (const Json* m = o.get("motion")) {
             if (!e.attachTo.empty()) c.d.error(o.at("motion"), "an effect either has its own \"motion\" or is attached to geometry; not both");

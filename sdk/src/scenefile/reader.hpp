@@ -157,6 +157,14 @@ struct Placement {
 void readEffects(Context& c, const std::string& path, const Json& v, const std::vector<RawGeometry>& geo,
                  const std::map<std::string, std::size_t>& geoByName, SceneFile& out);
 
+// [SECTION] Lights (lights.cpp; issue 16)
+
+// Top-level "lights" (a list) and "sceneShadow", into out.scene.
+void readLights(Context& c, const std::string& path, const Json& v, SceneFile& out);
+void readSceneShadow(Context& c, const std::string& path, const Json& v, SceneFile& out);
+// An effect's "lighting" object.
+void readEffectLighting(Context& c, const std::string& path, const Json& v, EffectLighting& out);
+
 // [SECTION] Camera and output
 
 void readCamera(Context& c, const std::string& path, const Json& v, CameraPath& cam);

@@ -7,6 +7,7 @@
 //   kinds.cpp          the table of effect kinds and geometry types, whose
 //                      readers are in kinds/ (one a file)
 //   camera_output.cpp  camera path and output settings
+//   lights.cpp         lights, the scene shadow, each effect's lighting
 //
 // [SECTION] Text checks (size, nesting, syntax with line and column)
 // [SECTION] Entry points
@@ -149,6 +150,8 @@ Result<SceneFile> parse(const std::string& text, const std::string& path, Materi
         }
     }
     if (const Json* v = o.get("effects")) readEffects(c, "effects", *v, geo, geoByName, out);
+    if (const Json* v = o.get("lights")) readLights(c, "lights", *v, out);           // issue 16
+    if (const Json* v = o.get("sceneShadow")) readSceneShadow(c, "sceneShadow", *v, out);
     o.finish();
     if (!d.ok()) return makeError(d.message());
     return out;

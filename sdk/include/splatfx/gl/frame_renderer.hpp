@@ -4,6 +4,9 @@
 // The host hands over, once per frame, everything it owns (framebuffer, host
 // depth texture, and hooks for its own opaque and transparent geometry), and
 // render() runs:
+//   0. uploads what changed: the frame's shadow table (Frame::shadow(), a 3D
+//      texture bound to FrameRendererDesc::shadowTextureUnit during the hooks;
+//      see shadowBinding() and docs/integration.md, "Shadows of the gas")
 //   1. the host's opaque pass   (HostTarget::drawOpaque; its depth is what cuts the volumes)
 //   2. the volumes: the frame's splats, back to front, premultiplied "over",
 //      tested against the host depth, at full resolution or at 1/2 or 1/4 per
@@ -35,6 +38,8 @@
 #include <functional>
 #include <memory>
 
+#include <glm/glm.hpp>
+
 #include "splatfx/frame.hpp"
 #include "splatfx/gl/framebuffer.hpp"
 #include "splatfx/gl/renderer.hpp"
@@ -50,7 +55,25 @@ struct FrameRendererDesc {
     int resolutionScale = 1;
     Precision reducedPrecision = Precision::F16; // reduced-resolution colour format; default F16
     float depthThreshold = 0.1f;          // reduced resolution: relative view depth still one surface; default 0.1
+    // ---- lighting (issue 16): the texture unit the frame's shadow table is
+    // bound to while the host's hooks run (splatfx_shadowTable of shadowGlsl()).
+    int shadowTextureUnit = 15;           // [0, 15] (GL 4.5 guarantees 16 per stage); default 15
 };
+
+// ---- lighting (issue 16): what a host surface shader with shadowGlsl()
+// (lighting.hpp) needs: the table's unit and the two matrices. Without a
+// shadow in the frame the unit holds a 1^3 table of zero depth, so
+// splatfx_shadow() returns 1 and the host shader needs no variant.
+struct ShadowBinding {
+    bool valid = false;               // the frame had a shadow
+    int textureUnit = 15;             // uniform sampler3D splatfx_shadowTable
+    unsigned texture = 0;             // GL name of the 3D texture (GL_R32F)
+    glm::mat4 worldToTable{1.0f};     // uniform mat4 splatfx_worldToTable
+    glm::vec4 lightInTable{0.0f, -1.0f, 0.0f, 0.0f}; // uniform vec4 splatfx_shadowLight
+};
+// Sets shadowGlsl()'s three uniforms on `program` (glProgramUniform: the
+// program need not be bound). Call it in the opaque hook, each frame.
+void setShadowUniforms(unsigned program, const ShadowBinding& binding);
 
 // What the host owns, handed over for one frame.
 struct HostTarget {
@@ -72,6 +95,7 @@ struct FrameRenderStats {
     std::uint64_t splats = 0;    // splats drawn
     std::uint64_t drawCalls = 0; // draw calls of the volume passes
     int resolutionScale = 1;     // the scale the splats were drawn at
+    std::uint64_t shadowUploads = 0; // lighting (issue 16): shadow-table uploads (cumulative; only when the frame's changed)
 };
 
 class FrameRenderer {
@@ -94,6 +118,9 @@ public:
     // The splat pass's renderer: what texture sampling upload() chose, its
     // layer texture (for tools and debug views).
     const Renderer& splatRenderer() const;
+    // lighting (issue 16): the shadow table of the last render(), for the
+    // host's shaders (bound to its unit only while render()'s hooks run).
+    ShadowBinding shadowBinding() const;
 
 private:
     struct Impl;

@@ -7,6 +7,7 @@
 
 #include <epoxy/gl.h>
 
+#include "shadow_pass.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
 
 namespace splatfx::gl {
@@ -17,12 +18,16 @@ struct FrameRenderer::Impl {
     std::optional<Renderer> full;
     std::optional<ScaledRenderer> reduced;
     FrameRenderStats stats;
+    std::optional<ShadowPass> shadow; // lighting (issue 16): pass 0, the frame's shadow table
 };
 
 Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
     if (desc.resolutionScale != 1 && desc.resolutionScale != 2 && desc.resolutionScale != 4)
         return makeError("FrameRendererDesc::resolutionScale must be 1, 2 or 4, got " + std::to_string(desc.resolutionScale));
+    if (desc.shadowTextureUnit < 0 || desc.shadowTextureUnit > 15)
+        return makeError("FrameRendererDesc::shadowTextureUnit must be in [0, 15], got " + std::to_string(desc.shadowTextureUnit));
     auto impl = std::make_unique<Impl>();
+    impl->shadow.emplace(desc.shadowTextureUnit); // lighting (issue 16)
     impl->desc = desc;
     impl->stats.resolutionScale = desc.resolutionScale;
     if (desc.resolutionScale == 1) {
@@ -51,6 +56,7 @@ Status FrameRenderer::upload(const Materials& materials) {
 
 const FrameRendererDesc& FrameRenderer::desc() const { return mImpl->desc; }
 const FrameRenderStats& FrameRenderer::stats() const { return mImpl->stats; }
+ShadowBinding FrameRenderer::shadowBinding() const { return mImpl->shadow->binding(); }
 const Renderer& FrameRenderer::splatRenderer() const { return mImpl->full ? *mImpl->full : mImpl->reduced->renderer(); }
 
 void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
@@ -58,6 +64,10 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
     const Camera& camera = frame.camera();
     assert(camera.viewport.x > 0 && camera.viewport.y > 0 && "FrameRenderer::render: the frame camera's viewport must be positive");
     const int w = camera.viewport.x, h = camera.viewport.y;
+
+    // 0. Uploads (lighting, issue 16): the frame's shadow table, bound for the hooks.
+    if (r.shadow->upload(frame.shadow())) ++r.stats.shadowUploads;
+    r.shadow->bind();
 
     // 1. The host's opaque pass: its depth is what the volumes are tested against.
     if (target.drawOpaque) {
@@ -84,6 +94,7 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         glViewport(target.x, target.y, w, h);
         target.drawTransparent();
     }
+    r.shadow->unbind(); // lighting (issue 16): the unit's previous binding back
 }
 
 } // namespace splatfx::gl

@@ -1,0 +1,202 @@
+// Scene lighting (issue 16; docs/lighting.md, "In a Scene"): lit effects'
+// splats get their colour from the low-albedo model (lightPoints at each
+// splat's centre, self-shadowed by tracing or by shadow tables rebuilt only
+// when the effect's density or a light changed), and one shadow table over
+// every lit, shadow-casting effect goes into the Frame for the host's
+// surfaces (FrameShadow).
+#include <algorithm>
+#include <cmath>
+
+#include "splatfx/scene.hpp"
+
+namespace splatfx {
+namespace {
+
+// The colour-table entry at t, exactly as the splat builder reads it (splats.cpp, tableAt).
+glm::vec4 tableAt(const ColorTable* table, float t) {
+    if (!table || table->entries.size() < 2) return glm::vec4(1.0f);
+    const std::vector<glm::vec4>& e = table->entries;
+    const float f = std::clamp(t, 0.0f, 1.0f) * float(e.size() - 1);
+    const std::size_t i = std::min(std::size_t(f), e.size() - 2);
+    return glm::clamp(glm::mix(e[i], e[i + 1], f - float(i)), glm::vec4(0.0f), glm::vec4(1.0f));
+}
+
+// Lit linear colour into the splat's RGBA8: a colour brighter than 1 in any
+// channel is scaled down by its largest channel, keeping its hue (a clamp per
+// channel would turn a bright orange flame yellow-white). So the lights'
+// intensities set the brightness up to the table colour's saturation, and a
+// brighter light can only whiten nothing: keep lit colours <= 1 for an
+// unsaturated look (docs/lighting.md, "In a Scene").
+std::uint32_t packLit(glm::vec3 c) {
+    for (int a = 0; a < 3; ++a) c[a] = std::isfinite(c[a]) ? std::max(c[a], 0.0f) : 0.0f;
+    const float m = std::max({c.r, c.g, c.b});
+    if (m > 1.0f) c /= m;
+    return std::uint32_t(c.r * 255.0f + 0.5f) | std::uint32_t(c.g * 255.0f + 0.5f) << 8 | std::uint32_t(c.b * 255.0f + 0.5f) << 16 |
+           0xff000000u;
+}
+
+} // namespace
+
+Result<std::size_t> Scene::addLight(const Light& light) {
+    if (Status s = validateLight(light, "lights[" + std::to_string(mLights.size()) + "]"); !s) return makeError(s.error());
+    mLights.push_back(light);
+    return mLights.size() - 1;
+}
+
+Status Scene::setLight(std::size_t i, const Light& light) {
+    if (i >= mLights.size()) return makeError("setLight: index " + std::to_string(i) + " is not a light (" + std::to_string(mLights.size()) + " lights)");
+    if (Status s = validateLight(light, "lights[" + std::to_string(i) + "]"); !s) return s;
+    mLights[i] = light;
+    return {};
+}
+
+void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first, const EmitOptions& draw) {
+    if (!e.effect) return; // other kinds: unlit
+    const EffectLighting& L = e.options.lighting;
+    const std::string at = "effect '" + e.options.name + "': lighting.";
+    if (!e.lit) e.lit = std::make_unique<LitState>();
+    LitState& lit = *e.lit;
+    const Effect& fx = *e.effect;
+
+    // The density the light sees: every layer's voxels with the opacity the
+    // splat builder draws them with (style and draw scales, table alpha), so
+    // the self-shadow matches the splats' own optical depth.
+    Grid& dg = lit.densityGrid;
+    const Grid& whole = fx.grid();
+    dg.dims = whole.dims;
+    dg.spacing = whole.spacing;
+    dg.transform = whole.transform;
+    dg.voxels.clear();
+    for (std::size_t li = 0; li < fx.layerCount(); ++li) {
+        const SplatStyle& style = fx.layer(li).style;
+        const ColorTable* table = style.colorTable < materials.colorTableCount() ? &materials.colorTable(style.colorTable) : nullptr;
+        const float scale = style.opacityScale * draw.opacityScale;
+        const float k = std::isfinite(scale) ? std::max(scale, 0.0f) : 0.0f;
+        for (Voxel v : fx.layerGrid(li).voxels) {
+            if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord)) continue;
+            v.opacity = std::clamp(v.opacity * k, 0.0f, 1.0f) * tableAt(table, v.colorCoord).a;
+            if (v.opacity > 0.0f) dg.voxels.push_back(v);
+        }
+    }
+    auto field = DensityField::fromGrid(dg);
+    if (!field) {
+        mLightingError = at + "density: " + field.error();
+        return;
+    }
+    lit.field = std::move(*field);
+
+    const ShadowProvider* shadows = nullptr;
+    ShadowTracer tracer(lit.field, mLights);
+    if (L.selfShadow == SelfShadow::Traced) {
+        shadows = &tracer;
+    } else if (L.selfShadow == SelfShadow::Table) {
+        if (lit.tableDims != L.tableDims) {
+            lit.tables = ShadowTables(ShadowTableDesc{.dims = L.tableDims});
+            lit.tableDims = L.tableDims;
+        }
+        std::uint64_t b0 = 0, r0 = 0, b1 = 0, r1 = 0;
+        for (const ShadowTable& t : lit.tables.tables()) b0 += t.builds(), r0 += t.reuses();
+        if (Status s = lit.tables.update(lit.field, mLights); !s) {
+            mLightingError = at + "tableDims: " + s.error();
+            return;
+        }
+        for (const ShadowTable& t : lit.tables.tables()) b1 += t.builds(), r1 += t.reuses();
+        e.status.shadowTableBuilds += b1 - b0;
+        e.status.shadowTableReuses += r1 - r0;
+        mCounters.shadowTableBuilds += b1 - b0;
+        mCounters.shadowTableReuses += r1 - r0;
+        shadows = &lit.tables;
+    }
+
+    // Per splat: the factor at its centre, times its table colour.
+    std::vector<Splat>& splats = builder.splats();
+    const std::size_t n = splats.size() - first;
+    lit.points.resize(n);
+    for (std::size_t i = 0; i < n; ++i) lit.points[i] = splats[first + i].center;
+    const glm::mat3 shape = glm::mat3(whole.transform) * glm::mat3(glm::vec3(whole.spacing.x, 0, 0), glm::vec3(0, whole.spacing.y, 0),
+                                                                  glm::vec3(0, 0, whole.spacing.z));
+    const float det = std::abs(glm::determinant(shape));
+    const float voxelSize = std::isfinite(det) ? std::cbrt(det) : 0.0f;
+    if (Status s = lightPoints(lit.points, voxelSize, builder.camera().eye(), mLights, shadows, L.gas, lit.factors); !s) {
+        mLightingError = at + "gas: " + s.error();
+        return;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        Splat& sp = splats[first + i];
+        const std::uint32_t row = std::uint32_t(std::lround(sp.colorRow));
+        const ColorTable* table = row < materials.colorTableCount() ? &materials.colorTable(row) : nullptr;
+        sp.color = packLit(glm::vec3(tableAt(table, sp.colorCoord)) * lit.factors[i]);
+    }
+    e.status.lit = true;
+    ++mCounters.litEffects;
+}
+
+void Scene::shadeScene(Frame& frame) {
+    const SceneShadowDesc& d = mSceneShadowDesc;
+    std::vector<const DensityField*> fields;
+    const Entry* only = nullptr; // the one casting effect, when there is one
+    if (d.enabled && d.light < mLights.size())
+        for (const Entry& e : mEntries)
+            if (e.status.lit && e.options.lighting.castsShadow && e.lit && !e.lit->field.empty()) {
+                fields.push_back(&e.lit->field);
+                only = &e;
+            }
+    if (fields.size() != 1) only = nullptr;
+    // One casting effect whose self-shadowing table for this light has the
+    // scene shadow's dims: that table is the scene shadow (the paper's one
+    // table serves both), so nothing more is built.
+    const ShadowTable* shared = nullptr;
+    if (only && only->options.lighting.selfShadow == SelfShadow::Table && only->options.lighting.tableDims == d.dims &&
+        d.light < only->lit->tables.tables().size())
+        shared = &only->lit->tables.tables()[d.light];
+    const ShadowTable* src = nullptr;
+    if (shared) {
+        src = shared;
+        if (shared != mSceneShadowSource || shared->builds() != mSceneShadowLastBuilds) {
+            mSceneShadowSource = shared;
+            mSceneShadowLastBuilds = shared->builds();
+            ++mSceneShadowVersion;
+        }
+    } else if (!fields.empty()) {
+        const ShadowTableDesc td{.dims = d.dims, .memoryBudgetBytes = d.memoryBudgetBytes};
+        if (td.dims != mSceneShadowTableDesc.dims || td.memoryBudgetBytes != mSceneShadowTableDesc.memoryBudgetBytes) {
+            mSceneShadow = ShadowTable(td);
+            mSceneShadowTableDesc = td;
+        }
+        const std::uint64_t reuses = mSceneShadow.reuses();
+        if (Status s = mSceneShadow.update(fields, mLights[d.light]); !s) {
+            mLightingError = "sceneShadow: " + s.error();
+        } else {
+            src = &mSceneShadow;
+            if (mSceneShadowSource != &mSceneShadow || mSceneShadow.builds() != mSceneShadowLastBuilds) {
+                if (mSceneShadow.builds() != mSceneShadowLastBuilds) {
+                    ++mCounters.shadowTableBuilds;
+                    ++mCounters.sceneShadowBuilds;
+                }
+                mSceneShadowSource = &mSceneShadow;
+                mSceneShadowLastBuilds = mSceneShadow.builds();
+                ++mSceneShadowVersion;
+            }
+            mCounters.shadowTableReuses += mSceneShadow.reuses() - reuses;
+        }
+    }
+    if (!src && mSceneShadowSource) {
+        mSceneShadowSource = nullptr;
+        ++mSceneShadowVersion;
+    }
+    FrameShadow& out = frame.shadow();
+    if (out.version == mSceneShadowVersion && mSceneShadowVersion != 0) return; // unchanged: nothing to copy
+    out.valid = src != nullptr;
+    out.version = mSceneShadowVersion;
+    if (src) {
+        out.depth = src->data();
+        out.dims = src->dims();
+        out.worldToTable = src->worldToTable();
+        out.lightInTable = src->lightInTable();
+    } else {
+        out.depth.clear();
+        out.dims = glm::ivec3(0);
+    }
+}
+
+} // namespace splatfx

@@ -1,0 +1,217 @@
+// The frame's shadow on host geometry (issue 16, item 4): FrameRenderer
+// uploads Frame::shadow() before the opaque hook, binds it, and a host surface
+// shader with shadowGlsl() (the docs/integration.md snippet) darkens the
+// ground under the gas exactly as ShadowTable::transmittance says.
+#include <cmath>
+#include <string>
+
+#include <epoxy/gl.h>
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "gl_fixture.hpp"
+#include "splatfx/gl/frame_renderer.hpp"
+#include "splatfx/lighting.hpp"
+#include "test_scenes.hpp"
+
+using namespace splatfx;
+
+namespace {
+
+// docs/integration.md, "Shadows of the gas": the host's ground shader. Keep the two in step.
+const char* kVertex = R"(#version 450 core
+uniform mat4 uViewProj;
+uniform float uHalf;          // the ground quad: [-uHalf, uHalf]^2 at y = 0
+out vec3 vWorldPos;
+void main() {
+    vec2 c = vec2((gl_VertexID & 1) != 0 ? 1.0 : -1.0, (gl_VertexID & 2) != 0 ? 1.0 : -1.0) * uHalf;
+    vWorldPos = vec3(c.x, 0.0, c.y);
+    gl_Position = uViewProj * vec4(vWorldPos, 1.0);
+}
+)";
+const char* kFragmentBody = R"(
+in vec3 vWorldPos;
+uniform vec3 uAlbedo;
+out vec4 fragColor;
+void main() {
+    // The sun's direct light times the gas's transmittance towards it, plus a little sky.
+    float sun = splatfx_shadow(vWorldPos);
+    fragColor = vec4(uAlbedo * (0.2 + 0.8 * sun), 1.0);
+}
+)";
+
+GLuint compile(GLenum type, const std::string& src, std::string& log) {
+    const GLuint s = glCreateShader(type);
+    const char* p = src.c_str();
+    glShaderSource(s, 1, &p, nullptr);
+    glCompileShader(s);
+    GLint ok = 0;
+    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+    char buf[4096] = {};
+    glGetShaderInfoLog(s, sizeof buf, nullptr, buf);
+    log += buf;
+    return ok ? s : 0;
+}
+
+GLuint groundProgram(std::string& log) {
+    const GLuint vs = compile(GL_VERTEX_SHADER, kVertex, log);
+    const GLuint fs = compile(GL_FRAGMENT_SHADER, std::string("#version 450 core\n") + shadowGlsl() + kFragmentBody, log);
+    if (!vs || !fs) return 0;
+    const GLuint prog = glCreateProgram();
+    glAttachShader(prog, vs);
+    glAttachShader(prog, fs);
+    glLinkProgram(prog);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = 0;
+    glGetProgramiv(prog, GL_LINK_STATUS, &ok);
+    return ok ? prog : 0;
+}
+
+constexpr int kSize = 64;
+constexpr float kHalf = 3.0f;
+const glm::vec3 kAlbedo{0.9f, 0.8f, 0.7f};
+
+// Looking straight down on the ground: pixel centres map to known world points.
+Camera topDown() {
+    const glm::mat4 view = glm::lookAt(glm::vec3(0, 10, 0), glm::vec3(0), glm::vec3(0, 0, -1));
+    const glm::mat4 proj = glm::ortho(-kHalf, kHalf, -kHalf, kHalf, 0.1f, 100.0f);
+    return Camera::fromMatrices(view, proj, {kSize, kSize});
+}
+
+// A gas blob floating 1.5 above the ground, its table for an oblique sun.
+struct Shadowed {
+    ShadowTable table{{.dims = glm::ivec3(32)}};
+    Frame frame;
+    Shadowed() {
+        Grid g = test::gaussianBlob(12, 0.2f, 0.9f);
+        g.transform = glm::translate(glm::mat4(1.0f), glm::vec3(-1.1f, 1.5f, -1.1f));
+        auto field = DensityField::fromGrid(g);
+        EXPECT_TRUE(field);
+        EXPECT_TRUE(table.update(*field, Light::directional({0.3f, -1.0f, 0.2f})));
+        frame.begin(0.0, topDown());
+        frame.end();
+        FrameShadow& s = frame.shadow(); // by hand, as a host without a Scene would
+        s.valid = true;
+        s.depth = table.data();
+        s.dims = table.dims();
+        s.worldToTable = table.worldToTable();
+        s.lightInTable = table.lightInTable();
+        s.version = 1;
+    }
+};
+
+class FrameShadowGL : public test::GLTest {};
+
+struct Drawn {
+    Image image;
+    gl::ShadowBinding binding;
+};
+
+Drawn draw(gl::FrameRenderer& fr, const Frame& frame, GLuint prog) {
+    auto fb = gl::Framebuffer::create({.width = kSize, .height = kSize, .color = gl::Precision::F32});
+    EXPECT_TRUE(fb);
+    const Camera cam = topDown();
+    const glm::mat4 vp = cam.proj * cam.view;
+    GLuint vao = 0;
+    glCreateVertexArrays(1, &vao);
+    Drawn out;
+    fr.render(frame, {.framebuffer = fb->handle(), .drawOpaque = [&] {
+                          glClearColor(0, 0, 0, 1);
+                          glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+                          glDisable(GL_BLEND);
+                          glDisable(GL_DEPTH_TEST);
+                          glUseProgram(prog);
+                          gl::setShadowUniforms(prog, fr.shadowBinding());
+                          glUniformMatrix4fv(glGetUniformLocation(prog, "uViewProj"), 1, GL_FALSE, glm::value_ptr(vp));
+                          glUniform1f(glGetUniformLocation(prog, "uHalf"), kHalf);
+                          glUniform3fv(glGetUniformLocation(prog, "uAlbedo"), 1, glm::value_ptr(kAlbedo));
+                          glBindVertexArray(vao);
+                          glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+                          glBindVertexArray(0);
+                          glUseProgram(0);
+                      }});
+    glDeleteVertexArrays(1, &vao);
+    out.image = fb->read();
+    out.binding = fr.shadowBinding();
+    return out;
+}
+
+// Largest difference between neighbouring table nodes (what GL's filter-weight precision scales).
+float maxNeighbourStep(const ShadowTable& t) {
+    const glm::ivec3 n = t.dims();
+    const auto& d = t.data();
+    float m = 0.0f;
+    auto at = [&](int i, int j, int k) { return d[std::size_t(i + n.x * (j + n.y * k))]; };
+    for (int k = 0; k < n.z; ++k)
+        for (int j = 0; j < n.y; ++j)
+            for (int i = 0; i < n.x; ++i) {
+                if (i + 1 < n.x) m = std::max(m, std::abs(at(i + 1, j, k) - at(i, j, k)));
+                if (j + 1 < n.y) m = std::max(m, std::abs(at(i, j + 1, k) - at(i, j, k)));
+                if (k + 1 < n.z) m = std::max(m, std::abs(at(i, j, k + 1) - at(i, j, k)));
+            }
+    return m;
+}
+
+} // namespace
+
+TEST_F(FrameShadowGL, HostGroundShaderDarkensUnderTheGasAsTheTableSays) {
+    std::string log;
+    const GLuint prog = groundProgram(log);
+    ASSERT_NE(prog, 0u) << log;
+    Shadowed s;
+    auto fr = gl::FrameRenderer::create();
+    ASSERT_TRUE(fr);
+    const Drawn d = draw(*fr, s.frame, prog);
+    EXPECT_TRUE(d.binding.valid);
+    EXPECT_EQ(d.binding.textureUnit, 15);
+    EXPECT_EQ(fr->stats().shadowUploads, 1u);
+    // Tolerance as tests/lighting/shadow_gl_test.cpp: GL may filter with 8-bit weights, an error of
+    // 3/256 of the largest node step in depth, i.e. ln 2 times that in transmittance (T <= 1);
+    // times 0.8 (the shader's sun share) in colour, plus float rounding.
+    const float tol = 0.8f * std::log(2.0f) * 3.0f / 256.0f * maxNeighbourStep(s.table) + 1e-5f;
+    const Camera cam = topDown();
+    const glm::mat4 inv = glm::inverse(cam.proj * cam.view);
+    float darkest = 1.0f, worst = 0.0f;
+    for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x) {
+            const glm::vec4 ndc((x + 0.5f) / kSize * 2.0f - 1.0f, 1.0f - (y + 0.5f) / kSize * 2.0f, 0.0f, 1.0f);
+            glm::vec4 w = inv * ndc;
+            const glm::vec3 world(w.x / w.w, 0.0f, w.z / w.w);
+            const float T = s.table.transmittance(world);
+            darkest = std::min(darkest, T);
+            for (int c = 0; c < 3; ++c) {
+                const float expected = kAlbedo[c] * (0.2f + 0.8f * T);
+                worst = std::max(worst, std::abs(d.image.at(x, y, c) - expected));
+            }
+        }
+    EXPECT_LE(worst, tol);
+    EXPECT_LT(darkest, 0.6f) << "the blob should cast a visible shadow on the ground";
+    // The same frame again: nothing uploaded.
+    draw(*fr, s.frame, prog);
+    EXPECT_EQ(fr->stats().shadowUploads, 1u);
+    glDeleteProgram(prog);
+}
+
+TEST_F(FrameShadowGL, WithoutAShadowTheIncludeReturnsOne) {
+    std::string log;
+    const GLuint prog = groundProgram(log);
+    ASSERT_NE(prog, 0u) << log;
+    Frame frame;
+    frame.begin(0.0, topDown());
+    frame.end();
+    auto fr = gl::FrameRenderer::create();
+    ASSERT_TRUE(fr);
+    const Drawn d = draw(*fr, frame, prog);
+    EXPECT_FALSE(d.binding.valid);
+    for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x)
+            for (int c = 0; c < 3; ++c) ASSERT_NEAR(d.image.at(x, y, c), kAlbedo[c], 1e-6f) << x << "," << y;
+    glDeleteProgram(prog);
+}
+
+TEST_F(FrameShadowGL, BadShadowUnitIsRefusedByName) {
+    auto fr = gl::FrameRenderer::create({.shadowTextureUnit = 16});
+    ASSERT_FALSE(fr);
+    EXPECT_NE(fr.error().find("shadowTextureUnit"), std::string::npos) << fr.error();
+}
