@@ -33,6 +33,7 @@
 #include "splatfx/camera.hpp"
 #include "splatfx/effect.hpp"
 #include "splatfx/effect_kind.hpp"
+#include "splatfx/fog.hpp"
 #include "splatfx/frame.hpp"
 #include "splatfx/materials.hpp"
 #include "splatfx/splats.hpp"
@@ -111,6 +112,14 @@ public:
     // frame.end (one back-to-front sort), and the frame's counters.
     void prepare(double timeSec, const Camera& camera, const Materials& materials, Frame& frame, const EmitOptions& options = {});
 
+    // --- Fog (issue 14) ---------------------------------------------------
+    // The scene's fog, handed to every Frame prepare() fills (Frame::setFog).
+    // A Fog is a pure function of time: it costs nothing while out of view.
+    void setFog(Fog fog) { mFog = std::make_shared<const Fog>(std::move(fog)); }
+    void clearFog() { mFog.reset(); }
+    const Fog* fog() const { return mFog.get(); }
+    // --- end fog -----------------------------------------------------------
+
     const EffectStatus& status(EffectId id) const { return mEntries.at(id).status; }
     const SceneCounters& counters() const { return mCounters; }
     double time() const { return mTime; }
@@ -132,6 +141,7 @@ private:
     SceneCounters mCounters;
     double mTime = 0.0;
     bool mUpdated = false;
+    std::shared_ptr<const Fog> mFog; // issue 14; default none
 };
 
 } // namespace splatfx

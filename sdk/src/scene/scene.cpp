@@ -108,6 +108,7 @@ void Scene::prepare(double timeSec, const Camera& camera, const Materials& mater
     frame.begin(timeSec, camera);
     emit(frame.builder(), materials, options);
     frame.end();
+    frame.setFog(mFog); // fog (issue 14)
     FrameCounters& c = frame.counters();
     c.declared = mCounters.declared;
     c.needed = mCounters.needed;

@@ -5,7 +5,9 @@ namespace splatfx::gl::detail {
 
 // Per instance: one Splat (see splats.hpp). Per vertex: a corner of the
 // octagon (or square) circumscribing the unit disc, from gl_VertexID.
-inline constexpr const char* kSplatVertex = R"(#version 450 core
+// Compiled after "#version 450 core\n#define FOG 0|1\n": the fog variant
+// (issue 14) passes the world position relative to the eye to the fragment.
+inline constexpr const char* kSplatVertex = R"(
 layout(location = 0) in vec4 aCenterDensity;
 layout(location = 1) in vec4 aAxisUColor;
 layout(location = 2) in vec4 aAxisVRow;
@@ -21,6 +23,10 @@ out vec2 vTex;
 flat out float vDensity;
 flat out vec3 vLayers;
 flat out vec3 vColor;
+#if FOG
+uniform vec3 uFogEye;
+out vec3 vFogRel;
+#endif
 
 // Octagon circumscribing the unit circle, in triangle-strip order.
 const vec2 kOct[8] = vec2[8](vec2(1.0, -0.41421356), vec2(1.0, 0.41421356), vec2(0.41421356, -1.0), vec2(0.41421356, 1.0),
@@ -36,18 +42,27 @@ void main() {
     vDensity = aCenterDensity.w;
     vLayers = vec3(float(aLayers.x), float(aLayers.y), aBlend);
     vColor = aColor.rgb;
+#if FOG
+    vFogRel = p - uFogEye;
+#endif
 }
 )";
 
-// Compiled twice, after "#version 450 core\n#define CROSSFADE 0|1\n": a draw
+// Compiled twice, after "#version 450 core\n#define CROSSFADE 0|1\n#define FOG 0\n": a draw
 // with no cross-faded splat skips the second fetch and the branch entirely
 // (software rasterizers execute both sides of a per-fragment branch).
+// With a fog, twice more with FOG 1 and fogGlsl()'s source before this one:
+// every premultiplied layer becomes f c + (1 - f) alpha C_fog, alpha
+// unchanged, f the transmittance from the eye to the fragment (docs/fog.md).
 inline constexpr const char* kSplatFragment = R"(
 layout(binding = 0) uniform sampler2DArray uLayers;
 in vec2 vTex;
 flat in float vDensity;
 flat in vec3 vLayers;
 flat in vec3 vColor;
+#if FOG
+in vec3 vFogRel;
+#endif
 layout(location = 0) out vec4 oColor;
 
 void main() {
@@ -57,7 +72,12 @@ void main() {
 #endif
     // Opacity from optical depth: alpha = 1 - 2^(-density * detail).
     float a = 1.0 - exp2(-vDensity * t.a);
-    oColor = vec4(vColor * t.rgb * a, a);
+    vec3 c = vColor * t.rgb * a;
+#if FOG
+    float f = splatfx_fog_transmittance(vec3(0.0), vFogRel);
+    c = f * c + (1.0 - f) * a * splatfx_fog_colour;
+#endif
+    oColor = vec4(c, a);
 }
 )";
 
