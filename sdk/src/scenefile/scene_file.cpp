@@ -7,6 +7,7 @@
 //   kinds.cpp          the table of effect kinds and geometry types, whose
 //                      readers are in kinds/ (one a file)
 //   camera_output.cpp  camera path and output settings
+//   fog_block.cpp      the "fog" block
 //
 // [SECTION] Text checks (size, nesting, syntax with line and column)
 // [SECTION] Entry points
@@ -149,6 +150,7 @@ Result<SceneFile> parse(const std::string& text, const std::string& path, Materi
         }
     }
     if (const Json* v = o.get("effects")) readEffects(c, "effects", *v, geo, geoByName, out);
+    if (const Json* v = o.get("fog")) readFog(c, "fog", *v, out.scene); // fog_block.cpp (issue 14)
     o.finish();
     if (!d.ok()) return makeError(d.message());
     return out;
