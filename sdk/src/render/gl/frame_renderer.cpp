@@ -78,7 +78,7 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
     const Fog* fog = frame.fog() && !frame.fog()->empty() ? frame.fog() : nullptr;
     if (fog && r.desc.fogHost) {
         unsigned depth = target.depthTexture;
-        if (!depth) {
+        if (!depth && target.framebuffer != 0) { // the default framebuffer's depth is never a texture
             GLint type = GL_NONE, name = 0;
             glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
             if (type == GL_TEXTURE)
