@@ -7,6 +7,7 @@
 int runAccuracy(int argc, char** argv); // accuracy.cpp: error vs time per quality knob (issue 5)
 int runTable1(int argc, char** argv);   // table1.cpp: the paper's Table I, fill limit, CPU scaling (issue 7)
 int runScheduling(int argc, char** argv); // scheduling.cpp: 1000 effects, 10 in view; catch-up error (issue 6)
+int runFog(int argc, char** argv);        // fog.cpp: Biri et al. 2002 Table 1, fog cost per pixel and per fog texture (issue 14)
 
 struct BenchCommand {
     const char* name;
@@ -18,4 +19,5 @@ inline constexpr BenchCommand kCommands[] = {
     {"accuracy", "error against the exact reference vs time per frame, for every quality knob", runAccuracy},
     {"table1", "King et al. 1999 Table I on this machine, fill limit, naive baseline, CPU scaling", runTable1},
     {"scheduling", "a level of 1000 effects with 10 in view vs those 10 alone; camera sweep; catch-up error", runScheduling},
+    {"fog", "Biri et al. 2002 Table 1: no fog, per-pixel fog, reduced fog textures at 800x600; error vs per pixel", runFog},
 };
