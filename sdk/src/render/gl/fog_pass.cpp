@@ -2,6 +2,7 @@
 #include "fog_pass.hpp"
 
 #include <algorithm>
+#include <string>
 
 #include <epoxy/gl.h>
 
@@ -157,6 +158,11 @@ Status FogPass::build(const Fog& fog) {
 Status FogPass::draw(const Fog& fog, double timeSec, const Camera& camera, const FogPassTarget& target, glm::ivec2 textureSize,
                      float depthThreshold) {
     if (fog.empty()) return {};
+    GLint samples = 0;
+    glGetTextureLevelParameteriv(target.depthTexture, 0, GL_TEXTURE_SAMPLES, &samples);
+    if (samples > 1)
+        return makeError("fog pass: HostTarget::depthTexture is multisampled (" + std::to_string(samples) +
+                         " samples); resolve it into a single-sample depth texture first");
     if (Status s = build(fog); !s) return s;
     const bool reduced = textureSize.x > 0 && textureSize.y > 0;
     if (reduced && textureSize != mTextureSize) {
