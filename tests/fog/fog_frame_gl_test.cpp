@@ -294,6 +294,51 @@ TEST_F(FogFrameGL, ReducedFogTextureStaysWithinTheSameSurfacesPerPixelRange) {
     }
 }
 
+// RendererDesc::fogPerSplat: f at each splat's centre. For a constant fog k,
+// f depends only on the distance from the eye, which differs between a
+// fragment and its splat's centre by at most the drawn half-diagonal R, so
+// each layer's f moves by at most k R, and the composite (weights summing to
+// at most 1, colours <= 1) by at most that on top of the splat-only error.
+TEST_F(FogFrameGL, PerSplatFogStaysWithinTheFogsVariationAcrossASplat) {
+    Splats s;
+    FogDesc fd;
+    const double k = 0.15;
+    fd.terms.push_back(FogTerm::constant(k));
+    fd.colour = {0.7, 0.75, 0.8};
+    const Fog fog = *Fog::create(fd);
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(fb);
+    auto draw = [&](bool perSplat, const Fog* f) {
+        auto fr = gl::FrameRenderer::create({.splats = {.sampling = gl::TextureSampling::Bilinear, .fogPerSplat = perSplat}});
+        EXPECT_TRUE(fr) << fr.error();
+        EXPECT_TRUE(fr->upload(s.materials));
+        s.frame.setFog(f ? std::make_shared<const Fog>(*f) : nullptr);
+        fr->render(s.frame, {.framebuffer = fb->handle(), .drawOpaque = drawHost});
+        return fb->read();
+    };
+    const Image plain = draw(false, nullptr);
+    const Image depth = fb->readDepth();
+    const Image perFragment = draw(false, &fog);
+    const Image perSplat = draw(true, &fog);
+    SplatExactDesc rd;
+    rd.host.background = kBackground;
+    rd.host.depth = &depth;
+    auto refPlain = renderSplatExact(s.frame.splats(), s.frame.camera(), s.materials, rd);
+    rd.fog = &fog;
+    SplatExactStats st;
+    auto refFog = renderSplatExact(s.frame.splats(), s.frame.camera(), s.materials, rd, &st);
+    ASSERT_TRUE(refPlain && refFog);
+    double radius = 0.0;
+    for (const Splat& sp : s.frame.splats())
+        radius = std::max(radius, double(gl::RendererDesc{}.footprintCut) * std::sqrt(double(glm::dot(sp.axisU, sp.axisU) + glm::dot(sp.axisV, sp.axisV))));
+    const double splatError = maxDiff(plain, *refPlain);
+    const double floatBound = 2.0 * tauFloatBound(fog, 36.0, k, 75.0 * 8.0 * kEps) + 2.0 * st.fogMaxErrorEstimate + 1e-6;
+    EXPECT_LE(maxDiff(perFragment, *refFog), splatError + floatBound);
+    EXPECT_LE(maxDiff(perSplat, *refFog), splatError + floatBound + k * radius) << "R = " << radius;
+    EXPECT_GT(maxDiff(perSplat, perFragment), 1e-4) << "the knob must change what is drawn";
+    EXPECT_LT(k * radius, 0.5) << "the bound must mean something";
+}
+
 TEST_F(FogFrameGL, FogTextureSizeIsValidated) {
     auto bad = gl::FrameRenderer::create({.fogTextureSize = {256, 0}});
     ASSERT_FALSE(bad);

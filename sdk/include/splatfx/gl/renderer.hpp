@@ -74,6 +74,11 @@ struct RendererDesc {
     // costs 0.77x the time of 1.0 at the same error against the exact
     // reference. Default 0.8125; 1 draws the whole support.
     float footprintCut = 0.8125f;
+    // With a fog (setFog): evaluate the transmittance once per splat, at its
+    // centre, instead of per fragment. Cheaper where fragments dominate; its
+    // error grows with the fog's variation across a splat (for a constant fog
+    // k, |df| <= k times the splat's drawn radius). Default false (per fragment).
+    bool fogPerSplat = false;
 };
 
 // Where to draw: the host's framebuffer object (0 = default framebuffer) and viewport.

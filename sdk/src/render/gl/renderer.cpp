@@ -133,8 +133,8 @@ Result<Renderer> Renderer::create(const RendererDesc& desc) {
     auto impl = std::make_unique<Impl>();
     impl->desc = desc;
     for (int crossfade = 0; crossfade < 2; ++crossfade) {
-        auto linked = linkProgram({"#version 450 core\n#define FOG 0\n", detail::kSplatVertex},
-                                          {"#version 450 core\n#define FOG 0\n", crossfade ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n", detail::kSplatFragment},
+        auto linked = linkProgram({"#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n", detail::kSplatVertex},
+                                          {"#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n", crossfade ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n", detail::kSplatFragment},
                                           "splat");
         if (!linked) return makeError(linked.error());
         Impl::Program& p = impl->programs[crossfade];
@@ -225,9 +225,11 @@ Status Renderer::setFog(const Fog* fog, double timeSec) {
         if (p.p.id) glDeleteProgram(p.p.id), p = {};
     r.fogSource.clear();
     for (int crossfade = 0; crossfade < 2; ++crossfade) {
-        auto linked = linkProgram({"#version 450 core\n#define FOG 1\n", detail::kSplatVertex},
-                                  {"#version 450 core\n#define FOG 1\n", crossfade ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n",
-                                   glsl->source.c_str(), detail::kSplatFragment},
+        const char* head = r.desc.fogPerSplat ? "#version 450 core\n#define FOG 1\n#define FOG_PER_SPLAT 1\n"
+                                              : "#version 450 core\n#define FOG 1\n#define FOG_PER_SPLAT 0\n";
+        auto linked = linkProgram({head, glsl->source.c_str(), detail::kSplatVertex},
+                                  {head, crossfade ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n", glsl->source.c_str(),
+                                   detail::kSplatFragment},
                                   "splat (fog)");
         if (!linked) {
             r.fog = nullptr;

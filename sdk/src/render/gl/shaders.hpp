@@ -5,8 +5,10 @@ namespace splatfx::gl::detail {
 
 // Per instance: one Splat (see splats.hpp). Per vertex: a corner of the
 // octagon (or square) circumscribing the unit disc, from gl_VertexID.
-// Compiled after "#version 450 core\n#define FOG 0|1\n": the fog variant
-// (issue 14) passes the world position relative to the eye to the fragment.
+// Compiled after "#version 450 core\n#define FOG 0|1\n#define FOG_PER_SPLAT 0|1\n" (and,
+// with FOG, fogGlsl()'s source): the fog variant (issue 14) passes the world
+// position relative to the eye to the fragment, or the transmittance to the
+// splat's centre, evaluated here once per vertex (RendererDesc::fogPerSplat).
 inline constexpr const char* kSplatVertex = R"(
 layout(location = 0) in vec4 aCenterDensity;
 layout(location = 1) in vec4 aAxisUColor;
@@ -25,7 +27,11 @@ flat out vec3 vLayers;
 flat out vec3 vColor;
 #if FOG
 uniform vec3 uFogEye;
+#if FOG_PER_SPLAT
+flat out float vFogF; // transmittance to the splat's centre (RendererDesc::fogPerSplat)
+#else
 out vec3 vFogRel;
+#endif
 #endif
 
 // Octagon circumscribing the unit circle, in triangle-strip order.
@@ -43,7 +49,11 @@ void main() {
     vLayers = vec3(float(aLayers.x), float(aLayers.y), aBlend);
     vColor = aColor.rgb;
 #if FOG
+#if FOG_PER_SPLAT
+    vFogF = splatfx_fog_transmittance(vec3(0.0), aCenterDensity.xyz - uFogEye);
+#else
     vFogRel = p - uFogEye;
+#endif
 #endif
 }
 )";
@@ -61,7 +71,11 @@ flat in float vDensity;
 flat in vec3 vLayers;
 flat in vec3 vColor;
 #if FOG
+#if FOG_PER_SPLAT
+flat in float vFogF;
+#else
 in vec3 vFogRel;
+#endif
 #endif
 layout(location = 0) out vec4 oColor;
 
@@ -74,7 +88,11 @@ void main() {
     float a = 1.0 - exp2(-vDensity * t.a);
     vec3 c = vColor * t.rgb * a;
 #if FOG
+#if FOG_PER_SPLAT
+    float f = vFogF;
+#else
     float f = splatfx_fog_transmittance(vec3(0.0), vFogRel);
+#endif
     c = f * c + (1.0 - f) * a * splatfx_fog_colour;
 #endif
     oColor = vec4(c, a);
