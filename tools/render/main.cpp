@@ -39,7 +39,7 @@ struct Args {
     std::optional<float> fps;
     bool traditional = false;
     bool quiet = false;
-    splatfx::gl::FrameRendererDesc renderer{}; // --scale, --sampling
+    splatfx::gl::FrameRendererDesc renderer{}; // --scale, --sampling, --fog-texture
     int abortAfter = -1; // testing aid: fail after this many frames
 };
 
@@ -55,6 +55,7 @@ void usage() {
         "  --traditional    draw every effect with plain footprints, no textures (the paper's Fig. 1a)\n"
         "  --scale N        draw the effects at 1/N resolution per axis (1, 2 or 4; default 1) with depth-aware upsampling\n"
         "  --sampling M     texture sampling: auto (default), bilinear, nearest, upsampled, upsampledN (N = 2..16)\n"
+        "  --fog-texture WxH  fog the host image through a reduced WxH fog texture (default: per pixel)\n"
         "  --quiet          no per-frame progress\n"
         "  --abort-after N  testing aid: fail on purpose after N frames (checks that nothing partial is left)\n"
         "<name> is the scene's output.name (default: the scene file's folder name).\n");
@@ -116,6 +117,16 @@ bool parse(int argc, char** argv, Args& a) {
                 std::fprintf(stderr, "splatfx-render: --sampling expects auto, bilinear, nearest, upsampled or upsampledN, got '%s'\n", v);
                 return false;
             }
+        } else if (s == "--fog-texture") {
+            // The host image's fog through a reduced fog texture (Biri et al. Table 1, Fig. 9).
+            if (!(v = value())) return false;
+            int fw = 0, fh = 0;
+            char tail = 0;
+            if (std::sscanf(v, "%dx%d%c", &fw, &fh, &tail) != 2 || fw < 1 || fh < 1 || fw > 8192 || fh > 8192) {
+                std::fprintf(stderr, "splatfx-render: --fog-texture expects WxH (1 to 8192 each), got '%s'\n", v);
+                return false;
+            }
+            a.renderer.fogTextureSize = {fw, fh};
         } else if (s == "--abort-after") {
             if (!(v = value()) || !integer(v, 0, 100000, n)) return false;
             a.abortAfter = int(n);

@@ -23,11 +23,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "splatfx/camera.hpp"
+#include "splatfx/fog.hpp"
 #include "splatfx/splats.hpp"
 
 namespace splatfx {
@@ -84,11 +86,22 @@ public:
     const FrameShadow& shadow() const { return mShadow; }
     FrameShadow& shadow() { return mShadow; }
 
+    // --- Fog (issue 14, docs/fog.md) -------------------------------------
+    // The one medium the frame is seen through: gl::FrameRenderer fogs the
+    // host's opaque image with it and applies it per fragment to every
+    // splat, at time(). Not cleared by begin() (a setting, not content);
+    // Scene::prepare sets it from Scene::setFog. nullptr: clear air (default).
+    void setFog(std::shared_ptr<const Fog> fog) { mFog = std::move(fog); }
+    const Fog* fog() const { return mFog.get(); }
+    const std::shared_ptr<const Fog>& sharedFog() const { return mFog; }
+    // --- end fog ---------------------------------------------------------
+
 private:
     SplatBuilder mBuilder;
     FrameCounters mCounters;
     FrameShadow mShadow; // lighting (issue 16)
     double mTime = 0.0;
+    std::shared_ptr<const Fog> mFog; // fog (issue 14); default none
 };
 
 } // namespace splatfx

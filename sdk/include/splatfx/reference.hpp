@@ -46,6 +46,7 @@
 #include <glm/glm.hpp>
 
 #include "splatfx/camera.hpp"
+#include "splatfx/fog.hpp"
 #include "splatfx/grid.hpp"
 #include "splatfx/image.hpp"
 #include "splatfx/materials.hpp"
@@ -84,12 +85,26 @@ struct SplatExactDesc {
     // which is what the GL pass draws and where a Scene puts lit colours
     // (docs/lighting.md, "In a Scene"). Default false.
     bool packedColor = false;
+    // Fog (issue 14): the medium the splats and the host are seen through,
+    // integrated numerically (integrateFogNumerically, never the closed
+    // forms) along each pixel ray from the eye: every fragment at world
+    // point X becomes f c + (1 - f) alpha C_fog (premultiplied), f = exp(-tau(eye, X))
+    // (0 beyond farDistanceWorld), and the host background is fogged to the
+    // host depth's point as gl::FrameRenderer's fog pass does: depth 1 (sky,
+    // or no depth image) to the far plane, NaN or outside [0, 1] fully fogged.
+    const Fog* fog = nullptr;   // default none
+    double fogTimeSec = 0.0;    // the fog's time; default 0
+    double fogTolerance = 1e-9; // absolute tolerance on each optical depth; default 1e-9
+    bool fogHost = true;        // fog the background too (false: as a frame drawn without the host fog pass); default true
 };
 
 struct SplatExactStats {
     std::uint64_t fragments = 0;    // (pixel, splat) pairs composited
     std::uint64_t maxOverlap = 0;   // most fragments on one pixel
     std::uint64_t skippedSplats = 0; // non-finite or degenerate splats, or layer/row out of range
+    double fogMaxOpticalDepth = 0.0;   // largest finite tau from the eye to a fragment or the host point
+    double fogMaxErrorEstimate = 0.0;  // largest quadrature error estimate of one pixel's optical depths (summed)
+    std::uint64_t fogUnconverged = 0;  // quadratures that missed fogTolerance
 };
 
 // Expects camera.viewport > 0 and materials holding every splat's layer and

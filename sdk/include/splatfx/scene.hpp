@@ -38,6 +38,7 @@
 #include "splatfx/camera.hpp"
 #include "splatfx/effect.hpp"
 #include "splatfx/effect_kind.hpp"
+#include "splatfx/fog.hpp"
 #include "splatfx/frame.hpp"
 #include "splatfx/lighting.hpp"
 #include "splatfx/materials.hpp"
@@ -176,6 +177,13 @@ public:
     // The last lighting failure (a bad EffectLighting or SceneShadowDesc: the
     // effect is drawn unlit, or no scene shadow); empty when the last emit() had none.
     const std::string& lightingError() const { return mLightingError; }
+    // --- Fog (issue 14) ---------------------------------------------------
+    // The scene's fog, handed to every Frame prepare() fills (Frame::setFog).
+    // A Fog is a pure function of time: it costs nothing while out of view.
+    void setFog(Fog fog) { mFog = std::make_shared<const Fog>(std::move(fog)); }
+    void clearFog() { mFog.reset(); }
+    const Fog* fog() const { return mFog.get(); }
+    // --- end fog -----------------------------------------------------------
 
     const EffectStatus& status(EffectId id) const { return mEntries.at(id).status; }
     const SceneCounters& counters() const { return mCounters; }
@@ -219,6 +227,7 @@ private:
     std::uint64_t mSceneShadowLastBuilds = 0;
     const ShadowTable* mSceneShadowSource = nullptr; // mSceneShadow, or a lit effect's own table it shares
     std::string mLightingError;
+    std::shared_ptr<const Fog> mFog; // issue 14; default none
 };
 
 } // namespace splatfx

@@ -10,6 +10,7 @@
 #include "splatfx/fog.hpp"
 #include "splatfx/footprint.hpp"
 #include "splatfx/frame.hpp"
+#include "splatfx/gl/fog_uniforms.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/gl/framebuffer.hpp"
 #include "splatfx/gl/program.hpp"

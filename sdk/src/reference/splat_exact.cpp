@@ -148,9 +148,21 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
     const reference::RayMapper mapper(camera);
     std::mutex statsMutex;
 
+    // Fog: integrated from the eye. With a perspective camera every pixel ray
+    // passes through the eye, so the optical depths to the fragments are
+    // accumulated piece by piece along the ray; otherwise each is integrated
+    // from the eye on its own.
+    const Fog* fog = desc.fog && !desc.fog->empty() ? desc.fog : nullptr;
+    const glm::dvec3 eye(camera.eye());
+    const bool throughEye = camera.perspective();
+    const double fogFar = fog ? fog->desc().farDistanceWorld : 0.0;
+    const glm::dvec3 fogColour = fog ? fog->desc().colour : glm::dvec3(0.0);
+
     reference::parallelRows(H, desc.threads, [&](int y) {
         std::vector<Fragment> frags;
         std::uint64_t fragCount = 0, maxOverlap = 0;
+        double fogTauMax = 0.0, fogErrMax = 0.0;
+        std::uint64_t fogBad = 0;
         for (int x = 0; x < W; ++x) {
             const reference::PixelRay ray = mapper.ray(x, y, reference::hostDepth(desc.host, x, y));
             frags.clear();
@@ -197,7 +209,44 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
             // Per-pixel exact order: farthest plane crossing first.
             std::stable_sort(frags.begin(), frags.end(), [](const Fragment& a, const Fragment& b) { return a.t > b.t; });
             glm::dvec4 acc = reference::background(desc.host, x, y);
-            for (const Fragment& f : frags) acc = glm::dvec4(f.color * f.alpha, f.alpha) + (1.0 - f.alpha) * acc;
+            if (!fog) {
+                for (const Fragment& f : frags) acc = glm::dvec4(f.color * f.alpha, f.alpha) + (1.0 - f.alpha) * acc;
+            } else {
+                // Transmittance from the eye to each fragment, nearest first.
+                std::vector<double> trans(frags.size(), 1.0);
+                double tau = 0.0, err = 0.0;
+                glm::dvec3 from = eye;
+                auto tauTo = [&](const glm::dvec3& p) {
+                    const glm::dvec3 a = throughEye ? from : eye;
+                    const FogQuadrature q = integrateFogNumerically(*fog, a, p, desc.fogTimeSec, desc.fogTolerance);
+                    if (!q.converged) ++fogBad;
+                    const double total = throughEye ? tau + q.value : q.value;
+                    err = throughEye ? err + q.errorEstimate : std::max(err, q.errorEstimate);
+                    if (throughEye) tau = total, from = p;
+                    return total;
+                };
+                auto transmittanceTo = [&](const glm::dvec3& p) {
+                    const double tp = tauTo(p);
+                    if (std::isfinite(tp)) fogTauMax = std::max(fogTauMax, tp);
+                    if (fogFar > 0.0 && glm::length(p - eye) > fogFar) return 0.0;
+                    return std::exp(-tp);
+                };
+                for (size_t k = frags.size(); k-- > 0;) trans[k] = transmittanceTo(ray.origin + frags[k].t * ray.dir);
+                if (desc.fogHost) {
+                    const double d = reference::hostDepth(desc.host, x, y);
+                    double fb = 0.0; // NaN or outside [0, 1]: fully fogged
+                    if (!desc.host.depth || d == 1.0) fb = transmittanceTo(ray.origin + ray.tFar * ray.dir);
+                    else if (d >= 0.0 && d < 1.0) fb = transmittanceTo(ray.origin + ray.tLimit * ray.dir);
+                    acc = glm::dvec4(fogColour * (1.0 - fb), 1.0 - fb) + fb * acc;
+                }
+                for (size_t k = 0; k < frags.size(); ++k) {
+                    const Fragment& f = frags[k];
+                    const double fk = trans[k];
+                    const glm::dvec3 c = fk * f.color * f.alpha + (1.0 - fk) * f.alpha * fogColour;
+                    acc = glm::dvec4(c, f.alpha) + (1.0 - f.alpha) * acc;
+                }
+                fogErrMax = std::max(fogErrMax, err);
+            }
             for (int ch = 0; ch < 4; ++ch) out.at(x, y, ch) = float(acc[ch]);
             fragCount += frags.size();
             maxOverlap = std::max<std::uint64_t>(maxOverlap, frags.size());
@@ -205,6 +254,9 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
         std::lock_guard<std::mutex> lock(statsMutex);
         stats.fragments += fragCount;
         stats.maxOverlap = std::max(stats.maxOverlap, maxOverlap);
+        stats.fogMaxOpticalDepth = std::max(stats.fogMaxOpticalDepth, fogTauMax);
+        stats.fogMaxErrorEstimate = std::max(stats.fogMaxErrorEstimate, fogErrMax);
+        stats.fogUnconverged += fogBad;
     });
     if (statsOut) *statsOut = stats;
     return out;

@@ -117,6 +117,7 @@ void Scene::prepare(double timeSec, const Camera& camera, const Materials& mater
     emit(frame.builder(), materials, options);
     shadeScene(frame); // lighting (issue 16): the shadow on the scene, into frame.shadow()
     frame.end();
+    frame.setFog(mFog); // fog (issue 14)
     FrameCounters& c = frame.counters();
     // ---- lighting (issue 16)
     c.litEffects = mCounters.litEffects;

@@ -170,4 +170,7 @@ void readEffectLighting(Context& c, const std::string& path, const Json& v, Effe
 void readCamera(Context& c, const std::string& path, const Json& v, CameraPath& cam);
 void readOutput(Context& c, const std::string& path, const Json& v, OutputSettings& out);
 
+// [SECTION] Fog (fog_block.cpp): the top-level "fog" block, set on the scene.
+void readFog(Context& c, const std::string& path, const Json& v, Scene& scene);
+
 } // namespace splatfx::scenefile

@@ -8,6 +8,7 @@
 //                      readers are in kinds/ (one a file)
 //   camera_output.cpp  camera path and output settings
 //   lights.cpp         lights, the scene shadow, each effect's lighting
+//   fog_block.cpp      the "fog" block
 //
 // [SECTION] Text checks (size, nesting, syntax with line and column)
 // [SECTION] Entry points
@@ -152,6 +153,7 @@ Result<SceneFile> parse(const std::string& text, const std::string& path, Materi
     if (const Json* v = o.get("effects")) readEffects(c, "effects", *v, geo, geoByName, out);
     if (const Json* v = o.get("lights")) readLights(c, "lights", *v, out);           // issue 16
     if (const Json* v = o.get("sceneShadow")) readSceneShadow(c, "sceneShadow", *v, out);
+    if (const Json* v = o.get("fog")) readFog(c, "fog", *v, out.scene); // fog_block.cpp (issue 14)
     o.finish();
     if (!d.ok()) return makeError(d.message());
     return out;

@@ -8,9 +8,13 @@
 //      texture bound to FrameRendererDesc::shadowTextureUnit during the hooks;
 //      see shadowBinding() and docs/integration.md, "Shadows of the gas")
 //   1. the host's opaque pass   (HostTarget::drawOpaque; its depth is what cuts the volumes)
+//   1b. the fog of the host's image (Frame::fog; issue 14): each pixel's host
+//      depth unprojected, C = f C + (1 - f) C_fog, per pixel or through a
+//      reduced fog texture (FrameRendererDesc::fogTextureSize)
 //   2. the volumes: the frame's splats, back to front, premultiplied "over",
 //      tested against the host depth, at full resolution or at 1/2 or 1/4 per
-//      axis with depth-aware upsampling (FrameRendererDesc::resolutionScale)
+//      axis with depth-aware upsampling (FrameRendererDesc::resolutionScale);
+//      with a fog, every splat fragment is fogged by the medium in front of it
 //   3. the host's transparent pass (HostTarget::drawTransparent), blended over
 // The passes of the systems still being built (fog of the host image, shadow
 // tables before the opaque pass, exact ordering among transparent surfaces,
@@ -37,6 +41,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
 
 #include <glm/glm.hpp>
 
@@ -58,6 +63,15 @@ struct FrameRendererDesc {
     // ---- lighting (issue 16): the texture unit the frame's shadow table is
     // bound to while the host's hooks run (splatfx_shadowTable of shadowGlsl()).
     int shadowTextureUnit = 15;           // [0, 15] (GL 4.5 guarantees 16 per stage); default 15
+    // --- Fog (issue 14, docs/fog.md) ---
+    // (0, 0): the host image's fog evaluated per pixel; otherwise the size of
+    // the reduced fog texture it is evaluated into (the paper's Table 1:
+    // 512x512 ... 128x128 for 800x600) and upsampled with depth-aware
+    // weights. Default (0, 0).
+    glm::ivec2 fogTextureSize{0, 0};
+    float fogDepthThreshold = 0.05f;      // fog texture: relative distance still one surface; default 0.05
+    bool fogHost = true;                  // fog the host's opaque image (false: only the splats); default true
+    // --- end fog ---
 };
 
 // ---- lighting (issue 16): what a host surface shader with shadowGlsl()
@@ -96,12 +110,18 @@ struct FrameRenderStats {
     std::uint64_t drawCalls = 0; // draw calls of the volume passes
     int resolutionScale = 1;     // the scale the splats were drawn at
     std::uint64_t shadowUploads = 0; // lighting (issue 16): shadow-table uploads (cumulative; only when the frame's changed)
+    // --- Fog (issue 14) ---
+    bool fogHost = false;        // the host image was fogged (a fog, fogHost and a host depth texture)
+    bool fogSplats = false;      // the splats were drawn with per-fragment fog
+    std::string fogError;        // empty, or why the fog could not be drawn (it was then skipped)
+    // --- end fog ---
 };
 
 class FrameRenderer {
 public:
-    // Compiles the passes. Fails when no GL 4.5 context is current or
-    // desc.resolutionScale is not 1, 2 or 4 (the message names the field).
+    // Compiles the passes. Fails when no GL 4.5 context is current,
+    // desc.resolutionScale is not 1, 2 or 4, or desc.fogTextureSize is
+    // negative or above 8192 (the message names the field).
     static Result<FrameRenderer> create(const FrameRendererDesc& desc = {});
     FrameRenderer(FrameRenderer&&) noexcept;
     FrameRenderer& operator=(FrameRenderer&&) noexcept;

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "splatfx/camera.hpp"
+#include "splatfx/fog.hpp"
 #include "splatfx/materials.hpp"
 #include "splatfx/result.hpp"
 #include "splatfx/splats.hpp"
@@ -73,6 +74,11 @@ struct RendererDesc {
     // costs 0.77x the time of 1.0 at the same error against the exact
     // reference. Default 0.8125; 1 draws the whole support.
     float footprintCut = 0.8125f;
+    // With a fog (setFog): evaluate the transmittance once per splat, at its
+    // centre, instead of per fragment. Cheaper where fragments dominate; its
+    // error grows with the fog's variation across a splat (for a constant fog
+    // k, |df| <= k times the splat's drawn radius). Default false (per fragment).
+    bool fogPerSplat = false;
 };
 
 // Where to draw: the host's framebuffer object (0 = default framebuffer) and viewport.
@@ -101,6 +107,17 @@ public:
     // Draws splats (already sorted back to front) with camera's matrices.
     // Expects upload() to have been called.
     void draw(const std::vector<Splat>& splats, const Camera& camera, const Target& target);
+
+    // Per-fragment fog (issue 14, docs/fog.md): from the next draw() on,
+    // every splat fragment becomes f c + (1 - f) alpha C_fog (premultiplied,
+    // alpha unchanged), f the transmittance from the camera's eye to the
+    // fragment's world position at timeSec. Compiles the fog variant of the
+    // shaders the first time a fog of this structure is seen (its generated
+    // GLSL is the cache key; only the uniforms change per frame), so draws
+    // without a fog run the plain shaders and cost nothing more. The Fog
+    // must outlive the draws that use it. nullptr: no fog (default). Fails
+    // only if the generated GLSL does not compile (the message says why).
+    Status setFog(const Fog* fog, double timeSec = 0.0);
 
     const DrawStats& stats() const;
     const RendererDesc& desc() const;

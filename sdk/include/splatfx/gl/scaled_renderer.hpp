@@ -75,6 +75,7 @@ public:
 
     const ScaledRendererDesc& desc() const;
     const Renderer& renderer() const;
+    Renderer& renderer(); // e.g. Renderer::setFog (issue 14)
 
 private:
     struct Impl;

@@ -8,6 +8,7 @@
 #include <epoxy/gl.h>
 
 #include "shadow_pass.hpp"
+#include "fog_pass.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
 
 namespace splatfx::gl {
@@ -19,6 +20,7 @@ struct FrameRenderer::Impl {
     std::optional<ScaledRenderer> reduced;
     FrameRenderStats stats;
     std::optional<ShadowPass> shadow; // lighting (issue 16): pass 0, the frame's shadow table
+    detail::FogPass fog; // fog of the host image (issue 14)
 };
 
 Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
@@ -26,6 +28,10 @@ Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
         return makeError("FrameRendererDesc::resolutionScale must be 1, 2 or 4, got " + std::to_string(desc.resolutionScale));
     if (desc.shadowTextureUnit < 0 || desc.shadowTextureUnit > 15)
         return makeError("FrameRendererDesc::shadowTextureUnit must be in [0, 15], got " + std::to_string(desc.shadowTextureUnit));
+    if (desc.fogTextureSize.x < 0 || desc.fogTextureSize.y < 0 || desc.fogTextureSize.x > 8192 || desc.fogTextureSize.y > 8192 ||
+        (desc.fogTextureSize.x == 0) != (desc.fogTextureSize.y == 0))
+        return makeError("FrameRendererDesc::fogTextureSize must be (0, 0) (per pixel) or between 1 and 8192 on each side, got " +
+                         std::to_string(desc.fogTextureSize.x) + "x" + std::to_string(desc.fogTextureSize.y));
     auto impl = std::make_unique<Impl>();
     impl->shadow.emplace(desc.shadowTextureUnit); // lighting (issue 16)
     impl->desc = desc;
@@ -74,6 +80,34 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
         glViewport(target.x, target.y, w, h);
         target.drawOpaque();
+    }
+
+    // 1b. Fog of the host's opaque image (issue 14): read from its depth texture.
+    r.stats.fogHost = r.stats.fogSplats = false;
+    r.stats.fogError.clear();
+    const Fog* fog = frame.fog() && !frame.fog()->empty() ? frame.fog() : nullptr;
+    if (fog && r.desc.fogHost) {
+        unsigned depth = target.depthTexture;
+        if (!depth && target.framebuffer != 0) { // the default framebuffer's depth is never a texture
+            GLint type = GL_NONE, name = 0;
+            glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
+            if (type == GL_TEXTURE)
+                glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &name);
+            depth = unsigned(name);
+        }
+        if (depth) {
+            const Status s = r.fog.draw(*fog, frame.time(), camera,
+                                        {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h, .depthTexture = depth},
+                                        r.desc.fogTextureSize, r.desc.fogDepthThreshold);
+            if (s) r.stats.fogHost = true;
+            else r.stats.fogError = s.error();
+        }
+    }
+    {
+        Renderer& splatPass = r.full ? *r.full : r.reduced->renderer();
+        const Status s = splatPass.setFog(fog, frame.time());
+        if (!s) r.stats.fogError = s.error();
+        r.stats.fogSplats = fog && s;
     }
 
     // 2. The volumes, back to front.

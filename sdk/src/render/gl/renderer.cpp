@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstring>
 #include <initializer_list>
+#include <string>
 #include <vector>
 
 #include <epoxy/gl.h>
@@ -56,6 +57,17 @@ struct Renderer::Impl {
         GLint uViewProj = -1, uOctagon = -1, uCut = -1;
     };
     Program programs[2]; // [0]: no cross-fade in the frame, [1]: with cross-fade
+    // Fog variant (issue 14): compiled for the structure of the last fog seen.
+    struct FogProgram {
+        Program p;
+        GLint uFogEye = -1, uParams = -1, uColour = -1, uFar = -1;
+    };
+    FogProgram fogPrograms[2];
+    std::string fogSource; // generated GLSL the fog programs were built from
+    int fogVec4s = 0;
+    const Fog* fog = nullptr;
+    double fogTimeSec = 0.0;
+    std::vector<glm::vec4> fogParams;
     GLuint vao = 0, instances = 0, layers = 0;
     // Instance data streams through a persistently mapped ring of kRing
     // regions: the CPU writes region i while the GPU may still read the
@@ -95,6 +107,8 @@ struct Renderer::Impl {
             if (f) glDeleteSync(f);
         for (const Program& p : programs)
             if (p.id) glDeleteProgram(p.id);
+        for (const FogProgram& p : fogPrograms)
+            if (p.p.id) glDeleteProgram(p.p.id);
         if (vao) glDeleteVertexArrays(1, &vao);
         if (instances) glDeleteBuffers(1, &instances);
         if (layers) glDeleteTextures(1, &layers);
@@ -119,8 +133,8 @@ Result<Renderer> Renderer::create(const RendererDesc& desc) {
     auto impl = std::make_unique<Impl>();
     impl->desc = desc;
     for (int crossfade = 0; crossfade < 2; ++crossfade) {
-        auto linked = linkProgram({detail::kSplatVertex},
-                                          {"#version 450 core\n", crossfade ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n", detail::kSplatFragment},
+        auto linked = linkProgram({"#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n", detail::kSplatVertex},
+                                          {"#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n", crossfade ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n", detail::kSplatFragment},
                                           "splat");
         if (!linked) return makeError(linked.error());
         Impl::Program& p = impl->programs[crossfade];
@@ -196,6 +210,46 @@ Status Renderer::upload(const Materials& materials) {
     return {};
 }
 
+Status Renderer::setFog(const Fog* fog, double timeSec) {
+    Impl& r = *mImpl;
+    r.fog = fog && !fog->empty() ? fog : nullptr; // zero terms: clear air, the plain shaders
+    r.fogTimeSec = timeSec;
+    if (!r.fog) return {};
+    auto glsl = fogGlsl(*r.fog);
+    if (!glsl) {
+        r.fog = nullptr;
+        return makeError("splatfx::gl::Renderer::setFog: " + glsl.error());
+    }
+    if (glsl->source == r.fogSource) return {};
+    for (Impl::FogProgram& p : r.fogPrograms)
+        if (p.p.id) glDeleteProgram(p.p.id), p = {};
+    r.fogSource.clear();
+    for (int crossfade = 0; crossfade < 2; ++crossfade) {
+        const char* head = r.desc.fogPerSplat ? "#version 450 core\n#define FOG 1\n#define FOG_PER_SPLAT 1\n"
+                                              : "#version 450 core\n#define FOG 1\n#define FOG_PER_SPLAT 0\n";
+        auto linked = linkProgram({head, glsl->source.c_str(), detail::kSplatVertex},
+                                  {head, crossfade ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n", glsl->source.c_str(),
+                                   detail::kSplatFragment},
+                                  "splat (fog)");
+        if (!linked) {
+            r.fog = nullptr;
+            return makeError(linked.error());
+        }
+        Impl::FogProgram& p = r.fogPrograms[crossfade];
+        p.p.id = *linked;
+        p.p.uViewProj = glGetUniformLocation(p.p.id, "uViewProj");
+        p.p.uOctagon = glGetUniformLocation(p.p.id, "uOctagon");
+        p.p.uCut = glGetUniformLocation(p.p.id, "uCut");
+        p.uFogEye = glGetUniformLocation(p.p.id, "uFogEye");
+        p.uParams = glGetUniformLocation(p.p.id, glsl->uniformName.c_str());
+        p.uColour = glGetUniformLocation(p.p.id, "splatfx_fog_colour");
+        p.uFar = glGetUniformLocation(p.p.id, "splatfx_fog_far");
+    }
+    r.fogSource = glsl->source;
+    r.fogVec4s = glsl->vec4Count;
+    return {};
+}
+
 void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, const Target& target) {
     Impl& r = *mImpl;
     assert(r.layers && "splatfx::gl::Renderer::draw: call upload(materials) first");
@@ -238,8 +292,20 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
     glDepthMask(GL_FALSE);
     glDisable(GL_CULL_FACE);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    const Impl::Program& p = r.programs[anyCrossfade ? 1 : 0];
+    const bool fogged = r.fog && r.fogPrograms[0].p.id;
+    const Impl::Program& p = fogged ? r.fogPrograms[anyCrossfade ? 1 : 0].p : r.programs[anyCrossfade ? 1 : 0];
     glUseProgram(p.id);
+    if (fogged) {
+        // Parameters in double relative to the eye, rounded to float once (docs/fog.md, GLSL).
+        const Impl::FogProgram& fp = r.fogPrograms[anyCrossfade ? 1 : 0];
+        const glm::dvec3 eye(camera.eye());
+        r.fogParams = r.fog->glslParameters(r.fogTimeSec, eye);
+        glUniform3f(fp.uFogEye, float(eye.x), float(eye.y), float(eye.z));
+        glUniform4fv(fp.uParams, GLsizei(r.fogParams.size()), glm::value_ptr(r.fogParams[0]));
+        const glm::dvec3 col = r.fog->desc().colour;
+        glUniform3f(fp.uColour, float(col.x), float(col.y), float(col.z));
+        glUniform1f(fp.uFar, float(r.fog->desc().farDistanceWorld));
+    }
     const glm::mat4 vp = camera.proj * camera.view;
     glUniformMatrix4fv(p.uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
     glUniform1i(p.uOctagon, r.desc.trimCorners ? 1 : 0);

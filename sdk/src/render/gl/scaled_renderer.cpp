@@ -89,6 +89,7 @@ ScaledRenderer& ScaledRenderer::operator=(ScaledRenderer&&) noexcept = default;
 ScaledRenderer::~ScaledRenderer() = default;
 const ScaledRendererDesc& ScaledRenderer::desc() const { return mImpl->desc; }
 const Renderer& ScaledRenderer::renderer() const { return *mImpl->inner; }
+Renderer& ScaledRenderer::renderer() { return *mImpl->inner; }
 
 Result<ScaledRenderer> ScaledRenderer::create(const ScaledRendererDesc& desc) {
     if (desc.scale != 1 && desc.scale != 2 && desc.scale != 4)

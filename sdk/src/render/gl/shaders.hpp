@@ -5,7 +5,11 @@ namespace splatfx::gl::detail {
 
 // Per instance: one Splat (see splats.hpp). Per vertex: a corner of the
 // octagon (or square) circumscribing the unit disc, from gl_VertexID.
-inline constexpr const char* kSplatVertex = R"(#version 450 core
+// Compiled after "#version 450 core\n#define FOG 0|1\n#define FOG_PER_SPLAT 0|1\n" (and,
+// with FOG, fogGlsl()'s source): the fog variant (issue 14) passes the world
+// position relative to the eye to the fragment, or the transmittance to the
+// splat's centre, evaluated here once per vertex (RendererDesc::fogPerSplat).
+inline constexpr const char* kSplatVertex = R"(
 layout(location = 0) in vec4 aCenterDensity;
 layout(location = 1) in vec4 aAxisUColor;
 layout(location = 2) in vec4 aAxisVRow;
@@ -21,6 +25,14 @@ out vec2 vTex;
 flat out float vDensity;
 flat out vec3 vLayers;
 flat out vec3 vColor;
+#if FOG
+uniform vec3 uFogEye;
+#if FOG_PER_SPLAT
+flat out float vFogF; // transmittance to the splat's centre (RendererDesc::fogPerSplat)
+#else
+out vec3 vFogRel;
+#endif
+#endif
 
 // Octagon circumscribing the unit circle, in triangle-strip order.
 const vec2 kOct[8] = vec2[8](vec2(1.0, -0.41421356), vec2(1.0, 0.41421356), vec2(0.41421356, -1.0), vec2(0.41421356, 1.0),
@@ -36,18 +48,35 @@ void main() {
     vDensity = aCenterDensity.w;
     vLayers = vec3(float(aLayers.x), float(aLayers.y), aBlend);
     vColor = aColor.rgb;
+#if FOG
+#if FOG_PER_SPLAT
+    vFogF = splatfx_fog_transmittance(vec3(0.0), aCenterDensity.xyz - uFogEye);
+#else
+    vFogRel = p - uFogEye;
+#endif
+#endif
 }
 )";
 
-// Compiled twice, after "#version 450 core\n#define CROSSFADE 0|1\n": a draw
+// Compiled twice, after "#version 450 core\n#define CROSSFADE 0|1\n#define FOG 0\n": a draw
 // with no cross-faded splat skips the second fetch and the branch entirely
 // (software rasterizers execute both sides of a per-fragment branch).
+// With a fog, twice more with FOG 1 and fogGlsl()'s source before this one:
+// every premultiplied layer becomes f c + (1 - f) alpha C_fog, alpha
+// unchanged, f the transmittance from the eye to the fragment (docs/fog.md).
 inline constexpr const char* kSplatFragment = R"(
 layout(binding = 0) uniform sampler2DArray uLayers;
 in vec2 vTex;
 flat in float vDensity;
 flat in vec3 vLayers;
 flat in vec3 vColor;
+#if FOG
+#if FOG_PER_SPLAT
+flat in float vFogF;
+#else
+in vec3 vFogRel;
+#endif
+#endif
 layout(location = 0) out vec4 oColor;
 
 void main() {
@@ -57,7 +86,16 @@ void main() {
 #endif
     // Opacity from optical depth: alpha = 1 - 2^(-density * detail).
     float a = 1.0 - exp2(-vDensity * t.a);
-    oColor = vec4(vColor * t.rgb * a, a);
+    vec3 c = vColor * t.rgb * a;
+#if FOG
+#if FOG_PER_SPLAT
+    float f = vFogF;
+#else
+    float f = splatfx_fog_transmittance(vec3(0.0), vFogRel);
+#endif
+    c = f * c + (1.0 - f) * a * splatfx_fog_colour;
+#endif
+    oColor = vec4(c, a);
 }
 )";
 

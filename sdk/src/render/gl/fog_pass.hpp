@@ -1,0 +1,62 @@
+// Fog of the host's opaque image (issue 14, item 2; Biri et al. 2002 sec. 4),
+// private to the GL backend and owned by gl::FrameRenderer.
+//
+// Reads the host depth texture, unprojects each pixel to its world position
+// relative to the eye (inverse projection, then the view's rotation: no large
+// absolute coordinate reaches the shader), evaluates the transmittance f
+// from the eye to it with fogGlsl()'s closed forms and blends
+// C = f C_in + (1 - f) C_fog (eq. 5) into the host colour as a premultiplied
+// "over" layer ((1 - f) C_fog, 1 - f) with (ONE, ONE_MINUS_SRC_ALPHA): no copy
+// of the colour, no feedback loop. The depth texture is only sampled (no depth
+// test, no depth writes), as every engine's deferred fog does.
+//  * depth 1 (sky): the far-plane point (fully fogged beyond the cut-off);
+//  * NaN or outside [0, 1]: fully fogged (as Fog::transmittance for invalid input);
+//  * beyond FogDesc::farDistanceWorld: fully fogged, no evaluation (sec. 4.2).
+// At full resolution (one evaluation per pixel) or into a reduced fog texture
+// (the paper's Table 1) holding (f, distance) per texel, upsampled with joint
+// bilinear weights that drop neighbours at another depth.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "splatfx/camera.hpp"
+#include "splatfx/fog.hpp"
+#include "splatfx/result.hpp"
+
+namespace splatfx::gl::detail {
+
+struct FogPassTarget {
+    unsigned framebuffer = 0;
+    int x = 0, y = 0, width = 0, height = 0;
+    unsigned depthTexture = 0; // the host depth, framebuffer-sized, window units
+};
+
+class FogPass {
+public:
+    FogPass() = default;
+    FogPass(const FogPass&) = delete;
+    FogPass& operator=(const FogPass&) = delete;
+    ~FogPass();
+
+    // textureSize (0, 0): per pixel; else the reduced fog texture's size.
+    // depthThreshold: relative distance difference still one surface when upsampling.
+    Status draw(const Fog& fog, double timeSec, const Camera& camera, const FogPassTarget& target, glm::ivec2 textureSize,
+                float depthThreshold);
+
+private:
+    Status build(const Fog& fog);
+    struct Prog {
+        unsigned id = 0;
+        int uInvRel = -1, uOrigin = -1, uSize = -1, uParams = -1, uColour = -1, uFar = -1, uFogSize = -1, uThreshold = -1;
+    };
+    Prog mFull, mLow, mUp; // per pixel; reduced: evaluate into the texture; upsample and blend
+    std::string mSource;   // generated GLSL the programs were built from
+    unsigned mVao = 0, mFbo = 0, mTexture = 0, mSampler = 0;
+    glm::ivec2 mTextureSize{0};
+    std::vector<glm::vec4> mParams;
+};
+
+} // namespace splatfx::gl::detail

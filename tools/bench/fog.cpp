@@ -1,0 +1,189 @@
+// splatfx-bench fog: Biri et al. 2002's Table 1 on this machine (issue 14,
+// item 8). The Fig. 6 scene (samples/09-fog-countryside: terrain, no
+// effects) at 800x600, each frame cleared, drawn and fogged by
+// gl::FrameRenderer, glFinish'ed: with no fog, with per-pixel fog and with
+// each reduced fog texture of the paper's table, for the polynomial fog
+// (Fig. 7, as sample 10), the constant fog and the Fig. 6 cosines, in one
+// run; each reduced texture's error against per-pixel on the same frame.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <epoxy/gl.h>
+
+#include "scene_player.hpp"
+#include "splatfx/context.hpp"
+#include "splatfx/fog.hpp"
+#include "splatfx/gl/framebuffer.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct FogCase {
+    const char* name;
+    splatfx::FogDesc desc;
+};
+
+splatfx::FogDesc polynomialFog() {
+    splatfx::FogDesc d = splatfx::paperFig7Fog(10.0);
+    for (splatfx::FogTerm& t : d.terms) t.weight *= 0.012; // as samples/10-fog-polynomial
+    d.farDistanceWorld = 150.0;
+    return d;
+}
+splatfx::FogDesc constantFog() {
+    splatfx::FogDesc d;
+    d.terms.push_back(splatfx::FogTerm::constant(0.02));
+    d.farDistanceWorld = 150.0;
+    return d;
+}
+
+double medianMs(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+}
+
+} // namespace
+
+int runFog(int argc, char** argv) {
+    std::string scenePath = "samples/09-fog-countryside/scene.json";
+    int frames = 30, rounds = 3;
+    glm::ivec2 size{800, 600};
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--scene" && i + 1 < argc) scenePath = argv[++i];
+        else if (a == "--frames" && i + 1 < argc) frames = std::max(3, std::atoi(argv[++i]));
+        else if (a == "--rounds" && i + 1 < argc) rounds = std::max(1, std::atoi(argv[++i]));
+        else if (a == "--quick") frames = 5, rounds = 1;
+        else if (a == "--help" || a == "-h") {
+            std::printf("usage: splatfx-bench fog [--scene samples/09-fog-countryside/scene.json] [--frames N (30)] [--rounds R (3)] [--quick]\n"
+                        "Frame time at 800x600 of the scene's geometry (its effects disabled) with no fog, per-pixel fog and\n"
+                        "the reduced fog textures of Biri et al.'s Table 1, for three fogs; error of each against per-pixel.\n");
+            return 0;
+        } else {
+            std::fprintf(stderr, "fog: unknown option '%s'\n", a.c_str());
+            return 2;
+        }
+    }
+    auto ctx = splatfx::HeadlessContext::create();
+    if (!ctx) {
+        std::fprintf(stderr, "fog: %s\n", ctx.error().c_str());
+        return 1;
+    }
+    auto player = scenehost::ScenePlayer::load(scenePath);
+    if (!player) {
+        std::fprintf(stderr, "fog: %s\n", player.error().c_str());
+        return 1;
+    }
+    splatfx::SceneFile& file = player->file();
+    for (const splatfx::SceneEffectInfo& e : file.effects) file.scene.setEnabled(e.id, false); // the paper's scene: terrain only
+    std::vector<FogCase> fogs{{"polynomial (Fig. 7)", polynomialFog()}, {"constant", constantFog()}};
+    if (const splatfx::Fog* own = file.scene.fog()) fogs.push_back({"cosines (Fig. 6)", own->desc()});
+    auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
+    if (!fb) {
+        std::fprintf(stderr, "fog: %s\n", fb.error().c_str());
+        return 1;
+    }
+    const splatfx::Camera cam = player->cameraAt(0.0, size);
+    double t = 0.0;
+    // Median ms of `frames` frames with this renderer; the last frame's image in `img`.
+    auto timeFrames = [&](splatfx::Image* img) {
+        std::vector<double> ms;
+        for (int f = 0; f < frames + 2; ++f) {
+            const auto a = Clock::now();
+            player->renderFrame(t, cam, fb->handle());
+            glFinish();
+            if (f >= 2) ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - a).count()); // 2 warm-up frames
+            t += 1.0 / 60.0;
+        }
+        if (img) *img = fb->read();
+        return medianMs(ms);
+    };
+    const std::vector<glm::ivec2> textures{{0, 0}, {512, 512}, {512, 256}, {256, 256}, {256, 128}, {128, 128}};
+
+    std::printf("fog on %s: %s at %dx%d, terrain only, least of %d rounds' medians of %d frames\n"
+                "(clear + geometry + fog pass, glFinish)\n",
+                ctx->renderer().c_str(), scenePath.c_str(), size.x, size.y, rounds, frames);
+    std::printf("The paper (GeForce 2, 800x600): 50 fps without fog; 3.5 fps (512x512, polynomials) to 40 fps (128x128, constant).\n\n");
+    // Configurations: (fog index or -1 for none, texture size). Timed in
+    // `rounds` interleaved rounds, each configuration's time the least of
+    // its per-round medians (the machine is shared: this takes the round
+    // least disturbed by others), so ratios within one run stay meaningful.
+    struct Config {
+        int fog;
+        glm::ivec2 tex;
+        double ms = 1e30;
+        std::string rmse = "-", maxe = "-";
+    };
+    std::vector<Config> configs{{-1, {0, 0}}};
+    fogs.push_back({"clear air (pass floor)", splatfx::FogDesc{{splatfx::FogTerm::constant(0.0)}, {0.8, 0.8, 0.85}, 0.0, {}}});
+    std::vector<splatfx::Fog> built;
+    for (const FogCase& fc : fogs) {
+        auto fog = splatfx::Fog::create(fc.desc);
+        if (!fog) {
+            std::fprintf(stderr, "fog: %s: %s\n", fc.name, fog.error().c_str());
+            return 1;
+        }
+        built.push_back(*fog);
+        const bool floorOnly = built.size() == fogs.size();
+        for (glm::ivec2 tex : textures) {
+            configs.push_back({int(built.size()) - 1, tex});
+            if (floorOnly) break;
+        }
+    }
+    auto use = [&](const Config& c) {
+        if (c.fog < 0) file.scene.clearFog();
+        else file.scene.setFog(built[std::size_t(c.fog)]);
+        return player->setRenderer({.fogTextureSize = c.tex});
+    };
+    for (int round = 0; round < rounds; ++round)
+        for (Config& c : configs) {
+            if (auto s = use(c); !s) {
+                std::fprintf(stderr, "fog: %s\n", s.error().c_str());
+                return 1;
+            }
+            c.ms = std::min(c.ms, timeFrames(nullptr));
+        }
+    // The error against per-pixel fog: this renderer's frame and the
+    // per-pixel renderer's at the same time (renderFrame's time must not decrease).
+    for (Config& c : configs) {
+        if (c.fog < 0 || c.tex.x == 0) continue;
+        if (!use(c)) return 1;
+        player->renderFrame(t, cam, fb->handle());
+        const splatfx::Image img = fb->read();
+        if (!use({c.fog, {0, 0}})) return 1;
+        player->renderFrame(t, cam, fb->handle());
+        const splatfx::Image perPixel = fb->read();
+        double sum = 0.0, worst = 0.0;
+        std::size_t n = 0;
+        for (std::size_t i = 0; i < img.pixels.size(); i += 4)
+            for (int ch = 0; ch < 3; ++ch) {
+                const double d = double(img.pixels[i + ch]) - double(perPixel.pixels[i + ch]);
+                sum += d * d, worst = std::max(worst, std::abs(d)), ++n;
+            }
+        char b1[32], b2[32];
+        std::snprintf(b1, sizeof b1, "%.4f", std::sqrt(sum / double(n)));
+        std::snprintf(b2, sizeof b2, "%.3f", worst);
+        c.rmse = b1, c.maxe = b2;
+    }
+    const double noneMs = configs[0].ms;
+    std::printf("%-24s %-10s %9s %7s %8s %11s %10s %s\n", "fog", "texture", "ms/frame", "Hz", "vs none", "RMSE vs pp", "max vs pp",
+                "cheaper than per pixel?");
+    double perPixelMs = 0.0;
+    for (const Config& c : configs) {
+        char texName[16];
+        if (c.tex.x == 0) std::snprintf(texName, sizeof texName, c.fog < 0 ? "-" : "per pixel");
+        else std::snprintf(texName, sizeof texName, "%dx%d", c.tex.x, c.tex.y);
+        if (c.tex.x == 0) perPixelMs = c.ms;
+        const char* pareto = c.tex.x == 0 ? "" : c.ms < perPixelMs ? "yes" : "NO: not Pareto-useful here";
+        std::printf("%-24s %-10s %9.2f %7.1f %8.2f %11s %10s %s\n", c.fog < 0 ? "none" : fogs[std::size_t(c.fog)].name, texName, c.ms,
+                    1000.0 / c.ms, c.ms / noneMs, c.rmse.c_str(), c.maxe.c_str(), pareto);
+    }
+    std::printf("\nRMSE / max: linear RGB in [0, 1] of the RGBA8 frame, against per-pixel fog at the same time (1/255 = 0.0039).\n");
+    std::printf("Targets (issue 14): per-pixel fog adds <= 30 %% to the frame without fog (vs none <= 1.30) and runs >= 60 Hz.\n");
+    return 0;
+}
