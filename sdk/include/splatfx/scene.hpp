@@ -36,6 +36,7 @@
 #include "splatfx/frame.hpp"
 #include "splatfx/materials.hpp"
 #include "splatfx/splats.hpp"
+#include "splatfx/volume.hpp"
 
 namespace splatfx {
 
@@ -80,6 +81,15 @@ struct SceneCounters {
     std::uint64_t splats = 0;   // splats emitted at the last emit()
 };
 
+// ---- [clouds, issue 17] LOD volumes, drawn as projected tetrahedra ----
+using VolumeId = std::uint32_t;
+struct VolumeOptions {
+    std::string name;          // for messages; default empty
+    bool enabled = true;       // default true
+    LodRefineDesc refine{};    // per-frame refinement (c, morphing, culling); default LodRefineDesc{}
+};
+// ---- end [clouds] ----
+
 class Scene {
 public:
     // An Effect (grid or solver); effect(id) returns it.
@@ -119,6 +129,18 @@ public:
     // (conservative: boxes near a frustum corner may pass).
     static bool inFrustum(const Aabb& box, const Camera& camera);
 
+    // ---- [clouds, issue 17] LOD volumes ----
+    // A volume with the transfer function its zero-opacity test uses and the
+    // table it is drawn with. prepare() refines every enabled volume whose box
+    // is in view (LodVolume::update) and adds its tetrahedra to the Frame.
+    VolumeId addVolume(LodVolume volume, TransferFunction transfer, PreIntegrationTable table, VolumeOptions options = {});
+    std::size_t volumeCount() const { return mVolumes.size(); }
+    LodVolume& volume(VolumeId id) { return mVolumes.at(id)->volume; }
+    VolumeOptions& volumeOptions(VolumeId id) { return mVolumes.at(id)->options; }
+    // Replaces the transfer function and table (the GL pass re-uploads it).
+    void setVolumeTransfer(VolumeId id, TransferFunction transfer, PreIntegrationTable table);
+    // ---- end [clouds] ----
+
 private:
     struct Entry {
         std::unique_ptr<EffectKind> kind; // never null
@@ -129,6 +151,16 @@ private:
     EffectId push(Entry entry);
 
     std::vector<Entry> mEntries;
+    // [clouds] Boxed so the table addresses the Frame points at stay put.
+    struct VolumeEntry {
+        LodVolume volume;
+        TransferFunction transfer;
+        PreIntegrationTable table;
+        std::uint64_t tableVersion = 1;
+        VolumeOptions options;
+    };
+    std::vector<std::unique_ptr<VolumeEntry>> mVolumes;
+    void prepareVolumes(const Camera& camera, Frame& frame); // [clouds]
     SceneCounters mCounters;
     double mTime = 0.0;
     bool mUpdated = false;
