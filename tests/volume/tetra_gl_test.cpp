@@ -1,0 +1,293 @@
+// [clouds, issue 17] The projected-tetrahedra pass against the CPU references
+// on the same emitted mesh: outside the cloud, with the host's depth cutting
+// it, and with the camera inside it (near-plane clipping).
+#include <algorithm>
+#include <cmath>
+
+#include <epoxy/gl.h>
+#include <gtest/gtest.h>
+
+#include "gl_fixture.hpp"
+
+using namespace splatfx;
+
+namespace {
+
+constexpr glm::ivec2 kSize{64, 48};
+
+struct Cloud {
+    ScalarVolume field;
+    std::optional<LodVolume> volume;
+    std::optional<TransferFunction> transfer;
+    std::optional<PreIntegrationTable> table;
+    float maxExtinction = 2.0f;
+    Cloud() {
+        auto f = makeCloudVolume({.dims = {17, 17, 9}, .seed = 5, .featureCells = 6.0f, .coverage = 0.6f});
+        field = *f;
+        volume.emplace(*LodVolume::create(field, {.spacingWorld = 1.0f}));
+        transfer.emplace(*makeCloudTransfer({.maxExtinctionPerWorld = maxExtinction}));
+        // The longest segment: the cube's diagonal (length scales are <= 1).
+        table.emplace(*PreIntegrationTable::create(
+            *transfer, {.scalarResolution = 32, .lengthResolution = 64, .maxLengthWorld = std::sqrt(3.0f) * 16.0f}));
+    }
+};
+
+// The ray through a pixel centre (x right, y top row first), from the eye (unit direction).
+glm::dvec3 pixelRay(const Camera& cam, int x, int y) {
+    const glm::dmat4 inv = glm::inverse(glm::dmat4(cam.proj) * glm::dmat4(cam.view));
+    const double nx = (x + 0.5) / cam.viewport.x * 2.0 - 1.0, ny = 1.0 - (y + 0.5) / cam.viewport.y * 2.0;
+    glm::dvec4 a = inv * glm::dvec4(nx, ny, -1.0, 1.0), b = inv * glm::dvec4(nx, ny, 1.0, 1.0);
+    return glm::normalize(glm::dvec3(b) / b.w - glm::dvec3(a) / a.w);
+}
+
+// What the GL pass computes for one ray, on the CPU in double: each
+// tetrahedron the ray crosses is one table lookup of (front scalar, back
+// scalar, length x mean length scale), composited front to back. `bound`
+// receives the derived worst case of |GL - this| (see below).
+glm::dvec4 passModel(const std::vector<Tetrahedron>& tets, const PreIntegrationTable& table, glm::dvec3 o, glm::dvec3 d,
+                     double tFar, double& bound) {
+    struct Piece {
+        double t0, t1;
+        std::size_t tet;
+    };
+    std::vector<Piece> pieces;
+    static constexpr int kFaces[4][4] = {{1, 2, 3, 0}, {0, 2, 3, 1}, {0, 1, 3, 2}, {0, 1, 2, 3}};
+    for (std::size_t i = 0; i < tets.size(); ++i) {
+        double lo = 0.0, hi = tFar;
+        for (const auto& f : kFaces) {
+            const auto& p = tets[i].position;
+            const glm::dvec3 a(p[std::size_t(f[0])]), b(p[std::size_t(f[1])]), c(p[std::size_t(f[2])]), q(p[std::size_t(f[3])]);
+            glm::dvec3 n = glm::cross(b - a, c - a);
+            if (glm::dot(n, q - a) < 0.0) n = -n;
+            const double num = glm::dot(n, o - a), den = glm::dot(n, d);
+            if (den == 0.0) {
+                if (num < 0.0) hi = lo - 1.0;
+                continue;
+            }
+            if (den > 0.0) lo = std::max(lo, -num / den);
+            else hi = std::min(hi, -num / den);
+        }
+        if (hi > lo) pieces.push_back({lo, hi, i});
+    }
+    std::sort(pieces.begin(), pieces.end(), [](const Piece& a, const Piece& b) { return a.t0 < b.t0; });
+    const glm::ivec3 n = table.dims();
+    const auto& data = table.data();
+    glm::dvec4 acc(0.0);
+    bound = 1e-5; // F32 framebuffer blending, once
+    for (const Piece& pc : pieces) {
+        const Tetrahedron& t = tets[pc.tet];
+        const auto [lo, hi] = std::minmax_element(t.scalar.begin(), t.scalar.end());
+        if (table.zeroOpacity(*lo, *hi)) continue; // the pass skips these: their table entries are zero
+        const glm::dvec3 p0(t.position[0]);
+        const glm::dmat3 inv = glm::inverse(glm::dmat3(glm::dvec3(t.position[1]) - p0, glm::dvec3(t.position[2]) - p0,
+                                                       glm::dvec3(t.position[3]) - p0));
+        auto at = [&](double tt, const std::array<float, 4>& v) {
+            const glm::dvec3 l = inv * (o + d * tt - p0);
+            return (1.0 - l.x - l.y - l.z) * v[0] + l.x * v[1] + l.y * v[2] + l.z * v[3];
+        };
+        const double sf = at(pc.t0, t.scalar), sb = at(pc.t1, t.scalar);
+        const double len = (pc.t1 - pc.t0) * std::max(0.5 * (at(pc.t0, t.lengthScale) + at(pc.t1, t.lengthScale)), 0.0);
+        const glm::dvec4 c(table.lookup(float(sf), float(sb), float(len)));
+        acc += (1.0 - acc.a) * c;
+        // Bound of one GL lookup against the float trilinear one: GL filters
+        // with as few as 8 bits of sub-texel weight (the D3D/GL hardware
+        // minimum), i.e. each of the 3 weights off by up to 2^-9, so the value
+        // is off by at most 3 * 2^-9 * (max - min of the 8 texels of the cell).
+        // A segment error e changes the composite by at most 2e (its colour,
+        // and its alpha times what lies behind, <= 1).
+        const glm::dvec3 g = glm::clamp(glm::dvec3(sf, sb, len / table.maxLengthWorld()), 0.0, 1.0) * glm::dvec3(n - 1);
+        const glm::ivec3 c0 = glm::min(glm::ivec3(glm::floor(g)), n - 2);
+        double spread = 0.0;
+        for (int ch = 0; ch < 4; ++ch) {
+            double vmin = 1e30, vmax = -1e30;
+            for (int k = 0; k < 8; ++k) {
+                const glm::ivec3 q = c0 + glm::ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+                const double v = data[((std::size_t(q.z) * n.y + q.y) * n.x + q.x) * 4 + ch];
+                vmin = std::min(vmin, v), vmax = std::max(vmax, v);
+            }
+            spread = std::max(spread, vmax - vmin);
+        }
+        // Float geometry: entry/exit from planes in eye-relative float, ~16 ulps
+        // of the distance (< 64 world units here) in t, times the largest
+        // extinction (2) at both ends, twice (colour and attenuation).
+        const double dt = 16.0 * std::ldexp(1.0, -24) * 64.0;
+        bound += 2.0 * (3.0 * std::ldexp(1.0, -9) * spread) + 4.0 * 2.0 * dt;
+    }
+    return acc;
+}
+
+struct Result3 {
+    double worstRatio = 0.0, maxGlVsModel = 0.0, maxGlVsExact = 0.0, maxModelVsExact = 0.0;
+    int over = 0;
+};
+
+class TetraPassGL : public test::GLTest {};
+
+void renderFrame(gl::FrameRenderer& fr, gl::Framebuffer& fb, Frame& frame, double clearDepth) {
+    fr.render(frame, {.framebuffer = fb.handle(), .depthTexture = fb.depthTexture(), .drawOpaque = [clearDepth] {
+                          glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+                          glClearDepth(clearDepth);
+                          glDepthMask(GL_TRUE);
+                          glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+                      }});
+}
+
+// Outside the cloud, LOD refinement: the GL image equals the pass's CPU model
+// within the derived bound at every pixel, and so stays within the table's own
+// error of the exact integral through the same emitted mesh.
+TEST_F(TetraPassGL, MatchesTheReferenceOnTheSameMeshWithinADerivedBound) {
+    Cloud cl;
+    const Camera cam = Camera::lookAt({-14.0f, 6.0f, 10.0f}, {8.0f, 8.0f, 4.0f}, {0, 0, 1}, glm::radians(50.0f), kSize, 0.5f, 200.0f);
+    Frame frame;
+    frame.begin(0.0, cam);
+    FrameVolume& fv = frame.volumes().emplace_back();
+    fv.table = &*cl.table;
+    ASSERT_TRUE(cl.volume->update(cam, {.detailC = 20.0f}, &*cl.transfer, fv.lod));
+    frame.end();
+    ASSERT_GT(fv.lod.tets.size(), 50u);
+    auto fr = gl::FrameRenderer::create();
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(fr && fb);
+    renderFrame(*fr, *fb, frame, 1.0);
+    const Image img = fb->read();
+    EXPECT_GT(fr->stats().tetrahedra, 0u);
+    Result3 r;
+    int covered = 0;
+    for (int y = 0; y < kSize.y; ++y)
+        for (int x = 0; x < kSize.x; ++x) {
+            const glm::dvec3 d = pixelRay(cam, x, y), o(cam.eye());
+            double bound = 0.0;
+            const glm::dvec4 model = passModel(fv.lod.tets, *cl.table, o, d, 1e30, bound);
+            const glm::dvec4 exact = integrateRay(fv.lod.tets, *cl.transfer, o, d, 0.0, 1e30);
+            double eModel = 0.0, eExact = 0.0, eME = 0.0;
+            for (int c = 0; c < 4; ++c) {
+                eModel = std::max(eModel, std::abs(double(img.at(x, y, c)) - model[c]));
+                eExact = std::max(eExact, std::abs(double(img.at(x, y, c)) - exact[c]));
+                eME = std::max(eME, std::abs(model[c] - exact[c]));
+            }
+            covered += exact.a > 0.05 ? 1 : 0;
+            r.maxGlVsModel = std::max(r.maxGlVsModel, eModel);
+            r.maxGlVsExact = std::max(r.maxGlVsExact, eExact);
+            r.maxModelVsExact = std::max(r.maxModelVsExact, eME);
+            r.worstRatio = std::max(r.worstRatio, eModel / bound);
+            if (eModel > bound) ++r.over;
+            EXPECT_LE(eExact, eME + bound) << "pixel " << x << "," << y;
+        }
+    EXPECT_GT(covered, kSize.x * kSize.y / 10) << "the view should see cloud";
+    EXPECT_EQ(r.over, 0) << "worst |GL - model| / bound " << r.worstRatio;
+    RecordProperty("max_gl_vs_model", std::to_string(r.maxGlVsModel));
+    RecordProperty("max_gl_vs_exact", std::to_string(r.maxGlVsExact));
+    RecordProperty("max_table_vs_exact", std::to_string(r.maxModelVsExact));
+    std::printf("GL vs model max %.2e (worst ratio to bound %.3f); GL vs exact max %.4f; table model vs exact max %.4f\n",
+                r.maxGlVsModel, r.worstRatio, r.maxGlVsExact, r.maxModelVsExact);
+}
+
+// The host's depth ends every segment: a plane through the middle of the
+// cloud (the depth buffer cleared to it) hides what lies behind it and the
+// part of each tetrahedron in front of it is drawn exactly (the scalar at the
+// cut interpolated), against the references integrated to the same depth.
+TEST_F(TetraPassGL, HostDepthCutsSegmentsInsideTetrahedra) {
+    Cloud cl;
+    const float nearP = 0.5f, farP = 200.0f;
+    const Camera cam = Camera::lookAt({-14.0f, 6.0f, 10.0f}, {8.0f, 8.0f, 4.0f}, {0, 0, 1}, glm::radians(50.0f), kSize, nearP, farP);
+    Frame frame;
+    frame.begin(0.0, cam);
+    FrameVolume& fv = frame.volumes().emplace_back();
+    fv.table = &*cl.table;
+    ASSERT_TRUE(cl.volume->update(cam, {.detailC = 20.0f}, &*cl.transfer, fv.lod));
+    frame.end();
+    // A view-aligned plane at view depth 22 (through the cloud): NDC depth of it.
+    const double zView = 22.0, n = nearP, f = farP;
+    const double ndc = ((f + n) / (f - n)) - 2.0 * f * n / ((f - n) * zView);
+    auto fr = gl::FrameRenderer::create();
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(fr && fb);
+    renderFrame(*fr, *fb, frame, 0.5 * ndc + 0.5);
+    const Image cut = fb->read(), depth = fb->readDepth();
+    renderFrame(*fr, *fb, frame, 1.0);
+    const Image whole = fb->read();
+    const glm::dmat4 invProj = glm::inverse(glm::dmat4(cam.proj));
+    int over = 0, differs = 0;
+    double worst = 0.0;
+    for (int y = 0; y < kSize.y; ++y)
+        for (int x = 0; x < kSize.x; ++x) {
+            const glm::dvec3 d = pixelRay(cam, x, y), o(cam.eye());
+            // The host depth as the pass sees it (the stored 24-bit value), to a ray distance.
+            auto tOf = [&](double dep) {
+                const double nx = (x + 0.5) / kSize.x * 2.0 - 1.0, ny = 1.0 - (y + 0.5) / kSize.y * 2.0;
+                glm::dvec4 v = invProj * glm::dvec4(nx, ny, dep * 2.0 - 1.0, 1.0);
+                return glm::length(glm::dvec3(v) / v.w);
+            };
+            const double dep = depth.at(x, y, 0), tHost = tOf(dep);
+            EXPECT_NEAR(tHost * glm::dot(d, glm::dvec3(cam.forward())), zView, 1e-2) << "depth buffer holds the plane";
+            double bound = 0.0;
+            const glm::dvec4 model = passModel(fv.lod.tets, *cl.table, o, d, tHost, bound);
+            const glm::dvec4 exact = integrateRay(fv.lod.tets, *cl.transfer, o, d, 0.0, tHost);
+            // The shader reconstructs the distance in float: ~16 ulps of the
+            // depth near 1 moves the cut by |t(dep + 2^-20) - t(dep)|, which
+            // changes the colour by at most 2 x extinction (2) x that.
+            bound += 4.0 * cl.maxExtinction * std::abs(tOf(dep + std::ldexp(1.0, -20)) - tHost);
+            double e = 0.0, eME = 0.0, dWhole = 0.0;
+            for (int c = 0; c < 4; ++c) {
+                e = std::max(e, std::abs(double(cut.at(x, y, c)) - model[c]));
+                eME = std::max(eME, std::abs(model[c] - exact[c]));
+                dWhole = std::max(dWhole, std::abs(double(cut.at(x, y, c)) - double(whole.at(x, y, c))));
+            }
+            over += e > bound ? 1 : 0;
+            worst = std::max(worst, e / bound);
+            differs += dWhole > 0.02 ? 1 : 0;
+            EXPECT_LE(std::abs(double(cut.at(x, y, 3)) - exact.a), eME + bound) << "pixel " << x << "," << y;
+        }
+    EXPECT_EQ(over, 0) << "worst |GL - model| / bound " << worst;
+    EXPECT_GT(differs, kSize.x * kSize.y / 20) << "the plane should hide part of the cloud";
+}
+
+// The camera inside the cloud: the emitted list (clipped at the near plane as
+// volumes) integrates to the finest mesh's integral from the near plane, and
+// the GL image matches the pass model within the bound at every pixel: no
+// pixel loses a tetrahedron at the near plane (no holes).
+TEST_F(TetraPassGL, CameraInsideTheCloudRendersWithoutHoles) {
+    Cloud cl;
+    // The eye at the densest grid point, looking along +x.
+    const auto it = std::max_element(cl.field.scalar.begin(), cl.field.scalar.end());
+    const std::size_t i = std::size_t(it - cl.field.scalar.begin());
+    const glm::vec3 eye(float(i % 17), float((i / 17) % 17), float(i / (17 * 17)));
+    ASSERT_GT(*it, 0.3f);
+    const float nearP = 0.3f;
+    const Camera cam = Camera::lookAt(eye, eye + glm::vec3(1.0f, 0.3f, 0.1f), {0, 0, 1}, glm::radians(60.0f), kSize, nearP, 200.0f);
+    Frame frame;
+    frame.begin(0.0, cam);
+    FrameVolume& fv = frame.volumes().emplace_back();
+    fv.table = &*cl.table;
+    ASSERT_TRUE(cl.volume->update(cam, {.detailC = 1e6f}, &*cl.transfer, fv.lod)); // finest level everywhere
+    frame.end();
+    ASSERT_GT(fv.lod.stats.clippedInput, 0u) << "the near plane must cut the mesh";
+    auto fr = gl::FrameRenderer::create();
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(fr && fb);
+    renderFrame(*fr, *fb, frame, 1.0);
+    const Image img = fb->read();
+    int over = 0, dense = 0;
+    double worst = 0.0;
+    for (int y = 0; y < kSize.y; ++y)
+        for (int x = 0; x < kSize.x; ++x) {
+            const glm::dvec3 d = pixelRay(cam, x, y), o(cam.eye());
+            const double tNear = nearP / glm::dot(d, glm::dvec3(cam.forward()));
+            const glm::dvec4 finest = cl.volume->integrateRay(*cl.transfer, o, d, tNear, 1e30);
+            const glm::dvec4 emitted = integrateRay(fv.lod.tets, *cl.transfer, o, d, 0.0, 1e30);
+            // Same field, clipped vertices in float (~2^-24 x 20 world units): 1e-4 is
+            // far above that and far below any missing piece of a cell.
+            for (int c = 0; c < 4; ++c) EXPECT_NEAR(emitted[c], finest[c], 1e-4) << "pixel " << x << "," << y;
+            double bound = 0.0;
+            const glm::dvec4 model = passModel(fv.lod.tets, *cl.table, o, d, 1e30, bound);
+            double e = 0.0;
+            for (int c = 0; c < 4; ++c) e = std::max(e, std::abs(double(img.at(x, y, c)) - model[c]));
+            over += e > bound ? 1 : 0;
+            worst = std::max(worst, e / bound);
+            dense += finest.a > 0.2 ? 1 : 0;
+        }
+    EXPECT_GT(dense, kSize.x * kSize.y / 4) << "inside a cloud most pixels see cloud";
+    EXPECT_EQ(over, 0) << "worst |GL - model| / bound " << worst;
+}
+
+} // namespace
