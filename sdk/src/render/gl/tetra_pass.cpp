@@ -28,7 +28,10 @@ layout(std430, binding = 0) readonly buffer Tets { vec4 uTets[]; };
 uniform mat4 uViewProjRel; // proj * view * translate(eye)
 uniform int uFirst;
 out vec3 vRel;
-flat out int vTet;
+// The per-tetrahedron functions as flat varyings: the fragment reads no buffer.
+flat out vec4 vPlane[4];
+flat out vec4 vScalar;
+flat out vec4 vLength;
 // The faces wound counter-clockwise seen from outside a positively oriented
 // tetrahedron (dot(p1-p0, cross(p2-p0, p3-p0)) > 0): opposite 0, 1, 2, 3.
 const int kFaces[12] = int[12](1, 2, 3, 0, 3, 2, 0, 1, 3, 0, 2, 1);
@@ -36,13 +39,14 @@ void main() {
     int tet = uFirst + gl_InstanceID;
     vec3 p = uTets[tet * 10 + kFaces[gl_VertexID]].xyz;
     vRel = p;
-    vTet = tet;
+    for (int i = 0; i < 4; ++i) vPlane[i] = uTets[tet * 10 + 4 + i];
+    vScalar = uTets[tet * 10 + 8];
+    vLength = uTets[tet * 10 + 9];
     gl_Position = uViewProjRel * vec4(p, 1.0);
 }
 )";
 
 constexpr const char* kTetraFragment = R"(
-layout(std430, binding = 0) readonly buffer Tets { vec4 uTets[]; };
 layout(binding = 1) uniform sampler2D uHostDepth;
 layout(binding = 2) uniform sampler3D uTable;
 uniform int uHasDepth;
@@ -54,7 +58,9 @@ uniform vec3 uTexScale;     // (n-1)/n, (n-1)/n, (m-1)/m: texel centres at the t
 uniform vec3 uTexOffset;    // 0.5/n, 0.5/n, 0.5/m
 uniform float uMaxLength;   // the table's maxLengthWorld
 in vec3 vRel;
-flat in int vTet;
+flat in vec4 vPlane[4];
+flat in vec4 vScalar;
+flat in vec4 vLength;
 layout(location = 0) out vec4 oColor;
 
 vec4 table(float sf, float sb, float l) {
@@ -74,9 +80,8 @@ void main() {
         tIn = -3.0e38;
     }
     float tOut = 3.0e38;
-    int base = vTet * 10;
     for (int i = 0; i < 4; ++i) {
-        vec4 b = uTets[base + 4 + i];
+        vec4 b = vPlane[i];
         float a = dot(b.xyz, o) + b.w, s = dot(b.xyz, d);
         // lambda_i(t) = a + s t >= 0 inside.
         if (s > 0.0) tIn = max(tIn, -a / s);
@@ -93,7 +98,7 @@ void main() {
         tOut = min(tOut, uPerspective != 0 ? length(v.xyz) : -v.z);
     }
     if (!(tOut > tIn)) discard;
-    vec4 S = uTets[base + 8], M = uTets[base + 9];
+    vec4 S = vScalar, M = vLength;
     vec3 pf = o + tIn * d, pb = o + tOut * d;
     float sf = dot(S.xyz, pf) + S.w, sb = dot(S.xyz, pb) + S.w;
     float mf = dot(M.xyz, pf) + M.w, mb = dot(M.xyz, pb) + M.w;
