@@ -49,11 +49,8 @@ void main() {
 constexpr const char* kTetraFragment = R"(
 layout(binding = 1) uniform sampler2D uHostDepth;
 layout(binding = 2) uniform sampler3D uTable;
-uniform int uHasDepth;
-uniform int uPerspective;
 uniform vec3 uForward;      // unit view direction
-uniform mat4 uInvProj;
-uniform vec4 uViewport;     // x, y, width, height
+uniform vec4 uDepthToView;  // inverse projection's (z, w) rows at (z, w) columns
 uniform vec3 uTexScale;     // (n-1)/n, (n-1)/n, (m-1)/m: texel centres at the table's samples
 uniform vec3 uTexOffset;    // 0.5/n, 0.5/n, 0.5/m
 uniform float uMaxLength;   // the table's maxLengthWorld
@@ -68,35 +65,40 @@ vec4 table(float sf, float sb, float l) {
 }
 
 void main() {
-    vec3 d, o;
-    float tIn;
-    if (uPerspective != 0) {
-        d = normalize(vRel);
-        o = vec3(0.0);
-        tIn = 0.0;
-    } else {
-        d = uForward;
-        o = vRel - d * dot(vRel, d); // on the plane through the eye
-        tIn = -3.0e38;
-    }
+    // Compiled per camera kind and host depth (#defines), so no lane pays for
+    // a branch it does not take (llvmpipe runs both sides of divergent code).
+#if PERSPECTIVE
+    // The fragment lies on the entry face: the ray from the eye enters here.
+    float tIn = length(vRel);
+    vec3 d = vRel / tIn, o = vec3(0.0);
     float tOut = 3.0e38;
     for (int i = 0; i < 4; ++i) {
-        vec4 b = vPlane[i];
-        float a = dot(b.xyz, o) + b.w, s = dot(b.xyz, d);
-        // lambda_i(t) = a + s t >= 0 inside.
+        // lambda_i(t) = w + s t >= 0 inside (o = 0): only the leaving planes bound tOut.
+        float s = dot(vPlane[i].xyz, d);
+        if (s < 0.0) tOut = min(tOut, -vPlane[i].w / s);
+    }
+#else
+    vec3 d = uForward, o = vRel - d * dot(vRel, d); // o on the plane through the eye
+    float tIn = -3.0e38, tOut = 3.0e38;
+    for (int i = 0; i < 4; ++i) {
+        float a = dot(vPlane[i].xyz, o) + vPlane[i].w, s = dot(vPlane[i].xyz, d);
         if (s > 0.0) tIn = max(tIn, -a / s);
         else if (s < 0.0) tOut = min(tOut, -a / s);
-        else if (a < 0.0) discard;
     }
-    if (uHasDepth != 0) {
-        // The ray ends at the host's surface: the segment is cut there, and the
-        // scalars below are interpolated at the cut (exact inside a tetrahedron).
-        vec2 ndc = (gl_FragCoord.xy - uViewport.xy) / uViewport.zw * 2.0 - 1.0;
-        float z = texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r * 2.0 - 1.0;
-        vec4 v = uInvProj * vec4(ndc, z, 1.0);
-        v.xyz /= v.w;
-        tOut = min(tOut, uPerspective != 0 ? length(v.xyz) : -v.z);
-    }
+#endif
+#if HAS_DEPTH
+    // The ray ends at the host's surface: the segment is cut there, and the
+    // scalars below are interpolated at the cut (exact inside a tetrahedron).
+    // View depth from the stored depth: |(a n + b) / (c n + d)| with the
+    // inverse projection's z and w rows; along the ray t = depth / dot(d, forward).
+    float nz = texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r * 2.0 - 1.0;
+    float zView = abs((uDepthToView.x * nz + uDepthToView.y) / (uDepthToView.z * nz + uDepthToView.w));
+#if PERSPECTIVE
+    tOut = min(tOut, zView / dot(d, uForward));
+#else
+    tOut = min(tOut, zView);
+#endif
+#endif
     if (!(tOut > tIn)) discard;
     vec4 S = vScalar, M = vLength;
     vec3 pf = o + tIn * d, pb = o + tOut * d;
@@ -125,10 +127,13 @@ void main() {
 } // namespace
 
 struct TetraPass::Impl {
-    GLuint program = 0, vao = 0, ssbo = 0;
+    struct Program {
+        GLuint id = 0;
+        GLint uViewProjRel = -1, uFirst = -1, uForward = -1, uDepthToView = -1, uTexScale = -1, uTexOffset = -1, uMaxLength = -1;
+    };
+    Program programs[4]; // [perspective * 2 + host depth]
+    GLuint vao = 0, ssbo = 0;
     std::size_t ssboBytes = 0;
-    GLint uViewProjRel = -1, uFirst = -1, uHasDepth = -1, uPerspective = -1, uForward = -1, uInvProj = -1, uViewport = -1,
-          uTexScale = -1, uTexOffset = -1, uMaxLength = -1;
     struct Table {
         const PreIntegrationTable* source = nullptr;
         std::uint64_t version = 0;
@@ -147,7 +152,8 @@ struct TetraPass::Impl {
     ~Impl() {
         if (!contextIsCurrent()) return;
         for (const Table& t : tables) glDeleteTextures(1, &t.texture);
-        if (program) glDeleteProgram(program);
+        for (const Program& p : programs)
+            if (p.id) glDeleteProgram(p.id);
         if (vao) glDeleteVertexArrays(1, &vao);
         if (ssbo) glDeleteBuffers(1, &ssbo);
     }
@@ -162,21 +168,23 @@ const TetraStats& TetraPass::stats() const { return mImpl->stats; }
 Result<TetraPass> TetraPass::create() {
     if (!contextIsCurrent()) return makeError("splatfx::gl tetrahedra pass: no OpenGL context is current on this thread");
     auto impl = std::make_unique<Impl>();
-    auto linked = linkProgram({"#version 450 core\n", kTetraVertex}, {"#version 450 core\n", kTetraFragment}, "tetrahedra");
-    if (!linked) return makeError(linked.error());
     Impl& r = *impl;
-    r.program = *linked;
-    auto loc = [&](const char* n) { return glGetUniformLocation(r.program, n); };
-    r.uViewProjRel = loc("uViewProjRel");
-    r.uFirst = loc("uFirst");
-    r.uHasDepth = loc("uHasDepth");
-    r.uPerspective = loc("uPerspective");
-    r.uForward = loc("uForward");
-    r.uInvProj = loc("uInvProj");
-    r.uViewport = loc("uViewport");
-    r.uTexScale = loc("uTexScale");
-    r.uTexOffset = loc("uTexOffset");
-    r.uMaxLength = loc("uMaxLength");
+    for (int v = 0; v < 4; ++v) {
+        const char* persp = (v & 2) ? "#define PERSPECTIVE 1\n" : "#define PERSPECTIVE 0\n";
+        const char* depth = (v & 1) ? "#define HAS_DEPTH 1\n" : "#define HAS_DEPTH 0\n";
+        auto linked = linkProgram({"#version 450 core\n", kTetraVertex}, {"#version 450 core\n", persp, depth, kTetraFragment}, "tetrahedra");
+        if (!linked) return makeError(linked.error());
+        Impl::Program& p = r.programs[v];
+        p.id = *linked;
+        auto loc = [&](const char* n) { return glGetUniformLocation(p.id, n); };
+        p.uViewProjRel = loc("uViewProjRel");
+        p.uFirst = loc("uFirst");
+        p.uForward = loc("uForward");
+        p.uDepthToView = loc("uDepthToView");
+        p.uTexScale = loc("uTexScale");
+        p.uTexOffset = loc("uTexOffset");
+        p.uMaxLength = loc("uMaxLength");
+    }
     glCreateVertexArrays(1, &r.vao); // no attributes: everything comes from the buffer
     glCreateBuffers(1, &r.ssbo);
     return TetraPass(std::move(impl));
@@ -355,21 +363,19 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     glFrontFace(area >= 0.0f ? GL_CCW : GL_CW);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 
-    glUseProgram(r.program);
+    const Impl::Program& p = r.programs[(camera.perspective() ? 2 : 0) + (hostDepth ? 1 : 0)];
+    glUseProgram(p.id);
     const glm::mat4 vpRel = vp * glm::translate(glm::mat4(1.0f), r.eye);
-    glUniformMatrix4fv(r.uViewProjRel, 1, GL_FALSE, glm::value_ptr(vpRel));
-    glUniform1i(r.uFirst, GLint(r.recordBase[volume] + a));
-    glUniform1i(r.uHasDepth, hostDepth ? 1 : 0);
-    glUniform1i(r.uPerspective, camera.perspective() ? 1 : 0);
+    glUniformMatrix4fv(p.uViewProjRel, 1, GL_FALSE, glm::value_ptr(vpRel));
+    glUniform1i(p.uFirst, GLint(r.recordBase[volume] + a));
     const glm::vec3 f = camera.forward();
-    glUniform3f(r.uForward, f.x, f.y, f.z);
+    glUniform3f(p.uForward, f.x, f.y, f.z);
     const glm::mat4 invProj = glm::inverse(camera.proj);
-    glUniformMatrix4fv(r.uInvProj, 1, GL_FALSE, glm::value_ptr(invProj));
-    glUniform4f(r.uViewport, float(target.x), float(target.y), float(target.width), float(target.height));
+    glUniform4f(p.uDepthToView, invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
     const glm::vec3 n(table.dims());
-    glUniform3f(r.uTexScale, (n.x - 1.0f) / n.x, (n.y - 1.0f) / n.y, (n.z - 1.0f) / n.z);
-    glUniform3f(r.uTexOffset, 0.5f / n.x, 0.5f / n.y, 0.5f / n.z);
-    glUniform1f(r.uMaxLength, table.maxLengthWorld());
+    glUniform3f(p.uTexScale, (n.x - 1.0f) / n.x, (n.y - 1.0f) / n.y, (n.z - 1.0f) / n.z);
+    glUniform3f(p.uTexOffset, 0.5f / n.x, 0.5f / n.y, 0.5f / n.z);
+    glUniform1f(p.uMaxLength, table.maxLengthWorld());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, r.ssbo);
     glBindTextureUnit(1, hostDepth);
     glBindTextureUnit(2, tex.texture);
