@@ -4,6 +4,7 @@
 
 #include "splatfx/frame.hpp"
 #include "splatfx/scene.hpp"
+#include "splatfx/scene_file.hpp"
 
 using namespace splatfx;
 
@@ -117,4 +118,23 @@ TEST(FrameVolumes, ScenePreparesTheVolumesInView) {
     scene.volumeOptions(id).enabled = false;
     scene.prepare(2.0, axisCamera(), materials, frame);
     EXPECT_TRUE(frame.volumes().empty());
+}
+
+// The scene file's "volumes" block builds a cloud volume into the Scene
+// (y up: the grid's second axis is the height), and bad fields are named.
+TEST(FrameVolumes, SceneFileVolumesBlock) {
+    Materials materials{Footprint{}};
+    const std::string ok = R"({"format": "splatfx-scene", "version": 1,
+        "volumes": [{"name": "cumulus", "kind": "clouds", "dims": [17, 9, 17], "position": [-8, 0, -8], "spacing": 1,
+                     "coverage": 0.6, "featureCells": 6, "tableScalars": 8, "tableLengths": 8}]})";
+    auto f = parseSceneFile(ok, "mem/scene.json", materials);
+    ASSERT_TRUE(f) << f.error();
+    ASSERT_EQ(f->scene.volumeCount(), 1u);
+    EXPECT_EQ(f->scene.volume(0).pointDims(), glm::ivec3(17, 9, 17));
+    EXPECT_EQ(f->scene.volumeOptions(0).name, "cumulus");
+    const std::string bad = R"({"format": "splatfx-scene", "version": 1, "volumes": [{"kind": "smoke", "dims": [1, 9, 17]}]})";
+    auto g = parseSceneFile(bad, "mem/scene.json", materials);
+    ASSERT_FALSE(g);
+    EXPECT_NE(g.error().find("volumes[0].kind"), std::string::npos) << g.error();
+    EXPECT_NE(g.error().find("volumes[0].dims"), std::string::npos) << g.error();
 }

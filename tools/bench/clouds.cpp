@@ -34,6 +34,7 @@ struct Options {
     int popFrames = 40;
     glm::ivec2 popSize{256, 192};
     float popDetailC = 10.0f;
+    float popStepWorld = 0.25f; // a quarter cell per frame
 };
 
 struct CloudSet {
@@ -72,6 +73,14 @@ splatfx::Camera flight(const glm::vec3& ext, int f, int frames, glm::ivec2 size)
     return splatfx::Camera::lookAt(eye, eye + dir, {0, 0, 1}, glm::radians(60.0f), size, 0.1f, 5000.0f);
 }
 
+// The same line at constant speed: `step` world units per frame from 10% of
+// the way (outside the -x face), so the flight approaches and enters the field.
+splatfx::Camera slowFlight(const glm::vec3& ext, int f, float step, glm::ivec2 size) {
+    const glm::vec3 start(-0.25f * ext.x, 0.37f * ext.y, 0.5f * ext.z), end(1.25f * ext.x, 0.61f * ext.y, 0.5f * ext.z);
+    const glm::vec3 dir = glm::normalize(end - start), eye = start + 0.1f * (end - start) + dir * (step * float(f));
+    return splatfx::Camera::lookAt(eye, eye + dir, {0, 0, 1}, glm::radians(60.0f), size, 0.1f, 5000.0f);
+}
+
 bool inside(const glm::vec3& ext, const splatfx::Camera& c) {
     const glm::vec3 e = c.eye();
     return e.x > 0 && e.y > 0 && e.z > 0 && e.x < ext.x && e.y < ext.y && e.z < ext.z;
@@ -85,7 +94,8 @@ double percentile(std::vector<double> v, double p) {
 
 int usage() {
     std::printf("usage: splatfx-bench clouds [--dims X Y Z] [--c DETAIL] [--frames N] [--size W H]\n"
-                "                            [--pop-dims X Y Z] [--pop-frames N] [--pop-size W H] [--pop-c DETAIL]\n");
+                "                            [--pop-dims X Y Z] [--pop-frames N] [--pop-size W H] [--pop-c DETAIL]\n"
+                "                            [--pop-step WORLD_PER_FRAME]\n");
     return 2;
 }
 
@@ -102,6 +112,7 @@ int runClouds(int argc, char** argv) {
         else if (!std::strcmp(argv[i], "--pop-size") && i + 2 < argc) next2(o.popSize);
         else if (!std::strcmp(argv[i], "--c") && i + 1 < argc) o.detailC = float(std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--pop-c") && i + 1 < argc) o.popDetailC = float(std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--pop-step") && i + 1 < argc) o.popStepWorld = float(std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) o.frames = std::atoi(argv[++i]);
         else if (!std::strcmp(argv[i], "--pop-frames") && i + 1 < argc) o.popFrames = std::atoi(argv[++i]);
         else return usage();
@@ -175,8 +186,9 @@ int runClouds(int argc, char** argv) {
         if (!makeClouds(o.popDims, o.popDetailC, cs)) return 1;
         auto fb = splatfx::gl::Framebuffer::create({.width = o.popSize.x, .height = o.popSize.y, .color = splatfx::gl::Precision::F32});
         if (!fb) return std::fprintf(stderr, "%s\n", fb.error().c_str()), 1;
-        std::printf("popping: clouds %dx%dx%d (full %llu tetrahedra), %d frames at %dx%d, c = %.1f\n", o.popDims.x, o.popDims.y,
-                    o.popDims.z, static_cast<unsigned long long>(cs.full), o.popFrames, o.popSize.x, o.popSize.y, o.popDetailC);
+        std::printf("popping: clouds %dx%dx%d (full %llu tetrahedra), %d frames at %dx%d, %.3f world units per frame, c = %.1f\n",
+                    o.popDims.x, o.popDims.y, o.popDims.z, static_cast<unsigned long long>(cs.full), o.popFrames, o.popSize.x,
+                    o.popSize.y, o.popStepWorld, o.popDetailC);
         struct Mode {
             const char* name;
             float c;
@@ -191,7 +203,7 @@ int runClouds(int argc, char** argv) {
             std::vector<double> change;
             double drawn = 0;
             for (int f = 0; f < o.popFrames; ++f) {
-                const splatfx::Camera cam = flight(cs.ext, f, o.popFrames, o.popSize);
+                const splatfx::Camera cam = slowFlight(cs.ext, f, o.popStepWorld, o.popSize);
                 cs.scene.prepare(f / 60.0 + 1.0, cam, materials, frame);
                 fr->render(frame, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture(), .drawOpaque = [] {
                                    glClearColor(0.0f, 0.0f, 0.0f, 0.0f);

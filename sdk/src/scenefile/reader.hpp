@@ -157,6 +157,9 @@ struct Placement {
 void readEffects(Context& c, const std::string& path, const Json& v, const std::vector<RawGeometry>& geo,
                  const std::map<std::string, std::size_t>& geoByName, SceneFile& out);
 
+// [clouds, issue 17] The top-level "volumes" block (volumes.cpp).
+void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& out);
+
 // [SECTION] Camera and output
 
 void readCamera(Context& c, const std::string& path, const Json& v, CameraPath& cam);

@@ -149,6 +149,7 @@ Result<SceneFile> parse(const std::string& text, const std::string& path, Materi
         }
     }
     if (const Json* v = o.get("effects")) readEffects(c, "effects", *v, geo, geoByName, out);
+    if (const Json* v = o.get("volumes")) readVolumes(c, "volumes", *v, out); // [clouds]
     o.finish();
     if (!d.ok()) return makeError(d.message());
     return out;
