@@ -3,11 +3,15 @@
 // it, and with the camera inside it (near-plane clipping).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "gl_fixture.hpp"
+#include "scenes.hpp"
 
 using namespace splatfx;
 
@@ -290,4 +294,154 @@ TEST_F(TetraPassGL, CameraInsideTheCloudRendersWithoutHoles) {
     EXPECT_EQ(over, 0) << "worst |GL - model| / bound " << worst;
 }
 
+
+// An orthographic camera: rays parallel to forward from the plane through the
+// eye; the pass's other shader variant, against the same model.
+TEST_F(TetraPassGL, OrthographicCameraMatchesTheModel) {
+    Cloud cl;
+    const glm::vec3 eye{-14.0f, 6.0f, 10.0f}, target{8.0f, 8.0f, 4.0f};
+    const glm::mat4 view = glm::lookAt(eye, target, glm::vec3(0, 0, 1));
+    const glm::mat4 proj = glm::ortho(-12.0f, 12.0f, -9.0f, 9.0f, 0.5f, 200.0f);
+    const Camera cam = Camera::fromMatrices(view, proj, kSize);
+    ASSERT_FALSE(cam.perspective());
+    Frame frame;
+    frame.begin(0.0, cam);
+    FrameVolume& fv = frame.volumes().emplace_back();
+    fv.table = &*cl.table;
+    ASSERT_TRUE(cl.volume->update(cam, {.detailC = 20.0f}, &*cl.transfer, fv.lod));
+    frame.end();
+    auto fr = gl::FrameRenderer::create();
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(fr && fb);
+    renderFrame(*fr, *fb, frame, 1.0);
+    const Image img = fb->read();
+    const glm::dmat4 inv = glm::inverse(glm::dmat4(cam.proj) * glm::dmat4(cam.view));
+    const glm::dvec3 d(cam.forward()), e(cam.eye());
+    int over = 0, covered = 0;
+    double worst = 0.0;
+    for (int y = 0; y < kSize.y; ++y)
+        for (int x = 0; x < kSize.x; ++x) {
+            const double nx = (x + 0.5) / kSize.x * 2.0 - 1.0, ny = 1.0 - (y + 0.5) / kSize.y * 2.0;
+            glm::dvec4 a = inv * glm::dvec4(nx, ny, -1.0, 1.0);
+            const glm::dvec3 pa = glm::dvec3(a) / a.w, o = pa - d * glm::dot(pa - e, d);
+            double bound = 0.0;
+            const glm::dvec4 model = passModel(fv.lod.tets, *cl.table, o, d, 1e30, bound);
+            double err = 0.0;
+            for (int c = 0; c < 4; ++c) err = std::max(err, std::abs(double(img.at(x, y, c)) - model[c]));
+            over += err > bound ? 1 : 0;
+            worst = std::max(worst, err / bound);
+            covered += model.a > 0.05 ? 1 : 0;
+        }
+    EXPECT_GT(covered, kSize.x * kSize.y / 10);
+    EXPECT_EQ(over, 0) << "worst |GL - model| / bound " << worst;
+}
+
+// Hard cases a host's own list may hold: a zero-volume tetrahedron, one with a
+// non-finite vertex and a transparent one are skipped (counted), and the image
+// is exactly that of the one visible tetrahedron.
+TEST_F(TetraPassGL, DegenerateNonFiniteAndTransparentTetrahedraAreSkipped) {
+    Cloud cl;
+    const Camera cam = Camera::lookAt({0.0f, -6.0f, 0.5f}, {0.0f, 0.0f, 0.3f}, {0, 0, 1}, glm::radians(50.0f), kSize, 0.1f, 100.0f);
+    Tetrahedron visible;
+    visible.position = {glm::vec3(-1, 0, 0), glm::vec3(1, 0, 0), glm::vec3(0, 1.5f, 0), glm::vec3(0, 0.5f, 1.5f)};
+    if (glm::dot(visible.position[1] - visible.position[0],
+                 glm::cross(visible.position[2] - visible.position[0], visible.position[3] - visible.position[0])) < 0.0f)
+        std::swap(visible.position[2], visible.position[3]);
+    visible.scalar = {0.9f, 0.7f, 0.8f, 1.0f};
+    visible.lengthScale = {1.0f, 1.0f, 1.0f, 1.0f};
+    Tetrahedron flat = visible;
+    flat.position[3] = 0.5f * (flat.position[0] + flat.position[1]); // coplanar: zero volume
+    Tetrahedron nan = visible;
+    nan.position[2].x = std::numeric_limits<float>::quiet_NaN();
+    Tetrahedron clear = visible;
+    clear.scalar = {0.0f, 0.01f, 0.0f, 0.02f}; // below the transfer function's threshold
+    auto fr = gl::FrameRenderer::create();
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(fr && fb);
+    auto draw = [&](std::vector<Tetrahedron> tets) {
+        Frame frame;
+        frame.begin(0.0, cam);
+        FrameVolume& fv = frame.volumes().emplace_back();
+        fv.table = &*cl.table;
+        fv.lod.tets = std::move(tets);
+        frame.end();
+        renderFrame(*fr, *fb, frame, 1.0);
+        return fb->read();
+    };
+    const Image alone = draw({visible});
+    EXPECT_EQ(fr->stats().tetrahedra, 1u);
+    const Image mixed = draw({flat, nan, visible, clear});
+    EXPECT_EQ(fr->stats().tetrahedra, 1u);
+    EXPECT_EQ(fr->stats().tetrahedraTransparent, 1u);
+    double maxAbs = 0.0, alpha = 0.0;
+    for (std::size_t i = 0; i < alone.pixels.size(); ++i) {
+        ASSERT_TRUE(std::isfinite(mixed.pixels[i]));
+        maxAbs = std::max(maxAbs, double(std::abs(mixed.pixels[i] - alone.pixels[i])));
+        if (i % 4 == 3) alpha = std::max(alpha, double(alone.pixels[i]));
+    }
+    EXPECT_EQ(maxAbs, 0.0);
+    EXPECT_GT(alpha, 0.1) << "the visible tetrahedron is drawn";
+}
+
+// Splats and tetrahedra in one back-to-front order: a fire in front of a
+// cloud draws after it, a cloud in front of the fire draws after the fire;
+// each equals drawing the two passes by hand in that order, and the wrong
+// order gives a visibly different image.
+TEST_F(TetraPassGL, SplatsAndTetrahedraCompositeInDepthOrder) {
+    Cloud cl;
+    Materials materials{Footprint{}};
+    const std::uint32_t set = materials.addTextureSet(TextureSet::turbulence({.count = 4, .size = 16, .seed = 3}));
+    const std::uint32_t colors = materials.addColorTable(ColorTable::fire());
+    const Camera cam = test::campfireCamera(kSize);
+    auto fr = gl::FrameRenderer::create();
+    auto splatsOnly = gl::Renderer::create();
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(fr && splatsOnly && fb);
+    ASSERT_TRUE(fr->upload(materials));
+    ASSERT_TRUE(splatsOnly->upload(materials));
+    for (const bool cloudInFront : {false, true}) {
+        SCOPED_TRACE(cloudInFront ? "cloud in front" : "cloud behind");
+        // The 16x16x8 cloud box: behind the fire (z in [-20, -12]) or between it and the eye (z in [4, 12]).
+        auto vol = LodVolume::create(cl.field, {.originWorld = {-8.0f, -4.0f, cloudInFront ? 4.0f : -20.0f}});
+        ASSERT_TRUE(vol);
+        Frame frame;
+        frame.begin(0.0, cam);
+        frame.builder().add(test::campfireGrid(3), materials, {.textureSet = set, .colorTable = colors});
+        FrameVolume& fv = frame.volumes().emplace_back();
+        fv.table = &*cl.table;
+        ASSERT_TRUE(vol->update(cam, {.detailC = 20.0f}, &*cl.transfer, fv.lod));
+        frame.end();
+        ASSERT_GT(frame.splats().size(), 0u);
+        ASSERT_GT(fv.lod.tets.size(), 0u);
+        ASSERT_EQ(frame.drawOrder().size(), 2u); // the two lists do not overlap in depth here
+        EXPECT_EQ(frame.drawOrder()[0].kind, cloudInFront ? DrawBatch::Kind::Splats : DrawBatch::Kind::Tetrahedra);
+        renderFrame(*fr, *fb, frame, 1.0);
+        const Image together = fb->read();
+        // By hand: the volume alone through the frame renderer, the splats alone through gl::Renderer.
+        Frame cloudOnly;
+        cloudOnly.begin(0.0, cam);
+        cloudOnly.volumes().push_back(fv);
+        cloudOnly.end();
+        auto byHand = [&](bool splatsFirst) {
+            fb->clear({0, 0, 0, 0});
+            auto splats = [&] {
+                splatsOnly->draw(frame.splats(), cam, {.framebuffer = fb->handle(), .width = kSize.x, .height = kSize.y});
+            };
+            if (splatsFirst) splats();
+            fr->render(cloudOnly, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture()});
+            if (!splatsFirst) splats();
+            return fb->read();
+        };
+        const Image right = byHand(cloudInFront), wrong = byHand(!cloudInFront);
+        double dRight = 0.0, dWrong = 0.0;
+        for (std::size_t i = 0; i < together.pixels.size(); ++i) {
+            dRight = std::max(dRight, double(std::abs(together.pixels[i] - right.pixels[i])));
+            dWrong = std::max(dWrong, double(std::abs(together.pixels[i] - wrong.pixels[i])));
+        }
+        EXPECT_EQ(dRight, 0.0);
+        EXPECT_GT(dWrong, 0.05) << "the order must matter where the fire and the cloud overlap";
+    }
+}
+
 } // namespace
+
