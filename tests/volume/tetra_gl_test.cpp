@@ -443,5 +443,51 @@ TEST_F(TetraPassGL, SplatsAndTetrahedraCompositeInDepthOrder) {
     }
 }
 
+
+// Ground fog (sec. 6) through the same pass: prisms over a wavy terrain with
+// the eye inside the fog; every pixel against the pass model within the bound.
+TEST_F(TetraPassGL, GroundFogDrawsThroughThePass) {
+    GroundFogDesc d;
+    d.dims = {17, 17};
+    d.originWorld = {-8.0f, 0.0f, -8.0f};
+    for (int j = 0; j < 17; ++j)
+        for (int i = 0; i < 17; ++i) {
+            d.terrainHeight.push_back(1.5f * std::sin(0.7f * float(i)) * std::cos(0.5f * float(j)));
+            d.fogTop.push_back(0.6f);
+        }
+    auto fog = GroundFog::create(d);
+    auto tf = makeGroundFogTransfer({0.8f, 0.85f, 0.9f}, 0.7f);
+    ASSERT_TRUE(fog && tf);
+    auto table = PreIntegrationTable::create(*tf, {.scalarResolution = 16, .lengthResolution = 64, .maxLengthWorld = 30.0f});
+    ASSERT_TRUE(table);
+    const Camera cam = Camera::lookAt({-7.0f, 0.4f, -6.5f}, {6.0f, -0.2f, 5.0f}, {0, 1, 0}, glm::radians(60.0f), kSize, 0.1f, 100.0f);
+    Frame frame;
+    frame.begin(0.0, cam);
+    FrameVolume& fv = frame.volumes().emplace_back();
+    fv.table = &*table;
+    ASSERT_TRUE(fog->update(cam, fv.lod));
+    frame.end();
+    auto fr = gl::FrameRenderer::create();
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(fr && fb);
+    renderFrame(*fr, *fb, frame, 1.0);
+    const Image img = fb->read();
+    int over = 0, covered = 0;
+    double worst = 0.0;
+    for (int y = 0; y < kSize.y; ++y)
+        for (int x = 0; x < kSize.x; ++x) {
+            const glm::dvec3 dir = pixelRay(cam, x, y), o(cam.eye());
+            double bound = 0.0;
+            const glm::dvec4 model = passModel(fv.lod.tets, *table, o, dir, 1e30, bound);
+            double e = 0.0;
+            for (int c = 0; c < 4; ++c) e = std::max(e, std::abs(double(img.at(x, y, c)) - model[c]));
+            over += e > bound ? 1 : 0;
+            worst = std::max(worst, e / bound);
+            covered += model.a > 0.05 ? 1 : 0;
+        }
+    EXPECT_GT(covered, kSize.x * kSize.y / 5);
+    EXPECT_EQ(over, 0) << "worst |GL - model| / bound " << worst;
+}
+
 } // namespace
 
