@@ -7,8 +7,10 @@
 // same Frame can be drawn by the GL backend and integrated by the CPU
 // reference, which is how the backend is measured.
 // It does not simulate (Scene does), render (gl::FrameRenderer does) or own
-// GPU resources. Later passes (fog, lights and shadow tables, volume
-// primitives) join it as further plain-data members.
+// GPU resources. Later passes (fog, lights and shadow tables) join it as
+// further plain-data members; LOD volumes already have (volumes(): their
+// tetrahedra and tables, and drawOrder(): splats and tetrahedra interleaved
+// back to front, made by end()).
 //
 //   splatfx::Frame frame;                          // keep it: it reuses its memory
 //   scene.prepare(timeSec, camera, materials, frame);

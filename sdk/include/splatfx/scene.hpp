@@ -19,7 +19,9 @@
 //   frameRenderer->render(frame, hostTarget);            // gl/frame_renderer.hpp
 //
 // prepare() is update() + emit() into a Frame + the sort; the two halves stay
-// public for hosts that feed their own SplatBuilder.
+// public for hosts that feed their own SplatBuilder. LOD volumes (clouds,
+// volume.hpp) are a second list (addVolume): prepare() refines those in view
+// into the Frame's volumes.
 //
 // Threading: one thread at a time.
 #pragma once
