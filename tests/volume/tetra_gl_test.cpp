@@ -489,5 +489,36 @@ TEST_F(TetraPassGL, GroundFogDrawsThroughThePass) {
     EXPECT_EQ(over, 0) << "worst |GL - model| / bound " << worst;
 }
 
+
+// With the splats at reduced resolution (FrameRendererDesc::resolutionScale)
+// the tetrahedra are still drawn at full resolution: a frame of tetrahedra
+// alone gives exactly the full-resolution image.
+TEST_F(TetraPassGL, ReducedResolutionSplatsLeaveTheTetrahedraAtFullResolution) {
+    Cloud cl;
+    const Camera cam = Camera::lookAt({-14.0f, 6.0f, 10.0f}, {8.0f, 8.0f, 4.0f}, {0, 0, 1}, glm::radians(50.0f), kSize, 0.5f, 200.0f);
+    Frame frame;
+    frame.begin(0.0, cam);
+    FrameVolume& fv = frame.volumes().emplace_back();
+    fv.table = &*cl.table;
+    ASSERT_TRUE(cl.volume->update(cam, {.detailC = 20.0f}, &*cl.transfer, fv.lod));
+    frame.end();
+    auto full = gl::FrameRenderer::create();
+    auto half = gl::FrameRenderer::create({.resolutionScale = 2});
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(full && half && fb);
+    renderFrame(*full, *fb, frame, 1.0);
+    const Image a = fb->read();
+    renderFrame(*half, *fb, frame, 1.0);
+    const Image b = fb->read();
+    double maxAbs = 0.0, alpha = 0.0;
+    for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+        maxAbs = std::max(maxAbs, double(std::abs(a.pixels[i] - b.pixels[i])));
+        if (i % 4 == 3) alpha = std::max(alpha, double(a.pixels[i]));
+    }
+    EXPECT_GT(alpha, 0.1);
+    EXPECT_EQ(maxAbs, 0.0);
+    EXPECT_EQ(half->stats().tetrahedra, full->stats().tetrahedra);
+}
+
 } // namespace
 
