@@ -9,6 +9,7 @@ int runTable1(int argc, char** argv);   // table1.cpp: the paper's Table I, fill
 int runScheduling(int argc, char** argv); // scheduling.cpp: 1000 effects, 10 in view; catch-up error (issue 6)
 int runShadows(int argc, char** argv);    // shadows.cpp: Ebert & Parent 1990 Table 2, shadow tables vs tracing (issue 16)
 int runFog(int argc, char** argv);        // fog.cpp: Biri et al. 2002 Table 1, fog cost per pixel and per fog texture (issue 14)
+int runClouds(int argc, char** argv);     // clouds.cpp: LOD volumes as projected tetrahedra, flight, popping (issue 17)
 
 struct BenchCommand {
     const char* name;
@@ -19,6 +20,7 @@ struct BenchCommand {
 inline constexpr BenchCommand kCommands[] = {
     {"accuracy", "error against the exact reference vs time per frame, for every quality knob", runAccuracy},
     {"table1", "King et al. 1999 Table I on this machine, fill limit, naive baseline, CPU scaling", runTable1},
+    {"clouds", "LOD cloud volumes as tetrahedra: count vs full, frame rate and memory outside/inside, popping", runClouds},
     {"scheduling", "a level of 1000 effects with 10 in view vs those 10 alone; camera sweep; catch-up error", runScheduling},
     {"shadows", "Ebert & Parent 1990 Table 2: steam from a glass, no/geometry/traced/table shadowing, table error", runShadows},
     {"fog", "Biri et al. 2002 Table 1: no fog, per-pixel fog, reduced fog textures at 800x600; error vs per pixel", runFog},

@@ -7,9 +7,10 @@
 // same Frame can be drawn by the GL backend and integrated by the CPU
 // reference, which is how the backend is measured.
 // It does not simulate (Scene does), render (gl::FrameRenderer does) or own
-// GPU resources. Later passes join it as further plain-data members: the
-// gas's shadow on the scene (shadow(), FrameShadow: issue 16); fog and volume
-// primitives to come.
+// GPU resources. Each system adds plain-data members: the gas's shadow on the
+// scene (shadow(), FrameShadow: issue 16), the fog (fog(): issue 14), LOD
+// volumes (volumes(): their tetrahedra and tables, and drawOrder(): splats and
+// tetrahedra interleaved back to front, made by end(): issue 17).
 //
 //   splatfx::Frame frame;                          // keep it: it reuses its memory
 //   scene.prepare(timeSec, camera, materials, frame);
@@ -31,6 +32,7 @@
 #include "splatfx/camera.hpp"
 #include "splatfx/fog.hpp"
 #include "splatfx/splats.hpp"
+#include "splatfx/volume.hpp"
 
 namespace splatfx {
 
@@ -62,6 +64,34 @@ struct FrameShadow {
     // Changes whenever the contents do (a renderer re-uploads only then); 0 when never filled.
     std::uint64_t version = 0;
 };
+
+
+// ---- [clouds, issue 17] LOD volumes drawn as projected tetrahedra ----
+// One volume's tetrahedra for this frame (LodVolume::update's output) and the
+// pre-integration table they are drawn with. Scene::prepare fills these;
+// hosts without a Scene push them between begin() and end().
+struct FrameVolume {
+    const PreIntegrationTable* table = nullptr; // not owned; must outlive the render; null: not drawn
+    std::uint64_t tableVersion = 0;            // change it when the table at this address changes (the GL pass re-uploads); default 0
+    LodFrame lod;                               // lod.tets back to front, world space
+};
+// One run of the interleaved back-to-front draw sequence (Frame::drawOrder).
+struct DrawBatch {
+    enum class Kind : std::uint8_t { Splats, Tetrahedra };
+    Kind kind = Kind::Splats;
+    std::uint32_t volume = 0;               // index into Frame::volumes() (Tetrahedra only)
+    std::uint32_t begin = 0, end = 0;       // [begin, end) into splats() or volumes()[volume].lod.tets
+};
+// Merges the splats (sorted back to front) and every volume's tetrahedra
+// (each list in its own exact visibility order) into one back-to-front
+// sequence of batches. Each list keeps its order; between lists, a
+// tetrahedron's key is the largest eye distance of a centroid at or after it
+// in its list (so the keys never increase along a list) and a splat's key is
+// its depth. Exact within each list; across lists it is a centroid order, so a
+// splat inside a tetrahedron is drawn wholly before or after it (docs/volume.md).
+void interleaveBackToFront(const std::vector<Splat>& splats, const std::vector<FrameVolume>& volumes, const Camera& camera,
+                           std::vector<DrawBatch>& out);
+// ---- end [clouds] ----
 
 class Frame {
 public:
@@ -96,12 +126,23 @@ public:
     const std::shared_ptr<const Fog>& sharedFog() const { return mFog; }
     // --- end fog ---------------------------------------------------------
 
+    // ---- [clouds, issue 17] ----
+    // Volumes to draw as tetrahedra (cleared by begin()).
+    std::vector<FrameVolume>& volumes() { return mVolumes; }
+    const std::vector<FrameVolume>& volumes() const { return mVolumes; }
+    // The interleaved draw sequence of splats and tetrahedra, made by end()
+    // (interleaveBackToFront); one Splats batch when there are no volumes.
+    const std::vector<DrawBatch>& drawOrder() const { return mDrawOrder; }
+    // ---- end [clouds] ----
+
 private:
     SplatBuilder mBuilder;
     FrameCounters mCounters;
     FrameShadow mShadow; // lighting (issue 16)
     double mTime = 0.0;
     std::shared_ptr<const Fog> mFog; // fog (issue 14); default none
+    std::vector<FrameVolume> mVolumes;   // [clouds]
+    std::vector<DrawBatch> mDrawOrder;   // [clouds]
 };
 
 } // namespace splatfx

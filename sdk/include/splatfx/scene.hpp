@@ -23,7 +23,9 @@
 //   frameRenderer->render(frame, hostTarget);            // gl/frame_renderer.hpp
 //
 // prepare() is update() + emit() into a Frame + the sort; the two halves stay
-// public for hosts that feed their own SplatBuilder.
+// public for hosts that feed their own SplatBuilder. LOD volumes (clouds,
+// volume.hpp) are a second list (addVolume): prepare() refines those in view
+// into the Frame's volumes.
 //
 // Threading: one thread at a time.
 #pragma once
@@ -43,6 +45,7 @@
 #include "splatfx/lighting.hpp"
 #include "splatfx/materials.hpp"
 #include "splatfx/splats.hpp"
+#include "splatfx/volume.hpp"
 
 namespace splatfx {
 
@@ -132,6 +135,15 @@ struct SceneCounters {
     std::uint64_t sceneShadowBuilds = 0;      // scene-shadow table builds (cumulative)
 };
 
+// ---- [clouds, issue 17] LOD volumes, drawn as projected tetrahedra ----
+using VolumeId = std::uint32_t;
+struct VolumeOptions {
+    std::string name;          // for messages; default empty
+    bool enabled = true;       // default true
+    LodRefineDesc refine{};    // per-frame refinement (c, morphing, culling); default LodRefineDesc{}
+};
+// ---- end [clouds] ----
+
 class Scene {
 public:
     // An Effect (grid or solver); effect(id) returns it.
@@ -193,6 +205,18 @@ public:
     // (conservative: boxes near a frustum corner may pass).
     static bool inFrustum(const Aabb& box, const Camera& camera);
 
+    // ---- [clouds, issue 17] LOD volumes ----
+    // A volume with the transfer function its zero-opacity test uses and the
+    // table it is drawn with. prepare() refines every enabled volume whose box
+    // is in view (LodVolume::update) and adds its tetrahedra to the Frame.
+    VolumeId addVolume(LodVolume volume, TransferFunction transfer, PreIntegrationTable table, VolumeOptions options = {});
+    std::size_t volumeCount() const { return mVolumes.size(); }
+    LodVolume& volume(VolumeId id) { return mVolumes.at(id)->volume; }
+    VolumeOptions& volumeOptions(VolumeId id) { return mVolumes.at(id)->options; }
+    // Replaces the transfer function and table (the GL pass re-uploads it).
+    void setVolumeTransfer(VolumeId id, TransferFunction transfer, PreIntegrationTable table);
+    // ---- end [clouds] ----
+
 private:
     // ---- lighting (issue 16): what a lit effect keeps between frames (scene_lighting.cpp).
     struct LitState {
@@ -215,6 +239,16 @@ private:
     void shadeScene(Frame& frame); // fills frame.shadow()
 
     std::vector<Entry> mEntries;
+    // [clouds] Boxed so the table addresses the Frame points at stay put.
+    struct VolumeEntry {
+        LodVolume volume;
+        TransferFunction transfer;
+        PreIntegrationTable table;
+        std::uint64_t tableVersion = 1;
+        VolumeOptions options;
+    };
+    std::vector<std::unique_ptr<VolumeEntry>> mVolumes;
+    void prepareVolumes(const Camera& camera, Frame& frame); // [clouds]
     SceneCounters mCounters;
     double mTime = 0.0;
     bool mUpdated = false;

@@ -12,7 +12,7 @@
 // segment, one ray through the finest mesh) are the references.
 //
 // It does NOT: draw anything (no GL here; the projected-tetrahedra pass reads
-// LodFrame::tets and PreIntegrationTable::data()), render ground fog (sec. 6),
+// LodFrame::tets and PreIntegrationTable::data()), LOD ground fog (sec. 6: GroundFog is the full-resolution prism layer),
 // or model anisotropic scattering (the light field is precomputed, sec. 5).
 //
 //   auto vol = splatfx::LodVolume::create(*splatfx::makeCloudVolume({}), {});
@@ -338,5 +338,46 @@ struct CloudTransferDesc {
 // field as scalar: then rho = Id * max extinction and kappa is a ramp in gamma.
 Result<TransferFunction> makeCloudTransfer(const CloudTransferDesc& desc = {},
                                            CloudModel model = CloudModel::DensityTableLightLength);
+
+// -----------------------------------------------------------------------------
+// [SECTION] Ground fog (sec. 6)
+// -----------------------------------------------------------------------------
+
+struct GroundFogDesc {
+    glm::ivec2 dims{0};               // height-field points along x and z (>= 2 each), y is up
+    glm::vec3 originWorld{0.0f};      // default (0,0,0): world x, z of point (0, 0) (y unused: heights are absolute)
+    float spacingWorld = 1.0f;        // default 1: world distance between points
+    std::vector<float> terrainHeight; // dims.x * dims.y world heights (x fastest)
+    std::vector<float> fogTop;        // same size: world height of the fog's top; <= terrain: no fog there
+    float density = 1.0f;             // default 1: the scalar at the terrain (the top boundary has 0, sec. 6)
+};
+
+// A fog layer over a terrain height field as vertical prisms of three
+// tetrahedra (sec. 6): every grid cell is two triangles (diagonals
+// alternating), every triangle a prism from the terrain to the fog top,
+// split into three tetrahedra by the global vertex order so neighbouring
+// prisms share their split faces (conforming). Prisms of zero height are
+// dropped; the scalar is `density` on the terrain and 0 on the top, linear in
+// between. update() emits them back to front for a camera (a BSP over the
+// grid, far half first, with MPVO inside a prism), clipped at the near plane.
+// Not done: the paper's LOD terrain and geomorphing of the fog top (the grid
+// is drawn at full resolution), and the sort-free emissive model.
+class GroundFog {
+public:
+    // Fails on dims < 2, size mismatches, non-finite heights or a bad field.
+    static Result<GroundFog> create(const GroundFogDesc& desc);
+    // Emits into out.tets (cleared first), back to front, with out.stats
+    // (emitted, fullResolution = prisms x 3, clipping). Fails on a non-finite camera.
+    Status update(const Camera& camera, LodFrame& out) const;
+    std::uint64_t prismCount() const { return mPrisms; }
+
+private:
+    GroundFogDesc mDesc;
+    std::uint64_t mPrisms = 0;
+};
+
+// A fog transfer function: constant colour, extinction linear in the scalar
+// (0 at 0, extinctionPerWorld at 1).
+Result<TransferFunction> makeGroundFogTransfer(glm::vec3 color, float extinctionPerWorld);
 
 } // namespace splatfx

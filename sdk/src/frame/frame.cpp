@@ -6,12 +6,14 @@ void Frame::begin(double timeSec, const Camera& camera) {
     mTime = timeSec;
     mCounters = {};
     mBuilder.begin(camera);
+    mVolumes.clear(); // [clouds]
 }
 
 void Frame::end(SortMode mode) {
     mBuilder.sort(mode);
     mCounters.splats = mBuilder.splats().size();
     mCounters.voxels = mBuilder.stats().voxelsIn;
+    interleaveBackToFront(mBuilder.splats(), mVolumes, mBuilder.camera(), mDrawOrder); // [clouds]
 }
 
 } // namespace splatfx

@@ -116,6 +116,7 @@ void Scene::prepare(double timeSec, const Camera& camera, const Materials& mater
     frame.begin(timeSec, camera);
     emit(frame.builder(), materials, options);
     shadeScene(frame); // lighting (issue 16): the shadow on the scene, into frame.shadow()
+    prepareVolumes(camera, frame); // [clouds]
     frame.end();
     frame.setFog(mFog); // fog (issue 14)
     FrameCounters& c = frame.counters();
@@ -128,6 +129,35 @@ void Scene::prepare(double timeSec, const Camera& camera, const Materials& mater
     c.simulated = mCounters.simulated;
     c.drawn = 0;
     for (const Entry& e : mEntries) c.drawn += e.status.splatsDrawn > 0 ? 1 : 0;
+}
+
+// ---- [clouds, issue 17] LOD volumes ----
+VolumeId Scene::addVolume(LodVolume volume, TransferFunction transfer, PreIntegrationTable table, VolumeOptions options) {
+    mVolumes.push_back(std::make_unique<VolumeEntry>(
+        VolumeEntry{std::move(volume), std::move(transfer), std::move(table), 1, std::move(options)}));
+    return VolumeId(mVolumes.size() - 1);
+}
+
+void Scene::setVolumeTransfer(VolumeId id, TransferFunction transfer, PreIntegrationTable table) {
+    VolumeEntry& e = *mVolumes.at(id);
+    e.transfer = std::move(transfer);
+    e.table = std::move(table);
+    ++e.tableVersion;
+}
+
+void Scene::prepareVolumes(const Camera& camera, Frame& frame) {
+    for (auto& owned : mVolumes) {
+        VolumeEntry& e = *owned;
+        if (!e.options.enabled) continue;
+        const glm::vec3 lo = e.volume.originWorld();
+        const glm::vec3 hi = lo + glm::vec3(e.volume.pointDims() - 1) * e.volume.spacingWorld();
+        if (!inFrustum(Aabb{lo, hi}, camera)) continue;
+        FrameVolume& fv = frame.volumes().emplace_back();
+        fv.table = &e.table;
+        fv.tableVersion = e.tableVersion;
+        // A failed update (non-finite camera, bad refine field) draws nothing for this volume.
+        if (!e.volume.update(camera, e.options.refine, &e.transfer, fv.lod)) frame.volumes().pop_back();
+    }
 }
 
 } // namespace splatfx

@@ -164,6 +164,8 @@ void readLights(Context& c, const std::string& path, const Json& v, SceneFile& o
 void readSceneShadow(Context& c, const std::string& path, const Json& v, SceneFile& out);
 // An effect's "lighting" object.
 void readEffectLighting(Context& c, const std::string& path, const Json& v, EffectLighting& out);
+// [clouds, issue 17] The top-level "volumes" block (volumes.cpp).
+void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& out);
 
 // [SECTION] Camera and output
 

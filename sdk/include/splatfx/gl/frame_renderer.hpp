@@ -15,6 +15,10 @@
 //      tested against the host depth, at full resolution or at 1/2 or 1/4 per
 //      axis with depth-aware upsampling (FrameRendererDesc::resolutionScale);
 //      with a fog, every splat fragment is fogged by the medium in front of it
+//      with the frame's LOD volumes (Frame::volumes) drawn as pre-integrated
+//      projected tetrahedra (the ray segment ended at the host depth, read
+//      from HostTarget::depthTexture) interleaved with the splats in
+//      Frame::drawOrder (at reduced resolution: all tetrahedra, then splats)
 //   3. the host's transparent pass (HostTarget::drawTransparent), blended over
 // The passes of the systems still being built (fog of the host image, shadow
 // tables before the opaque pass, exact ordering among transparent surfaces,
@@ -38,6 +42,7 @@
 // Threading: every call on the thread whose context is current. Move-only.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -95,7 +100,10 @@ struct HostTarget {
     int x = 0, y = 0;          // viewport origin; its size is the frame camera's viewport; default 0, 0
     // The host's depth as a texture (GL name). Reduced resolution reads it
     // (0: the framebuffer's depth attachment when it is a texture); at full
-    // resolution the framebuffer's own depth buffer tests the splats. Default 0.
+    // resolution the framebuffer's own depth buffer tests the splats. The
+    // tetrahedra end each ray segment at this depth (0: the depth attachment
+    // if it is a texture; with none, whole fragments are depth-tested, which is
+    // not exact inside a cloud). Default 0.
     unsigned depthTexture = 0;
     // The host's opaque geometry, drawn with depth writes before the volumes.
     // Empty: the host drew it before render(). Default empty.
@@ -115,6 +123,11 @@ struct FrameRenderStats {
     bool fogSplats = false;      // the splats were drawn with per-fragment fog
     std::string fogError;        // empty, or why the fog could not be drawn (it was then skipped)
     // --- end fog ---
+    // ---- [clouds, issue 17] projected tetrahedra ----
+    std::uint64_t tetrahedra = 0;            // tetrahedra drawn
+    std::uint64_t tetrahedraTransparent = 0; // skipped by the table's zero-opacity test
+    std::uint64_t batches = 0;               // runs of the interleaved splat/tetrahedron sequence
+    std::size_t tableBytes = 0;              // GPU bytes of the uploaded pre-integration tables
 };
 
 class FrameRenderer {
@@ -145,6 +158,7 @@ public:
 private:
     struct Impl;
     explicit FrameRenderer(std::unique_ptr<Impl> impl);
+    void drawInterleaved(const Frame& frame, const HostTarget& target); // [clouds]
     std::unique_ptr<Impl> mImpl;
 };
 

@@ -36,6 +36,8 @@ public:
     unsigned handle() const { return mFbo; }
     int width() const { return mDesc.width; }
     int height() const { return mDesc.height; }
+    // The depth attachment, a DEPTH_COMPONENT24 texture (HostTarget::depthTexture).
+    unsigned depthTexture() const { return mDepth; }
     void clear(glm::vec4 color, float depth = 1.0f);
     // RGBA float, top row first (flipped from GL's bottom-up order).
     Image read() const;

@@ -1,6 +1,7 @@
 // The frame's passes in their order (frame_renderer.hpp lists them).
 #include "splatfx/gl/frame_renderer.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <optional>
 #include <string>
@@ -10,6 +11,7 @@
 #include "shadow_pass.hpp"
 #include "fog_pass.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
+#include "tetra_pass.hpp"
 
 namespace splatfx::gl {
 
@@ -21,6 +23,9 @@ struct FrameRenderer::Impl {
     FrameRenderStats stats;
     std::optional<ShadowPass> shadow; // lighting (issue 16): pass 0, the frame's shadow table
     detail::FogPass fog; // fog of the host image (issue 14)
+    // [clouds] Projected tetrahedra, and the splats of one interleaved batch.
+    std::optional<detail::TetraPass> tetra;
+    std::vector<Splat> batch;
 };
 
 Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
@@ -48,6 +53,11 @@ Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
         if (!r) return makeError(r.error());
         impl->reduced.emplace(std::move(*r));
     }
+    { // [clouds]
+        auto t = detail::TetraPass::create();
+        if (!t) return makeError(t.error());
+        impl->tetra.emplace(std::move(*t));
+    }
     return FrameRenderer(std::move(impl));
 }
 
@@ -74,6 +84,10 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
     // 0. Uploads (lighting, issue 16): the frame's shadow table, bound for the hooks.
     if (r.shadow->upload(frame.shadow())) ++r.stats.shadowUploads;
     r.shadow->bind();
+    // 0. [clouds] Upload the pre-integration tables that changed; per-tetrahedron data.
+    const bool anyTets = std::any_of(frame.volumes().begin(), frame.volumes().end(),
+                                     [](const FrameVolume& v) { return v.table && !v.lod.tets.empty(); });
+    if (anyTets) r.tetra->prepare(frame);
 
     // 1. The host's opaque pass: its depth is what the volumes are tested against.
     if (target.drawOpaque) {
@@ -111,7 +125,10 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
     }
 
     // 2. The volumes, back to front.
-    if (r.full) {
+    if (anyTets) {
+        // [clouds] Splats and tetrahedra interleaved by Frame::drawOrder (frame.hpp).
+        drawInterleaved(frame, target);
+    } else if (r.full) {
         r.full->draw(frame.splats(), camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h});
         r.stats.drawCalls = r.full->stats().drawCalls;
     } else {
@@ -121,6 +138,7 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         r.stats.drawCalls = r.reduced->renderer().stats().drawCalls;
     }
     r.stats.splats = frame.splats().size();
+    if (!anyTets) r.stats.tetrahedra = r.stats.tetrahedraTransparent = r.stats.batches = 0;
 
     // 3. The host's transparent surfaces, over the volumes.
     if (target.drawTransparent) {
@@ -129,6 +147,45 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         target.drawTransparent();
     }
     r.shadow->unbind(); // lighting (issue 16): the unit's previous binding back
+}
+
+// ---- [clouds, issue 17] ----
+void FrameRenderer::drawInterleaved(const Frame& frame, const HostTarget& target) {
+    Impl& r = *mImpl;
+    const Camera& camera = frame.camera();
+    const int w = camera.viewport.x, h = camera.viewport.y;
+    const detail::TetraTarget tt{.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
+                                 .depthTexture = target.depthTexture};
+    std::uint64_t calls = 0, batches = 0;
+    if (r.reduced) {
+        // Reduced-resolution splats are composited in one pass, so the order
+        // is per pass: every tetrahedron (full resolution), then the splats.
+        for (const DrawBatch& b : frame.drawOrder())
+            if (b.kind == DrawBatch::Kind::Tetrahedra) r.tetra->draw(frame, b.volume, b.begin, b.end, tt), ++batches;
+        r.reduced->draw(frame.splats(), camera,
+                        {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
+                         .depthTexture = target.depthTexture});
+        calls += r.reduced->renderer().stats().drawCalls;
+        ++batches;
+    } else {
+        for (const DrawBatch& b : frame.drawOrder()) {
+            ++batches;
+            if (b.kind == DrawBatch::Kind::Tetrahedra) {
+                r.tetra->draw(frame, b.volume, b.begin, b.end, tt);
+                continue;
+            }
+            const auto& all = frame.splats();
+            r.batch.assign(all.begin() + std::ptrdiff_t(b.begin), all.begin() + std::ptrdiff_t(b.end));
+            r.full->draw(r.batch, camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h});
+            calls += r.full->stats().drawCalls;
+        }
+    }
+    const detail::TetraStats& ts = r.tetra->stats();
+    r.stats.drawCalls = calls + ts.drawCalls;
+    r.stats.tetrahedra = ts.tetrahedra;
+    r.stats.tetrahedraTransparent = ts.transparent;
+    r.stats.batches = batches;
+    r.stats.tableBytes = ts.tableBytes;
 }
 
 } // namespace splatfx::gl

@@ -1,0 +1,397 @@
+// [clouds, issue 17] Projected tetrahedra with pre-integration (tetra_pass.hpp).
+#include "tetra_pass.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <epoxy/gl.h>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
+
+#include "context_check.hpp"
+#include "saved_state.hpp"
+#include "splatfx/gl/program.hpp"
+
+namespace splatfx::gl::detail {
+namespace {
+
+// Per instance, 10 vec4 (std430): the four vertices relative to the eye,
+// the four barycentric planes lambda_i(x) = dot(B_i.xyz, x) + B_i.w (x
+// relative to the eye, lambda_i = 1 at vertex i, 0 on the opposite face),
+// and the scalar and length scale as linear functions of x.
+constexpr int kVec4PerTet = 10;
+
+constexpr const char* kTetraVertex = R"(
+layout(std430, binding = 0) readonly buffer Tets { vec4 uTets[]; };
+uniform mat4 uViewProjRel; // proj * view * translate(eye)
+uniform int uFirst;
+out vec3 vRel;
+// The per-tetrahedron functions as flat varyings: the fragment reads no buffer.
+flat out vec4 vPlane[4];
+flat out vec4 vScalar;
+flat out vec4 vLength;
+// The faces wound counter-clockwise seen from outside a positively oriented
+// tetrahedron (dot(p1-p0, cross(p2-p0, p3-p0)) > 0): opposite 0, 1, 2, 3.
+const int kFaces[12] = int[12](1, 2, 3, 0, 3, 2, 0, 1, 3, 0, 2, 1);
+void main() {
+    int tet = uFirst + gl_InstanceID;
+    vec3 p = uTets[tet * 10 + kFaces[gl_VertexID]].xyz;
+    vRel = p;
+    for (int i = 0; i < 4; ++i) vPlane[i] = uTets[tet * 10 + 4 + i];
+    vScalar = uTets[tet * 10 + 8];
+    vLength = uTets[tet * 10 + 9];
+    gl_Position = uViewProjRel * vec4(p, 1.0);
+}
+)";
+
+constexpr const char* kTetraFragment = R"(
+layout(binding = 1) uniform sampler2D uHostDepth;
+layout(binding = 2) uniform sampler3D uTable;
+uniform vec3 uForward;      // unit view direction
+uniform vec4 uDepthToView;  // inverse projection's (z, w) rows at (z, w) columns
+uniform vec3 uTexScale;     // (n-1)/n, (n-1)/n, (m-1)/m: texel centres at the table's samples
+uniform vec3 uTexOffset;    // 0.5/n, 0.5/n, 0.5/m
+uniform float uMaxLength;   // the table's maxLengthWorld
+in vec3 vRel;
+flat in vec4 vPlane[4];
+flat in vec4 vScalar;
+flat in vec4 vLength;
+layout(location = 0) out vec4 oColor;
+
+vec4 table(float sf, float sb, float l) {
+    return texture(uTable, vec3(clamp(sf, 0.0, 1.0), clamp(sb, 0.0, 1.0), l / uMaxLength) * uTexScale + uTexOffset);
+}
+
+void main() {
+    // Compiled per camera kind and host depth (#defines), so no lane pays for
+    // a branch it does not take (llvmpipe runs both sides of divergent code).
+#if PERSPECTIVE
+    // The fragment lies on the entry face: the ray from the eye enters here.
+    float tIn = length(vRel);
+    vec3 d = vRel / tIn, o = vec3(0.0);
+    float tOut = 3.0e38;
+    for (int i = 0; i < 4; ++i) {
+        // lambda_i(t) = w + s t >= 0 inside (o = 0): only the leaving planes bound tOut.
+        float s = dot(vPlane[i].xyz, d);
+        if (s < 0.0) tOut = min(tOut, -vPlane[i].w / s);
+    }
+#else
+    vec3 d = uForward, o = vRel - d * dot(vRel, d); // o on the plane through the eye
+    float tIn = -3.0e38, tOut = 3.0e38;
+    for (int i = 0; i < 4; ++i) {
+        float a = dot(vPlane[i].xyz, o) + vPlane[i].w, s = dot(vPlane[i].xyz, d);
+        if (s > 0.0) tIn = max(tIn, -a / s);
+        else if (s < 0.0) tOut = min(tOut, -a / s);
+    }
+#endif
+#if HAS_DEPTH
+    // The ray ends at the host's surface: the segment is cut there, and the
+    // scalars below are interpolated at the cut (exact inside a tetrahedron).
+    // View depth from the stored depth: |(a n + b) / (c n + d)| with the
+    // inverse projection's z and w rows; along the ray t = depth / dot(d, forward).
+    float nz = texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r * 2.0 - 1.0;
+    float zView = abs((uDepthToView.x * nz + uDepthToView.y) / (uDepthToView.z * nz + uDepthToView.w));
+#if PERSPECTIVE
+    tOut = min(tOut, zView / dot(d, uForward));
+#else
+    tOut = min(tOut, zView);
+#endif
+#endif
+    if (!(tOut > tIn)) discard;
+    vec4 S = vScalar, M = vLength;
+    vec3 pf = o + tIn * d, pb = o + tOut * d;
+    float sf = dot(S.xyz, pf) + S.w, sb = dot(S.xyz, pb) + S.w;
+    float mf = dot(M.xyz, pf) + M.w, mb = dot(M.xyz, pb) + M.w;
+    // The table assumes a constant length scale along the segment (eq. 9):
+    // the mean of the ends, exact for constant m (docs/volume.md).
+    float l = (tOut - tIn) * max(0.5 * (mf + mb), 0.0);
+    if (l <= uMaxLength) {
+        oColor = table(sf, sb, l);
+        return;
+    }
+    // Longer than the table: equal pieces (the scalar is linear, so each is
+    // a segment), front to back, as PreIntegrationTable::lookup does.
+    int n = min(int(ceil(l / uMaxLength)), 256);
+    float piece = l / float(n);
+    vec4 acc = vec4(0.0);
+    for (int k = 0; k < n && acc.a < 0.99999; ++k) {
+        vec4 c = table(mix(sf, sb, float(k) / float(n)), mix(sf, sb, float(k + 1) / float(n)), piece);
+        acc += (1.0 - acc.a) * c;
+    }
+    oColor = acc;
+}
+)";
+
+} // namespace
+
+struct TetraPass::Impl {
+    struct Program {
+        GLuint id = 0;
+        GLint uViewProjRel = -1, uFirst = -1, uForward = -1, uDepthToView = -1, uTexScale = -1, uTexOffset = -1, uMaxLength = -1;
+    };
+    Program programs[4]; // [perspective * 2 + host depth]
+    GLuint vao = 0, ssbo = 0;
+    std::size_t ssboBytes = 0;
+    struct Table {
+        const PreIntegrationTable* source = nullptr;
+        std::uint64_t version = 0;
+        const float* data = nullptr;
+        GLuint texture = 0;
+        bool used = false;
+    };
+    std::vector<Table> tables;
+    std::vector<int> tableOfVolume;               // per frame volume: index into tables (-1: not drawn)
+    std::vector<std::size_t> recordBase;          // per frame volume: first record
+    std::vector<std::vector<std::uint32_t>> firstRecord; // per volume: records before tet i (size tets + 1)
+    std::vector<glm::vec4> records;
+    glm::vec3 eye{0.0f};
+    TetraStats stats;
+
+    ~Impl() {
+        if (!contextIsCurrent()) return;
+        for (const Table& t : tables) glDeleteTextures(1, &t.texture);
+        for (const Program& p : programs)
+            if (p.id) glDeleteProgram(p.id);
+        if (vao) glDeleteVertexArrays(1, &vao);
+        if (ssbo) glDeleteBuffers(1, &ssbo);
+    }
+};
+
+TetraPass::TetraPass(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
+TetraPass::TetraPass(TetraPass&&) noexcept = default;
+TetraPass& TetraPass::operator=(TetraPass&&) noexcept = default;
+TetraPass::~TetraPass() = default;
+const TetraStats& TetraPass::stats() const { return mImpl->stats; }
+
+Result<TetraPass> TetraPass::create() {
+    if (!contextIsCurrent()) return makeError("splatfx::gl tetrahedra pass: no OpenGL context is current on this thread");
+    auto impl = std::make_unique<Impl>();
+    Impl& r = *impl;
+    for (int v = 0; v < 4; ++v) {
+        const char* persp = (v & 2) ? "#define PERSPECTIVE 1\n" : "#define PERSPECTIVE 0\n";
+        const char* depth = (v & 1) ? "#define HAS_DEPTH 1\n" : "#define HAS_DEPTH 0\n";
+        auto linked = linkProgram({"#version 450 core\n", kTetraVertex}, {"#version 450 core\n", persp, depth, kTetraFragment}, "tetrahedra");
+        if (!linked) return makeError(linked.error());
+        Impl::Program& p = r.programs[v];
+        p.id = *linked;
+        auto loc = [&](const char* n) { return glGetUniformLocation(p.id, n); };
+        p.uViewProjRel = loc("uViewProjRel");
+        p.uFirst = loc("uFirst");
+        p.uForward = loc("uForward");
+        p.uDepthToView = loc("uDepthToView");
+        p.uTexScale = loc("uTexScale");
+        p.uTexOffset = loc("uTexOffset");
+        p.uMaxLength = loc("uMaxLength");
+    }
+    glCreateVertexArrays(1, &r.vao); // no attributes: everything comes from the buffer
+    glCreateBuffers(1, &r.ssbo);
+    return TetraPass(std::move(impl));
+}
+
+void TetraPass::prepare(const Frame& frame) {
+    Impl& r = *mImpl;
+    const std::uint64_t uploads = r.stats.tableUploads;
+    r.stats = {};
+    r.stats.tableUploads = uploads;
+    const auto& volumes = frame.volumes();
+    for (auto& t : r.tables) t.used = false;
+    r.tableOfVolume.assign(volumes.size(), -1);
+    // 0. Upload the tables that changed.
+    for (std::size_t v = 0; v < volumes.size(); ++v) {
+        const PreIntegrationTable* src = volumes[v].table;
+        if (!src || src->data().empty()) continue;
+        int found = -1;
+        for (std::size_t i = 0; i < r.tables.size(); ++i)
+            if (r.tables[i].source == src) found = int(i);
+        if (found < 0) {
+            r.tables.push_back({});
+            found = int(r.tables.size() - 1);
+        }
+        Impl::Table& t = r.tables[std::size_t(found)];
+        if (!t.texture || t.version != volumes[v].tableVersion || t.data != src->data().data()) {
+            if (t.texture) glDeleteTextures(1, &t.texture);
+            const glm::ivec3 n = src->dims();
+            glCreateTextures(GL_TEXTURE_3D, 1, &t.texture);
+            glTextureStorage3D(t.texture, 1, GL_RGBA32F, n.x, n.y, n.z);
+            glTextureSubImage3D(t.texture, 0, 0, 0, 0, n.x, n.y, n.z, GL_RGBA, GL_FLOAT, src->data().data());
+            glTextureParameteri(t.texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+            glTextureParameteri(t.texture, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            for (GLenum w : {GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T, GL_TEXTURE_WRAP_R}) glTextureParameteri(t.texture, w, GL_CLAMP_TO_EDGE);
+            t.source = src;
+            t.version = volumes[v].tableVersion;
+            t.data = src->data().data();
+            ++r.stats.tableUploads;
+        }
+        t.used = true;
+        r.tableOfVolume[v] = found;
+    }
+    // Tables no frame volume uses any more are released (indices are re-mapped).
+    for (std::size_t i = r.tables.size(); i-- > 0;) {
+        if (r.tables[i].used) continue;
+        glDeleteTextures(1, &r.tables[i].texture);
+        r.tables.erase(r.tables.begin() + std::ptrdiff_t(i));
+        for (int& k : r.tableOfVolume)
+            if (k > int(i)) --k;
+    }
+    for (const auto& t : r.tables) r.stats.tableBytes += t.source ? t.source->bytes() : 0;
+
+    // Per-instance records, relative to the eye (float precision where it matters).
+    const Camera& camera = frame.camera();
+    r.eye = camera.eye();
+    const glm::dvec3 eye(r.eye);
+    r.records.clear();
+    r.recordBase.assign(volumes.size(), 0);
+    r.firstRecord.resize(volumes.size());
+    for (std::size_t v = 0; v < volumes.size(); ++v) {
+        auto& first = r.firstRecord[v];
+        const auto& tets = volumes[v].lod.tets;
+        first.assign(tets.size() + 1, 0);
+        r.recordBase[v] = r.records.size() / kVec4PerTet;
+        const PreIntegrationTable* table = r.tableOfVolume[v] >= 0 ? volumes[v].table : nullptr;
+        std::uint32_t count = 0;
+        for (std::size_t i = 0; i < tets.size(); ++i) {
+            first[i] = count;
+            if (!table) continue;
+            const Tetrahedron& t = tets[i];
+            const auto [lo, hi] = std::minmax_element(t.scalar.begin(), t.scalar.end());
+            if (table->zeroOpacity(*lo, *hi)) { // the paper's table form of the ZOT (sec. 4.1)
+                ++r.stats.transparent;
+                continue;
+            }
+            glm::dvec3 p[4];
+            for (int k = 0; k < 4; ++k) p[k] = glm::dvec3(t.position[std::size_t(k)]) - eye;
+            const glm::dmat3 m(p[1] - p[0], p[2] - p[0], p[3] - p[0]);
+            const double det = glm::determinant(m);
+            const double scale = glm::length(m[0]) * glm::length(m[1]) * glm::length(m[2]);
+            if (!std::isfinite(det) || !(std::abs(det) > 1e-9 * scale)) {
+                ++r.stats.degenerate;
+                continue;
+            }
+            const glm::dmat3 inv = glm::inverse(m); // rows: gradients of lambda_1..3
+            glm::dvec4 b[4];
+            glm::dvec3 g0(0.0);
+            for (int k = 1; k < 4; ++k) {
+                const glm::dvec3 g(inv[0][k - 1], inv[1][k - 1], inv[2][k - 1]);
+                b[k] = glm::dvec4(g, -glm::dot(g, p[0]));
+                g0 -= g;
+            }
+            b[0] = glm::dvec4(g0, 1.0 - glm::dot(g0, p[0]));
+            glm::dvec4 s(0.0), ls(0.0);
+            for (int k = 0; k < 4; ++k) {
+                s += double(t.scalar[std::size_t(k)]) * b[k];
+                ls += double(t.lengthScale[std::size_t(k)]) * b[k];
+            }
+            for (int k = 0; k < 4; ++k) r.records.emplace_back(glm::vec3(p[k]), 0.0f);
+            for (int k = 0; k < 4; ++k) r.records.emplace_back(b[k]);
+            r.records.emplace_back(s);
+            r.records.emplace_back(ls);
+            ++count;
+        }
+        first[tets.size()] = count;
+    }
+    const std::size_t bytes = r.records.size() * sizeof(glm::vec4);
+    if (bytes > 0) {
+        // Orphan and refill: no wait on last frame's draws.
+        glNamedBufferData(r.ssbo, GLsizeiptr(bytes), r.records.data(), GL_STREAM_DRAW);
+        r.ssboBytes = bytes;
+    }
+}
+
+void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const TetraTarget& target) {
+    Impl& r = *mImpl;
+    if (volume >= r.firstRecord.size() || r.tableOfVolume[volume] < 0) return;
+    const auto& first = r.firstRecord[volume];
+    end = std::min<std::uint32_t>(end, std::uint32_t(first.size() - 1));
+    if (begin >= end) return;
+    const std::uint32_t a = first[begin], b = first[end];
+    if (a >= b) return;
+    const PreIntegrationTable& table = *frame.volumes()[volume].table;
+    const Impl::Table& tex = r.tables[std::size_t(r.tableOfVolume[volume])];
+    const Camera& camera = frame.camera();
+
+    GLuint hostDepth = target.depthTexture;
+    if (!hostDepth) { // the framebuffer's depth attachment, when it is a texture
+        GLint type = GL_NONE;
+        if (target.framebuffer) {
+            glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
+            if (type == GL_TEXTURE) {
+                GLint name = 0;
+                glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &name);
+                hostDepth = GLuint(name);
+            }
+        }
+    }
+
+    // Which winding is front-facing on screen for this camera (hosts may mirror
+    // their projection): a triangle facing the eye, projected.
+    const glm::mat4 vp = camera.proj * camera.view;
+    const glm::vec3 eye = camera.eye(), c = eye + camera.forward() * std::max(1.0f, 2.0f * camera.nearPlane());
+    auto ndc = [&](glm::vec3 q) {
+        const glm::vec4 h = vp * glm::vec4(q, 1.0f);
+        return glm::vec2(h) / h.w;
+    };
+    const glm::vec2 pa = ndc(c), pb = ndc(c + camera.right()), pc = ndc(c + camera.up());
+    const float area = (pb.x - pa.x) * (pc.y - pa.y) - (pb.y - pa.y) * (pc.x - pa.x);
+
+    SavedState saved;
+    saved.save({.texture2DUnits = 2, .scissor = false});
+    GLint prevTex3D = 0, prevSsbo = 0, prevCullMode = 0, prevFrontFace = 0;
+    glActiveTexture(GL_TEXTURE2);
+    glGetIntegerv(GL_TEXTURE_BINDING_3D, &prevTex3D);
+    glGetIntegerv(GL_SHADER_STORAGE_BUFFER_BINDING, &prevSsbo);
+    glGetIntegerv(GL_CULL_FACE_MODE, &prevCullMode);
+    glGetIntegerv(GL_FRONT_FACE, &prevFrontFace);
+    const GLboolean prevClamp = glIsEnabled(GL_DEPTH_CLAMP);
+
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
+    glViewport(target.x, target.y, target.width, target.height);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    glBlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
+    glDepthMask(GL_FALSE);
+    if (hostDepth) {
+        glDisable(GL_DEPTH_TEST); // the shader cuts each segment at the host depth
+    } else {
+        glEnable(GL_DEPTH_TEST);  // no depth texture: whole fragments behind the host are dropped
+        glDepthFunc(GL_LEQUAL);
+    }
+    glEnable(GL_DEPTH_CLAMP); // the CPU clipped at the near plane; GL must not clip again by rounding
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    glFrontFace(area >= 0.0f ? GL_CCW : GL_CW);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+
+    const Impl::Program& p = r.programs[(camera.perspective() ? 2 : 0) + (hostDepth ? 1 : 0)];
+    glUseProgram(p.id);
+    const glm::mat4 vpRel = vp * glm::translate(glm::mat4(1.0f), r.eye);
+    glUniformMatrix4fv(p.uViewProjRel, 1, GL_FALSE, glm::value_ptr(vpRel));
+    glUniform1i(p.uFirst, GLint(r.recordBase[volume] + a));
+    const glm::vec3 f = camera.forward();
+    glUniform3f(p.uForward, f.x, f.y, f.z);
+    const glm::mat4 invProj = glm::inverse(camera.proj);
+    glUniform4f(p.uDepthToView, invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+    const glm::vec3 n(table.dims());
+    glUniform3f(p.uTexScale, (n.x - 1.0f) / n.x, (n.y - 1.0f) / n.y, (n.z - 1.0f) / n.z);
+    glUniform3f(p.uTexOffset, 0.5f / n.x, 0.5f / n.y, 0.5f / n.z);
+    glUniform1f(p.uMaxLength, table.maxLengthWorld());
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, r.ssbo);
+    glBindTextureUnit(1, hostDepth);
+    glBindTextureUnit(2, tex.texture);
+    glBindVertexArray(r.vao);
+    glDrawArraysInstanced(GL_TRIANGLES, 0, 12, GLsizei(b - a));
+    ++r.stats.drawCalls;
+    r.stats.tetrahedra += b - a;
+
+    // Put back what SavedState does not cover.
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, GLuint(prevSsbo));
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_3D, glIsTexture(GLuint(prevTex3D)) ? GLuint(prevTex3D) : 0);
+    glCullFace(GLenum(prevCullMode));
+    glFrontFace(GLenum(prevFrontFace));
+    if (!prevClamp) glDisable(GL_DEPTH_CLAMP);
+    saved.restore();
+}
+
+} // namespace splatfx::gl::detail

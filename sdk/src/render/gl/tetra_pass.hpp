@@ -1,0 +1,69 @@
+// [clouds, issue 17] The projected-tetrahedra pass (private to the GL backend,
+// owned by gl::FrameRenderer): draws a FrameVolume's tetrahedra back to front
+// with pre-integration (Roettger & Ertl 2002, sec. 4), premultiplied "over".
+//
+// Method ("ray-tetrahedron in the fragment shader"): every tetrahedron's four
+// faces are drawn with back faces culled, so each covered pixel gets exactly
+// one fragment (the front faces of a convex cell tile its projection). The
+// fragment intersects its pixel's ray with the tetrahedron's four face planes
+// (per-instance barycentric planes), which gives the entry and exit distances;
+// the scalar and length scale at both ends come from per-instance linear
+// functions. The exit is cut at the host's depth (from HostTarget's depth
+// texture) before the lookup, so host geometry inside a cloud is exact. Near-
+// plane clipping is done on the CPU (clipTetrahedron) and GL's own near/far
+// clipping is switched off (depth clamp) so a face lying in the near plane is
+// never lost to rounding. No CPU projection (Shirley-Tuchman classes) needed.
+//
+// It does not sort (the list is already in order) and writes no depth.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "splatfx/camera.hpp"
+#include "splatfx/frame.hpp"
+#include "splatfx/result.hpp"
+
+namespace splatfx::gl::detail {
+
+struct TetraTarget {
+    unsigned framebuffer = 0;
+    int x = 0, y = 0, width = 0, height = 0;
+    // The host's depth texture; 0: none (then the framebuffer's depth test
+    // culls whole fragments at the front face, which is not exact).
+    unsigned depthTexture = 0;
+};
+
+struct TetraStats {
+    std::uint64_t tetrahedra = 0;      // drawn this frame
+    std::uint64_t transparent = 0;     // skipped by the table's zero-opacity test
+    std::uint64_t degenerate = 0;      // skipped: zero or non-finite volume
+    std::uint64_t drawCalls = 0;
+    std::uint64_t tableUploads = 0;    // since creation
+    std::size_t tableBytes = 0;        // GPU bytes held by uploaded tables
+};
+
+class TetraPass {
+public:
+    static Result<TetraPass> create();
+    TetraPass(TetraPass&&) noexcept;
+    TetraPass& operator=(TetraPass&&) noexcept;
+    ~TetraPass();
+
+    // Step 0 of the frame: uploads the tables the frame's volumes use that
+    // changed (new address or version), drops tables no longer used, and
+    // builds the per-instance data of every volume. Resets the frame stats.
+    void prepare(const Frame& frame);
+    // Draws tetrahedra [begin, end) of frame.volumes()[volume] (after prepare).
+    void draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const TetraTarget& target);
+
+    const TetraStats& stats() const;
+
+private:
+    struct Impl;
+    explicit TetraPass(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> mImpl;
+};
+
+} // namespace splatfx::gl::detail

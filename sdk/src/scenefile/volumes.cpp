@@ -1,0 +1,123 @@
+// [clouds, issue 17] The top-level "volumes" block: LOD volumes drawn as
+// projected tetrahedra (docs/scene-format.md, `volumes[i]`). One kind so far:
+// "clouds" (makeCloudVolume + makeCloudTransfer, Roettger & Ertl 2002 sec. 5).
+#include <cmath>
+#include <string>
+#include <utility>
+
+#include "scenefile/reader.hpp"
+#include "splatfx/volume.hpp"
+
+namespace splatfx::scenefile {
+namespace {
+
+// Grid points a scene may ask for: 1 GiB is LodVolumeDesc's own budget; this
+// keeps a typo from building a field for minutes first.
+constexpr double kMaxVolumePoints = 64.0 * 1024 * 1024;
+
+// The cloud generator's vertical axis is grid z; scenes are y-up. The field is
+// generated with (x, z, y) dims and re-indexed so grid y is world up.
+ScalarVolume yUp(const ScalarVolume& zUp) {
+    const glm::ivec3 d = zUp.dims; // x, horizontal 2, height
+    ScalarVolume out;
+    out.dims = {d.x, d.z, d.y};
+    out.scalar.resize(zUp.scalar.size());
+    out.lengthScale.resize(zUp.lengthScale.size());
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x) {
+                const std::size_t src = std::size_t(x) + std::size_t(d.x) * (std::size_t(y) + std::size_t(d.y) * std::size_t(z));
+                const std::size_t dst = std::size_t(x) + std::size_t(d.x) * (std::size_t(z) + std::size_t(d.z) * std::size_t(y));
+                out.scalar[dst] = zUp.scalar[src];
+                if (!zUp.lengthScale.empty()) out.lengthScale[dst] = zUp.lengthScale[src];
+            }
+    return out;
+}
+
+} // namespace
+
+void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& out) {
+    if (!v.is_array() || v.size() > 64) {
+        c.d.error(path, "expected an array of at most 64 volume objects, got " + brief(v));
+        return;
+    }
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        const std::string p = index(path, i);
+        ObjectReader o(c.d, p, v[i]);
+        if (!o.valid()) continue;
+        const std::size_t before = c.d.count();
+        std::string name = "volume" + std::to_string(i), kind;
+        o.string("name", name);
+        o.string("kind", kind);
+        if (kind != "clouds") c.d.error(o.at("kind"), kind.empty() ? "required: \"clouds\"" : "unknown kind '" + kind + "' (known: clouds)");
+        bool enabled = true, morph = true;
+        glm::ivec3 dims{129, 17, 129};
+        glm::vec3 origin{0.0f}, sun{0.3f, 1.0f, 0.2f};
+        float spacing = 1.0f, detailC = 10.0f, minC = 4.0f;
+        std::uint32_t localSeed = std::uint32_t(i);
+        CloudDesc cd;
+        CloudTransferDesc td;
+        int scalarRes = 64, lengthRes = 128;
+        o.boolean("enabled", enabled);
+        o.ivec3("dims", dims, 2, 1025);
+        o.vec3("position", origin, -kMaxCoord, kMaxCoord);
+        o.number("spacing", spacing, 1e-4, 1e4);
+        o.seed("seed", localSeed);
+        o.number("featureCells", cd.featureCells, 1.0, 1e4);
+        o.integer("octaves", cd.octaves, 1, 8);
+        o.number("coverage", cd.coverage, 0.0, 1.0);
+        o.number("sharpness", cd.sharpness, 0.01, 100.0);
+        o.vec3("sunDirection", sun, -1e3, 1e3);
+        o.number("ambient", cd.ambient, 0.0, 1.0);
+        o.number("diffuse", cd.diffuse, 0.0, 1.0);
+        o.number("lightExtinctionPerCell", cd.lightExtinctionPerCell, 0.0, 100.0);
+        o.number("threshold", td.threshold, 0.0, 1.0);
+        o.number("extinctionPerWorld", td.maxExtinctionPerWorld, 0.0, 1e4);
+        o.color3("bright", td.bright);
+        o.color3("dark", td.dark);
+        o.number("detailC", detailC, 1e-3, 1e9);
+        o.number("minAccuracyC", minC, 0.9, 1e4);
+        o.boolean("morph", morph);
+        o.integer("tableScalars", scalarRes, 2, 256);
+        o.integer("tableLengths", lengthRes, 2, 512);
+        o.finish();
+        if (c.d.count() != before) continue;
+        if (double(dims.x) * dims.y * dims.z > kMaxVolumePoints) {
+            c.d.error(o.at("dims"), "more than 64 Mi grid points");
+            continue;
+        }
+        if (!(glm::length(sun) > 0.0f)) {
+            c.d.error(o.at("sunDirection"), "must not be zero");
+            continue;
+        }
+        cd.dims = {dims.x, dims.z, dims.y};                 // generator: z up
+        cd.sunDirection = {sun.x, sun.z, sun.y};
+        cd.seed = c.sceneSeed * 1000003u + 7919u + localSeed; // like effects: --seed changes them all
+        auto field = makeCloudVolume(cd);
+        if (!field) {
+            c.d.error(p, field.error());
+            continue;
+        }
+        auto vol = LodVolume::create(yUp(*field), {.originWorld = origin, .spacingWorld = spacing, .minAccuracyC = minC});
+        if (!vol) {
+            c.d.error(p, vol.error());
+            continue;
+        }
+        auto tf = makeCloudTransfer(td);
+        if (!tf) {
+            c.d.error(p, tf.error());
+            continue;
+        }
+        // The longest segment a root cube can hold (its diagonal; length scales are <= 1).
+        const float longest = std::sqrt(3.0f) * float(1 << vol->rootLevel()) * spacing;
+        auto table = PreIntegrationTable::create(*tf, {.scalarResolution = scalarRes, .lengthResolution = lengthRes, .maxLengthWorld = longest});
+        if (!table) {
+            c.d.error(p, table.error());
+            continue;
+        }
+        out.scene.addVolume(std::move(*vol), std::move(*tf), std::move(*table),
+                            {.name = name, .enabled = enabled, .refine = {.detailC = detailC, .morph = morph}});
+    }
+}
+
+} // namespace splatfx::scenefile

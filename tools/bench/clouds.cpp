@@ -1,0 +1,231 @@
+// splatfx-bench clouds (issue 17): LOD volumes drawn as pre-integrated
+// projected tetrahedra on a flight through a cloud field: tetrahedra drawn
+// against the full-resolution count, frame rate and memory outside and inside
+// the cloud, and a popping metric with and without morphing against the
+// finest level's own frame-to-frame change.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include <epoxy/gl.h>
+
+#include "splatfx/context.hpp"
+#include "splatfx/gl/frame_renderer.hpp"
+#include "splatfx/gl/framebuffer.hpp"
+#include "splatfx/scene.hpp"
+#include "splatfx/volume.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
+
+struct Options {
+    glm::ivec3 dims{257, 257, 33};
+    float detailC = 10.0f;
+    int frames = 120;
+    glm::ivec2 size{512, 384};
+    glm::ivec3 popDims{65, 65, 17};
+    int popFrames = 40;
+    glm::ivec2 popSize{256, 192};
+    float popDetailC = 10.0f;
+    float popStepWorld = 0.25f; // a quarter cell per frame
+};
+
+struct CloudSet {
+    splatfx::Scene scene;
+    splatfx::VolumeId id = 0;
+    std::size_t tableBytes = 0, volumeBytes = 0;
+    std::uint64_t full = 0;
+    glm::vec3 ext{0.0f};
+};
+
+bool makeClouds(glm::ivec3 dims, float detailC, CloudSet& out) {
+    splatfx::CloudDesc cd;
+    cd.dims = dims;
+    auto field = splatfx::makeCloudVolume(cd);
+    if (!field) return std::fprintf(stderr, "%s\n", field.error().c_str()), false;
+    auto vol = splatfx::LodVolume::create(*field, {});
+    if (!vol) return std::fprintf(stderr, "%s\n", vol.error().c_str()), false;
+    auto tf = splatfx::makeCloudTransfer({});
+    const float longest = std::sqrt(3.0f) * float(1 << vol->rootLevel()) * vol->spacingWorld();
+    auto table = splatfx::PreIntegrationTable::create(*tf, {.maxLengthWorld = longest});
+    if (!tf || !table) return std::fprintf(stderr, "transfer/table failed\n"), false;
+    out.tableBytes = table->bytes();
+    out.volumeBytes = vol->memoryBytes();
+    out.full = vol->fullResolutionTets();
+    out.ext = glm::vec3(vol->pointDims() - 1) * vol->spacingWorld();
+    out.id = out.scene.addVolume(std::move(*vol), std::move(*tf), std::move(*table), {.name = "clouds", .refine = {.detailC = detailC}});
+    return true;
+}
+
+// The flight of docs/volume.md: at mid height from outside the -x face,
+// through the field and out, at constant speed.
+splatfx::Camera flight(const glm::vec3& ext, int f, int frames, glm::ivec2 size) {
+    const glm::vec3 start(-0.25f * ext.x, 0.37f * ext.y, 0.5f * ext.z), end(1.25f * ext.x, 0.61f * ext.y, 0.5f * ext.z);
+    const float u = frames > 1 ? float(f) / float(frames - 1) : 0.0f;
+    const glm::vec3 eye = start + (end - start) * u, dir = glm::normalize(end - start);
+    return splatfx::Camera::lookAt(eye, eye + dir, {0, 0, 1}, glm::radians(60.0f), size, 0.1f, 5000.0f);
+}
+
+// The same line at constant speed: `step` world units per frame from 10% of
+// the way (outside the -x face), so the flight approaches and enters the field.
+splatfx::Camera slowFlight(const glm::vec3& ext, int f, float step, glm::ivec2 size) {
+    const glm::vec3 start(-0.25f * ext.x, 0.37f * ext.y, 0.5f * ext.z), end(1.25f * ext.x, 0.61f * ext.y, 0.5f * ext.z);
+    const glm::vec3 dir = glm::normalize(end - start), eye = start + 0.1f * (end - start) + dir * (step * float(f));
+    return splatfx::Camera::lookAt(eye, eye + dir, {0, 0, 1}, glm::radians(60.0f), size, 0.1f, 5000.0f);
+}
+
+bool inside(const glm::vec3& ext, const splatfx::Camera& c) {
+    const glm::vec3 e = c.eye();
+    return e.x > 0 && e.y > 0 && e.z > 0 && e.x < ext.x && e.y < ext.y && e.z < ext.z;
+}
+
+double percentile(std::vector<double> v, double p) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    return v[std::min(v.size() - 1, std::size_t(p * double(v.size() - 1) + 0.5))];
+}
+
+int usage() {
+    std::printf("usage: splatfx-bench clouds [--dims X Y Z] [--c DETAIL] [--frames N] [--size W H]\n"
+                "                            [--pop-dims X Y Z] [--pop-frames N] [--pop-size W H] [--pop-c DETAIL]\n"
+                "                            [--pop-step WORLD_PER_FRAME]\n");
+    return 2;
+}
+
+} // namespace
+
+int runClouds(int argc, char** argv) {
+    Options o;
+    for (int i = 1; i < argc; ++i) {
+        auto next3 = [&](glm::ivec3& v) { v = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2]), std::atoi(argv[i + 3])}; i += 3; };
+        auto next2 = [&](glm::ivec2& v) { v = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2])}; i += 2; };
+        if (!std::strcmp(argv[i], "--dims") && i + 3 < argc) next3(o.dims);
+        else if (!std::strcmp(argv[i], "--pop-dims") && i + 3 < argc) next3(o.popDims);
+        else if (!std::strcmp(argv[i], "--size") && i + 2 < argc) next2(o.size);
+        else if (!std::strcmp(argv[i], "--pop-size") && i + 2 < argc) next2(o.popSize);
+        else if (!std::strcmp(argv[i], "--c") && i + 1 < argc) o.detailC = float(std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--pop-c") && i + 1 < argc) o.popDetailC = float(std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--pop-step") && i + 1 < argc) o.popStepWorld = float(std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) o.frames = std::atoi(argv[++i]);
+        else if (!std::strcmp(argv[i], "--pop-frames") && i + 1 < argc) o.popFrames = std::atoi(argv[++i]);
+        else return usage();
+    }
+    if (o.frames < 2 || o.popFrames < 2 || o.size.x < 1 || o.size.y < 1 || o.popSize.x < 1 || o.popSize.y < 1) return usage();
+    auto ctx = splatfx::HeadlessContext::create();
+    if (!ctx) return std::fprintf(stderr, "%s\n", ctx.error().c_str()), 1;
+    auto fr = splatfx::gl::FrameRenderer::create();
+    if (!fr) return std::fprintf(stderr, "%s\n", fr.error().c_str()), 1;
+    splatfx::Materials materials{splatfx::Footprint{}};
+
+    // ---- 1. The flight: counts, frame rate, memory ----
+    {
+        CloudSet cs;
+        const auto t0 = Clock::now();
+        if (!makeClouds(o.dims, o.detailC, cs)) return 1;
+        std::printf("clouds %dx%dx%d, c = %.1f: field + octree + 64x64x128 table %.0f ms\n", o.dims.x, o.dims.y, o.dims.z,
+                    o.detailC, ms(Clock::now() - t0));
+        auto fb = splatfx::gl::Framebuffer::create({.width = o.size.x, .height = o.size.y});
+        if (!fb) return std::fprintf(stderr, "%s\n", fb.error().c_str()), 1;
+        splatfx::Frame frame;
+        std::vector<double> tOut, tIn, prepOut, prepIn, drawnOut, drawnIn;
+        std::size_t maxFrameBytes = 0;
+        for (int f = -2; f < o.frames; ++f) { // two warm-up frames (table upload, shader compile)
+            const splatfx::Camera cam = flight(cs.ext, std::max(f, 0), o.frames, o.size);
+            const auto a = Clock::now();
+            cs.scene.prepare(f / 60.0 + 1.0, cam, materials, frame);
+            const auto b = Clock::now();
+            fr->render(frame, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture(), .drawOpaque = [] {
+                               glClearColor(0.45f, 0.6f, 0.85f, 1.0f);
+                               glClearDepth(1.0);
+                               glDepthMask(GL_TRUE);
+                               glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+                           }});
+            glFinish();
+            const auto c = Clock::now();
+            if (f < 0) continue;
+            const bool in = inside(cs.ext, cam);
+            (in ? tIn : tOut).push_back(ms(c - a));
+            (in ? prepIn : prepOut).push_back(ms(b - a));
+            (in ? drawnIn : drawnOut).push_back(double(fr->stats().tetrahedra));
+            std::size_t bytes = 0;
+            for (const auto& v : frame.volumes()) bytes += v.lod.tets.size() * (sizeof(splatfx::Tetrahedron) + 160);
+            maxFrameBytes = std::max(maxFrameBytes, bytes);
+        }
+        auto mean = [](const std::vector<double>& v) {
+            double s = 0;
+            for (double x : v) s += x;
+            return v.empty() ? 0.0 : s / double(v.size());
+        };
+        std::printf("full resolution: %llu tetrahedra\n", static_cast<unsigned long long>(cs.full));
+        for (int in = 0; in < 2; ++in) {
+            const auto& t = in ? tIn : tOut;
+            const auto& d = in ? drawnIn : drawnOut;
+            const auto& p = in ? prepIn : prepOut;
+            if (t.empty()) continue;
+            const double dm = mean(d), med = percentile(t, 0.5);
+            std::printf("%s (%zu frames, %dx%d): drawn mean %.0f max %.0f (%.0fx fewer than full); frame ms median %.1f "
+                        "(%.1f Hz) mean %.1f p90 %.1f; of it prepare (LOD update) median %.1f ms\n",
+                        in ? "inside " : "outside", t.size(), o.size.x, o.size.y, dm, *std::max_element(d.begin(), d.end()),
+                        double(cs.full) / std::max(dm, 1.0), med, 1000.0 / med, mean(t), percentile(t, 0.9), percentile(p, 0.5));
+        }
+        std::printf("memory: LOD volume %zu bytes, table %zu bytes (CPU) + %zu (GPU, RGBA32F), per-frame tetrahedra up to %zu bytes "
+                    "(CPU list + GPU records)\n",
+                    cs.volumeBytes, cs.tableBytes, fr->stats().tableBytes, maxFrameBytes);
+    }
+
+    // ---- 2. Popping: per-pixel change between consecutive frames ----
+    {
+        CloudSet cs;
+        if (!makeClouds(o.popDims, o.popDetailC, cs)) return 1;
+        auto fb = splatfx::gl::Framebuffer::create({.width = o.popSize.x, .height = o.popSize.y, .color = splatfx::gl::Precision::F32});
+        if (!fb) return std::fprintf(stderr, "%s\n", fb.error().c_str()), 1;
+        std::printf("popping: clouds %dx%dx%d (full %llu tetrahedra), %d frames at %dx%d, %.3f world units per frame, c = %.1f\n",
+                    o.popDims.x, o.popDims.y, o.popDims.z, static_cast<unsigned long long>(cs.full), o.popFrames, o.popSize.x,
+                    o.popSize.y, o.popStepWorld, o.popDetailC);
+        struct Mode {
+            const char* name;
+            float c;
+            bool morph;
+        };
+        const Mode modes[] = {{"finest level", 1e9f, true}, {"LOD, morphing", o.popDetailC, true}, {"LOD, no morphing", o.popDetailC, false}};
+        double finestMax = 0, finestP99 = 0;
+        for (const Mode& m : modes) {
+            cs.scene.volumeOptions(cs.id).refine = {.detailC = m.c, .morph = m.morph};
+            splatfx::Frame frame;
+            splatfx::Image prev;
+            std::vector<double> change;
+            double drawn = 0;
+            for (int f = 0; f < o.popFrames; ++f) {
+                const splatfx::Camera cam = slowFlight(cs.ext, f, o.popStepWorld, o.popSize);
+                cs.scene.prepare(f / 60.0 + 1.0, cam, materials, frame);
+                fr->render(frame, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture(), .drawOpaque = [] {
+                                   glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+                                   glClearDepth(1.0);
+                                   glDepthMask(GL_TRUE);
+                                   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+                               }});
+                drawn += double(fr->stats().tetrahedra);
+                splatfx::Image img = fb->read();
+                if (f > 0)
+                    for (std::size_t p = 0; p < img.pixels.size(); p += 4) {
+                        double e = 0;
+                        for (int k = 0; k < 4; ++k) e = std::max(e, double(std::abs(img.pixels[p + std::size_t(k)] - prev.pixels[p + std::size_t(k)])));
+                        change.push_back(e);
+                    }
+                prev = std::move(img);
+            }
+            const double mx = percentile(change, 1.0), p99 = percentile(change, 0.99);
+            if (m.c >= 1e9f) finestMax = mx, finestP99 = p99;
+            std::printf("  %-17s drawn mean %9.0f  change max %.4f  p99 %.4f   (vs finest: max %.2fx, p99 %.2fx)\n", m.name,
+                        drawn / o.popFrames, mx, p99, mx / std::max(finestMax, 1e-12), p99 / std::max(finestP99, 1e-12));
+        }
+    }
+    return 0;
+}
