@@ -7,6 +7,7 @@
 int runAccuracy(int argc, char** argv); // accuracy.cpp: error vs time per quality knob (issue 5)
 int runTable1(int argc, char** argv);   // table1.cpp: the paper's Table I, fill limit, CPU scaling (issue 7)
 int runScheduling(int argc, char** argv); // scheduling.cpp: 1000 effects, 10 in view; catch-up error (issue 6)
+int runSoak(int argc, char** argv);       // soak.cpp: every preset for an hour of scene time; finite, flat bounds and memory (issue 13)
 
 struct BenchCommand {
     const char* name;
@@ -18,4 +19,5 @@ inline constexpr BenchCommand kCommands[] = {
     {"accuracy", "error against the exact reference vs time per frame, for every quality knob", runAccuracy},
     {"table1", "King et al. 1999 Table I on this machine, fill limit, naive baseline, CPU scaling", runTable1},
     {"scheduling", "a level of 1000 effects with 10 in view vs those 10 alone; camera sweep; catch-up error", runScheduling},
+    {"soak", "every preset stepped at 60 Hz for an hour of scene time: no NaN/Inf, bounds and memory flat", runSoak},
 };

@@ -10,6 +10,7 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "cli.hpp"
 #include "splatfx/presets.hpp"
 #include "splatfx/scene.hpp"
 
@@ -56,14 +57,20 @@ int runScheduling(int argc, char** argv) {
     int count = 1000, frames = 60;
     for (int i = 1; i < argc; ++i) { // argv[0] is the subcommand
         const std::string a = argv[i];
-        if (a == "--effects" && i + 1 < argc) count = std::max(20, std::atoi(argv[++i]));
-        else if (a == "--frames" && i + 1 < argc) frames = std::max(5, std::atoi(argv[++i]));
+        // Strict and bounded (tools/common/cli.hpp): 100000 effects is about 100x the level this bench models.
+        splatfx::Status st;
+        if (a == "--effects" && i + 1 < argc) st = cli::parseInt("--effects", argv[++i], 20, 100000, count);
+        else if (a == "--frames" && i + 1 < argc) st = cli::parseInt("--frames", argv[++i], 5, 100000, frames);
         else if (a == "--quick") frames = 15;
         else {
             std::printf("splatfx-bench scheduling [--effects N] [--frames N] [--quick]\n"
                         "  A level of N effects (fire, steam, smoke solver, fire-to-smoke) of which 10 are in view,\n"
                         "  against a scene holding only those 10; a camera sweep; solver catch-up error.\n");
             return a == "--help" || a == "-h" ? 0 : 2;
+        }
+        if (!st) {
+            std::fprintf(stderr, "scheduling: %s\n", st.error().c_str());
+            return 2;
         }
     }
     splatfx::Materials m{splatfx::Footprint{}};
