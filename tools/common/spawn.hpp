@@ -34,9 +34,9 @@ enum class ChildOutput {
 };
 
 struct SpawnDesc {
-    std::vector<std::string> argv;  // argv[0] is looked up in PATH (execvp); required, non-empty
-    std::string workingDir;         // default "": this process's working folder
-    std::vector<std::string> env;   // default none: NAME=VALUE entries added to (or replacing in) this environment
+    std::vector<std::string> argv{}; // argv[0] is looked up in PATH (execvp); required, non-empty
+    std::string workingDir{};       // default "": this process's working folder
+    std::vector<std::string> env{}; // default none: NAME=VALUE entries added to (or replacing in) this environment
     ChildOutput output = ChildOutput::Inherit; // default Inherit
 };
 
