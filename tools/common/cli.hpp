@@ -33,7 +33,15 @@
 namespace cli {
 
 namespace detail {
-inline std::string quoted(std::string_view text) { return "'" + std::string(text) + "'"; }
+// Built by appends: GCC 12's -Wrestrict misfires on "'" + std::string(...).
+inline std::string quoted(std::string_view text) {
+    std::string q;
+    q.reserve(text.size() + 2);
+    q.push_back('\'');
+    q.append(text);
+    q.push_back('\'');
+    return q;
+}
 
 template <class T>
 std::string show(T v) {
