@@ -18,6 +18,7 @@ FUZZ_SECONDS="${FUZZ_SECONDS:-60}"
 FUZZ_TARGETS="${FUZZ_TARGETS:-scene_file texture_set image mesh}"
 CXX_FUZZ="${CXX_FUZZ:-clang++}"
 
+[ "$CXX_FUZZ" = clang++ ] && tools/setup-deps.sh --fuzz
 command -v "$CXX_FUZZ" >/dev/null || { echo "fuzz: $CXX_FUZZ not found (Debian: apt-get install clang libclang-rt-dev)" >&2; exit 1; }
 echo "fuzz: configuring $BUILD_DIR with $CXX_FUZZ"
 cmake -S . -B "$BUILD_DIR" -DCMAKE_CXX_COMPILER="$CXX_FUZZ" -DSPLATFX_FUZZ=ON \

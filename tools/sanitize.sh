@@ -13,6 +13,7 @@ cd "$(dirname "$0")/.."
 BUILD_DIR="${BUILD_DIR:-build-asan}"
 JOBS="${JOBS:-$(nproc)}"
 start=$(date +%s)
+tools/setup-deps.sh
 echo "sanitize: configuring $BUILD_DIR (GCC, SPLATFX_SANITIZE=ON)"
 cmake -S . -B "$BUILD_DIR" -DSPLATFX_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DSPLATFX_BUILD_TESTS=ON -DSPLATFX_BUILD_TOOLS=ON -DSPLATFX_BUILD_SAMPLES=ON >/dev/null

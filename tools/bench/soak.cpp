@@ -4,6 +4,7 @@
 // Effect::bounds stays flat (does not grow without limit), and the process's
 // resident memory stays flat. Prints a table; exits 1 if any preset fails.
 // CPU only: no GL context is needed (simulation never touches GL).
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -67,6 +68,10 @@ struct Outcome {
     double nonFiniteAtSec = 0.0;
     splatfx::Aabb firstBox, lastBox; // union of bounds over the first and the last tenth of the run
     double rssFirstMiB = 0.0, rssLastMiB = 0.0;
+    // What the bounds do not show: live voxels and (solvers) total density,
+    // largest over the first and the last tenth, so a slow build-up is visible.
+    std::size_t voxelsFirst = 0, voxelsLast = 0;
+    double massFirst = 0.0, massLast = 0.0;
     bool boundsFlat = true, memoryFlat = true;
 };
 
@@ -142,6 +147,10 @@ int runSoak(int argc, char** argv) {
                 if ((inFirst || inLast) && (k % boundsEvery == 0 || k == tenth || k == steps)) {
                     const splatfx::Aabb b = e.bounds(e.time(), e.time());
                     (inFirst ? o.firstBox : o.lastBox).extend(b);
+                    std::size_t& vox = inFirst ? o.voxelsFirst : o.voxelsLast;
+                    double& mass = inFirst ? o.massFirst : o.massLast;
+                    vox = std::max(vox, e.grid().voxels.size());
+                    if (e.solver()) mass = std::max(mass, e.solver()->totalDensity());
                     if (inFirst && inLast) o.lastBox.extend(b); // runs shorter than 10 steps
                 }
                 if (k == tenth) o.rssFirstMiB = rssMiB();
@@ -168,18 +177,20 @@ int runSoak(int argc, char** argv) {
         out.push_back(o);
     }
 
-    std::printf("\n| preset | steps | scene time | wall s | us/step | NaN/Inf | bounds extent, first 10%% -> last 10%% | RSS MiB, at 10%% -> end | verdict |\n"
-                "|---|---:|---:|---:|---:|---|---|---|---|\n");
+    std::printf("\n| preset | steps | scene time | wall s | us/step | NaN/Inf | bounds extent, first 10%% -> last 10%% | RSS MiB, at 10%% -> end | max voxels, first -> last 10%% | max solver density sum | verdict |\n"
+                "|---|---:|---:|---:|---:|---|---|---|---|---|---|\n");
     bool ok = true;
     for (const Outcome& o : out) {
         const glm::vec3 a = extent(o.firstBox), b = extent(o.lastBox);
         const bool pass = o.nonFinite.empty() && o.boundsFlat && o.memoryFlat;
         ok = ok && pass;
         const std::string nan = o.nonFinite.empty() ? "none" : o.nonFinite + " at " + std::to_string(o.nonFiniteAtSec) + " s";
-        std::printf("| %s | %lld | %.1f min | %.1f | %.1f | %s | %.2f x %.2f x %.2f -> %.2f x %.2f x %.2f%s | %.1f -> %.1f%s | %s |\n",
+        char mass[64] = "-";
+        if (o.massFirst > 0.0 || o.massLast > 0.0) std::snprintf(mass, sizeof mass, "%.1f -> %.1f", o.massFirst, o.massLast);
+        std::printf("| %s | %lld | %.1f min | %.1f | %.1f | %s | %.2f x %.2f x %.2f -> %.2f x %.2f x %.2f%s | %.1f -> %.1f%s | %zu -> %zu | %s | %s |\n",
                     o.name.c_str(), o.steps, o.steps * dt / 60.0, o.wallSec, 1e6 * o.wallSec / double(o.steps), nan.c_str(), a.x, a.y, a.z,
                     b.x, b.y, b.z, o.boundsFlat ? "" : " (GROWS)", o.rssFirstMiB, o.rssLastMiB, o.memoryFlat ? "" : " (GROWS)",
-                    pass ? "pass" : "FAIL");
+                    o.voxelsFirst, o.voxelsLast, mass, pass ? "pass" : "FAIL");
     }
     std::printf("\nsoak: %s\n", ok ? "every preset stayed finite with flat bounds and memory" : "FAILED (see the table)");
     return ok ? 0 : 1;
