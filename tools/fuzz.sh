@@ -32,7 +32,9 @@ cmake --build "$BUILD_DIR" -j"$JOBS" --target "${targets[@]}"
 # Mesa/assimp/OpenImageIO are not instrumented; leaks inside them are not ours
 # (the same suppressions as the sanitizer suite), and leak checks stay on for the rest.
 export LSAN_OPTIONS="suppressions=$PWD/tools/lsan.supp:print_suppressions=0"
-export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}"
+# fast_unwind_on_malloc=0: those libraries have no frame pointers, and a suppression
+# only matches a frame the unwinder reached.
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:fast_unwind_on_malloc=0:allocator_may_return_null=1}"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 
 failed=()
