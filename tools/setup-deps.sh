@@ -2,6 +2,8 @@
 # Installs splatfx's build and test dependencies from Debian's archive.
 # Idempotent and fast when everything is present (no apt-get update then).
 # Needs root (or sudo) only when something is missing.
+#   tools/setup-deps.sh          build and test dependencies
+#   tools/setup-deps.sh --fuzz   ... and clang with libFuzzer (tools/fuzz.sh)
 set -euo pipefail
 
 PACKAGES=(
@@ -12,6 +14,10 @@ PACKAGES=(
   libassimp-dev libimgui-dev
   gnuplot-nox xvfb xauth
 )
+# tools/fuzz.sh needs clang and its libFuzzer runtime; only it asks for them (--fuzz).
+if [ "${1:-}" = "--fuzz" ]; then
+  PACKAGES+=(clang libclang-rt-14-dev)
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

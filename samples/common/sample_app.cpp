@@ -11,6 +11,7 @@
 #include <epoxy/gl.h>
 #include <GLFW/glfw3.h>
 
+#include "cli.hpp"
 #include "splatfx/context.hpp"
 
 namespace samples {
@@ -37,24 +38,24 @@ bool parseOptions(int argc, char** argv, const char* name, const char* about, Op
         } else if (a == "--traditional") {
             o.traditional = true;
         } else if (a == "--frames" && (v = next())) {
-            o.frames = std::atoi(v);
-            if (o.frames <= 0 || o.frames > 100000) {
-                std::fprintf(stderr, "%s: --frames must be between 1 and 100000, got '%s'\n", name, v);
+            if (auto st = cli::parseInt("--frames", v, 1, 100000, o.frames); !st) {
+                std::fprintf(stderr, "%s: %s\n", name, st.error().c_str());
                 return false;
             }
         } else if (a == "--out" && (v = next())) {
             o.out = v;
         } else if (a == "--size" && (v = next())) {
-            if (std::sscanf(v, "%dx%d", &o.size.x, &o.size.y) != 2 || o.size.x < 16 || o.size.y < 16 || o.size.x > 8192 ||
-                o.size.y > 8192) {
-                std::fprintf(stderr, "%s: --size must look like 640x480 (16..8192 per side), got '%s'\n", name, v);
+            if (auto st = cli::parseSize("--size", v, 16, 8192, o.size.x, o.size.y); !st) {
+                std::fprintf(stderr, "%s: %s (e.g. 640x480)\n", name, st.error().c_str());
                 return false;
             }
         } else if (a == "--seed" && (v = next())) {
-            o.seed = std::uint32_t(std::strtoul(v, nullptr, 10));
+            if (auto st = cli::parseInt("--seed", v, 0u, 4294967295u, o.seed); !st) {
+                std::fprintf(stderr, "%s: %s\n", name, st.error().c_str());
+                return false;
+            }
         } else if (a == "--fps" && (v = next())) {
-            o.fps = float(std::atof(v));
-            if (!(o.fps > 0.0f && o.fps <= 240.0f)) {
+            if (!cli::parseReal("--fps", v, 0.0f, 240.0f, o.fps) || !(o.fps > 0.0f)) {
                 std::fprintf(stderr, "%s: --fps must be in (0, 240], got '%s'\n", name, v);
                 return false;
             }
@@ -161,7 +162,8 @@ int runWindowed(const Options& o, const char* name, const std::function<bool()>&
 
 int run(const Options& o, const char* name, const std::function<bool()>& setup,
         const std::function<bool(const FrameContext&)>& frame) {
-    return o.frames > 0 ? runHeadless(o, name, setup, frame) : runWindowed(o, name, setup, frame);
+    // Any exception from a sample's setup or frame (std::bad_alloc at a huge --size) becomes a message and exit code 1.
+    return cli::guardedMain(name, [&] { return o.frames > 0 ? runHeadless(o, name, setup, frame) : runWindowed(o, name, setup, frame); });
 }
 
 } // namespace samples

@@ -31,6 +31,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "cli.hpp"
+#include "spawn.hpp"
 #include "commands.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/program.hpp"
@@ -63,6 +65,7 @@ struct Options {
     std::string out = "bench-accuracy";
     glm::ivec2 size{320, 240};
     int reps = 11;
+    bool replotOnly = false; // --replot: only run gnuplot on an existing DIR/accuracy.gp
     bool plots = true;
 };
 
@@ -356,13 +359,25 @@ bool parse(int argc, char** argv, Options& o) {
             if (!v) return false;
             o.out = v;
         } else if (a == "--size") {
+            // 2048 a side: the run keeps a dozen float images of this size
+            // (references in double), about 1 GB at the cap.
             const char* v = next();
-            if (!v || std::sscanf(v, "%dx%d", &o.size.x, &o.size.y) != 2 || o.size.x < 16 || o.size.y < 16) return false;
+            if (!v) return false;
+            if (auto s = cli::parseSize("--size", v, 16, 2048, o.size.x, o.size.y); !s) {
+                std::fprintf(stderr, "accuracy: %s\n", s.error().c_str());
+                return false;
+            }
         } else if (a == "--reps") {
             const char* v = next();
-            if (!v || (o.reps = std::atoi(v)) < 1) return false;
+            if (!v) return false;
+            if (auto s = cli::parseInt("--reps", v, 1, 10000, o.reps); !s) {
+                std::fprintf(stderr, "accuracy: %s\n", s.error().c_str());
+                return false;
+            }
         } else if (a == "--no-plots") {
             o.plots = false;
+        } else if (a == "--replot") {
+            o.replotOnly = true;
         } else {
             return false;
         }
@@ -413,21 +428,35 @@ void writePlots(const Bench& b, const std::string& dir) {
        << "'' index " << knobs.size() + 1 << " using 1:2:3 with labels left offset 1,0 font 'sans,8' notitle\n";
 }
 
+// gnuplot on DIR/accuracy.gp, run inside DIR (the script names its outputs relative to it).
+cli::SpawnResult plotCommand(const std::string& outDir) { return cli::spawn({.argv = {"gnuplot", "accuracy.gp"}, .workingDir = outDir}); }
+
 } // namespace
 
 int runAccuracy(int argc, char** argv) {
     Bench b;
     if (!parse(argc, argv, b.opt)) {
-        std::fprintf(stderr, "usage: splatfx-bench accuracy [--out DIR] [--size WxH] [--reps N] [--no-plots]\n"
+        std::fprintf(stderr, "usage: splatfx-bench accuracy [--out DIR] [--size WxH] [--reps N] [--no-plots] [--replot]\n"
                              "  --out DIR    where accuracy.csv, accuracy.dat, accuracy.gp and the PNG plots go (default bench-accuracy)\n"
                              "  --size WxH   frame size (default 320x240)\n"
-                             "  --reps N     timed frames per setting, median reported (default 11)\n");
+                             "  --reps N     timed frames per setting, median reported (default 11)\n"
+                             "  --replot     only run gnuplot again on DIR/accuracy.gp (after editing it)\n");
         return 2;
+    }
+    if (b.opt.replotOnly) {
+        const cli::SpawnResult gp = plotCommand(b.opt.out);
+        if (!gp.started || gp.exitCode != 0) {
+            std::fprintf(stderr, "accuracy: gnuplot failed on %s/accuracy.gp%s%s\n", b.opt.out.c_str(), gp.started ? "" : ": ",
+                         gp.error.c_str());
+            return 1;
+        }
+        std::printf("accuracy: replotted %s/accuracy.gp\n", b.opt.out.c_str());
+        return 0;
     }
     const auto start = Clock::now();
     std::error_code ec;
     fs::create_directories(b.opt.out, ec);
-    if (b.opt.plots && std::system("command -v gnuplot > /dev/null 2>&1") != 0) {
+    if (b.opt.plots && !cli::spawn({.argv = {"gnuplot", "--version"}, .output = cli::ChildOutput::Discard}).started) {
         std::fprintf(stderr, "accuracy: gnuplot is not installed; install it (Debian: apt-get install gnuplot-nox) or pass --no-plots\n");
         return 1;
     }
@@ -693,9 +722,11 @@ int runAccuracy(int argc, char** argv) {
 
     if (b.opt.plots) {
         writePlots(b, b.opt.out);
-        const std::string cmd = "cd '" + b.opt.out + "' && gnuplot accuracy.gp";
-        if (std::system(cmd.c_str()) != 0) {
-            std::fprintf(stderr, "accuracy: gnuplot failed on %s/accuracy.gp\n", b.opt.out.c_str());
+        // An argument vector, never a shell line: --out may hold quotes or ';'.
+        const cli::SpawnResult gp = plotCommand(b.opt.out);
+        if (!gp.started || gp.exitCode != 0) {
+            std::fprintf(stderr, "accuracy: gnuplot failed on %s/accuracy.gp%s%s\n", b.opt.out.c_str(), gp.started ? "" : ": ",
+                         gp.error.c_str());
             return 1;
         }
         std::printf("wrote %s/accuracy_knobs.png and %s/accuracy_pareto.png (data: accuracy.dat, script: accuracy.gp)\n", b.opt.out.c_str(),

@@ -13,6 +13,7 @@
 
 #include <epoxy/gl.h>
 
+#include "cli.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/gl/framebuffer.hpp"
@@ -90,8 +91,10 @@ int runScheduling(int argc, char** argv) {
     glm::ivec2 size{640, 480};
     for (int i = 1; i < argc; ++i) { // argv[0] is the subcommand
         const std::string a = argv[i];
-        if (a == "--effects" && i + 1 < argc) count = std::max(20, std::atoi(argv[++i]));
-        else if (a == "--frames" && i + 1 < argc) frames = std::max(5, std::atoi(argv[++i]));
+        // Strict and bounded (tools/common/cli.hpp): 100000 effects is about 100x the level this bench models.
+        splatfx::Status st;
+        if (a == "--effects" && i + 1 < argc) st = cli::parseInt("--effects", argv[++i], 20, 100000, count);
+        else if (a == "--frames" && i + 1 < argc) st = cli::parseInt("--frames", argv[++i], 5, 100000, frames);
         else if (a == "--quick") frames = 15;
         else if (a == "--size" && i + 1 < argc && std::sscanf(argv[i + 1], "%dx%d", &size.x, &size.y) == 2 && size.x > 0 && size.y > 0) ++i;
         else {
@@ -100,6 +103,10 @@ int runScheduling(int argc, char** argv) {
                         "  against a scene holding only those 10, drawn headless at WxH (default 640x480);\n"
                         "  a camera sweep; solver catch-up error.\n");
             return a == "--help" || a == "-h" ? 0 : 2;
+        }
+        if (!st) {
+            std::fprintf(stderr, "scheduling: %s\n", st.error().c_str());
+            return 2;
         }
     }
     auto ctx = splatfx::HeadlessContext::create();

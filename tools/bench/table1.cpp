@@ -18,6 +18,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "cli.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/program.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
@@ -527,10 +528,21 @@ int runTable1(int argc, char** argv) {
     bool quick = false;
     for (int i = 1; i < argc; ++i) { // argv[0] is the subcommand
         const std::string a = argv[i];
-        if (a == "--frames" && i + 1 < argc) frames = std::max(3, std::atoi(argv[++i]));
+        if (a == "--frames" && i + 1 < argc) {
+            if (auto st = cli::parseInt("--frames", argv[++i], 3, 100000, frames); !st) {
+                std::fprintf(stderr, "table1: %s\n", st.error().c_str());
+                return 2;
+            }
+        }
         else if (a == "--csv" && i + 1 < argc) csvPath = argv[++i];
         else if (a == "--quick") quick = true;
-        else if (a == "--footprint-cut" && i + 1 < argc) settings.renderer.footprintCut = float(std::atof(argv[++i]));
+        else if (a == "--footprint-cut" && i + 1 < argc) {
+            // A fraction of the footprint's peak below which fragments are discarded.
+            if (auto st = cli::parseReal("--footprint-cut", argv[++i], 0.0f, 1.0f, settings.renderer.footprintCut); !st) {
+                std::fprintf(stderr, "table1: %s\n", st.error().c_str());
+                return 2;
+            }
+        }
         else if (a == "--sampling" && i + 1 < argc) {
             using splatfx::gl::TextureSampling;
             const std::string v = argv[++i];
@@ -539,7 +551,13 @@ int runTable1(int argc, char** argv) {
             else if (v == "nearest") settings.renderer.sampling = TextureSampling::Nearest;
             else if (v.rfind("upsampled", 0) == 0) {
                 settings.renderer.sampling = TextureSampling::Upsampled;
-                settings.renderer.upsample = v.size() > 9 ? std::atoi(v.c_str() + 9) : 0; // "upsampled4" -> 4
+                settings.renderer.upsample = 0; // "upsampled": the renderer's default factor; "upsampled4" -> 4
+                if (v.size() > 9) {
+                    if (auto st = cli::parseInt("--sampling upsampledN", v.substr(9), 2, 16, settings.renderer.upsample); !st) {
+                        std::fprintf(stderr, "table1: %s\n", st.error().c_str());
+                        return 2;
+                    }
+                }
             } else {
                 std::fprintf(stderr, "table1: --sampling takes auto, bilinear, nearest, upsampled or upsampledN\n");
                 return 2;

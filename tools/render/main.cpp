@@ -20,6 +20,7 @@
 
 #include <unistd.h>
 
+#include "cli.hpp"
 #include "scene_player.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/framebuffer.hpp"
@@ -72,10 +73,8 @@ bool parse(int argc, char** argv, Args& a) {
             return argv[++i];
         };
         auto integer = [&](const char* v, long lo, long hi, long& out) {
-            char* end = nullptr;
-            out = std::strtol(v, &end, 10);
-            if (!*v || *end || out < lo || out > hi) {
-                std::fprintf(stderr, "splatfx-render: %s expects an integer in [%ld, %ld], got '%s'\n", s.c_str(), lo, hi, v);
+            if (auto st = cli::parseInt(s, v, lo, hi, out); !st) {
+                std::fprintf(stderr, "splatfx-render: %s\n", st.error().c_str());
                 return false;
             }
             return true;
@@ -136,17 +135,15 @@ bool parse(int argc, char** argv, Args& a) {
         } else if (s == "--size") {
             if (!(v = value())) return false;
             int w = 0, h = 0;
-            char tail = 0;
-            if (std::sscanf(v, "%dx%d%c", &w, &h, &tail) != 2 || w < 16 || h < 16 || w > 8192 || h > 8192) {
-                std::fprintf(stderr, "splatfx-render: --size expects WxH with 16..8192 pixels per side, e.g. 640x480; got '%s'\n", v);
+            if (auto st = cli::parseSize("--size", v, 16, 8192, w, h); !st) {
+                std::fprintf(stderr, "splatfx-render: %s (e.g. 640x480)\n", st.error().c_str());
                 return false;
             }
             a.size = glm::ivec2(w, h);
         } else if (s == "--fps") {
             if (!(v = value())) return false;
-            char* end = nullptr;
-            const float f = std::strtof(v, &end);
-            if (!*v || *end || !(f > 0.0f && f <= 240.0f)) {
+            float f = 0.0f;
+            if (!cli::parseReal("--fps", v, 0.0f, 240.0f, f) || !(f > 0.0f)) {
                 std::fprintf(stderr, "splatfx-render: --fps expects a number in (0, 240], got '%s'\n", v);
                 return false;
             }
@@ -175,7 +172,7 @@ int fail(const std::string& why) {
 
 } // namespace
 
-int main(int argc, char** argv) {
+static int renderMain(int argc, char** argv) {
     Args a;
     if (!parse(argc, argv, a)) return 2;
 
@@ -254,3 +251,6 @@ int main(int argc, char** argv) {
                 a.out.c_str(), name.c_str());
     return 0;
 }
+
+// Any exception that escapes (std::bad_alloc included) becomes a message and exit code 1.
+int main(int argc, char** argv) { return cli::guardedMain("splatfx-render", [&] { return renderMain(argc, argv); }); }

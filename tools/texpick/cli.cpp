@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli.hpp"
 #include "texpick.hpp"
 
 namespace texpick {
@@ -73,16 +74,15 @@ interactive:
   --screenshot FILE    write the window's picture to FILE before closing
 )";
 
+// Every number on the command line goes through tools/common/cli.hpp (whole
+// string, range-checked, finite).
 template <class T>
 splatfx::Result<T> number(const std::string& opt, const char* text, T lo, T hi) {
-    std::istringstream in(text);
     T v{};
-    char extra = 0;
-    if (!(in >> v) || (in >> extra) || v < lo || v > hi) {
-        std::ostringstream o;
-        o << opt << " must be a number in [" << lo << ", " << hi << "], got '" << text << "'";
-        return makeError(o.str());
-    }
+    splatfx::Status s;
+    if constexpr (std::is_floating_point_v<T>) s = cli::parseReal<T>(opt, text, lo, hi, v);
+    else s = cli::parseInt<T>(opt, text, lo, hi, v);
+    if (!s) return makeError(s.error());
     return v;
 }
 
@@ -114,7 +114,7 @@ splatfx::Result<Options> parseOptions(int argc, const char* const* argv) {
         }
         if (a == "--out") { if (!need()) return makeError("--out needs a folder"); o.out = v; continue; }
         if (a == "--patch") TEXPICK_NUM(o.patch, int, 1, 16384)
-        if (a == "--count") { o.countGiven = true; TEXPICK_NUM(o.count, int, 1, 4096) }
+        if (a == "--count") { o.countGiven = true; TEXPICK_NUM(o.count, int, 1, kMaxTextures) }
         if (a == "--seed") TEXPICK_NUM(o.seed, std::uint32_t, 0u, 4294967295u)
         if (a == "--min-std") TEXPICK_NUM(o.accept.minStd, float, 0.0f, 1.0f)
         if (a == "--min-mean") TEXPICK_NUM(o.accept.minMean, float, 0.0f, 1.0f)
@@ -219,6 +219,14 @@ splatfx::Result<Options> parseOptions(int argc, const char* const* argv) {
     if (o.mode == "positions" && o.at.empty()) return makeError("positions: give at least one --at X,Y[,SIZE]");
     if (o.mode == "path" && o.path.empty()) return makeError("path: give --path X,Y:X,Y[:X,Y...]");
     if (o.spread && o.mode != "spectral") return makeError("--spread only applies to the spectral mode");
+    // Each texel is kept as a float per channel several times over (the set, its
+    // windowed copy, the contact sheet), so bound the set before anything is built.
+    const double texels = double(o.count) * o.process.textureSize * o.process.textureSize * (o.process.color ? 3 : 1);
+    if (texels > kMaxSetTexels)
+        return makeError("--count " + std::to_string(o.count) + " x --size " + std::to_string(o.process.textureSize) +
+                         (o.process.color ? " (colour)" : "") + " asks for " + std::to_string((long long)texels) +
+                         " texels, more than the " + std::to_string(kMaxSetTexels) +
+                         " a texture set may hold (about 256 MB as floats); lower --count or --size");
     o.output.footprint = o.process.footprint;
     return o;
 }

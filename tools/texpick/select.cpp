@@ -4,6 +4,7 @@
 // [SECTION] Spectra
 // [SECTION] Selection: positions, random, spectral, path
 // [SECTION] Parsing
+#include <limits>
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -399,7 +400,12 @@ splatfx::Result<Selection> pickPath(const Source& s, const PathDesc& d) {
     std::vector<double> along{0.0};
     for (size_t i = 1; i < d.points.size(); ++i) along.push_back(along.back() + cv::norm(d.points[i] - d.points[i - 1]));
     const double length = along.back();
-    const int fit = int(std::floor(length / d.step + 1e-9)) + 1;
+    const double fitReal = std::floor(length / d.step + 1e-9) + 1.0;
+    if (d.count <= 0 && fitReal > kMaxTextures)
+        return makeError("path: --step " + str(d.step) + " along a path " + str(length) + " px long gives " + str(fitReal) +
+                         " patches, more than the " + std::to_string(kMaxTextures) +
+                         " a texture set may hold; raise --step or give --count");
+    const int fit = int(std::min(fitReal, double(std::numeric_limits<int>::max())));
     const int count = d.count > 0 ? d.count : fit;
     if (count > fit)
         return makeError("path: " + std::to_string(count) + " patches " + str(d.step) + " px apart need a path " +

@@ -39,6 +39,10 @@ inline constexpr const char* kToolVersion = "1.0.0";
 // Version of the "provenance" object texpick writes into manifest.json.
 inline constexpr int kProvenanceVersion = 1;
 inline constexpr int kMinPatch = 4; // smallest patch side, source pixels
+inline constexpr int kMaxTextures = 4096; // most textures in one set (--count, and patches a path may give)
+// Most texels (per channel) in one set: 64 Mi, 256 MB as floats, kept a few
+// times over while the set, its windowed copy and the contact sheet are built.
+inline constexpr long long kMaxSetTexels = 64ll << 20;
 
 // [SECTION] Source images
 

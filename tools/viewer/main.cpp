@@ -31,6 +31,7 @@
 #include <GLFW/glfw3.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "cli.hpp"
 #include "backends/imgui_impl_glfw.h"
 #include "backends/imgui_impl_opengl3.h"
 #include "imgui.h"
@@ -68,20 +69,24 @@ bool parse(int argc, char** argv, Args& a) {
                         "  --screenshot FILE    write the last frame (with the UI) to FILE (PNG)\n");
             std::exit(0);
         } else if (s == "--size" && (v = value())) {
-            if (std::sscanf(v, "%dx%d", &a.size.x, &a.size.y) != 2 || a.size.x < 64 || a.size.y < 64 || a.size.x > 8192 || a.size.y > 8192) {
-                std::fprintf(stderr, "splatfx-viewer: --size expects WxH (64..8192), got '%s'\n", v);
+            if (auto st = cli::parseSize("--size", v, 64, 8192, a.size.x, a.size.y); !st) {
+                std::fprintf(stderr, "splatfx-viewer: %s\n", st.error().c_str());
                 return false;
             }
         } else if (s == "--auto-quit-after" && (v = value())) {
-            a.autoQuitAfter = std::atoi(v);
-            if (a.autoQuitAfter < 1) {
-                std::fprintf(stderr, "splatfx-viewer: --auto-quit-after expects a positive frame count, got '%s'\n", v);
+            if (auto st = cli::parseInt("--auto-quit-after", v, 1, 1000000, a.autoQuitAfter); !st) {
+                std::fprintf(stderr, "splatfx-viewer: %s\n", st.error().c_str());
                 return false;
             }
         } else if (s == "--screenshot" && (v = value())) {
             a.screenshot = v;
         } else if (s == "--seed" && (v = value())) {
-            a.seed = std::uint32_t(std::strtoul(v, nullptr, 10));
+            std::uint32_t seed = 0;
+            if (auto st = cli::parseInt("--seed", v, 0u, 4294967295u, seed); !st) {
+                std::fprintf(stderr, "splatfx-viewer: %s\n", st.error().c_str());
+                return false;
+            }
+            a.seed = seed;
         } else if (s == "--camera" && (v = value())) {
             a.camera = v;
             if (a.camera != "path" && a.camera != "orbit" && a.camera != "fly") {
@@ -380,7 +385,7 @@ bool writeScreenshot(const std::string& file, glm::ivec2 size) {
 
 // [SECTION] Main loop
 
-int main(int argc, char** argv) {
+static int viewerMain(int argc, char** argv) {
     Viewer v;
     if (!parse(argc, argv, v.args)) return 2;
     v.mode = v.args.camera == "orbit" ? CameraMode::Orbit : v.args.camera == "fly" ? CameraMode::Fly : CameraMode::Path;
@@ -451,3 +456,6 @@ int main(int argc, char** argv) {
     ImGui::DestroyContext();
     return rc;
 }
+
+// Any exception that escapes (std::bad_alloc included) becomes a message and exit code 1.
+int main(int argc, char** argv) { return cli::guardedMain("splatfx-viewer", [&] { return viewerMain(argc, argv); }); }

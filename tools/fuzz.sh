@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# Fuzz the SDK's input boundaries with libFuzzer (issue 13, item 7).
+#   tools/fuzz.sh              configure build-fuzz/ (clang, SPLATFX_FUZZ=ON: the SDK
+#                              itself instrumented), build, run every target
+#   FUZZ_SECONDS=600 tools/fuzz.sh        longer runs (default 60 s per target)
+#   FUZZ_TARGETS="scene_file image" ...   a subset (default: all)
+# Each target starts from its seeds (tests/fuzz/corpus/<t>/) and past crashes
+# (tests/fuzz/regressions/<t>/); the working corpus grows in build-fuzz/corpus/<t>/.
+# Any finding (crash, sanitizer report, leak, timeout, out-of-memory) fails the
+# script and leaves the input in build-fuzz/findings/<t>/: commit it under
+# tests/fuzz/regressions/<t>/ with the fix, where fuzz_replay_<t> (a normal
+# test) replays it from then on.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BUILD_DIR="${BUILD_DIR:-build-fuzz}"
+JOBS="${JOBS:-$(nproc)}"
+FUZZ_SECONDS="${FUZZ_SECONDS:-60}"
+FUZZ_TARGETS="${FUZZ_TARGETS:-scene_file texture_set image mesh}"
+CXX_FUZZ="${CXX_FUZZ:-clang++}"
+
+[ "$CXX_FUZZ" = clang++ ] && tools/setup-deps.sh --fuzz
+command -v "$CXX_FUZZ" >/dev/null || { echo "fuzz: $CXX_FUZZ not found (Debian: apt-get install clang libclang-rt-dev)" >&2; exit 1; }
+echo "fuzz: configuring $BUILD_DIR with $CXX_FUZZ"
+cmake -S . -B "$BUILD_DIR" -DCMAKE_CXX_COMPILER="$CXX_FUZZ" -DSPLATFX_FUZZ=ON \
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+  -DSPLATFX_BUILD_TESTS=ON -DSPLATFX_BUILD_TOOLS=ON -DSPLATFX_BUILD_SAMPLES=OFF >/dev/null
+targets=()
+for t in $FUZZ_TARGETS; do targets+=("fuzz_$t"); done
+echo "fuzz: building ${targets[*]} with $JOBS jobs"
+cmake --build "$BUILD_DIR" -j"$JOBS" --target "${targets[@]}"
+
+# Mesa/assimp/OpenImageIO are not instrumented; leaks inside them are not ours
+# (the same suppressions as the sanitizer suite), and leak checks stay on for the rest.
+export LSAN_OPTIONS="suppressions=$PWD/tools/lsan.supp:print_suppressions=0"
+# fast_unwind_on_malloc=0: those libraries have no frame pointers, and a suppression
+# only matches a frame the unwinder reached.
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:fast_unwind_on_malloc=0:allocator_may_return_null=1}"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+
+failed=()
+for t in $FUZZ_TARGETS; do
+  corpus="$BUILD_DIR/corpus/$t" findings="$BUILD_DIR/findings/$t" log="$BUILD_DIR/fuzz-$t.log"
+  mkdir -p "$corpus" "$findings"
+  echo "fuzz: $t for ${FUZZ_SECONDS}s (log $log)"
+  # -timeout: one input taking 10 s is a hang; -rss_limit_mb: 2 GB is a memory bomb
+  # (every loader has budgets far below it). Seeds and regressions are read-only inputs.
+  if "$BUILD_DIR/tests/fuzz/fuzz_$t" "$corpus" "tests/fuzz/corpus/$t" "tests/fuzz/regressions/$t" \
+       -max_total_time="$FUZZ_SECONDS" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
+       -artifact_prefix="$findings/" -print_final_stats=1 >"$log" 2>&1; then
+    cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 || true)
+    runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || true)
+    echo "fuzz: $t: no finding ($cov, ${runs:-?} inputs)"
+  else
+    echo "fuzz: $t: FINDING; input(s) in $findings/:" >&2
+    ls "$findings" >&2 || true
+    grep -m1 -A25 -E 'ERROR: (AddressSanitizer|LeakSanitizer|libFuzzer)|runtime error|SUMMARY' "$log" >&2 || tail -40 "$log" >&2
+    failed+=("$t")
+  fi
+done
+if ((${#failed[@]})); then
+  echo "fuzz: findings in: ${failed[*]}" >&2
+  exit 1
+fi
+echo "fuzz: all targets ran ${FUZZ_SECONDS}s each with no finding"
