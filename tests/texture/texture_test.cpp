@@ -151,3 +151,41 @@ TEST(TextureSet, WindowedColourSetsRoundTrip) {
                 EXPECT_NEAR(back->layers[size_t(k)][i + size_t(c)], win.layers[size_t(k)][i + size_t(c)], 0.5 / 255 + 1e-6);
         }
 }
+
+// Manifest entries stay inside their folder, and every field a manifest
+// states is checked against the files (issue 13): a lying manifest is an
+// error naming the field, never a set built from the wrong files.
+TEST(TextureSetBadInput, LyingOrEscapingManifestsAreRefused) {
+    const std::string dir = splatfx::test::outputDir() + "/lying";
+    fs::remove_all(dir);
+    ASSERT_TRUE(TextureSet::turbulence({.count = 2, .size = 8}).save(dir, "{}"));
+    const std::string good = [&] {
+        std::ifstream in(dir + "/manifest.json");
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    }();
+    ASSERT_TRUE(TextureSet::load(dir));
+    auto withManifest = [&](const std::string& text) {
+        std::ofstream(dir + "/manifest.json") << text;
+        return TextureSet::load(dir);
+    };
+    auto replaced = [&](const std::string& from, const std::string& to) {
+        std::string s = good;
+        const auto at = s.find(from);
+        EXPECT_NE(at, std::string::npos) << from;
+        return s.replace(at, from.size(), to);
+    };
+    const struct {
+        std::string manifest, message;
+    } cases[] = {
+        {replaced("\"t000.png\"", "\"../../etc/passwd\""), "must be a file name inside the set's folder"},
+        {replaced("\"t000.png\"", "\"/etc/passwd\""), "must be a file name inside the set's folder"},
+        {replaced("\"size\": 8", "\"size\": 16"), "is 8x8, but field 'size' says 16"},
+        {replaced("\"size\": 8", "\"size\": 8, \"count\": 5"), "field 'count' says 5 but 'textures' lists 2"},
+        {replaced("\"windowed\": false", "\"windowed\": \"yes\""), "field 'windowed' must be true or false"},
+    };
+    for (const auto& c : cases) {
+        auto r = withManifest(c.manifest);
+        ASSERT_FALSE(r) << c.manifest;
+        EXPECT_NE(r.error().find(c.message), std::string::npos) << r.error();
+    }
+}

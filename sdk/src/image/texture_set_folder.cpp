@@ -17,11 +17,20 @@ namespace splatfx {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
+namespace {
+constexpr std::uintmax_t kMaxManifestBytes = 1u << 20; // 1 MiB: 4096 names and provenance fit with room to spare
+} // namespace
+
 Result<TextureSet> TextureSet::load(const std::string& folder) {
     const fs::path dir(folder);
     const fs::path manifestPath = dir / "manifest.json";
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) return makeError("texture set '" + folder + "': no such folder");
+    // The manifest is small text: a FIFO, a device or a huge file is refused before reading.
+    if (fs::exists(manifestPath, ec) && !fs::is_regular_file(manifestPath, ec))
+        return makeError(manifestPath.string() + ": not a regular file");
+    if (fs::is_regular_file(manifestPath, ec) && fs::file_size(manifestPath, ec) > kMaxManifestBytes)
+        return makeError(manifestPath.string() + ": larger than " + std::to_string(kMaxManifestBytes) + " bytes; not a texture-set manifest");
     std::ifstream in(manifestPath);
     if (!in) return makeError("texture set '" + folder + "': cannot open manifest.json");
     json m;
@@ -39,17 +48,38 @@ Result<TextureSet> TextureSet::load(const std::string& folder) {
     if (!m.contains("textures") || !m["textures"].is_array() || m["textures"].empty())
         return makeError(where + "field 'textures' must be a non-empty array of image file names");
     if (m["textures"].size() > 4096) return makeError(where + "field 'textures' lists more than 4096 images");
-    const bool color = m.contains("color") && m["color"].is_boolean() && m["color"].get<bool>();
-    const bool windowed = m.contains("windowed") && m["windowed"].is_boolean() && m["windowed"].get<bool>();
+    // Every field the manifest states is checked against the files, not trusted.
+    for (const char* flag : {"color", "windowed"})
+        if (m.contains(flag) && !m[flag].is_boolean()) return makeError(where + "field '" + flag + "' must be true or false");
+    const bool color = m.contains("color") && m["color"].get<bool>();
+    const bool windowed = m.contains("windowed") && m["windowed"].get<bool>();
+    int statedSize = 0;
+    if (m.contains("size")) {
+        if (!m["size"].is_number_integer() || m["size"].get<long long>() < 1 || m["size"].get<long long>() > 4096)
+            return makeError(where + "field 'size' must be a whole number of pixels in [1, 4096]");
+        statedSize = m["size"].get<int>();
+    }
+    if (m.contains("count") && (!m["count"].is_number_integer() || m["count"].get<long long>() != (long long)m["textures"].size()))
+        return makeError(where + "field 'count' says " + m["count"].dump() + " but 'textures' lists " + std::to_string(m["textures"].size()));
     std::vector<Image> images;
     for (size_t i = 0; i < m["textures"].size(); ++i) {
         const json& t = m["textures"][i];
-        if (!t.is_string()) return makeError(where + "textures[" + std::to_string(i) + "] must be a file name string");
-        const fs::path file = dir / t.get<std::string>();
+        const std::string at = where + "textures[" + std::to_string(i) + "]";
+        if (!t.is_string()) return makeError(at + " must be a file name string");
+        // Entries are confined to the set's folder: a plain file name, never a path out of it.
+        const std::string name = t.get<std::string>();
+        if (name.empty() || name == "." || name == ".." || name.find('/') != std::string::npos || name.find('\\') != std::string::npos)
+            return makeError(at + " '" + name + "' must be a file name inside the set's folder (no '/', not '..')");
+        const fs::path file = dir / name;
         // Windowed sets store straight colour with opacity in alpha; raw sets
         // made from photos keep alpha as coverage (composited over black).
         auto img = readImage(file.string(), windowed ? Alpha::Straight : Alpha::Premultiplied);
         if (!img) return makeError("texture set '" + folder + "': " + img.error());
+        if (statedSize > 0 && (img->width != statedSize || img->height != statedSize))
+            return makeError(at + " '" + name + "' is " + std::to_string(img->width) + "x" + std::to_string(img->height) + ", but field 'size' says " +
+                             std::to_string(statedSize));
+        if (windowed && img->channels != 4 && img->channels != 2)
+            return makeError(at + " '" + name + "' has no alpha channel, but field 'windowed' says the detail is stored in alpha");
         images.push_back(std::move(*img));
     }
     auto set = fromImages(images, color);
