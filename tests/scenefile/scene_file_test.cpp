@@ -174,9 +174,19 @@ TEST(SceneFile, AbsurdSizesAreRefusedBeforeAllocating) {
 }
 
 TEST(SceneFile, NonFiniteAndHugeValuesAreRefused) {
-    expectError(R"("effects": [{"kind": "fire", "position": [0, 1e999, 0]}])", {"dir/scene.json: number overflow parsing '1e999' (expected a finite number)"});
+    // The library gives no position for an overflowing literal; the reader finds it (line 1, after the head).
+    expectError(R"("effects": [{"kind": "fire", "position": [0, 1e999, 0]}])", {"dir/scene.json:1:", ": number overflow parsing '1e999' (expected a finite number)"});
     expectError(R"("effects": [{"kind": "fire", "position": [0, 1e30, 0]}])", {"effects[0].position[1]: expected a number in [-1e+06, 1e+06], got 1e+30"});
     expectError(R"("camera": {"fovDeg": 0})", {"camera.fovDeg: expected a number in [1, 170], got 0"});
+}
+
+// Bytes after a NUL were silently ignored; now the NUL itself is the error, with its place.
+TEST(SceneFile, ANulByteIsRefusedWhereItIs) {
+    splatfx::Materials m(splatfx::Footprint{});
+    const std::string text = std::string("{\"format\": \"splatfx-scene\", \"version\": 1}\n", 42) + std::string(1, '\0') + "garbage";
+    auto r = splatfx::parseSceneFile(text, "dir/scene.json", m);
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().find("dir/scene.json:2:1: a NUL byte"), std::string::npos) << r.error();
 }
 
 TEST(SceneFile, UnknownKeysAreReportedWithASuggestion) {

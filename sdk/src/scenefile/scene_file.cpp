@@ -80,6 +80,13 @@ std::string syntaxReason(const std::string& what) {
 Result<SceneFile> parse(const std::string& text, const std::string& path, Materials& materials, const SceneFileOptions& options) {
     if (text.size() > kMaxFileBytes)
         return makeError(path + ": file is " + std::to_string(text.size()) + " bytes; scene files are at most " + std::to_string(kMaxFileBytes));
+    // A NUL byte ends the text for some readers and not others: refuse it where it is,
+    // rather than silently ignore what follows it.
+    if (const std::size_t nul = text.find('\0'); nul != std::string::npos) {
+        const LineCol lc = lineColumn(text, nul);
+        return makeError(path + ":" + std::to_string(lc.line) + ":" + std::to_string(lc.column) +
+                         ": a NUL byte (scene files are text; is this the right file?)");
+    }
     if (auto at = tooDeep(text)) {
         const LineCol lc = lineColumn(text, *at);
         return makeError(path + ":" + std::to_string(lc.line) + ":" + std::to_string(lc.column) + ": nesting deeper than " +
@@ -93,10 +100,19 @@ Result<SceneFile> parse(const std::string& text, const std::string& path, Materi
         const LineCol lc = lineColumn(text, e.byte == 0 ? 0 : e.byte - 1);
         return makeError(path + ":" + std::to_string(lc.line) + ":" + std::to_string(lc.column) + ": syntax error: " + syntaxReason(e.what()));
     } catch (const Json::out_of_range& e) {
-        // A literal like 1e999: the JSON library refuses it while parsing.
+        // A literal like 1e999: the JSON library refuses it while parsing and
+        // gives no position, so find the literal it names to report where it is.
         std::string what = e.what();
         const std::size_t p = what.find("] ");
-        return makeError(path + ": " + (p == std::string::npos ? what : what.substr(p + 2)) + " (expected a finite number)");
+        what = p == std::string::npos ? what : what.substr(p + 2);
+        std::string where = path;
+        const std::size_t q0 = what.find('\''), q1 = q0 == std::string::npos ? q0 : what.find('\'', q0 + 1);
+        if (q1 != std::string::npos)
+            if (const std::size_t at = text.find(what.substr(q0 + 1, q1 - q0 - 1)); at != std::string::npos) {
+                const LineCol lc = lineColumn(text, at);
+                where += ":" + std::to_string(lc.line) + ":" + std::to_string(lc.column);
+            }
+        return makeError(where + ": " + what + " (expected a finite number)");
     }
 
     Diagnostics d(path, options.maxErrors);
