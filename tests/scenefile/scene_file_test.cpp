@@ -260,3 +260,16 @@ TEST(SceneFile, PathsAreRelativeToTheFile) {
 }
 
 } // namespace
+
+// Budgets checked while reading, before the memory is spent (issue 13): a
+// sampled set's texels, and the layers of all the scene's distinct sets (the
+// error names the effect that crosses the limit).
+TEST(SceneFile, TextureBudgetsAreCheckedBeforeBuilding) {
+    expectError(R"("effects": [{"kind": "grid", "dims": [2, 2, 2], "textureSet": {"sampleImage": {"image": "x.png", "count": 256, "size": 1024}}}])",
+                {"effects[0].textureSet.sampleImage: count 256 x size 1024^2 asks for 268435456 texels, over the budget of 16777216"});
+    std::string effects;
+    for (int i = 0; i < 300; ++i)
+        effects += std::string(i ? ", " : "") + R"({"kind": "grid", "dims": [2, 2, 2], "textureSet": {"procedural": {"count": 16, "seed": )" +
+                   std::to_string(i) + "}}}";
+    expectError(R"("effects": [)" + effects + "]", {"effects[127]: with this effect the scene's distinct texture sets hold 2049 layers"});
+}

@@ -43,6 +43,13 @@ inline constexpr int kMaxAttachDepth = 16;
 
 // [SECTION] Context
 
+// Texels of one sampled texture set (16 Mi: 64 windows of 512^2, 256 of 256^2).
+inline constexpr std::uint64_t kMaxSampledTexels = 16ull << 20;
+// Texture layers a scene's materials may hold: what every GL 4.5 guarantees
+// (GL_MAX_ARRAY_TEXTURE_LAYERS >= 2048). Checked as effects are read, so a
+// level of too many distinct sets stops at the effect that crosses it.
+inline constexpr std::uint32_t kMaxSceneLayers = 2048;
+
 struct Context {
     Diagnostics& d;
     std::filesystem::path baseDir;

@@ -203,6 +203,12 @@ std::optional<TextureSpec> readTextureSpec(Context& c, const std::string& path, 
             po.integer("size", t.size, 4, 1024);
             po.seed("seed", t.seed);
             po.boolean("color", t.keepColor);
+            // Each window becomes size^2 float RGBA texels: 256 windows of 1024^2 would be 4 GiB
+            // per effect, so the set's texels are budgeted before anything is read.
+            if (std::uint64_t(t.count) * std::uint64_t(t.size) * std::uint64_t(t.size) > kMaxSampledTexels)
+                c.d.error(po.path(), "count " + std::to_string(t.count) + " x size " + std::to_string(t.size) + "^2 asks for " +
+                                         std::to_string(std::uint64_t(t.count) * t.size * t.size) + " texels, over the budget of " +
+                                         std::to_string(kMaxSampledTexels) + "; use fewer or smaller windows");
             po.finish();
             if (!image.empty()) {
                 t.image = resolvePath(c, image);
