@@ -137,7 +137,7 @@ int runWindowed(const Options& o, const char* name, const std::function<bool()>&
                 const std::function<bool(const FrameContext&)>& frame) {
     auto window = splatfx::Window::create({.width = o.size.x, .height = o.size.y, .title = std::string("splatfx: ") + name});
     if (!window) {
-        std::fprintf(stderr, "%s: %s\n", name, window.error().c_str());
+        std::fprintf(stderr, "%s: %s\n%s: without a display, run headless: %s --frames N --out DIR\n", name, window.error().c_str(), name, name);
         return 1;
     }
     if (!setup()) return 1;

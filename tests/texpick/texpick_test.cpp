@@ -452,6 +452,16 @@ TEST_F(TexpickErrors, TinyImage) {
     expectNothingLeft();
 }
 
+// Smaller than any patch: the advice must not name a patch size that cannot work.
+TEST_F(TexpickErrors, ImageSmallerThanTheSmallestPatch) {
+    const std::string img = (dir / "one.png").string();
+    ASSERT_TRUE(splatfx::writeImage(img, grayImage(1, 1, [](int, int) { return 0.5; })));
+    auto [rc, err] = runCli({"random", img, "--out", out, "--no-preview"});
+    EXPECT_EQ(rc, 1);
+    EXPECT_EQ(err, "splatfx-texpick: image '" + img + "' is 1x1 pixels, smaller than the smallest patch (4 px); use a larger image\n");
+    expectNothingLeft();
+}
+
 TEST_F(TexpickErrors, PathLeavingTheImage) {
     const std::string img = (dir / "small.png").string();
     ASSERT_TRUE(splatfx::writeImage(img, grayImage(100, 80, [](int x, int y) { return ((x / 3 + y / 5) % 2) * 0.8 + 0.1; })));

@@ -43,6 +43,9 @@ bool inside(const Source& s, const Patch& p) {
 splatfx::Status checkPatchFits(const Source& s, int patch, const std::string& option) {
     if (patch < kMinPatch)
         return makeError(option + " must be at least " + std::to_string(kMinPatch) + " pixels, got " + std::to_string(patch));
+    if (std::min(s.width, s.height) < kMinPatch)
+        return makeError("image '" + s.path + "' is " + std::to_string(s.width) + "x" + std::to_string(s.height) +
+                         " pixels, smaller than the smallest patch (" + std::to_string(kMinPatch) + " px); use a larger image");
     if (patch > s.width || patch > s.height)
         return makeError("image '" + s.path + "' is " + std::to_string(s.width) + "x" + std::to_string(s.height) +
                          " pixels, too small for one " + std::to_string(patch) + "-px patch; use " + option + " " +

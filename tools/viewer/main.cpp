@@ -391,7 +391,8 @@ static int viewerMain(int argc, char** argv) {
     v.mode = v.args.camera == "orbit" ? CameraMode::Orbit : v.args.camera == "fly" ? CameraMode::Fly : CameraMode::Path;
     auto window = splatfx::Window::create({.width = v.args.size.x, .height = v.args.size.y, .title = "splatfx viewer", .vsync = v.args.autoQuitAfter == 0});
     if (!window) {
-        std::fprintf(stderr, "splatfx-viewer: %s\n", window.error().c_str());
+        std::fprintf(stderr, "splatfx-viewer: %s\nsplatfx-viewer: the viewer is interactive; without a display run it under xvfb-run, or render "
+                             "the scene headless with splatfx-render SCENE --out DIR\n", window.error().c_str());
         return 1;
     }
     IMGUI_CHECKVERSION();

@@ -12,7 +12,7 @@ Result<Window> Window::create(const WindowDesc& desc) {
         const char* why = nullptr;
         glfwGetError(&why);
         return makeError(std::string("cannot open a window: GLFW failed to initialize (") + (why ? why : "no display?") +
-                         "). Run headless with --frames N --out DIR, or start an X server (e.g. Xvfb).");
+                         "). A window needs a display: set DISPLAY or start an X server (e.g. Xvfb); without one, render headless (HeadlessContext).");
     }
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
