@@ -45,7 +45,7 @@ for t in $FUZZ_TARGETS; do
   # -timeout: one input taking 10 s is a hang; -rss_limit_mb: 2 GB is a memory bomb
   # (every loader has budgets far below it). Seeds and regressions are read-only inputs.
   if "$BUILD_DIR/tests/fuzz/fuzz_$t" "$corpus" "tests/fuzz/corpus/$t" "tests/fuzz/regressions/$t" \
-       -max_total_time="$FUZZ_SECONDS" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
+       -seed="${FUZZ_SEED:-1}" -max_total_time="$FUZZ_SECONDS" -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 \
        -artifact_prefix="$findings/" -print_final_stats=1 >"$log" 2>&1; then
     cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 || true)
     runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || true)
