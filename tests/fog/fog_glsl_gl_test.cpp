@@ -22,33 +22,11 @@ struct Seg {
     glm::dvec3 o, p; // world
 };
 
+// 0 and the driver's log in `log` when it does not build.
 GLuint compile(const std::string& src, std::string& log) {
-    GLuint s = glCreateShader(GL_COMPUTE_SHADER);
-    const char* c = src.c_str();
-    glShaderSource(s, 1, &c, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    if (!ok) {
-        char buf[8192];
-        glGetShaderInfoLog(s, sizeof buf, nullptr, buf);
-        log = buf;
-        glDeleteShader(s);
-        return 0;
-    }
-    GLuint p = glCreateProgram();
-    glAttachShader(p, s);
-    glLinkProgram(p);
-    glDeleteShader(s);
-    glGetProgramiv(p, GL_LINK_STATUS, &ok);
-    if (!ok) {
-        char buf[8192];
-        glGetProgramInfoLog(p, sizeof buf, nullptr, buf);
-        log = buf;
-        glDeleteProgram(p);
-        return 0;
-    }
-    return p;
+    auto p = gl::linkComputeProgram({src.c_str()}, "fog test");
+    if (!p) return log = p.error(), 0u;
+    return *p;
 }
 
 struct GpuResult {

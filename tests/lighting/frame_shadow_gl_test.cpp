@@ -40,32 +40,12 @@ void main() {
 }
 )";
 
-GLuint compile(GLenum type, const std::string& src, std::string& log) {
-    const GLuint s = glCreateShader(type);
-    const char* p = src.c_str();
-    glShaderSource(s, 1, &p, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    char buf[4096] = {};
-    glGetShaderInfoLog(s, sizeof buf, nullptr, buf);
-    log += buf;
-    return ok ? s : 0;
-}
-
+// The docs' ground shader: version line + shadowGlsl() + body, built with the SDK's own helper.
 GLuint groundProgram(std::string& log) {
-    const GLuint vs = compile(GL_VERTEX_SHADER, kVertex, log);
-    const GLuint fs = compile(GL_FRAGMENT_SHADER, std::string("#version 450 core\n") + shadowGlsl() + kFragmentBody, log);
-    if (!vs || !fs) return 0;
-    const GLuint prog = glCreateProgram();
-    glAttachShader(prog, vs);
-    glAttachShader(prog, fs);
-    glLinkProgram(prog);
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    GLint ok = 0;
-    glGetProgramiv(prog, GL_LINK_STATUS, &ok);
-    return ok ? prog : 0;
+    const std::string include = shadowGlsl();
+    auto p = gl::linkProgram({kVertex}, {"#version 450 core\n", include.c_str(), kFragmentBody}, "ground");
+    if (!p) return log = p.error(), 0u;
+    return *p;
 }
 
 constexpr int kSize = 64;
@@ -137,21 +117,6 @@ Drawn draw(gl::FrameRenderer& fr, const Frame& frame, GLuint prog) {
     return out;
 }
 
-// Largest difference between neighbouring table nodes (what GL's filter-weight precision scales).
-float maxNeighbourStep(const ShadowTable& t) {
-    const glm::ivec3 n = t.dims();
-    const auto& d = t.data();
-    float m = 0.0f;
-    auto at = [&](int i, int j, int k) { return d[std::size_t(i + n.x * (j + n.y * k))]; };
-    for (int k = 0; k < n.z; ++k)
-        for (int j = 0; j < n.y; ++j)
-            for (int i = 0; i < n.x; ++i) {
-                if (i + 1 < n.x) m = std::max(m, std::abs(at(i + 1, j, k) - at(i, j, k)));
-                if (j + 1 < n.y) m = std::max(m, std::abs(at(i, j + 1, k) - at(i, j, k)));
-                if (k + 1 < n.z) m = std::max(m, std::abs(at(i, j, k + 1) - at(i, j, k)));
-            }
-    return m;
-}
 
 } // namespace
 
@@ -169,7 +134,7 @@ TEST_F(FrameShadowGL, HostGroundShaderDarkensUnderTheGasAsTheTableSays) {
     // Tolerance as tests/lighting/shadow_gl_test.cpp: GL may filter with 8-bit weights, an error of
     // 3/256 of the largest node step in depth, i.e. ln 2 times that in transmittance (T <= 1);
     // times 0.8 (the shader's sun share) in colour, plus float rounding.
-    const float tol = 0.8f * std::log(2.0f) * 3.0f / 256.0f * maxNeighbourStep(s.table) + 1e-5f;
+    const float tol = 0.8f * std::log(2.0f) * 3.0f / 256.0f * test::maxNeighbourStep(s.table) + 1e-5f;
     const Camera cam = topDown();
     const glm::mat4 inv = glm::inverse(cam.proj * cam.view);
     float darkest = 1.0f, worst = 0.0f;

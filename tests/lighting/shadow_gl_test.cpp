@@ -15,48 +15,11 @@ using namespace splatfx;
 namespace {
 
 GLuint compileCompute(const std::string& src, std::string& log) {
-    const GLuint s = glCreateShader(GL_COMPUTE_SHADER);
-    const char* p = src.c_str();
-    glShaderSource(s, 1, &p, nullptr);
-    glCompileShader(s);
-    GLint ok = 0;
-    glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-    char buf[4096] = {};
-    glGetShaderInfoLog(s, sizeof buf, nullptr, buf);
-    log = buf;
-    if (!ok) {
-        glDeleteShader(s);
-        return 0;
-    }
-    const GLuint prog = glCreateProgram();
-    glAttachShader(prog, s);
-    glLinkProgram(prog);
-    glDeleteShader(s);
-    glGetProgramiv(prog, GL_LINK_STATUS, &ok);
-    glGetProgramInfoLog(prog, sizeof buf, nullptr, buf);
-    log += buf;
-    if (!ok) {
-        glDeleteProgram(prog);
-        return 0;
-    }
-    return prog;
+    auto p = gl::linkComputeProgram({src.c_str()}, "shadow include test");
+    if (!p) return log = p.error(), 0u;
+    return *p;
 }
 
-// Largest difference between neighbouring nodes along any axis.
-float maxNeighbourStep(const ShadowTable& t) {
-    const glm::ivec3 n = t.dims();
-    const auto& d = t.data();
-    float m = 0.0f;
-    auto at = [&](int i, int j, int k) { return d[std::size_t(i + n.x * (j + n.y * k))]; };
-    for (int k = 0; k < n.z; ++k)
-        for (int j = 0; j < n.y; ++j)
-            for (int i = 0; i < n.x; ++i) {
-                if (i + 1 < n.x) m = std::max(m, std::abs(at(i + 1, j, k) - at(i, j, k)));
-                if (j + 1 < n.y) m = std::max(m, std::abs(at(i, j + 1, k) - at(i, j, k)));
-                if (k + 1 < n.z) m = std::max(m, std::abs(at(i, j, k + 1) - at(i, j, k)));
-            }
-    return m;
-}
 
 class ShadowGlsl : public test::GLTest {};
 
@@ -125,7 +88,7 @@ TEST_F(ShadowGlsl, IncludeCompilesAndMatchesTheCpuLookup) {
         // trilinear sample may be off by up to 3 * 2^-8 of the largest step
         // between neighbouring nodes; exp2(-x) has slope at most ln 2; 1e-6
         // covers float rounding of the coordinates.
-        const float tol = std::log(2.0f) * 3.0f / 256.0f * maxNeighbourStep(table) + 1e-6f;
+        const float tol = std::log(2.0f) * 3.0f / 256.0f * test::maxNeighbourStep(table) + 1e-6f;
         int shadowed = 0;
         for (GLuint i = 0; i < count; ++i) {
             const float cpu = table.transmittance(glm::vec3(points[i]));

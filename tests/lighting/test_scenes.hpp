@@ -1,9 +1,11 @@
 // Grids shared by the lighting tests and the shadow benchmark.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include "splatfx/grid.hpp"
+#include "splatfx/lighting.hpp"
 
 namespace splatfx::test {
 
@@ -27,6 +29,23 @@ inline Grid effect1560(float spacing = 0.25f) {
         v.opacity = 0.7f * std::exp(-2.0f * (x * x + z * z)) * (1.0f - 0.8f * y);
     }
     return g;
+}
+
+// Largest difference between neighbouring table nodes along any axis (what
+// GL's filter-weight precision scales).
+inline float maxNeighbourStep(const ShadowTable& t) {
+    const glm::ivec3 n = t.dims();
+    const auto& d = t.data();
+    float m = 0.0f;
+    auto at = [&](int i, int j, int k) { return d[std::size_t(i + n.x * (j + n.y * k))]; };
+    for (int k = 0; k < n.z; ++k)
+        for (int j = 0; j < n.y; ++j)
+            for (int i = 0; i < n.x; ++i) {
+                if (i + 1 < n.x) m = std::max(m, std::abs(at(i + 1, j, k) - at(i, j, k)));
+                if (j + 1 < n.y) m = std::max(m, std::abs(at(i, j + 1, k) - at(i, j, k)));
+                if (k + 1 < n.z) m = std::max(m, std::abs(at(i, j, k + 1) - at(i, j, k)));
+            }
+    return m;
 }
 
 } // namespace splatfx::test

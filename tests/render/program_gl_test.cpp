@@ -34,6 +34,15 @@ TEST_F(ProgramGL, ACompileErrorNamesTheStage) {
     EXPECT_EQ(p.error().rfind("broken pass fragment shader failed to compile: ", 0), 0u) << p.error();
 }
 
+TEST_F(ProgramGL, AComputeProgramBuildsAndItsErrorsNameTheStage) {
+    auto good = gl::linkComputeProgram({kVersion, "layout(local_size_x = 1) in; void main() {}\n"}, "probe");
+    ASSERT_TRUE(good) << good.error();
+    glDeleteProgram(*good);
+    auto bad = gl::linkComputeProgram({kVersion, "layout(local_size_x = 1) in; void main() { x = 1; }\n"}, "probe");
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().rfind("probe compute shader failed to compile: ", 0), 0u) << bad.error();
+}
+
 TEST_F(ProgramGL, ALinkErrorIsReportedToo) {
     // Both stages compile; linking fails because the fragment stage reads an
     // input no vertex output feeds (GLSL 4.50, sec. 4.3.4).

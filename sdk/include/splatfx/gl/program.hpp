@@ -1,5 +1,5 @@
-// splatfx/gl/program.hpp: one vertex + fragment shader program, compiled and
-// linked with both steps checked.
+// splatfx/gl/program.hpp: one vertex + fragment (or compute) shader program,
+// compiled and linked with both steps checked.
 //
 // The GL backend builds its programs with it, and hosts (the samples'
 // geometry, the benchmarks' probes, the tests' stand-in hosts) may use it for
@@ -27,5 +27,7 @@ namespace splatfx::gl {
 // the stage that failed to compile ("vertex"/"fragment") or says the link
 // failed, and ends with the driver's log.
 Result<unsigned> linkProgram(std::initializer_list<const char*> vertex, std::initializer_list<const char*> fragment, const char* what);
+// The same for a compute shader (the "compute" stage in messages); GL 4.3+.
+Result<unsigned> linkComputeProgram(std::initializer_list<const char*> compute, const char* what);
 
 } // namespace splatfx::gl

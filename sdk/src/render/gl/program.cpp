@@ -10,26 +10,36 @@ namespace splatfx::gl {
 
 static_assert(std::is_same_v<GLuint, unsigned>, "splatfx/gl/program.hpp hands out GL names as unsigned");
 
-Result<unsigned> linkProgram(std::initializer_list<const char*> vertex, std::initializer_list<const char*> fragment, const char* what) {
-    const std::vector<const char*> sources[2] = {vertex, fragment};
-    GLuint stages[2] = {glCreateShader(GL_VERTEX_SHADER), glCreateShader(GL_FRAGMENT_SHADER)};
+namespace {
+
+struct Stage {
+    GLenum type;
+    const char* name; // in messages
+    std::vector<const char*> pieces;
+};
+
+// Compiles every stage, links them, and reports the first failure with the driver's log.
+Result<unsigned> link(const std::vector<Stage>& stages, const char* what) {
+    std::vector<GLuint> shaders;
     std::string log;
-    for (int i = 0; i < 2 && log.empty(); ++i) {
-        glShaderSource(stages[i], GLsizei(sources[i].size()), sources[i].data(), nullptr);
-        glCompileShader(stages[i]);
+    for (const Stage& st : stages) {
+        if (!log.empty()) break;
+        const GLuint s = glCreateShader(st.type);
+        shaders.push_back(s);
+        glShaderSource(s, GLsizei(st.pieces.size()), st.pieces.data(), nullptr);
+        glCompileShader(s);
         GLint ok = 0;
-        glGetShaderiv(stages[i], GL_COMPILE_STATUS, &ok);
+        glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
         if (!ok) {
             char buf[4096] = {};
-            glGetShaderInfoLog(stages[i], sizeof buf, nullptr, buf);
-            log = std::string(what) + (i == 0 ? " vertex" : " fragment") + " shader failed to compile: " + buf;
+            glGetShaderInfoLog(s, sizeof buf, nullptr, buf);
+            log = std::string(what) + " " + st.name + " shader failed to compile: " + buf;
         }
     }
     GLuint program = 0;
     if (log.empty()) {
         program = glCreateProgram();
-        glAttachShader(program, stages[0]);
-        glAttachShader(program, stages[1]);
+        for (GLuint s : shaders) glAttachShader(program, s);
         glLinkProgram(program);
         GLint ok = 0;
         glGetProgramiv(program, GL_LINK_STATUS, &ok);
@@ -40,10 +50,19 @@ Result<unsigned> linkProgram(std::initializer_list<const char*> vertex, std::ini
             glDeleteProgram(program);
         }
     }
-    glDeleteShader(stages[0]);
-    glDeleteShader(stages[1]);
+    for (GLuint s : shaders) glDeleteShader(s);
     if (!log.empty()) return makeError(log);
     return program;
+}
+
+} // namespace
+
+Result<unsigned> linkProgram(std::initializer_list<const char*> vertex, std::initializer_list<const char*> fragment, const char* what) {
+    return link({{GL_VERTEX_SHADER, "vertex", vertex}, {GL_FRAGMENT_SHADER, "fragment", fragment}}, what);
+}
+
+Result<unsigned> linkComputeProgram(std::initializer_list<const char*> compute, const char* what) {
+    return link({{GL_COMPUTE_SHADER, "compute", compute}}, what);
 }
 
 } // namespace splatfx::gl
