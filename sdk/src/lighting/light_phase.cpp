@@ -1,20 +1,17 @@
 // Lights and Henyey-Greenstein phase functions (Ebert & Parent 1990, "Illumination of gaseous phenomena").
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 
 #include "splatfx/lighting.hpp"
+
+#include "grid/number_text.hpp"
 
 namespace splatfx {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string str(float v) {
-    std::ostringstream os;
-    os << v;
-    return os.str();
-}
+using grid_detail::str; // numbers in messages as the grid module shows them
 
 bool finite3(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
