@@ -44,12 +44,14 @@ enum class Alpha {
 
 // Budgets checked before anything is decoded.
 inline constexpr int kMaxImageSide = 16384;                        // pixels on a side
+inline constexpr long long kMaxImagePixels = 1ll << 26;            // 8192x8192: 1 GiB as float RGBA
 inline constexpr unsigned long long kMaxImageFileBytes = 1ull << 30; // 1 GiB of file
 
 // Fails with the file name and the reason: missing, a symbolic-link loop, not
 // a regular file (FIFOs and devices are never read: they could block or never
-// end), empty, over kMaxImageFileBytes, unreadable, or more than
-// kMaxImageSide pixels on a side.
+// end), empty, over kMaxImageFileBytes, unreadable, more than kMaxImageSide
+// pixels on a side or more than kMaxImagePixels in all (a few hundred bytes
+// of header can claim any size). Only the first four channels are decoded.
 Result<Image> readImage(const std::string& path, Alpha alpha = Alpha::Premultiplied);
 
 // What an image file says about itself, from its header alone (nothing is

@@ -62,18 +62,19 @@ Result<Image> readImage(const std::string& path, Alpha alpha) {
     if (spec.width > kMaxImageSide || spec.height > kMaxImageSide)
         return makeError("cannot read image '" + path + "': " + std::to_string(spec.width) + "x" +
                          std::to_string(spec.height) + " is larger than " + std::to_string(kMaxImageSide) + " on a side");
+    if (static_cast<long long>(spec.width) * spec.height > kMaxImagePixels)
+        return makeError("cannot read image '" + path + "': " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                         " is over the budget of " + std::to_string(kMaxImagePixels) + " pixels");
     Image img;
     img.width = spec.width;
     img.height = spec.height;
     img.channels = std::min(spec.nchannels, 4);
-    std::vector<float> all(size_t(spec.width) * spec.height * spec.nchannels);
-    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) {
+    // Only the channels kept are decoded: a header claiming a thousand channels costs nothing.
+    img.pixels.resize(size_t(img.width) * img.height * img.channels);
+    if (!in->read_image(0, 0, 0, img.channels, OIIO::TypeDesc::FLOAT, img.pixels.data())) {
         std::string why = in->geterror();
         return makeError("cannot read image '" + path + "': " + (why.empty() ? "truncated or corrupt data" : why));
     }
-    img.pixels.resize(size_t(img.width) * img.height * img.channels);
-    for (size_t p = 0, n = size_t(img.width) * img.height; p < n; ++p)
-        for (int c = 0; c < img.channels; ++c) img.pixels[p * img.channels + c] = all[p * spec.nchannels + c];
     return img;
 }
 
