@@ -57,6 +57,35 @@ std::string pngHeader(std::uint32_t width, std::uint32_t height) {
     return s;
 }
 
+// The start of an OpenEXR file: magic, version flags, and a header with the
+// given data window (and tiles, when tileSide > 0). A few dozen bytes that
+// OpenEXR sizes its chunk table from when the file is opened.
+std::string exrHeader(std::int32_t width, std::int32_t height, std::uint32_t tileSide = 0) {
+    std::string s("\x76\x2f\x31\x01", 4);
+    auto le32 = [](std::string& out, std::uint32_t v) {
+        for (int i = 0; i < 4; ++i) out.push_back(char((v >> (8 * i)) & 0xff));
+    };
+    le32(s, tileSide ? 0x202u : 2u);
+    auto attribute = [&](const std::string& name, const std::string& type, const std::string& value) {
+        s += name + '\0' + type + '\0';
+        le32(s, std::uint32_t(value.size()));
+        s += value;
+    };
+    std::string window;
+    for (std::uint32_t v : {0u, 0u, std::uint32_t(width - 1), std::uint32_t(height - 1)}) le32(window, v);
+    attribute("dataWindow", "box2i", window);
+    attribute("displayWindow", "box2i", window);
+    if (tileSide) {
+        std::string tiles;
+        le32(tiles, tileSide), le32(tiles, tileSide);
+        tiles.push_back('\0');
+        attribute("tiles", "tiledesc", tiles);
+    }
+    s.push_back('\0');
+    s += std::string(64, '\0'); // where the chunk table would start
+    return s;
+}
+
 } // namespace
 
 TEST(ImageRead, AFifoIsNeverOpened) {
@@ -99,4 +128,39 @@ TEST(ImageRead, ATextureSetWhoseFirstTextureIsAFifoFailsInsteadOfHanging) {
     auto loaded = TextureSet::load(set.string());
     ASSERT_FALSE(loaded);
     EXPECT_NE(loaded.error().find("t000.png"), std::string::npos) << loaded.error();
+}
+
+TEST(ImageRead, AHeaderClaimingTooManyPixelsIsRefusedBeforeDecoding) {
+    // Within the side limit, over the pixel budget: 10000^2 float RGBA would be 1.6 GB.
+    const fs::path p = dir() / "many.png";
+    std::ofstream(p, std::ios::binary) << pngHeader(10000, 10000);
+    expectRefused(p.string(), "over the budget of 67108864 pixels");
+}
+
+TEST(ImageRead, AnExrHeaderClaimingAHugeWindowIsRefusedBeforeOpenExrSeesIt) {
+    // OpenEXR allocates its chunk table from the window when the file is
+    // opened: this 120-byte file would cost gigabytes there (tools/fuzz.sh found it).
+    const fs::path p = dir() / "window.exr";
+    std::ofstream(p, std::ios::binary) << exrHeader(16000, 16000);
+    expectRefused(p.string(), "over the image budget");
+}
+
+TEST(ImageRead, AnExrHeaderClaimingOnePixelTilesIsRefusedBeforeOpenExrSeesIt) {
+    // 8192^2 is within the pixel budget, but as 1x1 tiles it is 2^26 chunks.
+    const fs::path p = dir() / "tiles.exr";
+    std::ofstream(p, std::ios::binary) << exrHeader(8192, 8192, 1);
+    expectRefused(p.string(), "chunks, over the budget");
+}
+
+TEST(ImageRead, AnExrWithinTheBudgetsStillReads) {
+    const fs::path p = dir() / "small.exr";
+    Image img;
+    img.width = 5, img.height = 3, img.channels = 4;
+    img.pixels.assign(5 * 3 * 4, 0.25f);
+    ASSERT_TRUE(writeImage(p.string(), img));
+    auto back = readImage(p.string());
+    ASSERT_TRUE(back) << back.error();
+    EXPECT_EQ(back->width, 5);
+    EXPECT_EQ(back->channels, 4);
+    EXPECT_FLOAT_EQ(back->at(4, 2, 3), 0.25f);
 }

@@ -9,6 +9,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "checked_file.hpp"
+#include "exr_header.hpp"
 
 namespace splatfx {
 
@@ -31,7 +32,7 @@ Status checkImageFile(const std::string& path) {
     if (bytes == 0) return makeError(what + "the file is empty");
     if (bytes > kMaxImageFileBytes)
         return makeError(what + std::to_string(bytes) + " bytes, over the image-file budget of " + std::to_string(kMaxImageFileBytes) + " bytes");
-    return {};
+    return detail::checkExrHeader(path);
 }
 
 } // namespace

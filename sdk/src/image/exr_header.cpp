@@ -1,0 +1,122 @@
+#include "exr_header.hpp"
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <vector>
+
+#include "splatfx/image.hpp"
+
+namespace splatfx::detail {
+
+namespace {
+
+// Headers hold a few attributes; anything longer than this is not an image header.
+constexpr std::size_t kMaxHeaderBytes = 1 << 20;
+
+std::int32_t readInt32(const unsigned char* p) {
+    std::uint32_t v = std::uint32_t(p[0]) | std::uint32_t(p[1]) << 8 | std::uint32_t(p[2]) << 16 | std::uint32_t(p[3]) << 24;
+    std::int32_t s;
+    std::memcpy(&s, &v, 4);
+    return s;
+}
+
+struct Part {
+    bool hasWindow = false;
+    std::int64_t width = 0, height = 0;
+    std::int64_t tileX = 0, tileY = 0; // 0: scanlines
+    int levelMode = 0;                 // 0 one level, 1 mipmap, 2 ripmap
+    std::int64_t chunkCount = -1; // multi-part files state it; OpenEXR trusts it
+};
+
+// Scanlines per chunk, by compression (OpenEXR's file layout); an unknown
+// code counts as one line per chunk, the most chunks.
+std::int64_t linesPerChunk(unsigned char compression) {
+    switch (compression) {
+    case 3: case 5: return 16;                 // ZIP, PXR24
+    case 4: case 6: case 7: case 8: return 32; // PIZ, B44, B44A, DWAA
+    case 9: return 256;                        // DWAB
+    default: return 1;                         // none, RLE, ZIPS
+    }
+}
+
+} // namespace
+
+bool looksLikeExr(const unsigned char* head, std::size_t size) {
+    return size >= 4 && head[0] == 0x76 && head[1] == 0x2f && head[2] == 0x31 && head[3] == 0x01;
+}
+
+Status checkExrHeader(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::vector<unsigned char> buf(kMaxHeaderBytes);
+    in.read(reinterpret_cast<char*>(buf.data()), std::streamsize(buf.size()));
+    const std::size_t n = std::size_t(in.gcount());
+    if (!looksLikeExr(buf.data(), n)) return {};
+    const std::string what = "cannot read image '" + path + "': OpenEXR header ";
+    if (n < 8) return makeError(what + "is truncated");
+    const std::uint32_t flags = std::uint32_t(readInt32(&buf[4]));
+    const bool singleTiled = flags & 0x200, multipart = flags & 0x1000;
+    std::size_t at = 8;
+    auto readString = [&](std::string& out) {
+        const auto end = std::find(buf.begin() + std::ptrdiff_t(at), buf.begin() + std::ptrdiff_t(n), 0);
+        if (end == buf.begin() + std::ptrdiff_t(n) || end - (buf.begin() + std::ptrdiff_t(at)) > 255) return false;
+        out.assign(buf.begin() + std::ptrdiff_t(at), end);
+        at = std::size_t(end - buf.begin()) + 1;
+        return true;
+    };
+    for (int partIndex = 0;; ++partIndex) {
+        Part part;
+        unsigned char compression = 0;
+        std::string name, type;
+        for (;;) {
+            if (!readString(name)) return makeError(what + "does not end within " + std::to_string(kMaxHeaderBytes) + " bytes");
+            if (name.empty()) break; // end of this part's header
+            if (!readString(type) || at + 4 > n) return makeError(what + "is truncated in attribute '" + name + "'");
+            const std::int32_t size = readInt32(&buf[at]);
+            at += 4;
+            if (size < 0 || at + std::size_t(size) > n) return makeError(what + "attribute '" + name + "' has a bad size");
+            const unsigned char* v = &buf[at];
+            if (name == "dataWindow" && type == "box2i" && size == 16) {
+                const std::int64_t x0 = readInt32(v), y0 = readInt32(v + 4), x1 = readInt32(v + 8), y1 = readInt32(v + 12);
+                part.hasWindow = true;
+                part.width = x1 - x0 + 1;
+                part.height = y1 - y0 + 1;
+            } else if (name == "tiles" && type == "tiledesc" && size == 9) {
+                part.tileX = std::uint32_t(readInt32(v));
+                part.tileY = std::uint32_t(readInt32(v + 4));
+                part.levelMode = v[8] & 0x0f;
+            } else if (name == "chunkCount" && type == "int" && size == 4) {
+                part.chunkCount = readInt32(v);
+            } else if (name == "compression" && type == "compression" && size == 1) {
+                compression = v[0];
+            }
+            at += std::size_t(size);
+        }
+        if (partIndex > 0 && !part.hasWindow && multipart) break; // the empty header closing a multi-part file
+        if (!part.hasWindow) return makeError(what + "has no data window");
+        const std::string partName = multipart ? "part " + std::to_string(partIndex) + " " : "";
+        if (part.width <= 0 || part.height <= 0) return makeError(what + partName + "has an empty data window");
+        if (part.width > kMaxImageSide || part.height > kMaxImageSide || part.width * part.height > kMaxImagePixels)
+            return makeError(what + partName + "claims " + std::to_string(part.width) + "x" + std::to_string(part.height) +
+                             " pixels, over the image budget (" + std::to_string(kMaxImageSide) + " on a side, " +
+                             std::to_string(kMaxImagePixels) + " in all)");
+        std::int64_t chunks;
+        if (part.tileX > 0 || part.tileY > 0 || singleTiled) {
+            if (part.tileX <= 0 || part.tileY <= 0) return makeError(what + partName + "has tiles of zero size");
+            const std::int64_t tiles = ((part.width + part.tileX - 1) / part.tileX) * ((part.height + part.tileY - 1) / part.tileY);
+            // Mip levels add at most a third, rip levels at most three times (geometric sums).
+            chunks = part.levelMode == 0 ? tiles : part.levelMode == 1 ? tiles * 2 : tiles * 4;
+        } else {
+            chunks = (part.height + linesPerChunk(compression) - 1) / linesPerChunk(compression);
+        }
+        chunks = std::max(chunks, part.chunkCount);
+        if (std::uint64_t(chunks) > kMaxExrChunks)
+            return makeError(what + partName + "claims " + std::to_string(chunks) + " chunks, over the budget of " +
+                             std::to_string(kMaxExrChunks));
+        if (!multipart) break;
+        if (partIndex > 64) return makeError(what + "has more than 64 parts");
+    }
+    return {};
+}
+
+} // namespace splatfx::detail
