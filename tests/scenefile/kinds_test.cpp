@@ -55,10 +55,10 @@ TEST(SceneFileKinds, AnUnknownKindNamesEveryKnownKind) {
     for (const std::string& k : splatfx::scenefile::effectKindNames()) listed += (listed.empty() ? "" : ", ") + ("\"" + k + "\"");
     EXPECT_NE(r.error().find("expected one of " + listed), std::string::npos) << r.error();
     // The list is the documented one (docs/scene-format.md), in its order.
-    EXPECT_EQ(listed, R"("fire", "smoke", "steam", "dust", "fireToSmoke", "ghosts", "grid")");
+    EXPECT_EQ(listed, R"("fire", "smoke", "steam", "dust", "fireToSmoke", "ghosts", "grid", "gas")");
     auto missing = parse(R"("effects": [{"name": "a"}])");
     ASSERT_FALSE(missing);
-    EXPECT_NE(missing.error().find("missing \"kind\" (one of fire, smoke, steam, dust, fireToSmoke, ghosts, grid)"), std::string::npos)
+    EXPECT_NE(missing.error().find("missing \"kind\" (one of fire, smoke, steam, dust, fireToSmoke, ghosts, grid, gas)"), std::string::npos)
         << missing.error();
 }
 
@@ -105,4 +105,20 @@ TEST(SceneFileKinds, SmokeAndDustShareOneReaderButKeepTheirOwnKeys) {
         ASSERT_FALSE(moved) << kind;
         EXPECT_NE(moved.error().find(std::string("solver effects (\"") + kind + "\") stay put"), std::string::npos) << moved.error();
     }
+}
+
+TEST(SceneFileKinds, AGasTakesOnlyItsTypesKeysAndNamesBadValues) {
+    auto fog = parse(R"("effects": [{"kind": "gas", "dims": [6, 3, 6], "gas": {"type": "fog", "frontSpeed": 2, "turbulence": {"octaves": 3}}}])");
+    ASSERT_TRUE(fog) << fog.error();
+    ASSERT_EQ(fog->effects.size(), 1u);
+    // ellipse1 is the fog's: a steam gas does not take it (a misplaced key is not silently ignored).
+    auto misplaced = parse(R"("effects": [{"kind": "gas", "gas": {"type": "steam", "ellipse1": 0.5}}])");
+    ASSERT_FALSE(misplaced);
+    EXPECT_NE(misplaced.error().find("effects[0].gas.ellipse1: unknown key"), std::string::npos) << misplaced.error();
+    auto badType = parse(R"("effects": [{"kind": "gas", "gas": {"type": "smog"}}])");
+    ASSERT_FALSE(badType);
+    EXPECT_NE(badType.error().find("effects[0].gas.type"), std::string::npos) << badType.error();
+    auto octaves = parse(R"("effects": [{"kind": "gas", "gas": {"turbulence": {"octaves": 40}}}])");
+    ASSERT_FALSE(octaves);
+    EXPECT_NE(octaves.error().find("effects[0].gas.turbulence.octaves"), std::string::npos) << octaves.error();
 }

@@ -13,10 +13,12 @@
 // color tables and differing texture sets").
 //
 // An Effect is an EffectKind (effect_kind.hpp), the interface Scene schedules
-// by; it is a copyable value that owns one of the SDK's two kinds:
+// by; it is a copyable value that owns one of the SDK's three kinds:
 //   - grid effects (fromGrid) are stateless: update(t) computes frame t
 //     directly from (voxel, t, seed), in any order, at no cost for skipped
 //     frames. step(dt) is update(time() + dt); advanceTo(t) is update(t).
+//   - procedural gases (fromProceduralGas) are stateless the same way: the
+//     turbulent density is sampled into a fixed lattice at t.
 //   - solver effects (fromSolver) are stateful: step(dt) simulates; update()
 //     asserts; advanceTo(t) steps to t, catching up after a gap in a bounded
 //     number of coarse steps (AdvanceContext).
@@ -43,6 +45,7 @@
 #include "splatfx/effect_kind.hpp"
 #include "splatfx/grid.hpp"
 #include "splatfx/motion.hpp"
+#include "splatfx/procedural_gas.hpp"
 #include "splatfx/result.hpp"
 #include "splatfx/solver.hpp"
 #include "splatfx/splats.hpp"
@@ -102,6 +105,13 @@ public:
     // A stateful effect driven by a solver. desc.motion must be at rest
     // (attach motion to the emitters instead: the smoke should trail).
     static Result<Effect> fromSolver(FluidSolver solver, EffectDesc desc);
+    // A stateless turbulent gas (Ebert & Parent 1990, procedural_gas.hpp)
+    // sampled into `lattice`'s cells (dims, spacing, transform; its voxels are
+    // ignored) at every update; desc.motion moves the lattice through the
+    // gas's world, desc.textures.cycling picks each cell's texture.
+    // Fails on an invalid gas desc (the message names the field), a lattice
+    // with no cells or over kMaxVoxels.
+    static Result<Effect> fromProceduralGas(ProceduralGasDesc gas, Grid lattice, EffectDesc desc);
 
     Effect(const Effect& other);
     Effect& operator=(const Effect& other);

@@ -100,6 +100,25 @@ struct SteamDesc {
 };
 Result<Effect> steam(Materials& materials, const SteamDesc& desc = {});
 
+// A turbulent procedural gas (Ebert & Parent 1990; procedural_gas.hpp):
+// steam from a glass, fog rolling in (chess_fog), an ellipsoidal cloud,
+// sampled into a lattice of `dims` cells placed with its base centre at
+// `position`; the gas's own coordinates are world coordinates.
+struct GasDesc {
+    ProceduralGasDesc gas{};          // which gas and its parameters; default rising steam
+    glm::ivec3 dims{16, 16, 16};      // lattice cells sampled per update; default 16^3
+    glm::vec3 spacing{0.125f};        // world units; default 0.125
+    glm::vec3 position{0.0f};         // world position of the lattice's base centre; default origin
+    std::optional<TextureSet> textureSet{}; // default none (procedural turbulence)
+    int textureCount = 16;            // default 16
+    float opacity = 1.0f;             // scales the gas's density into splat opacity, (0, 1]; default 1
+    float texturesPerSec = 3.0f;      // local dynamics' cycling rate; default 3
+    Motion motion{};                  // moves the lattice; default at rest
+    std::uint32_t seed = 1;           // texture cycling; default 1
+    std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
+};
+Result<Effect> gas(Materials& materials, const GasDesc& desc = {});
+
 struct DustDesc {
     glm::ivec3 dims{24, 6, 12};       // solver cells; default 24x6x12
     glm::vec3 spacing{0.5f};          // world units per cell; default 0.5

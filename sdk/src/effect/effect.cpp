@@ -32,6 +32,13 @@ Result<Effect> Effect::fromSolver(FluidSolver solver, EffectDesc desc) {
     return Effect(std::move(*body));
 }
 
+Result<Effect> Effect::fromProceduralGas(ProceduralGasDesc gas, Grid lattice, EffectDesc desc) {
+    if (Status s = detail::EffectBody::checkDesc(desc); !s) return makeError(s.error());
+    auto body = detail::makeGasBody(std::move(gas), std::move(lattice), std::move(desc));
+    if (!body) return makeError(body.error());
+    return Effect(std::move(*body));
+}
+
 bool Effect::isStateless() const { return mBody->stateless(); }
 void Effect::update(double timeSec) { mBody->update(timeSec); }
 void Effect::step(double dtSec) { mBody->step(dtSec); }

@@ -1,7 +1,7 @@
 // The inside of an Effect: what both shipped kinds share (desc, layers, the
 // current grid and its height split into layers, emit, the splat-extent part
 // of bounds) and the virtual functions each kind implements
-// (grid_effect.cpp: stateless; solver_effect.cpp: stateful).
+// (grid_effect.cpp and gas_effect.cpp: stateless; solver_effect.cpp: stateful).
 // Private to the SDK: the public extension point is EffectKind.
 #pragma once
 
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "splatfx/effect.hpp"
+#include "splatfx/procedural_gas.hpp"
 
 namespace splatfx::detail {
 
@@ -56,5 +57,6 @@ public:
 
 std::unique_ptr<EffectBody> makeGridBody(Grid base, EffectDesc desc);
 Result<std::unique_ptr<EffectBody>> makeSolverBody(FluidSolver solver, EffectDesc desc);
+Result<std::unique_ptr<EffectBody>> makeGasBody(ProceduralGasDesc gas, Grid lattice, EffectDesc desc);
 
 } // namespace splatfx::detail

@@ -181,6 +181,28 @@ Result<Effect> steam(Materials& materials, const SteamDesc& d) {
     return Effect::fromGrid(std::move(*grid), std::move(e));
 }
 
+Result<Effect> gas(Materials& materials, const GasDesc& d) {
+    if (Status s = checkCount("GasDesc.textureCount", d.textureCount); !s) return makeError(s.error());
+    if (!(d.opacity > 0.0f && d.opacity <= 1.0f)) return makeError("GasDesc.opacity must be in (0, 1]");
+    if (Status s = checkRate("GasDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
+    Result<Grid> lattice = Grid::box(glm::ivec3(1), d.spacing); // spacing checked by the grid's own rules
+    if (!lattice) return makeError("GasDesc.spacing: " + lattice.error());
+    if (glm::any(glm::lessThan(d.dims, glm::ivec3(1)))) return makeError("GasDesc.dims must be at least 1 on every axis");
+    lattice->dims = d.dims;
+    lattice->voxels.clear();
+    lattice->transform = at(d.position); // lattices are centred on x and z (Grid::localPosition): the base centre
+    Result<PendingSet> set = resolveSet(materials, d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.textureSeed});
+    if (!set) return makeError("GasDesc.textureSet: " + set.error());
+
+    EffectDesc e = gridDesc("gas", materials, d.motion, d.seed);
+    e.textures.cycling = {.mode = Cycling::Ordered, .texturesPerSec = d.texturesPerSec, .rateJitter = 0.25f};
+    const Result<std::uint32_t> setId = registerSet(materials, *set);
+    if (!setId) return makeError("GasDesc.textureSet: " + setId.error());
+    const std::uint32_t tableId = materials.addColorTable(ColorTable::steam());
+    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true, .opacityScale = d.opacity}}};
+    return Effect::fromProceduralGas(d.gas, std::move(*lattice), std::move(e));
+}
+
 Result<Effect> dust(Materials& materials, const DustDesc& d) {
     if (Status s = checkCount("DustDesc.textureCount", d.textureCount); !s) return makeError(s.error());
     if (!(d.sourceRadius > 0.0f)) return makeError("DustDesc.sourceRadius must be > 0");

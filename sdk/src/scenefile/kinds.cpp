@@ -5,7 +5,7 @@
 namespace splatfx::scenefile {
 
 // Effect readers, one a file in kinds/.
-EffectReaderFn readFire, readSmoke, readSteam, readDust, readFireToSmoke, readGhosts, readGridKind;
+EffectReaderFn readFire, readSmoke, readSteam, readDust, readFireToSmoke, readGhosts, readGridKind, readGasKind;
 // Geometry readers, for the types with keys of their own.
 GeometryReaderFn readMeshGeometry;
 
@@ -20,6 +20,7 @@ constexpr EffectKind kEffectKinds[] = {
     {"fireToSmoke", &readFireToSmoke}, // kinds/fire_to_smoke.cpp
     {"ghosts", &readGhosts},           // kinds/ghosts.cpp
     {"grid", &readGridKind},           // kinds/grid.cpp
+    {"gas", &readGasKind},             // kinds/gas.cpp
 };
 
 constexpr GeometryKind kGeometryKinds[] = {
