@@ -1,9 +1,10 @@
 // tools/common/cli.hpp: the command-line boundary shared by every tool and sample.
 //
 // What it is: strict number parsing (the whole string, range-checked, no
-// silent wrap-around), a "WxH" size parser, an "A-B[:STEP]" frame-range parser, and a guard for main() that turns
-// any escaping std::exception (std::bad_alloc included) into a message and a
-// non-zero exit instead of std::terminate's abort.
+// silent wrap-around), a "WxH" size parser, an "A-B[:STEP]" frame-range
+// parser (render-farm tasks), and a guard for main() that turns any escaping
+// std::exception (std::bad_alloc included) into a message and a non-zero
+// exit instead of std::terminate's abort.
 // What it does not do: option tables or usage text (each tool keeps its own),
 // locale handling (numbers are C-locale: '.' is the decimal point).
 //
