@@ -324,14 +324,18 @@ TEST(TexpickRandom, RejectsFlatPatches) {
     EXPECT_GT(sel->rejected, 0);
     for (size_t k = 0; k < sel->patches.size(); ++k) {
         EXPECT_GT(sel->patches[k].x + sel->patches[k].size, 128) << "patch " << k << " lies wholly in the flat half";
-        EXPECT_GE(sel->stats[k].stddev, accept.minStd);
+        // Relative thresholds (the default): minStd times the source's luminance range.
+        EXPECT_GE(sel->stats[k].stddev, texpick::effectiveThresholds(src, accept).minStd);
     }
     const texpick::Source flat = texpick::sourceFromImage(grayImage(64, 64, [](int, int) { return 0.5; }), "flat");
     auto none = texpick::pickRandom(flat, {.count = 2, .patch = 16, .seed = 1, .maxTries = 50});
     ASSERT_FALSE(none);
-    EXPECT_EQ(none.error(), "random: only 0 of 2 16-px patches of 'flat' passed after 50 tries (the rest were flat, "
-                            "near-empty, outside the cut-out); lower --min-std 0.03, --min-mean 0.03, --min-coverage 0.9 "
-                            "or use a smaller --patch");
+    // Every try counted against the threshold that rejected it: a constant
+    // image is judged as if it spanned one 8-bit step (0.03 / 255).
+    EXPECT_EQ(none.error(), "random: only 0 of 2 16-px patches of 'flat' passed after 50 tries: of 50 candidates, 0 were rejected "
+                            "by --min-coverage 0.9 (mean alpha; alpha read as coverage), 0 by --min-mean 0.03 (0.015 for this "
+                            "source's luminance 0.5..0.5), 50 by --min-std 0.03 (0.000117647 for this source's luminance 0.5..0.5); "
+                            "lower --min-std or use a smaller --patch");
 }
 
 // [SECTION] Processing

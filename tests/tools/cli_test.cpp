@@ -132,3 +132,42 @@ TEST(CliSpawn, ExitCodesEnvironmentAndFailuresToStart) {
     EXPECT_NE(noDir.error.find("cannot enter folder '/nonexistent/splatfx'"), std::string::npos) << noDir.error;
     EXPECT_FALSE(cli::spawn({}).started);
 }
+
+// Farm task ranges (issue 18, item 3).
+TEST(CliFrameRange, AcceptsRangesAndSteps) {
+    cli::FrameRange r;
+    ASSERT_TRUE(cli::parseFrameRange("--range", "8-15", 99999, r));
+    EXPECT_EQ(r.first, 8);
+    EXPECT_EQ(r.last, 15);
+    EXPECT_EQ(r.step, 1);
+    EXPECT_EQ(r.count(), 8);
+    ASSERT_TRUE(cli::parseFrameRange("--range", "2-23:7", 99999, r));
+    EXPECT_EQ(r.count(), 4); // 2, 9, 16, 23
+    for (int i = 0; i < 30; ++i) EXPECT_EQ(r.contains(i), i == 2 || i == 9 || i == 16 || i == 23) << i;
+    ASSERT_TRUE(cli::parseFrameRange("--range", "5-5", 99999, r));
+    EXPECT_EQ(r.count(), 1);
+    ASSERT_TRUE(cli::parseFrameRange("--range", "0-6:4", 99999, r));
+    EXPECT_EQ(r.count(), 2); // 0, 4: the last index need not be on the step
+    EXPECT_TRUE(cli::checkFrameRange("--range", r, 7));
+}
+
+TEST(CliFrameRange, RefusesBackwardsZeroStepGarbageAndBeyondTheSequence) {
+    cli::FrameRange r{3, 4, 1};
+    const std::string head = "--range expects A-B or A-B:STEP (frame indices from 0, e.g. 0-23 or 0-95:4), got ";
+    EXPECT_EQ(cli::parseFrameRange("--range", "8-3", 99999, r).error(), head + "'8-3' (the last frame 3 comes before the first 8)");
+    EXPECT_EQ(cli::parseFrameRange("--range", "0-7:0", 99999, r).error(), head + "'0-7:0' (STEP must be at least 1)");
+    EXPECT_EQ(cli::parseFrameRange("--range", "0-100000", 99999, r).error(), head + "'0-100000' (frame indices go from 0 to 99999)");
+    for (const char* bad : {"", "7", "-", "3-", "-3", "-3-5", "3-+5", "+3-5", "3-5:", "3-5:x", "3-5:-1", "a-b", "1-2-3", " 1-2", "1-2 ",
+                            "0x1-2", "1.5-2", "1-2:1:1", "99999999999999999999-1"}) {
+        const splatfx::Status s = cli::parseFrameRange("--range", bad, 99999, r);
+        ASSERT_FALSE(s) << "'" << bad << "'";
+        EXPECT_EQ(s.error().rfind(head + "'" + bad + "'", 0), 0u) << s.error();
+    }
+    EXPECT_EQ(r.first, 3) << "a refused range must not be stored";
+    EXPECT_EQ(r.last, 4);
+    const cli::FrameRange beyond{20, 30, 5};
+    EXPECT_EQ(cli::checkFrameRange("--range", beyond, 24).error(),
+              "--range 20-30:5 goes beyond the sequence: it has 24 frame(s), indices 0-23 "
+              "(set the sequence's length with --frames, the same for every task)");
+    EXPECT_TRUE(cli::checkFrameRange("--range", cli::FrameRange{20, 23, 1}, 24));
+}

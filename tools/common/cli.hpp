@@ -1,9 +1,10 @@
 // tools/common/cli.hpp: the command-line boundary shared by every tool and sample.
 //
 // What it is: strict number parsing (the whole string, range-checked, no
-// silent wrap-around), a "WxH" size parser, and a guard for main() that turns
-// any escaping std::exception (std::bad_alloc included) into a message and a
-// non-zero exit instead of std::terminate's abort.
+// silent wrap-around), a "WxH" size parser, an "A-B[:STEP]" frame-range
+// parser (render-farm tasks), and a guard for main() that turns any escaping
+// std::exception (std::bad_alloc included) into a message and a non-zero
+// exit instead of std::terminate's abort.
 // What it does not do: option tables or usage text (each tool keeps its own),
 // locale handling (numbers are C-locale: '.' is the decimal point).
 //
@@ -111,6 +112,64 @@ inline splatfx::Status parseSize(std::string_view option, std::string_view text,
     width = w;
     height = h;
     return {};
+}
+
+// A range of frame indices for one render-farm task: "A-B" (every frame
+// from A to B, both included) or "A-B:STEP" (A, A+STEP, ... up to B).
+struct FrameRange {
+    int first = 0; // default 0
+    int last = 0;  // >= first; default 0
+    int step = 1;  // >= 1; default 1
+    bool contains(int i) const { return i >= first && i <= last && (i - first) % step == 0; }
+    int count() const { return (last - first) / step + 1; }
+};
+
+// "A-B" or "A-B:STEP" with A, B whole numbers in [0, maxIndex], B >= A and
+// STEP a whole number in [1, maxIndex + 1]. Whether B lies inside a given
+// sequence is the caller's check (checkFrameRange), since the sequence's
+// length is often known only later. Errors name the option and the text.
+inline splatfx::Status parseFrameRange(std::string_view option, std::string_view text, int maxIndex, FrameRange& out) {
+    const std::string opt(option);
+    auto bad = [&](const std::string& why) {
+        return splatfx::makeError(opt + " expects A-B or A-B:STEP (frame indices from 0, e.g. 0-23 or 0-95:4), got " +
+                                  detail::quoted(text) + why);
+    };
+    const size_t dash = text.find('-');
+    if (dash == std::string_view::npos) return bad("");
+    const std::string_view a = text.substr(0, dash);
+    std::string_view rest = text.substr(dash + 1);
+    std::string_view b = rest, st;
+    if (const size_t colon = rest.find(':'); colon != std::string_view::npos) {
+        b = rest.substr(0, colon);
+        st = rest.substr(colon + 1);
+    }
+    // Each part digits only: no signs ("--range -3-5" or "3-+5" is garbage, not a negative frame).
+    auto digitsOnly = [](std::string_view v) {
+        return !v.empty() && v.find_first_not_of("0123456789") == std::string_view::npos;
+    };
+    if (!digitsOnly(a) || !digitsOnly(b) || (rest.find(':') != std::string_view::npos && !digitsOnly(st))) return bad("");
+    FrameRange r;
+    if (!parseInt(option, a, 0, maxIndex, r.first) || !parseInt(option, b, 0, maxIndex, r.last))
+        return bad(" (frame indices go from 0 to " + std::to_string(maxIndex) + ")");
+    if (r.last < r.first)
+        return bad(" (the last frame " + std::to_string(r.last) + " comes before the first " + std::to_string(r.first) + ")");
+    if (!st.empty()) {
+        long long step = 0;
+        if (!parseInt(option, st, 0ll, (long long)maxIndex + 1, step)) return bad(" (STEP must be a whole number from 1)");
+        if (step == 0) return bad(" (STEP must be at least 1)");
+        r.step = int(step);
+    }
+    out = r;
+    return {};
+}
+
+// The range inside a sequence of `frames` frames (indices 0 .. frames - 1).
+inline splatfx::Status checkFrameRange(std::string_view option, const FrameRange& r, int frames) {
+    if (r.last < frames) return {};
+    return splatfx::makeError(std::string(option) + " " + std::to_string(r.first) + "-" + std::to_string(r.last) +
+                              (r.step > 1 ? ":" + std::to_string(r.step) : std::string()) + " goes beyond the sequence: it has " +
+                              std::to_string(frames) + " frame(s), indices 0-" + std::to_string(frames - 1) +
+                              " (set the sequence's length with --frames, the same for every task)");
 }
 
 // Runs body() (returning the exit code) and turns an escaping exception into

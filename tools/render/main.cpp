@@ -8,6 +8,13 @@
 // written; DIR/.<name>.outputs records them, so only files this tool wrote
 // are ever replaced or removed, and a run killed while publishing is
 // finished by the next one.
+//
+// Render farms (docs/render-farm.md): --range A-B[:STEP] writes only those
+// frames, bit for bit the frames a full run writes, by replaying the frames
+// before them without drawing (solver effects need their history). A range
+// task is its own output set, DIR/.<name>.frames-A-B[-every-STEP].outputs, so
+// it replaces only its own frames, never another task's, and writes no GIF;
+// --assemble writes the GIF from the frames in DIR once every task is done.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -42,6 +49,8 @@ struct Args {
     bool quiet = false;
     splatfx::gl::FrameRendererDesc renderer{}; // --scale, --sampling, --fog-texture
     int abortAfter = -1; // testing aid: fail after this many frames
+    std::optional<cli::FrameRange> range; // --range: only these frames, no GIF
+    bool assemble = false;                // --assemble: the GIF from the frames in --out
 };
 
 void usage() {
@@ -57,6 +66,9 @@ void usage() {
         "  --scale N        draw the effects at 1/N resolution per axis (1, 2 or 4; default 1) with depth-aware upsampling\n"
         "  --sampling M     texture sampling: auto (default), bilinear, nearest, upsampled, upsampledN (N = 2..16)\n"
         "  --fog-texture WxH  fog the host image through a reduced WxH fog texture (default: per pixel)\n"
+        "  --range A-B[:STEP]  render-farm task: write only frames A..B (every STEP-th; indices from 0), exactly\n"
+        "                   as a full run writes them; no GIF (see --assemble; docs/render-farm.md)\n"
+        "  --assemble       write DIR/<name>.gif from the frames DIR/<name>_NNNN.png the tasks wrote (renders nothing)\n"
         "  --quiet          no per-frame progress\n"
         "  --abort-after N  testing aid: fail on purpose after N frames (checks that nothing partial is left)\n"
         "<name> is the scene's output.name (default: the scene file's folder name).\n");
@@ -126,6 +138,16 @@ bool parse(int argc, char** argv, Args& a) {
                 return false;
             }
             a.renderer.fogTextureSize = {fw, fh};
+        } else if (s == "--range") {
+            if (!(v = value())) return false;
+            cli::FrameRange r;
+            if (auto st = cli::parseFrameRange("--range", v, 99999, r); !st) {
+                std::fprintf(stderr, "splatfx-render: %s\n", st.error().c_str());
+                return false;
+            }
+            a.range = r;
+        } else if (s == "--assemble") {
+            a.assemble = true;
         } else if (s == "--abort-after") {
             if (!(v = value()) || !integer(v, 0, 100000, n)) return false;
             a.abortAfter = int(n);
@@ -162,6 +184,10 @@ bool parse(int argc, char** argv, Args& a) {
         std::fprintf(stderr, "splatfx-render: no scene file given (try --help)\n");
         return false;
     }
+    if (a.assemble && a.range) {
+        std::fprintf(stderr, "splatfx-render: --assemble writes the GIF of the whole sequence; it takes no --range\n");
+        return false;
+    }
     return true;
 }
 
@@ -170,11 +196,64 @@ int fail(const std::string& why) {
     return 1;
 }
 
+char* frameName(char (&buf)[128], const std::string& name, int i) {
+    std::snprintf(buf, sizeof buf, "%s_%04d.png", name.c_str(), i);
+    return buf;
+}
+
+// --assemble: the whole sequence's GIF from the frames in the output folder
+// (written by range tasks, or a full run), as its own output set. Every
+// frame must be there and of the sequence's size; the GIF is then byte for
+// byte the one a full run writes (the frames are 8-bit PNGs of the same
+// pixels the full run hands to its GIF writer, which keeps 8-bit RGB).
+int assemble(const Args& a) {
+    splatfx::Materials materials{splatfx::Footprint{}};
+    splatfx::SceneFileOptions so;
+    so.seed = a.seed;
+    auto file = splatfx::loadSceneFile(a.scene, materials, so);
+    if (!file) return fail(file.error());
+    const glm::ivec2 size = a.size.value_or(file->output.size);
+    const int frames = a.frames.value_or(file->output.frames);
+    const float fps = a.fps.value_or(file->output.fps);
+    const std::string name = file->output.name;
+    std::vector<int> missing;
+    char png[128];
+    for (int i = 0; i < frames; ++i) {
+        std::error_code ec;
+        if (!fs::is_regular_file(fs::path(a.out) / frameName(png, name, i), ec)) missing.push_back(i);
+    }
+    if (!missing.empty()) {
+        std::string list;
+        for (std::size_t k = 0; k < missing.size() && k < 8; ++k) list += (k ? ", " : "") + std::to_string(missing[k]);
+        if (missing.size() > 8) list += ", ...";
+        return fail("--assemble: " + std::to_string(missing.size()) + " of the " + std::to_string(frames) + " frames are missing from '" +
+                    a.out + "' (frame " + list + "); render them first (--range), with the same --frames");
+    }
+    auto outputs = splatfx::OutputSet::begin(a.out, name + ".gif");
+    if (!outputs) return fail(outputs.error());
+    splatfx::AnimationWriter gif(outputs->path(name + ".gif"), fps);
+    for (int i = 0; i < frames; ++i) {
+        const std::string path = (fs::path(a.out) / frameName(png, name, i)).string();
+        auto img = splatfx::readImage(path);
+        if (!img) return fail("--assemble: " + img.error());
+        if (img->width != size.x || img->height != size.y)
+            return fail("--assemble: '" + path + "' is " + std::to_string(img->width) + "x" + std::to_string(img->height) + ", the sequence is " +
+                        std::to_string(size.x) + "x" + std::to_string(size.y) + " (a task rendered with another --size?)");
+        if (auto w = gif.add(*img); !w) return fail(w.error());
+    }
+    if (auto w = gif.finish(); !w) return fail(w.error());
+    outputs->add(name + ".gif");
+    if (auto w = outputs->publish(); !w) return fail(w.error());
+    std::printf("splatfx-render: assembled %s/%s.gif from %d frames at %g fps\n", a.out.c_str(), name.c_str(), frames, fps);
+    return 0;
+}
+
 } // namespace
 
 static int renderMain(int argc, char** argv) {
     Args a;
     if (!parse(argc, argv, a)) return 2;
+    if (a.assemble) return assemble(a);
 
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) return fail(ctx.error());
@@ -185,28 +264,64 @@ static int renderMain(int argc, char** argv) {
     const int frames = a.frames.value_or(file.output.frames);
     const float fps = a.fps.value_or(file.output.fps);
     const std::string name = file.output.name;
+    if (a.range)
+        if (auto st = cli::checkFrameRange("--range", *a.range, frames); !st) return fail(st.error());
+    const bool whole = !a.range;
+    // The frames this run writes, and the last it must reach.
+    const int toWrite = whole ? frames : a.range->count();
+    const int lastIndex = whole ? frames - 1 : a.range->first + (a.range->count() - 1) * a.range->step;
 
-    // Frames and GIF are one set: staged, then published together (output_set.hpp).
-    auto outputs = splatfx::OutputSet::begin(a.out, name);
+    // A full run's frames and GIF are one set: staged, then published
+    // together (output_set.hpp). A range task's frames are a set of their
+    // own, so publishing it removes nothing another task wrote.
+    std::string setName = name;
+    if (a.range) {
+        char buf[96];
+        std::snprintf(buf, sizeof buf, ".frames-%04d-%04d", a.range->first, a.range->last);
+        setName += buf;
+        if (a.range->step > 1) setName += "-every-" + std::to_string(a.range->step);
+    }
+    auto outputs = splatfx::OutputSet::begin(a.out, setName);
     if (!outputs) return fail(outputs.error());
 
     auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
     if (!fb) return fail(fb.error());
     std::printf("splatfx-render: %s (%s) on %s\n", a.scene.c_str(), file.title.empty() ? name.c_str() : file.title.c_str(),
                 ctx->renderer().c_str());
-    std::printf("splatfx-render: %d frames at %dx%d, %g fps, seed %u, %s splats -> %s/%s_NNNN.png + %s.gif\n", frames, size.x, size.y,
-                fps, file.seed, a.traditional ? "traditional" : "textured", a.out.c_str(), name.c_str(), name.c_str());
+    if (whole)
+        std::printf("splatfx-render: %d frames at %dx%d, %g fps, seed %u, %s splats -> %s/%s_NNNN.png + %s.gif\n", frames, size.x, size.y,
+                    fps, file.seed, a.traditional ? "traditional" : "textured", a.out.c_str(), name.c_str(), name.c_str());
+    else
+        std::printf("splatfx-render: frames %d-%d%s (%d of the sequence's %d) at %dx%d, %g fps, seed %u, %s splats -> %s/%s_NNNN.png "
+                    "(no GIF: --assemble writes it)\n",
+                    a.range->first, a.range->last, a.range->step > 1 ? (":" + std::to_string(a.range->step)).c_str() : "", toWrite, frames,
+                    size.x, size.y, fps, file.seed, a.traditional ? "traditional" : "textured", a.out.c_str(), name.c_str());
 
-    splatfx::AnimationWriter gif(outputs->path(name + ".gif"), fps);
+    std::optional<splatfx::AnimationWriter> gif;
+    if (whole) gif.emplace(outputs->path(name + ".gif"), fps);
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
     double renderMs = 0.0, prepareMs = 0.0, submitMs = 0.0;
     std::uint64_t splatsMin = ~0ull, splatsMax = 0, splatsSum = 0, voxelsMax = 0;
     std::size_t visibleMax = 0, simulatedMax = 0, drawnMax = 0, visibleSum = 0, simulatedSum = 0, drawnSum = 0;
     const bool tty = isatty(fileno(stdout)) != 0;
-    for (int i = 0; i < frames; ++i) {
-        if (i == a.abortAfter) return fail("aborted on purpose after " + std::to_string(i) + " frames (--abort-after); no output kept");
+    int written = 0, replayed = 0;
+    double replayMs = 0.0, reachMs = 0.0; // all the replay; the part before the first frame written
+    for (int i = 0; i <= lastIndex; ++i) {
+        // Frame i shows time i / fps in every mode, so a task's frame i is the full run's.
         const double t = i / double(fps);
+        if (!whole && !a.range->contains(i)) {
+            // Before or between this task's frames: the scene steps through
+            // them as a full run does (same times, same cameras), undrawn.
+            const auto r0 = Clock::now();
+            player->advance(t, player->cameraAt(t, size), {.traditional = a.traditional});
+            replayMs += std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
+            ++replayed;
+            continue;
+        }
+        if (written == 0) reachMs = replayMs;
+        if (written == a.abortAfter)
+            return fail("aborted on purpose after " + std::to_string(written) + " frames (--abort-after); no output kept");
         const auto f0 = Clock::now();
         player->renderFrame(t, player->cameraAt(t, size), fb->handle(), {.traditional = a.traditional});
         splatfx::Image img = fb->read();
@@ -218,37 +333,51 @@ static int renderMain(int argc, char** argv) {
         visibleMax = std::max(visibleMax, s.needed), simulatedMax = std::max(simulatedMax, s.simulated), drawnMax = std::max(drawnMax, s.drawn);
         visibleSum += s.needed, simulatedSum += s.simulated, drawnSum += s.drawn;
         char png[128];
-        std::snprintf(png, sizeof png, "%s_%04d.png", name.c_str(), i);
+        frameName(png, name, i);
         if (auto w = splatfx::writeImage(outputs->path(png), img); !w) return fail(w.error());
         outputs->add(png);
-        if (auto w = gif.add(img); !w) return fail(w.error());
+        if (gif)
+            if (auto w = gif->add(img); !w) return fail(w.error());
+        ++written;
         // A terminal gets a live line; a log gets about ten lines.
-        if (!a.quiet && (tty || (i + 1) % std::max(1, frames / 10) == 0 || i + 1 == frames)) {
-            std::printf("%ssplatfx-render: frame %d/%d  t=%.2fs  %llu splats  %zu/%zu effects visible", tty ? "\r" : "", i + 1, frames, t,
-                        (unsigned long long)s.splats, s.needed, s.declared);
+        if (!a.quiet && (tty || written % std::max(1, toWrite / 10) == 0 || written == toWrite)) {
+            std::printf("%ssplatfx-render: frame %d (%d/%d)  t=%.2fs  %llu splats  %zu/%zu effects visible", tty ? "\r" : "", i, written,
+                        toWrite, t, (unsigned long long)s.splats, s.needed, s.declared);
             if (!tty) std::printf("\n");
             std::fflush(stdout);
         }
     }
     if (!a.quiet && tty) std::printf("\n");
-    if (auto w = gif.finish(); !w) return fail(w.error());
-    outputs->add(name + ".gif");
+    if (gif) {
+        if (auto w = gif->finish(); !w) return fail(w.error());
+        outputs->add(name + ".gif");
+    }
     if (auto w = outputs->publish(); !w) return fail(w.error());
 
     const double sec = std::chrono::duration<double>(Clock::now() - start).count();
     const splatfx::FrameCounters& last = player->stats().counters;
     std::printf("splatfx-render: summary for %s\n", a.scene.c_str());
-    std::printf("  frames            %d (%dx%d, %.3g s of animation at %g fps)\n", frames, size.x, size.y, frames / double(fps), fps);
-    std::printf("  time              %.2f s in all, %.1f ms per frame (frame + readback %.1f ms: prepare %.2f, GL submission %.2f; PNG/GIF the rest)\n",
-                sec, 1000.0 * sec / frames, renderMs / frames, prepareMs / frames, submitMs / frames);
-    std::printf("  splats per frame  min %llu, mean %.0f, max %llu\n", (unsigned long long)splatsMin, double(splatsSum) / frames,
+    const int n = written;
+    std::printf("  frames            %d (%dx%d, %.3g s of animation at %g fps)\n", n, size.x, size.y, n / double(fps), fps);
+    if (replayed > 0)
+        std::printf("  replay            %d frame(s) before or between this task's stepped through undrawn, as a full run steps through them: "
+                    "%.2f s (%.1f ms each), %.2f s of it to reach frame %d\n",
+                    replayed, replayMs / 1000.0, replayMs / replayed, reachMs / 1000.0, a.range->first);
+    std::printf("  time              %.2f s in all, %.1f ms per frame written (frame + readback %.1f ms: prepare %.2f, GL submission %.2f; PNG/GIF the rest)\n",
+                sec, 1000.0 * sec / n, renderMs / n, prepareMs / n, submitMs / n);
+    std::printf("  splats per frame  min %llu, mean %.0f, max %llu\n", (unsigned long long)splatsMin, double(splatsSum) / n,
                 (unsigned long long)splatsMax);
     std::printf("  voxels            at most %llu per frame (of the effects needed)\n", (unsigned long long)voxelsMax);
     std::printf("  effects           %zu declared; per frame mean/max: %.1f/%zu simulated, %.1f/%zu visible, %.1f/%zu drawn\n", last.declared,
-                double(simulatedSum) / frames, simulatedMax, double(visibleSum) / frames, visibleMax, double(drawnSum) / frames, drawnMax);
+                double(simulatedSum) / n, simulatedMax, double(visibleSum) / n, visibleMax, double(drawnSum) / n, drawnMax);
     std::printf("  geometry          %zu objects, %zu triangles\n", player->geometry().stats().objects, player->geometry().stats().triangles);
-    std::printf("  wrote             %s/%s_0000.png .. %s_%04d.png and %s/%s.gif\n", a.out.c_str(), name.c_str(), name.c_str(), frames - 1,
-                a.out.c_str(), name.c_str());
+    if (whole)
+        std::printf("  wrote             %s/%s_0000.png .. %s_%04d.png and %s/%s.gif\n", a.out.c_str(), name.c_str(), name.c_str(), frames - 1,
+                    a.out.c_str(), name.c_str());
+    else
+        std::printf("  wrote             %s/%s_%04d.png .. %s_%04d.png (%d frames%s)\n", a.out.c_str(), name.c_str(), a.range->first, name.c_str(),
+                    lastIndex, n,
+                    a.range->step > 1 ? (", step " + std::to_string(a.range->step)).c_str() : "");
     return 0;
 }
 

@@ -97,17 +97,24 @@ GeometryRenderer& ScenePlayer::geometry() { return *mImpl->geometry; }
 
 splatfx::Camera ScenePlayer::cameraAt(double t, glm::ivec2 viewport) const { return evaluate(mImpl->file->camera, t, viewport); }
 
-void ScenePlayer::renderFrame(double t, const splatfx::Camera& camera, unsigned framebuffer, const FrameOptions& options) {
+void ScenePlayer::advance(double t, const splatfx::Camera& camera, const FrameOptions& options) {
     Impl& p = *mImpl;
     splatfx::SceneFile& f = *p.file;
     FrameStats& s = p.stats;
-
-    auto t0 = Clock::now();
+    const auto t0 = Clock::now();
     f.scene.prepare(t, camera, p.materials, p.frame, {.textured = !options.traditional, .opacityScale = options.opacityScale});
     s.prepareMs = msSince(t0);
+    s.renderMs = 0.0;
     s.counters = p.frame.counters();
     s.splatsPerEffect.assign(f.effects.size(), 0);
     for (std::size_t i = 0; i < f.effects.size(); ++i) s.splatsPerEffect[i] = f.scene.status(f.effects[i].id).splatsDrawn;
+}
+
+void ScenePlayer::renderFrame(double t, const splatfx::Camera& camera, unsigned framebuffer, const FrameOptions& options) {
+    advance(t, camera, options);
+    Impl& p = *mImpl;
+    splatfx::SceneFile& f = *p.file;
+    FrameStats& s = p.stats;
 
     // This host's opaque pass: background, then geometry with depth writes.
     auto drawOpaque = [&] {
@@ -119,7 +126,7 @@ void ScenePlayer::renderFrame(double t, const splatfx::Camera& camera, unsigned 
         }
         if (options.drawGeometry) p.geometry->draw(t, camera, geometryLighting(f.scene, *p.renderer));
     };
-    t0 = Clock::now();
+    const auto t0 = Clock::now();
     p.renderer->render(p.frame, {.framebuffer = framebuffer, .drawOpaque = drawOpaque});
     s.renderMs = msSince(t0);
 }

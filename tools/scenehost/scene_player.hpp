@@ -11,7 +11,7 @@
 //   auto player = scenehost::ScenePlayer::load("samples/05-teapot-steam/scene.json", {});
 //   player->renderFrame(timeSec, player->cameraAt(timeSec, size), fbo);
 //
-// Time passed to renderFrame must not decrease (solver effects simulate
+// Time passed to renderFrame / advance must not decrease (solver effects simulate
 // forward); reload to start over.
 // Threading: the GL thread only. Move-only.
 #pragma once
@@ -62,6 +62,13 @@ public:
     // Draws the frame at timeSec (>= the previous call's) into the host
     // framebuffer (0: the default one) over camera.viewport.
     void renderFrame(double timeSec, const splatfx::Camera& camera, unsigned framebuffer, const FrameOptions& options = {});
+    // Everything renderFrame does except drawing: Scene::prepare (decide,
+    // simulate, emit, sort) for this time and camera, stats() updated. A
+    // render-farm task replays the frames before its range with it, so the
+    // scene's state (solver effects, catch-ups, shadow tables) at its first
+    // frame is the state a full run has there; the GL side caches only by
+    // content version, so skipping its draws changes nothing drawn later.
+    void advance(double timeSec, const splatfx::Camera& camera, const FrameOptions& options = {});
 
     splatfx::SceneFile& file();
     const splatfx::SceneFile& file() const;

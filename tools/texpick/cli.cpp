@@ -39,9 +39,13 @@ selection:
   --count N            textures in the set (default 8; path: as many as fit)
   --seed S             random seed (default 1)
   --at X,Y[,SIZE]      positions: one patch centre (and side); repeat
-  --min-std F          reject patches whose luminance std is below F (default 0.03)
-  --min-mean F         reject near-empty patches, mean luminance below F (default 0.03)
-  --min-coverage F     reject patches mostly outside an alpha cut-out (default 0.9)
+  --min-std F          reject flat patches: luminance std below F of the source's own luminance range (default 0.03)
+  --min-mean F         reject near-empty patches: mean luminance below F of the source's brightest (default 0.03)
+  --min-coverage F     reject patches mostly outside an alpha cut-out: mean alpha below F (default 0.9)
+  --absolute-thresholds  --min-std and --min-mean in luminance units (0..1), not relative to the source's range
+  --alpha MODE         auto | coverage | density: what the source's alpha is. coverage: a cut-out (--min-coverage
+                       applies); density: a game sprite's alpha, the gas itself (colour x alpha is the texture,
+                       never a cut-out); auto (default): density when over half the covered pixels are semi-transparent
   --min-distance D     smallest distance between picked centres (random 0, spectral P/2)
   --band LO:HI         spectral: frequency band in cycles per pixel (default 0.125:0.75)
   --spread             spectral: maximize spectral variation across the set instead
@@ -119,6 +123,16 @@ splatfx::Result<Options> parseOptions(int argc, const char* const* argv) {
         if (a == "--min-std") TEXPICK_NUM(o.accept.minStd, float, 0.0f, 1.0f)
         if (a == "--min-mean") TEXPICK_NUM(o.accept.minMean, float, 0.0f, 1.0f)
         if (a == "--min-coverage") TEXPICK_NUM(o.accept.minCoverage, float, 0.0f, 1.0f)
+        if (a == "--absolute-thresholds") { o.accept.relative = false; continue; }
+        if (a == "--alpha") {
+            if (!need()) return makeError("--alpha needs auto, coverage or density");
+            const std::string m = v;
+            if (m == "auto") o.source.alpha = AlphaUse::Auto;
+            else if (m == "coverage") o.source.alpha = AlphaUse::Coverage;
+            else if (m == "density") o.source.alpha = AlphaUse::Density;
+            else return makeError("--alpha expects auto, coverage or density, got '" + m + "'");
+            continue;
+        }
         if (a == "--min-distance") TEXPICK_NUM(o.minDistance, float, 0.0f, 1e6f)
         if (a == "--stride") TEXPICK_NUM(o.stride, int, 1, 16384)
         if (a == "--step") TEXPICK_NUM(o.step, double, 1e-3, 1e6)
@@ -323,9 +337,22 @@ int run(const Options& o) {
     if (o.mode == "turbulence") return runTurbulence(o);
     if (o.mode == "merge") return runMerge(o);
     if (o.mode == "interactive") return runInteractive(o);
-    auto src = loadSource(o.input);
+    auto src = loadSource(o.input, o.source);
     if (!src) return fail(src.error());
-    if (!o.quiet) std::printf("%s: %s: %s, %dx%d\n", kToolName, o.mode.c_str(), o.input.c_str(), src->width, src->height);
+    if (!o.quiet) {
+        std::printf("%s: %s: %s, %dx%d, luminance %.3g..%.3g", kToolName, o.mode.c_str(), o.input.c_str(), src->width, src->height,
+                    src->luminanceMin, src->luminanceMax);
+        if (src->fileChannels == 4)
+            std::printf(", alpha as %s (%s; %.0f%% of covered pixels semi-transparent)", alphaUseName(src->alpha),
+                        o.source.alpha == AlphaUse::Auto ? "detected" : "--alpha", 100.0 * src->softAlphaFraction);
+        std::printf("\n");
+    }
+    // What the thresholds were read against, for the manifest.
+    auto sourceParams = [&](json& params) {
+        params["alpha"] = alphaUseName(src->alpha);
+        params["thresholds"] = o.accept.relative ? "relative" : "absolute";
+        params["luminanceRange"] = {f6(src->luminanceMin), f6(src->luminanceMax)};
+    };
     splatfx::Result<Selection> sel = makeError("unreachable");
     json params;
     if (o.mode == "positions") {
@@ -339,6 +366,7 @@ int run(const Options& o) {
         params = {{"count", o.count}, {"patch", o.patch}, {"seed", o.seed}, {"minStd", f6(o.accept.minStd)},
                   {"minMean", f6(o.accept.minMean)}, {"minCoverage", f6(o.accept.minCoverage)}, {"minDistance", f6(minDistance)},
                   {"rng", "std::mt19937, raw words modulo the span"}};
+        sourceParams(params);
     } else if (o.mode == "spectral") {
         SpectralDesc d{.count = o.count, .patch = o.patch, .stride = o.stride, .bandLo = o.bandLo, .bandHi = o.bandHi,
                        .spread = o.spread, .minDistance = o.minDistance, .accept = o.accept};
@@ -346,6 +374,7 @@ int run(const Options& o) {
         params = {{"count", o.count}, {"patch", o.patch}, {"stride", o.stride > 0 ? o.stride : std::max(1, o.patch / 4)},
                   {"minDistance", o.minDistance >= 0.0f ? f6(o.minDistance) : 0.5 * o.patch},
                   {"minStd", f6(o.accept.minStd)}, {"minMean", f6(o.accept.minMean)}, {"minCoverage", f6(o.accept.minCoverage)}};
+        sourceParams(params);
         if (o.spread) params["spread"] = true;
         else params["bandCyclesPerPixel"] = {o.bandLo, o.bandHi};
     } else if (o.mode == "path") {

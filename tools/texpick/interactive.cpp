@@ -258,7 +258,7 @@ struct App {
 } // namespace
 
 int runInteractive(const Options& o) {
-    auto src = loadSource(o.input);
+    auto src = loadSource(o.input, o.source);
     if (!src) {
         std::fprintf(stderr, "%s: %s\n", kToolName, src.error().c_str());
         return 1;

@@ -57,9 +57,32 @@ splatfx::Status checkPatchFits(const Source& s, int patch, const std::string& op
 
 // [SECTION] Source images
 
-Source sourceFromImage(const splatfx::Image& img, const std::string& name) {
+const char* alphaUseName(AlphaUse use) {
+    switch (use) {
+    case AlphaUse::Auto: return "auto";
+    case AlphaUse::Coverage: return "coverage";
+    case AlphaUse::Density: return "density";
+    }
+    return "?";
+}
+
+Source sourceFromImage(const splatfx::Image& img, const std::string& name, const SourceDesc& desc) {
     assert((img.channels == 1 || img.channels == 3 || img.channels == 4) && "image must have 1, 3 or 4 channels");
     Source s;
+    // What the alpha is: the share of covered pixels that are semi-transparent.
+    if (img.channels == 4) {
+        std::size_t covered = 0, soft = 0;
+        for (std::size_t p = 0; p < std::size_t(img.width) * img.height; ++p) {
+            const float a = img.pixels[p * 4 + 3];
+            if (!(a > kCoveredAlpha)) continue; // NaN counts as empty
+            ++covered;
+            if (a < 1.0 - kCoveredAlpha) ++soft;
+        }
+        s.softAlphaFraction = covered ? double(soft) / double(covered) : 0.0;
+    }
+    const bool sprite = img.channels == 4 && s.softAlphaFraction > kSpriteSoftFraction;
+    s.alpha = desc.alpha != AlphaUse::Auto ? desc.alpha : (sprite ? AlphaUse::Density : AlphaUse::Coverage);
+    const bool density = s.alpha == AlphaUse::Density;
     s.path = name;
     s.width = img.width;
     s.height = img.height;
@@ -78,12 +101,17 @@ Source sourceFromImage(const splatfx::Image& img, const std::string& name) {
             cv::Vec3f& p = s.rgb.at<cv::Vec3f>(y, x);
             for (int c = 0; c < 3; ++c) p[c] = rgb[c] * (std::isfinite(a) ? a : 0.0f);
             s.luminance.at<float>(y, x) = 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2];
-            s.coverage.at<float>(y, x) = std::isfinite(a) ? a : 0.0f;
+            // Density alpha is already in the luminance (colour x density); it covers everything.
+            s.coverage.at<float>(y, x) = density ? 1.0f : (std::isfinite(a) ? a : 0.0f);
         }
+    double lo = 0.0, hi = 0.0;
+    if (img.width > 0 && img.height > 0) cv::minMaxLoc(s.luminance, &lo, &hi);
+    s.luminanceMin = float(lo);
+    s.luminanceMax = float(hi);
     return s;
 }
 
-splatfx::Result<Source> loadSource(const std::string& path) {
+splatfx::Result<Source> loadSource(const std::string& path, const SourceDesc& desc) {
     std::error_code ec;
     const std::string what = "cannot read image '" + path + "': ";
     if (!fs::exists(path, ec)) return makeError(what + "no such file");
@@ -95,7 +123,9 @@ splatfx::Result<Source> loadSource(const std::string& path) {
         if (!probe) return makeError(what + "the file cannot be opened (check its permissions)");
         if (probe.peek() == std::ifstream::traits_type::eof()) return makeError(what + "the file is empty");
     }
-    auto img = splatfx::readImage(path);
+    // Straight alpha, as stored: sourceFromImage multiplies the colour by it
+    // once (a premultiplied read would multiply twice, squaring a sprite's density).
+    auto img = splatfx::readImage(path, splatfx::Alpha::Straight);
     if (!img) {
         // OpenImageIO first (it knows EXR, HDR, DPX...), OpenCV only for what it
         // cannot open at all: a file whose header OpenImageIO read was refused
@@ -129,7 +159,7 @@ splatfx::Result<Source> loadSource(const std::string& path) {
         }
         im = std::move(rgba);
     }
-    return sourceFromImage(im, path);
+    return sourceFromImage(im, path, desc);
 }
 
 // [SECTION] Spectra
@@ -232,12 +262,21 @@ double bandFraction(const Source& s, const Patch& p, double lo, double hi) {
 
 namespace {
 
-// Why a candidate fails `a`, or empty when it passes.
-std::string rejection(const SpectralStats& st, const Acceptance& a) {
-    if (st.coverage < a.minCoverage) return "coverage";
-    if (st.mean < a.minMean) return "near-empty";
-    if (st.stddev < a.minStd) return "flat";
-    return {};
+enum class Reject { None, Coverage, Empty, Flat };
+
+// Why a candidate fails `t`, the first test it fails in this order.
+Reject rejection(const SpectralStats& st, const Thresholds& t) {
+    if (st.coverage < t.minCoverage) return Reject::Coverage;
+    if (st.mean < t.minMean) return Reject::Empty;
+    if (st.stddev < t.minStd) return Reject::Flat;
+    return Reject::None;
+}
+
+void count(Selection& sel, Reject why) {
+    ++sel.rejected;
+    if (why == Reject::Coverage) ++sel.rejectedCoverage;
+    else if (why == Reject::Empty) ++sel.rejectedEmpty;
+    else if (why == Reject::Flat) ++sel.rejectedFlat;
 }
 
 bool farEnough(const std::vector<Patch>& picked, const Patch& p, double minDistance) {
@@ -246,9 +285,53 @@ bool farEnough(const std::vector<Patch>& picked, const Patch& p, double minDista
     return true;
 }
 
-std::string acceptanceText(const Acceptance& a) {
-    return "--min-std " + str(a.minStd) + ", --min-mean " + str(a.minMean) + ", --min-coverage " + str(a.minCoverage);
+// Which threshold rejected how many candidates, with each threshold as given
+// and as applied to this source, then what to change.
+std::string rejectionText(const Source& s, const Selection& sel, const Acceptance& a, double minDistance) {
+    const Thresholds t = effectiveThresholds(s, a);
+    auto unit = [&](double applied) {
+        return a.relative ? " (" + str(applied) + " for this source's luminance " + str(s.luminanceMin) + ".." + str(s.luminanceMax) + ")"
+                          : std::string(" (absolute)");
+    };
+    std::string text = "of " + std::to_string(sel.candidates) + " candidates, " + std::to_string(sel.rejectedCoverage) +
+                       " were rejected by --min-coverage " + str(a.minCoverage) + " (mean alpha; alpha read as " + alphaUseName(s.alpha) +
+                       (s.alpha == AlphaUse::Density ? ", so never" : "") + "), " + std::to_string(sel.rejectedEmpty) + " by --min-mean " +
+                       str(a.minMean) + unit(t.minMean) + ", " + std::to_string(sel.rejectedFlat) + " by --min-std " + str(a.minStd) +
+                       unit(t.minStd);
+    if (minDistance > 0) text += ", " + std::to_string(sel.rejectedDistance) + " by --min-distance " + str(minDistance);
+    // Advice for the threshold that did the most.
+    const int most = std::max({sel.rejectedCoverage, sel.rejectedEmpty, sel.rejectedFlat, sel.rejectedDistance});
+    std::string advice;
+    if (most == 0) advice = "use a smaller --patch or a lower --count";
+    else if (most == sel.rejectedCoverage) advice = "lower --min-coverage, or give --alpha density if the alpha is the gas's density (a sprite)";
+    else if (most == sel.rejectedEmpty) advice = "lower --min-mean or use a smaller --patch";
+    else if (most == sel.rejectedFlat) advice = "lower --min-std or use a smaller --patch";
+    else advice = "lower --min-distance or --count";
+    return text + "; " + advice;
 }
+
+} // namespace
+
+Thresholds effectiveThresholds(const Source& s, const Acceptance& a) {
+    Thresholds t;
+    t.minCoverage = a.minCoverage;
+    if (!a.relative) {
+        t.minStd = a.minStd;
+        t.minMean = a.minMean;
+        return t;
+    }
+    // Flatness against the source's contrast (its range), emptiness against
+    // its brightest texel (empty is black, wherever the source's darkest
+    // lies). A source flatter or darker than one 8-bit step is judged as if
+    // it reached one, so a constant image stays flat instead of passing a
+    // zero threshold.
+    constexpr double kStep = 1.0 / 255.0;
+    t.minStd = a.minStd * std::max(double(s.luminanceMax) - double(s.luminanceMin), kStep);
+    t.minMean = a.minMean * std::max(double(s.luminanceMax), kStep);
+    return t;
+}
+
+namespace {
 
 } // namespace
 
@@ -280,6 +363,7 @@ splatfx::Result<Selection> pickRandom(const Source& s, const RandomDesc& d) {
     std::mt19937 rng(d.seed);
     const auto spanX = std::uint32_t(s.width - d.patch + 1), spanY = std::uint32_t(s.height - d.patch + 1);
     const int maxTries = d.maxTries > 0 ? d.maxTries : 2000 * d.count;
+    const Thresholds th = effectiveThresholds(s, d.accept);
     Selection sel;
     while (int(sel.patches.size()) < d.count && sel.candidates < maxTries) {
         // Raw mt19937 words modulo the span: the standard fixes mt19937's
@@ -288,8 +372,13 @@ splatfx::Result<Selection> pickRandom(const Source& s, const RandomDesc& d) {
         const Patch p{int(rng() % spanX), int(rng() % spanY), d.patch};
         ++sel.candidates;
         const SpectralStats st = analyze(s, p);
-        if (!rejection(st, d.accept).empty() || !farEnough(sel.patches, p, d.minDistance)) {
+        if (const Reject why = rejection(st, th); why != Reject::None) {
+            count(sel, why);
+            continue;
+        }
+        if (!farEnough(sel.patches, p, d.minDistance)) {
             ++sel.rejected;
+            ++sel.rejectedDistance;
             continue;
         }
         sel.patches.push_back(p);
@@ -298,9 +387,7 @@ splatfx::Result<Selection> pickRandom(const Source& s, const RandomDesc& d) {
     if (int(sel.patches.size()) < d.count)
         return makeError("random: only " + std::to_string(sel.patches.size()) + " of " + std::to_string(d.count) + " " +
                          std::to_string(d.patch) + "-px patches of '" + s.path + "' passed after " +
-                         std::to_string(sel.candidates) + " tries (the rest were flat, near-empty, outside the cut-out" +
-                         (d.minDistance > 0 ? " or closer than --min-distance" : std::string()) + "); lower " +
-                         acceptanceText(d.accept) + " or use a smaller --patch");
+                         std::to_string(sel.candidates) + " tries: " + rejectionText(s, sel, d.accept, d.minDistance));
     return sel;
 }
 
@@ -318,14 +405,15 @@ splatfx::Result<Selection> pickSpectral(const Source& s, const SpectralDesc& d) 
         double score = 0.0;
     };
     std::vector<Candidate> cands;
+    const Thresholds th = effectiveThresholds(s, d.accept);
     Selection sel;
     for (int y = 0; y + d.patch <= s.height; y += stride)
         for (int x = 0; x + d.patch <= s.width; x += stride) {
             Candidate c{{x, y, d.patch}, {}, 0.0};
             c.stats = analyze(s, c.patch);
             ++sel.candidates;
-            if (!rejection(c.stats, d.accept).empty()) {
-                ++sel.rejected;
+            if (const Reject why = rejection(c.stats, th); why != Reject::None) {
+                count(sel, why);
                 continue;
             }
             if (!d.spread) c.score = bandFraction(s, c.patch, d.bandLo, d.bandHi);
@@ -349,7 +437,7 @@ splatfx::Result<Selection> pickSpectral(const Source& s, const SpectralDesc& d) 
         for (size_t i : idx) {
             if (int(sel.patches.size()) == d.count) break;
             if (farEnough(sel.patches, cands[i].patch, minDistance)) take(i);
-            else ++sel.rejected;
+            else ++sel.rejected, ++sel.rejectedDistance;
         }
     } else if (!cands.empty()) {
         // Farthest-point selection on the band-energy vectors: start with the
@@ -374,13 +462,14 @@ splatfx::Result<Selection> pickSpectral(const Source& s, const SpectralDesc& d) 
             take(best);
             for (size_t i = 0; i < cands.size(); ++i) nearest[i] = std::min(nearest[i], distance2(cands[i].stats, cands[best].stats));
         }
+        // Short of the count: every candidate left over was too close to a pick.
+        const int blocked = int(cands.size() - sel.patches.size());
+        if (int(sel.patches.size()) < d.count) sel.rejected += blocked, sel.rejectedDistance += blocked;
     }
     if (int(sel.patches.size()) < d.count)
         return makeError("spectral: only " + std::to_string(sel.patches.size()) + " of " + std::to_string(d.count) + " " +
-                         std::to_string(d.patch) + "-px patches of '" + s.path + "' are usable (of " +
-                         std::to_string(sel.candidates) + " candidates, " + std::to_string(sel.rejected) +
-                         " were flat, near-empty, outside the cut-out or within --min-distance " + str(minDistance) +
-                         " of a pick); lower --count, --min-distance or " + acceptanceText(d.accept));
+                         std::to_string(d.patch) + "-px patches of '" + s.path + "' are usable: " +
+                         rejectionText(s, sel, d.accept, minDistance));
     return sel;
 }
 

@@ -46,28 +46,60 @@ inline constexpr long long kMaxSetTexels = 64ll << 20;
 
 // [SECTION] Source images
 
-// A photograph ready for cutting: RGB composited over black (an alpha cut-out
-// becomes black, i.e. empty, which the flatness test rejects), its luminance,
-// and its coverage (alpha, 1 where the file has none).
+// What a source's alpha channel means (issue 18, item 4).
+enum class AlphaUse {
+    Auto,     // Density when the alpha looks like a sprite's (see kSpriteSoftFraction), else Coverage (default)
+    Coverage, // a cut-out (a photographed stamp): patches mostly outside it are rejected (Acceptance::minCoverage)
+    Density,  // a game particle sprite: alpha is how much gas there is, part of the texture, never a cut-out
+};
+const char* alphaUseName(AlphaUse use); // "auto" | "coverage" | "density"
+
+// Auto takes the alpha as density (the source is a sprite) when more than
+// kSpriteSoftFraction of the pixels it covers (alpha > kCoveredAlpha) are
+// semi-transparent (alpha below 1 - kCoveredAlpha): a cut-out photograph is
+// opaque inside and soft only along its edge, a particle puff or a
+// translucent stamp is soft almost everywhere (a radial falloff: over 90%;
+// textures/sources/fire.png, a Tux Paint stamp of translucent flames: 63%).
+// A hard-edged (binary) alpha is a cut-out; --alpha density overrides.
+inline constexpr double kSpriteSoftFraction = 0.5;
+inline constexpr double kCoveredAlpha = 2.0 / 255.0; // two 8-bit steps: below is empty, whatever the encoder left
+
+struct SourceDesc {
+    AlphaUse alpha = AlphaUse::Auto; // default Auto
+};
+
+// A source ready for cutting: RGB times alpha (composited over black: a
+// cut-out's outside becomes black, i.e. empty, which the thresholds reject;
+// a sprite's thin gas becomes dark), its luminance, and its coverage (alpha
+// when the alpha is a cut-out; 1 where the file has none or the alpha is
+// density, which the luminance then already carries).
 struct Source {
     
     std::string path{};   // as given
     int width = 0, height = 0;
     int fileChannels = 0;
     
-    cv::Mat rgb{};        // CV_32FC3, [0, 1], premultiplied by coverage
+    cv::Mat rgb{};        // CV_32FC3, [0, 1], premultiplied by alpha (straight alpha read from the file, multiplied once)
     
     cv::Mat luminance{};  // CV_32FC1, Rec. 709 weights
     
     cv::Mat coverage{};   // CV_32FC1, [0, 1]
+    // The alpha's meaning as used (never Auto here) and the evidence for Auto.
+    AlphaUse alpha = AlphaUse::Coverage;
+    double softAlphaFraction = 0.0; // of the covered pixels, the semi-transparent ones (0 without alpha)
+    // The source's own luminance range (every pixel): relative thresholds
+    // (Acceptance::relative) scale with it, so a dark sprite is judged
+    // against its own contrast, not a photograph's.
+    float luminanceMin = 0.0f, luminanceMax = 0.0f;
 };
 
-// Reads any format OpenImageIO reads (falling back to OpenCV). On failure the
-// message names the file and the reason: no such file, a folder, empty,
-// unreadable, corrupt or of an unknown format.
-splatfx::Result<Source> loadSource(const std::string& path);
-// Wraps an image made in memory (tests, turbulence). Expects 1, 3 or 4 channels.
-Source sourceFromImage(const splatfx::Image& image, const std::string& name);
+// Reads any format OpenImageIO reads (falling back to OpenCV), alpha as
+// stored (straight). On failure the message names the file and the reason:
+// no such file, a folder, empty, unreadable, corrupt or of an unknown format.
+splatfx::Result<Source> loadSource(const std::string& path, const SourceDesc& desc = {});
+// Wraps an image made in memory (tests, turbulence), colour not
+// premultiplied by its alpha. Expects 1, 3 or 4 channels.
+Source sourceFromImage(const splatfx::Image& image, const std::string& name, const SourceDesc& desc = {});
 
 // [SECTION] Patches and their spectra
 
@@ -108,11 +140,23 @@ double bandFraction(const Source& source, const Patch& patch, double lo, double 
 // [SECTION] Selection
 
 // What makes a patch worth keeping (random and spectral modes).
+// Relative (the default): minStd is a fraction of the source's own
+// luminance range (Source::luminanceMax - luminanceMin) and minMean of its
+// brightest luminance (luminanceMax), so a particle sprite whose brightest
+// texel is 68/255 is judged by its own contrast; a source spanning 0..1
+// gets the absolute thresholds texpick always had.
 struct Acceptance {
-    float minStd = 0.03f;      // luminance standard deviation below this is flat; default 0.03
-    float minMean = 0.03f;     // luminance mean below this is near-empty (black or cut-out); default 0.03
-    float minCoverage = 0.9f;  // mean alpha below this is mostly outside a cut-out; default 0.9
+    float minStd = 0.03f;      // luminance std below this x the source's range is flat; default 0.03
+    float minMean = 0.03f;     // luminance mean below this x the source's brightest is near-empty (black or cut-out); default 0.03
+    float minCoverage = 0.9f;  // mean alpha below this is mostly outside a cut-out (coverage alpha only); default 0.9
+    bool relative = true;      // scale minStd, minMean by the source's range; default true
 };
+
+// The thresholds in the source's luminance units, as applied.
+struct Thresholds {
+    double minStd = 0.0, minMean = 0.0, minCoverage = 0.0;
+};
+Thresholds effectiveThresholds(const Source& source, const Acceptance& accept);
 
 struct Selection {
     
@@ -120,7 +164,12 @@ struct Selection {
     
     std::vector<SpectralStats> stats{}; // one per patch
     int candidates = 0;               // patches considered
-    int rejected = 0;                 // flat, near-empty or too close to a pick
+    int rejected = 0;                 // flat, near-empty, outside a cut-out or too close to a pick
+    // ... by reason (each rejected candidate counted once, for the first test it fails in this order).
+    int rejectedCoverage = 0;         // mean alpha below --min-coverage
+    int rejectedEmpty = 0;            // mean luminance below --min-mean
+    int rejectedFlat = 0;             // luminance std below --min-std
+    int rejectedDistance = 0;         // closer than --min-distance to a pick
 };
 
 // Each position is a patch centre; size 0 takes `defaultSize`. Errors name
@@ -276,6 +325,7 @@ struct Options {
     std::uint32_t seed = 1;
     
     std::vector<cv::Point3i> at{};  // positions
+    SourceDesc source{};          // --alpha
     Acceptance accept{};
     float minDistance = -1.0f;    // -1: the mode's default
     double bandLo = 0.125, bandHi = 0.75;
