@@ -151,6 +151,71 @@ static void test_every_preset(void) {
     splatfx_error_destroy(err);
 }
 
+/* Keyframed object dynamics through the C desc: a fire that crosses the view
+ * is needed only while it is in it (the scene culls by its moving bounds). */
+static void test_motion(void) {
+    splatfx_error* err = splatfx_error_create();
+    splatfx_materials* m = NULL;
+    splatfx_scene* scene = NULL;
+    splatfx_frame* frame = NULL;
+    CHECK_OK(splatfx_materials_create(NULL, &m, err), err);
+    CHECK_OK(splatfx_scene_create(&scene, err), err);
+    CHECK_OK(splatfx_frame_create(&frame, err), err);
+    splatfx_camera cam = front_camera(err);
+    /* front_camera sees x in about [-19, 19] at the fire's depth (30 * tan(0.45) * 160 / 120);
+     * keys at x = -60 and +60 put the fire (3.5 wide) well outside at t = 0 and t = 4. */
+    splatfx_keyframe keys[2];
+    splatfx_keyframe_init(&keys[0]);
+    splatfx_keyframe_init(&keys[1]);
+    CHECK(keys[0].rotation[0] == 1.0f && keys[0].scale[1] == 1.0f && keys[0].opacity == 1.0f && keys[0].growth == 1.0f &&
+              keys[0].easing == SPLATFX_EASING_LINEAR, "keyframe defaults");
+    keys[0].position[0] = -60.0f;
+    keys[1].time_sec = 4.0;
+    keys[1].position[0] = 60.0f;
+    splatfx_fire_desc d;
+    splatfx_fire_desc_init(&d);
+    d.motion_keys = keys;
+    d.motion_key_count = 2;
+    CHECK_OK(splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err), err);
+    /* The scene culls by the bounds swept since the previous prepare (conservative: a fire that
+     * crossed the view between two frames counts as in it), so t = 4 is asked twice: the first
+     * sweeps [2, 4] through the view, the second [4, 4] only. -1: not asserted. */
+    const double times[4] = {0.0, 2.0, 4.0, 4.0};
+    const int needed[4] = {0, 1, -1, 0};
+    for (int i = 0; i < 4; ++i) {
+        CHECK_OK(splatfx_scene_prepare(scene, times[i], &cam, m, frame, err), err);
+        splatfx_frame_stats st;
+        CHECK_OK(splatfx_frame_get_stats(frame, &st, err), err);
+        CHECK(needed[i] < 0 || st.needed == (uint64_t)needed[i], "prepare %d (t = %g): needed %llu, expected %d", i, times[i],
+              (unsigned long long)st.needed, needed[i]);
+    }
+    /* Bad tracks: the key and the field are named, nothing is added. */
+    keys[1].time_sec = 0.0;
+    CHECK_FAILS(splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "desc.motion: keyframe 1: timeSec 0.000000 must be greater");
+    keys[1].time_sec = 4.0;
+    keys[1].scale[2] = 0.0f;
+    CHECK_FAILS(splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "pose.scale must be positive");
+    keys[1].scale[2] = 1.0f;
+    keys[1].easing = (splatfx_easing)7;
+    CHECK_FAILS(splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                "desc.motion_keys[1].easing is 7");
+    d.motion_keys = NULL;
+    CHECK_FAILS(splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                "desc.motion_keys is NULL but desc.motion_key_count is 2");
+    splatfx_smoke_desc sd;
+    splatfx_smoke_desc_init(&sd);
+    sd.source_motion_keys = keys;
+    sd.source_motion_key_count = 1;
+    keys[0].time_sec = NAN;
+    CHECK_FAILS(splatfx_scene_add_smoke(scene, m, &sd, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                "desc.source_motion_keys[0].time_sec is nan");
+    CHECK(splatfx_scene_effect_count(scene) == 1, "failed adds added effects: %u", splatfx_scene_effect_count(scene));
+    splatfx_frame_destroy(frame);
+    splatfx_scene_destroy(scene);
+    splatfx_materials_destroy(m);
+    splatfx_error_destroy(err);
+}
+
 /* A texture-set folder and a scene file, and their missing counterparts. */
 static void test_files(void) {
     splatfx_error* err = splatfx_error_create();
@@ -335,6 +400,7 @@ int main(void) {
     test_version_and_error_object();
     test_fire_prepares();
     test_every_preset();
+    test_motion();
     test_files();
     test_bad_input();
     if (g_failures) {

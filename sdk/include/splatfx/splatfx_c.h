@@ -157,6 +157,30 @@ typedef struct splatfx_effect_options {
 } splatfx_effect_options;
 SPLATFX_C_API void splatfx_effect_options_init(splatfx_effect_options* options);
 
+/* Object dynamics (motion.hpp; King et al. 1999 sec. 3.1): a keyframe track
+ * of poses, interpolated between keys, holding the first before it and the
+ * last after it. Given to a preset as a pointer and a count (copied at add
+ * time); keys must have strictly increasing times. A grid preset's motion
+ * moves it from where it was built: object to world at t is
+ * motion(t) * translate(desc.position). A solver preset's source motion is
+ * where its emitter is, in world space (the smoke trails it). */
+typedef enum splatfx_easing {
+    SPLATFX_EASING_LINEAR = 0, /* constant rate between keys */
+    SPLATFX_EASING_SMOOTH = 1, /* smoothstep: eases in and out of each key */
+    SPLATFX_EASING_STEP = 2    /* holds the key until the next one */
+} splatfx_easing;
+
+typedef struct splatfx_keyframe {
+    double time_sec;        /* strictly increasing along the track; default 0 */
+    float position[3];      /* world units; default 0 */
+    float rotation[4];      /* unit quaternion w, x, y, z; default 1, 0, 0, 0 */
+    float scale[3];         /* per axis, > 0; default 1 */
+    float opacity;          /* multiplies the effect's opacity (fades), >= 0; default 1 */
+    float growth;           /* fraction of the material present, [0, 1]; default 1 */
+    splatfx_easing easing;  /* of the segment from this key to the next; default SPLATFX_EASING_LINEAR */
+} splatfx_keyframe;
+SPLATFX_C_API void splatfx_keyframe_init(splatfx_keyframe* key);
+
 /* The presets (presets.hpp; King et al. 1999's scenes). Each *_init fills
  * the C++ descriptor's defaults. texture_set: NULL for procedural
  * turbulence; otherwise copied at add time (the handle may be destroyed
@@ -171,6 +195,8 @@ typedef struct splatfx_fire_desc {
     float propagation_steps_per_sec;  /* cells per second the detail rises; default 8 */
     float textures_per_sec;           /* texture cycling rate; default 6 */
     int crossfade;                    /* cross-fade consecutive textures; default 1 */
+    const splatfx_keyframe* motion_keys; /* object dynamics of the whole fire; default NULL (at rest) */
+    uint32_t motion_key_count;        /* keys at motion_keys; default 0 */
     uint32_t seed;                    /* texture dynamics; default 1 */
     uint32_t texture_seed;            /* procedural texture set; default 1 */
 } splatfx_fire_desc;
@@ -188,6 +214,8 @@ typedef struct splatfx_smoke_desc {
     int32_t texture_count;            /* default 8 */
     float textures_per_sec;           /* default 3 */
     int32_t substeps;                 /* solver substeps per step; default 1 */
+    const splatfx_keyframe* source_motion_keys; /* the object the chimney sits on; default NULL (at rest at position) */
+    uint32_t source_motion_key_count; /* default 0 */
     uint32_t seed;                    /* default 1 */
     uint32_t texture_seed;            /* default 1 */
 } splatfx_smoke_desc;
@@ -202,6 +230,8 @@ typedef struct splatfx_steam_desc {
     float opacity;                    /* at the spout; default 0.35 */
     float propagation_steps_per_sec;  /* default 10 */
     float textures_per_sec;           /* default 4 */
+    const splatfx_keyframe* motion_keys; /* default NULL (at rest) */
+    uint32_t motion_key_count;        /* default 0 */
     uint32_t seed;                    /* default 1 */
     uint32_t texture_seed;            /* default 1 */
 } splatfx_steam_desc;
@@ -218,6 +248,8 @@ typedef struct splatfx_dust_desc {
     float dissipation;                /* 1/s; default 0.3 */
     const splatfx_texture_set* texture_set; /* default NULL (procedural) */
     int32_t texture_count;            /* default 8 */
+    const splatfx_keyframe* source_motion_keys; /* the animal kicking up dust; default NULL (at rest at position) */
+    uint32_t source_motion_key_count; /* default 0 */
     uint32_t seed;                    /* default 1 */
     uint32_t texture_seed;            /* default 1 */
 } splatfx_dust_desc;
@@ -233,6 +265,8 @@ typedef struct splatfx_fire_to_smoke_desc {
     const splatfx_texture_set* smoke_texture_set; /* default NULL (procedural) */
     float propagation_steps_per_sec;  /* default 8 */
     float textures_per_sec;           /* default 5 */
+    const splatfx_keyframe* motion_keys; /* default NULL (at rest) */
+    uint32_t motion_key_count;        /* default 0 */
     uint32_t seed;                    /* default 1 */
     uint32_t texture_seed;            /* default 1 */
 } splatfx_fire_to_smoke_desc;

@@ -1,6 +1,7 @@
 // splatfx_c.h, the GL-free half: errors, materials, texture sets, the scene and its presets, cameras, frames.
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <glm/gtc/type_ptr.hpp>
 
@@ -37,6 +38,37 @@ std::optional<Outcome> setTextureSet(const std::string& field, const splatfx_tex
     if (!given) return std::nullopt;
     if (auto bad = checkHandle(given, Magic::TextureSet, field.c_str(), "splatfx_texture_set")) return bad;
     out = given->value;
+    return std::nullopt;
+}
+
+// A C keyframe track to a Motion; Motion::create checks the keys (its message names the key and field).
+std::optional<Outcome> toMotion(const std::string& field, const splatfx_keyframe* keys, std::uint32_t count, Motion& out) {
+    if (count == 0) return std::nullopt;
+    if (!keys) return invalid(field + "_keys is NULL but " + field + "_key_count is " + std::to_string(count));
+    constexpr std::uint32_t kMaxKeys = 1u << 20; // a track, not a baked simulation: 10^6 keys is already hours at 240 Hz
+    if (count > kMaxKeys)
+        return invalid(field + "_key_count is " + std::to_string(count) + "; expected at most " + std::to_string(kMaxKeys));
+    std::vector<Keyframe> track;
+    track.reserve(count);
+    for (std::uint32_t i = 0; i < count; ++i) {
+        const splatfx_keyframe& k = keys[i];
+        const std::string at = field + "_keys[" + std::to_string(i) + "]";
+        if (!std::isfinite(k.time_sec)) return invalid(at + ".time_sec is " + str(float(k.time_sec)) + "; expected a finite number");
+        if (k.easing != SPLATFX_EASING_LINEAR && k.easing != SPLATFX_EASING_SMOOTH && k.easing != SPLATFX_EASING_STEP)
+            return invalid(at + ".easing is " + std::to_string(int(k.easing)) + "; expected a splatfx_easing value");
+        Keyframe key;
+        key.timeSec = k.time_sec;
+        key.pose.position = vec3Of(k.position);
+        key.pose.rotation = glm::quat(k.rotation[0], k.rotation[1], k.rotation[2], k.rotation[3]);
+        key.pose.scale = vec3Of(k.scale);
+        key.pose.opacity = k.opacity;
+        key.pose.growth = k.growth;
+        key.easing = k.easing == SPLATFX_EASING_SMOOTH ? Easing::Smooth : k.easing == SPLATFX_EASING_STEP ? Easing::Step : Easing::Linear;
+        track.push_back(key);
+    }
+    Result<Motion> motion = Motion::create(std::move(track));
+    if (!motion) return invalid(field + ": " + motion.error());
+    out = std::move(*motion);
     return std::nullopt;
 }
 
@@ -220,6 +252,21 @@ void splatfx_effect_options_init(splatfx_effect_options* options) {
     options->opacity_scale = o.draw.opacityScale;
 }
 
+void splatfx_keyframe_init(splatfx_keyframe* key) {
+    if (!key) return;
+    const Keyframe k{};
+    key->time_sec = k.timeSec;
+    store3(key->position, k.pose.position);
+    key->rotation[0] = k.pose.rotation.w;
+    key->rotation[1] = k.pose.rotation.x;
+    key->rotation[2] = k.pose.rotation.y;
+    key->rotation[3] = k.pose.rotation.z;
+    store3(key->scale, k.pose.scale);
+    key->opacity = k.pose.opacity;
+    key->growth = k.pose.growth;
+    key->easing = SPLATFX_EASING_LINEAR;
+}
+
 void splatfx_fire_desc_init(splatfx_fire_desc* desc) {
     if (!desc) return;
     const presets::FireDesc d{};
@@ -232,6 +279,8 @@ void splatfx_fire_desc_init(splatfx_fire_desc* desc) {
     desc->propagation_steps_per_sec = d.propagationStepsPerSec;
     desc->textures_per_sec = d.texturesPerSec;
     desc->crossfade = d.crossfade ? 1 : 0;
+    desc->motion_keys = nullptr;
+    desc->motion_key_count = 0;
     desc->seed = d.seed;
     desc->texture_seed = d.textureSeed;
 }
@@ -250,6 +299,8 @@ void splatfx_smoke_desc_init(splatfx_smoke_desc* desc) {
     desc->texture_count = d.textureCount;
     desc->textures_per_sec = d.texturesPerSec;
     desc->substeps = d.substeps;
+    desc->source_motion_keys = nullptr;
+    desc->source_motion_key_count = 0;
     desc->seed = d.seed;
     desc->texture_seed = d.textureSeed;
 }
@@ -265,6 +316,8 @@ void splatfx_steam_desc_init(splatfx_steam_desc* desc) {
     desc->opacity = d.opacity;
     desc->propagation_steps_per_sec = d.propagationStepsPerSec;
     desc->textures_per_sec = d.texturesPerSec;
+    desc->motion_keys = nullptr;
+    desc->motion_key_count = 0;
     desc->seed = d.seed;
     desc->texture_seed = d.textureSeed;
 }
@@ -282,6 +335,8 @@ void splatfx_dust_desc_init(splatfx_dust_desc* desc) {
     desc->dissipation = d.dissipation;
     desc->texture_set = nullptr;
     desc->texture_count = d.textureCount;
+    desc->source_motion_keys = nullptr;
+    desc->source_motion_key_count = 0;
     desc->seed = d.seed;
     desc->texture_seed = d.textureSeed;
 }
@@ -298,6 +353,8 @@ void splatfx_fire_to_smoke_desc_init(splatfx_fire_to_smoke_desc* desc) {
     desc->smoke_texture_set = nullptr;
     desc->propagation_steps_per_sec = d.propagationStepsPerSec;
     desc->textures_per_sec = d.texturesPerSec;
+    desc->motion_keys = nullptr;
+    desc->motion_key_count = 0;
     desc->seed = d.seed;
     desc->texture_seed = d.textureSeed;
 }
@@ -341,6 +398,7 @@ splatfx_status splatfx_scene_add_fire(splatfx_scene* scene, splatfx_materials* m
         d.propagationStepsPerSec = c.propagation_steps_per_sec;
         d.texturesPerSec = c.textures_per_sec;
         d.crossfade = c.crossfade != 0;
+        if (auto bad = toMotion("desc.motion", c.motion_keys, c.motion_key_count, d.motion)) return *bad;
         d.seed = c.seed;
         d.textureSeed = c.texture_seed;
         return addPreset(scene, materials, options, out_id,
@@ -373,6 +431,7 @@ splatfx_status splatfx_scene_add_smoke(splatfx_scene* scene, splatfx_materials* 
         d.textureCount = c.texture_count;
         d.texturesPerSec = c.textures_per_sec;
         d.substeps = c.substeps;
+        if (auto bad = toMotion("desc.source_motion", c.source_motion_keys, c.source_motion_key_count, d.sourceMotion)) return *bad;
         d.seed = c.seed;
         d.textureSeed = c.texture_seed;
         return addPreset(scene, materials, options, out_id,
@@ -399,6 +458,7 @@ splatfx_status splatfx_scene_add_steam(splatfx_scene* scene, splatfx_materials* 
         d.opacity = c.opacity;
         d.propagationStepsPerSec = c.propagation_steps_per_sec;
         d.texturesPerSec = c.textures_per_sec;
+        if (auto bad = toMotion("desc.motion", c.motion_keys, c.motion_key_count, d.motion)) return *bad;
         d.seed = c.seed;
         d.textureSeed = c.texture_seed;
         return addPreset(scene, materials, options, out_id,
@@ -428,6 +488,7 @@ splatfx_status splatfx_scene_add_dust(splatfx_scene* scene, splatfx_materials* m
         d.settle = c.settle;
         d.dissipation = c.dissipation;
         d.textureCount = c.texture_count;
+        if (auto bad = toMotion("desc.source_motion", c.source_motion_keys, c.source_motion_key_count, d.sourceMotion)) return *bad;
         d.seed = c.seed;
         d.textureSeed = c.texture_seed;
         return addPreset(scene, materials, options, out_id,
@@ -455,6 +516,7 @@ splatfx_status splatfx_scene_add_fire_to_smoke(splatfx_scene* scene, splatfx_mat
         d.position = vec3Of(c.position);
         d.split = c.split;
         d.blend = c.blend;
+        if (auto bad = toMotion("desc.motion", c.motion_keys, c.motion_key_count, d.motion)) return *bad;
         d.propagationStepsPerSec = c.propagation_steps_per_sec;
         d.texturesPerSec = c.textures_per_sec;
         d.seed = c.seed;
