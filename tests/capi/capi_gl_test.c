@@ -304,7 +304,16 @@ int main(void) {
     test_fire_against_host_depth(err, 2);
     test_render_errors(err);
     CHECK(glGetError() == GL_NO_ERROR, "a GL error was raised");
+    /* A renderer outliving its context: destroying it then must not abort in the GL loader, and
+     * GL calls through the API are refused with a message. */
+    splatfx_renderer* orphan = NULL;
+    splatfx_materials* m = NULL;
+    CHECK_OK(splatfx_renderer_create(NULL, &orphan, err), err);
+    CHECK_OK(splatfx_materials_create(NULL, &m, err), err);
     splatfx_headless_context_destroy(ctx);
+    CHECK_FAILS(splatfx_renderer_upload(orphan, m, err), err, SPLATFX_ERROR_GL, "no OpenGL context is current");
+    splatfx_renderer_destroy(orphan);
+    splatfx_materials_destroy(m);
     splatfx_error_destroy(err);
     if (g_failures) {
         fprintf(stderr, "capi_gl_test: %d check(s) failed\n", g_failures);

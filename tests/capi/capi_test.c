@@ -398,6 +398,22 @@ static void test_bad_input(void) {
     CHECK(splatfx_scene_effect_count(scene) == effectsBefore, "failed adds added %u effects",
           splatfx_scene_effect_count(scene) - effectsBefore);
 
+    /* A scene's effects index the materials they were built with. */
+    {
+        splatfx_scene* own = NULL;
+        splatfx_materials* other = NULL;
+        CHECK_OK(splatfx_scene_create(&own, err), err);
+        CHECK_OK(splatfx_materials_create(NULL, &other, err), err);
+        CHECK_OK(splatfx_scene_add_fire(own, m, NULL, NULL, NULL, err), err);
+        CHECK_FAILS(splatfx_scene_prepare(own, 0.0, &cam, other, frame, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                    "materials are not the ones this scene's effects were built with");
+        CHECK_FAILS(splatfx_scene_add_steam(own, other, NULL, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                    "materials are not the ones this scene's effects were built with");
+        CHECK(splatfx_scene_effect_count(own) == 1, "an add with other materials added an effect");
+        splatfx_materials_destroy(other);
+        splatfx_scene_destroy(own);
+    }
+
     /* GL calls without a current context: an error, not the loader's abort. */
     splatfx_renderer* r = (splatfx_renderer*)&err;
     CHECK_FAILS(splatfx_renderer_create(NULL, &r, err), err, SPLATFX_ERROR_GL, "no OpenGL context is current");

@@ -289,7 +289,9 @@ SPLATFX_C_API void splatfx_ghosts_desc_init(splatfx_ghosts_desc* desc);
 
 /* Builds the preset (registering its texture sets and colour tables in
  * `materials`) and adds it to the scene; *out_id (may be NULL) receives its
- * id. desc and options may be NULL (defaults). On failure nothing is added. */
+ * id. desc and options may be NULL (defaults). On failure nothing is added.
+ * A scene's effects are built with one materials handle: the first add (or
+ * the load) fixes it, and adding or preparing with another is an error. */
 SPLATFX_C_API splatfx_status splatfx_scene_add_fire(splatfx_scene* scene, splatfx_materials* materials,
                                                     const splatfx_fire_desc* desc, const splatfx_effect_options* options,
                                                     uint32_t* out_id, splatfx_error* error);
@@ -377,7 +379,8 @@ SPLATFX_C_API void splatfx_renderer_desc_init(splatfx_renderer_desc* desc);
 
 /* What the host hands over for one frame (gl::HostTarget). */
 typedef struct splatfx_host_target {
-    uint32_t framebuffer;   /* the host's framebuffer object (0: the default framebuffer); default 0 */
+    uint32_t framebuffer;   /* the host's framebuffer object (0: the default framebuffer); it must exist
+                               (glCreateFramebuffers, or glGenFramebuffers and bound once); default 0 */
     int32_t x, y;           /* viewport origin, >= 0; default 0, 0 */
     int32_t width, height;  /* viewport size; 0, 0: the frame camera's viewport; otherwise must equal it; default 0, 0 */
     uint32_t depth_texture; /* the host's depth as a GL texture (0: the framebuffer's depth attachment if a texture); default 0 */
@@ -402,7 +405,9 @@ typedef struct splatfx_render_stats {
 typedef struct splatfx_renderer splatfx_renderer;
 SPLATFX_C_API splatfx_status splatfx_renderer_create(const splatfx_renderer_desc* desc, splatfx_renderer** out,
                                                      splatfx_error* error);
-/* Call with its context current. */
+/* Call with its context current. Without one its GL objects cannot be
+ * deleted (GL would abort): they are left to the context's own destruction
+ * (and its CPU-side memory is not freed) rather than crash. */
 SPLATFX_C_API void splatfx_renderer_destroy(splatfx_renderer* renderer);
 /* Uploads the materials' texture layers (only when they changed since the
  * last upload of these materials). Optional: render uploads too; call it to

@@ -88,18 +88,31 @@ std::optional<Outcome> toEffectOptions(const splatfx_effect_options* given, Effe
     return std::nullopt;
 }
 
+// A scene's effects index the materials they were built with.
+std::optional<Outcome> checkSceneMaterials(const splatfx_scene& scene, const splatfx_materials& materials) {
+    if (!scene.hasMaterials) return std::nullopt;
+    const std::shared_ptr<int> own = scene.materials.lock();
+    if (own == materials.identity) return std::nullopt;
+    return invalid(own ? "materials are not the ones this scene's effects were built with (their texture sets and colour "
+                         "tables are registered there); use one splatfx_materials per scene"
+                       : "the materials this scene's effects were built with were destroyed");
+}
+
 // The shared tail of every splatfx_scene_add_<preset>: check the handles, build, add.
 template <class Build>
 Outcome addPreset(splatfx_scene* scene, splatfx_materials* materials, const splatfx_effect_options* options,
                   std::uint32_t* outId, Build&& build) {
     if (auto bad = checkHandle(scene, Magic::Scene, "scene", "splatfx_scene")) return *bad;
     if (auto bad = checkHandle(materials, Magic::Materials, "materials", "splatfx_materials")) return *bad;
+    if (auto bad = checkSceneMaterials(*scene, *materials)) return *bad;
     EffectOptions opts;
     if (auto bad = toEffectOptions(options, opts)) return *bad;
     Outcome failed;
     std::optional<Effect> effect = build(materials->value, failed);
     if (!effect) return failed;
     const EffectId id = scene->value.add(std::move(*effect), std::move(opts));
+    scene->materials = materials->identity;
+    scene->hasMaterials = true;
     if (outId) *outId = id;
     return success();
 }
@@ -567,6 +580,8 @@ splatfx_status splatfx_scene_load_file(const char* path, splatfx_materials* mate
         if (!file) return failure(SPLATFX_ERROR_FILE, file.error());
         auto scene = std::make_unique<splatfx_scene>();
         scene->value = std::move(file->scene); // before any prepare: nothing in it points at itself yet
+        scene->materials = materials->identity;
+        scene->hasMaterials = true;
         *out = scene.release();
         return success();
     });
@@ -679,6 +694,7 @@ splatfx_status splatfx_scene_prepare(splatfx_scene* scene, double time_sec, cons
         if (auto bad = checkHandle(scene, Magic::Scene, "scene", "splatfx_scene")) return *bad;
         if (auto bad = checkHandle(materials, Magic::Materials, "materials", "splatfx_materials")) return *bad;
         if (auto bad = checkHandle(frame, Magic::Frame, "frame", "splatfx_frame")) return *bad;
+        if (auto bad = checkSceneMaterials(*scene, *materials)) return *bad;
         if (!camera) return invalid("camera is NULL");
         if (!std::isfinite(time_sec)) return invalid("time_sec is " + str(float(time_sec)) + "; expected a finite number of seconds");
         if (time_sec < 0.0) return invalid("time_sec is " + str(float(time_sec)) + "; expected seconds >= 0");

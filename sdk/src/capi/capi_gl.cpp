@@ -115,6 +115,12 @@ void splatfx_renderer_destroy(splatfx_renderer* renderer) {
     if (!renderer || renderer->magic != Magic::Renderer) return;
     renderer->magic = Magic::Dead;
     try {
+        // Deleting GL objects with no context current would abort in the GL
+        // loader. Then they are left to die with their context: the renderer
+        // is moved out and its owner deliberately never freed (a documented
+        // leak, not a crash; splatfx_c.h, splatfx_renderer_destroy).
+        if (renderer->value && !gl::detail::contextIsCurrent())
+            (void)new gl::FrameRenderer(std::move(*renderer->value));
         delete renderer;
     } catch (...) {
     }

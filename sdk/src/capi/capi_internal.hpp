@@ -110,6 +110,11 @@ struct splatfx_texture_set {
 struct splatfx_scene {
     splatfx::capi::Magic magic = splatfx::capi::Magic::Scene;
     splatfx::Scene value;
+    // The materials its effects registered their texture sets and colour
+    // tables in (set at the first add or load): their ids mean nothing in
+    // other materials, so adding or preparing with others is refused.
+    std::weak_ptr<int> materials;
+    bool hasMaterials = false;
 };
 
 struct splatfx_frame {
