@@ -12,10 +12,10 @@
  * exports only the splatfx_* functions below; find_package(splatfx
  * COMPONENTS c) finds it and asks for no other package.
  *
- * What it does NOT do: expose the whole C++ API (hand-shaped grids, motions,
- * fog, lights, LOD volumes, the reference renderer and the bare splat pass
- * are C++ only; docs/c-api.md lists them), create a context for a window,
- * clear the host's framebuffer or write its depth.
+ * What it does NOT do: expose the whole C++ API (hand-shaped grids,
+ * procedural motion, fog, lights, LOD volumes, the reference renderer and the
+ * bare splat pass are C++ only; docs/c-api.md lists them), create a context
+ * for a window, clear the host's framebuffer or write its depth.
  *
  *   splatfx_materials* m; splatfx_scene* s; uint32_t id;
  *   splatfx_materials_create(NULL, &m, err); splatfx_scene_create(&s, err);
@@ -26,7 +26,7 @@
  * caller owns (or NULL when the caller only wants the status). On failure the
  * error object receives the status and a message naming the function, the
  * parameter or field and the value (e.g. "splatfx_scene_prepare: time_sec
- * is nan; expected a finite number"); on success it is cleared. There is no
+ * is nan; expected a finite number of seconds"); on success it is cleared. There is no
  * global or thread-local error state: one error object per thread, reused.
  * No C++ exception crosses this header: each function catches everything and
  * reports SPLATFX_ERROR_OUT_OF_MEMORY or SPLATFX_ERROR_INTERNAL. NULL handles
@@ -36,8 +36,9 @@
  * Ownership: each *_create returns a handle the caller frees with the
  * matching *_destroy (NULL is accepted and ignored). Handles are
  * independent: a scene does not keep its materials, a frame does not keep
- * its scene; a renderer must be destroyed while its GL context is current,
- * before the context.
+ * its scene (though a scene is tied to the materials its effects were built
+ * with, and a frame to those it was prepared with: others are refused); a
+ * renderer is destroyed while its GL context is current, before the context.
  *
  * Threading: one thread at a time per handle; different handles on different
  * threads freely, except that the renderer and the headless context are used
