@@ -7,6 +7,10 @@
 
 #include <splatfx/splatfx_c.h>
 
+/* The ABI the header promises: its enums are 32-bit. */
+_Static_assert(sizeof(splatfx_status) == sizeof(int32_t), "splatfx_status is 32-bit");
+_Static_assert(sizeof(splatfx_easing) == sizeof(int32_t), "splatfx_easing is 32-bit");
+
 /* Failed checks so far; main returns nonzero when any failed. */
 static int g_failures = 0; /* test-program state, not SDK state */
 

@@ -70,6 +70,18 @@
 #  define SPLATFX_C_API
 #endif
 
+/* Enums are 32-bit signed integers on both sides. In C++ they get that as a
+ * fixed underlying type, so any value a C caller or an FFI passes (say 7 for
+ * a 3-value enum) is a value of the type and the library can reject it
+ * (without it, C++ may assume an enum holds only its enumerators' range); in
+ * C each enum carries a 0x7fffffff enumerator, which keeps it int-sized under
+ * -fshort-enums too. */
+#ifdef __cplusplus
+#  define SPLATFX_C_ENUM(name) enum name : int32_t
+#else
+#  define SPLATFX_C_ENUM(name) enum name
+#endif
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -81,7 +93,7 @@ SPLATFX_C_API uint32_t splatfx_c_api_version(void);
 
 /* ---- [errors] ------------------------------------------------------------ */
 
-typedef enum splatfx_status {
+typedef SPLATFX_C_ENUM(splatfx_status) {
     SPLATFX_OK = 0,
     SPLATFX_ERROR_INVALID_ARGUMENT = 1, /* a NULL handle, a field out of range, a NaN */
     SPLATFX_ERROR_INVALID_STATE = 2,    /* e.g. rendering a frame that was never prepared */
@@ -89,7 +101,8 @@ typedef enum splatfx_status {
     SPLATFX_ERROR_FILE = 4,             /* a scene file or texture-set folder could not be read or is invalid */
     SPLATFX_ERROR_GL = 5,               /* no OpenGL 4.5 context, no EGL display, a GL name that is not what was asked */
     SPLATFX_ERROR_OUT_OF_MEMORY = 6,
-    SPLATFX_ERROR_INTERNAL = 7          /* an unexpected C++ exception, caught at the boundary */
+    SPLATFX_ERROR_INTERNAL = 7,         /* an unexpected C++ exception, caught at the boundary */
+    SPLATFX_STATUS_MAX_ENUM = 0x7fffffff
 } splatfx_status;
 
 /* A short constant name for a status ("SPLATFX_ERROR_FILE"); never NULL. */
@@ -165,10 +178,11 @@ SPLATFX_C_API void splatfx_effect_options_init(splatfx_effect_options* options);
  * moves it from where it was built: object to world at t is
  * motion(t) * translate(desc.position). A solver preset's source motion is
  * where its emitter is, in world space (the smoke trails it). */
-typedef enum splatfx_easing {
+typedef SPLATFX_C_ENUM(splatfx_easing) {
     SPLATFX_EASING_LINEAR = 0, /* constant rate between keys */
     SPLATFX_EASING_SMOOTH = 1, /* smoothstep: eases in and out of each key */
-    SPLATFX_EASING_STEP = 2    /* holds the key until the next one */
+    SPLATFX_EASING_STEP = 2,   /* holds the key until the next one */
+    SPLATFX_EASING_MAX_ENUM = 0x7fffffff
 } splatfx_easing;
 
 typedef struct splatfx_keyframe {

@@ -166,6 +166,7 @@ const char* splatfx_status_name(splatfx_status status) {
     case SPLATFX_ERROR_GL: return "SPLATFX_ERROR_GL";
     case SPLATFX_ERROR_OUT_OF_MEMORY: return "SPLATFX_ERROR_OUT_OF_MEMORY";
     case SPLATFX_ERROR_INTERNAL: return "SPLATFX_ERROR_INTERNAL";
+    case SPLATFX_STATUS_MAX_ENUM: break;
     }
     return "SPLATFX_ERROR_UNKNOWN_STATUS";
 }

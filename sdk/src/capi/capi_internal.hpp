@@ -137,3 +137,6 @@ struct splatfx_headless_context {
     std::optional<splatfx::HeadlessContext> value;
     std::string renderer;
 };
+
+// The C side sees int-sized enums (splatfx_c.h, SPLATFX_C_ENUM).
+static_assert(sizeof(splatfx_status) == 4 && sizeof(splatfx_easing) == 4, "splatfx_c.h enums must be 32-bit");
