@@ -20,11 +20,12 @@ JOBS="${JOBS:-$(nproc)}"
 FUZZ_SECONDS="${FUZZ_SECONDS:-60}"
 FUZZ_TARGETS="${FUZZ_TARGETS:-scene_file texture_set image mesh}"
 CXX_FUZZ="${CXX_FUZZ:-clang++}"
+CC_FUZZ="${CC_FUZZ:-clang}" # the C API's C tests share the instrumentation flags, which gcc does not know
 
 [ "$CXX_FUZZ" = clang++ ] && tools/setup-deps.sh --fuzz
 command -v "$CXX_FUZZ" >/dev/null || { echo "fuzz: $CXX_FUZZ not found (Debian: apt-get install clang libclang-rt-dev)" >&2; exit 1; }
 echo "fuzz: configuring $BUILD_DIR with $CXX_FUZZ"
-cmake -S . -B "$BUILD_DIR" -DCMAKE_CXX_COMPILER="$CXX_FUZZ" -DSPLATFX_FUZZ=ON \
+cmake -S . -B "$BUILD_DIR" -DCMAKE_CXX_COMPILER="$CXX_FUZZ" -DCMAKE_C_COMPILER="$CC_FUZZ" -DSPLATFX_FUZZ=ON \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
   -DSPLATFX_BUILD_TESTS=ON -DSPLATFX_BUILD_TOOLS=ON -DSPLATFX_BUILD_SAMPLES=OFF >/dev/null
 targets=()

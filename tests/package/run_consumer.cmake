@@ -1,9 +1,13 @@
-# cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... [-DCORE_ONLY=ON] -P run_consumer.cmake
+# cmake -DBUILD_DIR=... -DSOURCE_DIR=... -DWORK_DIR=... [-DCORE_ONLY=ON | -DC_ONLY=ON -DNM=...] -P run_consumer.cmake
 # Installs the SDK into a scratch prefix, configures, builds and runs the
 # consumer project in SOURCE_DIR. With CORE_ONLY the consumer asks for the
 # core component alone; then the test also requires that configuring found
 # none of GL's, EGL's, GLFW's or OpenImageIO's packages, and that the
 # consumer's link line names none of them (nor another splatfx library).
+# With C_ONLY the consumer is a C project asking for the C API alone: it must
+# find no package at all, link libsplatfx_c.so and nothing else of splatfx
+# or its dependencies, and the installed library must export only splatfx_*
+# symbols (read with NM).
 file(REMOVE_RECURSE ${WORK_DIR})
 set(prefix ${WORK_DIR}/prefix)
 
@@ -22,6 +26,8 @@ set(configure_output "${last_output}")
 step(${CMAKE_COMMAND} --build ${WORK_DIR}/build)
 if(CORE_ONLY)
   set(program core_consumer)
+elseif(C_ONLY)
+  set(program c_consumer)
 else()
   set(program consumer)
 endif()
@@ -60,4 +66,48 @@ if(CORE_ONLY)
       message(FATAL_ERROR "the core consumer's link line matches '${forbidden}': ${link_line}")
     endif()
   endforeach()
+endif()
+
+if(C_ONLY)
+  file(READ ${WORK_DIR}/build/CMakeCache.txt cache)
+  foreach(probe "glm_DIR:PATH=[^\n]*[^-\n]" "OpenImageIO_DIR:PATH=[^\n]*[^-\n]" "glfw3_DIR:PATH=[^\n]*[^-\n]"
+                "nlohmann_json_DIR:PATH=[^\n]*[^-\n]" "EPOXY_FOUND" "EGL_FOUND")
+    if(cache MATCHES "${probe}")
+      string(REGEX MATCH "[^\n]*${probe}[^\n]*" line "${cache}")
+      message(FATAL_ERROR "find_package(splatfx COMPONENTS c) looked for a dependency: ${line}")
+    endif()
+  endforeach()
+  set(link_file ${WORK_DIR}/build/CMakeFiles/${program}.dir/link.txt)
+  file(READ ${link_file} link_line)
+  message(STATUS "c consumer link line: ${link_line}")
+  if(NOT link_line MATCHES "libsplatfx_c\\.so")
+    message(FATAL_ERROR "the C consumer does not link libsplatfx_c.so: ${link_line}")
+  endif()
+  string(TOLOWER "${link_line}" lower)
+  foreach(forbidden "splatfx_core" "splatfx_io" "splatfx_gl" "splatfx_context" "stdc\\+\\+" "epoxy" "egl" "glfw" "openimageio")
+    if(lower MATCHES "${forbidden}")
+      message(FATAL_ERROR "the C consumer's link line matches '${forbidden}': ${link_line}")
+    endif()
+  endforeach()
+  file(GLOB libs ${prefix}/lib*/libsplatfx_c.so)
+  if(NOT libs)
+    message(FATAL_ERROR "no libsplatfx_c.so installed under ${prefix}")
+  endif()
+  list(GET libs 0 lib)
+  step(${NM} -D --defined-only ${lib})
+  string(REPLACE "\n" ";" symbols "${last_output}")
+  set(count 0)
+  foreach(line ${symbols})
+    if(line MATCHES "^[0-9a-fA-F]+ [A-Za-z] (.+)$")
+      set(name ${CMAKE_MATCH_1})
+      if(NOT name MATCHES "^splatfx_")
+        message(FATAL_ERROR "libsplatfx_c.so exports a symbol outside the C API: ${name}")
+      endif()
+      math(EXPR count "${count} + 1")
+    endif()
+  endforeach()
+  if(count LESS 40)
+    message(FATAL_ERROR "libsplatfx_c.so exports only ${count} symbols; is nm reading it? ${last_output}")
+  endif()
+  message(STATUS "libsplatfx_c.so exports ${count} symbols, all splatfx_*")
 endif()

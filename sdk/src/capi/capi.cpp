@@ -1,0 +1,710 @@
+// splatfx_c.h, the GL-free half: errors, materials, texture sets, the scene and its presets, cameras, frames.
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include "capi/capi_internal.hpp"
+#include "grid/number_text.hpp"
+#include "splatfx/presets.hpp"
+#include "splatfx/scene_file.hpp"
+
+using namespace splatfx;
+using namespace splatfx::capi;
+using grid_detail::str;
+
+namespace {
+
+// Viewport sides the C API accepts: GL 4.5 guarantees 16384 as GL_MAX_VIEWPORT_DIMS.
+constexpr std::int32_t kMaxViewportSide = 16384;
+
+std::optional<Outcome> checkFinite(const std::string& field, float v) {
+    if (!std::isfinite(v)) return invalid(field + " is " + str(v) + "; expected a finite number");
+    return std::nullopt;
+}
+std::optional<Outcome> checkFinite3(const std::string& field, const float v[3]) {
+    for (int i = 0; i < 3; ++i)
+        if (auto bad = checkFinite(field + "[" + std::to_string(i) + "]", v[i])) return bad;
+    return std::nullopt;
+}
+glm::vec3 vec3Of(const float v[3]) { return {v[0], v[1], v[2]}; }
+glm::ivec3 ivec3Of(const std::int32_t v[3]) { return {v[0], v[1], v[2]}; }
+void store3(float out[3], glm::vec3 v) { out[0] = v.x; out[1] = v.y; out[2] = v.z; }
+void store3(std::int32_t out[3], glm::ivec3 v) { out[0] = v.x; out[1] = v.y; out[2] = v.z; }
+
+std::optional<Outcome> setTextureSet(const std::string& field, const splatfx_texture_set* given,
+                                     std::optional<TextureSet>& out) {
+    if (!given) return std::nullopt;
+    if (auto bad = checkHandle(given, Magic::TextureSet, field.c_str(), "splatfx_texture_set")) return bad;
+    out = given->value;
+    return std::nullopt;
+}
+
+// A C keyframe track to a Motion; Motion::create checks the keys (its message names the key and field).
+std::optional<Outcome> toMotion(const std::string& field, const splatfx_keyframe* keys, std::uint32_t count, Motion& out) {
+    if (count == 0) return std::nullopt;
+    if (!keys) return invalid(field + "_keys is NULL but " + field + "_key_count is " + std::to_string(count));
+    constexpr std::uint32_t kMaxKeys = 1u << 20; // a track, not a baked simulation: 10^6 keys is already hours at 240 Hz
+    if (count > kMaxKeys)
+        return invalid(field + "_key_count is " + std::to_string(count) + "; expected at most " + std::to_string(kMaxKeys));
+    std::vector<Keyframe> track;
+    track.reserve(count);
+    for (std::uint32_t i = 0; i < count; ++i) {
+        const splatfx_keyframe& k = keys[i];
+        const std::string at = field + "_keys[" + std::to_string(i) + "]";
+        if (!std::isfinite(k.time_sec)) return invalid(at + ".time_sec is " + str(float(k.time_sec)) + "; expected a finite number");
+        if (k.easing != SPLATFX_EASING_LINEAR && k.easing != SPLATFX_EASING_SMOOTH && k.easing != SPLATFX_EASING_STEP)
+            return invalid(at + ".easing is " + std::to_string(int(k.easing)) + "; expected a splatfx_easing value");
+        Keyframe key;
+        key.timeSec = k.time_sec;
+        key.pose.position = vec3Of(k.position);
+        key.pose.rotation = glm::quat(k.rotation[0], k.rotation[1], k.rotation[2], k.rotation[3]);
+        key.pose.scale = vec3Of(k.scale);
+        key.pose.opacity = k.opacity;
+        key.pose.growth = k.growth;
+        key.easing = k.easing == SPLATFX_EASING_SMOOTH ? Easing::Smooth : k.easing == SPLATFX_EASING_STEP ? Easing::Step : Easing::Linear;
+        track.push_back(key);
+    }
+    Result<Motion> motion = Motion::create(std::move(track));
+    if (!motion) return invalid(field + ": " + motion.error());
+    out = std::move(*motion);
+    return std::nullopt;
+}
+
+std::optional<Outcome> toEffectOptions(const splatfx_effect_options* given, EffectOptions& out) {
+    splatfx_effect_options o;
+    splatfx_effect_options_init(&o);
+    if (given) o = *given;
+    if (!(o.range_world > 0.0f)) // NaN fails too; +inf is "no limit"
+        return invalid("options.range_world is " + str(o.range_world) + "; expected > 0 (INFINITY: no limit)");
+    if (!(o.opacity_scale >= 0.0f && o.opacity_scale <= 1000.0f))
+        return invalid("options.opacity_scale is " + str(o.opacity_scale) + "; expected a number in [0, 1000]");
+    out.name = o.name ? o.name : "";
+    out.rangeWorld = o.range_world;
+    out.enabled = o.enabled != 0;
+    out.draw.textured = o.textured != 0;
+    out.draw.opacityScale = o.opacity_scale;
+    return std::nullopt;
+}
+
+// A scene's effects index the materials they were built with.
+std::optional<Outcome> checkSceneMaterials(const splatfx_scene& scene, const splatfx_materials& materials) {
+    if (!scene.hasMaterials) return std::nullopt;
+    const std::shared_ptr<int> own = scene.materials.lock();
+    if (own == materials.identity) return std::nullopt;
+    return invalid(own ? "materials are not the ones this scene's effects were built with (their texture sets and colour "
+                         "tables are registered there); use one splatfx_materials per scene"
+                       : "the materials this scene's effects were built with were destroyed");
+}
+
+// The shared tail of every splatfx_scene_add_<preset>: check the handles, build, add.
+template <class Build>
+Outcome addPreset(splatfx_scene* scene, splatfx_materials* materials, const splatfx_effect_options* options,
+                  std::uint32_t* outId, Build&& build) {
+    if (auto bad = checkHandle(scene, Magic::Scene, "scene", "splatfx_scene")) return *bad;
+    if (auto bad = checkHandle(materials, Magic::Materials, "materials", "splatfx_materials")) return *bad;
+    if (auto bad = checkSceneMaterials(*scene, *materials)) return *bad;
+    EffectOptions opts;
+    if (auto bad = toEffectOptions(options, opts)) return *bad;
+    Outcome failed;
+    std::optional<Effect> effect = build(materials->value, failed);
+    if (!effect) return failed;
+    const EffectId id = scene->value.add(std::move(*effect), std::move(opts));
+    scene->materials = materials->identity;
+    scene->hasMaterials = true;
+    if (outId) *outId = id;
+    return success();
+}
+
+std::optional<Effect> fromResult(Result<Effect> r, Outcome& failed) {
+    if (!r) {
+        failed = invalid(r.error());
+        return std::nullopt;
+    }
+    return std::move(*r);
+}
+
+std::optional<Outcome> checkCamera(const splatfx_camera& c, const std::string& param) {
+    for (int i = 0; i < 16; ++i) {
+        if (auto bad = checkFinite(param + ".view[" + std::to_string(i) + "]", c.view[i])) return bad;
+        if (auto bad = checkFinite(param + ".proj[" + std::to_string(i) + "]", c.proj[i])) return bad;
+    }
+    for (int i = 0; i < 2; ++i)
+        if (c.viewport[i] < 1 || c.viewport[i] > kMaxViewportSide)
+            return invalid(param + ".viewport[" + std::to_string(i) + "] is " + std::to_string(c.viewport[i]) +
+                           "; expected a size in [1, " + std::to_string(kMaxViewportSide) + "] pixels");
+    // The eye and the frustum come from the inverses: a singular matrix has neither.
+    const double dv = glm::determinant(glm::dmat4(glm::make_mat4(c.view)));
+    if (!(std::abs(dv) > 1e-12) || !std::isfinite(dv))
+        return invalid(param + ".view is singular (determinant " + str(float(dv)) + "); expected an invertible world-to-view matrix");
+    const double dp = glm::determinant(glm::dmat4(glm::make_mat4(c.proj)));
+    if (!(std::abs(dp) > 0.0) || !std::isfinite(dp))
+        return invalid(param + ".proj is singular (determinant " + str(float(dp)) + "); expected an invertible projection");
+    return std::nullopt;
+}
+
+Camera toCamera(const splatfx_camera& c) {
+    return Camera::fromMatrices(glm::make_mat4(c.view), glm::make_mat4(c.proj), {c.viewport[0], c.viewport[1]});
+}
+
+} // namespace
+
+extern "C" {
+
+uint32_t splatfx_c_api_version(void) { return SPLATFX_C_API_VERSION; }
+
+// ---- [errors]
+
+const char* splatfx_status_name(splatfx_status status) {
+    switch (status) {
+    case SPLATFX_OK: return "SPLATFX_OK";
+    case SPLATFX_ERROR_INVALID_ARGUMENT: return "SPLATFX_ERROR_INVALID_ARGUMENT";
+    case SPLATFX_ERROR_INVALID_STATE: return "SPLATFX_ERROR_INVALID_STATE";
+    case SPLATFX_ERROR_NOT_FOUND: return "SPLATFX_ERROR_NOT_FOUND";
+    case SPLATFX_ERROR_FILE: return "SPLATFX_ERROR_FILE";
+    case SPLATFX_ERROR_GL: return "SPLATFX_ERROR_GL";
+    case SPLATFX_ERROR_OUT_OF_MEMORY: return "SPLATFX_ERROR_OUT_OF_MEMORY";
+    case SPLATFX_ERROR_INTERNAL: return "SPLATFX_ERROR_INTERNAL";
+    case SPLATFX_STATUS_MAX_ENUM: break;
+    }
+    return "SPLATFX_ERROR_UNKNOWN_STATUS";
+}
+
+splatfx_error* splatfx_error_create(void) { return new (std::nothrow) splatfx_error(); }
+void splatfx_error_destroy(splatfx_error* error) { delete error; }
+splatfx_status splatfx_error_status(const splatfx_error* error) {
+    return error ? error->status : SPLATFX_ERROR_INVALID_ARGUMENT;
+}
+const char* splatfx_error_message(const splatfx_error* error) {
+    if (!error) return "splatfx_error_message: error is NULL";
+    if (error->status != SPLATFX_OK && error->message.empty()) return "out of memory while writing the error message";
+    return error->message.c_str();
+}
+
+// ---- [materials and texture sets]
+
+void splatfx_materials_desc_init(splatfx_materials_desc* desc) {
+    if (!desc) return;
+    const MaterialsDesc d{};
+    desc->layer_size = d.layerSize;
+    desc->color_table_size = d.colorTableSize;
+}
+
+splatfx_status splatfx_materials_create(const splatfx_materials_desc* desc, splatfx_materials** out, splatfx_error* error) {
+    return guard("splatfx_materials_create", error, [&] {
+        if (!out) return invalid("out is NULL");
+        *out = nullptr;
+        splatfx_materials_desc d;
+        splatfx_materials_desc_init(&d);
+        if (desc) d = *desc;
+        // Materials asserts these (a misuse in C++); here they are the caller's input.
+        if (d.layer_size < 4 || d.layer_size > 1024)
+            return invalid("desc.layer_size is " + std::to_string(d.layer_size) + "; expected texels in [4, 1024]");
+        if (d.color_table_size < 2 || d.color_table_size > 65536)
+            return invalid("desc.color_table_size is " + std::to_string(d.color_table_size) + "; expected entries in [2, 65536]");
+        *out = new splatfx_materials(MaterialsDesc{.layerSize = d.layer_size, .colorTableSize = d.color_table_size});
+        return success();
+    });
+}
+
+void splatfx_materials_destroy(splatfx_materials* materials) {
+    if (!materials || materials->magic != Magic::Materials) return;
+    materials->magic = Magic::Dead;
+    delete materials;
+}
+
+uint32_t splatfx_materials_layer_count(const splatfx_materials* materials) {
+    return materials && materials->magic == Magic::Materials ? materials->value.layerCount() : 0;
+}
+
+splatfx_status splatfx_texture_set_load(const char* folder, splatfx_texture_set** out, splatfx_error* error) {
+    return guard("splatfx_texture_set_load", error, [&] {
+        if (!out) return invalid("out is NULL");
+        *out = nullptr;
+        if (!folder) return invalid("folder is NULL");
+        Result<TextureSet> set = TextureSet::load(folder);
+        if (!set) return failure(SPLATFX_ERROR_FILE, set.error());
+        *out = new splatfx_texture_set{Magic::TextureSet, std::move(*set)};
+        return success();
+    });
+}
+
+void splatfx_texture_set_destroy(splatfx_texture_set* set) {
+    if (!set || set->magic != Magic::TextureSet) return;
+    set->magic = Magic::Dead;
+    delete set;
+}
+
+uint32_t splatfx_texture_set_count(const splatfx_texture_set* set) {
+    return set && set->magic == Magic::TextureSet ? std::uint32_t(set->value.count()) : 0;
+}
+
+// ---- [scene and presets]
+
+splatfx_status splatfx_scene_create(splatfx_scene** out, splatfx_error* error) {
+    return guard("splatfx_scene_create", error, [&] {
+        if (!out) return invalid("out is NULL");
+        *out = new splatfx_scene();
+        return success();
+    });
+}
+
+void splatfx_scene_destroy(splatfx_scene* scene) {
+    if (!scene || scene->magic != Magic::Scene) return;
+    scene->magic = Magic::Dead;
+    delete scene;
+}
+
+void splatfx_effect_options_init(splatfx_effect_options* options) {
+    if (!options) return;
+    const EffectOptions o{};
+    options->name = nullptr;
+    options->range_world = o.rangeWorld;
+    options->enabled = o.enabled ? 1 : 0;
+    options->textured = o.draw.textured ? 1 : 0;
+    options->opacity_scale = o.draw.opacityScale;
+}
+
+void splatfx_keyframe_init(splatfx_keyframe* key) {
+    if (!key) return;
+    const Keyframe k{};
+    key->time_sec = k.timeSec;
+    store3(key->position, k.pose.position);
+    key->rotation[0] = k.pose.rotation.w;
+    key->rotation[1] = k.pose.rotation.x;
+    key->rotation[2] = k.pose.rotation.y;
+    key->rotation[3] = k.pose.rotation.z;
+    store3(key->scale, k.pose.scale);
+    key->opacity = k.pose.opacity;
+    key->growth = k.pose.growth;
+    key->easing = SPLATFX_EASING_LINEAR;
+}
+
+void splatfx_fire_desc_init(splatfx_fire_desc* desc) {
+    if (!desc) return;
+    const presets::FireDesc d{};
+    store3(desc->dims, d.dims);
+    store3(desc->spacing, d.spacing);
+    store3(desc->position, d.position);
+    desc->texture_set = nullptr;
+    desc->texture_count = d.textureCount;
+    desc->opacity = d.opacity;
+    desc->propagation_steps_per_sec = d.propagationStepsPerSec;
+    desc->textures_per_sec = d.texturesPerSec;
+    desc->crossfade = d.crossfade ? 1 : 0;
+    desc->motion_keys = nullptr;
+    desc->motion_key_count = 0;
+    desc->seed = d.seed;
+    desc->texture_seed = d.textureSeed;
+}
+
+void splatfx_smoke_desc_init(splatfx_smoke_desc* desc) {
+    if (!desc) return;
+    const presets::SmokeDesc d{};
+    store3(desc->dims, d.dims);
+    store3(desc->spacing, d.spacing);
+    store3(desc->position, d.position);
+    store3(desc->source_offset, d.sourceOffset);
+    desc->source_radius = d.sourceRadius;
+    store3(desc->wind_world, d.windWorld);
+    desc->dissipation = d.dissipation;
+    desc->texture_set = nullptr;
+    desc->texture_count = d.textureCount;
+    desc->textures_per_sec = d.texturesPerSec;
+    desc->substeps = d.substeps;
+    desc->source_motion_keys = nullptr;
+    desc->source_motion_key_count = 0;
+    desc->seed = d.seed;
+    desc->texture_seed = d.textureSeed;
+}
+
+void splatfx_steam_desc_init(splatfx_steam_desc* desc) {
+    if (!desc) return;
+    const presets::SteamDesc d{};
+    store3(desc->dims, d.dims);
+    store3(desc->spacing, d.spacing);
+    store3(desc->position, d.position);
+    desc->texture_set = nullptr;
+    desc->texture_count = d.textureCount;
+    desc->opacity = d.opacity;
+    desc->propagation_steps_per_sec = d.propagationStepsPerSec;
+    desc->textures_per_sec = d.texturesPerSec;
+    desc->motion_keys = nullptr;
+    desc->motion_key_count = 0;
+    desc->seed = d.seed;
+    desc->texture_seed = d.textureSeed;
+}
+
+void splatfx_dust_desc_init(splatfx_dust_desc* desc) {
+    if (!desc) return;
+    const presets::DustDesc d{};
+    store3(desc->dims, d.dims);
+    store3(desc->spacing, d.spacing);
+    store3(desc->position, d.position);
+    store3(desc->source_offset, d.sourceOffset);
+    desc->source_radius = d.sourceRadius;
+    store3(desc->wind_world, d.windWorld);
+    desc->settle = d.settle;
+    desc->dissipation = d.dissipation;
+    desc->texture_set = nullptr;
+    desc->texture_count = d.textureCount;
+    desc->source_motion_keys = nullptr;
+    desc->source_motion_key_count = 0;
+    desc->seed = d.seed;
+    desc->texture_seed = d.textureSeed;
+}
+
+void splatfx_fire_to_smoke_desc_init(splatfx_fire_to_smoke_desc* desc) {
+    if (!desc) return;
+    const presets::FireToSmokeDesc d{};
+    store3(desc->dims, d.dims);
+    store3(desc->spacing, d.spacing);
+    store3(desc->position, d.position);
+    desc->split = d.split;
+    desc->blend = d.blend;
+    desc->fire_texture_set = nullptr;
+    desc->smoke_texture_set = nullptr;
+    desc->propagation_steps_per_sec = d.propagationStepsPerSec;
+    desc->textures_per_sec = d.texturesPerSec;
+    desc->motion_keys = nullptr;
+    desc->motion_key_count = 0;
+    desc->seed = d.seed;
+    desc->texture_seed = d.textureSeed;
+}
+
+void splatfx_ghosts_desc_init(splatfx_ghosts_desc* desc) {
+    if (!desc) return;
+    const presets::GhostsDesc d{};
+    desc->head_radius_cells = d.headRadiusCells;
+    desc->plume_cells = d.plumeCells;
+    store3(desc->spacing, d.spacing);
+    store3(desc->position, d.position);
+    desc->texture_set = nullptr;
+    desc->texture_count = d.textureCount;
+    desc->opacity = d.opacity;
+    desc->textures_per_sec = d.texturesPerSec;
+    desc->propagation_steps_per_sec = d.propagationStepsPerSec;
+    desc->seed = d.seed;
+    desc->texture_seed = d.textureSeed;
+}
+
+// The presets validate their own ranges (messages name the C++ field,
+// FireDesc.textureCount for texture_count); the C layer adds what the C++
+// types cannot carry wrong: NaN/Inf in every float field, bad handles.
+splatfx_status splatfx_scene_add_fire(splatfx_scene* scene, splatfx_materials* materials, const splatfx_fire_desc* desc,
+                                      const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
+    return guard("splatfx_scene_add_fire", error, [&] {
+        splatfx_fire_desc c;
+        splatfx_fire_desc_init(&c);
+        if (desc) c = *desc;
+        for (auto bad : {checkFinite3("desc.spacing", c.spacing), checkFinite3("desc.position", c.position),
+                         checkFinite("desc.opacity", c.opacity), checkFinite("desc.propagation_steps_per_sec", c.propagation_steps_per_sec),
+                         checkFinite("desc.textures_per_sec", c.textures_per_sec)})
+            if (bad) return *bad;
+        presets::FireDesc d;
+        if (auto bad = setTextureSet("desc.texture_set", c.texture_set, d.textureSet)) return *bad;
+        d.dims = ivec3Of(c.dims);
+        d.spacing = vec3Of(c.spacing);
+        d.position = vec3Of(c.position);
+        d.textureCount = c.texture_count;
+        d.opacity = c.opacity;
+        d.propagationStepsPerSec = c.propagation_steps_per_sec;
+        d.texturesPerSec = c.textures_per_sec;
+        d.crossfade = c.crossfade != 0;
+        if (auto bad = toMotion("desc.motion", c.motion_keys, c.motion_key_count, d.motion)) return *bad;
+        d.seed = c.seed;
+        d.textureSeed = c.texture_seed;
+        return addPreset(scene, materials, options, out_id,
+                         [&](Materials& m, Outcome& failed) { return fromResult(presets::fire(m, d), failed); });
+    });
+}
+
+splatfx_status splatfx_scene_add_smoke(splatfx_scene* scene, splatfx_materials* materials, const splatfx_smoke_desc* desc,
+                                       const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
+    return guard("splatfx_scene_add_smoke", error, [&] {
+        splatfx_smoke_desc c;
+        splatfx_smoke_desc_init(&c);
+        if (desc) c = *desc;
+        for (auto bad : {checkFinite3("desc.spacing", c.spacing), checkFinite3("desc.position", c.position),
+                         checkFinite3("desc.source_offset", c.source_offset), checkFinite("desc.source_radius", c.source_radius),
+                         checkFinite3("desc.wind_world", c.wind_world), checkFinite("desc.dissipation", c.dissipation),
+                         checkFinite("desc.textures_per_sec", c.textures_per_sec)})
+            if (bad) return *bad;
+        if (c.substeps < 1 || c.substeps > 64)
+            return invalid("desc.substeps is " + std::to_string(c.substeps) + "; expected solver substeps in [1, 64]");
+        presets::SmokeDesc d;
+        if (auto bad = setTextureSet("desc.texture_set", c.texture_set, d.textureSet)) return *bad;
+        d.dims = ivec3Of(c.dims);
+        d.spacing = vec3Of(c.spacing);
+        d.position = vec3Of(c.position);
+        d.sourceOffset = vec3Of(c.source_offset);
+        d.sourceRadius = c.source_radius;
+        d.windWorld = vec3Of(c.wind_world);
+        d.dissipation = c.dissipation;
+        d.textureCount = c.texture_count;
+        d.texturesPerSec = c.textures_per_sec;
+        d.substeps = c.substeps;
+        if (auto bad = toMotion("desc.source_motion", c.source_motion_keys, c.source_motion_key_count, d.sourceMotion)) return *bad;
+        d.seed = c.seed;
+        d.textureSeed = c.texture_seed;
+        return addPreset(scene, materials, options, out_id,
+                         [&](Materials& m, Outcome& failed) { return fromResult(presets::smoke(m, d), failed); });
+    });
+}
+
+splatfx_status splatfx_scene_add_steam(splatfx_scene* scene, splatfx_materials* materials, const splatfx_steam_desc* desc,
+                                       const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
+    return guard("splatfx_scene_add_steam", error, [&] {
+        splatfx_steam_desc c;
+        splatfx_steam_desc_init(&c);
+        if (desc) c = *desc;
+        for (auto bad : {checkFinite3("desc.spacing", c.spacing), checkFinite3("desc.position", c.position),
+                         checkFinite("desc.opacity", c.opacity), checkFinite("desc.propagation_steps_per_sec", c.propagation_steps_per_sec),
+                         checkFinite("desc.textures_per_sec", c.textures_per_sec)})
+            if (bad) return *bad;
+        presets::SteamDesc d;
+        if (auto bad = setTextureSet("desc.texture_set", c.texture_set, d.textureSet)) return *bad;
+        d.dims = ivec3Of(c.dims);
+        d.spacing = vec3Of(c.spacing);
+        d.position = vec3Of(c.position);
+        d.textureCount = c.texture_count;
+        d.opacity = c.opacity;
+        d.propagationStepsPerSec = c.propagation_steps_per_sec;
+        d.texturesPerSec = c.textures_per_sec;
+        if (auto bad = toMotion("desc.motion", c.motion_keys, c.motion_key_count, d.motion)) return *bad;
+        d.seed = c.seed;
+        d.textureSeed = c.texture_seed;
+        return addPreset(scene, materials, options, out_id,
+                         [&](Materials& m, Outcome& failed) { return fromResult(presets::steam(m, d), failed); });
+    });
+}
+
+splatfx_status splatfx_scene_add_dust(splatfx_scene* scene, splatfx_materials* materials, const splatfx_dust_desc* desc,
+                                      const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
+    return guard("splatfx_scene_add_dust", error, [&] {
+        splatfx_dust_desc c;
+        splatfx_dust_desc_init(&c);
+        if (desc) c = *desc;
+        for (auto bad : {checkFinite3("desc.spacing", c.spacing), checkFinite3("desc.position", c.position),
+                         checkFinite3("desc.source_offset", c.source_offset), checkFinite("desc.source_radius", c.source_radius),
+                         checkFinite3("desc.wind_world", c.wind_world), checkFinite("desc.settle", c.settle),
+                         checkFinite("desc.dissipation", c.dissipation)})
+            if (bad) return *bad;
+        presets::DustDesc d;
+        if (auto bad = setTextureSet("desc.texture_set", c.texture_set, d.textureSet)) return *bad;
+        d.dims = ivec3Of(c.dims);
+        d.spacing = vec3Of(c.spacing);
+        d.position = vec3Of(c.position);
+        d.sourceOffset = vec3Of(c.source_offset);
+        d.sourceRadius = c.source_radius;
+        d.windWorld = vec3Of(c.wind_world);
+        d.settle = c.settle;
+        d.dissipation = c.dissipation;
+        d.textureCount = c.texture_count;
+        if (auto bad = toMotion("desc.source_motion", c.source_motion_keys, c.source_motion_key_count, d.sourceMotion)) return *bad;
+        d.seed = c.seed;
+        d.textureSeed = c.texture_seed;
+        return addPreset(scene, materials, options, out_id,
+                         [&](Materials& m, Outcome& failed) { return fromResult(presets::dust(m, d), failed); });
+    });
+}
+
+splatfx_status splatfx_scene_add_fire_to_smoke(splatfx_scene* scene, splatfx_materials* materials,
+                                               const splatfx_fire_to_smoke_desc* desc, const splatfx_effect_options* options,
+                                               uint32_t* out_id, splatfx_error* error) {
+    return guard("splatfx_scene_add_fire_to_smoke", error, [&] {
+        splatfx_fire_to_smoke_desc c;
+        splatfx_fire_to_smoke_desc_init(&c);
+        if (desc) c = *desc;
+        for (auto bad : {checkFinite3("desc.spacing", c.spacing), checkFinite3("desc.position", c.position),
+                         checkFinite("desc.split", c.split), checkFinite("desc.blend", c.blend),
+                         checkFinite("desc.propagation_steps_per_sec", c.propagation_steps_per_sec),
+                         checkFinite("desc.textures_per_sec", c.textures_per_sec)})
+            if (bad) return *bad;
+        presets::FireToSmokeDesc d;
+        if (auto bad = setTextureSet("desc.fire_texture_set", c.fire_texture_set, d.fireTextureSet)) return *bad;
+        if (auto bad = setTextureSet("desc.smoke_texture_set", c.smoke_texture_set, d.smokeTextureSet)) return *bad;
+        d.dims = ivec3Of(c.dims);
+        d.spacing = vec3Of(c.spacing);
+        d.position = vec3Of(c.position);
+        d.split = c.split;
+        d.blend = c.blend;
+        if (auto bad = toMotion("desc.motion", c.motion_keys, c.motion_key_count, d.motion)) return *bad;
+        d.propagationStepsPerSec = c.propagation_steps_per_sec;
+        d.texturesPerSec = c.textures_per_sec;
+        d.seed = c.seed;
+        d.textureSeed = c.texture_seed;
+        return addPreset(scene, materials, options, out_id,
+                         [&](Materials& m, Outcome& failed) { return fromResult(presets::fireToSmoke(m, d), failed); });
+    });
+}
+
+splatfx_status splatfx_scene_add_ghosts(splatfx_scene* scene, splatfx_materials* materials, const splatfx_ghosts_desc* desc,
+                                        const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
+    return guard("splatfx_scene_add_ghosts", error, [&] {
+        splatfx_ghosts_desc c;
+        splatfx_ghosts_desc_init(&c);
+        if (desc) c = *desc;
+        for (auto bad : {checkFinite("desc.head_radius_cells", c.head_radius_cells), checkFinite3("desc.spacing", c.spacing),
+                         checkFinite3("desc.position", c.position), checkFinite("desc.opacity", c.opacity),
+                         checkFinite("desc.textures_per_sec", c.textures_per_sec),
+                         checkFinite("desc.propagation_steps_per_sec", c.propagation_steps_per_sec)})
+            if (bad) return *bad;
+        presets::GhostsDesc d;
+        if (auto bad = setTextureSet("desc.texture_set", c.texture_set, d.textureSet)) return *bad;
+        d.headRadiusCells = c.head_radius_cells;
+        d.plumeCells = c.plume_cells;
+        d.spacing = vec3Of(c.spacing);
+        d.position = vec3Of(c.position);
+        d.textureCount = c.texture_count;
+        d.opacity = c.opacity;
+        d.texturesPerSec = c.textures_per_sec;
+        d.propagationStepsPerSec = c.propagation_steps_per_sec;
+        d.seed = c.seed;
+        d.textureSeed = c.texture_seed;
+        return addPreset(scene, materials, options, out_id,
+                         [&](Materials& m, Outcome& failed) { return fromResult(presets::ghosts(m, d), failed); });
+    });
+}
+
+splatfx_status splatfx_scene_load_file(const char* path, splatfx_materials* materials, const uint32_t* seed,
+                                       splatfx_scene** out, splatfx_error* error) {
+    return guard("splatfx_scene_load_file", error, [&] {
+        if (!out) return invalid("out is NULL");
+        *out = nullptr;
+        if (!path) return invalid("path is NULL");
+        if (auto bad = checkHandle(materials, Magic::Materials, "materials", "splatfx_materials")) return *bad;
+        SceneFileOptions options;
+        if (seed) options.seed = *seed;
+        Result<SceneFile> file = loadSceneFile(path, materials->value, options);
+        if (!file) return failure(SPLATFX_ERROR_FILE, file.error());
+        auto scene = std::make_unique<splatfx_scene>();
+        scene->value = std::move(file->scene); // before any prepare: nothing in it points at itself yet
+        scene->materials = materials->identity;
+        scene->hasMaterials = true;
+        *out = scene.release();
+        return success();
+    });
+}
+
+uint32_t splatfx_scene_effect_count(const splatfx_scene* scene) {
+    return scene && scene->magic == Magic::Scene ? std::uint32_t(scene->value.size()) : 0;
+}
+
+splatfx_status splatfx_scene_set_effect_enabled(splatfx_scene* scene, uint32_t id, int enabled, splatfx_error* error) {
+    return guard("splatfx_scene_set_effect_enabled", error, [&] {
+        if (auto bad = checkHandle(scene, Magic::Scene, "scene", "splatfx_scene")) return *bad;
+        if (id >= scene->value.size())
+            return failure(SPLATFX_ERROR_NOT_FOUND, "id " + std::to_string(id) + " is not an effect of this scene (it has " +
+                                                        std::to_string(scene->value.size()) + ")");
+        scene->value.setEnabled(id, enabled != 0);
+        return success();
+    });
+}
+
+// ---- [camera]
+
+splatfx_status splatfx_camera_from_matrices(const float view[16], const float proj[16], int32_t width, int32_t height,
+                                            splatfx_camera* out, splatfx_error* error) {
+    return guard("splatfx_camera_from_matrices", error, [&] {
+        if (!out) return invalid("out is NULL");
+        if (!view) return invalid("view is NULL");
+        if (!proj) return invalid("proj is NULL");
+        splatfx_camera c{};
+        for (int i = 0; i < 16; ++i) {
+            c.view[i] = view[i];
+            c.proj[i] = proj[i];
+        }
+        c.viewport[0] = width;
+        c.viewport[1] = height;
+        if (auto bad = checkCamera(c, "camera")) return *bad;
+        *out = c;
+        return success();
+    });
+}
+
+splatfx_status splatfx_camera_look_at(const float eye[3], const float target[3], const float up[3], float fov_y,
+                                      int32_t width, int32_t height, float near_plane, float far_plane,
+                                      splatfx_camera* out, splatfx_error* error) {
+    return guard("splatfx_camera_look_at", error, [&] {
+        if (!out) return invalid("out is NULL");
+        if (!eye) return invalid("eye is NULL");
+        if (!target) return invalid("target is NULL");
+        if (!up) return invalid("up is NULL");
+        for (auto bad : {checkFinite3("eye", eye), checkFinite3("target", target), checkFinite3("up", up)})
+            if (bad) return *bad;
+        if (!(fov_y > 0.0f && fov_y < 3.14159265f))
+            return invalid("fov_y is " + str(fov_y) + "; expected radians in (0, pi)");
+        if (!(near_plane > 0.0f && far_plane > near_plane && std::isfinite(far_plane)))
+            return invalid("near_plane " + str(near_plane) + ", far_plane " + str(far_plane) +
+                           "; expected 0 < near_plane < far_plane, both finite");
+        const glm::vec3 e = vec3Of(eye), t = vec3Of(target), u = vec3Of(up);
+        const glm::vec3 forward = t - e;
+        if (!(glm::length(forward) > 0.0f)) return invalid("eye and target are the same point; expected a direction to look in");
+        if (!(glm::length(glm::cross(glm::normalize(forward), u)) > 1e-6f))
+            return invalid("up is zero or parallel to target - eye; expected a direction across the view");
+        if (width < 1 || width > kMaxViewportSide || height < 1 || height > kMaxViewportSide)
+            return invalid("width, height are " + std::to_string(width) + ", " + std::to_string(height) +
+                           "; expected sizes in [1, " + std::to_string(kMaxViewportSide) + "] pixels");
+        const Camera cam = Camera::lookAt(e, t, u, fov_y, {width, height}, near_plane, far_plane);
+        splatfx_camera c{};
+        const float* v = glm::value_ptr(cam.view);
+        const float* p = glm::value_ptr(cam.proj);
+        for (int i = 0; i < 16; ++i) {
+            c.view[i] = v[i];
+            c.proj[i] = p[i];
+        }
+        c.viewport[0] = width;
+        c.viewport[1] = height;
+        if (auto bad = checkCamera(c, "camera")) return *bad;
+        *out = c;
+        return success();
+    });
+}
+
+// ---- [frame]
+
+splatfx_status splatfx_frame_create(splatfx_frame** out, splatfx_error* error) {
+    return guard("splatfx_frame_create", error, [&] {
+        if (!out) return invalid("out is NULL");
+        *out = new splatfx_frame();
+        return success();
+    });
+}
+
+void splatfx_frame_destroy(splatfx_frame* frame) {
+    if (!frame || frame->magic != Magic::Frame) return;
+    frame->magic = Magic::Dead;
+    delete frame;
+}
+
+splatfx_status splatfx_frame_get_stats(const splatfx_frame* frame, splatfx_frame_stats* out, splatfx_error* error) {
+    return guard("splatfx_frame_get_stats", error, [&] {
+        if (!out) return invalid("out is NULL");
+        if (auto bad = checkHandle(frame, Magic::Frame, "frame", "splatfx_frame")) return *bad;
+        const FrameCounters& c = frame->value.counters();
+        *out = splatfx_frame_stats{c.declared, c.needed, c.simulated, c.drawn, c.splats, frame->value.time()};
+        return success();
+    });
+}
+
+splatfx_status splatfx_scene_prepare(splatfx_scene* scene, double time_sec, const splatfx_camera* camera,
+                                     const splatfx_materials* materials, splatfx_frame* frame, splatfx_error* error) {
+    return guard("splatfx_scene_prepare", error, [&] {
+        if (auto bad = checkHandle(scene, Magic::Scene, "scene", "splatfx_scene")) return *bad;
+        if (auto bad = checkHandle(materials, Magic::Materials, "materials", "splatfx_materials")) return *bad;
+        if (auto bad = checkHandle(frame, Magic::Frame, "frame", "splatfx_frame")) return *bad;
+        if (auto bad = checkSceneMaterials(*scene, *materials)) return *bad;
+        if (!camera) return invalid("camera is NULL");
+        if (!std::isfinite(time_sec)) return invalid("time_sec is " + str(float(time_sec)) + "; expected a finite number of seconds");
+        if (time_sec < 0.0) return invalid("time_sec is " + str(float(time_sec)) + "; expected seconds >= 0");
+        if (auto bad = checkCamera(*camera, "camera")) return *bad;
+        scene->value.prepare(time_sec, toCamera(*camera), materials->value, frame->value);
+        frame->prepared = true;
+        frame->materials = materials->identity;
+        return success();
+    });
+}
+
+} // extern "C"
