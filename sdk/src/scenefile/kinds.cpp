@@ -8,6 +8,7 @@ namespace splatfx::scenefile {
 EffectReaderFn readFire, readSmoke, readSteam, readDust, readFireToSmoke, readGhosts, readGridKind;
 // Geometry readers, for the types with keys of their own.
 GeometryReaderFn readMeshGeometry;
+GeometryReaderFn readHeightmapGeometry; // [foggaps]
 
 namespace {
 
@@ -28,6 +29,7 @@ constexpr GeometryKind kGeometryKinds[] = {
     {"cylinder", GeometryType::Cylinder, nullptr},
     {"sphere", GeometryType::Sphere, nullptr},
     {"mesh", GeometryType::Mesh, &readMeshGeometry}, // kinds/mesh.cpp
+    {"heightmap", GeometryType::Heightmap, &readHeightmapGeometry}, // kinds/heightmap.cpp [foggaps]
     {"empty", GeometryType::Empty, nullptr},
 };
 
