@@ -555,6 +555,218 @@ TEST_F(TetraPassGL, ReducedResolutionSplatsLeaveTheTetrahedraAtFullResolution) {
     EXPECT_EQ(half->stats().tetrahedra, full->stats().tetrahedra);
 }
 
+// [foggaps, issue 17 item 8] The camera inside one tetrahedron: cut at the
+// near plane as a volume (clipTetrahedron: the tip left by three vertices
+// behind the plane, and a prism of three pieces when one is), the pass draws
+// every pixel (no holes), within the derived bound of its CPU model, and the
+// pieces integrate to the original tetrahedron's integral from the near plane.
+TEST_F(TetraPassGL, CameraInsideOneTetrahedronIsClippedWithoutHoles) {
+    Cloud cl;
+    const float nearP = 0.2f;
+    const glm::vec3 eye{0.3f, 0.2f, 0.0f};
+    const Camera cam = Camera::lookAt(eye, eye + glm::vec3(0.1f, 0.05f, 1.0f), {0, 1, 0}, glm::radians(40.0f), kSize, nearP, 200.0f);
+    auto positive = [](Tetrahedron t) {
+        if (glm::dot(t.position[1] - t.position[0], glm::cross(t.position[2] - t.position[0], t.position[3] - t.position[0])) < 0.0f)
+            std::swap(t.position[2], t.position[3]);
+        return t;
+    };
+    Tetrahedron tip, prism;
+    // Three vertices behind the eye (z = -3), the apex far ahead: the visible part is a tip.
+    tip.position = {glm::vec3(-20, -20, -3), glm::vec3(20, -20, -3), glm::vec3(0, 25, -3), glm::vec3(0.5f, 0.3f, 30)};
+    // One vertex behind, three far ahead: the visible part is a prism of three.
+    prism.position = {glm::vec3(0.2f, 0.1f, -3), glm::vec3(-30, -30, 30), glm::vec3(30, -30, 30), glm::vec3(0, 35, 30)};
+    for (Tetrahedron* t : {&tip, &prism}) {
+        // One scalar: one colour along every ray, so the pieces' list order cannot matter.
+        t->scalar = {0.5f, 0.5f, 0.5f, 0.5f};
+        t->lengthScale = {1.0f, 1.0f, 1.0f, 1.0f};
+        *t = positive(*t);
+    }
+    const glm::vec3 f = cam.forward();
+    for (const auto& [tet, expectPieces] : {std::pair{tip, 1}, std::pair{prism, 3}}) {
+        std::vector<Tetrahedron> pieces;
+        ASSERT_EQ(clipTetrahedron(tet, f, glm::dot(f, eye) + nearP, pieces), expectPieces);
+        Frame frame;
+        frame.begin(0.0, cam);
+        FrameVolume& fv = frame.volumes().emplace_back();
+        fv.table = &*cl.table;
+        fv.lod.tets = pieces;
+        frame.end();
+        auto fr = gl::FrameRenderer::create();
+        auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+        ASSERT_TRUE(fr && fb);
+        renderFrame(*fr, *fb, frame, 1.0);
+        const Image img = fb->read();
+        int over = 0, holes = 0, seen = 0;
+        double worst = 0.0;
+        for (int y = 0; y < kSize.y; ++y)
+            for (int x = 0; x < kSize.x; ++x) {
+                const glm::dvec3 d = pixelRay(cam, x, y), o(eye);
+                const double tNear = nearP / glm::dot(d, glm::dvec3(f));
+                const glm::dvec4 whole = integrateRay({tet}, *cl.transfer, o, d, tNear, 1e30);
+                const glm::dvec4 cut = integrateRay(pieces, *cl.transfer, o, d, 0.0, 1e30);
+                // Clipped vertices in float (~2^-24 x 60 world units) move the ends by far less than 1e-4.
+                for (int c = 0; c < 4; ++c) EXPECT_NEAR(cut[c], whole[c], 1e-4) << "pixel " << x << "," << y;
+                double bound = 0.0;
+                const glm::dvec4 model = passModel(pieces, *cl.table, o, d, 1e30, bound);
+                double e = 0.0;
+                for (int c = 0; c < 4; ++c) e = std::max(e, std::abs(double(img.at(x, y, c)) - model[c]));
+                over += e > bound ? 1 : 0;
+                worst = std::max(worst, e / bound);
+                holes += whole.a > 0.01 && !(double(img.at(x, y, 3)) > 0.5 * whole.a) ? 1 : 0;
+                seen += whole.a > 0.5 ? 1 : 0;
+            }
+        EXPECT_GT(seen, kSize.x * kSize.y * 9 / 10) << "from inside, nearly every ray sees dense cloud";
+        EXPECT_EQ(holes, 0) << expectPieces << " piece(s): every ray from inside crosses the tetrahedron";
+        EXPECT_EQ(over, 0) << expectPieces << " piece(s): worst |GL - model| / bound " << worst;
+    }
+}
+
+// [foggaps, issue 17 item 8] A sliver (thickness 1e-3 of its size, far above
+// the degenerate cut of 1e-9) seen face-on and edge-on: finite pixels, within
+// the model's bound, i.e. its huge barycentric gradients do not blow up the
+// entry and exit distances.
+TEST_F(TetraPassGL, SliverTetrahedraStayFiniteAndWithinTheBound) {
+    Cloud cl;
+    Tetrahedron sliver;
+    sliver.position = {glm::vec3(-2, -2, 0), glm::vec3(2, -2, 0), glm::vec3(0, 2.5f, 0), glm::vec3(0.1f, 0.0f, 0.004f)};
+    if (glm::dot(sliver.position[1] - sliver.position[0],
+                 glm::cross(sliver.position[2] - sliver.position[0], sliver.position[3] - sliver.position[0])) < 0.0f)
+        std::swap(sliver.position[2], sliver.position[3]);
+    sliver.scalar = {1.0f, 0.6f, 0.9f, 1.0f};
+    sliver.lengthScale = {1.0f, 1.0f, 1.0f, 1.0f};
+    for (const glm::vec3 eye : {glm::vec3(0.2f, 0.1f, 6.0f), glm::vec3(6.0f, 0.3f, 0.002f)}) { // face-on, edge-on
+        const Camera cam = Camera::lookAt(eye, {0.0f, 0.0f, 0.002f}, {0, 1, 0}, glm::radians(50.0f), kSize, 0.1f, 100.0f);
+        Frame frame;
+        frame.begin(0.0, cam);
+        FrameVolume& fv = frame.volumes().emplace_back();
+        fv.table = &*cl.table;
+        fv.lod.tets = {sliver};
+        frame.end();
+        auto fr = gl::FrameRenderer::create();
+        auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+        ASSERT_TRUE(fr && fb);
+        renderFrame(*fr, *fb, frame, 1.0);
+        EXPECT_EQ(fr->stats().tetrahedra, 1u) << "a sliver is not degenerate";
+        const Image img = fb->read();
+        int over = 0;
+        double worst = 0.0, alpha = 0.0;
+        for (int y = 0; y < kSize.y; ++y)
+            for (int x = 0; x < kSize.x; ++x) {
+                const glm::dvec3 d = pixelRay(cam, x, y), o(eye);
+                double bound = 0.0;
+                const glm::dvec4 model = passModel(fv.lod.tets, *cl.table, o, d, 1e30, bound);
+                alpha = std::max(alpha, double(img.at(x, y, 3)));
+                double e = 0.0;
+                for (int c = 0; c < 4; ++c) {
+                    ASSERT_TRUE(std::isfinite(img.at(x, y, c))) << "pixel " << x << "," << y;
+                    e = std::max(e, std::abs(double(img.at(x, y, c)) - model[c]));
+                }
+                over += e > bound ? 1 : 0;
+                worst = std::max(worst, e / bound);
+            }
+        EXPECT_GT(alpha, 1e-3) << "the sliver is drawn";
+        EXPECT_EQ(over, 0) << "eye (" << eye.x << ", " << eye.y << ", " << eye.z << "): worst |GL - model| / bound " << worst;
+    }
+}
+
+// [foggaps] How many tetrahedra the ray o + t d (t > 0) crosses.
+int crossings(const std::vector<Tetrahedron>& tets, glm::dvec3 o, glm::dvec3 d) {
+    static constexpr int kFaces[4][4] = {{1, 2, 3, 0}, {0, 2, 3, 1}, {0, 1, 3, 2}, {0, 1, 2, 3}};
+    int n = 0;
+    for (const Tetrahedron& t : tets) {
+        double lo = 0.0, hi = 1e30;
+        for (const auto& f : kFaces) {
+            const auto& p = t.position;
+            const glm::dvec3 a(p[std::size_t(f[0])]), b(p[std::size_t(f[1])]), c(p[std::size_t(f[2])]), q(p[std::size_t(f[3])]);
+            glm::dvec3 nrm = glm::cross(b - a, c - a);
+            if (glm::dot(nrm, q - a) < 0.0) nrm = -nrm;
+            const double num = glm::dot(nrm, o - a), den = glm::dot(nrm, d);
+            if (den == 0.0) {
+                if (num < 0.0) hi = lo - 1.0;
+                continue;
+            }
+            if (den > 0.0) lo = std::max(lo, -num / den);
+            else hi = std::min(hi, -num / den);
+        }
+        n += hi > lo ? 1 : 0;
+    }
+    return n;
+}
+
+// [foggaps, issue 17] The sort-free emissive model (sec. 6, eq. 10): the
+// layer emitted in grid order draws the sorted image up to float rounding,
+// because one-colour "over" blends commute; with a transfer function whose
+// colour varies the two orders differ far beyond that bound, so the equality
+// is the model's property, not a test that cannot fail.
+TEST_F(TetraPassGL, SortFreeGroundFogMatchesTheSortedImage) {
+    GroundFogDesc d;
+    d.dims = {17, 17};
+    d.originWorld = {-8.0f, 0.0f, -8.0f};
+    for (int j = 0; j < 17; ++j)
+        for (int i = 0; i < 17; ++i) {
+            d.terrainHeight.push_back(1.5f * std::sin(0.7f * float(i)) * std::cos(0.5f * float(j)));
+            d.fogTop.push_back(0.6f);
+        }
+    GroundFogDesc free = d;
+    free.sortFree = true;
+    auto sortedFog = GroundFog::create(d);
+    auto freeFog = GroundFog::create(free);
+    ASSERT_TRUE(sortedFog && freeFog);
+    // Seen from above at a slant: rays cross many prisms.
+    const Camera cam = Camera::lookAt({-12.0f, 6.0f, -10.0f}, {2.0f, -0.5f, 2.0f}, {0, 1, 0}, glm::radians(55.0f), kSize, 0.1f, 100.0f);
+    auto render = [&](const GroundFog& fog, const PreIntegrationTable& table, std::vector<Tetrahedron>* tetsOut) {
+        Frame frame;
+        frame.begin(0.0, cam);
+        FrameVolume& fv = frame.volumes().emplace_back();
+        fv.table = &table;
+        EXPECT_TRUE(fog.update(cam, fv.lod));
+        frame.end();
+        if (tetsOut) *tetsOut = fv.lod.tets;
+        auto fr = gl::FrameRenderer::create();
+        auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+        EXPECT_TRUE(fr && fb);
+        renderFrame(*fr, *fb, frame, 1.0);
+        return fb->read();
+    };
+    auto oneColour = makeGroundFogTransfer({0.8f, 0.85f, 0.9f}, 0.7f);
+    auto twoColours = TransferFunction::create({{0.0f, {1.0f, 0.1f, 0.1f}, 0.0f}, {1.0f, {0.1f, 0.2f, 1.0f}, 0.7f}});
+    ASSERT_TRUE(oneColour && twoColours);
+    auto table1 = PreIntegrationTable::create(*oneColour, {.scalarResolution = 16, .lengthResolution = 64, .maxLengthWorld = 30.0f});
+    auto table2 = PreIntegrationTable::create(*twoColours, {.scalarResolution = 16, .lengthResolution = 64, .maxLengthWorld = 30.0f});
+    ASSERT_TRUE(table1 && table2);
+    std::vector<Tetrahedron> sortedTets, freeTets;
+    const Image sorted = render(*sortedFog, *table1, &sortedTets), unsorted = render(*freeFog, *table1, &freeTets);
+    ASSERT_EQ(sortedTets.size(), freeTets.size()) << "the same layer, only the order differs";
+    int moved = 0;
+    for (std::size_t i = 0; i < sortedTets.size(); ++i) moved += sortedTets[i].position != freeTets[i].position ? 1 : 0;
+    ASSERT_GT(moved, int(sortedTets.size() / 4)) << "the grid order must differ from the back-to-front one";
+    const Image sorted2 = render(*sortedFog, *table2, nullptr), unsorted2 = render(*freeFog, *table2, nullptr);
+    int over = 0, layered = 0, orderMatters = 0;
+    double worst = 0.0, worstTwo = 0.0;
+    for (int y = 0; y < kSize.y; ++y)
+        for (int x = 0; x < kSize.x; ++x) {
+            const int n = crossings(sortedTets, glm::dvec3(cam.eye()), pixelRay(cam, x, y));
+            // F32 blending: each "over" rounds twice (product, sum) by at most
+            // 2^-24 of values <= 1, and an earlier error is only scaled by
+            // (1 - a) <= 1, so n layers differ by at most 2 n 2^-24 per order: twice that.
+            const double bound = 4.0 * std::max(n, 1) * std::ldexp(1.0, -24);
+            double e = 0.0, e2 = 0.0;
+            for (int c = 0; c < 4; ++c) {
+                e = std::max(e, std::abs(double(sorted.at(x, y, c)) - double(unsorted.at(x, y, c))));
+                e2 = std::max(e2, std::abs(double(sorted2.at(x, y, c)) - double(unsorted2.at(x, y, c))));
+            }
+            over += e > bound ? 1 : 0;
+            worst = std::max(worst, e / bound);
+            layered += n >= 4 ? 1 : 0;
+            orderMatters += e2 > 100.0 * bound ? 1 : 0;
+            worstTwo = std::max(worstTwo, e2);
+        }
+    EXPECT_GT(layered, kSize.x * kSize.y / 10) << "many pixels should see several prisms";
+    EXPECT_EQ(over, 0) << "worst |sorted - sort-free| / bound " << worst;
+    EXPECT_GT(orderMatters, kSize.x * kSize.y / 20) << "with two colours the order must matter (max difference " << worstTwo << ")";
+    std::printf("sort-free ground fog: worst |sorted - sort-free| / bound %.3f; two-colour max difference %.3f\n", worst, worstTwo);
+}
+
 // [foggaps, issue 14] One medium: a fog in front of, inside and around the
 // cloud. Every GL pixel matches the pass's CPU model of the fog variant within
 // the derived bound, and the model matches the physical integral of cloud and

@@ -106,8 +106,8 @@ struct Config {
 
 // [foggaps] The bench fog: Biri et al.'s Fig. 6 formula (paperFig6Fog) with
 // one paper unit = 4 world units (the fire is 10 units tall), thinned so the
-// fog in front of the fire has an optical depth of about 0.5, drifting with
-// no wind (one still frame). Its terms in the paper's order: the constant,
+// fog in front of the fire has an optical depth of about 0.5, with no wind
+// (one still frame), far cut-off 60. Its terms in the paper's order: the constant,
 // the three cosines, the product of two.
 splatfx::FogDesc benchFog(int terms) {
     splatfx::FogDesc d = splatfx::paperFig6Fog();
@@ -120,6 +120,9 @@ splatfx::FogDesc benchFog(int terms) {
     // Dropping terms keeps the density non-negative: the constant (first) stays.
     d.terms.resize(std::size_t(std::clamp(terms, 0, int(d.terms.size()))));
     d.colour = {0.55, 0.58, 0.65};
+    // Fully fogged beyond 60 units (the sky): the reference then integrates
+    // no ray longer than that (the camera's far plane is at 1000).
+    d.farDistanceWorld = 60.0;
     return d;
 }
 

@@ -61,6 +61,8 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     o.color3("colour", colour);
     o.integer("tableScalars", scalarRes, 2, 256);
     o.integer("tableLengths", lengthRes, 2, 512);
+    bool sortFree = false;
+    o.boolean("sortFree", sortFree);
     o.finish();
     if (c.d.count() != before || file.empty()) return;
     const std::string path = resolvePath(c, file);
@@ -93,6 +95,7 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     gd.originWorld = corner;
     gd.spacingWorld = spacing * float(step);
     gd.density = density;
+    gd.sortFree = sortFree;
     gd.terrainHeight.resize(std::size_t(gd.dims.x) * gd.dims.y);
     gd.fogTop.resize(gd.terrainHeight.size());
     float lowest = 1e30f;
