@@ -14,6 +14,10 @@
 // clipping is switched off (depth clamp) so a face lying in the near plane is
 // never lost to rounding. No CPU projection (Shirley-Tuchman classes) needed.
 //
+// With a fog (setFog, issue 14) a second set of variants fogs each segment's
+// colour as the splats do, f from the eye (also for orthographic cameras,
+// like the splats) to the segment's opacity centroid (docs/fog.md).
+//
 // It does not sort (the list is already in order) and writes no depth.
 #pragma once
 
