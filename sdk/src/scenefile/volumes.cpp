@@ -66,6 +66,17 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     o.finish();
     if (c.d.count() != before || file.empty()) return;
     const std::string path = resolvePath(c, file);
+    // The header first: a huge image is refused before anything is decoded.
+    auto info = readImageInfo(path);
+    if (!info) {
+        c.d.error(o.at("heightmap"), info.error());
+        return;
+    }
+    if (double(info->width) * info->height > 16.0 * 1024 * 1024) {
+        c.d.error(o.at("heightmap"), "'" + file + "' is " + std::to_string(info->width) + "x" + std::to_string(info->height) +
+                                         ", more than the 16 Mi samples a ground-fog heightmap may have");
+        return;
+    }
     auto img = readImage(path, Alpha::Straight);
     if (!img) {
         c.d.error(o.at("heightmap"), img.error());
