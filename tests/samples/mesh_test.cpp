@@ -3,6 +3,7 @@
 // hold or than the budget allows, and non-regular files.
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include <sys/stat.h>
 
@@ -10,6 +11,7 @@
 
 #include "gl_fixture.hpp"
 #include "mesh.hpp"
+#include "splatfx/scene_file.hpp"
 
 namespace fs = std::filesystem;
 
@@ -62,4 +64,43 @@ TEST(SceneHostMesh, AFifoIsNotRead) {
     fs::remove(fifo);
     ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
     expectRefused(fifo, "not a regular file");
+}
+
+// [foggaps] The "heightmap" geometry: every 16-bit sample becomes
+// heightmapPoint(...) exactly (code / 65535 in float, as OpenImageIO reads it),
+// two upward-facing triangles a cell; a missing or 1-pixel-wide image is refused.
+TEST(SceneHostHeightmap, SamplesBecomeGridPointsFacingUp) {
+    const int w = 4, h = 3;
+    std::string pgm = "P5\n4 3\n65535\n";
+    std::vector<int> codes;
+    for (int j = 0; j < h; ++j)
+        for (int i = 0; i < w; ++i) {
+            const int c = 1000 * (i + 1) + 7000 * j;
+            codes.push_back(c);
+            pgm += char(c >> 8);
+            pgm += char(c & 255);
+        }
+    const std::string path = writeFile("heightmap_4x3.pgm", pgm);
+    auto m = scenehost::heightmapMesh(path, 2.0f, 50.0f);
+    ASSERT_TRUE(m) << m.error();
+    ASSERT_EQ(m->positions.size(), std::size_t(w * h));
+    EXPECT_EQ(m->indices.size(), std::size_t(6 * (w - 1) * (h - 1)));
+    for (int j = 0; j < h; ++j)
+        for (int i = 0; i < w; ++i) {
+            const glm::vec3 want = splatfx::heightmapPoint(i, j, w, h, float(codes[std::size_t(j * w + i)]) / 65535.0f, 2.0f, 50.0f);
+            const glm::vec3 got = m->positions[std::size_t(j * w + i)];
+            // OpenImageIO's code -> float conversion and ours may differ by one float rounding.
+            EXPECT_NEAR(got.x, want.x, 1e-6f);
+            EXPECT_NEAR(got.y, want.y, 1e-5f * 50.0f);
+            EXPECT_NEAR(got.z, want.z, 1e-6f);
+        }
+    for (std::size_t t = 0; t + 2 < m->indices.size(); t += 3) {
+        const glm::vec3 a = m->positions[m->indices[t]], b = m->positions[m->indices[t + 1]], c = m->positions[m->indices[t + 2]];
+        EXPECT_GT(glm::cross(b - a, c - a).y, 0.0f) << "triangle " << t / 3 << " faces +y";
+    }
+    auto missing = scenehost::heightmapMesh(writeFile("heightmap_none.txt", "") + ".absent", 1.0f, 1.0f);
+    EXPECT_FALSE(missing);
+    auto thin = scenehost::heightmapMesh(writeFile("heightmap_1x3.pgm", std::string("P5\n1 3\n65535\n") + std::string(6, '\1')), 1.0f, 1.0f);
+    ASSERT_FALSE(thin);
+    EXPECT_NE(thin.error().find("at least 2x2"), std::string::npos) << thin.error();
 }

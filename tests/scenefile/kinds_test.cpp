@@ -69,7 +69,7 @@ TEST(SceneFileKinds, AnUnknownGeometryTypeNamesEveryKnownType) {
         EXPECT_NE(r.error().find("\"" + t + "\""), std::string::npos) << t << " not offered in:\n" << r.error();
     auto missing = parse(R"("geometry": [{}])");
     ASSERT_FALSE(missing);
-    EXPECT_NE(missing.error().find(R"(missing "type" ("plane", "box", "cylinder", "sphere", "mesh" or "empty"))"), std::string::npos)
+    EXPECT_NE(missing.error().find(R"(missing "type" ("plane", "box", "cylinder", "sphere", "mesh", "heightmap" or "empty"))"), std::string::npos)
         << missing.error();
 }
 

@@ -1,7 +1,10 @@
 // Ground fog (sec. 6) as vertical prisms of three tetrahedra: volume, dropped
 // zero-height prisms, back-to-front order along rays, near-plane clipping, bad input.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -146,4 +149,40 @@ TEST(GroundFog, BadInputIsAnError) {
     d.dims = {1, 25};
     EXPECT_FALSE(GroundFog::create(d));
     EXPECT_FALSE(makeGroundFogTransfer({1, 1, 1}, -1.0f));
+}
+
+// [foggaps] The sort-free emissive model (GroundFogDesc::sortFree) emits the
+// same tetrahedra as the sorted layer, in another order, from outside and
+// from inside the fog (near-plane clipping included).
+TEST(GroundFog, SortFreeEmitsTheSameTetrahedraInGridOrder) {
+    GroundFogDesc d = valleys({17, 13}, 0.8f);
+    GroundFogDesc free = d;
+    free.sortFree = true;
+    auto sorted = GroundFog::create(d);
+    auto unsorted = GroundFog::create(free);
+    ASSERT_TRUE(sorted && unsorted);
+    const Camera inside = Camera::lookAt({0.5f, 0.6f, 0.3f}, {8.0f, 0.2f, 3.0f}, {0, 1, 0}, glm::radians(60.0f), {64, 48}, 0.3f, 500.0f);
+    for (const Camera& cam : {farCamera(), inside}) {
+        LodFrame a, b;
+        ASSERT_TRUE(sorted->update(cam, a));
+        ASSERT_TRUE(unsorted->update(cam, b));
+        ASSERT_EQ(a.tets.size(), b.tets.size());
+        EXPECT_EQ(a.stats.clippedInput, b.stats.clippedInput);
+        auto key = [](const Tetrahedron& t) {
+            std::array<float, 28> k{};
+            std::size_t i = 0;
+            for (const glm::vec3& p : t.position) k[i++] = p.x, k[i++] = p.y, k[i++] = p.z;
+            for (float s : t.scalar) k[i++] = s;
+            for (float m : t.lengthScale) k[i++] = m;
+            return k;
+        };
+        std::vector<std::array<float, 28>> ka, kb;
+        for (const Tetrahedron& t : a.tets) ka.push_back(key(t));
+        for (const Tetrahedron& t : b.tets) kb.push_back(key(t));
+        const bool sameOrder = ka == kb;
+        EXPECT_FALSE(sameOrder) << "grid order should differ from back to front for this view";
+        std::sort(ka.begin(), ka.end());
+        std::sort(kb.begin(), kb.end());
+        EXPECT_EQ(ka, kb) << "the same tetrahedra, only reordered";
+    }
 }

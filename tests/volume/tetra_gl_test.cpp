@@ -48,8 +48,22 @@ glm::dvec3 pixelRay(const Camera& cam, int x, int y) {
 // tetrahedron the ray crosses is one table lookup of (front scalar, back
 // scalar, length x mean length scale), composited front to back. `bound`
 // receives the derived worst case of |GL - this| (see below).
+// [foggaps] With a fog (and `transfer`), each segment is fogged as the fog
+// variant does (f at the opacity centroid, closed-form f in double) and three
+// more figures per ray are summed over the segments: `tableError`, 2 x the
+// largest channel of |lookup - exact segment integral| (a layer error e moves
+// the composite by <= 2e), and `placement`, 2 alpha_i (f(entry) - f(exit)):
+// the most that putting the segment's fog in front of or behind its matter
+// can change the pixel (colours <= 1; docs/fog.md, "Tetrahedra").
+struct FogModel {
+    const Fog* fog = nullptr;
+    const TransferFunction* transfer = nullptr;
+    double tableError = 0.0, placement = 0.0;
+    glm::dvec4 exactSegments{0.0}; // the same fogged composite of the exact segment integrals (no table)
+};
+
 glm::dvec4 passModel(const std::vector<Tetrahedron>& tets, const PreIntegrationTable& table, glm::dvec3 o, glm::dvec3 d,
-                     double tFar, double& bound) {
+                     double tFar, double& bound, FogModel* fm = nullptr) {
     struct Piece {
         double t0, t1;
         std::size_t tet;
@@ -91,7 +105,28 @@ glm::dvec4 passModel(const std::vector<Tetrahedron>& tets, const PreIntegrationT
         };
         const double sf = at(pc.t0, t.scalar), sb = at(pc.t1, t.scalar);
         const double len = (pc.t1 - pc.t0) * std::max(0.5 * (at(pc.t0, t.lengthScale) + at(pc.t1, t.lengthScale)), 0.0);
-        const glm::dvec4 c(table.lookup(float(sf), float(sb), float(len)));
+        glm::dvec4 c(table.lookup(float(sf), float(sb), float(len)));
+        if (fm && fm->fog) {
+            const glm::dvec4 exactSeg = integrateSegment(*fm->transfer, sf, sb, pc.t1 - pc.t0, at(pc.t0, t.lengthScale), at(pc.t1, t.lengthScale));
+            double e = 0.0;
+            for (int ch = 0; ch < 4; ++ch) e = std::max(e, std::abs(c[ch] - exactSeg[ch]));
+            fm->tableError += 2.0 * e;
+            const double a = std::clamp(c.a, 0.0, 1.0), tau = -std::log(std::max(1.0 - a, 1e-30));
+            const double w = tau < 1e-2 ? 0.5 - tau / 12.0 : 1.0 / tau - 1.0 / std::expm1(std::min(tau, 80.0));
+            const double f = fm->fog->transmittance(o, o + d * (pc.t0 + w * (pc.t1 - pc.t0)), 0.0);
+            fm->placement += 2.0 * a * (fm->fog->transmittance(o, o + d * pc.t0, 0.0) - fm->fog->transmittance(o, o + d * pc.t1, 0.0));
+            c = glm::dvec4(f * glm::dvec3(c) + (1.0 - f) * c.a * fm->fog->desc().colour, c.a);
+            // The exact segment, fogged by the same rule at its own centroid.
+            const double ae = std::clamp(exactSeg.a, 0.0, 1.0), te = -std::log(std::max(1.0 - ae, 1e-30));
+            const double we = te < 1e-2 ? 0.5 - te / 12.0 : 1.0 / te - 1.0 / std::expm1(std::min(te, 80.0));
+            const double fe = fm->fog->transmittance(o, o + d * (pc.t0 + we * (pc.t1 - pc.t0)), 0.0);
+            fm->exactSegments += (1.0 - fm->exactSegments.a) *
+                                 glm::dvec4(fe * glm::dvec3(exactSeg) + (1.0 - fe) * ae * fm->fog->desc().colour, ae);
+            // The shader's f in float: tau <= 4 here, summed from a few terms
+            // with ~2^-20 relative error each, so |df| <= 2^-16; it moves the
+            // layer by alpha df, the composite by twice that.
+            bound += 2.0 * a * std::ldexp(1.0, -16);
+        }
         acc += (1.0 - acc.a) * c;
         // Bound of one GL lookup against the float trilinear one: GL filters
         // with as few as 8 bits of sub-texel weight (the D3D/GL hardware
@@ -518,6 +553,298 @@ TEST_F(TetraPassGL, ReducedResolutionSplatsLeaveTheTetrahedraAtFullResolution) {
     EXPECT_GT(alpha, 0.1);
     EXPECT_EQ(maxAbs, 0.0);
     EXPECT_EQ(half->stats().tetrahedra, full->stats().tetrahedra);
+}
+
+// [foggaps, issue 17 item 8] The camera inside one tetrahedron: cut at the
+// near plane as a volume (clipTetrahedron: the tip left by three vertices
+// behind the plane, and a prism of three pieces when one is), the pass draws
+// every pixel (no holes), within the derived bound of its CPU model, and the
+// pieces integrate to the original tetrahedron's integral from the near plane.
+TEST_F(TetraPassGL, CameraInsideOneTetrahedronIsClippedWithoutHoles) {
+    Cloud cl;
+    const float nearP = 0.2f;
+    const glm::vec3 eye{0.3f, 0.2f, 0.0f};
+    const Camera cam = Camera::lookAt(eye, eye + glm::vec3(0.1f, 0.05f, 1.0f), {0, 1, 0}, glm::radians(40.0f), kSize, nearP, 200.0f);
+    auto positive = [](Tetrahedron t) {
+        if (glm::dot(t.position[1] - t.position[0], glm::cross(t.position[2] - t.position[0], t.position[3] - t.position[0])) < 0.0f)
+            std::swap(t.position[2], t.position[3]);
+        return t;
+    };
+    Tetrahedron tip, prism;
+    // Three vertices behind the eye (z = -3), the apex far ahead: the visible part is a tip.
+    tip.position = {glm::vec3(-20, -20, -3), glm::vec3(20, -20, -3), glm::vec3(0, 25, -3), glm::vec3(0.5f, 0.3f, 30)};
+    // One vertex behind, three far ahead: the visible part is a prism of three.
+    prism.position = {glm::vec3(0.2f, 0.1f, -3), glm::vec3(-30, -30, 30), glm::vec3(30, -30, 30), glm::vec3(0, 35, 30)};
+    for (Tetrahedron* t : {&tip, &prism}) {
+        // One scalar: one colour along every ray, so the pieces' list order cannot matter.
+        t->scalar = {0.5f, 0.5f, 0.5f, 0.5f};
+        t->lengthScale = {1.0f, 1.0f, 1.0f, 1.0f};
+        *t = positive(*t);
+    }
+    const glm::vec3 f = cam.forward();
+    for (const auto& [tet, expectPieces] : {std::pair{tip, 1}, std::pair{prism, 3}}) {
+        std::vector<Tetrahedron> pieces;
+        ASSERT_EQ(clipTetrahedron(tet, f, glm::dot(f, eye) + nearP, pieces), expectPieces);
+        Frame frame;
+        frame.begin(0.0, cam);
+        FrameVolume& fv = frame.volumes().emplace_back();
+        fv.table = &*cl.table;
+        fv.lod.tets = pieces;
+        frame.end();
+        auto fr = gl::FrameRenderer::create();
+        auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+        ASSERT_TRUE(fr && fb);
+        renderFrame(*fr, *fb, frame, 1.0);
+        const Image img = fb->read();
+        int over = 0, holes = 0, seen = 0;
+        double worst = 0.0;
+        for (int y = 0; y < kSize.y; ++y)
+            for (int x = 0; x < kSize.x; ++x) {
+                const glm::dvec3 d = pixelRay(cam, x, y), o(eye);
+                const double tNear = nearP / glm::dot(d, glm::dvec3(f));
+                const glm::dvec4 whole = integrateRay({tet}, *cl.transfer, o, d, tNear, 1e30);
+                const glm::dvec4 cut = integrateRay(pieces, *cl.transfer, o, d, 0.0, 1e30);
+                // Clipped vertices in float (~2^-24 x 60 world units) move the ends by far less than 1e-4.
+                for (int c = 0; c < 4; ++c) EXPECT_NEAR(cut[c], whole[c], 1e-4) << "pixel " << x << "," << y;
+                double bound = 0.0;
+                const glm::dvec4 model = passModel(pieces, *cl.table, o, d, 1e30, bound);
+                double e = 0.0;
+                for (int c = 0; c < 4; ++c) e = std::max(e, std::abs(double(img.at(x, y, c)) - model[c]));
+                over += e > bound ? 1 : 0;
+                worst = std::max(worst, e / bound);
+                holes += whole.a > 0.01 && !(double(img.at(x, y, 3)) > 0.5 * whole.a) ? 1 : 0;
+                seen += whole.a > 0.5 ? 1 : 0;
+            }
+        EXPECT_GT(seen, kSize.x * kSize.y * 9 / 10) << "from inside, nearly every ray sees dense cloud";
+        EXPECT_EQ(holes, 0) << expectPieces << " piece(s): every ray from inside crosses the tetrahedron";
+        EXPECT_EQ(over, 0) << expectPieces << " piece(s): worst |GL - model| / bound " << worst;
+    }
+}
+
+// [foggaps, issue 17 item 8] A sliver (thickness 1e-3 of its size, far above
+// the degenerate cut of 1e-9) seen face-on and grazing: finite pixels, within
+// the model's bound, i.e. its huge barycentric gradients do not blow up the
+// entry and exit distances.
+TEST_F(TetraPassGL, SliverTetrahedraStayFiniteAndWithinTheBound) {
+    Cloud cl;
+    Tetrahedron sliver;
+    sliver.position = {glm::vec3(-2, -2, 0), glm::vec3(2, -2, 0), glm::vec3(0, 2.5f, 0), glm::vec3(0.1f, 0.0f, 0.004f)};
+    if (glm::dot(sliver.position[1] - sliver.position[0],
+                 glm::cross(sliver.position[2] - sliver.position[0], sliver.position[3] - sliver.position[0])) < 0.0f)
+        std::swap(sliver.position[2], sliver.position[3]);
+    sliver.scalar = {1.0f, 0.6f, 0.9f, 1.0f};
+    sliver.lengthScale = {1.0f, 1.0f, 1.0f, 1.0f};
+    // Face-on, and grazing (2.4 degrees off its plane: long thin chords through it).
+    for (const glm::vec3 eye : {glm::vec3(0.2f, 0.1f, 6.0f), glm::vec3(6.0f, 0.3f, 0.25f)}) {
+        const Camera cam = Camera::lookAt(eye, {0.0f, 0.0f, 0.002f}, {0, 1, 0}, glm::radians(50.0f), kSize, 0.1f, 100.0f);
+        Frame frame;
+        frame.begin(0.0, cam);
+        FrameVolume& fv = frame.volumes().emplace_back();
+        fv.table = &*cl.table;
+        fv.lod.tets = {sliver};
+        frame.end();
+        auto fr = gl::FrameRenderer::create();
+        auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+        ASSERT_TRUE(fr && fb);
+        renderFrame(*fr, *fb, frame, 1.0);
+        EXPECT_EQ(fr->stats().tetrahedra, 1u) << "a sliver is not degenerate";
+        const Image img = fb->read();
+        int over = 0;
+        double worst = 0.0, alpha = 0.0;
+        for (int y = 0; y < kSize.y; ++y)
+            for (int x = 0; x < kSize.x; ++x) {
+                const glm::dvec3 d = pixelRay(cam, x, y), o(eye);
+                double bound = 0.0;
+                const glm::dvec4 model = passModel(fv.lod.tets, *cl.table, o, d, 1e30, bound);
+                alpha = std::max(alpha, double(img.at(x, y, 3)));
+                double e = 0.0;
+                for (int c = 0; c < 4; ++c) {
+                    ASSERT_TRUE(std::isfinite(img.at(x, y, c))) << "pixel " << x << "," << y;
+                    e = std::max(e, std::abs(double(img.at(x, y, c)) - model[c]));
+                }
+                over += e > bound ? 1 : 0;
+                worst = std::max(worst, e / bound);
+            }
+        EXPECT_GT(alpha, 1e-3) << "the sliver is drawn; eye z " << eye.z;
+        EXPECT_EQ(over, 0) << "eye (" << eye.x << ", " << eye.y << ", " << eye.z << "): worst |GL - model| / bound " << worst;
+    }
+}
+
+// [foggaps] How many tetrahedra the ray o + t d (t > 0) crosses.
+int crossings(const std::vector<Tetrahedron>& tets, glm::dvec3 o, glm::dvec3 d) {
+    static constexpr int kFaces[4][4] = {{1, 2, 3, 0}, {0, 2, 3, 1}, {0, 1, 3, 2}, {0, 1, 2, 3}};
+    int n = 0;
+    for (const Tetrahedron& t : tets) {
+        double lo = 0.0, hi = 1e30;
+        for (const auto& f : kFaces) {
+            const auto& p = t.position;
+            const glm::dvec3 a(p[std::size_t(f[0])]), b(p[std::size_t(f[1])]), c(p[std::size_t(f[2])]), q(p[std::size_t(f[3])]);
+            glm::dvec3 nrm = glm::cross(b - a, c - a);
+            if (glm::dot(nrm, q - a) < 0.0) nrm = -nrm;
+            const double num = glm::dot(nrm, o - a), den = glm::dot(nrm, d);
+            if (den == 0.0) {
+                if (num < 0.0) hi = lo - 1.0;
+                continue;
+            }
+            if (den > 0.0) lo = std::max(lo, -num / den);
+            else hi = std::min(hi, -num / den);
+        }
+        n += hi > lo ? 1 : 0;
+    }
+    return n;
+}
+
+// [foggaps, issue 17] The sort-free emissive model (sec. 6, eq. 10): the
+// layer emitted in grid order draws the sorted image up to float rounding,
+// because one-colour "over" blends commute; with a transfer function whose
+// colour varies the two orders differ far beyond that bound, so the equality
+// is the model's property, not a test that cannot fail.
+TEST_F(TetraPassGL, SortFreeGroundFogMatchesTheSortedImage) {
+    GroundFogDesc d;
+    d.dims = {17, 17};
+    d.originWorld = {-8.0f, 0.0f, -8.0f};
+    for (int j = 0; j < 17; ++j)
+        for (int i = 0; i < 17; ++i) {
+            d.terrainHeight.push_back(1.5f * std::sin(0.7f * float(i)) * std::cos(0.5f * float(j)));
+            d.fogTop.push_back(0.6f);
+        }
+    GroundFogDesc free = d;
+    free.sortFree = true;
+    auto sortedFog = GroundFog::create(d);
+    auto freeFog = GroundFog::create(free);
+    ASSERT_TRUE(sortedFog && freeFog);
+    // Seen from above at a slant: rays cross many prisms.
+    const Camera cam = Camera::lookAt({-12.0f, 6.0f, -10.0f}, {2.0f, -0.5f, 2.0f}, {0, 1, 0}, glm::radians(55.0f), kSize, 0.1f, 100.0f);
+    auto render = [&](const GroundFog& fog, const PreIntegrationTable& table, std::vector<Tetrahedron>* tetsOut) {
+        Frame frame;
+        frame.begin(0.0, cam);
+        FrameVolume& fv = frame.volumes().emplace_back();
+        fv.table = &table;
+        EXPECT_TRUE(fog.update(cam, fv.lod));
+        frame.end();
+        if (tetsOut) *tetsOut = fv.lod.tets;
+        auto fr = gl::FrameRenderer::create();
+        auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+        EXPECT_TRUE(fr && fb);
+        renderFrame(*fr, *fb, frame, 1.0);
+        return fb->read();
+    };
+    auto oneColour = makeGroundFogTransfer({0.8f, 0.85f, 0.9f}, 0.7f);
+    auto twoColours = TransferFunction::create({{0.0f, {1.0f, 0.1f, 0.1f}, 0.0f}, {1.0f, {0.1f, 0.2f, 1.0f}, 0.7f}});
+    ASSERT_TRUE(oneColour && twoColours);
+    auto table1 = PreIntegrationTable::create(*oneColour, {.scalarResolution = 16, .lengthResolution = 64, .maxLengthWorld = 30.0f});
+    auto table2 = PreIntegrationTable::create(*twoColours, {.scalarResolution = 16, .lengthResolution = 64, .maxLengthWorld = 30.0f});
+    ASSERT_TRUE(table1 && table2);
+    std::vector<Tetrahedron> sortedTets, freeTets;
+    const Image sorted = render(*sortedFog, *table1, &sortedTets), unsorted = render(*freeFog, *table1, &freeTets);
+    ASSERT_EQ(sortedTets.size(), freeTets.size()) << "the same layer, only the order differs";
+    int moved = 0;
+    for (std::size_t i = 0; i < sortedTets.size(); ++i) moved += sortedTets[i].position != freeTets[i].position ? 1 : 0;
+    ASSERT_GT(moved, int(sortedTets.size() / 4)) << "the grid order must differ from the back-to-front one";
+    const Image sorted2 = render(*sortedFog, *table2, nullptr), unsorted2 = render(*freeFog, *table2, nullptr);
+    int over = 0, layered = 0, orderMatters = 0;
+    double worst = 0.0, worstTwo = 0.0;
+    for (int y = 0; y < kSize.y; ++y)
+        for (int x = 0; x < kSize.x; ++x) {
+            const int n = crossings(sortedTets, glm::dvec3(cam.eye()), pixelRay(cam, x, y));
+            // F32 blending: each "over" rounds twice (product, sum) by at most
+            // 2^-24 of values <= 1, and an earlier error is only scaled by
+            // (1 - a) <= 1, so n layers differ by at most 2 n 2^-24 per order: twice that.
+            const double bound = 4.0 * std::max(n, 1) * std::ldexp(1.0, -24);
+            double e = 0.0, e2 = 0.0;
+            for (int c = 0; c < 4; ++c) {
+                e = std::max(e, std::abs(double(sorted.at(x, y, c)) - double(unsorted.at(x, y, c))));
+                e2 = std::max(e2, std::abs(double(sorted2.at(x, y, c)) - double(unsorted2.at(x, y, c))));
+            }
+            over += e > bound ? 1 : 0;
+            worst = std::max(worst, e / bound);
+            layered += n >= 4 ? 1 : 0;
+            orderMatters += e2 > 100.0 * bound ? 1 : 0;
+            worstTwo = std::max(worstTwo, e2);
+        }
+    EXPECT_GT(layered, kSize.x * kSize.y / 10) << "many pixels should see several prisms";
+    EXPECT_EQ(over, 0) << "worst |sorted - sort-free| / bound " << worst;
+    EXPECT_GT(orderMatters, kSize.x * kSize.y / 20) << "with two colours the order must matter (max difference " << worstTwo << ")";
+    std::printf("sort-free ground fog: worst |sorted - sort-free| / bound %.3f; two-colour max difference %.3f\n", worst, worstTwo);
+}
+
+// [foggaps, issue 14] One medium: a fog in front of, inside and around the
+// cloud. Every GL pixel matches the pass's CPU model of the fog variant within
+// the derived bound, and the model matches the physical integral of cloud and
+// fog together (renderTetraExact's ray integral) within the table's error
+// plus the placement bound. The fog changes most covered pixels by far more
+// than the bound, so a pass that dropped the fog would fail.
+TEST_F(TetraPassGL, FogAttenuatesEveryTetrahedronAsOneMedium) {
+    Cloud cl;
+    const Camera cam = Camera::lookAt({-14.0f, 6.0f, 10.0f}, {8.0f, 8.0f, 4.0f}, {0, 0, 1}, glm::radians(50.0f), kSize, 0.5f, 200.0f);
+    FogDesc fd;
+    fd.terms = {FogTerm::constant(0.05), FogTerm::cosine(0.03, 0.5, {1.0, 0.0, 0.3}, 0.4)};
+    fd.colour = {0.9, 0.5, 0.2};
+    auto fog = Fog::create(fd);
+    ASSERT_TRUE(fog) << fog.error();
+    auto shared = std::make_shared<const Fog>(*fog);
+    Frame frame;
+    frame.begin(0.0, cam);
+    frame.setFog(shared);
+    FrameVolume& fv = frame.volumes().emplace_back();
+    fv.table = &*cl.table;
+    ASSERT_TRUE(cl.volume->update(cam, {.detailC = 20.0f}, &*cl.transfer, fv.lod));
+    frame.end();
+    // No host fog pass: the tetrahedra alone carry the fog (the host's is tested in tests/fog).
+    auto fr = gl::FrameRenderer::create({.fogHost = false});
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(fr && fb);
+    renderFrame(*fr, *fb, frame, 1.0);
+    EXPECT_TRUE(fr->stats().fogTetrahedra) << fr->stats().fogError;
+    const Image img = fb->read();
+    int over = 0, overExact = 0, overRule = 0, covered = 0, changed = 0;
+    double worst = 0.0, worstExact = 0.0, worstRule = 0.0, maxRule = 0.0, maxPlacement = 0.0;
+    for (int y = 0; y < kSize.y; ++y)
+        for (int x = 0; x < kSize.x; ++x) {
+            const glm::dvec3 d = pixelRay(cam, x, y), o(cam.eye());
+            double bound = 0.0, boundClear = 0.0;
+            FogModel fm{.fog = &*fog, .transfer = &*cl.transfer};
+            const glm::dvec4 model = passModel(fv.lod.tets, *cl.table, o, d, 1e30, bound, &fm);
+            const glm::dvec4 clear = passModel(fv.lod.tets, *cl.table, o, d, 1e30, boundClear);
+            RayFogStats rs;
+            // To the far plane (the quadrature of a cosine fog to 1e30 would never end).
+            const double tFar = 200.0 / glm::dot(d, glm::dvec3(cam.forward()));
+            const glm::dvec4 exact = integrateRayWithFog(fv.lod.tets, *cl.transfer, o, d, 0.0, tFar, {.fog = &*fog, .fogHost = false}, &rs);
+            ASSERT_TRUE(rs.converged);
+            double e = 0.0, eExact = 0.0, eRule = 0.0, effect = 0.0;
+            for (int c = 0; c < 4; ++c) {
+                e = std::max(e, std::abs(double(img.at(x, y, c)) - model[c]));
+                eExact = std::max(eExact, std::abs(model[c] - exact[c]));
+                eRule = std::max(eRule, std::abs(fm.exactSegments[c] - exact[c]));
+                effect = std::max(effect, std::abs(model[c] - clear[c]));
+            }
+            // The reference's own error: its estimate (tolerance-level) counted twice.
+            const double refError = 2.0 * rs.errorEstimate + 1e-9;
+            const double boundExact = fm.tableError + fm.placement + refError;
+            over += e > bound ? 1 : 0;
+            overExact += eExact > boundExact ? 1 : 0;
+            overRule += eRule > fm.placement + refError ? 1 : 0;
+            worst = std::max(worst, e / bound);
+            worstExact = std::max(worstExact, eExact / boundExact);
+            if (fm.placement > 1e-6) worstRule = std::max(worstRule, eRule / fm.placement);
+            maxRule = std::max(maxRule, eRule);
+            maxPlacement = std::max(maxPlacement, fm.placement);
+            if (exact.a > 0.05) {
+                ++covered;
+                // A pass that dropped the fog would be within boundClear of `clear`,
+                // hence more than `bound` from `model` wherever effect > bound + boundClear.
+                changed += effect > bound + boundClear ? 1 : 0;
+            }
+        }
+    EXPECT_GT(covered, kSize.x * kSize.y / 10) << "the view should see cloud";
+    EXPECT_EQ(over, 0) << "worst |GL - model| / bound " << worst;
+    EXPECT_EQ(overExact, 0) << "worst |model - exact| / bound " << worstExact;
+    EXPECT_EQ(overRule, 0) << "worst |rule on exact segments - exact| / placement bound " << worstRule;
+    EXPECT_GT(changed, covered / 2) << "the fog must change most covered pixels by more than the GL bounds";
+    RecordProperty("fog_rule_vs_exact_max", std::to_string(maxRule));
+    std::printf("fogged tetrahedra: worst |GL - model|/bound %.3f; worst |model - exact|/bound %.3f; fog rule on exact "
+                "segments vs exact: max %.2e, worst ratio to the placement bound %.3f (bound at most %.2e)\n",
+                worst, worstExact, maxRule, worstRule, maxPlacement);
 }
 
 } // namespace

@@ -12,6 +12,10 @@
 // voxels sit between textures, and the solver-substeps knob on a fluid
 // simulation against 32 substeps. Separately it reports what splatting itself
 // costs against volume-exact rendering, and the reference's own convergence.
+// The fog knobs (issue 14; --fog-only runs just these) put the same fire and
+// host in a Biri fog (benchFog) and measure against splat-exact with the fog
+// integrated numerically along every ray: the host image's fog texture, the
+// splats' fog per splat instead of per fragment, and dropping fog terms.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -67,6 +71,7 @@ struct Options {
     int reps = 11;
     bool replotOnly = false; // --replot: only run gnuplot on an existing DIR/accuracy.gp
     bool plots = true;
+    bool fogOnly = false;    // --fog-only: only the fog knobs (issue 14) and their reference
 };
 
 // Texture slices: the truth set has kTruthCount textures along the noise loop
@@ -91,7 +96,35 @@ struct Config {
     bool octagons = splatfx::gl::RendererDesc{}.trimCorners;        // the SDK default
     splatfx::gl::TextureSampling sampling = splatfx::gl::RendererDesc{}.sampling; // the SDK default
     int upsample = splatfx::gl::RendererDesc{}.upsample;
+    // [foggaps] Fog knobs (issue 14): the bench fog's first `fogTerms` terms
+    // (0: no fog), the host image's fog texture ({0, 0}: per pixel) and the
+    // splats' fog once per splat instead of per fragment.
+    int fogTerms = 0;
+    glm::ivec2 fogTexture{0, 0};
+    bool fogPerSplat = false;
 };
+
+// [foggaps] The bench fog: Biri et al.'s Fig. 6 formula (paperFig6Fog) with
+// one paper unit = 4 world units (the fire is 10 units tall), thinned so the
+// fog in front of the fire has an optical depth of about 0.5, with no wind
+// (one still frame), far cut-off 60. Its terms in the paper's order: the constant,
+// the three cosines, the product of two.
+splatfx::FogDesc benchFog(int terms) {
+    splatfx::FogDesc d = splatfx::paperFig6Fog();
+    const double scale = 4.0, density = 0.15;
+    for (splatfx::FogTerm& t : d.terms) {
+        t.weight *= density / scale;
+        t.wave /= scale;
+        t.wave2 /= scale;
+    }
+    // Dropping terms keeps the density non-negative: the constant (first) stays.
+    d.terms.resize(std::size_t(std::clamp(terms, 0, int(d.terms.size()))));
+    d.colour = {0.55, 0.58, 0.65};
+    // Fully fogged beyond 60 units (the sky): the reference then integrates
+    // no ray longer than that (the camera's far plane is at 1000).
+    d.farDistanceWorld = 60.0;
+    return d;
+}
 
 struct Row {
     std::string knob, setting;
@@ -245,11 +278,13 @@ struct Bench {
         std::optional<splatfx::gl::Framebuffer> fb;
         std::optional<splatfx::gl::FrameRenderer> sr;
         const splatfx::Image* truth = nullptr;
+        std::shared_ptr<const splatfx::Fog> fog; // [foggaps] null: clear air
         double extraCpuMs = 0.0;
         std::vector<double> cpu, total;
 
         const splatfx::Frame& prepare(const splatfx::Camera& cam) {
             frame->begin(0.0, cam);
+            frame->setFog(fog); // [foggaps]
             frame->builder().add(grid, *mat, {.textureSet = setId, .colorTable = 0, .textured = config.textured, .crossfade = true});
             frame->end(config.sort);
             return *frame;
@@ -260,6 +295,7 @@ struct Bench {
     // Registers one setting of the fire; everything is timed later, round-robin.
     void add(const std::string& knob, const std::string& setting, const Config& c, const splatfx::Grid& truthGrid,
              const splatfx::Image& truth, bool mainTruth = true, bool remapTextures = true, double extraCpuMs = 0.0) {
+        if (opt.fogOnly && knob.rfind("fog", 0) != 0) return; // [foggaps] --fog-only
         auto s = std::make_unique<Setting>();
         s->row = Row{knob, setting};
         s->row.mainTruth = mainTruth;
@@ -275,7 +311,16 @@ struct Bench {
         rdesc.trimCorners = c.octagons;
         rdesc.sampling = c.sampling;
         rdesc.upsample = c.upsample;
-        auto sr = splatfx::gl::FrameRenderer::create({.splats = rdesc, .resolutionScale = c.scale});
+        rdesc.fogPerSplat = c.fogPerSplat; // [foggaps]
+        if (c.fogTerms > 0) {
+            auto fog = splatfx::Fog::create(benchFog(c.fogTerms));
+            if (!fog) {
+                std::fprintf(stderr, "accuracy: bench fog: %s\n", fog.error().c_str());
+                return;
+            }
+            s->fog = std::make_shared<const splatfx::Fog>(std::move(*fog));
+        }
+        auto sr = splatfx::gl::FrameRenderer::create({.splats = rdesc, .resolutionScale = c.scale, .fogTextureSize = c.fogTexture});
         if (!fb || !sr || !sr->upload(*s->mat)) {
             std::fprintf(stderr, "accuracy: cannot set up GL for %s %s\n", knob.c_str(), setting.c_str());
             return;
@@ -326,8 +371,10 @@ struct Bench {
         return m;
     }
 
-    // Splat-exact truth for a grid drawn with the full truth set at 128 texels (or untextured).
-    splatfx::Image truthImage(const splatfx::Grid& grid, const Config& c) const {
+    // Splat-exact truth for a grid drawn with the full truth set at 128 texels
+    // (or untextured); with `fog`, the fog integrated numerically along every
+    // pixel ray through the splats to the host's surface (SplatExactDesc::fog).
+    splatfx::Image truthImage(const splatfx::Grid& grid, const Config& c, const splatfx::Fog* fog = nullptr) const {
         std::uint32_t setId = 0;
         Config tc = c;
         tc.layerSize = kTruthLayer;
@@ -335,7 +382,7 @@ struct Bench {
         splatfx::SplatBuilder builder;
         builder.begin(cam);
         builder.add(grid, mat, {.textureSet = setId, .colorTable = 0, .textured = c.textured, .crossfade = true});
-        auto img = splatfx::renderSplatExact(builder.splats(), cam, mat, {.host = refHost()});
+        auto img = splatfx::renderSplatExact(builder.splats(), cam, mat, {.host = refHost(), .fog = fog});
         return img ? *img : splatfx::Image{};
     }
 };
@@ -378,6 +425,8 @@ bool parse(int argc, char** argv, Options& o) {
             o.plots = false;
         } else if (a == "--replot") {
             o.replotOnly = true;
+        } else if (a == "--fog-only") {
+            o.fogOnly = true;
         } else {
             return false;
         }
@@ -440,7 +489,8 @@ int runAccuracy(int argc, char** argv) {
                              "  --out DIR    where accuracy.csv, accuracy.dat, accuracy.gp and the PNG plots go (default bench-accuracy)\n"
                              "  --size WxH   frame size (default 320x240)\n"
                              "  --reps N     timed frames per setting, median reported (default 11)\n"
-                             "  --replot     only run gnuplot again on DIR/accuracy.gp (after editing it)\n");
+                             "  --replot     only run gnuplot again on DIR/accuracy.gp (after editing it)\n"
+                             "  --fog-only   only the fog knobs (host fog texture, per-splat fog, fog terms) and their reference\n");
         return 2;
     }
     if (b.opt.replotOnly) {
@@ -486,13 +536,21 @@ int runAccuracy(int argc, char** argv) {
     const Config def;
     const splatfx::Grid onTexture = fireGrid(kTruthCount / def.count); // every voxel exactly on one of the 8 textures
     const splatfx::Grid between = fireGrid(1);                           // voxels anywhere along the loop
-    const splatfx::Image truth = b.truthImage(onTexture, def);
-    const splatfx::Image truthBetween = b.truthImage(between, def);
+    const bool all = !b.opt.fogOnly;
+    const splatfx::Image truth = all ? b.truthImage(onTexture, def) : splatfx::Image{};
+    const splatfx::Image truthBetween = all ? b.truthImage(between, def) : splatfx::Image{};
     Config gaussTruthCfg;
     gaussTruthCfg.textured = false;
     gaussTruthCfg.gaussian = true;
     gaussTruthCfg.gaussianRadius = 4.2f; // 6 sigma: the truncated mass is below 1e-7
-    const splatfx::Image truthGauss = b.truthImage(onTexture, gaussTruthCfg);
+    const splatfx::Image truthGauss = all ? b.truthImage(onTexture, gaussTruthCfg) : splatfx::Image{};
+    // [foggaps] The fire in the full bench fog, fog and splats integrated together.
+    auto fullFog = splatfx::Fog::create(benchFog(5));
+    if (!fullFog) {
+        std::fprintf(stderr, "accuracy: bench fog: %s\n", fullFog.error().c_str());
+        return 1;
+    }
+    const splatfx::Image truthFog = b.truthImage(onTexture, def, &*fullFog);
     std::printf("reference images done (%.1f s)\n\n", ms(start, Clock::now()) / 1e3);
 
     std::printf("setting up every knob setting (materials, GL targets)...\n");
@@ -596,9 +654,35 @@ int runAccuracy(int argc, char** argv) {
         b.add("combined", "quarter + 64 bins + 16^2", c, onTexture, truth);
     }
 
+    // [foggaps] Fog knobs (issue 14), against the fire and host in the full bench fog.
+    {
+        const glm::ivec2 sz = b.opt.size;
+        for (int div : {1, 2, 4, 8}) {
+            Config c;
+            c.fogTerms = 5;
+            c.fogTexture = div == 1 ? glm::ivec2(0) : glm::max(sz / div, glm::ivec2(1));
+            char label[64];
+            if (div == 1) std::snprintf(label, sizeof label, "per pixel (default)");
+            else std::snprintf(label, sizeof label, "%dx%d texture (1/%d)", c.fogTexture.x, c.fogTexture.y, div);
+            b.add("fog: host image", label, c, onTexture, truthFog, false);
+        }
+        for (bool perSplat : {false, true}) {
+            Config c;
+            c.fogTerms = 5;
+            c.fogPerSplat = perSplat;
+            b.add("fog: splats", perSplat ? "once per splat" : "per fragment (default)", c, onTexture, truthFog, false);
+        }
+        for (int terms : {5, 4, 2, 1, 0}) {
+            Config c;
+            c.fogTerms = terms;
+            b.add("fog: terms kept", terms == 5 ? "all 5 (default: the fog as given)" : terms == 0 ? "0 (no fog)" : std::to_string(terms) + " of 5", c,
+                  onTexture, truthFog, false);
+        }
+    }
+
     // Object dynamics: the fluid solver's substeps, against 32 substeps.
     splatfx::Image truthSolver;
-    {
+    if (all) {
         const int frames = 45;
         const double dt = 1.0 / 30.0;
         auto simulate = [&](int substeps, double& msPerFrame) {
@@ -625,10 +709,10 @@ int runAccuracy(int argc, char** argv) {
             const splatfx::Grid g = simulate(s, solveMs);
             b.add("solver substeps", std::to_string(s) + (s == 1 ? " (default)" : ""), c, g, truthSolver, false, false, solveMs);
         }
-        std::printf("timing %zu settings round-robin; median per frame (splat build + sort + GL draw to glFinish), error vs reference:\n",
-                    b.settings.size());
-        b.measureAll();
     }
+    std::printf("timing %zu settings round-robin; median per frame (splat build + sort + GL draw to glFinish), error vs reference:\n",
+                b.settings.size());
+    b.measureAll();
 
     // Pareto front over the settings measured against the main truth.
     for (Row& r : b.rows) {
@@ -639,8 +723,8 @@ int runAccuracy(int argc, char** argv) {
     }
 
     // What splatting itself costs: untextured splats against volume-exact rendering.
-    std::printf("\nsplatting vs volume rendering (untextured fire, no host geometry, %dx%d):\n", b.opt.size.x / 2, b.opt.size.y / 2);
-    {
+    if (all) std::printf("\nsplatting vs volume rendering (untextured fire, no host geometry, %dx%d):\n", b.opt.size.x / 2, b.opt.size.y / 2);
+    if (all) {
         const glm::ivec2 vs = b.opt.size / 2;
         const splatfx::Camera vcam = camera(vs);
         splatfx::Materials mat(splatfx::Footprint{});
@@ -676,9 +760,9 @@ int runAccuracy(int argc, char** argv) {
     }
 
     // The reference's own accuracy: step halving on the same field (colour varies along rays).
-    std::printf("\nvolume-exact self-check (fixed steps vs step h0/256, %dx%d, h0 = 0.2 = a quarter of the kernel radius):\n",
+    if (all) std::printf("\nvolume-exact self-check (fixed steps vs step h0/256, %dx%d, h0 = 0.2 = a quarter of the kernel radius):\n",
                 b.opt.size.x / 4, b.opt.size.y / 4);
-    {
+    if (all) {
         const glm::ivec2 vs = b.opt.size / 4;
         const splatfx::Camera vcam = camera(vs);
         splatfx::Materials mat(splatfx::Footprint{});

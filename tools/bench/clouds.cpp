@@ -2,7 +2,9 @@
 // projected tetrahedra on a flight through a cloud field: tetrahedra drawn
 // against the full-resolution count, frame rate and memory outside and inside
 // the cloud, and a popping metric with and without morphing against the
-// finest level's own frame-to-frame change.
+// finest level's own frame-to-frame change. Then (issue 14 with 17) the cost
+// and error of Biri fog on the tetrahedra: GL with and without the per-segment
+// fog against renderTetraExact (cloud and fog as one medium, double).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -16,7 +18,9 @@
 
 #include "splatfx/context.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
+#include "splatfx/fog.hpp"
 #include "splatfx/gl/framebuffer.hpp"
+#include "splatfx/reference.hpp"
 #include "splatfx/scene.hpp"
 #include "splatfx/volume.hpp"
 
@@ -35,6 +39,11 @@ struct Options {
     glm::ivec2 popSize{256, 192};
     float popDetailC = 10.0f;
     float popStepWorld = 0.25f; // a quarter cell per frame
+    // [foggaps] Fog on the tetrahedra: a small cloud (the reference is brute force), frames timed per mode.
+    glm::ivec3 fogDims{33, 33, 9};
+    glm::ivec2 fogSize{128, 96};
+    int fogFrames = 41;
+    bool fogOnly = false; // --fog-only: skip the flight and the popping runs
 };
 
 struct CloudSet {
@@ -95,7 +104,8 @@ double percentile(std::vector<double> v, double p) {
 int usage() {
     std::printf("usage: splatfx-bench clouds [--dims X Y Z] [--c DETAIL] [--frames N] [--size W H]\n"
                 "                            [--pop-dims X Y Z] [--pop-frames N] [--pop-size W H] [--pop-c DETAIL]\n"
-                "                            [--pop-step WORLD_PER_FRAME]\n");
+                "                            [--pop-step WORLD_PER_FRAME]\n"
+                "                            [--fog-dims X Y Z] [--fog-size W H] [--fog-frames N] [--fog-only]\n");
     return 2;
 }
 
@@ -114,6 +124,10 @@ int runClouds(int argc, char** argv) {
         else if (!std::strcmp(argv[i], "--pop-c") && i + 1 < argc) o.popDetailC = float(std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--pop-step") && i + 1 < argc) o.popStepWorld = float(std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) o.frames = std::atoi(argv[++i]);
+        else if (!std::strcmp(argv[i], "--fog-dims") && i + 3 < argc) next3(o.fogDims);
+        else if (!std::strcmp(argv[i], "--fog-size") && i + 2 < argc) next2(o.fogSize);
+        else if (!std::strcmp(argv[i], "--fog-frames") && i + 1 < argc) o.fogFrames = std::atoi(argv[++i]);
+        else if (!std::strcmp(argv[i], "--fog-only")) o.fogOnly = true;
         else if (!std::strcmp(argv[i], "--pop-frames") && i + 1 < argc) o.popFrames = std::atoi(argv[++i]);
         else return usage();
     }
@@ -125,7 +139,7 @@ int runClouds(int argc, char** argv) {
     splatfx::Materials materials{splatfx::Footprint{}};
 
     // ---- 1. The flight: counts, frame rate, memory ----
-    {
+    if (!o.fogOnly) {
         CloudSet cs;
         const auto t0 = Clock::now();
         if (!makeClouds(o.dims, o.detailC, cs)) return 1;
@@ -181,7 +195,7 @@ int runClouds(int argc, char** argv) {
     }
 
     // ---- 2. Popping: per-pixel change between consecutive frames ----
-    {
+    if (!o.fogOnly) {
         CloudSet cs;
         if (!makeClouds(o.popDims, o.popDetailC, cs)) return 1;
         auto fb = splatfx::gl::Framebuffer::create({.width = o.popSize.x, .height = o.popSize.y, .color = splatfx::gl::Precision::F32});
@@ -226,6 +240,78 @@ int runClouds(int argc, char** argv) {
             std::printf("  %-17s drawn mean %9.0f  change max %.4f  p99 %.4f   (vs finest: max %.2fx, p99 %.2fx)\n", m.name,
                         drawn / o.popFrames, mx, p99, mx / std::max(finestMax, 1e-12), p99 / std::max(finestP99, 1e-12));
         }
+    }
+
+    // ---- 3. [foggaps] Biri fog on the tetrahedra: cost and error against the one-medium reference ----
+    if (o.fogFrames >= 1 && o.fogSize.x >= 1 && o.fogSize.y >= 1) {
+        CloudSet cs;
+        if (!makeClouds(o.fogDims, 10.0f, cs)) return 1;
+        // A constant haze plus a cosine bank: about 1 optical depth from the eye to the cloud.
+        splatfx::FogDesc fd;
+        fd.terms = {splatfx::FogTerm::constant(0.03), splatfx::FogTerm::cosine(0.02, 0.2, {1.0, 0.3, 0.2}, 0.5)};
+        fd.colour = {0.75, 0.78, 0.85};
+        auto fog = splatfx::Fog::create(fd);
+        auto tf = splatfx::makeCloudTransfer({}); // the one makeClouds gave the scene
+        auto frNoFog = splatfx::gl::FrameRenderer::create({.fogHost = false});
+        auto frFog = splatfx::gl::FrameRenderer::create({.fogHost = false});
+        auto fb = splatfx::gl::Framebuffer::create({.width = o.fogSize.x, .height = o.fogSize.y, .color = splatfx::gl::Precision::F32});
+        if (!fog || !tf || !frNoFog || !frFog || !fb) return std::fprintf(stderr, "fog on tetrahedra: setup failed\n"), 1;
+        // Outside, above a corner, the whole field in view (z up).
+        const splatfx::Camera cam = splatfx::Camera::lookAt(glm::vec3(-0.6f, -0.35f, 1.8f) * cs.ext, 0.5f * cs.ext, {0, 0, 1},
+                                                            glm::radians(60.0f), o.fogSize, 0.1f, 5000.0f);
+        splatfx::Frame frame;
+        cs.scene.prepare(1.0, cam, materials, frame);
+        auto shared = std::make_shared<const splatfx::Fog>(*fog);
+        auto draw = [&](splatfx::gl::FrameRenderer& r, bool fogged) {
+            frame.setFog(fogged ? shared : nullptr);
+            r.render(frame, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture(), .drawOpaque = [] {
+                             glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+                             glClearDepth(1.0);
+                             glDepthMask(GL_TRUE);
+                             glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+                         }});
+            glFinish();
+        };
+        std::vector<double> tNo, tYes;
+        for (int f = -2; f < o.fogFrames; ++f) // interleaved (which goes first alternates), two warm-up rounds
+            for (int k = 0; k < 2; ++k) {
+                const int fogged = (k + f) & 1;
+                const auto a = Clock::now();
+                draw(fogged ? *frFog : *frNoFog, fogged != 0);
+                if (f >= 0) (fogged ? tYes : tNo).push_back(ms(Clock::now() - a));
+            }
+        draw(*frNoFog, false);
+        const splatfx::Image glNo = fb->read();
+        draw(*frFog, true);
+        const splatfx::Image glYes = fb->read();
+        const std::vector<splatfx::Tetrahedron>& tets = frame.volumes().empty() ? std::vector<splatfx::Tetrahedron>{} : frame.volumes()[0].lod.tets;
+        const auto r0 = Clock::now();
+        splatfx::TetraExactStats sNo, sYes;
+        auto refNo = splatfx::renderTetraExact(tets, *tf, cam, {.fogHost = false}, &sNo);
+        auto refYes = splatfx::renderTetraExact(tets, *tf, cam, {.fog = &*fog, .fogHost = false}, &sYes);
+        const double refMs = ms(Clock::now() - r0);
+        if (!refNo || !refYes) return std::fprintf(stderr, "fog on tetrahedra: %s\n", (refNo ? refYes.error() : refNo.error()).c_str()), 1;
+        auto err = [](const splatfx::Image& a, const splatfx::Image& b, double& rmse, double& mx) {
+            double sum = 0;
+            mx = 0;
+            for (std::size_t i = 0; i < a.pixels.size(); ++i) {
+                const double d = double(a.pixels[i]) - double(b.pixels[i]);
+                sum += d * d, mx = std::max(mx, std::abs(d));
+            }
+            rmse = std::sqrt(sum / double(std::max<std::size_t>(a.pixels.size(), 1)));
+        };
+        double rNo, mNo, rYes, mYes, rEffect, mEffect;
+        err(glNo, *refNo, rNo, mNo);
+        err(glYes, *refYes, rYes, mYes);
+        err(*refNo, *refYes, rEffect, mEffect);
+        std::printf("fog on tetrahedra: clouds %dx%dx%d, %zu tetrahedra drawn, %dx%d, %d frames per mode (RGBA, F32, no host fog pass;\n"
+                    "  reference renderTetraExact, cloud and fog as one medium, %.0f ms for both, %llu + %llu pixels unconverged)\n",
+                    o.fogDims.x, o.fogDims.y, o.fogDims.z, tets.size(), o.fogSize.x, o.fogSize.y, o.fogFrames, refMs,
+                    static_cast<unsigned long long>(sNo.unconverged), static_cast<unsigned long long>(sYes.unconverged));
+        std::printf("  no fog               frame ms median %7.2f   vs reference: RMSE %.5f  max %.4f\n", percentile(tNo, 0.5), rNo, mNo);
+        std::printf("  per-segment fog      frame ms median %7.2f   vs reference: RMSE %.5f  max %.4f   (%.2fx the no-fog frame)\n",
+                    percentile(tYes, 0.5), rYes, mYes, percentile(tYes, 0.5) / std::max(percentile(tNo, 0.5), 1e-9));
+        std::printf("  the fog's own effect (reference with vs without): RMSE %.5f  max %.4f\n", rEffect, mEffect);
     }
     return 0;
 }

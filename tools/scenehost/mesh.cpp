@@ -8,6 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "splatfx/image.hpp"
+#include "splatfx/scene_file.hpp"
+
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -122,6 +125,29 @@ splatfx::Result<Mesh> loadMesh(const std::string& path) {
             return splatfx::makeError(path + ": the mesh has non-finite vertex positions");
     computeNormals(out);
     return out;
+}
+
+splatfx::Result<Mesh> heightmapMesh(const std::string& path, float spacing, float heightScale) {
+    auto img = splatfx::readImage(path, splatfx::Alpha::Straight);
+    if (!img) return splatfx::makeError(img.error());
+    const int w = img->width, h = img->height;
+    if (w < 2 || h < 2) return splatfx::makeError(path + ": a heightmap needs at least 2x2 samples, got " + std::to_string(w) + "x" + std::to_string(h));
+    Mesh m;
+    m.positions.reserve(std::size_t(w) * std::size_t(h));
+    for (int j = 0; j < h; ++j)
+        for (int i = 0; i < w; ++i) {
+            const float v = img->at(i, j, 0);
+            if (!std::isfinite(v)) return splatfx::makeError(path + ": sample (" + std::to_string(i) + ", " + std::to_string(j) + ") is not finite");
+            m.positions.push_back(splatfx::heightmapPoint(i, j, w, h, v, spacing, heightScale));
+        }
+    for (int j = 0; j + 1 < h; ++j)
+        for (int i = 0; i + 1 < w; ++i) {
+            const std::uint32_t a = std::uint32_t(j * w + i), b = a + 1, c = a + std::uint32_t(w), d = c + 1;
+            // Counter-clockwise seen from +y (z grows with j).
+            for (std::uint32_t k : {a, c, b, b, c, d}) m.indices.push_back(k);
+        }
+    computeNormals(m);
+    return m;
 }
 
 void computeNormals(Mesh& mesh) {

@@ -25,6 +25,11 @@
 //    step until two successive results agree to VolumeExactDesc::tolerance.
 //    It measures what splatting itself costs against true volume rendering.
 //
+//  * Tetrahedra with fog (renderTetraExact, integrateRayWithFog): a LOD
+//    volume's emitted tetrahedra and a Biri fog as one medium, integrated
+//    numerically; what gl::FrameRenderer's tetrahedra pass with per-segment
+//    fog is measured against.
+//
 // It does NOT: draw anything with GL, apply the splat builder's near-plane
 // fade in volume mode (rays simply start at the near plane), model textured
 // detail in volume mode (the field is the traditional, untextured one), or
@@ -52,6 +57,7 @@
 #include "splatfx/materials.hpp"
 #include "splatfx/result.hpp"
 #include "splatfx/splats.hpp"
+#include "splatfx/volume.hpp"
 
 namespace splatfx {
 
@@ -189,5 +195,60 @@ struct VolumeExactStats {
 // Gauss-Legendre: exact for a constant colour, second order in h otherwise.
 Result<Image> renderVolumeExact(const VolumeField& field, const Camera& camera, const VolumeExactDesc& desc = {},
                                 VolumeExactStats* stats = nullptr);
+
+// ---- [foggaps, issues 14 + 17] Tetrahedra (LOD volumes) and fog in one medium ----
+
+struct RayFogDesc {
+    const Fog* fog = nullptr;  // default none (then the cloud alone, like integrateRay)
+    double timeSec = 0.0;      // the fog's time; default 0
+    // true: the fog is integrated to the ray's end (the host point) and counts
+    // in alpha, as a frame with gl::FrameRenderer's host fog pass; false: as a
+    // frame drawn without it (fog only in front of cloud matter, alpha the
+    // cloud's). Default true.
+    bool fogHost = true;
+    double tolerance = 1e-6;   // per tetrahedron piece: halve the step until two results differ by less; default 1e-6
+    int maxHalvings = 12;      // at most this many halvings per piece; default 12
+};
+struct RayFogStats {
+    double errorEstimate = 0.0;      // sum of the pieces' last differences and the fog quadratures' estimates
+    bool converged = true;           // every piece and quadrature met the tolerance
+    double cloudTransmittance = 1.0; // the cloud's own, through the whole ray
+    double fogTransmittance = 1.0;   // the fog's, from the eye to the ray's end (0 beyond farDistanceWorld)
+};
+
+// The emission-absorption integral of a tetrahedron list (e.g. LodFrame::tets)
+// and a fog together along eye + t dir, t in [tNear, tFar] (multiples of
+// |dir|): extinction sigma_cloud + K_t, emission sigma_cloud kappa + K_t
+// C_fog, the cloud as integrateRay sees it (linear scalar and length scale
+// in each tetrahedron, pieces in ray order), the fog numerically
+// (integrateFogNumerically between tetrahedra, Gauss-Legendre on the density
+// inside them; never the closed forms) and starting at the eye. Beyond the
+// fog's farDistanceWorld the fog's transmittance is 0 (its colour at the cut-off),
+// as the GL passes do. Premultiplied RGBA. Brute force: for tests and benches.
+glm::dvec4 integrateRayWithFog(const std::vector<Tetrahedron>& tets, const TransferFunction& transfer, glm::dvec3 eye,
+                               glm::dvec3 dir, double tNear, double tFar, const RayFogDesc& desc = {},
+                               RayFogStats* stats = nullptr);
+
+struct TetraExactDesc {
+    ReferenceHost host{};      // default: transparent black, no depth (a depth that is NaN or < 0 is ignored)
+    const Fog* fog = nullptr;  // default none
+    double fogTimeSec = 0.0;   // default 0
+    bool fogHost = true;       // RayFogDesc::fogHost; default true
+    double tolerance = 1e-6;   // RayFogDesc::tolerance; default 1e-6
+    int maxHalvings = 12;      // in [1, 20]; default 12
+    int threads = 0;           // 0 = std::thread::hardware_concurrency(); default 0
+};
+struct TetraExactStats {
+    double maxErrorEstimate = 0.0;  // largest RayFogStats::errorEstimate of a pixel
+    std::uint64_t unconverged = 0;  // pixels whose integral missed the tolerance somewhere
+};
+
+// integrateRayWithFog through every pixel centre (GL's conventions, as the
+// other modes) from the eye, the near plane to the far plane or the host
+// depth, then C + T * background. Needs a perspective camera (the fog is
+// integrated from the eye along the pixel ray). Fails on a bad host image,
+// tolerance or maxHalvings, or an orthographic camera.
+Result<Image> renderTetraExact(const std::vector<Tetrahedron>& tets, const TransferFunction& transfer, const Camera& camera,
+                               const TetraExactDesc& desc = {}, TetraExactStats* stats = nullptr);
 
 } // namespace splatfx

@@ -350,6 +350,16 @@ struct GroundFogDesc {
     std::vector<float> terrainHeight; // dims.x * dims.y world heights (x fastest)
     std::vector<float> fogTop;        // same size: world height of the fog's top; <= terrain: no fog there
     float density = 1.0f;             // default 1: the scalar at the terrain (the top boundary has 0, sec. 6)
+    // [foggaps] The paper's sort-free emissive model (sec. 6, eq. 10): true
+    // emits the tetrahedra in grid order with no back-to-front sorting. With
+    // one fog colour C (makeGroundFogTransfer) every segment blends as
+    // I' = eps C + (1 - eps) I, and two such blends commute (the result is
+    // C (1 - (1-e1)(1-e2)) + (1-e1)(1-e2) I either way), so the image is the
+    // sorted one up to rounding. Not so with a transfer function whose colour
+    // varies, with Biri fog applied per segment, or where splats or other
+    // volumes interleave with the layer (their order then is per batch only).
+    // Default false (sorted).
+    bool sortFree = false;
 };
 
 // A fog layer over a terrain height field as vertical prisms of three
@@ -361,7 +371,8 @@ struct GroundFogDesc {
 // between. update() emits them back to front for a camera (a BSP over the
 // grid, far half first, with MPVO inside a prism), clipped at the near plane.
 // Not done: the paper's LOD terrain and geomorphing of the fog top (the grid
-// is drawn at full resolution), and the sort-free emissive model.
+// is drawn at full resolution), and the sort-free emissive model. In a Scene:
+// Scene::addGroundFog; in scene files: volumes kind "groundFog".
 class GroundFog {
 public:
     // Fails on dims < 2, size mismatches, non-finite heights or a bad field.

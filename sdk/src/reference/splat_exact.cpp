@@ -226,9 +226,11 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                     return total;
                 };
                 auto transmittanceTo = [&](const glm::dvec3& p) {
+                    // Beyond the cut-off f = 0 by definition: no integral (the points come
+                    // nearest first, so every later one is beyond it too). [foggaps]
+                    if (fogFar > 0.0 && glm::length(p - eye) > fogFar) return 0.0;
                     const double tp = tauTo(p);
                     if (std::isfinite(tp)) fogTauMax = std::max(fogTauMax, tp);
-                    if (fogFar > 0.0 && glm::length(p - eye) > fogFar) return 0.0;
                     return std::exp(-tp);
                 };
                 for (size_t k = frags.size(); k-- > 0;) trans[k] = transmittanceTo(ray.origin + frags[k].t * ray.dir);

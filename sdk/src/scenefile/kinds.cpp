@@ -8,6 +8,7 @@ namespace splatfx::scenefile {
 EffectReaderFn readFire, readSmoke, readSteam, readDust, readFireToSmoke, readGhosts, readGridKind, readGasKind;
 // Geometry readers, for the types with keys of their own.
 GeometryReaderFn readMeshGeometry;
+GeometryReaderFn readHeightmapGeometry; // [foggaps]
 
 namespace {
 
@@ -29,6 +30,7 @@ constexpr GeometryKind kGeometryKinds[] = {
     {"cylinder", GeometryType::Cylinder, nullptr},
     {"sphere", GeometryType::Sphere, nullptr},
     {"mesh", GeometryType::Mesh, &readMeshGeometry}, // kinds/mesh.cpp
+    {"heightmap", GeometryType::Heightmap, &readHeightmapGeometry}, // kinds/heightmap.cpp [foggaps]
     {"empty", GeometryType::Empty, nullptr},
 };
 

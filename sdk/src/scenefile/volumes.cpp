@@ -1,11 +1,14 @@
 // [clouds, issue 17] The top-level "volumes" block: LOD volumes drawn as
-// projected tetrahedra (docs/scene-format.md, `volumes[i]`). One kind so far:
-// "clouds" (makeCloudVolume + makeCloudTransfer, Roettger & Ertl 2002 sec. 5).
+// projected tetrahedra (docs/scene-format.md, `volumes[i]`). Two kinds:
+// "clouds" (makeCloudVolume + makeCloudTransfer, Roettger & Ertl 2002 sec. 5)
+// and "groundFog" (GroundFog over a heightmap, sec. 6).
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
 
 #include "scenefile/reader.hpp"
+#include "splatfx/image.hpp"
 #include "splatfx/volume.hpp"
 
 namespace splatfx::scenefile {
@@ -34,6 +37,108 @@ ScalarVolume yUp(const ScalarVolume& zUp) {
     return out;
 }
 
+// [foggaps, issue 17] kind "groundFog": prisms over a heightmap terrain
+// (Roettger & Ertl sec. 6), the terrain placed as a "heightmap" geometry with
+// the same heightmap, spacing, heightScale and position is (heightmapPoint).
+void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std::string& name, SceneFile& out) {
+    const std::size_t before = c.d.count();
+    std::string file;
+    bool enabled = true;
+    glm::vec3 position{0.0f}, colour{0.85f, 0.87f, 0.9f};
+    float spacing = 1.0f, heightScale = 1.0f, fogTop = 0.0f, density = 1.0f, extinction = 0.5f;
+    int step = 1, scalarRes = 32, lengthRes = 128;
+    if (!o.has("heightmap")) c.d.error(p, "missing \"heightmap\" (an image file, e.g. a 16-bit PGM, relative to the scene file)");
+    if (!o.has("fogTop")) c.d.error(p, "missing \"fogTop\" (the world height of the fog's top)");
+    o.string("heightmap", file);
+    o.boolean("enabled", enabled);
+    o.vec3("position", position, -kMaxCoord, kMaxCoord);
+    o.number("spacing", spacing, 1e-4, 1e4);
+    o.number("heightScale", heightScale, -1e6, 1e6);
+    o.integer("step", step, 1, 64);
+    o.number("fogTop", fogTop, -kMaxCoord, kMaxCoord);
+    o.number("density", density, 0.0, 1.0);
+    o.number("extinctionPerWorld", extinction, 0.0, 1e4);
+    o.color3("colour", colour);
+    o.integer("tableScalars", scalarRes, 2, 256);
+    o.integer("tableLengths", lengthRes, 2, 512);
+    bool sortFree = false;
+    o.boolean("sortFree", sortFree);
+    o.finish();
+    if (c.d.count() != before || file.empty()) return;
+    const std::string path = resolvePath(c, file);
+    // The header first: a huge image is refused before anything is decoded.
+    auto info = readImageInfo(path);
+    if (!info) {
+        c.d.error(o.at("heightmap"), info.error());
+        return;
+    }
+    if (double(info->width) * info->height > 16.0 * 1024 * 1024) {
+        c.d.error(o.at("heightmap"), "'" + file + "' is " + std::to_string(info->width) + "x" + std::to_string(info->height) +
+                                         ", more than the 16 Mi samples a ground-fog heightmap may have");
+        return;
+    }
+    auto img = readImage(path, Alpha::Straight);
+    if (!img) {
+        c.d.error(o.at("heightmap"), img.error());
+        return;
+    }
+    const int w = img->width, h = img->height;
+    // Every step-th sample (step divides the cells, checked below, so the last row and column are kept).
+    auto samples = [&](int n) { return (n - 1) / step + 1; };
+    auto source = [&](int k, int n) { return std::min(k * step, n - 1); };
+    GroundFogDesc gd;
+    gd.dims = {samples(w), samples(h)};
+    if (gd.dims.x < 2 || gd.dims.y < 2) {
+        c.d.error(o.at("heightmap"), "needs at least 2x2 samples after \"step\", got " + std::to_string(gd.dims.x) + "x" + std::to_string(gd.dims.y));
+        return;
+    }
+    if (double(gd.dims.x) * gd.dims.y > 4.0 * 1024 * 1024) {
+        c.d.error(o.at("step"), "more than 4 Mi samples: raise \"step\"");
+        return;
+    }
+    // The grid is uniform only if the last sample lands on a multiple of step.
+    if ((w - 1) % step != 0 || (h - 1) % step != 0) {
+        c.d.error(o.at("step"), "must divide the heightmap's " + std::to_string(w - 1) + "x" + std::to_string(h - 1) +
+                                    " cells so the layer's grid stays uniform");
+        return;
+    }
+    const glm::vec3 corner = position + heightmapPoint(0, 0, w, h, 0.0f, spacing, 0.0f);
+    gd.originWorld = corner;
+    gd.spacingWorld = spacing * float(step);
+    gd.density = density;
+    gd.sortFree = sortFree;
+    gd.terrainHeight.resize(std::size_t(gd.dims.x) * gd.dims.y);
+    gd.fogTop.resize(gd.terrainHeight.size());
+    float lowest = 1e30f;
+    for (int j = 0; j < gd.dims.y; ++j)
+        for (int i = 0; i < gd.dims.x; ++i) {
+            const float v = img->at(source(i, w), source(j, h), 0);
+            const std::size_t k = std::size_t(i) + std::size_t(gd.dims.x) * std::size_t(j);
+            gd.terrainHeight[k] = position.y + heightScale * v;
+            gd.fogTop[k] = fogTop;
+            lowest = std::min(lowest, gd.terrainHeight[k]);
+        }
+    auto layer = GroundFog::create(gd);
+    if (!layer) {
+        c.d.error(p, layer.error());
+        return;
+    }
+    auto tf = makeGroundFogTransfer(colour, extinction);
+    if (!tf) {
+        c.d.error(p, tf.error());
+        return;
+    }
+    // The longest segment in one prism: its base diagonal and full height.
+    const float cell = gd.spacingWorld, tall = std::max(fogTop - lowest, 0.0f);
+    const float longest = std::max(std::sqrt(2.0f * cell * cell + tall * tall), 1e-3f);
+    auto table = PreIntegrationTable::create(*tf, {.scalarResolution = scalarRes, .lengthResolution = lengthRes, .maxLengthWorld = longest});
+    if (!table) {
+        c.d.error(p, table.error());
+        return;
+    }
+    out.scene.addGroundFog(std::move(*layer), std::move(*tf), std::move(*table), {.name = name, .enabled = enabled});
+}
+
 } // namespace
 
 void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& out) {
@@ -49,7 +154,12 @@ void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& 
         std::string name = "volume" + std::to_string(i), kind;
         o.string("name", name);
         o.string("kind", kind);
-        if (kind != "clouds") c.d.error(o.at("kind"), kind.empty() ? "required: \"clouds\"" : "unknown kind '" + kind + "' (known: clouds)");
+        if (kind == "groundFog") { // [foggaps]
+            readGroundFog(c, p, o, name, out);
+            continue;
+        }
+        if (kind != "clouds")
+            c.d.error(o.at("kind"), kind.empty() ? "required: \"clouds\" or \"groundFog\"" : "unknown kind '" + kind + "' (known: clouds, groundFog)");
         bool enabled = true, morph = true;
         glm::ivec3 dims{129, 17, 129};
         glm::vec3 origin{0.0f}, sun{0.3f, 1.0f, 0.2f};

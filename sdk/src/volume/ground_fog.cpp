@@ -130,7 +130,8 @@ struct Emitter {
         const bool zeroNearer = nearerFirstSide(B[1], B[2], T[0], B[0]); // t0 vs t1
         const bool twoNearer = nearerFirstSide(B[2], T[0], T[1], T[2]);  // t2 vs t1
         int order[3];
-        if (!zeroNearer && twoNearer) order[0] = 0, order[1] = 1, order[2] = 2;      // t0 < t1 < t2
+        if (d.sortFree) order[0] = 0, order[1] = 1, order[2] = 2; // eq. 10: any order
+        else if (!zeroNearer && twoNearer) order[0] = 0, order[1] = 1, order[2] = 2;      // t0 < t1 < t2
         else if (zeroNearer && !twoNearer) order[0] = 2, order[1] = 1, order[2] = 0; // t2 < t1 < t0
         else if (zeroNearer && twoNearer) order[0] = 1, order[1] = 0, order[2] = 2;  // t1 first; t0, t2 share an edge only
         else order[0] = 0, order[1] = 2, order[2] = 1;                              // t1 last
@@ -155,7 +156,7 @@ struct Emitter {
         const glm::dvec3 p0(diag0.x, 0.0, diag0.z);
         const glm::dvec3 n = glm::cross(glm::dvec3(diag1.x, 0.0, diag1.z) - p0, glm::dvec3(0.0, 1.0, 0.0));
         const bool firstNear = (eyeSide(cam, p0, n) > 0.0) == (glm::dot(n, glm::dvec3(apexFirst.x, 0.0, apexFirst.z) - p0) > 0.0);
-        if (firstNear) {
+        if (firstNear && !d.sortFree) {
             prism(second[0], second[1], second[2]);
             prism(first[0], first[1], first[2]);
         } else {
@@ -227,7 +228,12 @@ Status GroundFog::update(const Camera& camera, LodFrame& out) const {
     Emitter em{mDesc, camera, out, {}, 0.0f, {}};
     em.nearNormal = f;
     em.nearOffset = glm::dot(f, e) + camera.nearPlane();
-    em.range(0, mDesc.dims.x - 1, 0, mDesc.dims.y - 1);
+    if (mDesc.sortFree) { // [foggaps] eq. 10: grid order, no BSP
+        for (int j = 0; j + 1 < mDesc.dims.y; ++j)
+            for (int i = 0; i + 1 < mDesc.dims.x; ++i) em.cell(i, j);
+    } else {
+        em.range(0, mDesc.dims.x - 1, 0, mDesc.dims.y - 1);
+    }
     out.stats.fullResolution *= 3; // counted per prism above
     out.stats.emitted = out.tets.size();
     return {};

@@ -19,6 +19,8 @@
 //      projected tetrahedra (the ray segment ended at the host depth, read
 //      from HostTarget::depthTexture) interleaved with the splats in
 //      Frame::drawOrder (at reduced resolution: all tetrahedra, then splats)
+//      and, with a fog, every tetrahedron's segment fogged like a splat fragment
+//      (f from the eye to the segment's opacity centroid; docs/fog.md, "Tetrahedra")
 //   3. the host's transparent pass (HostTarget::drawTransparent), blended over
 // The passes of the systems still being built (fog of the host image, shadow
 // tables before the opaque pass, exact ordering among transparent surfaces,
@@ -121,6 +123,7 @@ struct FrameRenderStats {
     // --- Fog (issue 14) ---
     bool fogHost = false;        // the host image was fogged (a fog, fogHost and a host depth texture)
     bool fogSplats = false;      // the splats were drawn with per-fragment fog
+    bool fogTetrahedra = false;  // the tetrahedra were drawn with per-segment fog [foggaps]
     std::string fogError;        // empty, or why the fog could not be drawn (it was then skipped)
     // --- end fog ---
     // ---- [clouds, issue 17] projected tetrahedra ----

@@ -124,6 +124,14 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         r.stats.fogSplats = fog && s;
     }
 
+    // [foggaps, issue 14] The tetrahedra in the same medium as the splats.
+    r.stats.fogTetrahedra = false;
+    if (anyTets) {
+        const Status s = r.tetra->setFog(fog, frame.time());
+        if (!s) r.stats.fogError = s.error();
+        r.stats.fogTetrahedra = fog && s;
+    }
+
     // 2. The volumes, back to front.
     if (anyTets) {
         // [clouds] Splats and tetrahedra interleaved by Frame::drawOrder (frame.hpp).

@@ -60,6 +60,27 @@ flat in vec4 vScalar;
 flat in vec4 vLength;
 layout(location = 0) out vec4 oColor;
 
+#if FOG
+// [foggaps, issue 14] One medium with the clouds: the segment's premultiplied
+// colour becomes f c + (1 - f) alpha C_fog (alpha unchanged), as every splat
+// fragment does, f = the fog's transmittance from the eye (the origin of the
+// eye-relative positions here) to one point of the segment. The point is the
+// segment's opacity centroid for a homogeneous segment of the same alpha:
+// with tau = -ln(1 - alpha), w = 1/tau - 1/(e^tau - 1) of the way in (1/2 for
+// thin segments, the entry for opaque ones), so the error is second order in
+// the fog's optical depth across the segment (docs/fog.md, "Tetrahedra").
+vec4 fogSegment(vec4 c, vec3 pf, vec3 pb) {
+    float a = clamp(c.a, 0.0, 1.0);
+    float tau = -log(max(1.0 - a, 1.0e-30));
+    float w = tau < 1.0e-2 ? 0.5 - tau / 12.0 : 1.0 / tau - 1.0 / (exp(min(tau, 80.0)) - 1.0);
+    float f = splatfx_fog_transmittance(vec3(0.0), mix(pf, pb, w));
+    return vec4(f * c.rgb + (1.0 - f) * c.a * splatfx_fog_colour, c.a);
+}
+#define FOGGED(c) fogSegment(c, pf, pb)
+#else
+#define FOGGED(c) (c)
+#endif
+
 vec4 table(float sf, float sb, float l) {
     return texture(uTable, vec3(clamp(sf, 0.0, 1.0), clamp(sb, 0.0, 1.0), l / uMaxLength) * uTexScale + uTexOffset);
 }
@@ -108,7 +129,7 @@ void main() {
     // the mean of the ends, exact for constant m (docs/volume.md).
     float l = (tOut - tIn) * max(0.5 * (mf + mb), 0.0);
     if (l <= uMaxLength) {
-        oColor = table(sf, sb, l);
+        oColor = FOGGED(table(sf, sb, l));
         return;
     }
     // Longer than the table: equal pieces (the scalar is linear, so each is
@@ -120,7 +141,7 @@ void main() {
         vec4 c = table(mix(sf, sb, float(k) / float(n)), mix(sf, sb, float(k + 1) / float(n)), piece);
         acc += (1.0 - acc.a) * c;
     }
-    oColor = acc;
+    oColor = FOGGED(acc);
 }
 )";
 
@@ -130,8 +151,15 @@ struct TetraPass::Impl {
     struct Program {
         GLuint id = 0;
         GLint uViewProjRel = -1, uFirst = -1, uForward = -1, uDepthToView = -1, uTexScale = -1, uTexOffset = -1, uMaxLength = -1;
+        GLint uFogParams = -1, uFogColour = -1, uFogFar = -1; // [foggaps] fog variants only
     };
     Program programs[4]; // [perspective * 2 + host depth]
+    // [foggaps, issue 14] The fog variants, built for the structure of the last fog seen.
+    Program fogPrograms[4];
+    std::string fogSource;
+    std::string fogUniform;
+    const Fog* fog = nullptr;
+    double fogTimeSec = 0.0;
     GLuint vao = 0, ssbo = 0;
     std::size_t ssboBytes = 0;
     struct Table {
@@ -154,10 +182,33 @@ struct TetraPass::Impl {
         for (const Table& t : tables) glDeleteTextures(1, &t.texture);
         for (const Program& p : programs)
             if (p.id) glDeleteProgram(p.id);
+        for (const Program& p : fogPrograms)
+            if (p.id) glDeleteProgram(p.id);
         if (vao) glDeleteVertexArrays(1, &vao);
         if (ssbo) glDeleteBuffers(1, &ssbo);
     }
 };
+
+namespace {
+TetraPass::Impl::Program locate(GLuint id, const std::string& fogUniform) {
+    TetraPass::Impl::Program p;
+    p.id = id;
+    auto loc = [&](const char* n) { return glGetUniformLocation(id, n); };
+    p.uViewProjRel = loc("uViewProjRel");
+    p.uFirst = loc("uFirst");
+    p.uForward = loc("uForward");
+    p.uDepthToView = loc("uDepthToView");
+    p.uTexScale = loc("uTexScale");
+    p.uTexOffset = loc("uTexOffset");
+    p.uMaxLength = loc("uMaxLength");
+    if (!fogUniform.empty()) {
+        p.uFogParams = loc(fogUniform.c_str());
+        p.uFogColour = loc("splatfx_fog_colour");
+        p.uFogFar = loc("splatfx_fog_far");
+    }
+    return p;
+}
+} // namespace
 
 TetraPass::TetraPass(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
 TetraPass::TetraPass(TetraPass&&) noexcept = default;
@@ -165,29 +216,60 @@ TetraPass& TetraPass::operator=(TetraPass&&) noexcept = default;
 TetraPass::~TetraPass() = default;
 const TetraStats& TetraPass::stats() const { return mImpl->stats; }
 
+namespace {
+// Compiles variant v (perspective * 2 + host depth) after `fogSource` (empty: no fog).
+Result<GLuint> buildTetraProgram(int v, const std::string& fogSource) {
+    const char* persp = (v & 2) ? "#define PERSPECTIVE 1\n" : "#define PERSPECTIVE 0\n";
+    const char* depth = (v & 1) ? "#define HAS_DEPTH 1\n" : "#define HAS_DEPTH 0\n";
+    const char* fog = fogSource.empty() ? "#define FOG 0\n" : "#define FOG 1\n";
+    return linkProgram({"#version 450 core\n", kTetraVertex},
+                       {"#version 450 core\n", persp, depth, fog, fogSource.c_str(), kTetraFragment},
+                       fogSource.empty() ? "tetrahedra" : "tetrahedra (fog)");
+}
+} // namespace
+
 Result<TetraPass> TetraPass::create() {
     if (!contextIsCurrent()) return makeError("splatfx::gl tetrahedra pass: no OpenGL context is current on this thread");
     auto impl = std::make_unique<Impl>();
     Impl& r = *impl;
     for (int v = 0; v < 4; ++v) {
-        const char* persp = (v & 2) ? "#define PERSPECTIVE 1\n" : "#define PERSPECTIVE 0\n";
-        const char* depth = (v & 1) ? "#define HAS_DEPTH 1\n" : "#define HAS_DEPTH 0\n";
-        auto linked = linkProgram({"#version 450 core\n", kTetraVertex}, {"#version 450 core\n", persp, depth, kTetraFragment}, "tetrahedra");
+        auto linked = buildTetraProgram(v, {});
         if (!linked) return makeError(linked.error());
-        Impl::Program& p = r.programs[v];
-        p.id = *linked;
-        auto loc = [&](const char* n) { return glGetUniformLocation(p.id, n); };
-        p.uViewProjRel = loc("uViewProjRel");
-        p.uFirst = loc("uFirst");
-        p.uForward = loc("uForward");
-        p.uDepthToView = loc("uDepthToView");
-        p.uTexScale = loc("uTexScale");
-        p.uTexOffset = loc("uTexOffset");
-        p.uMaxLength = loc("uMaxLength");
+        r.programs[v] = locate(*linked, {});
     }
     glCreateVertexArrays(1, &r.vao); // no attributes: everything comes from the buffer
     glCreateBuffers(1, &r.ssbo);
     return TetraPass(std::move(impl));
+}
+
+// [foggaps, issue 14]
+Status TetraPass::setFog(const Fog* fog, double timeSec) {
+    Impl& r = *mImpl;
+    r.fog = fog && !fog->empty() ? fog : nullptr; // zero terms: clear air, the plain programs
+    r.fogTimeSec = timeSec;
+    if (!r.fog) return {};
+    auto glsl = fogGlsl(*r.fog);
+    if (!glsl) {
+        r.fog = nullptr;
+        return makeError("splatfx::gl tetrahedra pass: " + glsl.error());
+    }
+    if (glsl->source == r.fogSource) return {};
+    for (Impl::Program& p : r.fogPrograms)
+        if (p.id) glDeleteProgram(p.id), p = {};
+    r.fogSource.clear();
+    for (int v = 0; v < 4; ++v) {
+        auto linked = buildTetraProgram(v, glsl->source);
+        if (!linked) {
+            for (Impl::Program& p : r.fogPrograms)
+                if (p.id) glDeleteProgram(p.id), p = {};
+            r.fog = nullptr;
+            return makeError(linked.error());
+        }
+        r.fogPrograms[v] = locate(*linked, glsl->uniformName);
+    }
+    r.fogSource = glsl->source;
+    r.fogUniform = glsl->uniformName;
+    return {};
 }
 
 void TetraPass::prepare(const Frame& frame) {
@@ -363,8 +445,19 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     glFrontFace(area >= 0.0f ? GL_CCW : GL_CW);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 
-    const Impl::Program& p = r.programs[(camera.perspective() ? 2 : 0) + (hostDepth ? 1 : 0)];
+    const int variant = (camera.perspective() ? 2 : 0) + (hostDepth ? 1 : 0);
+    const bool fogged = r.fog && r.fogPrograms[variant].id; // [foggaps]
+    const Impl::Program& p = fogged ? r.fogPrograms[variant] : r.programs[variant];
     glUseProgram(p.id);
+    if (fogged) {
+        // [foggaps] Parameters in double relative to the eye the records are relative to (docs/fog.md, GLSL).
+        const std::vector<glm::vec4> fp = r.fog->glslParameters(r.fogTimeSec, glm::dvec3(r.eye));
+        glUniform4fv(p.uFogParams, GLsizei(fp.size()), glm::value_ptr(fp[0]));
+        const glm::dvec3 col = r.fog->desc().colour;
+        glUniform3f(p.uFogColour, float(col.x), float(col.y), float(col.z));
+        glUniform1f(p.uFogFar, float(r.fog->desc().farDistanceWorld));
+        ++r.stats.foggedDraws;
+    }
     const glm::mat4 vpRel = vp * glm::translate(glm::mat4(1.0f), r.eye);
     glUniformMatrix4fv(p.uViewProjRel, 1, GL_FALSE, glm::value_ptr(vpRel));
     glUniform1i(p.uFirst, GLint(r.recordBase[volume] + a));

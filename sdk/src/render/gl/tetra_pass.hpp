@@ -14,6 +14,10 @@
 // clipping is switched off (depth clamp) so a face lying in the near plane is
 // never lost to rounding. No CPU projection (Shirley-Tuchman classes) needed.
 //
+// With a fog (setFog, issue 14) a second set of variants fogs each segment's
+// colour as the splats do, f from the eye (also for orthographic cameras,
+// like the splats) to the segment's opacity centroid (docs/fog.md).
+//
 // It does not sort (the list is already in order) and writes no depth.
 #pragma once
 
@@ -22,6 +26,7 @@
 #include <vector>
 
 #include "splatfx/camera.hpp"
+#include "splatfx/fog.hpp"
 #include "splatfx/frame.hpp"
 #include "splatfx/result.hpp"
 
@@ -42,6 +47,7 @@ struct TetraStats {
     std::uint64_t drawCalls = 0;
     std::uint64_t tableUploads = 0;    // since creation
     std::size_t tableBytes = 0;        // GPU bytes held by uploaded tables
+    std::uint64_t foggedDraws = 0;     // [foggaps] draws with the fog variant this frame
 };
 
 class TetraPass {
@@ -57,11 +63,17 @@ public:
     void prepare(const Frame& frame);
     // Draws tetrahedra [begin, end) of frame.volumes()[volume] (after prepare).
     void draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const TetraTarget& target);
+    // [foggaps, issue 14] The fog every following draw is seen through (null
+    // or empty: none): each segment's colour becomes f c + (1 - f) alpha C_fog
+    // with f from the eye to the segment's opacity centroid. Builds the fog
+    // variants when the fog's GLSL structure changed; an error leaves no fog.
+    Status setFog(const Fog* fog, double timeSec);
 
     const TetraStats& stats() const;
 
+    struct Impl; // public so the .cpp's helpers can name Impl::Program; defined there only
+
 private:
-    struct Impl;
     explicit TetraPass(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> mImpl;
 };

@@ -1,0 +1,120 @@
+// [foggaps] The "heightmap" geometry type and the "groundFog" volume kind: a
+// terrain and a fog layer read from one 16-bit PGM share every sample point,
+// the fog layer reaches the Frame through Scene::prepare, and bad input is a
+// message naming the field.
+#include <cstdio>
+#include <cstdlib>
+#include <unistd.h>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "splatfx/frame.hpp"
+#include "splatfx/scene_file.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A w x h 16-bit binary PGM (big-endian) in a fresh folder; value(i, j) in codes.
+struct TempTerrain {
+    fs::path dir;
+    int w = 0, h = 0;
+    std::vector<int> codes;
+    TempTerrain(int width, int height, const std::string& tag) : w(width), h(height) {
+        dir = fs::temp_directory_path() / ("splatfx-heightmap-" + tag + "-" + std::to_string(::getpid()));
+        fs::create_directories(dir);
+        std::ofstream f(dir / "dem.pgm", std::ios::binary);
+        f << "P5\n" << w << " " << h << "\n65535\n";
+        for (int j = 0; j < h; ++j)
+            for (int i = 0; i < w; ++i) {
+                // A valley along x = middle: low in the centre, high at the sides.
+                const int c = 1000 + 4000 * std::abs(2 * i - (w - 1)) + 100 * j;
+                codes.push_back(c);
+                f.put(char(c >> 8)).put(char(c & 255));
+            }
+    }
+    ~TempTerrain() {
+        std::error_code ec;
+        fs::remove_all(dir, ec);
+    }
+    splatfx::Result<splatfx::SceneFile> parse(const std::string& body, splatfx::Materials& m) const {
+        return splatfx::parseSceneFile(R"({"format": "splatfx-scene", "version": 1, )" + body + "}", (dir / "scene.json").string(), m);
+    }
+};
+
+} // namespace
+
+TEST(SceneFileHeightmap, TerrainAndGroundFogShareEverySamplePoint) {
+    const TempTerrain t(9, 5, "share");
+    splatfx::Materials m(splatfx::Footprint{});
+    const float spacing = 2.0f, scale = 100.0f, fogTop = 6.0f;
+    const glm::vec3 pos{10.0f, -1.0f, 4.0f};
+    auto r = t.parse(R"("geometry": [{"name": "terrain", "type": "heightmap", "heightmap": "dem.pgm", "spacing": 2, "heightScale": 100,
+                         "position": [10, -1, 4]}],
+                        "volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "spacing": 2, "heightScale": 100,
+                         "position": [10, -1, 4], "step": 2, "fogTop": 6}])",
+                     m);
+    ASSERT_TRUE(r) << r.error();
+    ASSERT_EQ(r->geometry.size(), 1u);
+    const splatfx::GeometryDesc& g = r->geometry[0];
+    EXPECT_EQ(g.type, splatfx::GeometryType::Heightmap);
+    EXPECT_EQ(fs::path(g.heightmapPath), t.dir / "dem.pgm");
+    EXPECT_FLOAT_EQ(g.heightmapSpacing, spacing);
+    EXPECT_FLOAT_EQ(g.heightmapScale, scale);
+    ASSERT_EQ(r->scene.groundFogCount(), 1u);
+
+    // Every vertex of every emitted tetrahedron is either a terrain sample of
+    // the step-2 grid (the heightmap geometry's own point, placed at `pos`)
+    // or on the fog top above one.
+    std::vector<glm::vec3> terrain;
+    for (int j = 0; j < t.h; j += 2)
+        for (int i = 0; i < t.w; i += 2)
+            terrain.push_back(pos + splatfx::heightmapPoint(i, j, t.w, t.h, float(t.codes[std::size_t(j * t.w + i)]) / 65535.0f, spacing, scale));
+    const splatfx::Camera cam = splatfx::Camera::lookAt(pos + glm::vec3(0, 40, 30), pos, {0, 1, 0}, glm::radians(60.0f), {64, 48}, 0.5f, 500.0f);
+    splatfx::Frame frame;
+    r->scene.prepare(0.0, cam, m, frame);
+    ASSERT_EQ(frame.volumes().size(), 1u);
+    const auto& tets = frame.volumes()[0].lod.tets;
+    ASSERT_GT(tets.size(), 0u) << "the valley lies under the fog top";
+    std::size_t onTerrain = 0;
+    for (const splatfx::Tetrahedron& tet : tets)
+        for (const glm::vec3& p : tet.position) {
+            bool matched = false;
+            for (const glm::vec3& q : terrain) {
+                // The same float formula on both sides, up to one rounding of the addition.
+                const bool sameColumn = std::abs(p.x - q.x) < 1e-4f && std::abs(p.z - q.z) < 1e-4f;
+                if (!sameColumn) continue;
+                if (std::abs(p.y - q.y) < 1e-4f) matched = true, ++onTerrain;
+                else if (std::abs(p.y - fogTop) < 1e-4f && q.y < fogTop) matched = true;
+            }
+            EXPECT_TRUE(matched) << "vertex (" << p.x << ", " << p.y << ", " << p.z << ") is neither a terrain sample nor on the fog top";
+        }
+    EXPECT_GT(onTerrain, 0u);
+    // Disabled: nothing reaches the frame.
+    r->scene.groundFogOptions(0).enabled = false;
+    splatfx::Frame off;
+    r->scene.prepare(0.0, cam, m, off);
+    EXPECT_TRUE(off.volumes().empty());
+}
+
+TEST(SceneFileHeightmap, BadInputNamesTheField) {
+    const TempTerrain t(9, 5, "bad");
+    splatfx::Materials m(splatfx::Footprint{});
+    auto expectError = [&](const std::string& body, const std::string& part) {
+        auto r = t.parse(body, m);
+        ASSERT_FALSE(r) << body;
+        EXPECT_NE(r.error().find(part), std::string::npos) << r.error();
+    };
+    expectError(R"("geometry": [{"type": "heightmap"}])", R"(geometry[0]: missing "heightmap")");
+    expectError(R"("geometry": [{"type": "heightmap", "heightmap": "nope.pgm"}])", "geometry[0].heightmap: heightmap file 'nope.pgm' not found");
+    expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm"}])", R"(volumes[0]: missing "fogTop")");
+    // 8 x 4 cells: a step of 3 divides neither.
+    expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "fogTop": 1, "step": 3}])", "volumes[0].step: must divide");
+    expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "gone.pgm", "fogTop": 1}])", "volumes[0].heightmap:");
+    expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "fogTop": 1, "colour": [2, 0, 0]}])", "volumes[0].colour");
+    expectError(R"("volumes": [{"kind": "fogg"}])", "unknown kind 'fogg' (known: clouds, groundFog)");
+}
