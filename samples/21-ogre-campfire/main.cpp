@@ -46,11 +46,13 @@ int run(int argc, char** argv) {
         if (auto s = (*app)->render({.timeSec = t < 0.0 ? 0.0 : t}); !s) return fail(s.error());
     }
     const ogrefx::HookInfo& h = (*app)->hook();
-    std::printf("ogre-campfire: %s; %d frames; OGRE framebuffer %u (OGRE says %u), depth %s 0x%x %s, viewport %d %d %d %d%s; %zu splats\n",
+    std::printf("ogre-campfire: %s; %d frames; OGRE framebuffer %u (OGRE says %u), depth %s 0x%x %s, viewport %d %d %d %d, "
+                "scissor %s %d %d %d %d%s; %zu splats\n",
                 h.glRenderer.c_str(), frames, h.framebuffer, h.framebufferFromOgre,
                 h.depthObjectType == 0x8D41 ? "renderbuffer" : "texture", h.depthInternalFormat,
                 h.depthCopied ? "(copied to a texture)" : "(handed over as it is)", h.viewport[0], h.viewport[1], h.viewport[2],
-                h.viewport[3], h.flipped ? ", flipped" : "", h.splats);
+                h.viewport[3], h.scissor ? "on" : "off", h.scissorBox[0], h.scissorBox[1], h.scissorBox[2], h.scissorBox[3],
+                h.flipped ? ", flipped" : "", h.splats);
     if (!screenshot.empty()) {
         auto image = (*app)->readColour();
         if (!image) return fail(image.error());

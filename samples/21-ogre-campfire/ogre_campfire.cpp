@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <optional>
 
@@ -154,6 +155,9 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
         glGetNamedFramebufferAttachmentParameteriv(fbo, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &name);
         info.depthObjectType = unsigned(type);
         if (type == GL_TEXTURE) { // a depth texture already: hand it over as it is
+            GLint format = 0;
+            glGetTextureLevelParameteriv(GLuint(name), 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
+            info.depthInternalFormat = unsigned(format);
             info.depthCopied = false;
             return GLuint(name);
         }
@@ -190,9 +194,9 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
             depthCopyW = w;
             depthCopyH = h;
         }
-        // A blit is not a draw: only the scissor test applies (OGRE's scissor,
-        // when on, is its viewport, the region we copy), and a named blit
-        // binds nothing. Same internal format on both sides, as GL requires.
+        // A blit is not a draw: of the per-fragment operations only the
+        // scissor test applies (HookInfo::scissor records OGRE's), and a named
+        // blit binds nothing. Same internal format on both sides, as GL requires.
         glBlitNamedFramebuffer(fbo, depthCopyFbo, 0, 0, w, h, 0, 0, w, h, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
         info.depthCopied = true;
         return depthCopy;
@@ -221,6 +225,8 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
         GLint vp[4] = {};
         glGetIntegerv(GL_VIEWPORT, vp);
         std::copy(vp, vp + 4, info.viewport);
+        info.scissor = glIsEnabled(GL_SCISSOR_TEST) == GL_TRUE;
+        glGetIntegerv(GL_SCISSOR_BOX, info.scissorBox);
         // 2. OGRE's depth as a texture (a copy: see depthTextureFor).
         const GLuint depth = depthTextureFor(GLuint(fbo), desc.width, desc.height);
         if (!depth) return;

@@ -59,6 +59,8 @@ struct HookInfo {
     unsigned depthInternalFormat = 0;    // its GL internal format (the copy's)
     bool depthCopied = false;            // the depth was blitted into a texture (renderbuffer depth)
     int viewport[4] = {0, 0, 0, 0};      // the GL viewport OGRE set
+    bool scissor = false;                // OGRE left the scissor test on (it limits the depth blit)
+    int scissorBox[4] = {0, 0, 0, 0};    // and its box
     bool flipped = false;                // OGRE renders this target upside down (requiresTextureFlipping)
     std::size_t splats = 0;              // splats splatfx drew
     std::string glRenderer;              // GL_RENDERER / GL_VERSION of OGRE's context
