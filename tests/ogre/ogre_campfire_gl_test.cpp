@@ -227,11 +227,12 @@ void expectOccludedExactly(OgreApp<Scale>& t, int edge) {
     EXPECT_GT(brightening, 0.0);
     EXPECT_GT(warmth, 0.0);
 
-    // For a person looking at a failure: the last frame (D, no log).
-    if (auto image = T::sApp->readColour()) {
-        const splatfx::Status st = splatfx::writeImage(splatfx::test::outputDir() + "/ogre_campfire_without_log.png", *image);
-        EXPECT_TRUE(st) << st.error();
-    }
+    // The screenshot: frame B (fire and log), for a person looking at a failure.
+    splatfx::Image image{.width = kW, .height = kH, .channels = 4, .pixels = {}};
+    for (std::uint8_t v : b.rgba) image.pixels.push_back(float(v) / 255.0f);
+    const splatfx::Status st =
+        splatfx::writeImage(splatfx::test::outputDir() + "/ogre_campfire_scale" + std::to_string(Scale) + ".png", image);
+    EXPECT_TRUE(st) << st.error();
 }
 
 TEST_F(OgreCampfireTest, OgresGeometryOccludesTheFireExactly) { expectOccludedExactly(*this, 0); }
