@@ -4,6 +4,7 @@
 # Needs root (or sudo) only when something is missing.
 #   tools/setup-deps.sh          build and test dependencies
 #   tools/setup-deps.sh --fuzz   ... and clang with libFuzzer (tools/fuzz.sh)
+#   tools/setup-deps.sh --ogre   ... and OGRE 1.12 (sample 21, tests/ogre: splatfx inside an engine)
 set -euo pipefail
 
 PACKAGES=(
@@ -15,9 +16,14 @@ PACKAGES=(
   gnuplot-nox xvfb xauth
 )
 # tools/fuzz.sh needs clang and its libFuzzer runtime; only it asks for them (--fuzz).
-if [ "${1:-}" = "--fuzz" ]; then
-  PACKAGES+=(clang libclang-rt-14-dev)
-fi
+# Sample 21 (splatfx inside OGRE) is optional: configure skips it, with a message, without OGRE (--ogre).
+for arg in "$@"; do
+  case "$arg" in
+    --fuzz) PACKAGES+=(clang libclang-rt-14-dev) ;;
+    --ogre) PACKAGES+=(libogre-1.12-dev) ;;
+    *) echo "setup-deps: unknown option $arg (expected --fuzz, --ogre)" >&2; exit 2 ;;
+  esac
+done
 
 missing=()
 for p in "${PACKAGES[@]}"; do

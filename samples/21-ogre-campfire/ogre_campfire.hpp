@@ -1,0 +1,104 @@
+// samples/21-ogre-campfire/ogre_campfire.hpp: splatfx's campfire drawn inside
+// OGRE 1.12 (GL3Plus): into OGRE's render target, against OGRE's depth, from a
+// RenderQueueListener in OGRE's own frame, with OGRE's camera.
+//
+// What it is: a small OGRE application (its Root, a hidden window for the GL
+// context, a scene manager with a ground, a log in front of the fire and a
+// wall behind it, drawn with GLSL materials made in code) whose main render
+// queue ends with splatfx's gl::FrameRenderer drawing the campfire into the
+// framebuffer OGRE has bound. It shows what an engine hands over (its
+// framebuffer name, its depth as a texture, its camera) and what state has
+// to survive (docs/integration.md, "Inside an engine").
+// What it does not do: load OGRE's sample media (Debian ships none), use
+// OGRE's RTSS, draw to the window (the frame is a render texture, read back).
+//
+//   auto app = ogrefx::OgreCampfire::create({.width = 640, .height = 360});
+//   if (!app) return fail(app.error());
+//   (*app)->render({.timeSec = 1.0}); auto image = (*app)->readColour();
+//
+// Needs an X display (GLX; run headless under xvfb-run). Threading: one
+// thread, the one that created it (OGRE's GL context is current there).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "splatfx/camera.hpp"
+#include "splatfx/frame.hpp"
+#include "splatfx/image.hpp"
+#include "splatfx/result.hpp"
+
+namespace ogrefx {
+
+struct OgreCampfireDesc {
+    int width = 640;             // render-texture size, pixels; default 640
+    int height = 360;            // default 360
+    std::uint32_t seed = 1;      // the fire's texture dynamics; default 1
+    int resolutionScale = 1;     // splatfx::gl::FrameRendererDesc::resolutionScale (1, 2, 4); default 1
+    // splatfx's GL-state guard (RendererDesc::restoreState). false only to
+    // show what OGRE's state cache does without it (the test's negative
+    // control); default true.
+    bool restoreState = true;
+    std::string pluginDir{};     // OGRE's plugin folder; empty: the one OGRE's CMake package names; default empty
+};
+
+struct FrameOptions {
+    double timeSec = 1.0;        // the fire's time; default 1
+    bool fire = true;            // draw splatfx in OGRE's frame; default true
+    bool log = true;             // OGRE draws the log in front of the fire; default true
+};
+
+// What the render-queue hook saw in the last frame (for the docs and tests).
+struct HookInfo {
+    int calls = 0;                       // times the hook drew splatfx in the last frame
+    unsigned framebuffer = 0;            // OGRE's draw framebuffer at the hook
+    unsigned framebufferFromOgre = 0;    // the same, asked of OGRE (RenderTarget "GL_FBOID"/"FBO")
+    unsigned depthObjectType = 0;        // GL_RENDERBUFFER or GL_TEXTURE: what OGRE attached as depth
+    unsigned depthInternalFormat = 0;    // its GL internal format (the copy's)
+    bool depthCopied = false;            // the depth was blitted into a texture (renderbuffer depth)
+    int viewport[4] = {0, 0, 0, 0};      // the GL viewport OGRE set
+    bool scissor = false;                // OGRE left the scissor test on (it limits the depth blit)
+    int scissorBox[4] = {0, 0, 0, 0};    // and its box
+    bool flipped = false;                // OGRE renders this target upside down (requiresTextureFlipping)
+    std::size_t splats = 0;              // splats splatfx drew
+    std::string glRenderer;              // GL_RENDERER / GL_VERSION of OGRE's context
+};
+
+class OgreCampfire {
+public:
+    // Starts OGRE (GL3Plus plugin, a hidden window, the scene) and splatfx
+    // (the fire preset, gl::FrameRenderer). Fails with OGRE's message when
+    // there is no display or no GL3Plus plugin, and with splatfx's when the
+    // context is not GL 4.5.
+    static splatfx::Result<std::unique_ptr<OgreCampfire>> create(const OgreCampfireDesc& desc = {});
+    ~OgreCampfire();
+    OgreCampfire(const OgreCampfire&) = delete;
+    OgreCampfire& operator=(const OgreCampfire&) = delete;
+
+    // One OGRE frame (Root::renderOneFrame): OGRE clears and draws its
+    // queues; at the end of the main queue the hook draws the fire.
+    splatfx::Status render(const FrameOptions& options = {});
+    // The render texture as OGRE reads it back: RGBA in [0, 1], top row first.
+    splatfx::Result<splatfx::Image> readColour() const;
+    // OGRE's depth as handed to splatfx (the copy), window depth in [0, 1],
+    // width*height values, top row first (same rows as readColour()).
+    splatfx::Result<std::vector<float>> readDepth() const;
+    // The camera splatfx drew with (converted from Ogre::Camera, flip included).
+    const splatfx::Camera& camera() const;
+    // The camera computed from Ogre::Camera now (valid before any frame).
+    splatfx::Camera convertedCamera() const;
+    const splatfx::Frame& frame() const;
+    const HookInfo& hook() const;
+    int width() const;
+    int height() const;
+
+    struct Impl;
+
+private:
+    explicit OgreCampfire(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> mImpl;
+};
+
+} // namespace ogrefx

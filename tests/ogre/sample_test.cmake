@@ -1,0 +1,16 @@
+# ogre-campfire under Xvfb: a few frames and a screenshot that is not blank.
+file(REMOVE_RECURSE ${OUT})
+file(MAKE_DIRECTORY ${OUT})
+execute_process(COMMAND ${XVFB} -a -s "-screen 0 640x480x24" ${SAMPLE} --frames 3 --size 320x180 --screenshot ${OUT}/ogre-campfire.png
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT EXISTS ${OUT}/ogre-campfire.png)
+  message(FATAL_ERROR "ogre-campfire failed (${rc}):\n${out}\n${err}")
+endif()
+string(FIND "${out}" "splats" at)
+if(at EQUAL -1)
+  message(FATAL_ERROR "ogre-campfire summary unexpected:\n${out}")
+endif()
+file(SIZE ${OUT}/ogre-campfire.png size)
+if(size LESS 5000)
+  message(FATAL_ERROR "screenshot suspiciously small (${size} bytes): blank?")
+endif()
