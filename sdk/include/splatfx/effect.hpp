@@ -42,6 +42,7 @@
 #include "splatfx/dynamics.hpp"
 #include "splatfx/effect_kind.hpp"
 #include "splatfx/grid.hpp"
+#include "splatfx/grid_sequence.hpp"
 #include "splatfx/motion.hpp"
 #include "splatfx/result.hpp"
 #include "splatfx/solver.hpp"
@@ -102,6 +103,16 @@ public:
     // A stateful effect driven by a solver. desc.motion must be at rest
     // (attach motion to the emitters instead: the smoke should trail).
     static Result<Effect> fromSolver(FluidSolver solver, EffectDesc desc);
+    // A baked simulation played back (grid_sequence.hpp; splatfx/vdb.hpp reads
+    // OpenVDB files into one): frames interpolated at t, looping or clamped,
+    // moved as a whole by desc.motion (its opacity fades it; growth is not
+    // applied), voxels below desc.sparse.minOpacity left out, textures
+    // propagated along the sequence's velocity (Propagation::Velocity) or a
+    // fixed direction, on a fixed clock of stepsPerSec, so update(t) is a
+    // function of t alone (earlier times replay from step 0: cost linear in
+    // t * stepsPerSec). isStateless() is true. Fails on an invalid sequence,
+    // or Propagation::Velocity without velocity; the message names the field.
+    static Result<Effect> fromSequence(GridSequence sequence, EffectDesc desc);
 
     Effect(const Effect& other);
     Effect& operator=(const Effect& other);
