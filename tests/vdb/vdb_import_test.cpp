@@ -167,6 +167,12 @@ TEST(VdbImport, TemperatureAndVelocity) {
     EXPECT_NEAR(vel.y, 0.0f, 1e-6f);
     EXPECT_NEAR(vel.z, -5.0f, 1e-5f);
 
+    // In file voxels per second: 1 voxel/s x 2 = 0.2 world units/s = 1 cell/s.
+    auto voxels = loadVdb((dir / "tv.vdb").string(), {.temperatureGrid = "", .voxelsPerCell = 2,
+                                                       .velocityUnit = VdbImportDesc::VelocityUnit::VoxelsPerSec, .velocityScale = 2.0f});
+    ASSERT_TRUE(voxels) << voxels.error();
+    EXPECT_NEAR(voxels->frames[0].velocityCellsPerSec[0].x, 1.0f, 1e-6f);
+
     // Automatic range: the only cell is both the hottest and the coldest -> hot.
     auto autoSeq = loadVdb((dir / "tv.vdb").string(), {.temperatureGrid = "flame", .voxelsPerCell = 2});
     ASSERT_TRUE(autoSeq) << autoSeq.error();

@@ -60,9 +60,13 @@ struct VdbImportDesc {
     // over all frames. Default NaN (automatic).
     float temperatureHot = std::numeric_limits<float>::quiet_NaN();
     float temperatureCold = std::numeric_limits<float>::quiet_NaN();
-    // The file's velocity times this is world units per second (exporters
-    // differ: Blender's mantaflow stores its solver's units). Default 1.
-    float velocityScale = 1.0f;
+    // The unit of the file's velocity grid: world units per second, or file
+    // voxels per second (Blender 3.4's mantaflow cache: on the committed bake
+    // the density-weighted mean upward velocity, 14.8 voxels/s at frame 16,
+    // matches the density centroid rising about 16 voxels/s).
+    enum class VelocityUnit { WorldPerSec, VoxelsPerSec };
+    VelocityUnit velocityUnit = VelocityUnit::WorldPerSec; // default WorldPerSec
+    float velocityScale = 1.0f;         // multiplies the file's velocity (after the unit); default 1
     double framesPerSec = 24.0;          // playback rate of the sequence, > 0; default 24
     SequenceEnd end = SequenceEnd::Loop; // default Loop
     // A grid whose metadata reports more active voxels than this is refused

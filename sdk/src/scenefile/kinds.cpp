@@ -6,6 +6,9 @@ namespace splatfx::scenefile {
 
 // Effect readers, one a file in kinds/.
 EffectReaderFn readFire, readSmoke, readSteam, readDust, readFireToSmoke, readGhosts, readGridKind;
+#if SPLATFX_WITH_VDB
+EffectReaderFn readVdbKind; // only when splatfx::vdb is built (OpenVDB found)
+#endif
 // Geometry readers, for the types with keys of their own.
 GeometryReaderFn readMeshGeometry;
 
@@ -20,6 +23,9 @@ constexpr EffectKind kEffectKinds[] = {
     {"fireToSmoke", &readFireToSmoke}, // kinds/fire_to_smoke.cpp
     {"ghosts", &readGhosts},           // kinds/ghosts.cpp
     {"grid", &readGridKind},           // kinds/grid.cpp
+#if SPLATFX_WITH_VDB
+    {"vdb", &readVdbKind},             // kinds/vdb.cpp
+#endif
 };
 
 constexpr GeometryKind kGeometryKinds[] = {

@@ -323,8 +323,9 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
                 v[std::size_t(k)] += glm::dvec3(u[0] - bg[0], u[1] - bg[1], u[2] - bg[2]);
             });
             if (bad) return makeError(where(fi.path, fi.frame, desc.velocityGrid) + "holds NaN or infinite velocities");
-            // World units per second to lattice cells per second.
-            const double toCells = double(desc.velocityScale) / cellWorld;
+            // World units (or file voxels) per second to lattice cells per second.
+            const double unit = desc.velocityUnit == VdbImportDesc::VelocityUnit::VoxelsPerSec ? lat.voxelSize : 1.0;
+            const double toCells = double(desc.velocityScale) * unit / cellWorld;
             frame.velocityCellsPerSec.resize(n);
             for (std::size_t k = 0; k < n; ++k) {
                 const glm::dvec3 mean = glm::dvec3(bg[0], bg[1], bg[2]) + v[k] / blockVoxels;
