@@ -2,11 +2,10 @@
 // not empty, and geometry is depth-correct against the splats (Fig. 3: the
 // cow in front of the fire hides it, the fire in front of the cow veils it).
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include <gtest/gtest.h>
-
-#include <cstdio>
 
 #include "gl_fixture.hpp"
 #include "scene_player.hpp"
