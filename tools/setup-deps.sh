@@ -4,6 +4,7 @@
 # Needs root (or sudo) only when something is missing.
 #   tools/setup-deps.sh          build and test dependencies
 #   tools/setup-deps.sh --fuzz   ... and clang with libFuzzer (tools/fuzz.sh)
+#   tools/setup-deps.sh --bake   ... and blender (tools/bake-smoke.py rebakes samples/20-vdb-smoke; not a build dependency)
 set -euo pipefail
 
 PACKAGES=(
@@ -13,10 +14,18 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools python3-imath libopencv-dev nlohmann-json3-dev libgtest-dev
   libassimp-dev libimgui-dev
   gnuplot-nox xvfb xauth
+  # OpenVDB import (splatfx::vdb, optional at configure: SPLATFX_VDB). Debian's
+  # FindOpenVDB.cmake also needs Boost iostreams; python3-openvdb reads and
+  # writes grids from scripts (the bake's provenance checks).
+  libopenvdb-dev libboost-iostreams-dev python3-openvdb
 )
 # tools/fuzz.sh needs clang and its libFuzzer runtime; only it asks for them (--fuzz).
 if [ "${1:-}" = "--fuzz" ]; then
   PACKAGES+=(clang libclang-rt-14-dev)
+fi
+# tools/bake-smoke.py needs Blender with mantaflow (Debian's build has it); only --bake asks for it.
+if [ "${1:-}" = "--bake" ]; then
+  PACKAGES+=(blender)
 fi
 
 missing=()
