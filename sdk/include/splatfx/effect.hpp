@@ -13,13 +13,18 @@
 // color tables and differing texture sets").
 //
 // An Effect is an EffectKind (effect_kind.hpp), the interface Scene schedules
-// by; it is a copyable value that owns one of the SDK's two kinds:
+// by; it is a copyable value that owns one of the SDK's three kinds:
 //   - grid effects (fromGrid) are stateless: update(t) computes frame t
 //     directly from (voxel, t, seed), in any order, at no cost for skipped
 //     frames. step(dt) is update(time() + dt); advanceTo(t) is update(t).
 //   - solver effects (fromSolver) are stateful: step(dt) simulates; update()
 //     asserts; advanceTo(t) steps to t, catching up after a gap in a bounded
 //     number of coarse steps (AdvanceContext).
+//   - sequence effects (fromSequence) play a baked simulation (GridSequence,
+//     e.g. from OpenVDB files through splatfx/vdb.hpp), interpolated between
+//     frames; their texture propagation runs on a fixed clock and is replayed
+//     as needed, so update(t) depends on t alone: stateless, at a cost linear
+//     in the propagation steps replayed.
 // isStateless() tells which; bounds(t0, t1) is a conservative world box of
 // every splat the effect can produce in [t0, t1] (motion and splat extent
 // included), for culling by a scheduler. Other kinds implement EffectKind
