@@ -43,6 +43,10 @@
 
 namespace splatfx {
 
+// Largest coarse cells x frames a sequence may hold (each cell-frame is 20
+// bytes: optical depth, colour, velocity): 2^27, 2.5 GiB.
+inline constexpr std::uint64_t kMaxVdbSequenceCells = std::uint64_t(1) << 27;
+
 struct VdbImportDesc {
     std::string densityGrid = "density";         // float grid, required; default "density"
     std::string temperatureGrid = "temperature"; // float grid; empty: colour by height; default "temperature" (Blender; "flame" and "heat" are common too)

@@ -251,6 +251,10 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
                          " voxels per cell that is " + std::to_string(cells) + " coarse cells, more than " + std::to_string(kMaxVoxels) +
                          " (raise VdbImportDesc::voxelsPerCell)");
     lat.dims = glm::ivec3(hi.x() - lat.lo.x() + 1, hi.y() - lat.lo.y() + 1, hi.z() - lat.lo.z() + 1);
+    if (cells * infos.size() > kMaxVdbSequenceCells)
+        return makeError(where(infos[0].path, infos[0].frame, desc.densityGrid) + "the sequence would hold " + std::to_string(cells) +
+                         " coarse cells x " + std::to_string(infos.size()) + " frames, more than " + std::to_string(kMaxVdbSequenceCells) +
+                         " cells in all (kMaxVdbSequenceCells); raise VdbImportDesc::voxelsPerCell or load fewer frames");
 
     GridSequence seq;
     seq.dims = lat.dims;
