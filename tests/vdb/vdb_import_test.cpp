@@ -340,6 +340,29 @@ TEST(VdbImport, BillionVoxelGridRefusedBeforeReading) {
     EXPECT_NE(c.error().find("has 1073741824 active voxels (from the file's metadata; nothing was read)"), std::string::npos) << c.error();
 }
 
+// Two voxels far apart make a tiny file but a huge lattice: refused from
+// the boxes in the metadata, per frame (kMaxVoxels) and per sequence
+// (kMaxVdbSequenceCells), before voxels are read.
+TEST(VdbImport, HugeLatticesRefusedBeforeReading) {
+    const fs::path dir = tempDir();
+    for (int f = 0; f < 10; ++f) {
+        auto g = openvdb::FloatGrid::create(0.0f);
+        g->setName("density");
+        g->tree().setValue({0, 0, 0}, 1.0f);
+        g->tree().setValue({f == 0 ? 600 : 255, 255, 255}, 1.0f);
+        write(dir / vdbFramePath("h#.vdb", f), {g});
+    }
+    auto one = loadVdb((dir / "h0.vdb").string(), {.temperatureGrid = "", .velocityGrid = "", .voxelsPerCell = 1});
+    ASSERT_FALSE(one);
+    EXPECT_NE(one.error().find("spans 601 x 256 x 256 voxels; at 1 voxels per cell that is 39387136 coarse cells, more than 16777216"),
+              std::string::npos)
+        << one.error();
+    // 256^3 = 2^24 cells a frame is allowed; 8 frames of it (2^27) would be too, 9 are not.
+    auto nine = loadVdbSequence((dir / "h#.vdb").string(), 1, 9, {.temperatureGrid = "", .velocityGrid = "", .voxelsPerCell = 1});
+    ASSERT_FALSE(nine);
+    EXPECT_NE(nine.error().find("would hold 16777216 coarse cells x 9 frames, more than 134217728"), std::string::npos) << nine.error();
+}
+
 TEST(VdbImport, BadFileAndDescriptor) {
     const fs::path dir = tempDir();
     std::ofstream(dir / "junk.vdb") << "not a vdb file";
