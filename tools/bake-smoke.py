@@ -4,7 +4,8 @@
 #   blender -b --factory-startup -P tools/bake-smoke.py -- OUT_DIR [RESOLUTION] [FRAMES]
 #
 # Writes OUT_DIR/fluid_data_0001.vdb ... (one file a frame: grids "density",
-# "heat", "flame", "velocity", ...) and OUT_DIR/bake-info.txt (Blender version,
+# "flame", "temperature", "velocity", "shadow"; earlier fluid_data_*.vdb in
+# OUT_DIR are removed first) and OUT_DIR/bake-info.txt (Blender version,
 # settings, bake time). Defaults: resolution 32 (cells along the domain's
 # longest side), 24 frames. samples/20-vdb-smoke/data was made with 40 and 32.
 # mantaflow's smoke solver has no random source in this setup (no noise, no
@@ -32,7 +33,7 @@ scene.frame_start = 1
 scene.frame_end = frames
 scene.render.fps = 24
 
-# Domain: a 2 x 3 x 2 box standing on z = 0 (Blender is z-up).
+# Domain: a 2 x 2 x 3 box (x, y, z) standing on z = 0 (Blender is z-up).
 bpy.ops.mesh.primitive_cube_add(size=2.0, location=(0.0, 0.0, 1.5))
 domain = bpy.context.active_object
 domain.name = "SmokeDomain"
@@ -79,6 +80,9 @@ for frame in range(1, frames + 1):
 seconds = time.monotonic() - start
 
 os.makedirs(out_dir, exist_ok=True)
+for old in os.listdir(out_dir):
+    if old.startswith("fluid_data_") and old.endswith(".vdb"):
+        os.remove(os.path.join(out_dir, old))
 data = os.path.join(work, "data")
 written = sorted(f for f in os.listdir(data) if f.startswith("fluid_data_") and f.endswith(".vdb"))
 if not written:
