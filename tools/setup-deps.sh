@@ -5,6 +5,7 @@
 #   tools/setup-deps.sh          build and test dependencies
 #   tools/setup-deps.sh --fuzz   ... and clang with libFuzzer (tools/fuzz.sh)
 #   tools/setup-deps.sh --ogre   ... and OGRE 1.12 (sample 21, tests/ogre: splatfx inside an engine)
+#   tools/setup-deps.sh --bake   ... and blender (tools/bake-smoke.py rebakes samples/20-vdb-smoke; not a build dependency)
 set -euo pipefail
 
 PACKAGES=(
@@ -14,14 +15,20 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools python3-imath libopencv-dev nlohmann-json3-dev libgtest-dev
   libassimp-dev libimgui-dev
   gnuplot-nox xvfb xauth
+  # OpenVDB import (splatfx::vdb, optional at configure: SPLATFX_VDB). Debian's
+  # FindOpenVDB.cmake also needs Boost iostreams; python3-openvdb reads and
+  # writes grids from scripts (the bake's provenance checks).
+  libopenvdb-dev libboost-iostreams-dev python3-openvdb
 )
 # tools/fuzz.sh needs clang and its libFuzzer runtime; only it asks for them (--fuzz).
 # Sample 21 (splatfx inside OGRE) is optional: configure skips it, with a message, without OGRE (--ogre).
+# tools/bake-smoke.py needs Blender with mantaflow (Debian's build has it); only --bake asks for it.
 for arg in "$@"; do
   case "$arg" in
     --fuzz) PACKAGES+=(clang libclang-rt-14-dev) ;;
     --ogre) PACKAGES+=(libogre-1.12-dev) ;;
-    *) echo "setup-deps: unknown option $arg (expected --fuzz, --ogre)" >&2; exit 2 ;;
+    --bake) PACKAGES+=(blender) ;;
+    *) echo "setup-deps: unknown option $arg (expected --fuzz, --ogre, --bake)" >&2; exit 2 ;;
   esac
 done
 

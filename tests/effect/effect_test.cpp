@@ -215,6 +215,24 @@ TEST(Effect, BoundsContainEverySplatOverALongAnimation) {
     EffectDesc sd{.name = "stretched", .motion = wanderingMotion()};
     sd.footprintRadius = m.footprint().radius();
     cases.push_back({"stretched", Effect::fromGrid(stretched, sd)});
+    // A baked sequence (Effect::fromSequence) on a rotated lattice, moving: material shifts between frames.
+    GridSequence seq;
+    seq.dims = {5, 6, 4};
+    seq.spacing = glm::vec3(0.45f);
+    seq.transform = glm::rotate(glm::translate(glm::mat4(1.0f), {0.5f, 1.0f, 0.0f}), 0.6f, glm::vec3(0, 0, 1));
+    seq.framesPerSec = 3.0;
+    for (int f = 0; f < 4; ++f) {
+        GridSequenceFrame fr;
+        for (std::size_t i = 0; i < seq.cellCount(); ++i) {
+            fr.opticalDepth.push_back(float((i * 7 + std::size_t(f) * 5) % 11) * 0.1f);
+            fr.velocityCellsPerSec.push_back({float(f) - 1.5f, 2.0f, 0.5f});
+        }
+        seq.frames.push_back(std::move(fr));
+    }
+    EffectDesc qd{.name = "sequence", .motion = wanderingMotion()};
+    qd.textures.propagation.mode = Propagation::Velocity;
+    qd.footprintRadius = m.footprint().radius();
+    cases.push_back({"sequence", Effect::fromSequence(seq, qd)});
 
     const double duration = 20.0, dt = 1.0 / 12.0;
     for (Case& c : cases) {

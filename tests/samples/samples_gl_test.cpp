@@ -2,6 +2,7 @@
 // not empty, and geometry is depth-correct against the splats (Fig. 3: the
 // cow in front of the fire hides it, the fire in front of the cow veils it).
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 
 #include <gtest/gtest.h>
@@ -44,6 +45,13 @@ TEST_F(SamplesGL, EverySampleLoadsAndRendersAFrame) {
     for (const fs::path& p : scenes) {
         SCOPED_TRACE(p.string());
         auto player = scenehost::ScenePlayer::load(p.string());
+#if !SPLATFX_WITH_VDB
+        // Samples of kind "vdb" (20-vdb-smoke) need splatfx::vdb; this build has none, and the loader says so.
+        if (!player.ok() && player.error().find("needs splatfx built with OpenVDB") != std::string::npos) {
+            std::printf("skipped %s: built without OpenVDB\n", p.string().c_str());
+            continue;
+        }
+#endif
         ASSERT_TRUE(player.ok()) << player.error();
         // A few frames up to 1.5 s, so solver effects have emitted and moving objects are in view.
         const splatfx::Image img = render(*player, {0.0, 0.5, 1.0, 1.5}, {160, 120});

@@ -24,6 +24,7 @@ splatfx::Result<splatfx::SceneFile> parse(const std::string& body) {
 std::string minimalEffect(const std::string& kind) {
     if (kind == "grid") return R"({"kind": "grid", "dims": [3, 3, 3]})";
     if (kind == "smoke" || kind == "dust") return R"({"kind": ")" + kind + R"(", "dims": [4, 4, 4]})";
+    if (kind == "vdb") return R"({"kind": "vdb", "files": ")" SPLATFX_SOURCE_DIR R"(/samples/20-vdb-smoke/data/fluid_data_####.vdb", "lastFrame": 2})";
     return R"({"kind": ")" + kind + R"("})";
 }
 
@@ -54,11 +55,13 @@ TEST(SceneFileKinds, AnUnknownKindNamesEveryKnownKind) {
     std::string listed;
     for (const std::string& k : splatfx::scenefile::effectKindNames()) listed += (listed.empty() ? "" : ", ") + ("\"" + k + "\"");
     EXPECT_NE(r.error().find("expected one of " + listed), std::string::npos) << r.error();
-    // The list is the documented one (docs/scene-format.md), in its order.
-    EXPECT_EQ(listed, R"("fire", "smoke", "steam", "dust", "fireToSmoke", "ghosts", "grid", "gas")");
+    // The list is the documented one (docs/scene-format.md), in its order;
+    // "vdb" only in builds with OpenVDB (splatfx::vdb).
+    const std::string vdb = SPLATFX_WITH_VDB ? ", vdb" : "";
+    EXPECT_EQ(listed, std::string(R"("fire", "smoke", "steam", "dust", "fireToSmoke", "ghosts", "grid", "gas")") + (SPLATFX_WITH_VDB ? R"(, "vdb")" : ""));
     auto missing = parse(R"("effects": [{"name": "a"}])");
     ASSERT_FALSE(missing);
-    EXPECT_NE(missing.error().find("missing \"kind\" (one of fire, smoke, steam, dust, fireToSmoke, ghosts, grid, gas)"), std::string::npos)
+    EXPECT_NE(missing.error().find("missing \"kind\" (one of fire, smoke, steam, dust, fireToSmoke, ghosts, grid, gas" + vdb + ")"), std::string::npos)
         << missing.error();
 }
 

@@ -22,6 +22,11 @@
 //   - solver effects (fromSolver) are stateful: step(dt) simulates; update()
 //     asserts; advanceTo(t) steps to t, catching up after a gap in a bounded
 //     number of coarse steps (AdvanceContext).
+//   - sequence effects (fromSequence) play a baked simulation (GridSequence,
+//     e.g. from OpenVDB files through splatfx/vdb.hpp), interpolated between
+//     frames; their texture propagation runs on a fixed clock and is replayed
+//     as needed, so update(t) depends on t alone: stateless, at a cost linear
+//     in the propagation steps replayed.
 // isStateless() tells which; bounds(t0, t1) is a conservative world box of
 // every splat the effect can produce in [t0, t1] (motion and splat extent
 // included), for culling by a scheduler. Other kinds implement EffectKind
@@ -44,6 +49,7 @@
 #include "splatfx/dynamics.hpp"
 #include "splatfx/effect_kind.hpp"
 #include "splatfx/grid.hpp"
+#include "splatfx/grid_sequence.hpp"
 #include "splatfx/motion.hpp"
 #include "splatfx/procedural_gas.hpp"
 #include "splatfx/result.hpp"
@@ -112,6 +118,16 @@ public:
     // Fails on an invalid gas desc (the message names the field), a lattice
     // with no cells or over kMaxVoxels.
     static Result<Effect> fromProceduralGas(ProceduralGasDesc gas, Grid lattice, EffectDesc desc);
+    // A baked simulation played back (grid_sequence.hpp; splatfx/vdb.hpp reads
+    // OpenVDB files into one): frames interpolated at t, looping or clamped,
+    // moved as a whole by desc.motion (its opacity fades it; growth is not
+    // applied), voxels below desc.sparse.minOpacity left out, textures
+    // propagated along the sequence's velocity (Propagation::Velocity) or a
+    // fixed direction, on a fixed clock of stepsPerSec, so update(t) is a
+    // function of t alone (earlier times replay from step 0: cost linear in
+    // t * stepsPerSec). isStateless() is true. Fails on an invalid sequence,
+    // or Propagation::Velocity without velocity; the message names the field.
+    static Result<Effect> fromSequence(GridSequence sequence, EffectDesc desc);
 
     Effect(const Effect& other);
     Effect& operator=(const Effect& other);

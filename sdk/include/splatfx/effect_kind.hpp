@@ -6,11 +6,12 @@
 // splats into a frame. Scene (scene.hpp) decides per frame which kinds are
 // needed (enabled, in range, in view by bounds(), alive()) and calls
 // advanceTo() and emit() on exactly those; it knows nothing else about them.
-// The two kinds the SDK ships are both behind `Effect` (effect.hpp): the
+// The kinds the SDK ships are all behind `Effect` (effect.hpp): the
 // stateless grid effect (base grid + Motion + growth + texture dynamics,
-// King et al. 1999 sec. 3.1-3.3, evaluated at t directly) and the stateful
+// King et al. 1999 sec. 3.1-3.3, evaluated at t directly), the stateful
 // solver effect (FluidSolver + emitters + texture propagation, stepped, and
-// caught up in bounded coarse steps after a gap).
+// caught up in bounded coarse steps after a gap) and the sequence effect (a
+// baked simulation played back, e.g. imported from OpenVDB).
 // It does not own materials, sort or render (the Frame and the renderer do).
 //
 // How to add a kind (a cloud volume, a procedural gas):

@@ -17,6 +17,7 @@
 #include "splatfx/gl/renderer.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
 #include "splatfx/grid.hpp"
+#include "splatfx/grid_sequence.hpp"
 #include "splatfx/image.hpp"
 #include "splatfx/lighting.hpp"
 #include "splatfx/materials.hpp"

@@ -1,5 +1,5 @@
-// Effect: the value type around one of the SDK's two effect kinds
-// (grid_effect.cpp, solver_effect.cpp; their shared code in effect_body.cpp).
+// Effect: the value type around one of the SDK's effect kinds
+// (grid_effect.cpp, solver_effect.cpp, sequence_effect.cpp; their shared code in effect_body.cpp).
 // It only forwards: no function here branches on the kind.
 #include "splatfx/effect.hpp"
 
@@ -35,6 +35,13 @@ Result<Effect> Effect::fromSolver(FluidSolver solver, EffectDesc desc) {
 Result<Effect> Effect::fromProceduralGas(ProceduralGasDesc gas, Grid lattice, EffectDesc desc) {
     if (Status s = detail::EffectBody::checkDesc(desc); !s) return makeError(s.error());
     auto body = detail::makeGasBody(std::move(gas), std::move(lattice), std::move(desc));
+    if (!body) return makeError(body.error());
+    return Effect(std::move(*body));
+}
+
+Result<Effect> Effect::fromSequence(GridSequence sequence, EffectDesc desc) {
+    if (Status s = detail::EffectBody::checkDesc(desc); !s) return makeError(s.error());
+    auto body = detail::makeSequenceBody(std::move(sequence), std::move(desc));
     if (!body) return makeError(body.error());
     return Effect(std::move(*body));
 }

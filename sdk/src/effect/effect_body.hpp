@@ -58,5 +58,6 @@ public:
 std::unique_ptr<EffectBody> makeGridBody(Grid base, EffectDesc desc);
 Result<std::unique_ptr<EffectBody>> makeSolverBody(FluidSolver solver, EffectDesc desc);
 Result<std::unique_ptr<EffectBody>> makeGasBody(ProceduralGasDesc gas, Grid lattice, EffectDesc desc);
+Result<std::unique_ptr<EffectBody>> makeSequenceBody(GridSequence sequence, EffectDesc desc); // sequence_effect.cpp
 
 } // namespace splatfx::detail

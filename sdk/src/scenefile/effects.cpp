@@ -22,7 +22,10 @@ void readEffects(Context& c, const std::string& path, const Json& v, const std::
         ObjectReader o(c.d, e.path, v[i]);
         if (!o.valid()) continue;
         if (const Json* k = o.get("kind")) {
-            if (auto s = readChoice(c.d, o.at("kind"), *k, kinds)) e.kind = *s;
+            if (k->is_string() && *k == "vdb" && !findEffectKind("vdb"))
+                c.d.error(o.at("kind"), "kind \"vdb\" needs splatfx built with OpenVDB (libopenvdb-dev and libboost-iostreams-dev, "
+                                        "tools/setup-deps.sh); this build was configured without it (SPLATFX_VDB)");
+            else if (auto s = readChoice(c.d, o.at("kind"), *k, kinds)) e.kind = *s;
         } else {
             c.d.error(e.path, "missing \"kind\" (one of " + kindList + ")");
         }

@@ -6,6 +6,9 @@ namespace splatfx::scenefile {
 
 // Effect readers, one a file in kinds/.
 EffectReaderFn readFire, readSmoke, readSteam, readDust, readFireToSmoke, readGhosts, readGridKind, readGasKind;
+#if SPLATFX_WITH_VDB
+EffectReaderFn readVdbKind; // only when splatfx::vdb is built (OpenVDB found)
+#endif
 // Geometry readers, for the types with keys of their own.
 GeometryReaderFn readMeshGeometry;
 GeometryReaderFn readHeightmapGeometry; // [foggaps]
@@ -22,6 +25,9 @@ constexpr EffectKind kEffectKinds[] = {
     {"ghosts", &readGhosts},           // kinds/ghosts.cpp
     {"grid", &readGridKind},           // kinds/grid.cpp
     {"gas", &readGasKind},             // kinds/gas.cpp
+#if SPLATFX_WITH_VDB
+    {"vdb", &readVdbKind},             // kinds/vdb.cpp
+#endif
 };
 
 constexpr GeometryKind kGeometryKinds[] = {

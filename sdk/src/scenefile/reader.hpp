@@ -122,6 +122,11 @@ void readDims(Context& c, ObjectReader& o, glm::ivec3& dims, std::uint64_t limit
 
 glm::vec3 applyPoint(const glm::mat4& m, glm::vec3 p);
 
+// A "propagation" object (dynamics.hpp, sec. 3.2); allowVelocity admits mode
+// "velocity" (kinds that carry a flow: "vdb"). And a "cycling" object (sec. 3.3).
+void readPropagation(Context& c, ObjectReader& o, PropagationDesc& p, bool allowVelocity);
+void readCycling(Context& c, ObjectReader& o, CyclingDesc& cy);
+
 // [SECTION] Geometry
 
 struct RawGeometry {

@@ -309,4 +309,28 @@ void readDims(Context& c, ObjectReader& o, glm::ivec3& dims, std::uint64_t limit
 
 glm::vec3 applyPoint(const glm::mat4& m, glm::vec3 p) { return glm::vec3(m * glm::vec4(p, 1.0f)); }
 
+// "propagation" and "cycling" objects (kinds grid and vdb).
+void readPropagation(Context& c, ObjectReader& o, PropagationDesc& p, bool allowVelocity) {
+    if (const Json* m = o.get("mode")) {
+        const std::vector<std::string> modes = allowVelocity ? std::vector<std::string>{"none", "fixed", "velocity"} : std::vector<std::string>{"none", "fixed"};
+        if (auto s = readChoice(c.d, o.at("mode"), *m, modes))
+            p.mode = *s == "none" ? Propagation::None : *s == "fixed" ? Propagation::Fixed : Propagation::Velocity;
+    }
+    o.ivec3("direction", p.direction, -8, 8);
+    o.number("stepsPerSec", p.stepsPerSec, 1e-3, 1e3);
+    int offset = int(p.offset);
+    o.integer("offset", offset, 0, 1 << 20);
+    p.offset = std::uint32_t(offset);
+    if (p.mode == Propagation::Fixed && p.direction == glm::ivec3(0)) c.d.error(o.at("direction"), "must be non-zero for mode \"fixed\"");
+}
+
+void readCycling(Context& c, ObjectReader& o, CyclingDesc& cy) {
+    if (const Json* m = o.get("mode"))
+        if (auto s = readChoice(c.d, o.at("mode"), *m, {"none", "ordered", "random"}))
+            cy.mode = *s == "none" ? Cycling::None : *s == "ordered" ? Cycling::Ordered : Cycling::Random;
+    o.number("texturesPerSec", cy.texturesPerSec, 0.0, 1e3);
+    o.number("rateJitter", cy.rateJitter, 0.0, 0.99);
+    o.boolean("randomStart", cy.randomStart);
+}
+
 } // namespace splatfx::scenefile

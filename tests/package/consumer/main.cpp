@@ -5,6 +5,9 @@
 
 #include <splatfx/context.hpp>
 #include <splatfx/splatfx.hpp>
+#if CONSUMER_HAS_VDB
+#include <splatfx/vdb.hpp>
+#endif
 
 int main() {
     auto ctx = splatfx::HeadlessContext::create();
@@ -46,6 +49,12 @@ int main() {
         for (int x = 0; x < 64; ++x) brightest = std::max(brightest, lit.at(x, y, 0));
     if (!opaqueDrawn || frame.counters().needed != 1 || frame.splats().empty() || !(brightest > 0.1f))
         return std::fprintf(stderr, "consumer: the scene drew nothing\n"), 1;
+#if CONSUMER_HAS_VDB
+    // splatfx::vdb links OpenVDB: a missing file is an error naming it, not a crash.
+    auto vdb = splatfx::loadVdb("no-such-smoke.vdb");
+    if (vdb || vdb.error().find("no-such-smoke.vdb' (frame 0): no such file") == std::string::npos)
+        return std::fprintf(stderr, "consumer: loadVdb: unexpected answer '%s'\n", vdb.error().c_str()), 1;
+#endif
     std::printf("consumer: ok (%zu splats on %s)\n", frame.splats().size(), ctx->renderer().c_str());
     return 0;
 }

@@ -49,26 +49,6 @@ void readShape(Context& c, ObjectReader& o, Shape& s) {
     o.number("softCells", s.softCells, 0.05, L);
 }
 
-void readPropagation(Context& c, ObjectReader& o, PropagationDesc& p) {
-    if (const Json* m = o.get("mode"))
-        if (auto s = readChoice(c.d, o.at("mode"), *m, {"none", "fixed"})) p.mode = *s == "none" ? Propagation::None : Propagation::Fixed;
-    o.ivec3("direction", p.direction, -8, 8);
-    o.number("stepsPerSec", p.stepsPerSec, 1e-3, 1e3);
-    int offset = int(p.offset);
-    o.integer("offset", offset, 0, 1 << 20);
-    p.offset = std::uint32_t(offset);
-    if (p.mode == Propagation::Fixed && p.direction == glm::ivec3(0)) c.d.error(o.at("direction"), "must be non-zero for mode \"fixed\"");
-}
-
-void readCycling(Context& c, ObjectReader& o, CyclingDesc& cy) {
-    if (const Json* m = o.get("mode"))
-        if (auto s = readChoice(c.d, o.at("mode"), *m, {"none", "ordered", "random"}))
-            cy.mode = *s == "none" ? Cycling::None : *s == "ordered" ? Cycling::Ordered : Cycling::Random;
-    o.number("texturesPerSec", cy.texturesPerSec, 0.0, 1e3);
-    o.number("rateJitter", cy.rateJitter, 0.0, 0.99);
-    o.boolean("randomStart", cy.randomStart);
-}
-
 } // namespace
 
 // A hand-shaped grid effect: the full Effect::fromGrid control.
@@ -103,7 +83,9 @@ std::optional<Effect> readGridKind(Context& c, ObjectReader& o, const EffectComm
     EffectDesc desc;
     desc.textures.seed = e.seed;
     if (const Json* p = o.get("propagation"))
-        if (auto x = readObject<PropagationDesc>(c, o.at("propagation"), *p, readPropagation)) desc.textures.propagation = *x;
+        if (auto x = readObject<PropagationDesc>(c, o.at("propagation"), *p,
+                                                 [](Context& c2, ObjectReader& o2, PropagationDesc& v) { readPropagation(c2, o2, v, false); }))
+            desc.textures.propagation = *x;
     if (const Json* p = o.get("cycling"))
         if (auto x = readObject<CyclingDesc>(c, o.at("cycling"), *p, readCycling)) desc.textures.cycling = *x;
     bool crossfade = true;

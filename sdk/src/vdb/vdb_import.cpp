@@ -1,0 +1,399 @@
+// OpenVDB import (splatfx::vdb): grid metadata checked for every frame first,
+// then each frame's density, temperature and velocity box-filtered onto one
+// coarse lattice (see splatfx/vdb.hpp for the filters and why the density
+// filter preserves each coarse cell's optical depth). OpenVDB throws; no
+// exception leaves this file.
+#include "splatfx/vdb.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <openvdb/openvdb.h>
+
+namespace splatfx {
+namespace {
+
+constexpr int kMaxFrames = 100000; // a sequence longer than this is a pattern mistake
+
+std::string num(double v) {
+    std::ostringstream os;
+    os << v;
+    return os.str();
+}
+
+std::string where(const std::string& path, int frame, const std::string& grid) {
+    return "OpenVDB file '" + path + "' (frame " + std::to_string(frame) + "), grid '" + grid + "': ";
+}
+
+// floor(a / b) for b > 0.
+int floorDiv(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
+
+// What the metadata of one frame says, before any voxel is read.
+struct FrameInfo {
+    std::string path;
+    int frame = 0;
+    openvdb::math::Transform::Ptr transform;
+    openvdb::CoordBBox densityBox;
+    bool hasMetaBox = false; // false: the file lacks OpenVDB's statistics metadata
+};
+
+// Checks one grid's metadata: present, of the expected type, a fog volume,
+// within the voxel budget, not empty. `box` gets the file's bounding box.
+template <class GridT>
+Status checkGrid(const openvdb::GridPtrVec& grids, const std::string& path, int frame, const std::string& name, const char* typeWanted,
+                 const VdbImportDesc& desc, openvdb::GridBase::ConstPtr& found, openvdb::CoordBBox& box, bool& hasBox) {
+    const std::string at = where(path, frame, name);
+    std::string names;
+    for (const auto& g : grids) {
+        if (!g) continue;
+        if (g->getName() == name) found = g;
+        names += (names.empty() ? "" : ", ") + ("'" + g->getName() + "'");
+    }
+    if (!found) return makeError(at + "no such grid in the file (it has " + (names.empty() ? std::string("no grids") : names) + ")");
+    if (!found->isType<GridT>())
+        return makeError(at + "holds " + found->valueType() + " values; expected a " + typeWanted + " grid");
+    if (found->getGridClass() == openvdb::GRID_LEVEL_SET)
+        return makeError(at + "is a level set (signed distances), not a density/fog volume");
+    const auto countMeta = found->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT);
+    const auto lo = found->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
+    const auto hi = found->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
+    hasBox = countMeta && lo && hi;
+    if (countMeta) {
+        const std::int64_t count = countMeta->value();
+        if (count <= 0) return makeError(at + "is empty (no active voxels)");
+        if (std::uint64_t(count) > desc.maxFileVoxels)
+            return makeError(at + "has " + std::to_string(count) + " active voxels (from the file's metadata; nothing was read); the limit is " +
+                             std::to_string(desc.maxFileVoxels) + " (VdbImportDesc::maxFileVoxels)");
+    }
+    if (hasBox) box = openvdb::CoordBBox(openvdb::Coord(lo->value()), openvdb::Coord(hi->value()));
+    return {};
+}
+
+// The transform must be a uniform scale plus a translation (axis-aligned
+// cubic voxels): the box filter's exactness needs blocks of whole voxels.
+Status checkTransform(const openvdb::math::Transform& xf, const std::string& at, double& voxelSize, openvdb::Vec3d& origin) {
+    if (!xf.isLinear()) return makeError(at + "has a non-linear (frustum) transform; only a uniform scale plus translation is supported");
+    const openvdb::Mat4d m = xf.baseMap()->getAffineMap()->getMat4();
+    const double s = m(0, 0);
+    const double tol = 1e-9 * std::abs(s);
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) {
+            const double want = r == c ? s : 0.0;
+            if (std::abs(m(r, c) - want) > tol)
+                return makeError(at + "has a rotated, sheared or non-uniform transform (voxel size " + num(xf.voxelSize()[0]) + ", " +
+                                 num(xf.voxelSize()[1]) + ", " + num(xf.voxelSize()[2]) +
+                                 "); only a uniform scale plus translation is supported");
+        }
+    if (!(s > 0.0) || !std::isfinite(s)) return makeError(at + "has voxel size " + num(s) + "; expected a positive finite value");
+    voxelSize = s;
+    origin = openvdb::Vec3d(m(3, 0), m(3, 1), m(3, 2)); // OpenVDB matrices act on row vectors: translation in row 3
+    return {};
+}
+
+// Calls f(coord, value) for every active voxel of the grid, tiles expanded.
+template <class GridT, class F>
+void forEachActive(const GridT& grid, F&& f) {
+    for (auto it = grid.cbeginValueOn(); it; ++it) {
+        if (it.isVoxelValue()) {
+            f(it.getCoord(), *it);
+        } else {
+            openvdb::CoordBBox b;
+            it.getBoundingBox(b);
+            const auto v = *it;
+            for (auto c = b.begin(); c; ++c) f(*c, v);
+        }
+    }
+}
+
+struct Lattice {
+    int factor = 1;
+    openvdb::Coord lo; // first coarse cell, in coarse cell units of the file's index space
+    glm::ivec3 dims{0};
+    double voxelSize = 1.0;
+    openvdb::Vec3d origin{0.0};
+
+    // Linear cell index of a file voxel, or -1 outside the lattice.
+    std::int64_t cellOf(const openvdb::Coord& c) const {
+        const int x = floorDiv(c.x(), factor) - lo.x(), y = floorDiv(c.y(), factor) - lo.y(), z = floorDiv(c.z(), factor) - lo.z();
+        if (x < 0 || y < 0 || z < 0 || x >= dims.x || y >= dims.y || z >= dims.z) return -1;
+        return (std::int64_t(z) * dims.y + y) * dims.x + x;
+    }
+};
+
+Result<GridSequence> load(const std::vector<std::string>& paths, const std::vector<int>& frameNumbers, const VdbImportDesc& desc) {
+    if (desc.densityGrid.empty()) return makeError("VdbImportDesc::densityGrid is empty; name the density grid (e.g. \"density\")");
+    if (desc.voxelsPerCell < 0) return makeError("VdbImportDesc::voxelsPerCell is " + std::to_string(desc.voxelsPerCell) + "; expected >= 0");
+    if (desc.voxelsPerCell == 0 && desc.maxCellsPerAxis < 1)
+        return makeError("VdbImportDesc::maxCellsPerAxis is " + std::to_string(desc.maxCellsPerAxis) + "; expected >= 1");
+    if (!(desc.extinctionPerDensity >= 0.0f) || !std::isfinite(desc.extinctionPerDensity))
+        return makeError("VdbImportDesc::extinctionPerDensity is " + num(desc.extinctionPerDensity) + "; expected a finite value >= 0");
+    if (!std::isfinite(desc.velocityScale)) return makeError("VdbImportDesc::velocityScale is not finite");
+    if (!(desc.framesPerSec > 0.0) || !std::isfinite(desc.framesPerSec))
+        return makeError("VdbImportDesc::framesPerSec is " + num(desc.framesPerSec) + "; expected a positive finite value");
+    const bool autoRange = std::isnan(desc.temperatureHot) && std::isnan(desc.temperatureCold);
+    if (!autoRange && !(std::isfinite(desc.temperatureHot) && std::isfinite(desc.temperatureCold) && desc.temperatureHot != desc.temperatureCold))
+        return makeError("VdbImportDesc::temperatureHot and temperatureCold must both be NaN (automatic) or finite and different; got " +
+                         num(desc.temperatureHot) + " and " + num(desc.temperatureCold));
+
+    openvdb::initialize();
+    std::vector<FrameInfo> infos;
+    // Pass 1: metadata only, every frame, so a bad frame 200 fails before frame 1's voxels are read.
+    for (std::size_t i = 0; i < paths.size(); ++i) {
+        FrameInfo fi;
+        fi.path = paths[i];
+        fi.frame = frameNumbers[i];
+        const std::string fileAt = "OpenVDB file '" + fi.path + "' (frame " + std::to_string(fi.frame) + "): ";
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(fi.path, ec)) return makeError(fileAt + "no such file");
+        openvdb::GridPtrVecPtr grids;
+        try {
+            openvdb::io::File file(fi.path);
+            file.open(false);
+            grids = file.readAllGridMetadata();
+            file.close();
+        } catch (const std::exception& e) {
+            return makeError(fileAt + "cannot be read as OpenVDB: " + e.what());
+        }
+        openvdb::GridBase::ConstPtr density, temperature, velocity;
+        openvdb::CoordBBox unusedBox;
+        bool unusedHas = false;
+        if (Status s = checkGrid<openvdb::FloatGrid>(*grids, fi.path, fi.frame, desc.densityGrid, "float", desc, density, fi.densityBox, fi.hasMetaBox); !s)
+            return makeError(s.error());
+        if (!desc.temperatureGrid.empty())
+            if (Status s = checkGrid<openvdb::FloatGrid>(*grids, fi.path, fi.frame, desc.temperatureGrid, "float", desc, temperature, unusedBox, unusedHas); !s)
+                return makeError(s.error());
+        if (!desc.velocityGrid.empty())
+            if (Status s = checkGrid<openvdb::Vec3SGrid>(*grids, fi.path, fi.frame, desc.velocityGrid, "vec3s (float vector)", desc, velocity, unusedBox, unusedHas); !s)
+                return makeError(s.error());
+        fi.transform = density->transform().copy();
+        double vs = 0.0;
+        openvdb::Vec3d origin;
+        if (Status s = checkTransform(*fi.transform, where(fi.path, fi.frame, desc.densityGrid), vs, origin); !s) return makeError(s.error());
+        for (const auto& other : {temperature, velocity})
+            if (other && !(other->transform() == *fi.transform))
+                return makeError(where(fi.path, fi.frame, other->getName()) + "has a transform different from grid '" + desc.densityGrid +
+                                 "' in the same file (voxel size " + num(other->transform().voxelSize()[0]) + " vs " + num(vs) +
+                                 "); every imported grid must share one transform");
+        if (!infos.empty() && !(*fi.transform == *infos[0].transform)) {
+            const openvdb::Vec3d o0 = infos[0].transform->indexToWorld(openvdb::Vec3d(0.0)), o1 = fi.transform->indexToWorld(openvdb::Vec3d(0.0));
+            return makeError(where(fi.path, fi.frame, desc.densityGrid) + "has a transform different from frame " +
+                             std::to_string(infos[0].frame) + "'s ('" + infos[0].path + "'): voxel size " + num(vs) + " vs " +
+                             num(infos[0].transform->voxelSize()[0]) + ", index origin at (" + num(o1[0]) + ", " + num(o1[1]) + ", " +
+                             num(o1[2]) + ") vs (" + num(o0[0]) + ", " + num(o0[1]) + ", " + num(o0[2]) +
+                             "); every frame of a sequence must share one transform");
+        }
+        infos.push_back(std::move(fi));
+    }
+
+    // Pass 2: read each frame, then resample. Files without statistics
+    // metadata have their boxes and voxel counts checked right after reading.
+    struct Loaded {
+        openvdb::FloatGrid::ConstPtr density, temperature;
+        openvdb::Vec3SGrid::ConstPtr velocity;
+    };
+    auto readFrame = [&](const FrameInfo& fi, Loaded& out) -> Status {
+        try {
+            openvdb::io::File file(fi.path);
+            file.open(false);
+            out.density = openvdb::gridConstPtrCast<openvdb::FloatGrid>(file.readGrid(desc.densityGrid));
+            if (!desc.temperatureGrid.empty())
+                out.temperature = openvdb::gridConstPtrCast<openvdb::FloatGrid>(file.readGrid(desc.temperatureGrid));
+            if (!desc.velocityGrid.empty()) out.velocity = openvdb::gridConstPtrCast<openvdb::Vec3SGrid>(file.readGrid(desc.velocityGrid));
+            file.close();
+        } catch (const std::exception& e) {
+            return makeError("OpenVDB file '" + fi.path + "' (frame " + std::to_string(fi.frame) + "): reading the grids failed: " + e.what());
+        }
+        const std::string at = where(fi.path, fi.frame, desc.densityGrid);
+        if (!out.density) return makeError(at + "could not be read as a float grid");
+        if (out.density->background() != 0.0f)
+            return makeError(at + "has background " + num(out.density->background()) + "; a density grid's empty space must be 0");
+        if (!fi.hasMetaBox) {
+            const openvdb::Index64 count = out.density->activeVoxelCount();
+            if (count == 0) return makeError(at + "is empty (no active voxels)");
+            if (count > desc.maxFileVoxels)
+                return makeError(at + "has " + std::to_string(count) + " active voxels; the limit is " + std::to_string(desc.maxFileVoxels) +
+                                 " (VdbImportDesc::maxFileVoxels; the file had no voxel-count metadata, so this was found after reading)");
+        }
+        return {};
+    };
+
+    // The lattice: the union of the frames' density boxes, in blocks of `factor` voxels.
+    std::vector<Loaded> early(infos.size());
+    openvdb::CoordBBox unionBox;
+    for (std::size_t i = 0; i < infos.size(); ++i) {
+        FrameInfo& fi = infos[i];
+        if (!fi.hasMetaBox) {
+            if (Status s = readFrame(fi, early[i]); !s) return makeError(s.error());
+            fi.densityBox = early[i].density->evalActiveVoxelBoundingBox();
+        }
+        unionBox.expand(fi.densityBox);
+    }
+    Lattice lat;
+    {
+        openvdb::Vec3d origin;
+        (void)checkTransform(*infos[0].transform, "", lat.voxelSize, origin);
+        lat.origin = origin;
+    }
+    const openvdb::Coord extent = unionBox.dim();
+    const int longest = std::max({extent.x(), extent.y(), extent.z()});
+    lat.factor = desc.voxelsPerCell > 0 ? desc.voxelsPerCell : std::max(1, (longest + desc.maxCellsPerAxis - 1) / desc.maxCellsPerAxis);
+    lat.lo = openvdb::Coord(floorDiv(unionBox.min().x(), lat.factor), floorDiv(unionBox.min().y(), lat.factor), floorDiv(unionBox.min().z(), lat.factor));
+    const openvdb::Coord hi(floorDiv(unionBox.max().x(), lat.factor), floorDiv(unionBox.max().y(), lat.factor), floorDiv(unionBox.max().z(), lat.factor));
+    const std::uint64_t cells = std::uint64_t(hi.x() - lat.lo.x() + 1) * std::uint64_t(hi.y() - lat.lo.y() + 1) * std::uint64_t(hi.z() - lat.lo.z() + 1);
+    if (cells > kMaxVoxels)
+        return makeError(where(infos[0].path, infos[0].frame, desc.densityGrid) + "the frames' density spans " + std::to_string(extent.x()) + " x " +
+                         std::to_string(extent.y()) + " x " + std::to_string(extent.z()) + " voxels; at " + std::to_string(lat.factor) +
+                         " voxels per cell that is " + std::to_string(cells) + " coarse cells, more than " + std::to_string(kMaxVoxels) +
+                         " (raise VdbImportDesc::voxelsPerCell)");
+    lat.dims = glm::ivec3(hi.x() - lat.lo.x() + 1, hi.y() - lat.lo.y() + 1, hi.z() - lat.lo.z() + 1);
+    if (cells * infos.size() > kMaxVdbSequenceCells)
+        return makeError(where(infos[0].path, infos[0].frame, desc.densityGrid) + "the sequence would hold " + std::to_string(cells) +
+                         " coarse cells x " + std::to_string(infos.size()) + " frames, more than " + std::to_string(kMaxVdbSequenceCells) +
+                         " cells in all (kMaxVdbSequenceCells); raise VdbImportDesc::voxelsPerCell or load fewer frames");
+
+    GridSequence seq;
+    seq.dims = lat.dims;
+    const double cellWorld = lat.voxelSize * lat.factor;
+    seq.spacing = glm::vec3(float(cellWorld));
+    seq.framesPerSec = desc.framesPerSec;
+    seq.end = desc.end;
+    {
+        // World position of coarse cell 0's centre: the centre of its block,
+        // file index lo * factor + (factor - 1) / 2 (OpenVDB voxel centres sit
+        // on integer index coordinates). Grid::localPosition centres x and z,
+        // so the transform adds that half-extent back.
+        const double c0 = 0.5 * double(lat.factor - 1);
+        const openvdb::Vec3d p0 = infos[0].transform->indexToWorld(
+            openvdb::Vec3d(lat.lo.x() * double(lat.factor) + c0, lat.lo.y() * double(lat.factor) + c0, lat.lo.z() * double(lat.factor) + c0));
+        const glm::dvec3 half(0.5 * (lat.dims.x - 1) * cellWorld, 0.0, 0.5 * (lat.dims.z - 1) * cellWorld);
+        seq.transform = glm::mat4(1.0f);
+        seq.transform[3] = glm::vec4(glm::vec3(glm::dvec3(p0[0], p0[1], p0[2]) + half), 1.0f);
+    }
+    const std::size_t n = seq.cellCount();
+    const double blockVoxels = double(lat.factor) * lat.factor * lat.factor;
+    // tau = sigma_mean * edge = extinction * (sum of density / voxels in block) * cellWorld.
+    const double depthPerDensitySum = double(desc.extinctionPerDensity) * cellWorld / blockVoxels;
+    std::vector<std::vector<double>> temperatures; // per frame, density-weighted mean (NaN: no material)
+    float tMin = std::numeric_limits<float>::infinity(), tMax = -std::numeric_limits<float>::infinity();
+
+    for (std::size_t i = 0; i < infos.size(); ++i) {
+        const FrameInfo& fi = infos[i];
+        Loaded g = std::move(early[i]);
+        if (!g.density)
+            if (Status s = readFrame(fi, g); !s) return makeError(s.error());
+        GridSequenceFrame frame;
+        std::vector<double> sum(n, 0.0), sumT(n, 0.0);
+        auto tAcc = g.temperature ? std::make_unique<openvdb::FloatGrid::ConstAccessor>(g.temperature->getConstAccessor()) : nullptr;
+        bool negative = false;
+        forEachActive(*g.density, [&](const openvdb::Coord& c, float d) {
+            const std::int64_t k = lat.cellOf(c);
+            if (k < 0 || d == 0.0f) return;
+            if (!(d >= 0.0f) || !std::isfinite(d)) {
+                negative = true;
+                return;
+            }
+            sum[std::size_t(k)] += d;
+            if (tAcc) sumT[std::size_t(k)] += double(d) * double(tAcc->getValue(c));
+        });
+        if (negative)
+            return makeError(where(fi.path, fi.frame, desc.densityGrid) + "holds negative, NaN or infinite densities; expected finite values >= 0");
+        frame.opticalDepth.resize(n);
+        for (std::size_t k = 0; k < n; ++k) frame.opticalDepth[k] = float(sum[k] * depthPerDensitySum);
+        if (g.temperature) {
+            std::vector<double> t(n, std::numeric_limits<double>::quiet_NaN());
+            for (std::size_t k = 0; k < n; ++k)
+                if (sum[k] > 0.0 && frame.opticalDepth[k] > 0.0f) {
+                    t[k] = sumT[k] / sum[k];
+                    if (!std::isfinite(t[k]))
+                        return makeError(where(fi.path, fi.frame, desc.temperatureGrid) + "holds NaN or infinite temperatures where there is density");
+                    tMin = std::min(tMin, float(t[k]));
+                    tMax = std::max(tMax, float(t[k]));
+                }
+            temperatures.push_back(std::move(t));
+        }
+        if (g.velocity) {
+            const openvdb::Vec3s bg = g.velocity->background();
+            std::vector<glm::dvec3> v(n, glm::dvec3(0.0));
+            bool bad = false;
+            forEachActive(*g.velocity, [&](const openvdb::Coord& c, const openvdb::Vec3s& u) {
+                const std::int64_t k = lat.cellOf(c);
+                if (k < 0) return;
+                if (!std::isfinite(u[0]) || !std::isfinite(u[1]) || !std::isfinite(u[2])) bad = true;
+                v[std::size_t(k)] += glm::dvec3(u[0] - bg[0], u[1] - bg[1], u[2] - bg[2]);
+            });
+            if (bad) return makeError(where(fi.path, fi.frame, desc.velocityGrid) + "holds NaN or infinite velocities");
+            // World units (or file voxels) per second to lattice cells per second.
+            const double unit = desc.velocityUnit == VdbImportDesc::VelocityUnit::VoxelsPerSec ? lat.voxelSize : 1.0;
+            const double toCells = double(desc.velocityScale) * unit / cellWorld;
+            frame.velocityCellsPerSec.resize(n);
+            for (std::size_t k = 0; k < n; ++k) {
+                const glm::dvec3 mean = glm::dvec3(bg[0], bg[1], bg[2]) + v[k] / blockVoxels;
+                frame.velocityCellsPerSec[k] = glm::vec3(mean * toCells);
+            }
+        }
+        seq.frames.push_back(std::move(frame));
+    }
+
+    if (!desc.temperatureGrid.empty()) {
+        float hot = desc.temperatureHot, cold = desc.temperatureCold;
+        if (autoRange) hot = tMax, cold = tMin;
+        const double span = double(hot) - double(cold);
+        for (std::size_t i = 0; i < seq.frames.size(); ++i) {
+            std::vector<float>& cc = seq.frames[i].colorCoord;
+            cc.assign(n, 0.0f);
+            for (std::size_t k = 0; k < n; ++k) {
+                const double t = temperatures[i][k];
+                if (std::isnan(t)) continue; // no material: the colour is never seen (depth-weighted)
+                // An automatic range of one temperature maps everything to hot.
+                const double u = span != 0.0 ? (t - double(cold)) / span : 1.0;
+                cc[k] = float(std::clamp(1.0 - u, 0.0, 1.0));
+            }
+        }
+    }
+    if (Status s = seq.validate(); !s) return makeError("OpenVDB import of '" + infos[0].path + "': " + s.error());
+    return seq;
+}
+
+} // namespace
+
+std::string vdbFramePath(const std::string& pattern, int frame) {
+    const std::size_t first = pattern.rfind('#');
+    if (first == std::string::npos) return pattern;
+    std::size_t start = first;
+    while (start > 0 && pattern[start - 1] == '#') --start;
+    const std::size_t width = first - start + 1;
+    std::string digits = std::to_string(frame < 0 ? -frame : frame);
+    if (digits.size() < width) digits.insert(0, width - digits.size(), '0');
+    if (frame < 0) digits.insert(0, 1, '-');
+    return pattern.substr(0, start) + digits + pattern.substr(first + 1);
+}
+
+Result<GridSequence> loadVdb(const std::string& path, const VdbImportDesc& desc) { return load({path}, {0}, desc); }
+
+Result<GridSequence> loadVdbSequence(const std::string& pattern, int firstFrame, int lastFrame, const VdbImportDesc& desc) {
+    if (pattern.find('#') == std::string::npos)
+        return makeError("OpenVDB sequence '" + pattern + "': the pattern has no '#' run for the frame number (e.g. fluid_data_####.vdb)");
+    std::vector<std::string> paths;
+    std::vector<int> frames;
+    if (lastFrame >= firstFrame) {
+        if (std::int64_t(lastFrame) - firstFrame >= kMaxFrames)
+            return makeError("OpenVDB sequence '" + pattern + "': " + std::to_string(std::int64_t(lastFrame) - firstFrame + 1) +
+                             " frames; the limit is " + std::to_string(kMaxFrames));
+        for (int f = firstFrame; f <= lastFrame; ++f) paths.push_back(vdbFramePath(pattern, f)), frames.push_back(f);
+    } else {
+        std::error_code ec;
+        for (int f = firstFrame; f < firstFrame + kMaxFrames && std::filesystem::is_regular_file(vdbFramePath(pattern, f), ec); ++f)
+            paths.push_back(vdbFramePath(pattern, f)), frames.push_back(f);
+        if (paths.empty())
+            return makeError("OpenVDB sequence '" + pattern + "': no file for its first frame " + std::to_string(firstFrame) + " ('" +
+                             vdbFramePath(pattern, firstFrame) + "')");
+    }
+    return load(paths, frames, desc);
+}
+
+} // namespace splatfx
