@@ -1,4 +1,4 @@
-// [foggaps] The one-medium reference (integrateRayWithFog, renderTetraExact)
+// The one-medium reference (integrateRayWithFog, renderTetraExact)
 // against the closed form of a constant fog through one homogeneous
 // tetrahedron: fog only, cloud and fog together, fog only again.
 #include <cmath>

@@ -66,7 +66,7 @@ TEST(SceneHostMesh, AFifoIsNotRead) {
     expectRefused(fifo, "not a regular file");
 }
 
-// [foggaps] The "heightmap" geometry: every 16-bit sample becomes
+// The "heightmap" geometry: every 16-bit sample becomes
 // heightmapPoint(...) exactly (code / 65535 in float, as OpenImageIO reads it),
 // two upward-facing triangles a cell; a missing or 1-pixel-wide image is refused.
 TEST(SceneHostHeightmap, SamplesBecomeGridPointsFacingUp) {

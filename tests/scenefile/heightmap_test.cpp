@@ -1,4 +1,4 @@
-// [foggaps] The "heightmap" geometry type and the "groundFog" volume kind: a
+// The "heightmap" geometry type and the "groundFog" volume kind: a
 // terrain and a fog layer read from one 16-bit PGM share every sample point,
 // the fog layer reaches the Frame through Scene::prepare, and bad input is a
 // message naming the field.

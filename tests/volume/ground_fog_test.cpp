@@ -151,7 +151,7 @@ TEST(GroundFog, BadInputIsAnError) {
     EXPECT_FALSE(makeGroundFogTransfer({1, 1, 1}, -1.0f));
 }
 
-// [foggaps] The sort-free emissive model (GroundFogDesc::sortFree) emits the
+// The sort-free emissive model (GroundFogDesc::sortFree) emits the
 // same tetrahedra as the sorted layer, in another order, from outside and
 // from inside the fog (near-plane clipping included).
 TEST(GroundFog, SortFreeEmitsTheSameTetrahedraInGridOrder) {

@@ -48,7 +48,7 @@ glm::dvec3 pixelRay(const Camera& cam, int x, int y) {
 // tetrahedron the ray crosses is one table lookup of (front scalar, back
 // scalar, length x mean length scale), composited front to back. `bound`
 // receives the derived worst case of |GL - this| (see below).
-// [foggaps] With a fog (and `transfer`), each segment is fogged as the fog
+// With a fog (and `transfer`), each segment is fogged as the fog
 // variant does (f at the opacity centroid, closed-form f in double) and three
 // more figures per ray are summed over the segments: `tableError`, 2 x the
 // largest channel of |lookup - exact segment integral| (a layer error e moves
@@ -555,7 +555,7 @@ TEST_F(TetraPassGL, ReducedResolutionSplatsLeaveTheTetrahedraAtFullResolution) {
     EXPECT_EQ(half->stats().tetrahedra, full->stats().tetrahedra);
 }
 
-// [foggaps, issue 17 item 8] The camera inside one tetrahedron: cut at the
+// (issue 17 item 8) The camera inside one tetrahedron: cut at the
 // near plane as a volume (clipTetrahedron: the tip left by three vertices
 // behind the plane, and a prism of three pieces when one is), the pass draws
 // every pixel (no holes), within the derived bound of its CPU model, and the
@@ -621,7 +621,7 @@ TEST_F(TetraPassGL, CameraInsideOneTetrahedronIsClippedWithoutHoles) {
     }
 }
 
-// [foggaps, issue 17 item 8] A sliver (thickness 1e-3 of its size, far above
+// (issue 17 item 8) A sliver (thickness 1e-3 of its size, far above
 // the degenerate cut of 1e-9) seen face-on and grazing: finite pixels, within
 // the model's bound, i.e. its huge barycentric gradients do not blow up the
 // entry and exit distances.
@@ -670,7 +670,7 @@ TEST_F(TetraPassGL, SliverTetrahedraStayFiniteAndWithinTheBound) {
     }
 }
 
-// [foggaps] How many tetrahedra the ray o + t d (t > 0) crosses.
+// How many tetrahedra the ray o + t d (t > 0) crosses.
 int crossings(const std::vector<Tetrahedron>& tets, glm::dvec3 o, glm::dvec3 d) {
     static constexpr int kFaces[4][4] = {{1, 2, 3, 0}, {0, 2, 3, 1}, {0, 1, 3, 2}, {0, 1, 2, 3}};
     int n = 0;
@@ -694,7 +694,7 @@ int crossings(const std::vector<Tetrahedron>& tets, glm::dvec3 o, glm::dvec3 d) 
     return n;
 }
 
-// [foggaps, issue 17] The sort-free emissive model (sec. 6, eq. 10): the
+// (issue 17) The sort-free emissive model (sec. 6, eq. 10): the
 // layer emitted in grid order draws the sorted image up to float rounding,
 // because one-colour "over" blends commute; with a transfer function whose
 // colour varies the two orders differ far beyond that bound, so the equality
@@ -768,7 +768,7 @@ TEST_F(TetraPassGL, SortFreeGroundFogMatchesTheSortedImage) {
     std::printf("sort-free ground fog: worst |sorted - sort-free| / bound %.3f; two-colour max difference %.3f\n", worst, worstTwo);
 }
 
-// [foggaps, issue 14] One medium: a fog in front of, inside and around the
+// (issue 14) One medium: a fog in front of, inside and around the
 // cloud. Every GL pixel matches the pass's CPU model of the fog variant within
 // the derived bound, and the model matches the physical integral of cloud and
 // fog together (renderTetraExact's ray integral) within the table's error

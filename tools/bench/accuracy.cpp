@@ -96,7 +96,7 @@ struct Config {
     bool octagons = splatfx::gl::RendererDesc{}.trimCorners;        // the SDK default
     splatfx::gl::TextureSampling sampling = splatfx::gl::RendererDesc{}.sampling; // the SDK default
     int upsample = splatfx::gl::RendererDesc{}.upsample;
-    // [foggaps] Fog knobs (issue 14): the bench fog's first `fogTerms` terms
+    // Fog knobs (issue 14): the bench fog's first `fogTerms` terms
     // (0: no fog), the host image's fog texture ({0, 0}: per pixel) and the
     // splats' fog once per splat instead of per fragment.
     int fogTerms = 0;
@@ -104,7 +104,7 @@ struct Config {
     bool fogPerSplat = false;
 };
 
-// [foggaps] The bench fog: Biri et al.'s Fig. 6 formula (paperFig6Fog) with
+// The bench fog: Biri et al.'s Fig. 6 formula (paperFig6Fog) with
 // one paper unit = 4 world units (the fire is 10 units tall), thinned so the
 // fog in front of the fire has an optical depth of about 0.5, with no wind
 // (one still frame), far cut-off 60. Its terms in the paper's order: the constant,
@@ -278,13 +278,13 @@ struct Bench {
         std::optional<splatfx::gl::Framebuffer> fb;
         std::optional<splatfx::gl::FrameRenderer> sr;
         const splatfx::Image* truth = nullptr;
-        std::shared_ptr<const splatfx::Fog> fog; // [foggaps] null: clear air
+        std::shared_ptr<const splatfx::Fog> fog; // null: clear air
         double extraCpuMs = 0.0;
         std::vector<double> cpu, total;
 
         const splatfx::Frame& prepare(const splatfx::Camera& cam) {
             frame->begin(0.0, cam);
-            frame->setFog(fog); // [foggaps]
+            frame->setFog(fog);
             frame->builder().add(grid, *mat, {.textureSet = setId, .colorTable = 0, .textured = config.textured, .crossfade = true});
             frame->end(config.sort);
             return *frame;
@@ -295,7 +295,7 @@ struct Bench {
     // Registers one setting of the fire; everything is timed later, round-robin.
     void add(const std::string& knob, const std::string& setting, const Config& c, const splatfx::Grid& truthGrid,
              const splatfx::Image& truth, bool mainTruth = true, bool remapTextures = true, double extraCpuMs = 0.0) {
-        if (opt.fogOnly && knob.rfind("fog", 0) != 0) return; // [foggaps] --fog-only
+        if (opt.fogOnly && knob.rfind("fog", 0) != 0) return; // --fog-only
         auto s = std::make_unique<Setting>();
         s->row = Row{knob, setting};
         s->row.mainTruth = mainTruth;
@@ -311,7 +311,7 @@ struct Bench {
         rdesc.trimCorners = c.octagons;
         rdesc.sampling = c.sampling;
         rdesc.upsample = c.upsample;
-        rdesc.fogPerSplat = c.fogPerSplat; // [foggaps]
+        rdesc.fogPerSplat = c.fogPerSplat;
         if (c.fogTerms > 0) {
             auto fog = splatfx::Fog::create(benchFog(c.fogTerms));
             if (!fog) {
@@ -544,7 +544,7 @@ int runAccuracy(int argc, char** argv) {
     gaussTruthCfg.gaussian = true;
     gaussTruthCfg.gaussianRadius = 4.2f; // 6 sigma: the truncated mass is below 1e-7
     const splatfx::Image truthGauss = all ? b.truthImage(onTexture, gaussTruthCfg) : splatfx::Image{};
-    // [foggaps] The fire in the full bench fog, fog and splats integrated together.
+    // The fire in the full bench fog, fog and splats integrated together.
     auto fullFog = splatfx::Fog::create(benchFog(5));
     if (!fullFog) {
         std::fprintf(stderr, "accuracy: bench fog: %s\n", fullFog.error().c_str());
@@ -654,7 +654,7 @@ int runAccuracy(int argc, char** argv) {
         b.add("combined", "quarter + 64 bins + 16^2", c, onTexture, truth);
     }
 
-    // [foggaps] Fog knobs (issue 14), against the fire and host in the full bench fog.
+    // Fog knobs (issue 14), against the fire and host in the full bench fog.
     {
         const glm::ivec2 sz = b.opt.size;
         for (int div : {1, 2, 4, 8}) {

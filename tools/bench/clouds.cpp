@@ -39,7 +39,7 @@ struct Options {
     glm::ivec2 popSize{256, 192};
     float popDetailC = 10.0f;
     float popStepWorld = 0.25f; // a quarter cell per frame
-    // [foggaps] Fog on the tetrahedra: a small cloud (the reference is brute force), frames timed per mode.
+    // Fog on the tetrahedra: a small cloud (the reference is brute force), frames timed per mode.
     glm::ivec3 fogDims{33, 33, 9};
     glm::ivec2 fogSize{128, 96};
     int fogFrames = 41;
@@ -242,7 +242,7 @@ int runClouds(int argc, char** argv) {
         }
     }
 
-    // ---- 3. [foggaps] Biri fog on the tetrahedra: cost and error against the one-medium reference ----
+    // ---- 3. Biri fog on the tetrahedra: cost and error against the one-medium reference ----
     if (o.fogFrames >= 1 && o.fogSize.x >= 1 && o.fogSize.y >= 1) {
         CloudSet cs;
         if (!makeClouds(o.fogDims, 10.0f, cs)) return 1;

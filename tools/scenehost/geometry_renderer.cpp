@@ -102,7 +102,7 @@ splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<spl
             mesh = g.fitSize > 0.0f ? fitted(it->second, g.fitSize) : it->second;
             break;
         }
-        case splatfx::GeometryType::Heightmap: { // [foggaps]
+        case splatfx::GeometryType::Heightmap: {
             splatfx::Result<Mesh> m = heightmapMesh(g.heightmapPath, g.heightmapSpacing, g.heightmapScale);
             if (!m) return splatfx::makeError("geometry '" + g.name + "': " + m.error());
             mesh = std::move(*m);

@@ -33,7 +33,7 @@ struct Mesh {
 
 // Every mesh of the file, node transforms applied, merged. Errors name the file.
 splatfx::Result<Mesh> loadMesh(const std::string& path);
-// [foggaps] A terrain grid from an image's channel 0 (splatfx::heightmapPoint
+// A terrain grid from an image's channel 0 (splatfx::heightmapPoint
 // for each sample, two triangles a cell, facing +y). Errors name the file.
 splatfx::Result<Mesh> heightmapMesh(const std::string& path, float spacing, float heightScale);
 // Scaled so the largest bounding-box side is `size`, centred on x and z, resting on y = 0.

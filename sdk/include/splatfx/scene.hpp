@@ -216,14 +216,14 @@ public:
     // Replaces the transfer function and table (the GL pass re-uploads it).
     void setVolumeTransfer(VolumeId id, TransferFunction transfer, PreIntegrationTable table);
     // ---- end [clouds] ----
-    // ---- [foggaps, issue 17] Ground fog (prisms over a terrain, volume.hpp GroundFog) ----
+    // ---- (issue 17) Ground fog (prisms over a terrain, volume.hpp GroundFog) ----
     // prepare() emits every enabled layer (GroundFog::update: back to front,
     // near-clipped) as one more Frame volume, drawn by the same pass as the
     // clouds (options.refine is unused: the layer is at full resolution).
     VolumeId addGroundFog(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, VolumeOptions options = {});
     std::size_t groundFogCount() const { return mGroundFogs.size(); }
     VolumeOptions& groundFogOptions(VolumeId id) { return mGroundFogs.at(id)->options; }
-    // ---- end [foggaps] ----
+    // ---- end ----
 
 private:
     // ---- lighting (issue 16): what a lit effect keeps between frames (scene_lighting.cpp).
@@ -256,7 +256,7 @@ private:
         VolumeOptions options;
     };
     std::vector<std::unique_ptr<VolumeEntry>> mVolumes;
-    struct GroundFogEntry { // [foggaps]
+    struct GroundFogEntry {
         GroundFog fog;
         TransferFunction transfer;
         PreIntegrationTable table;

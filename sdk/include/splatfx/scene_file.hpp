@@ -53,7 +53,7 @@ enum class GeometryType {
     Cylinder, // along object +y from y = 0 to size.y, radius size.x / 2
     Sphere,   // radius size.x / 2, centred on the object origin
     Mesh,     // triangles from meshPath (the host loads it)
-    Heightmap, // [foggaps] a terrain grid from heightmapPath (an image, channel 0), centred on the object origin
+    Heightmap, // a terrain grid from heightmapPath (an image, channel 0), centred on the object origin
     Empty,    // nothing drawn: an anchor whose motion other objects and effects share
 };
 
@@ -75,7 +75,7 @@ struct GeometryDesc {
     // and rest it on y = 0 centred on x and z (before `transform`); 0 keeps
     // the file's own units. Default 0.
     float fitSize = 0.0f;
-    // [foggaps] Heightmap: sample (i, j) of the image (row 0 = -z edge) is the
+    // Heightmap: sample (i, j) of the image (row 0 = -z edge) is the
     // point ((i - (w-1)/2) s, heightScale v, (j - (h-1)/2) s), s = heightmapSpacing,
     // v the image value in [0, 1] (a 16-bit PGM: code / 65535). heightmapPoint() below.
     std::string heightmapPath;      // Heightmap: resolved against the scene file
@@ -83,7 +83,7 @@ struct GeometryDesc {
     float heightmapScale = 1.0f;    // world height of value 1; default 1
 };
 
-// [foggaps] Object-space point of heightmap sample (i, j) of a w x h image with value v.
+// Object-space point of heightmap sample (i, j) of a w x h image with value v.
 inline glm::vec3 heightmapPoint(int i, int j, int w, int h, float v, float spacing, float scale) {
     return {(float(i) - 0.5f * float(w - 1)) * spacing, scale * v, (float(j) - 0.5f * float(h - 1)) * spacing};
 }

@@ -350,7 +350,7 @@ struct GroundFogDesc {
     std::vector<float> terrainHeight; // dims.x * dims.y world heights (x fastest)
     std::vector<float> fogTop;        // same size: world height of the fog's top; <= terrain: no fog there
     float density = 1.0f;             // default 1: the scalar at the terrain (the top boundary has 0, sec. 6)
-    // [foggaps] The paper's sort-free emissive model (sec. 6, eq. 10): true
+    // The paper's sort-free emissive model (sec. 6, eq. 10): true
     // emits the tetrahedra in grid order with no back-to-front sorting. With
     // one fog colour C (makeGroundFogTransfer) every segment blends as
     // I' = eps C + (1 - eps) I, and two such blends commute (the result is

@@ -227,7 +227,7 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                 };
                 auto transmittanceTo = [&](const glm::dvec3& p) {
                     // Beyond the cut-off f = 0 by definition: no integral (the points come
-                    // nearest first, so every later one is beyond it too). [foggaps]
+                    // nearest first, so every later one is beyond it too).
                     if (fogFar > 0.0 && glm::length(p - eye) > fogFar) return 0.0;
                     const double tp = tauTo(p);
                     if (std::isfinite(tp)) fogTauMax = std::max(fogTauMax, tp);

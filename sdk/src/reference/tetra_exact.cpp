@@ -1,4 +1,4 @@
-// [foggaps, issue 14 + 17] Tetrahedra and fog in one medium (reference.hpp,
+// (issue 14 + 17) Tetrahedra and fog in one medium (reference.hpp,
 // renderTetraExact / integrateRayWithFog): the physical emission-absorption
 // integral of the cloud's transfer function and the fog together, in double.
 #include <algorithm>

@@ -158,7 +158,7 @@ void Scene::prepareVolumes(const Camera& camera, Frame& frame) {
         // A failed update (non-finite camera, bad refine field) draws nothing for this volume.
         if (!e.volume.update(camera, e.options.refine, &e.transfer, fv.lod)) frame.volumes().pop_back();
     }
-    for (auto& owned : mGroundFogs) { // [foggaps] ground fog layers
+    for (auto& owned : mGroundFogs) { // ground fog layers
         GroundFogEntry& e = *owned;
         if (!e.options.enabled) continue;
         FrameVolume& fv = frame.volumes().emplace_back();
@@ -168,7 +168,7 @@ void Scene::prepareVolumes(const Camera& camera, Frame& frame) {
     }
 }
 
-// [foggaps]
+//
 VolumeId Scene::addGroundFog(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, VolumeOptions options) {
     mGroundFogs.push_back(std::make_unique<GroundFogEntry>(GroundFogEntry{std::move(fog), std::move(transfer), std::move(table), std::move(options)}));
     return VolumeId(mGroundFogs.size() - 1);

@@ -11,7 +11,7 @@ EffectReaderFn readVdbKind; // only when splatfx::vdb is built (OpenVDB found)
 #endif
 // Geometry readers, for the types with keys of their own.
 GeometryReaderFn readMeshGeometry;
-GeometryReaderFn readHeightmapGeometry; // [foggaps]
+GeometryReaderFn readHeightmapGeometry;
 
 namespace {
 
@@ -36,7 +36,7 @@ constexpr GeometryKind kGeometryKinds[] = {
     {"cylinder", GeometryType::Cylinder, nullptr},
     {"sphere", GeometryType::Sphere, nullptr},
     {"mesh", GeometryType::Mesh, &readMeshGeometry}, // kinds/mesh.cpp
-    {"heightmap", GeometryType::Heightmap, &readHeightmapGeometry}, // kinds/heightmap.cpp [foggaps]
+    {"heightmap", GeometryType::Heightmap, &readHeightmapGeometry}, // kinds/heightmap.cpp
     {"empty", GeometryType::Empty, nullptr},
 };
 

@@ -37,7 +37,7 @@ ScalarVolume yUp(const ScalarVolume& zUp) {
     return out;
 }
 
-// [foggaps, issue 17] kind "groundFog": prisms over a heightmap terrain
+// (issue 17) kind "groundFog": prisms over a heightmap terrain
 // (Roettger & Ertl sec. 6), the terrain placed as a "heightmap" geometry with
 // the same heightmap, spacing, heightScale and position is (heightmapPoint).
 void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std::string& name, SceneFile& out) {
@@ -154,7 +154,7 @@ void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& 
         std::string name = "volume" + std::to_string(i), kind;
         o.string("name", name);
         o.string("kind", kind);
-        if (kind == "groundFog") { // [foggaps]
+        if (kind == "groundFog") {
             readGroundFog(c, p, o, name, out);
             continue;
         }

@@ -228,7 +228,7 @@ Status GroundFog::update(const Camera& camera, LodFrame& out) const {
     Emitter em{mDesc, camera, out, {}, 0.0f, {}};
     em.nearNormal = f;
     em.nearOffset = glm::dot(f, e) + camera.nearPlane();
-    if (mDesc.sortFree) { // [foggaps] eq. 10: grid order, no BSP
+    if (mDesc.sortFree) { // eq. 10: grid order, no BSP
         for (int j = 0; j + 1 < mDesc.dims.y; ++j)
             for (int i = 0; i + 1 < mDesc.dims.x; ++i) em.cell(i, j);
     } else {

@@ -123,7 +123,7 @@ struct FrameRenderStats {
     // --- Fog (issue 14) ---
     bool fogHost = false;        // the host image was fogged (a fog, fogHost and a host depth texture)
     bool fogSplats = false;      // the splats were drawn with per-fragment fog
-    bool fogTetrahedra = false;  // the tetrahedra were drawn with per-segment fog [foggaps]
+    bool fogTetrahedra = false;  // the tetrahedra were drawn with per-segment fog
     std::string fogError;        // empty, or why the fog could not be drawn (it was then skipped)
     // --- end fog ---
     // ---- [clouds, issue 17] projected tetrahedra ----

@@ -124,7 +124,7 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         r.stats.fogSplats = fog && s;
     }
 
-    // [foggaps, issue 14] The tetrahedra in the same medium as the splats.
+    // (issue 14) The tetrahedra in the same medium as the splats.
     r.stats.fogTetrahedra = false;
     if (anyTets) {
         const Status s = r.tetra->setFog(fog, frame.time());

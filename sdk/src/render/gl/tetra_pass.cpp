@@ -61,7 +61,7 @@ flat in vec4 vLength;
 layout(location = 0) out vec4 oColor;
 
 #if FOG
-// [foggaps, issue 14] One medium with the clouds: the segment's premultiplied
+// (issue 14) One medium with the clouds: the segment's premultiplied
 // colour becomes f c + (1 - f) alpha C_fog (alpha unchanged), as every splat
 // fragment does, f = the fog's transmittance from the eye (the origin of the
 // eye-relative positions here) to one point of the segment. The point is the
@@ -151,10 +151,10 @@ struct TetraPass::Impl {
     struct Program {
         GLuint id = 0;
         GLint uViewProjRel = -1, uFirst = -1, uForward = -1, uDepthToView = -1, uTexScale = -1, uTexOffset = -1, uMaxLength = -1;
-        GLint uFogParams = -1, uFogColour = -1, uFogFar = -1; // [foggaps] fog variants only
+        GLint uFogParams = -1, uFogColour = -1, uFogFar = -1; // fog variants only
     };
     Program programs[4]; // [perspective * 2 + host depth]
-    // [foggaps, issue 14] The fog variants, built for the structure of the last fog seen.
+    // (issue 14) The fog variants, built for the structure of the last fog seen.
     Program fogPrograms[4];
     std::string fogSource;
     std::string fogUniform;
@@ -242,7 +242,7 @@ Result<TetraPass> TetraPass::create() {
     return TetraPass(std::move(impl));
 }
 
-// [foggaps, issue 14]
+// (issue 14)
 Status TetraPass::setFog(const Fog* fog, double timeSec) {
     Impl& r = *mImpl;
     r.fog = fog && !fog->empty() ? fog : nullptr; // zero terms: clear air, the plain programs
@@ -446,11 +446,11 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 
     const int variant = (camera.perspective() ? 2 : 0) + (hostDepth ? 1 : 0);
-    const bool fogged = r.fog && r.fogPrograms[variant].id; // [foggaps]
+    const bool fogged = r.fog && r.fogPrograms[variant].id;
     const Impl::Program& p = fogged ? r.fogPrograms[variant] : r.programs[variant];
     glUseProgram(p.id);
     if (fogged) {
-        // [foggaps] Parameters in double relative to the eye the records are relative to (docs/fog.md, GLSL).
+        // Parameters in double relative to the eye the records are relative to (docs/fog.md, GLSL).
         const std::vector<glm::vec4> fp = r.fog->glslParameters(r.fogTimeSec, glm::dvec3(r.eye));
         glUniform4fv(p.uFogParams, GLsizei(fp.size()), glm::value_ptr(fp[0]));
         const glm::dvec3 col = r.fog->desc().colour;

@@ -47,7 +47,7 @@ struct TetraStats {
     std::uint64_t drawCalls = 0;
     std::uint64_t tableUploads = 0;    // since creation
     std::size_t tableBytes = 0;        // GPU bytes held by uploaded tables
-    std::uint64_t foggedDraws = 0;     // [foggaps] draws with the fog variant this frame
+    std::uint64_t foggedDraws = 0;     // draws with the fog variant this frame
 };
 
 class TetraPass {
@@ -63,7 +63,7 @@ public:
     void prepare(const Frame& frame);
     // Draws tetrahedra [begin, end) of frame.volumes()[volume] (after prepare).
     void draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const TetraTarget& target);
-    // [foggaps, issue 14] The fog every following draw is seen through (null
+    // (issue 14) The fog every following draw is seen through (null
     // or empty: none): each segment's colour becomes f c + (1 - f) alpha C_fog
     // with f from the eye to the segment's opacity centroid. Builds the fog
     // variants when the fog's GLSL structure changed; an error leaves no fog.

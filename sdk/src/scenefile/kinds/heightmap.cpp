@@ -1,4 +1,4 @@
-// [foggaps] Geometry type "heightmap": a terrain grid from an image the host
+// Geometry type "heightmap": a terrain grid from an image the host
 // turns into triangles (docs/scene-format.md; GeometryDesc::heightmapPath).
 #include <filesystem>
 
