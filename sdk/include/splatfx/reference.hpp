@@ -196,7 +196,7 @@ struct VolumeExactStats {
 Result<Image> renderVolumeExact(const VolumeField& field, const Camera& camera, const VolumeExactDesc& desc = {},
                                 VolumeExactStats* stats = nullptr);
 
-// ---- [foggaps, issues 14 + 17] Tetrahedra (LOD volumes) and fog in one medium ----
+// ---- Tetrahedra (LOD volumes) and fog in one medium ----
 
 struct RayFogDesc {
     const Fog* fog = nullptr;  // default none (then the cloud alone, like integrateRay)
