@@ -49,7 +49,7 @@ TEST(SceneHostMesh, AFaceIndexPastTheVerticesIsAnError) {
 }
 
 TEST(SceneHostMesh, AnOffHeaderClaimingAHundredMillionFacesIsRefusedBeforeReading) {
-    expectRefused(writeFile("bomb.off", "OFF\n100000000 100000000 0\n0 0 0\n"), "over the mesh budget");
+    expectRefused(writeFile("bomb.off", "OFF\n100000000 100000000 0\n0 0 0\n"), "over the budget of 20000000 (raise Budgets::meshElements)");
 }
 
 TEST(SceneHostMesh, APlyClaimingMoreVerticesThanItsBytesIsRefused) {

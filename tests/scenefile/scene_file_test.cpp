@@ -167,8 +167,8 @@ TEST(SceneFile, PresetTextureFoldersAreLoadedByTheReader) {
 
 TEST(SceneFile, AbsurdSizesAreRefusedBeforeAllocating) {
     expectError(R"("effects": [{"kind": "fire", "dims": [1000, 1000, 1000]}])",
-                {"effects[0].dims: 1000x1000x1000 = 1000000000 cells is too many; expected at most 16777216"});
-    expectError(R"("effects": [{"kind": "smoke", "dims": [100, 100, 100]}])", {"effects[0].dims:", "at most 262144", "solver"});
+                {"effects[0].dims: 1000x1000x1000 (grid effects) needs 1000000000 cells, over the budget of 16777216 (raise Budgets::effectCells)"});
+    expectError(R"("effects": [{"kind": "smoke", "dims": [100, 100, 100]}])", {"effects[0].dims:", "over the budget of 262144", "solver", "Budgets::solverCells"});
     expectError(R"("effects": [{"kind": "grid", "dims": [5, 99999, 5]}])", {"effects[0].dims[1]: expected an integer in [1, 4096], got 99999"});
     expectError(R"("output": {"size": [100000, 10]})", {"output.size[0]: expected an integer in [16, 8192], got 100000"});
 }
@@ -266,10 +266,33 @@ TEST(SceneFile, PathsAreRelativeToTheFile) {
 // error names the effect that crosses the limit).
 TEST(SceneFile, TextureBudgetsAreCheckedBeforeBuilding) {
     expectError(R"("effects": [{"kind": "grid", "dims": [2, 2, 2], "textureSet": {"sampleImage": {"image": "x.png", "count": 256, "size": 1024}}}])",
-                {"effects[0].textureSet.sampleImage: count 256 x size 1024^2 asks for 268435456 texels, over the budget of 16777216"});
+                {"effects[0].textureSet.sampleImage: count 256 x size 1024^2 needs 268435456 texels, over the budget of 16777216 (raise Budgets::sampledTexels)"});
     std::string effects;
     for (int i = 0; i < 300; ++i)
         effects += std::string(i ? ", " : "") + R"({"kind": "grid", "dims": [2, 2, 2], "textureSet": {"procedural": {"count": 16, "seed": )" +
                    std::to_string(i) + "}}}";
-    expectError(R"("effects": [)" + effects + "]", {"effects[127]: with this effect the scene's distinct texture sets hold 2049 layers"});
+    expectError(R"("effects": [)" + effects + "]", {"effects[127]: the scene, with this effect, needs 2049 layers, over the budget of 2048 (raise Budgets::textureLayers) in its distinct texture sets"});
+}
+
+// The budgets are the user's to raise (budget.hpp): the same files load once
+// SceneFileOptions::budgets allows them, and only then.
+TEST(SceneFile, RaisedBudgetsLetTheSameFileLoad) {
+    const std::string smoke = R"({"format": "splatfx-scene", "version": 1, "effects": [{"kind": "smoke", "dims": [72, 72, 72]}]})";
+    splatfx::Materials m(splatfx::Footprint{});
+    auto refused = splatfx::parseSceneFile(smoke, "dir/scene.json", m);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().find("needs 373248 cells, over the budget of 262144 (raise Budgets::solverCells)"), std::string::npos)
+        << refused.error();
+    splatfx::SceneFileOptions raised;
+    raised.budgets.solverCells = 400000;
+    auto loaded = splatfx::parseSceneFile(smoke, "dir/scene.json", m, raised);
+    ASSERT_TRUE(loaded) << loaded.error();
+    EXPECT_EQ(loaded->effects.size(), 1u);
+    // Lowering one works the same way: a 7x20x5 fire over a 500-cell budget is refused.
+    splatfx::SceneFileOptions lowered;
+    lowered.budgets.effectCells = 500;
+    auto fire = splatfx::parseSceneFile(R"({"format": "splatfx-scene", "version": 1, "effects": [{"kind": "fire", "dims": [7, 20, 5]}]})",
+                                        "dir/scene.json", m, lowered);
+    ASSERT_FALSE(fire);
+    EXPECT_NE(fire.error().find("needs 700 cells, over the budget of 500 (raise Budgets::effectCells)"), std::string::npos) << fire.error();
 }

@@ -51,6 +51,7 @@ struct Args {
     int abortAfter = -1; // testing aid: fail after this many frames
     std::optional<cli::FrameRange> range; // --range: only these frames, no GIF
     bool assemble = false;                // --assemble: the GIF from the frames in --out
+    splatfx::Budgets budgets{};           // --budget NAME=N
 };
 
 void usage() {
@@ -69,6 +70,8 @@ void usage() {
         "  --range A-B[:STEP]  render-farm task: write only frames A..B (every STEP-th; indices from 0), exactly\n"
         "                   as a full run writes them; no GIF (see --assemble; docs/render-farm.md)\n"
         "  --assemble       write DIR/<name>.gif from the frames DIR/<name>_NNNN.png the tasks wrote (renders nothing)\n"
+        "  --budget NAME=N  raise (or lower) one of the loader's budgets (splatfx/budget.hpp; repeatable): effectCells,\n"
+        "                   solverCells, sampledTexels, textureLayers, meshElements, meshFileBytes\n"
         "  --quiet          no per-frame progress\n"
         "  --abort-after N  testing aid: fail on purpose after N frames (checks that nothing partial is left)\n"
         "<name> is the scene's output.name (default: the scene file's folder name).\n");
@@ -146,6 +149,12 @@ bool parse(int argc, char** argv, Args& a) {
                 return false;
             }
             a.range = r;
+        } else if (s == "--budget") {
+            if (!(v = value())) return false;
+            if (auto st = splatfx::setBudget(a.budgets, v); !st) {
+                std::fprintf(stderr, "splatfx-render: --budget: %s\n", st.error().c_str());
+                return false;
+            }
         } else if (s == "--assemble") {
             a.assemble = true;
         } else if (s == "--abort-after") {
@@ -257,7 +266,7 @@ static int renderMain(int argc, char** argv) {
 
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) return fail(ctx.error());
-    auto player = scenehost::ScenePlayer::load(a.scene, {.seed = a.seed, .renderer = a.renderer});
+    auto player = scenehost::ScenePlayer::load(a.scene, {.seed = a.seed, .renderer = a.renderer, .budgets = a.budgets});
     if (!player) return fail(player.error());
     const splatfx::SceneFile& file = player->file();
     const glm::ivec2 size = a.size.value_or(file.output.size);

@@ -71,7 +71,7 @@ struct GeometryRenderer::Impl {
     }
 };
 
-splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<splatfx::GeometryDesc>& geometry) {
+splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<splatfx::GeometryDesc>& geometry, const splatfx::Budgets& budgets) {
     if (!epoxy_has_gl_extension("GL_ARB_direct_state_access") && epoxy_gl_version() < 45)
         return splatfx::makeError("GeometryRenderer: needs a current OpenGL 4.5 context");
     auto impl = std::make_unique<Impl>();
@@ -95,7 +95,7 @@ splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<spl
         case splatfx::GeometryType::Mesh: {
             auto it = meshes.find(g.meshPath);
             if (it == meshes.end()) {
-                splatfx::Result<Mesh> m = loadMesh(g.meshPath);
+                splatfx::Result<Mesh> m = loadMesh(g.meshPath, budgets);
                 if (!m) return splatfx::makeError("geometry '" + g.name + "': " + m.error());
                 it = meshes.emplace(g.meshPath, std::move(*m)).first;
             }

@@ -45,7 +45,8 @@ struct GeometryLighting {
 class GeometryRenderer {
 public:
     // Loads meshes and uploads every object. Errors name the object and file.
-    static splatfx::Result<GeometryRenderer> create(const std::vector<splatfx::GeometryDesc>& geometry);
+    // Mesh files are checked against `budgets` (meshFileBytes, meshElements) before they are read.
+    static splatfx::Result<GeometryRenderer> create(const std::vector<splatfx::GeometryDesc>& geometry, const splatfx::Budgets& budgets = {});
     GeometryRenderer(GeometryRenderer&&) noexcept;
     GeometryRenderer& operator=(GeometryRenderer&&) noexcept;
     ~GeometryRenderer();

@@ -25,16 +25,15 @@ splatfx::Aabb Mesh::bounds() const {
 
 namespace {
 
-// Budgets for meshes a scene file names, checked before assimp allocates:
-// a crafted header can claim billions of elements in a few bytes.
-constexpr std::uintmax_t kMaxMeshFileBytes = 512ull << 20; // 512 MiB
-constexpr std::uint64_t kMaxMeshElements = 20'000'000;     // vertices or faces
+// Budgets for meshes a scene file names (Budgets::meshFileBytes,
+// meshElements), checked before assimp allocates: a crafted header can claim
+// billions of elements in a few bytes.
 
 // PLY and OFF state their element counts in a text header. A count is
 // refused when it exceeds the budget, or when the file is too short to hold
 // that many elements at their smallest encoding (ASCII "0 0 0\n" is 6 bytes a
 // vertex, binary is 12; a face is at least 4 bytes either way).
-splatfx::Status checkHeaderCounts(const std::string& path, std::uintmax_t fileBytes) {
+splatfx::Status checkHeaderCounts(const std::string& path, std::uintmax_t fileBytes, const splatfx::Budgets& budgets) {
     std::ifstream in(path, std::ios::binary);
     std::string line;
     if (!std::getline(in, line)) return {};
@@ -69,9 +68,8 @@ splatfx::Status checkHeaderCounts(const std::string& path, std::uintmax_t fileBy
         }
     }
     for (const Claim& c : claims) {
-        if (c.count > kMaxMeshElements)
-            return splatfx::makeError(path + ": the header claims " + std::to_string(c.count) + " " + c.what + ", over the mesh budget of " +
-                                      std::to_string(kMaxMeshElements));
+        if (auto s = splatfx::checkBudget(path + ": the mesh, by its header,", c.count, c.what, budgets.meshElements, "meshElements"); !s)
+            return s;
         if (c.count * c.minBytes > fileBytes)
             return splatfx::makeError(path + ": the header claims " + std::to_string(c.count) + " " + c.what + " but the file has only " +
                                       std::to_string(fileBytes) + " bytes (truncated or crafted)");
@@ -103,15 +101,15 @@ void appendNode(const aiScene* scene, const aiNode* node, const aiMatrix4x4& par
 
 } // namespace
 
-splatfx::Result<Mesh> loadMesh(const std::string& path) {
+splatfx::Result<Mesh> loadMesh(const std::string& path, const splatfx::Budgets& budgets) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) return splatfx::makeError(path + ": mesh file not found");
     if (!std::filesystem::is_regular_file(path, ec)) return splatfx::makeError(path + ": not a regular file (a folder, FIFO or device is never read as a mesh)");
     const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
     if (ec) return splatfx::makeError(path + ": cannot read its size: " + ec.message());
-    if (bytes > kMaxMeshFileBytes)
-        return splatfx::makeError(path + ": " + std::to_string(bytes) + " bytes, over the mesh budget of " + std::to_string(kMaxMeshFileBytes) + " bytes");
-    if (auto s = checkHeaderCounts(path, bytes); !s) return splatfx::makeError(s.error());
+    if (auto s = splatfx::checkBudget(path + ": the mesh file", bytes, "bytes", budgets.meshFileBytes, "meshFileBytes"); !s)
+        return splatfx::makeError(s.error());
+    if (auto s = checkHeaderCounts(path, bytes, budgets); !s) return splatfx::makeError(s.error());
     Assimp::Importer importer;
     // Validation makes assimp refuse out-of-range indices and other broken structure instead of handing them on.
     const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |

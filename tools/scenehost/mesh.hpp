@@ -19,6 +19,7 @@
 
 #include <glm/glm.hpp>
 
+#include "splatfx/budget.hpp"
 #include "splatfx/motion.hpp"
 #include "splatfx/result.hpp"
 
@@ -32,7 +33,7 @@ struct Mesh {
 };
 
 // Every mesh of the file, node transforms applied, merged. Errors name the file.
-splatfx::Result<Mesh> loadMesh(const std::string& path);
+splatfx::Result<Mesh> loadMesh(const std::string& path, const splatfx::Budgets& budgets = {});
 // A terrain grid from an image's channel 0 (splatfx::heightmapPoint
 // for each sample, two triangles a cell, facing +y). Errors name the file.
 splatfx::Result<Mesh> heightmapMesh(const std::string& path, float spacing, float heightScale);

@@ -40,13 +40,13 @@ double msSince(Clock::time_point t0) { return std::chrono::duration<double, std:
 } // namespace
 
 // Geometry and the splat renderer, once the scene file is read.
-splatfx::Status ScenePlayer::setupGl(Impl& impl, const std::string& path, const splatfx::gl::FrameRendererDesc& desc) {
-    auto geo = GeometryRenderer::create(impl.file->geometry);
+splatfx::Status ScenePlayer::setupGl(Impl& impl, const std::string& path, const PlayerOptions& options) {
+    auto geo = GeometryRenderer::create(impl.file->geometry, options.budgets);
     if (!geo) return splatfx::makeError(path + ": " + geo.error());
     impl.geometry.emplace(std::move(*geo));
     // A scene of geometry only still needs one row for the renderer to upload.
     if (impl.materials.colorTableCount() == 0) impl.materials.addColorTable(splatfx::ColorTable::constant(glm::vec4(1.0f)));
-    return installRenderer(impl, desc);
+    return installRenderer(impl, options.renderer);
 }
 
 // A splat renderer with these settings and the materials uploaded; on failure
@@ -66,10 +66,11 @@ splatfx::Result<ScenePlayer> ScenePlayer::load(const std::string& path, const Pl
     auto impl = std::make_unique<Impl>();
     splatfx::SceneFileOptions so;
     so.seed = options.seed;
+    so.budgets = options.budgets;
     auto file = splatfx::loadSceneFile(path, impl->materials, so);
     if (!file) return splatfx::makeError(file.error());
     impl->file.emplace(std::move(*file));
-    if (auto s = setupGl(*impl, path, options.renderer); !s) return splatfx::makeError(s.error());
+    if (auto s = setupGl(*impl, path, options); !s) return splatfx::makeError(s.error());
     return ScenePlayer(std::move(impl));
 }
 
@@ -77,10 +78,11 @@ splatfx::Result<ScenePlayer> ScenePlayer::fromText(const std::string& text, cons
     auto impl = std::make_unique<Impl>();
     splatfx::SceneFileOptions so;
     so.seed = options.seed;
+    so.budgets = options.budgets;
     auto file = splatfx::parseSceneFile(text, path, impl->materials, so);
     if (!file) return splatfx::makeError(file.error());
     impl->file.emplace(std::move(*file));
-    if (auto s = setupGl(*impl, path, options.renderer); !s) return splatfx::makeError(s.error());
+    if (auto s = setupGl(*impl, path, options); !s) return splatfx::makeError(s.error());
     return ScenePlayer(std::move(impl));
 }
 

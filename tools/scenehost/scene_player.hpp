@@ -31,6 +31,7 @@ namespace scenehost {
 struct PlayerOptions {
     std::optional<std::uint32_t> seed;            // replaces the file's seed; default the file's
     splatfx::gl::FrameRendererDesc renderer{};    // the frame renderer's settings; default the SDK's
+    splatfx::Budgets budgets{};                   // what the file and its meshes may ask for (budget.hpp); default the SDK's
 };
 
 struct FrameOptions {
@@ -82,7 +83,7 @@ public:
 private:
     struct Impl;
     explicit ScenePlayer(std::unique_ptr<Impl> impl);
-    static splatfx::Status setupGl(Impl& impl, const std::string& path, const splatfx::gl::FrameRendererDesc& desc);
+    static splatfx::Status setupGl(Impl& impl, const std::string& path, const PlayerOptions& options);
     static splatfx::Status installRenderer(Impl& impl, const splatfx::gl::FrameRendererDesc& desc);
     std::unique_ptr<Impl> mImpl;
 };

@@ -36,6 +36,7 @@
 
 #include <glm/glm.hpp>
 
+#include "splatfx/budget.hpp"
 #include "splatfx/materials.hpp"
 #include "splatfx/motion.hpp"
 #include "splatfx/result.hpp"
@@ -135,6 +136,9 @@ struct SceneFileOptions {
     // Replaces the file's top-level "seed" (every effect's seed derives from it).
     std::optional<std::uint32_t> seed;   // default: the file's seed
     int maxErrors = 8;                   // problems reported before giving up, >= 1; default 8
+    // What the file may ask to build: lattice and solver cells, sampled
+    // texels, texture layers (budget.hpp); checked before each is built.
+    Budgets budgets{};                   // default: Budgets' defaults
 };
 
 // Reads and builds a scene file. Expects options.maxErrors >= 1.

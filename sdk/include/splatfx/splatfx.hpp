@@ -2,6 +2,7 @@
 // Contexts (EGL, GLFW) are in splatfx/context.hpp and the splatfx::context target.
 #pragma once
 
+#include "splatfx/budget.hpp"
 #include "splatfx/camera.hpp"
 #include "splatfx/color_table.hpp"
 #include "splatfx/dynamics.hpp"

@@ -64,15 +64,19 @@ void readEffects(Context& c, const std::string& path, const Json& v, const std::
         std::optional<Effect> effect = findEffectKind(e.kind)->read(c, o, e, pl);
         o.finish();
         if (!effect || c.d.count() != before) continue;
-        if (c.materials.layerCount() > kMaxSceneLayers) {
-            c.d.error(e.path, "with this effect the scene's distinct texture sets hold " + std::to_string(c.materials.layerCount()) +
-                                  " layers, more than the " + std::to_string(kMaxSceneLayers) +
-                                  " every GL 4.5 can draw; share texture sets between effects (equal parameters and seeds) or use fewer textures");
+        // The default layer budget is what every GL 4.5 guarantees (GL_MAX_ARRAY_TEXTURE_LAYERS
+        // >= 2048); checked as effects are read, so a level of too many distinct sets stops at
+        // the effect that crosses it.
+        if (Status s = checkBudget("the scene, with this effect,", c.materials.layerCount(), "layers",
+                                   c.budgets.textureLayers, "textureLayers");
+            !s) {
+            c.d.error(e.path, s.error() + " in its distinct texture sets; share texture sets between effects (equal parameters and seeds) or use fewer textures");
             return;
         }
         totalCells += effect->costCells(); // EffectKind: cells or voxels one advance evaluates
-        if (totalCells > kMaxVoxels) {
-            c.d.error(e.path, "the scene's effects hold more than " + std::to_string(kMaxVoxels) + " voxels/cells in all");
+        if (Status s = checkBudget("the scene, with this effect,", totalCells, "cells", c.budgets.effectCells, "effectCells");
+            !s) {
+            c.d.error(e.path, s.error());
             return;
         }
         effect->setToggles(e.toggles);

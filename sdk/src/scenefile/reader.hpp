@@ -33,7 +33,6 @@ namespace splatfx::scenefile {
 inline constexpr double kMaxCoord = 1.0e6;                   // world units for positions and offsets
 inline constexpr double kMaxSeconds = 1.0e6;                 // key times
 inline constexpr int kMaxAxis = 4096;                        // cells per lattice axis
-inline constexpr std::uint64_t kMaxSolverCells = 1u << 18;   // solver effects: every cell is simulated every step
 inline constexpr std::size_t kMaxEffects = 4096;
 inline constexpr std::size_t kMaxGeometry = 4096;
 inline constexpr std::size_t kMaxKeys = 100000;
@@ -43,18 +42,15 @@ inline constexpr int kMaxAttachDepth = 16;
 
 // [SECTION] Context
 
-// Texels of one sampled texture set (16 Mi: 64 windows of 512^2, 256 of 256^2).
-inline constexpr std::uint64_t kMaxSampledTexels = 16ull << 20;
-// Texture layers a scene's materials may hold: what every GL 4.5 guarantees
-// (GL_MAX_ARRAY_TEXTURE_LAYERS >= 2048). Checked as effects are read, so a
-// level of too many distinct sets stops at the effect that crosses it.
-inline constexpr std::uint32_t kMaxSceneLayers = 2048;
+// Sizes that cost memory or time in proportion (cells, texels, texture
+// layers) are budgets the user can raise: Context::budgets (budget.hpp).
 
 struct Context {
     Diagnostics& d;
     std::filesystem::path baseDir;
     Materials& materials;
     std::uint32_t sceneSeed = 1;
+    Budgets budgets{};          // SceneFileOptions::budgets
     // Texture-set folders already read for this file, by canonical path: a
     // level naming one folder for a thousand effects reads it once.
     std::map<std::string, TextureSet> folders{};
@@ -118,7 +114,8 @@ std::optional<ColorTable> readColorTable(Context& c, const std::string& path, co
 
 std::uint64_t cells(glm::ivec3 d);
 // Reads "dims" (required positive) with the kind's cell limit; `why` explains the limit.
-void readDims(Context& c, ObjectReader& o, glm::ivec3& dims, std::uint64_t limit, const char* why);
+// dims checked against a budget: `field` names the Budgets member it is (messages say how to raise it).
+void readDims(Context& c, ObjectReader& o, glm::ivec3& dims, std::uint64_t limit, const char* field, const char* why);
 
 glm::vec3 applyPoint(const glm::mat4& m, glm::vec3 p);
 

@@ -119,6 +119,7 @@ Result<SceneFile> parse(const std::string& text, const std::string& path, Materi
     SceneFile out;
     out.path = path;
     Context c{d, fs::path(path).parent_path(), materials};
+    c.budgets = options.budgets;
     ObjectReader o(d, "", root);
     if (!o.valid()) return makeError(path + ": expected a JSON object {\"format\": \"splatfx-scene\", \"version\": 1, ...}");
 

@@ -42,10 +42,10 @@ Result<TextureSet> sampleImageFile(const TextureSpec& t) {
                                           .sourceName = "image '" + t.image + "'"});
 }
 
-bool checkDims(Context& c, const std::string& path, glm::ivec3 dims, std::uint64_t limit, const char* why) {
-    if (cells(dims) > limit) {
-        c.d.error(path, std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" + std::to_string(dims.z) + " = " +
-                            std::to_string(cells(dims)) + " cells is too many; expected at most " + std::to_string(limit) + " (" + why + ")");
+bool checkDims(Context& c, const std::string& path, glm::ivec3 dims, std::uint64_t limit, const char* field, const char* why) {
+    const std::string what = std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" + std::to_string(dims.z) + " (" + why + ")";
+    if (Status s = checkBudget(what, cells(dims), "cells", limit, field); !s) {
+        c.d.error(path, s.error());
         return false;
     }
     return true;
@@ -205,10 +205,11 @@ std::optional<TextureSpec> readTextureSpec(Context& c, const std::string& path, 
             po.boolean("color", t.keepColor);
             // Each window becomes size^2 float RGBA texels: 256 windows of 1024^2 would be 4 GiB
             // per effect, so the set's texels are budgeted before anything is read.
-            if (std::uint64_t(t.count) * std::uint64_t(t.size) * std::uint64_t(t.size) > kMaxSampledTexels)
-                c.d.error(po.path(), "count " + std::to_string(t.count) + " x size " + std::to_string(t.size) + "^2 asks for " +
-                                         std::to_string(std::uint64_t(t.count) * t.size * t.size) + " texels, over the budget of " +
-                                         std::to_string(kMaxSampledTexels) + "; use fewer or smaller windows");
+            if (Status s = checkBudget("count " + std::to_string(t.count) + " x size " + std::to_string(t.size) + "^2",
+                                       std::uint64_t(t.count) * std::uint64_t(t.size) * std::uint64_t(t.size), "texels",
+                                       c.budgets.sampledTexels, "sampledTexels");
+                !s)
+                c.d.error(po.path(), s.error() + "; or use fewer or smaller windows");
             po.finish();
             if (!image.empty()) {
                 t.image = resolvePath(c, image);
@@ -300,10 +301,10 @@ std::optional<ColorTable> readColorTable(Context& c, const std::string& path, co
 
 std::uint64_t cells(glm::ivec3 d) { return std::uint64_t(d.x) * std::uint64_t(d.y) * std::uint64_t(d.z); }
 
-void readDims(Context& c, ObjectReader& o, glm::ivec3& dims, std::uint64_t limit, const char* why) {
+void readDims(Context& c, ObjectReader& o, glm::ivec3& dims, std::uint64_t limit, const char* field, const char* why) {
     if (const Json* v = o.get("dims"))
         if (auto x = readIvec3(c.d, o.at("dims"), *v, 1, kMaxAxis)) {
-            if (checkDims(c, o.at("dims"), *x, limit, why)) dims = *x;
+            if (checkDims(c, o.at("dims"), *x, limit, field, why)) dims = *x;
         }
 }
 

@@ -6,7 +6,7 @@ namespace splatfx::scenefile {
 
 std::optional<Effect> readFireToSmoke(Context& c, ObjectReader& o, const EffectCommon& e, const Placement& pl) {
     presets::FireToSmokeDesc d;
-    readDims(c, o, d.dims, kMaxVoxels, "grid effects");
+    readDims(c, o, d.dims, c.budgets.effectCells, "effectCells", "grid effects");
     o.vec3("spacing", d.spacing, 1e-4, 1e3, true);
     o.vec3("position", d.position, -kMaxCoord, kMaxCoord);
     o.number("split", d.split, 1e-3, 0.999);

@@ -68,7 +68,7 @@ void readGas(Context& c, ObjectReader& g, ProceduralGasDesc& d) {
 
 std::optional<Effect> readGasKind(Context& c, ObjectReader& o, const EffectCommon& e, const Placement& pl) {
     presets::GasDesc d;
-    readDims(c, o, d.dims, kMaxVoxels, "gas effects");
+    readDims(c, o, d.dims, c.budgets.effectCells, "effectCells", "gas effects");
     o.vec3("spacing", d.spacing, 1e-4, 1e3, true);
     o.vec3("position", d.position, -kMaxCoord, kMaxCoord);
     const std::optional<TextureSpec> tex = readPresetTextureSet(c, o, e.seed, d.textureCount);

@@ -56,7 +56,7 @@ std::optional<Effect> readGridKind(Context& c, ObjectReader& o, const EffectComm
     glm::ivec3 dims{7, 20, 5};
     glm::vec3 spacing(0.5f);
     if (!o.has("dims")) c.d.error(o.path(), "missing \"dims\" (lattice cells [x, y, z]) for kind \"grid\"");
-    readDims(c, o, dims, kMaxVoxels, "grid effects");
+    readDims(c, o, dims, c.budgets.effectCells, "effectCells", "grid effects");
     o.vec3("spacing", spacing, 1e-4, 1e3, true);
     const glm::mat4 local = readPlacement(o, false);
     std::vector<Shape> shapes;

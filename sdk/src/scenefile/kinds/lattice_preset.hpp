@@ -12,7 +12,7 @@ template <class Desc, class Extra>
 std::optional<Effect> readLatticePreset(Context& c, ObjectReader& o, const EffectCommon& e, const Placement& pl, Extra extra,
                                         Result<Effect> (*make)(Materials&, const Desc&)) {
     Desc d;
-    readDims(c, o, d.dims, kMaxVoxels, "grid effects");
+    readDims(c, o, d.dims, c.budgets.effectCells, "effectCells", "grid effects");
     o.vec3("spacing", d.spacing, 1e-4, 1e3, true);
     o.vec3("position", d.position, -kMaxCoord, kMaxCoord);
     const std::optional<TextureSpec> tex = readPresetTextureSet(c, o, e.seed, d.textureCount);

@@ -23,7 +23,7 @@ std::optional<Effect> readSolverEffect(Context& c, ObjectReader& o, const Effect
     }
     Desc d;
     // The keys in the order the messages report them (the order the file format lists them).
-    readDims(c, o, d.dims, kMaxSolverCells, "solver effects simulate every cell every step");
+    readDims(c, o, d.dims, c.budgets.solverCells, "solverCells", "solver effects simulate every cell every step");
     o.vec3("spacing", d.spacing, 1e-4, 1e3, true);
     o.vec3("position", d.position, -kMaxCoord, kMaxCoord);
     o.vec3("sourceOffset", d.sourceOffset, -kMaxCoord, kMaxCoord);
