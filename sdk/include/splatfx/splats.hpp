@@ -47,10 +47,27 @@ struct Splat {
     std::uint16_t layer = 0;     // texture-array layer (Materials)
     std::uint16_t nextLayer = 0; // layer cross-faded towards
     float blend = 0.0f;          // cross-fade weight towards nextLayer
-    std::uint32_t color = 0xffffffffu; // RGBA8, R in the lowest byte
+    // RGB8 colour, R in the lowest byte; the top byte is the kernel's
+    // along-ray scale code (rayScaleCode; 255, the default, is 1).
+    std::uint32_t color = 0xffffffffu;
     float depth = 0.0f;          // distance from the eye (perspective) or along forward (ortho); sort key
 };
 static_assert(sizeof(Splat) == 64, "Splat must match the GPU layout");
+
+// The depth cut (issue 15, docs/architecture.md "The depth cut") needs the
+// kernel's extent along the ray, which the ellipse alone does not give for an
+// anisotropic kernel: the world length of one kernel unit along the ray d
+// through the centre is l = 1 / |M^-1 d|. With the ellipse's half-axes
+// reaching the footprint radius R, |axisU x axisV| = R^2 |det M| |M^-1 d|,
+// so l = rho * sqrt(|axisU x axisV|) / R with rho = (|det M|^(1/3) |M^-1 d|)^(-3/2),
+// 1 for any isotropic kernel. rho is stored in the top byte of Splat::color
+// as code = 127 + round(32 log2 rho) in [0, 254] (1.1 % steps, rho in
+// [2^-3.97, 2^3.97], clamped), 255 meaning exactly 1.
+std::uint8_t rayScaleCode(float rho);
+float rayScaleRho(std::uint8_t code);
+// World length per kernel unit along the splat's centre ray (see above);
+// 0 for a degenerate ellipse.
+float splatRayScale(const Splat& splat, float footprintRadius);
 
 // How a grid's voxels become splats.
 struct SplatStyle {
