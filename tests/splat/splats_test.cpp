@@ -157,7 +157,7 @@ TEST(SplatBuilder, NearPlaneFadesInsteadOfPopping) {
     // The fade is a smoothstep (slope at most 1.5) over (end - start) * extent,
     // extent = R * sqrt(3) for a unit cube; the density may change per step by
     // at most tau * 1.5 * dz / ((end - start) * extent). tau: textured sets carry a gain.
-    const SplatBuilderDesc desc;
+    const SplatBuilderDesc desc{.nearFade = true};
     const float tau = 1.0f * m.set(0).gain;
     const float maxJump = tau * 1.5f * dz / ((desc.nearFadeEnd - desc.nearFadeStart) * m.footprint().radius() * std::sqrt(3.0f));
     // Walk the camera towards the voxel: density must fall smoothly to zero.

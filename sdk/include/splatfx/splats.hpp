@@ -2,9 +2,9 @@
 //
 // For each voxel the builder computes the ellipse its (possibly anisotropic)
 // kernel projects to for this camera, the optical depth along the ray
-// through its centre, its texture layer(s) and colour coordinate, and fades
-// it out as it nears the near plane (so a camera inside an effect sees no
-// popping). The list is then sorted back to front for composite-every-sample
+// through its centre, its texture layer(s) and colour coordinate, and the
+// kernel's along-ray scale for the depth cut (or, with
+// SplatBuilderDesc::nearFade, a fade towards the near plane). The list is then sorted back to front for composite-every-sample
 // splatting (King et al. 1999, sec. 2 step 4). The resulting SplatList is
 // exactly what the GL renderer draws and the reference renderer integrates.
 // It does no GL and no animation.
@@ -39,7 +39,7 @@ namespace splatfx {
 // the reference renderer, which reads the table exactly.
 struct Splat {
     glm::vec3 center{0.0f};
-    float density = 0.0f;        // optical depth scale, log2 units (already includes the near-plane fade)
+    float density = 0.0f;        // optical depth scale, log2 units (includes the near-plane fade when SplatBuilderDesc::nearFade)
     glm::vec3 axisU{0.0f};       // ellipse half-axis reaching the footprint's support radius
     float colorCoord = 0.0f;
     glm::vec3 axisV{0.0f};
@@ -85,7 +85,13 @@ enum class SortMode {
 };
 
 struct SplatBuilderDesc {
-    float nearFadeStart = 0.25f; // near-plane fade begins at near + nearFadeStart * splat extent; default 0.25
+    // The near-plane fade of the splats' density (before issue 15). Off by
+    // default: the GL renderer and the reference cut every splat exactly at
+    // the near plane (RendererDesc::depthCut, docs/architecture.md "The depth
+    // cut"). Turn it on with RendererDesc::depthCut = false to get the old,
+    // all-or-nothing test at the splat plane without popping at the near plane.
+    bool nearFade = false;       // default false
+    float nearFadeStart = 0.25f; // with nearFade: fade begins at near + nearFadeStart * splat extent; default 0.25
     float nearFadeEnd = 1.5f;    // ... and is complete (full opacity) at near + nearFadeEnd * extent; default 1.5
     bool frustumCull = true;     // drop splats wholly outside the view frustum; default true
     std::uint32_t buckets = 64;  // depth bins for SortMode::Bucketed; default 64

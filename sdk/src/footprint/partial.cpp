@@ -141,8 +141,8 @@ std::string partialGlsl(const Footprint& fp, int binding) {
     s += "// s signed along the ray from its closest approach to the kernel centre.\n";
     s += "float splatfx_partial_before(float r, float s) {\n";
     s += "    const float R = " + num(R) + ";\n";
-    s += "    float half = sqrt(max(R * R - r * r, 0.0));\n";
-    s += "    float x = clamp(s / max(half, 1e-6), -1.0, 1.0) * 0.5 + 0.5;\n";
+    s += "    float chord = sqrt(max(R * R - r * r, 0.0));\n";
+    s += "    float x = clamp(s / max(chord, 1e-6), -1.0, 1.0) * 0.5 + 0.5;\n";
     s += "    float y = min(abs(r) / R, 1.0);\n";
     // Texel centres: entry j at (j + 0.5) / cols, so GL_LINEAR reproduces the CPU's bilinear lookup.
     s += "    vec2 tc = vec2(x * " + num(double(cols - 1) / cols) + " + " + num(0.5 / cols) + ", y * " +

@@ -270,6 +270,7 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         // Local copies: the compiler cannot keep values read through
         // references in registers across the stores to *out (they might alias).
         const float nearZL = nearZ, fadeStart = mDesc.nearFadeStart, fadeEnd = mDesc.nearFadeEnd;
+        const bool nearFade = mDesc.nearFade;
         const bool cull = cullEach, crossfade = style.crossfade, perspL = persp;
         const float colorRow = hasTable ? float(style.colorTable) : 0.0f, gain = range.gain, scaleL = opacityScale;
         const std::uint32_t setFirst = range.first;
@@ -321,7 +322,7 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
                 if (cull)
                     for (const auto& p : planes) outside = outside || glm::dot(glm::vec3(p), g.center) + p.w < -extent;
                 const float fadeFrom = nearZL + fadeStart * extent, fadeTo = nearZL + fadeEnd * extent;
-                const float fade = g.viewZ >= fadeTo ? 1.0f : smoothstep(fadeFrom, fadeTo, g.viewZ);
+                const float fade = !nearFade || g.viewZ >= fadeTo ? 1.0f : smoothstep(fadeFrom, fadeTo, g.viewZ);
                 if (outside || fade <= 0.0f) {
                     ++stats.culled;
                     continue;
