@@ -107,10 +107,11 @@ struct Target {
 struct DrawStats {
     std::uint64_t splats = 0;
     std::uint64_t drawCalls = 0;
-    // Depth cut (issue 15): splats drawn with the near-plane cut, and those
-    // whose polygon crosses the eye plane (drawn as a screen-covering quad);
-    // whether the host depth was read.
-    std::uint64_t cutNear = 0, cutGeneral = 0;
+    // Depth cut (issue 15): splats drawn with the near-plane cut, those whose
+    // polygon crosses the eye plane (drawn as a screen-covering quad), those
+    // drawn with the host-depth cut, and those skipped as wholly behind the
+    // host surface; whether the host depth was read.
+    std::uint64_t cutNear = 0, cutGeneral = 0, cutHost = 0, cutHidden = 0;
     bool cutHostDepth = false;
 };
 

@@ -84,6 +84,12 @@ struct Renderer::Impl {
     std::vector<std::uint8_t> classes;
     GLuint depthQueried = 0;  // the host depth texture last checked, and whether it can be sampled
     bool depthUsable = false;
+    // The host depth as view depth (R32F, the target's size), its framebuffer and program.
+    // The host view-depth range per kCutTile tile (RG32F), read back per draw.
+    GLuint tiles = 0, tilesFbo = 0, tilesProgram = 0, tilesVao = 0;
+    GLint uTilesDepthToView = -1, uTilesTarget = -1;
+    std::vector<float> tileRange;
+    int tilesW = 0, tilesH = 0;
     GLuint vao = 0, instances = 0, layers = 0;
     // Instance data streams through a persistently mapped ring of kRing
     // regions: the CPU writes region i while the GPU may still read the
@@ -135,6 +141,10 @@ struct Renderer::Impl {
         for (const auto& p : programs)
             if (p.second.id) glDeleteProgram(p.second.id);
         if (vao) glDeleteVertexArrays(1, &vao);
+        if (tilesVao) glDeleteVertexArrays(1, &tilesVao);
+        if (tiles) glDeleteTextures(1, &tiles);
+        if (tilesFbo) glDeleteFramebuffers(1, &tilesFbo);
+        if (tilesProgram) glDeleteProgram(tilesProgram);
         if (instances) glDeleteBuffers(1, &instances);
         if (layers) glDeleteTextures(1, &layers);
     }
@@ -277,6 +287,15 @@ Status Renderer::upload(const Materials& materials) {
         r.partialSource = partial;
     }
     if (r.desc.depthCut && !r.program(Impl::kCut)) return makeError("splatfx::gl::Renderer::upload: " + r.programError);
+    if (r.desc.depthCut && !r.tilesProgram) {
+        auto tiles = linkProgram({"#version 450 core\n", detail::kDepthToViewVertex}, {"#version 450 core\n", detail::kDepthTilesFragment},
+                                 "splat depth cut (host depth tiles)");
+        if (!tiles) return makeError("splatfx::gl::Renderer::upload: " + tiles.error());
+        r.tilesProgram = *tiles;
+        r.uTilesDepthToView = glGetUniformLocation(r.tilesProgram, "uDepthToView");
+        r.uTilesTarget = glGetUniformLocation(r.tilesProgram, "uTarget");
+        glCreateVertexArrays(1, &r.tilesVao);
+    }
     return {};
 }
 
@@ -324,7 +343,7 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
     assert(r.layers && "splatfx::gl::Renderer::draw: call upload(materials) first");
     r.stats.splats = splats.size();
     r.stats.drawCalls = 0;
-    r.stats.cutNear = r.stats.cutGeneral = 0;
+    r.stats.cutNear = r.stats.cutGeneral = r.stats.cutHost = r.stats.cutHidden = 0;
     r.stats.cutHostDepth = false;
     if (splats.empty() || !r.layers) return;
 
@@ -342,55 +361,15 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
     const glm::vec3 eye = camera.eye(), fwd = camera.forward();
     const float nearZ = camera.nearPlane();
     const float cutExtent = std::clamp(r.desc.footprintCut, 0.05f, 1.0f);
-    // One pass over the splats: copy into the ring, note whether any
-    // cross-fades and (cut) which need the near-plane cut or the general
-    // variant. Class 0: support wholly beyond the near plane; 1: the near
-    // plane meets it; 2: the drawn polygon nearly crosses the eye plane
-    // (perspective), drawn as a screen-covering quad. The thresholds leave
-    // margin against the vertex shader's own float arithmetic (which drops
-    // a polygon only below 0.25 near).
-    Splat* dst = r.mapped + first;
-    bool anyCrossfade = false;
-    if (cut) r.classes.resize(splats.size());
-    for (std::size_t i = 0; i < splats.size(); ++i) {
-        const Splat& sp = splats[i];
-        dst[i] = sp;
-        anyCrossfade |= sp.blend > 0.0f;
-        if (!cut) continue;
-        const float a = std::abs(glm::dot(sp.axisU, fwd)), b = std::abs(glm::dot(sp.axisV, fwd));
-        const float reach = r.desc.trimCorners ? std::max(a + 0.41421356f * b, 0.41421356f * a + b) : a + b;
-        const float minZ = glm::dot(sp.center - eye, fwd) - cutExtent * reach;
-        const float area = glm::length(glm::cross(sp.axisU, sp.axisV));
-        const float l = r.rho[sp.color >> 24] * std::sqrt(area) / r.kernelRadius;
-        std::uint8_t c = minZ - 1.01f * r.kernelRadius * l < nearZ * 1.01f + 1e-6f ? 1 : 0;
-        if (persp && !(minZ >= 0.5f * nearZ)) c = 2; // also NaN
-        r.classes[i] = c;
-    }
 
     // draw() binds unit 0's texture array and, with the cut, 2D textures on units 1 and 2.
     detail::SavedState saved;
     if (r.desc.restoreState) saved.save({.texture2DUnits = cut ? 3 : 0, .scissor = false});
 
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
-    glViewport(target.x, target.y, target.width, target.height);
-    glEnable(GL_BLEND);
-    glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-    glBlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
-    if (r.desc.depthTest) {
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_LEQUAL);
-    } else {
-        glDisable(GL_DEPTH_TEST);
-    }
-    glDepthMask(GL_FALSE);
-    glDisable(GL_CULL_FACE);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-
-    // The cut reads the host depth where it can sample it (single-sampled),
-    // and keeps the hardware test (LEQUAL, read-only) on the polygons the
-    // vertex shader moved in front of each support, to skip hidden ones early.
+    // The cut reads the host depth where it can sample it (single-sampled):
+    // first as view depth per pixel and its range per tile (read back).
     GLuint depthTex = 0;
-    if (cut && r.desc.depthTest) {
+    if (cut && r.desc.depthTest && r.tilesProgram) {
         depthTex = hostDepthTexture(target);
         if (depthTex && depthTex != r.depthQueried) {
             GLint samples = 0;
@@ -401,12 +380,114 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
         if (depthTex && !r.depthUsable) depthTex = 0; // multisampled: the plain test at the splat plane
     }
     r.stats.cutHostDepth = depthTex != 0;
+    const glm::mat4 invProj = glm::inverse(camera.proj);
+    const int tile = detail::kCutTile;
+    const int tilesX = (target.width + tile - 1) / tile, tilesY = (target.height + tile - 1) / tile;
+    if (depthTex) {
+        if (r.tilesW != tilesX || r.tilesH != tilesY) {
+            if (r.tiles) glDeleteTextures(1, &r.tiles);
+            if (!r.tilesFbo) glCreateFramebuffers(1, &r.tilesFbo);
+            glCreateTextures(GL_TEXTURE_2D, 1, &r.tiles);
+            glTextureStorage2D(r.tiles, 1, GL_RG32F, std::max(tilesX, 1), std::max(tilesY, 1));
+            glNamedFramebufferTexture(r.tilesFbo, GL_COLOR_ATTACHMENT0, r.tiles, 0);
+            r.tilesW = tilesX;
+            r.tilesH = tilesY;
+        }
+        glDisable(GL_BLEND);
+        glDisable(GL_DEPTH_TEST);
+        glDisable(GL_CULL_FACE);
+        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glBindVertexArray(r.tilesVao);
+        glBindFramebuffer(GL_DRAW_FRAMEBUFFER, r.tilesFbo);
+        glViewport(0, 0, tilesX, tilesY);
+        glUseProgram(r.tilesProgram);
+        glUniform4f(r.uTilesDepthToView, invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+        glUniform4i(r.uTilesTarget, target.x, target.y, target.width, target.height);
+        glBindTextureUnit(1, depthTex);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        r.tileRange.resize(std::size_t(tilesX) * std::size_t(tilesY) * 2);
+        glGetTextureImage(r.tiles, 0, GL_RG, GL_FLOAT, GLsizei(r.tileRange.size() * sizeof(float)), r.tileRange.data());
+    }
+
+    // One pass over the splats: classify (cut), copy the drawn ones into the
+    // ring in order, note whether any cross-fades. Needs per splat: the near
+    // cut (its support meets the near plane), the host cut (its support
+    // meets the range of host depths over the tiles it covers), the general
+    // variant (perspective: its polygon nearly crosses the eye plane, drawn
+    // as a screen-covering quad), or none; a support wholly behind the host
+    // surface is not drawn (its share is 0 everywhere). Thresholds carry 1 %
+    // margin against the shaders' float arithmetic (the vertex shader drops
+    // a polygon only below 0.25 near, the CPU routes below 0.5 near).
+    Splat* dst = r.mapped + first;
+    bool anyCrossfade = false;
+    std::size_t drawn = 0;
+    if (cut) r.classes.resize(splats.size());
+    const glm::mat4 vp = camera.proj * camera.view;
+    const float focalY = std::abs(camera.proj[1][1]) * 0.5f * float(target.height), focalX = std::abs(camera.proj[0][0]) * 0.5f * float(target.width);
+    for (std::size_t i = 0; i < splats.size(); ++i) {
+        const Splat& sp = splats[i];
+        if (cut) {
+            const float a = std::abs(glm::dot(sp.axisU, fwd)), b = std::abs(glm::dot(sp.axisV, fwd));
+            const float reach = cutExtent * (r.desc.trimCorners ? std::max(a + 0.41421356f * b, 0.41421356f * a + b) : a + b);
+            const float zc = glm::dot(sp.center - eye, fwd);
+            const float minZ = zc - reach, maxZ = zc + reach;
+            const float area = glm::length(glm::cross(sp.axisU, sp.axisV));
+            // The support's reach along the rays, R l (l = rho sqrt(area) / R), with 1 % margin.
+            const float depthReach = 1.01f * r.rho[sp.color >> 24] * std::sqrt(area);
+            std::uint8_t c = minZ - depthReach < nearZ * 1.01f + 1e-6f ? std::uint8_t(Impl::kNear) : std::uint8_t(0);
+            if (persp && !(minZ >= 0.5f * nearZ)) c = std::uint8_t(Impl::kGeneral); // also NaN
+            if (depthTex) {
+                // The host depths over the splat's screen rectangle (centre
+                // projected, half-size from its largest in-plane extent).
+                float lo = 0.0f, hi = 3.4e38f;
+                if (!(c & Impl::kGeneral)) {
+                    const glm::vec4 cc = vp * glm::vec4(sp.center, 1.0f);
+                    const float ext = cutExtent * (glm::length(sp.axisU) + glm::length(sp.axisV)) * 1.01f;
+                    const float px = (cc.x / cc.w * 0.5f + 0.5f) * float(target.width), py = (cc.y / cc.w * 0.5f + 0.5f) * float(target.height);
+                    const float hx = persp ? ext * focalX / minZ : ext * focalX, hy = persp ? ext * focalY / minZ : ext * focalY;
+                    const int x0 = std::clamp(int(std::floor((px - hx) / float(tile))), 0, tilesX - 1), x1 = std::clamp(int(std::floor((px + hx) / float(tile))), 0, tilesX - 1);
+                    const int y0 = std::clamp(int(std::floor((py - hy) / float(tile))), 0, tilesY - 1), y1 = std::clamp(int(std::floor((py + hy) / float(tile))), 0, tilesY - 1);
+                    if (std::isfinite(px) && std::isfinite(py) && std::isfinite(hx) && std::isfinite(hy)) {
+                        lo = 3.4e38f, hi = 0.0f;
+                        for (int ty = y0; ty <= y1; ++ty)
+                            for (int tx = x0; tx <= x1; ++tx) {
+                                const float* t = &r.tileRange[(std::size_t(ty) * std::size_t(tilesX) + std::size_t(tx)) * 2];
+                                lo = std::min(lo, t[0]);
+                                hi = std::max(hi, t[1]);
+                            }
+                    }
+                }
+                if (minZ - depthReach > hi * 1.01f + 1e-6f) { // wholly behind the surface
+                    ++r.stats.cutHidden;
+                    continue;
+                }
+                if (!(maxZ + depthReach < lo * 0.99f)) c |= std::uint8_t(Impl::kHostDepth); // the surface may meet the support
+            }
+            r.classes[drawn] = c;
+        }
+        dst[drawn++] = sp;
+        anyCrossfade |= sp.blend > 0.0f;
+    }
+
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
+    glViewport(target.x, target.y, target.width, target.height);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    glBlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
+    // With the host depth read, the cut replaces the hardware test (the
+    // depth texture is read, never written: the test and writes are off).
+    if (r.desc.depthTest && !depthTex) {
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LEQUAL);
+    } else {
+        glDisable(GL_DEPTH_TEST);
+    }
+    glDepthMask(GL_FALSE);
+    glDisable(GL_CULL_FACE);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 
     const bool fogged = r.fog && !r.fogSource.empty();
-    const unsigned base = (anyCrossfade ? Impl::kCrossfade : 0u) | (fogged ? Impl::kFog : 0u) | (cut ? Impl::kCut : 0u) |
-                          (depthTex ? Impl::kHostDepth : 0u);
-    const glm::mat4 vp = camera.proj * camera.view;
-    const glm::mat4 invProj = glm::inverse(camera.proj);
+    const unsigned base = (anyCrossfade ? Impl::kCrossfade : 0u) | (fogged ? Impl::kFog : 0u) | (cut ? Impl::kCut : 0u);
     const glm::mat4 invVp = glm::inverse(vp);
     if (fogged) r.fogParams = r.fog->glslParameters(r.fogTimeSec, glm::dvec3(eye));
     glBindTextureUnit(0, r.layers);
@@ -449,20 +530,40 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
     };
 
     if (!cut) {
-        drawRange(base, 0, splats.size());
+        drawRange(base, 0, drawn);
     } else {
-        // Back to front, the splats the near plane meets come last: the bulk
-        // in one draw without the near cut, then runs of near and general.
+        // Runs in back-to-front order, each with the variant its splats need.
+        // A short run (< kMerge splats) that needs no more than its
+        // predecessor joins it (drawn with a costlier but exact variant)
+        // rather than costing a draw call; the general variant covers the
+        // screen, so only general splats get it.
+        constexpr std::size_t kMerge = 24;
         std::size_t i = 0;
-        while (i < splats.size() && r.classes[i] == 0) ++i;
-        drawRange(base, 0, i);
-        while (i < splats.size()) {
-            const bool general = r.classes[i] == 2;
-            std::size_t j = i;
-            while (j < splats.size() && (r.classes[j] == 2) == general) ++j;
-            drawRange(base | (general ? Impl::kGeneral : Impl::kNear), i, j);
-            if (general) r.stats.cutGeneral += j - i;
-            else r.stats.cutNear += j - i;
+        while (i < drawn) {
+            unsigned need = r.classes[i];
+            std::size_t j = i + 1;
+            for (;;) {
+                while (j < drawn && r.classes[j] == need) ++j;
+                if (j >= drawn || (need & Impl::kGeneral) || (r.classes[j] & Impl::kGeneral)) break;
+                const unsigned c = r.classes[j];
+                if (j - i < kMerge) { // a short run takes on the next one's needs (or its splat, if it needs less)
+                    if ((c & ~need) == 0) ++j;
+                    else need |= c;
+                    continue;
+                }
+                if ((c & ~need) != 0) break;
+                // Cheaper splats inside a long run: absorbed if only a few.
+                std::size_t k = j;
+                while (k < drawn && k - j < kMerge && r.classes[k] != need && (r.classes[k] & ~need) == 0) ++k;
+                if (k - j >= kMerge) break;
+                j = k;
+            }
+            drawRange(base | need, i, j);
+            for (std::size_t q = i; q < j; ++q) {
+                if (need & Impl::kGeneral) ++r.stats.cutGeneral;
+                else if (need & Impl::kNear) ++r.stats.cutNear;
+                if (need & Impl::kHostDepth) ++r.stats.cutHost;
+            }
             i = j;
         }
     }

@@ -80,25 +80,18 @@ void main() {
     vAxisU = au;
     vAxisV = av;
 #else
-    // Draw the polygon moved along the rays so that (with a host depth) the
-    // hardware depth test rejects only fragments whose whole support on the
-    // ray lies behind the surface (z >= zp - R l), and never in front of the
-    // near plane. A uniform scale about the eye (perspective) or a shift
-    // along forward (orthographic) keeps its screen image and the
-    // interpolation of vTex and vRel exactly (both are affine in position).
+    // A polygon in front of the near plane is moved behind it along the rays
+    // (GL would clip it; its support may reach past the near plane). A
+    // uniform scale about the eye (perspective) or a shift along forward
+    // (orthographic) keeps its screen image and the interpolation of vTex and
+    // vRel exactly (both are affine in position). With a host depth the
+    // hardware depth test is off (the CPU drops splats wholly behind the
+    // surface per tile; the shader cuts the rest), so nothing else moves.
     if (uPersp != 0) {
-        float k = 1.0;
-#if HOST_DEPTH
-        k = 1.0 - uKernelRadius * l / max(minZ, 1e-30);
-#endif
-        k = max(k, zDraw / max(minZ, 1e-30));
+        float k = max(1.0, zDraw / max(minZ, 1e-30));
         if (k != 1.0) p = uEye + k * (p - uEye); // k = 1: the plain path's position, bit for bit
     } else {
-        float d = 0.0;
-#if HOST_DEPTH
-        d = -uKernelRadius * l;
-#endif
-        d = max(d, zDraw - minZ);
+        float d = max(0.0, zDraw - minZ);
         if (d != 0.0) p += d * uForward;
     }
     gl_Position = uViewProj * vec4(p, 1.0);
@@ -154,7 +147,7 @@ uniform float uKernelRadius;
 flat in float vScale;
 in vec3 vRel;
 #if HOST_DEPTH
-layout(binding = 1) uniform sampler2D uHostDepth;
+layout(binding = 1) uniform sampler2D uHostDepth; // the host's depth texture (read only; the depth test is off)
 uniform vec4 uDepthToView; // inverse projection's (z, w) rows at (z, w) columns
 #endif
 #if GENERAL
@@ -230,6 +223,39 @@ void main() {
     c = f * c + (1.0 - f) * a * splatfx_fog_colour;
 #endif
     oColor = vec4(c, a);
+}
+)";
+
+// A full-screen triangle (the depth-cut tile pass).
+inline constexpr const char* kDepthToViewVertex = R"(
+void main() {
+    vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
+    gl_Position = vec4(p, 0.0, 1.0);
+}
+)";
+// Per kCutTile x kCutTile tile of the target, the nearest and farthest host
+// view depth (RG32F), read back so the CPU can give the cut program only to
+// the splats whose support meets the surface: on a software rasterizer every
+// extra texture fetch of a fragment costs about as much as the splat's own
+// (masked branches still run), so per-draw variants are the only cheap path.
+inline constexpr int kCutTile = 16;
+inline constexpr const char* kDepthTilesFragment = R"(
+layout(binding = 1) uniform sampler2D uHostDepth;
+uniform vec4 uDepthToView; // inverse projection's (z, w) rows at (z, w) columns
+uniform ivec4 uTarget;     // x, y, width, height of the target in the depth texture
+layout(location = 0) out vec2 oRange;
+void main() {
+    ivec2 first = ivec2(gl_FragCoord.xy) * 16;
+    ivec2 last = min(first + 16, uTarget.zw);
+    float lo = 3.4e38, hi = 0.0;
+    for (int y = first.y; y < last.y; ++y)
+        for (int x = first.x; x < last.x; ++x) {
+            float nz = texelFetch(uHostDepth, ivec2(x, y) + uTarget.xy, 0).r * 2.0 - 1.0;
+            float z = abs((uDepthToView.x * nz + uDepthToView.y) / (uDepthToView.z * nz + uDepthToView.w));
+            lo = min(lo, z);
+            hi = max(hi, z);
+        }
+    oRange = vec2(lo, hi);
 }
 )";
 
