@@ -57,6 +57,7 @@ void usage() {
         "  --scale N        draw the effects at 1/N resolution per axis (1, 2 or 4; default 1) with depth-aware upsampling\n"
         "  --sampling M     texture sampling: auto (default), bilinear, nearest, upsampled, upsampledN (N = 2..16)\n"
         "  --fog-texture WxH  fog the host image through a reduced WxH fog texture (default: per pixel)\n"
+        "  --no-depth-cut   the plain depth test at each splat's plane instead of the exact cut (RendererDesc::depthCut)\n"
         "  --quiet          no per-frame progress\n"
         "  --abort-after N  testing aid: fail on purpose after N frames (checks that nothing partial is left)\n"
         "<name> is the scene's output.name (default: the scene file's folder name).\n");
@@ -126,6 +127,8 @@ bool parse(int argc, char** argv, Args& a) {
                 return false;
             }
             a.renderer.fogTextureSize = {fw, fh};
+        } else if (s == "--no-depth-cut") {
+            a.renderer.splats.depthCut = false; // issue 15: for before/after comparisons
         } else if (s == "--abort-after") {
             if (!(v = value()) || !integer(v, 0, 100000, n)) return false;
             a.abortAfter = int(n);

@@ -1,9 +1,11 @@
 // splatfx/gl/renderer.hpp: the OpenGL 4.5 backend that draws a SplatList.
 //
 // Draws sorted splats as instanced quads into a framebuffer the host owns,
-// with premultiplied-alpha "over" compositing, testing (not writing) the
-// host's depth buffer so scene geometry drawn first occludes and cuts through
-// the effect. It never creates a context or a window, and never clears.
+// with premultiplied-alpha "over" compositing, cutting every splat exactly
+// at the host's depth and the near plane (RendererDesc::depthCut; or testing,
+// not writing, the host's depth buffer at each splat's plane) so scene
+// geometry drawn first occludes and cuts through the effect. It never
+// creates a context or a window, and never clears.
 //
 //   auto r = splatfx::gl::Renderer::create();   // a GL 4.5 context must be current
 //   r->upload(materials);                       // when materials change
