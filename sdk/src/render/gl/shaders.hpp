@@ -136,6 +136,9 @@ flat in vec3 vColor;
 flat in float vFogF;
 #else
 in vec3 vFogRel;
+#if CUT && GENERAL
+uniform vec3 uFogEye;
+#endif
 #endif
 #endif
 layout(location = 0) out vec4 oColor;
@@ -217,6 +220,8 @@ void main() {
 #if FOG
 #if FOG_PER_SPLAT
     float f = vFogF;
+#elif CUT && GENERAL
+    float f = splatfx_fog_transmittance(vec3(0.0), uEye + tP * dir - uFogEye); // the point this fragment met
 #else
     float f = splatfx_fog_transmittance(vec3(0.0), vFogRel);
 #endif
