@@ -72,6 +72,7 @@ void usage() {
         "  --assemble       write DIR/<name>.gif from the frames DIR/<name>_NNNN.png the tasks wrote (renders nothing)\n"
         "  --budget NAME=N  raise (or lower) one of the loader's budgets (splatfx/budget.hpp; repeatable): effectCells,\n"
         "                   solverCells, sampledTexels, textureLayers, meshElements, meshFileBytes\n"
+        "  --no-depth-cut   the plain depth test at each splat's plane instead of the exact cut (RendererDesc::depthCut)\n"
         "  --quiet          no per-frame progress\n"
         "  --abort-after N  testing aid: fail on purpose after N frames (checks that nothing partial is left)\n"
         "<name> is the scene's output.name (default: the scene file's folder name).\n");
@@ -157,6 +158,8 @@ bool parse(int argc, char** argv, Args& a) {
             }
         } else if (s == "--assemble") {
             a.assemble = true;
+        } else if (s == "--no-depth-cut") {
+            a.renderer.splats.depthCut = false; // issue 15: for before/after comparisons
         } else if (s == "--abort-after") {
             if (!(v = value()) || !integer(v, 0, 100000, n)) return false;
             a.abortAfter = int(n);
