@@ -13,7 +13,7 @@
 // color tables and differing texture sets").
 //
 // An Effect is an EffectKind (effect_kind.hpp), the interface Scene schedules
-// by; it is a copyable value that owns one of the SDK's three kinds:
+// by; it is a copyable value that owns one of the SDK's four kinds:
 //   - grid effects (fromGrid) are stateless: update(t) computes frame t
 //     directly from (voxel, t, seed), in any order, at no cost for skipped
 //     frames. step(dt) is update(time() + dt); advanceTo(t) is update(t).

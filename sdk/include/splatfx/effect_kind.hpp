@@ -10,8 +10,9 @@
 // stateless grid effect (base grid + Motion + growth + texture dynamics,
 // King et al. 1999 sec. 3.1-3.3, evaluated at t directly), the stateful
 // solver effect (FluidSolver + emitters + texture propagation, stepped, and
-// caught up in bounded coarse steps after a gap) and the sequence effect (a
-// baked simulation played back, e.g. imported from OpenVDB).
+// caught up in bounded coarse steps after a gap), the procedural gas (Ebert &
+// Parent's turbulent densities sampled at t) and the sequence effect (a baked
+// simulation played back, e.g. imported from OpenVDB).
 // It does not own materials, sort or render (the Frame and the renderer do).
 //
 // How to add a kind (a cloud volume, a procedural gas):
