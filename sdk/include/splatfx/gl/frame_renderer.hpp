@@ -77,6 +77,16 @@ struct FrameRendererDesc {
     float fogDepthThreshold = 0.05f;      // fog texture: relative distance still one surface; default 0.05
     bool fogHost = true;                  // fog the host's opaque image (false: only the splats); default true
     // --- end fog ---
+    // ---- [oit, issue 15] order-exact transparency (HostTarget::transparentToLists) ----
+    // The fragment budget for the host's transparent surfaces: the node pool
+    // holds viewport pixels x this many nodes (16 bytes each, plus 8 bytes of
+    // head and count per pixel: at 8 and 640x480, 41.8 MB), and a pixel
+    // resolves this many surfaces exactly (more: the farthest are merged,
+    // counted in FrameRenderStats). The splats take no nodes: they are
+    // composited per section into 2, 4 or 8 RGBA16F targets (8 bytes a pixel
+    // each). [1, 128]. Default 8.
+    int fragmentsPerPixel = 8;
+    // ---- end [oit] ----
 };
 
 // ---- lighting (issue 16): what a host surface shader with shadowGlsl()
@@ -111,6 +121,17 @@ struct HostTarget {
     // The host's transparent surfaces, blended after the volumes (ordered
     // blend; exact interleaving with the volumes is issue 15's pass). Default empty.
     std::function<void()> drawTransparent{};
+    // ---- [oit, issue 15] ----
+    // drawTransparent emits its fragments into per-pixel lists through
+    // transparentGlsl()'s splatfx_emitTransparent (transparency.hpp) instead
+    // of blending them: the splats are then cut into sections at those
+    // surfaces and every pixel is sorted and composited exactly (the
+    // order-exact path, docs/integration.md "Transparent surfaces"). The hook
+    // runs with the lists bound, premultiplied "over" blending and the depth
+    // test on without writes. false (or no hook): today's ordered blend at
+    // today's cost. Default false.
+    bool transparentToLists = false;
+    // ---- end [oit] ----
 };
 
 struct FrameRenderStats {
@@ -128,6 +149,19 @@ struct FrameRenderStats {
     std::uint64_t tetrahedraTransparent = 0; // skipped by the table's zero-opacity test
     std::uint64_t batches = 0;               // runs of the interleaved splat/tetrahedron sequence
     std::size_t tableBytes = 0;              // GPU bytes of the uploaded pre-integration tables
+    // ---- [oit, issue 15] order-exact transparency (last frame) ----
+    bool transparentLists = false;        // the host's surfaces went through the fragment lists
+    bool splatsInLists = false;           // ... and the splats too (false: drawn before them, ordered blend; see transparentNote)
+    std::string transparentNote;          // empty, or why the splats took the ordered blend in a list frame
+    std::uint64_t transparentNodes = 0;   // surface fragments stored in the lists
+    std::uint64_t transparentFallback = 0;     // surface fragments that found the pool full: blended directly by the include, unsorted
+    std::uint64_t transparentOverflowPixels = 0; // pixels with more surfaces than fragmentsPerPixel (their farthest merged)
+    std::uint64_t transparentMergedNodes = 0;    // surface nodes merged so
+    std::uint64_t transparentMaxSurfaces = 0;    // most surfaces stored on one pixel
+    int transparentSections = 0;                 // section targets the splats were composited into (2, 4 or 8; 0: none)
+    std::uint64_t transparentSectionOverflow = 0; // splat fragment parts behind more surfaces than sections (merged into the last)
+    std::size_t transparentBytes = 0;     // GPU bytes of the lists (pool, heads, counts, counters, section targets)
+    // ---- end [oit] ----
 };
 
 class FrameRenderer {
