@@ -32,7 +32,8 @@ Image renderCampfire(std::uint32_t seed, glm::ivec2 size, const gl::RendererDesc
     EXPECT_TRUE(fb) << fb.error();
     auto r = gl::Renderer::create(desc);
     EXPECT_TRUE(r) << r.error();
-    EXPECT_TRUE(r->upload(f.materials));
+    const Status up = r->upload(f.materials);
+    EXPECT_TRUE(up) << up.error();
     fb->clear({0.02f, 0.02f, 0.04f, 1.0f});
     const Camera cam = test::campfireCamera(size);
     SplatBuilder b;
@@ -156,7 +157,8 @@ TEST_F(RendererGL, TexturedSplatsShowDetailTraditionalDoNot) {
         FireMaterials f(1);
         auto fb = gl::Framebuffer::create({.width = 160, .height = 120});
         auto r = gl::Renderer::create();
-        EXPECT_TRUE(r->upload(f.materials));
+        const Status up = r->upload(f.materials);
+    EXPECT_TRUE(up) << up.error();
         fb->clear({0, 0, 0, 1});
         const Camera cam = test::campfireCamera({160, 120});
         SplatBuilder b;
@@ -178,7 +180,8 @@ TEST_F(RendererGL, OpaqueObjectInsideTheFireHidesExactlyTheSplatsBehindIt) {
     // Orthographic view down -z: every splat plane is parallel to the host's
     // quad at z = 0.25 (between two voxel layers, so none is coplanar), so each splat is wholly in front of it or wholly behind.
     // Drawing all splats with the depth test must then equal drawing only the
-    // front splats with no depth test at all, bit for bit.
+    // front splats with no depth test at all, bit for bit. This is the plain
+    // test (RendererDesc::depthCut = false); the cut is tested in cut_gl_test.cpp.
     const glm::ivec2 size(120, 160);
     FireMaterials f(1);
     Grid g = test::campfireGrid(1);
@@ -194,9 +197,9 @@ TEST_F(RendererGL, OpaqueObjectInsideTheFireHidesExactlyTheSplatsBehindIt) {
     ASSERT_GT(front.size(), 10u);
     ASSERT_LT(front.size(), b.splats().size() - 10);
 
-    auto r = gl::Renderer::create();
+    auto r = gl::Renderer::create({.depthCut = false});
     ASSERT_TRUE(r->upload(f.materials));
-    auto rNoDepth = gl::Renderer::create({.depthTest = false});
+    auto rNoDepth = gl::Renderer::create({.depthTest = false, .depthCut = false});
     ASSERT_TRUE(rNoDepth->upload(f.materials));
     HostQuad quad;
     const gl::Target target{.framebuffer = 0, .width = size.x, .height = size.y};

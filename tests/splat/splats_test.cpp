@@ -157,7 +157,7 @@ TEST(SplatBuilder, NearPlaneFadesInsteadOfPopping) {
     // The fade is a smoothstep (slope at most 1.5) over (end - start) * extent,
     // extent = R * sqrt(3) for a unit cube; the density may change per step by
     // at most tau * 1.5 * dz / ((end - start) * extent). tau: textured sets carry a gain.
-    const SplatBuilderDesc desc;
+    const SplatBuilderDesc desc{.nearFade = true};
     const float tau = 1.0f * m.set(0).gain;
     const float maxJump = tau * 1.5f * dz / ((desc.nearFadeEnd - desc.nearFadeStart) * m.footprint().radius() * std::sqrt(3.0f));
     // Walk the camera towards the voxel: density must fall smoothly to zero.
@@ -277,4 +277,51 @@ TEST(SplatBuilder, TextureIndexWrapsAroundItsSet) {
         EXPECT_EQ(b.splats()[i].layer, range.first + index) << textures[i];
         EXPECT_EQ(b.splats()[i].nextLayer, range.first + (index + 1) % 7u) << textures[i];
     }
+}
+
+// The depth cut's along-ray scale (issue 15): splatRayScale must give the
+// world length of one kernel unit along the centre ray, 1 / |M^-1 d|, for an
+// anisotropic, rotated, stretched kernel, and the spacing for a cubic one.
+TEST(SplatBuilder, RayScaleIsTheKernelsLengthAlongTheRay) {
+    const Materials m = plainMaterials();
+    const float R = m.footprint().radius();
+    for (int stretched = 0; stretched < 2; ++stretched) {
+        Grid g;
+        g.spacing = {0.7f, 1.9f, 1.1f};
+        g.transform = glm::rotate(glm::mat4(1.0f), 0.6f, glm::normalize(glm::vec3(1, 2, 0.5f)));
+        Voxel v;
+        if (stretched) v.stretch = {0.8f, 0.3f, -0.5f};
+        g.voxels.push_back(v);
+        const glm::vec3 eye(3.0f, 4.0f, 12.0f);
+        SplatBuilder b;
+        b.begin(Camera::lookAt(eye, {0, 0, 0}, {0, 1, 0}, 1.0f, {64, 64}));
+        b.add(g, m);
+        ASSERT_EQ(b.splats().size(), 1u);
+        const Splat& s = b.splats()[0];
+        glm::dmat3 M = glm::dmat3(glm::mat3(g.transform)) * glm::dmat3(glm::dvec3(0.7, 0, 0), glm::dvec3(0, 1.9, 0), glm::dvec3(0, 0, 1.1));
+        if (stretched) {
+            const glm::dvec3 st(0.8, 0.3, -0.5);
+            const double sl = glm::length(st);
+            M = M * (glm::dmat3(1.0) + sl * glm::outerProduct(st / sl, st / sl));
+        }
+        const glm::dvec3 d = glm::normalize(glm::dvec3(s.center) - glm::dvec3(eye));
+        const double expected = 1.0 / glm::length(glm::inverse(M) * d);
+        // The code stores rho in 1/32 steps of log2: at most 2^(1/64) - 1 = 1.09 % off.
+        EXPECT_NEAR(splatRayScale(s, R), expected, 0.011 * expected) << "stretched " << stretched;
+        EXPECT_NE(s.color >> 24, 255u); // anisotropic: a code is stored
+    }
+    // Cubic spacing: exactly the spacing, code 255.
+    Grid g;
+    g.spacing = glm::vec3(0.8f);
+    g.voxels.push_back(Voxel{});
+    SplatBuilder b;
+    b.begin(Camera::lookAt({2, 1, 9}, {0, 0, 0}, {0, 1, 0}, 1.0f, {64, 64}));
+    b.add(g, m);
+    ASSERT_EQ(b.splats().size(), 1u);
+    EXPECT_EQ(b.splats()[0].color >> 24, 255u);
+    EXPECT_NEAR(splatRayScale(b.splats()[0], R), 0.8f, 1e-5f);
+    // Codes round-trip; bad input is clamped, never NaN.
+    for (float rho : {0.2f, 0.5f, 1.0f, 1.7f, 9.0f}) EXPECT_NEAR(rayScaleRho(rayScaleCode(rho)), rho, 0.011f * rho);
+    EXPECT_EQ(rayScaleCode(std::nanf("")), 0);
+    EXPECT_GT(rayScaleRho(rayScaleCode(1e9f)), 10.0f);
 }

@@ -2,9 +2,9 @@
 //
 // For each voxel the builder computes the ellipse its (possibly anisotropic)
 // kernel projects to for this camera, the optical depth along the ray
-// through its centre, its texture layer(s) and colour coordinate, and fades
-// it out as it nears the near plane (so a camera inside an effect sees no
-// popping). The list is then sorted back to front for composite-every-sample
+// through its centre, its texture layer(s) and colour coordinate, and the
+// kernel's along-ray scale for the depth cut (or, with
+// SplatBuilderDesc::nearFade, a fade towards the near plane). The list is then sorted back to front for composite-every-sample
 // splatting (King et al. 1999, sec. 2 step 4). The resulting SplatList is
 // exactly what the GL renderer draws and the reference renderer integrates.
 // It does no GL and no animation.
@@ -39,7 +39,7 @@ namespace splatfx {
 // the reference renderer, which reads the table exactly.
 struct Splat {
     glm::vec3 center{0.0f};
-    float density = 0.0f;        // optical depth scale, log2 units (already includes the near-plane fade)
+    float density = 0.0f;        // optical depth scale, log2 units (includes the near-plane fade when SplatBuilderDesc::nearFade)
     glm::vec3 axisU{0.0f};       // ellipse half-axis reaching the footprint's support radius
     float colorCoord = 0.0f;
     glm::vec3 axisV{0.0f};
@@ -47,10 +47,27 @@ struct Splat {
     std::uint16_t layer = 0;     // texture-array layer (Materials)
     std::uint16_t nextLayer = 0; // layer cross-faded towards
     float blend = 0.0f;          // cross-fade weight towards nextLayer
-    std::uint32_t color = 0xffffffffu; // RGBA8, R in the lowest byte
+    // RGB8 colour, R in the lowest byte; the top byte is the kernel's
+    // along-ray scale code (rayScaleCode; 255, the default, is 1).
+    std::uint32_t color = 0xffffffffu;
     float depth = 0.0f;          // distance from the eye (perspective) or along forward (ortho); sort key
 };
 static_assert(sizeof(Splat) == 64, "Splat must match the GPU layout");
+
+// The depth cut (issue 15, docs/architecture.md "The depth cut") needs the
+// kernel's extent along the ray, which the ellipse alone does not give for an
+// anisotropic kernel: the world length of one kernel unit along the ray d
+// through the centre is l = 1 / |M^-1 d|. With the ellipse's half-axes
+// reaching the footprint radius R, |axisU x axisV| = R^2 |det M| |M^-1 d|,
+// so l = rho * sqrt(|axisU x axisV|) / R with rho = (|det M|^(1/3) |M^-1 d|)^(-3/2),
+// 1 for any isotropic kernel. rho is stored in the top byte of Splat::color
+// as code = 127 + round(32 log2 rho) in [0, 254] (1.1 % steps, rho in
+// [2^-3.97, 2^3.97], clamped), 255 meaning exactly 1.
+std::uint8_t rayScaleCode(float rho);
+float rayScaleRho(std::uint8_t code);
+// World length per kernel unit along the splat's centre ray (see above);
+// 0 for a degenerate ellipse.
+float splatRayScale(const Splat& splat, float footprintRadius);
 
 // How a grid's voxels become splats.
 struct SplatStyle {
@@ -68,7 +85,13 @@ enum class SortMode {
 };
 
 struct SplatBuilderDesc {
-    float nearFadeStart = 0.25f; // near-plane fade begins at near + nearFadeStart * splat extent; default 0.25
+    // The near-plane fade of the splats' density (before issue 15). Off by
+    // default: the GL renderer and the reference cut every splat exactly at
+    // the near plane (RendererDesc::depthCut, docs/architecture.md "The depth
+    // cut"). Turn it on with RendererDesc::depthCut = false to get the old,
+    // all-or-nothing test at the splat plane without popping at the near plane.
+    bool nearFade = false;       // default false
+    float nearFadeStart = 0.25f; // with nearFade: fade begins at near + nearFadeStart * splat extent; default 0.25
     float nearFadeEnd = 1.5f;    // ... and is complete (full opacity) at near + nearFadeEnd * extent; default 1.5
     bool frustumCull = true;     // drop splats wholly outside the view frustum; default true
     std::uint32_t buckets = 64;  // depth bins for SortMode::Bucketed; default 64

@@ -1,5 +1,6 @@
 #include "splatfx/footprint.hpp"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 
@@ -44,10 +45,13 @@ double integrate(F f, double a, double b, int panels) {
 
 } // namespace
 
+void buildPartialTable(const Footprint& fp, double R, int rows, int cols, std::vector<float>& out); // partial.cpp
+
 Footprint::Footprint(const FootprintDesc& desc) : mDesc(desc) {
     assert(desc.tableSize >= 2 && "FootprintDesc::tableSize must be at least 2");
     assert(desc.gaussianSigma > 0.0f && desc.gaussianRadius > 0.0f);
     mRadius = desc.kernel == Kernel::CrawfisMax ? float(kCmRadius) : desc.gaussianRadius;
+    mRadiusExact = desc.kernel == Kernel::CrawfisMax ? kCmRadius : double(desc.gaussianRadius);
     // Normalize the 3D kernel to unit integral: 4 pi * integral r^2 h(r) dr = 1.
     const double volume = 4.0 * kPi * integrate([&](double r) { return r * r * rawKernel(mDesc, r); }, 0.0, mRadius, 64);
     mNorm = 1.0 / volume;
@@ -57,6 +61,9 @@ Footprint::Footprint(const FootprintDesc& desc) : mDesc(desc) {
         mTable[size_t(i)] = float(exact(r));
     }
     mInvCentre = mTable[0] > 0.0f ? 1.0f / mTable[0] : 0.0f;
+    mPartialRows = std::clamp(desc.partialRadialSize, 2, 1024);
+    mPartialCols = std::clamp(desc.partialDepthSize, 2, 1024);
+    buildPartialTable(*this, mRadiusExact, mPartialRows, mPartialCols, mPartial);
 }
 
 double Footprint::kernel(double r) const { return mNorm * rawKernel(mDesc, std::abs(r)); }

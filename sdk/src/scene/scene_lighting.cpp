@@ -125,7 +125,8 @@ void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& mater
         Splat& sp = splats[first + i];
         const std::uint32_t row = std::uint32_t(std::lround(sp.colorRow));
         const ColorTable* table = row < materials.colorTableCount() ? &materials.colorTable(row) : nullptr;
-        sp.color = packLit(glm::vec3(tableAt(table, sp.colorCoord)) * lit.factors[i]);
+        // The top byte is the depth cut's along-ray scale (splats.hpp, rayScaleCode): kept.
+        sp.color = (packLit(glm::vec3(tableAt(table, sp.colorCoord)) * lit.factors[i]) & 0x00ffffffu) | (sp.color & 0xff000000u);
     }
     e.status.lit = true;
     ++mCounters.litEffects;

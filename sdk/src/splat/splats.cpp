@@ -182,6 +182,21 @@ void computeGeometry(const Frame& f, const Shape& shape, const Voxel* voxels, in
 
 } // namespace
 
+std::uint8_t rayScaleCode(float rho) {
+    if (rho == 1.0f) return 255;
+    if (!(rho > 0.0f)) return 0; // also NaN
+    const float c = std::clamp(std::round(32.0f * std::log2(rho)) + 127.0f, 0.0f, 254.0f);
+    return c == 127.0f ? 255 : std::uint8_t(c);
+}
+
+float rayScaleRho(std::uint8_t code) { return code == 255 ? 1.0f : std::exp2((float(code) - 127.0f) / 32.0f); }
+
+float splatRayScale(const Splat& sp, float footprintRadius) {
+    const float area = glm::length(glm::cross(sp.axisU, sp.axisV));
+    if (!(area > 0.0f) || !(footprintRadius > 0.0f) || !std::isfinite(area)) return 0.0f;
+    return rayScaleRho(std::uint8_t(sp.color >> 24)) * std::sqrt(area) / footprintRadius;
+}
+
 void SplatBuilder::begin(const Camera& camera) {
     mCamera = camera;
     mSplats.clear();
@@ -255,6 +270,7 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         // Local copies: the compiler cannot keep values read through
         // references in registers across the stores to *out (they might alias).
         const float nearZL = nearZ, fadeStart = mDesc.nearFadeStart, fadeEnd = mDesc.nearFadeEnd;
+        const bool nearFade = mDesc.nearFade;
         const bool cull = cullEach, crossfade = style.crossfade, perspL = persp;
         const float colorRow = hasTable ? float(style.colorTable) : 0.0f, gain = range.gain, scaleL = opacityScale;
         const std::uint32_t setFirst = range.first;
@@ -278,6 +294,7 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
                 Geometry g;
                 float extent = plain.extent;
                 bool shapeOk = plain.ok;
+                bool isoKernel = plain.isotropic;
                 if (stretch2 > 0.0f) {
                     // A stretched kernel has its own shape: the same math, one voxel.
                     const float stretchLen = std::sqrt(stretch2);
@@ -285,6 +302,7 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
                     const Shape shape(gridShape * (glm::mat3(1.0f) + stretchLen * glm::outerProduct(sd, sd)), R);
                     shapeOk = shape.ok && std::isfinite(stretchLen);
                     extent = shape.extent;
+                    isoKernel = shape.isotropic;
                     if (shapeOk) {
                         GeometryBatch one;
                         if (shape.isotropic) computeGeometry<true>(frame, shape, &v, 1, one);
@@ -304,7 +322,7 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
                 if (cull)
                     for (const auto& p : planes) outside = outside || glm::dot(glm::vec3(p), g.center) + p.w < -extent;
                 const float fadeFrom = nearZL + fadeStart * extent, fadeTo = nearZL + fadeEnd * extent;
-                const float fade = g.viewZ >= fadeTo ? 1.0f : smoothstep(fadeFrom, fadeTo, g.viewZ);
+                const float fade = !nearFade || g.viewZ >= fadeTo ? 1.0f : smoothstep(fadeFrom, fadeTo, g.viewZ);
                 if (outside || fade <= 0.0f) {
                     ++stats.culled;
                     continue;
@@ -342,7 +360,9 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
                 const std::uint32_t index = setCount.mod(v.texture);
                 sp.layer = std::uint16_t(setFirst + index);
                 sp.nextLayer = std::uint16_t(setFirst + (index + 1 == setCount.d ? 0 : index + 1));
-                sp.color = packedColor;
+                // The along-ray scale for the depth cut (splats.hpp, rayScaleCode):
+                // chord = l / |det M|^(1/3), so rho = chord^(3/2); 1 (code 255) when isotropic.
+                sp.color = isoKernel ? packedColor : (packedColor & 0x00ffffffu) | std::uint32_t(rayScaleCode(std::pow(g.chord, 1.5f))) << 24;
                 sp.blend = crossfade ? std::clamp(v.phase - std::floor(v.phase), 0.0f, 1.0f) : 0.0f;
                 sp.depth = perspL ? g.dist : g.viewZ;
                 ++out;

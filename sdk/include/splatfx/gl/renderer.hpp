@@ -79,6 +79,18 @@ struct RendererDesc {
     // error grows with the fog's variation across a splat (for a constant fog
     // k, |df| <= k times the splat's drawn radius). Default false (per fragment).
     bool fogPerSplat = false;
+    // The depth cut (issue 15, docs/architecture.md "The depth cut"): each
+    // fragment keeps the share of its kernel's line integral that lies
+    // between the near plane and the host's opaque depth on its pixel ray
+    // (Footprint::fractionBefore), instead of the all-or-nothing depth test
+    // at the splat plane, so geometry inside an effect and a camera inside
+    // one show no popping (pair it with SplatBuilderDesc::nearFade = false,
+    // the default). The host depth is read from Target::depthTexture or the
+    // target framebuffer's depth attachment when it is a single-sampled
+    // texture; without one only the near plane is cut exactly and the host
+    // surface is tested at the splat plane as before. false: that plain test
+    // everywhere (pair it with SplatBuilderDesc::nearFade = true). Default true.
+    bool depthCut = true;
 };
 
 // Where to draw: the host's framebuffer object (0 = default framebuffer) and viewport.
@@ -86,11 +98,20 @@ struct Target {
     unsigned framebuffer = 0;
     int x = 0, y = 0;
     int width = 0, height = 0;
+    // The host's depth as a GL texture (depth format, single-sampled, the
+    // framebuffer's size) for RendererDesc::depthCut; 0: the framebuffer's
+    // depth attachment if it is a texture, else none. Default 0.
+    unsigned depthTexture = 0;
 };
 
 struct DrawStats {
     std::uint64_t splats = 0;
     std::uint64_t drawCalls = 0;
+    // Depth cut (issue 15): splats drawn with the near-plane cut, and those
+    // whose polygon crosses the eye plane (drawn as a screen-covering quad);
+    // whether the host depth was read.
+    std::uint64_t cutNear = 0, cutGeneral = 0;
+    bool cutHostDepth = false;
 };
 
 class Renderer {

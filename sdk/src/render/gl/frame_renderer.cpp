@@ -167,7 +167,8 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         // [clouds] Splats and tetrahedra interleaved by Frame::drawOrder (frame.hpp).
         drawInterleaved(frame, target);
     } else if (r.full) {
-        r.full->draw(frame.splats(), camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h});
+        r.full->draw(frame.splats(), camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
+                                              .depthTexture = target.depthTexture}); // [cut] the host depth the splats are cut by
         r.stats.drawCalls = r.full->stats().drawCalls;
     } else {
         r.reduced->draw(frame.splats(), camera,
@@ -241,7 +242,8 @@ void FrameRenderer::drawInterleaved(const Frame& frame, const HostTarget& target
             }
             const auto& all = frame.splats();
             r.batch.assign(all.begin() + std::ptrdiff_t(b.begin), all.begin() + std::ptrdiff_t(b.end));
-            r.full->draw(r.batch, camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h});
+            r.full->draw(r.batch, camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
+                                           .depthTexture = target.depthTexture}); // [cut]
             calls += r.full->stats().drawCalls;
         }
     }

@@ -1,6 +1,9 @@
 #include "splatfx/gl/renderer.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
 #include <cassert>
 #include <cstddef>
 #include <cstring>
@@ -13,6 +16,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "context_check.hpp"
+#include "partial_texture.hpp"
 #include "saved_state.hpp"
 #include "splatfx/gl/program.hpp"
 #include "shaders.hpp"
@@ -52,22 +56,34 @@ const float* upsampleBilinear(const float* src, int n, int factor, std::vector<f
 struct Renderer::Impl {
     RendererDesc desc;
     DrawStats stats;
+    // Programs by variant (kCrossfade | kFog | ...), compiled on first use:
+    // each draw run picks the cheapest variant that is exact for its splats.
+    enum Variant : unsigned { kCrossfade = 1, kFog = 2, kCut = 4, kHostDepth = 8, kNear = 16, kGeneral = 32 };
     struct Program {
         GLuint id = 0;
         GLint uViewProj = -1, uOctagon = -1, uCut = -1;
-    };
-    Program programs[2]; // [0]: no cross-fade in the frame, [1]: with cross-fade
-    // Fog variant (issue 14): compiled for the structure of the last fog seen.
-    struct FogProgram {
-        Program p;
+        // Fog (issue 14)
         GLint uFogEye = -1, uParams = -1, uColour = -1, uFar = -1;
+        // Depth cut (issue 15)
+        GLint uEye = -1, uForward = -1, uNearZ = -1, uPersp = -1, uKernelRadius = -1, uDepthToView = -1, uInvViewProj = -1,
+              uViewport = -1;
     };
-    FogProgram fogPrograms[2];
+    std::map<unsigned, Program> programs;
+    std::string programError; // the last variant that failed to build (never expected: a shader bug)
     std::string fogSource; // generated GLSL the fog programs were built from
+    std::string fogUniform;
     int fogVec4s = 0;
     const Fog* fog = nullptr;
     double fogTimeSec = 0.0;
     std::vector<glm::vec4> fogParams;
+    // Depth cut (issue 15): the partial table, its GLSL, per-splat classes.
+    detail::PartialTexture partial;
+    std::string partialSource;
+    float kernelRadius = 1.6f;
+    std::array<float, 256> rho{}; // rayScaleRho by code
+    std::vector<std::uint8_t> classes;
+    GLuint depthQueried = 0;  // the host depth texture last checked, and whether it can be sampled
+    bool depthUsable = false;
     GLuint vao = 0, instances = 0, layers = 0;
     // Instance data streams through a persistently mapped ring of kRing
     // regions: the CPU writes region i while the GPU may still read the
@@ -81,6 +97,17 @@ struct Renderer::Impl {
     std::uint64_t uploadedVersion = 0;
     TextureSampling sampling = TextureSampling::Bilinear; // resolved at upload
     int upsample = 1;
+
+    const Program* program(unsigned variant);
+    void dropPrograms(unsigned mask) {
+        for (auto it = programs.begin(); it != programs.end();)
+            if (it->first & mask) {
+                if (it->second.id) glDeleteProgram(it->second.id);
+                it = programs.erase(it);
+            } else {
+                ++it;
+            }
+    }
 
     void grow(std::size_t splats) {
         for (GLsync& f : fences)
@@ -105,15 +132,55 @@ struct Renderer::Impl {
         if (!detail::contextIsCurrent()) return;
         for (GLsync f : fences)
             if (f) glDeleteSync(f);
-        for (const Program& p : programs)
-            if (p.id) glDeleteProgram(p.id);
-        for (const FogProgram& p : fogPrograms)
-            if (p.p.id) glDeleteProgram(p.p.id);
+        for (const auto& p : programs)
+            if (p.second.id) glDeleteProgram(p.second.id);
         if (vao) glDeleteVertexArrays(1, &vao);
         if (instances) glDeleteBuffers(1, &instances);
         if (layers) glDeleteTextures(1, &layers);
     }
 };
+
+const Renderer::Impl::Program* Renderer::Impl::program(unsigned v) {
+    if (auto it = programs.find(v); it != programs.end()) return it->second.id ? &it->second : nullptr;
+    Program& p = programs[v];
+    const bool cut = v & kCut;
+    std::string head = "#version 450 core\n";
+    head += (v & kFog) ? "#define FOG 1\n" : "#define FOG 0\n";
+    head += (v & kFog) && desc.fogPerSplat ? "#define FOG_PER_SPLAT 1\n" : "#define FOG_PER_SPLAT 0\n";
+    head += cut ? "#define CUT 1\n" : "#define CUT 0\n";
+    head += cut && (v & kHostDepth) ? "#define HOST_DEPTH 1\n" : "#define HOST_DEPTH 0\n";
+    head += cut && (v & (kNear | kGeneral)) ? "#define NEAR_CUT 1\n" : "#define NEAR_CUT 0\n";
+    head += cut && (v & kGeneral) ? "#define GENERAL 1\n" : "#define GENERAL 0\n";
+    const std::string fs = head + ((v & kCrossfade) ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n");
+    const char* fogSrc = (v & kFog) ? fogSource.c_str() : "";
+    const char* partialSrc = cut ? partialSource.c_str() : "";
+    auto linked = linkProgram({head.c_str(), fogSrc, partialSrc, detail::kSplatVertex}, {fs.c_str(), fogSrc, partialSrc, detail::kSplatFragment},
+                              (v & kFog) ? "splat (fog)" : "splat");
+    if (!linked) {
+        programError = linked.error();
+        return nullptr;
+    }
+    p.id = *linked;
+    auto loc = [&](const char* name) { return glGetUniformLocation(p.id, name); };
+    p.uViewProj = loc("uViewProj");
+    p.uOctagon = loc("uOctagon");
+    p.uCut = loc("uCut");
+    if (v & kFog) {
+        p.uFogEye = loc("uFogEye");
+        p.uParams = loc(fogUniform.c_str());
+        p.uColour = loc("splatfx_fog_colour");
+        p.uFar = loc("splatfx_fog_far");
+    }
+    p.uEye = loc("uEye");
+    p.uForward = loc("uForward");
+    p.uNearZ = loc("uNearZ");
+    p.uPersp = loc("uPersp");
+    p.uKernelRadius = loc("uKernelRadius");
+    p.uDepthToView = loc("uDepthToView");
+    p.uInvViewProj = loc("uInvViewProj");
+    p.uViewport = loc("uViewport");
+    return &p;
+}
 
 Renderer::Renderer(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
 Renderer::Renderer(Renderer&&) noexcept = default;
@@ -132,17 +199,10 @@ Result<Renderer> Renderer::create(const RendererDesc& desc) {
                          std::to_string(epoxy_gl_version() / 10) + "." + std::to_string(epoxy_gl_version() % 10));
     auto impl = std::make_unique<Impl>();
     impl->desc = desc;
-    for (int crossfade = 0; crossfade < 2; ++crossfade) {
-        auto linked = linkProgram({"#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n", detail::kSplatVertex},
-                                          {"#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n", crossfade ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n", detail::kSplatFragment},
-                                          "splat");
-        if (!linked) return makeError(linked.error());
-        Impl::Program& p = impl->programs[crossfade];
-        p.id = *linked;
-        p.uViewProj = glGetUniformLocation(p.id, "uViewProj");
-        p.uOctagon = glGetUniformLocation(p.id, "uOctagon");
-        p.uCut = glGetUniformLocation(p.id, "uCut");
-    }
+    for (int c = 0; c < 256; ++c) impl->rho[size_t(c)] = rayScaleRho(std::uint8_t(c));
+    // The plain program now, so a broken build of the shaders fails here
+    // (the cut variants need the materials' footprint: built at upload).
+    if (!impl->program(0)) return makeError(impl->programError);
 
     glCreateVertexArrays(1, &impl->vao);
     impl->grow(0);
@@ -207,6 +267,16 @@ Status Renderer::upload(const Materials& materials) {
     r.sampling = mode;
     r.upsample = factor;
     r.uploadedVersion = materials.version();
+
+    // Depth cut (issue 15): the footprint's partial table and its lookup.
+    r.partial.update(materials.footprint());
+    r.kernelRadius = materials.footprint().radius();
+    const std::string partial = partialGlsl(materials.footprint(), 2);
+    if (partial != r.partialSource) {
+        r.dropPrograms(Impl::kCut);
+        r.partialSource = partial;
+    }
+    if (r.desc.depthCut && !r.program(Impl::kCut)) return makeError("splatfx::gl::Renderer::upload: " + r.programError);
     return {};
 }
 
@@ -221,40 +291,41 @@ Status Renderer::setFog(const Fog* fog, double timeSec) {
         return makeError("splatfx::gl::Renderer::setFog: " + glsl.error());
     }
     if (glsl->source == r.fogSource) return {};
-    for (Impl::FogProgram& p : r.fogPrograms)
-        if (p.p.id) glDeleteProgram(p.p.id), p = {};
-    r.fogSource.clear();
-    for (int crossfade = 0; crossfade < 2; ++crossfade) {
-        const char* head = r.desc.fogPerSplat ? "#version 450 core\n#define FOG 1\n#define FOG_PER_SPLAT 1\n"
-                                              : "#version 450 core\n#define FOG 1\n#define FOG_PER_SPLAT 0\n";
-        auto linked = linkProgram({head, glsl->source.c_str(), detail::kSplatVertex},
-                                  {head, crossfade ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n", glsl->source.c_str(),
-                                   detail::kSplatFragment},
-                                  "splat (fog)");
-        if (!linked) {
-            r.fog = nullptr;
-            return makeError(linked.error());
-        }
-        Impl::FogProgram& p = r.fogPrograms[crossfade];
-        p.p.id = *linked;
-        p.p.uViewProj = glGetUniformLocation(p.p.id, "uViewProj");
-        p.p.uOctagon = glGetUniformLocation(p.p.id, "uOctagon");
-        p.p.uCut = glGetUniformLocation(p.p.id, "uCut");
-        p.uFogEye = glGetUniformLocation(p.p.id, "uFogEye");
-        p.uParams = glGetUniformLocation(p.p.id, glsl->uniformName.c_str());
-        p.uColour = glGetUniformLocation(p.p.id, "splatfx_fog_colour");
-        p.uFar = glGetUniformLocation(p.p.id, "splatfx_fog_far");
-    }
+    r.dropPrograms(Impl::kFog);
     r.fogSource = glsl->source;
+    r.fogUniform = glsl->uniformName;
     r.fogVec4s = glsl->vec4Count;
+    if (!r.program(Impl::kFog | (r.desc.depthCut && !r.partialSource.empty() ? Impl::kCut : 0u))) {
+        r.fog = nullptr;
+        r.fogSource.clear();
+        return makeError(r.programError);
+    }
     return {};
 }
+
+namespace {
+
+// The host depth the cut reads: the target's texture, else the framebuffer's
+// depth attachment when it is a texture (the default framebuffer's never is).
+GLuint hostDepthTexture(const Target& target) {
+    if (target.depthTexture) return target.depthTexture;
+    if (target.framebuffer == 0) return 0;
+    GLint type = GL_NONE, name = 0;
+    glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
+    if (type != GL_TEXTURE) return 0;
+    glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &name);
+    return GLuint(name);
+}
+
+} // namespace
 
 void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, const Target& target) {
     Impl& r = *mImpl;
     assert(r.layers && "splatfx::gl::Renderer::draw: call upload(materials) first");
     r.stats.splats = splats.size();
     r.stats.drawCalls = 0;
+    r.stats.cutNear = r.stats.cutGeneral = 0;
+    r.stats.cutHostDepth = false;
     if (splats.empty() || !r.layers) return;
 
     if (splats.size() > r.regionSplats) r.grow(splats.size());
@@ -266,17 +337,39 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
         f = nullptr;
     }
     const std::size_t first = std::size_t(r.region) * r.regionSplats;
-    // One pass over the splats: copy into the ring and note whether any cross-fades.
+    const bool cut = r.desc.depthCut && !r.partialSource.empty();
+    const bool persp = camera.perspective();
+    const glm::vec3 eye = camera.eye(), fwd = camera.forward();
+    const float nearZ = camera.nearPlane();
+    const float cutExtent = std::clamp(r.desc.footprintCut, 0.05f, 1.0f);
+    // One pass over the splats: copy into the ring, note whether any
+    // cross-fades and (cut) which need the near-plane cut or the general
+    // variant. Class 0: support wholly beyond the near plane; 1: the near
+    // plane meets it; 2: the drawn polygon nearly crosses the eye plane
+    // (perspective), drawn as a screen-covering quad. The thresholds leave
+    // margin against the vertex shader's own float arithmetic (which drops
+    // a polygon only below 0.25 near).
     Splat* dst = r.mapped + first;
     bool anyCrossfade = false;
+    if (cut) r.classes.resize(splats.size());
     for (std::size_t i = 0; i < splats.size(); ++i) {
-        dst[i] = splats[i];
-        anyCrossfade |= splats[i].blend > 0.0f;
+        const Splat& sp = splats[i];
+        dst[i] = sp;
+        anyCrossfade |= sp.blend > 0.0f;
+        if (!cut) continue;
+        const float a = std::abs(glm::dot(sp.axisU, fwd)), b = std::abs(glm::dot(sp.axisV, fwd));
+        const float reach = r.desc.trimCorners ? std::max(a + 0.41421356f * b, 0.41421356f * a + b) : a + b;
+        const float minZ = glm::dot(sp.center - eye, fwd) - cutExtent * reach;
+        const float area = glm::length(glm::cross(sp.axisU, sp.axisV));
+        const float l = r.rho[sp.color >> 24] * std::sqrt(area) / r.kernelRadius;
+        std::uint8_t c = minZ - 1.01f * r.kernelRadius * l < nearZ * 1.01f + 1e-6f ? 1 : 0;
+        if (persp && !(minZ >= 0.5f * nearZ)) c = 2; // also NaN
+        r.classes[i] = c;
     }
 
-    // draw() binds only unit 0's texture array (no GL_TEXTURE_2D, no scissor).
+    // draw() binds unit 0's texture array and, with the cut, 2D textures on units 1 and 2.
     detail::SavedState saved;
-    if (r.desc.restoreState) saved.save({.texture2DUnits = 0, .scissor = false});
+    if (r.desc.restoreState) saved.save({.texture2DUnits = cut ? 3 : 0, .scissor = false});
 
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
     glViewport(target.x, target.y, target.width, target.height);
@@ -292,29 +385,88 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
     glDepthMask(GL_FALSE);
     glDisable(GL_CULL_FACE);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    const bool fogged = r.fog && r.fogPrograms[0].p.id;
-    const Impl::Program& p = fogged ? r.fogPrograms[anyCrossfade ? 1 : 0].p : r.programs[anyCrossfade ? 1 : 0];
-    glUseProgram(p.id);
-    if (fogged) {
-        // Parameters in double relative to the eye, rounded to float once (docs/fog.md, GLSL).
-        const Impl::FogProgram& fp = r.fogPrograms[anyCrossfade ? 1 : 0];
-        const glm::dvec3 eye(camera.eye());
-        r.fogParams = r.fog->glslParameters(r.fogTimeSec, eye);
-        glUniform3f(fp.uFogEye, float(eye.x), float(eye.y), float(eye.z));
-        glUniform4fv(fp.uParams, GLsizei(r.fogParams.size()), glm::value_ptr(r.fogParams[0]));
-        const glm::dvec3 col = r.fog->desc().colour;
-        glUniform3f(fp.uColour, float(col.x), float(col.y), float(col.z));
-        glUniform1f(fp.uFar, float(r.fog->desc().farDistanceWorld));
+
+    // The cut reads the host depth where it can sample it (single-sampled),
+    // and keeps the hardware test (LEQUAL, read-only) on the polygons the
+    // vertex shader moved in front of each support, to skip hidden ones early.
+    GLuint depthTex = 0;
+    if (cut && r.desc.depthTest) {
+        depthTex = hostDepthTexture(target);
+        if (depthTex && depthTex != r.depthQueried) {
+            GLint samples = 0;
+            glGetTextureLevelParameteriv(depthTex, 0, GL_TEXTURE_SAMPLES, &samples);
+            r.depthQueried = depthTex;
+            r.depthUsable = samples <= 1;
+        }
+        if (depthTex && !r.depthUsable) depthTex = 0; // multisampled: the plain test at the splat plane
     }
+    r.stats.cutHostDepth = depthTex != 0;
+
+    const bool fogged = r.fog && !r.fogSource.empty();
+    const unsigned base = (anyCrossfade ? Impl::kCrossfade : 0u) | (fogged ? Impl::kFog : 0u) | (cut ? Impl::kCut : 0u) |
+                          (depthTex ? Impl::kHostDepth : 0u);
     const glm::mat4 vp = camera.proj * camera.view;
-    glUniformMatrix4fv(p.uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
-    glUniform1i(p.uOctagon, r.desc.trimCorners ? 1 : 0);
-    glUniform1f(p.uCut, std::clamp(r.desc.footprintCut, 0.05f, 1.0f));
+    const glm::mat4 invProj = glm::inverse(camera.proj);
+    const glm::mat4 invVp = glm::inverse(vp);
+    if (fogged) r.fogParams = r.fog->glslParameters(r.fogTimeSec, glm::dvec3(eye));
     glBindTextureUnit(0, r.layers);
+    if (cut) {
+        glBindTextureUnit(1, depthTex);
+        glBindTextureUnit(2, r.partial.texture());
+    }
     glBindVertexArray(r.vao);
-    glDrawArraysInstancedBaseInstance(GL_TRIANGLE_STRIP, 0, r.desc.trimCorners ? 8 : 4, GLsizei(splats.size()), GLuint(first));
+    const GLsizei corners = r.desc.trimCorners ? 8 : 4;
+
+    auto drawRange = [&](unsigned variant, std::size_t begin, std::size_t end) {
+        if (end <= begin) return;
+        const Impl::Program* p = r.program(variant);
+        assert(p && "splatfx::gl::Renderer: a shader variant failed to build");
+        if (!p) return;
+        glUseProgram(p->id);
+        if (variant & Impl::kFog) {
+            // Parameters in double relative to the eye, rounded to float once (docs/fog.md, GLSL).
+            glUniform3f(p->uFogEye, eye.x, eye.y, eye.z);
+            glUniform4fv(p->uParams, GLsizei(r.fogParams.size()), glm::value_ptr(r.fogParams[0]));
+            const glm::dvec3 col = r.fog->desc().colour;
+            glUniform3f(p->uColour, float(col.x), float(col.y), float(col.z));
+            glUniform1f(p->uFar, float(r.fog->desc().farDistanceWorld));
+        }
+        glUniformMatrix4fv(p->uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
+        glUniform1i(p->uOctagon, r.desc.trimCorners ? 1 : 0);
+        glUniform1f(p->uCut, cutExtent);
+        if (variant & Impl::kCut) {
+            glUniform3f(p->uEye, eye.x, eye.y, eye.z);
+            glUniform3f(p->uForward, fwd.x, fwd.y, fwd.z);
+            glUniform1f(p->uNearZ, nearZ);
+            glUniform1i(p->uPersp, persp ? 1 : 0);
+            glUniform1f(p->uKernelRadius, r.kernelRadius);
+            glUniform4f(p->uDepthToView, invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+            glUniformMatrix4fv(p->uInvViewProj, 1, GL_FALSE, glm::value_ptr(invVp));
+            glUniform4f(p->uViewport, float(target.x), float(target.y), float(target.width), float(target.height));
+        }
+        glDrawArraysInstancedBaseInstance(GL_TRIANGLE_STRIP, 0, corners, GLsizei(end - begin), GLuint(first + begin));
+        ++r.stats.drawCalls;
+    };
+
+    if (!cut) {
+        drawRange(base, 0, splats.size());
+    } else {
+        // Back to front, the splats the near plane meets come last: the bulk
+        // in one draw without the near cut, then runs of near and general.
+        std::size_t i = 0;
+        while (i < splats.size() && r.classes[i] == 0) ++i;
+        drawRange(base, 0, i);
+        while (i < splats.size()) {
+            const bool general = r.classes[i] == 2;
+            std::size_t j = i;
+            while (j < splats.size() && (r.classes[j] == 2) == general) ++j;
+            drawRange(base | (general ? Impl::kGeneral : Impl::kNear), i, j);
+            if (general) r.stats.cutGeneral += j - i;
+            else r.stats.cutNear += j - i;
+            i = j;
+        }
+    }
     r.fences[r.region] = glFenceSync(GL_SYNC_GPU_COMMANDS_COMPLETE, 0);
-    r.stats.drawCalls = 1;
 
     if (r.desc.restoreState) saved.restore();
 }
