@@ -160,6 +160,8 @@ struct FrameRenderStats {
     std::uint64_t transparentMaxSurfaces = 0;    // most surfaces stored on one pixel
     int transparentSections = 0;                 // section targets the splats were composited into (2, 4 or 8; 0: none)
     std::uint64_t transparentSectionOverflow = 0; // splat fragment parts behind more surfaces than sections (merged into the last)
+    bool transparentCut = false;          // sections weighted by the kernel's partial line integral (RendererDesc::depthCut)
+    std::uint64_t transparentEyeCrossing = 0; // splats whose polygon crosses the eye plane: not drawn in the lists (camera inside a kernel)
     std::size_t transparentBytes = 0;     // GPU bytes of the lists (pool, heads, counts, counters, section targets)
     // ---- end [oit] ----
 };

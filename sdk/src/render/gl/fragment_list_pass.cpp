@@ -11,9 +11,11 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "context_check.hpp"
+#include "partial_texture.hpp"
 #include "scaled_shaders.hpp"
 #include "shaders.hpp"
 #include "splatfx/gl/program.hpp"
+#include "splatfx/footprint.hpp"
 #include "splatfx/transparency.hpp"
 
 namespace splatfx::gl::detail {
@@ -24,36 +26,69 @@ constexpr int kCounterWords = 12;
 constexpr GLsizeiptr kCounterBytes = kCounterWords * 4;
 
 // Splat fragments into their sections. Compiled after "#version 450 core",
-// "#define FOG 0", "#define SECTIONS n" and transparentGlsl().
+// the splat vertex shader's defines (FOG 0, CUT 0|1 with HOST_DEPTH and
+// NEAR_CUT equal to CUT, GENERAL 0), "#define SECTIONS n", partialGlsl()
+// (CUT 1) and transparentGlsl().
 constexpr const char* kSectionFragment = R"(
 layout(binding = 0) uniform sampler2DArray uLayers;
-// The surface heads read as a texture, not an image: Mesa's llvmpipe returns
-// 0 from imageLoad in partially covered blocks (seen as a band along every
-// triangle edge), while texelFetch is exact. The lists are complete before
-// this pass (a barrier), so a plain fetch is all it needs.
+// The surface heads read as a texture, not an image: the lists are complete
+// before this pass (a barrier), so a plain fetch is all it needs.
 layout(binding = 2) uniform usampler2D uHeads;
-uniform ivec2 uOrigin; // the lists' viewport origin (a uniform: see the resolve)
+uniform ivec2 uOrigin; // the lists' viewport origin
 in vec2 vTex;
 flat in float vDensity;
 flat in vec3 vLayers;
 flat in vec3 vColor;
 layout(location = 0) out vec4 oSection[SECTIONS];
 
-// The fraction of this fragment's optical depth (its kernel's line integral
-// along the pixel ray) in front of window depth d, non-decreasing in d.
-// Today's splat model concentrates the kernel on its plane: a step at the
-// plane's depth (LEQUAL, as the ordered blend's depth test). The exact
-// partial integral (issue 15 item 1, helper "cut") replaces this one function.
+#if CUT
+// The kernel's partial line integral (issue 15 item 1; PARTIAL_API.md and
+// the splat pass's shader, whose vertex stage this program shares).
+uniform vec3 uForward;
+uniform float uNearZ;
+uniform int uPersp;
+uniform float uKernelRadius;
+layout(binding = 1) uniform sampler2D uHostDepth;
+uniform vec4 uDepthToView; // inverse projection's (z, w) rows at (z, w) columns
+flat in float vScale;
+in vec3 vRel;
+float gR, gTP, gInvCos, gInvL, gLo, gHi;
+float viewDepth(float windowDepth) {
+    float nz = windowDepth * 2.0 - 1.0;
+    return abs((uDepthToView.x * nz + uDepthToView.y) / (uDepthToView.z * nz + uDepthToView.w));
+}
+// Share of the kernel's line integral on this ray in front of view depth z.
+float beforeView(float z) { return splatfx_partial_before(gR, (z * gInvCos - gTP) * gInvL); }
+// The share of this fragment's optical depth (between the near plane and the
+// host's opaque surface) in front of window depth d: non-decreasing in d.
+float sectionFraction(float d) { return clamp(beforeView(viewDepth(d)), gLo, gHi) - gLo; }
+#else
+// Without the cut the kernel is concentrated on its plane: a step at the
+// plane's depth (LEQUAL, as the ordered blend's depth test).
 float sectionFraction(float d) { return gl_FragCoord.z <= d ? 1.0 : 0.0; }
+#endif
 
 void main() {
     vec4 acc[SECTIONS];
     for (int k = 0; k < SECTIONS; ++k) acc[k] = vec4(0.0);
     vec4 t = texture(uLayers, vec3(vTex, vLayers.x));
     if (vLayers.z > 0.0) t = mix(t, texture(uLayers, vec3(vTex, vLayers.y)), vLayers.z);
-    float tau = vDensity * t.a; // log2 optical depth of the whole fragment
+#if CUT
+    vec2 uvk = vec2(2.0 * vTex.x - 1.0, 1.0 - 2.0 * vTex.y);
+    float zP = dot(vRel, uForward);
+    gR = uKernelRadius * length(uvk);
+    gTP = uPersp != 0 ? length(vRel) : zP; // along the ray from the eye (ortho: from its plane)
+    gInvCos = uPersp != 0 ? gTP / zP : 1.0;
+    gInvL = 1.0 / vScale;
+    gLo = beforeView(uNearZ);
+    gHi = max(beforeView(viewDepth(texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r)), gLo);
+    float total = gHi - gLo;
+#else
+    float total = 1.0;
+#endif
+    float tau = vDensity * t.a; // log2 optical depth of the whole (uncut) fragment
     vec3 colour = vColor * t.rgb;
-    if (tau > 0.0) {
+    if (tau > 0.0 && total > 0.0) {
         ivec2 p = ivec2(gl_FragCoord.xy) - uOrigin;
         // base: surfaces wholly in front; cuts: those inside the kernel, near to far.
         int base = 0, n = 0;
@@ -63,7 +98,7 @@ void main() {
             float d = uintBitsToFloat(splatfx_nodes[i].depthBits);
             float f = sectionFraction(d);
             if (f <= 0.0) { ++base; continue; }
-            if (f >= 1.0) continue;
+            if (f >= total) continue;
             if (n == SECTIONS) { atomicAdd(splatfx_sectionOverflow, 1u); continue; }
             int j = n++;
             while (j > 0 && cuts[j - 1] > d) {
@@ -76,10 +111,12 @@ void main() {
         }
         float before = 0.0;
         for (int k = 0; k <= n; ++k) {
-            float F = k < n ? fracs[k] : 1.0;
+            float F = k < n ? fracs[k] : total;
             float frac = max(F - before, 0.0);
             before = max(before, F);
             if (frac <= 0.0) continue;
+            // A section's alpha from its share: the sections' transmittances
+            // multiply back to the (cut) splat's.
             float a = 1.0 - exp2(-tau * frac);
             int s = base + k;
             if (s >= SECTIONS) {
@@ -186,9 +223,49 @@ struct FragmentListPass::Impl {
     struct SectionProgram {
         int sections = 0;
         GLuint id = 0;
-        GLint uViewProj = -1, uOctagon = -1, uCut = -1;
+        GLint uViewProj = -1, uOctagon = -1, uCut = -1, uOrigin = -1;
+        GLint uEye = -1, uForward = -1, uNearZ = -1, uPersp = -1, uKernelRadius = -1, uDepthToView = -1;
     };
-    SectionProgram sectionPrograms[3]; // 2, 4, 8 sections
+    SectionProgram sectionPrograms[2][3]; // [plain, cut][2, 4, 8 sections]
+    PartialTexture partial;               // the footprint's partial-integral table (cut programs)
+    std::string partialSource;            // partialGlsl() the cut programs were built from
+    float kernelRadius = 1.0f;
+    std::string programError;
+
+    // Builds the three section programs of one kind (cut: with the partial integral).
+    bool buildSections(bool cut) {
+        const std::string include = transparentGlsl();
+        const int counts[3] = {2, 4, kTransparentMaxSections};
+        const std::string head = std::string("#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n") +
+                                 (cut ? "#define CUT 1\n#define HOST_DEPTH 1\n#define NEAR_CUT 1\n" : "#define CUT 0\n#define HOST_DEPTH 0\n#define NEAR_CUT 0\n") +
+                                 "#define GENERAL 0\n#define CROSSFADE 1\n";
+        const char* partialSrc = cut ? partialSource.c_str() : "";
+        for (int v = 0; v < 3; ++v) {
+            SectionProgram& p = sectionPrograms[cut][v];
+            if (p.id) glDeleteProgram(p.id), p = {};
+            const std::string def = "#define SECTIONS " + std::to_string(counts[v]) + "\n";
+            auto linked = linkProgram({head.c_str(), partialSrc, kSplatVertex},
+                                      {head.c_str(), def.c_str(), partialSrc, include.c_str(), kSectionFragment}, "fragment lists (splat sections)");
+            if (!linked) {
+                programError = linked.error();
+                return false;
+            }
+            p.sections = counts[v];
+            p.id = *linked;
+            auto loc = [&](const char* name) { return glGetUniformLocation(p.id, name); };
+            p.uViewProj = loc("uViewProj");
+            p.uOctagon = loc("uOctagon");
+            p.uCut = loc("uCut");
+            p.uOrigin = loc("uOrigin");
+            p.uEye = loc("uEye");
+            p.uForward = loc("uForward");
+            p.uNearZ = loc("uNearZ");
+            p.uPersp = loc("uPersp");
+            p.uKernelRadius = loc("uKernelRadius");
+            p.uDepthToView = loc("uDepthToView");
+        }
+        return true;
+    }
     GLuint resolveProgram = 0, compositeProgram = 0;
     GLuint resolved = 0; // RGBA16F, the lists' viewport
     GLuint vao = 0, instances = 0, emptyVao = 0;
@@ -204,8 +281,9 @@ struct FragmentListPass::Impl {
 
     ~Impl() {
         if (!contextIsCurrent()) return;
-        for (const SectionProgram& p : sectionPrograms)
-            if (p.id) glDeleteProgram(p.id);
+        for (const auto& kind : sectionPrograms)
+            for (const SectionProgram& p : kind)
+                if (p.id) glDeleteProgram(p.id);
         if (resolveProgram) glDeleteProgram(resolveProgram);
         if (compositeProgram) glDeleteProgram(compositeProgram);
         GLuint vaos[2] = {vao, emptyVao};
@@ -274,20 +352,8 @@ const FragmentListStats& FragmentListPass::stats() const { return mImpl->stats; 
 Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
     auto impl = std::make_unique<Impl>();
     impl->perPixel = std::clamp(fragmentsPerPixel, 1, kMaxFragmentsPerPixel);
+    if (!impl->buildSections(false)) return makeError(impl->programError);
     const std::string include = transparentGlsl();
-    const int counts[3] = {2, 4, kTransparentMaxSections};
-    for (int v = 0; v < 3; ++v) {
-        const std::string def = "#define SECTIONS " + std::to_string(counts[v]) + "\n";
-        auto linked = linkProgram({"#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n", kSplatVertex},
-                                  {"#version 450 core\n", def.c_str(), include.c_str(), kSectionFragment}, "fragment lists (splat sections)");
-        if (!linked) return makeError(linked.error());
-        Impl::SectionProgram& p = impl->sectionPrograms[v];
-        p.sections = counts[v];
-        p.id = *linked;
-        p.uViewProj = glGetUniformLocation(p.id, "uViewProj");
-        p.uOctagon = glGetUniformLocation(p.id, "uOctagon");
-        p.uCut = glGetUniformLocation(p.id, "uCut");
-    }
     const std::string k = "#define K " + std::to_string(impl->perPixel) + "\n";
     std::string computeInclude = include;
     const std::string early = "layout(early_fragment_tests) in;\n";
@@ -319,11 +385,27 @@ Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
     return FragmentListPass(std::move(impl));
 }
 
+Status FragmentListPass::upload(const Materials& materials) {
+    Impl& r = *mImpl;
+    r.partial.update(materials.footprint());
+    r.kernelRadius = materials.footprint().radius();
+    const std::string partial = partialGlsl(materials.footprint(), 3);
+    if (partial == r.partialSource) return {};
+    r.partialSource = partial;
+    if (!r.buildSections(true)) {
+        r.partialSource.clear();
+        return makeError("fragment lists: " + r.programError);
+    }
+    return {};
+}
+
 Status FragmentListPass::collectSurfaces(const FragmentListTarget& target, const std::function<void()>& drawSurfaces) {
     Impl& r = *mImpl;
     if (target.width <= 0 || target.height <= 0) return makeError("fragment lists: the viewport must be positive");
     r.resize(target.width, target.height);
     r.sectionsThisFrame = 0;
+    r.stats.eyeCrossing = 0;
+    r.stats.cut = false;
     const GLuint end = kEnd, zero = 0;
     glClearTexImage(r.heads, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &end);
     glClearTexImage(r.counts, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
@@ -349,15 +431,17 @@ Status FragmentListPass::collectSurfaces(const FragmentListTarget& target, const
 }
 
 void FragmentListPass::insertSplats(const std::vector<Splat>& splats, const Camera& camera, unsigned layerTexture, float cut, bool trimCorners,
-                                    const FragmentListTarget& target) {
+                                    bool depthCut, const FragmentListTarget& target) {
     Impl& r = *mImpl;
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     if (splats.empty() || !layerTexture || !target.depthTexture) return;
     // How many sections the frame needs: one more than the most surfaces on a pixel.
     GLuint maxSurfaces = 0;
     glGetNamedBufferSubData(r.counters, 6 * 4, 4, &maxSurfaces);
-    const Impl::SectionProgram* prog = &r.sectionPrograms[2];
-    for (const Impl::SectionProgram& p : r.sectionPrograms)
+    const bool partial = depthCut && !r.partialSource.empty();
+    r.stats.cut = partial;
+    const Impl::SectionProgram* prog = &r.sectionPrograms[partial][2];
+    for (const Impl::SectionProgram& p : r.sectionPrograms[partial])
         if (GLuint(p.sections) >= maxSurfaces + 1) {
             prog = &p;
             break;
@@ -395,7 +479,30 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& splats, const Came
     glUniformMatrix4fv(prog->uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
     glUniform1i(prog->uOctagon, trimCorners ? 1 : 0);
     glUniform1f(prog->uCut, std::clamp(cut, 0.05f, 1.0f));
-    glUniform2i(glGetUniformLocation(prog->id, "uOrigin"), target.x, target.y);
+    glUniform2i(prog->uOrigin, target.x, target.y);
+    if (partial) {
+        const glm::vec3 eye = camera.eye(), fwd = camera.forward();
+        const glm::mat4 invProj = glm::inverse(camera.proj);
+        glUniform3f(prog->uEye, eye.x, eye.y, eye.z);
+        glUniform3f(prog->uForward, fwd.x, fwd.y, fwd.z);
+        glUniform1f(prog->uNearZ, camera.nearPlane());
+        glUniform1i(prog->uPersp, camera.perspective() ? 1 : 0);
+        glUniform1f(prog->uKernelRadius, r.kernelRadius);
+        glUniform4f(prog->uDepthToView, invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+        glBindTextureUnit(1, target.depthTexture);
+        glBindTextureUnit(3, r.partial.texture());
+        // The vertex shader drops a polygon that crosses the eye plane (the
+        // splat pass draws those with its general variant; not here): counted.
+        std::uint64_t crossing = 0;
+        const float nearZ = camera.nearPlane(), extent = std::clamp(cut, 0.05f, 1.0f);
+        if (camera.perspective())
+            for (const Splat& sp : splats) {
+                const float a = std::abs(glm::dot(sp.axisU, fwd)), b = std::abs(glm::dot(sp.axisV, fwd));
+                const float reach = trimCorners ? std::max(a + 0.41421356f * b, 0.41421356f * a + b) : a + b;
+                if (!(glm::dot(sp.center - eye, fwd) - extent * reach >= 0.25f * nearZ)) ++crossing;
+            }
+        r.stats.eyeCrossing = crossing;
+    }
     glBindTextureUnit(0, layerTexture);
     glBindTextureUnit(2, r.heads);
     glBindVertexArray(r.vao);
@@ -448,6 +555,7 @@ void FragmentListPass::resolve(const FragmentListTarget& target) {
     glBindImageTexture(kTransparentCountImageUnit, 0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glBindTextureUnit(1, 0);
     glBindTextureUnit(2, 0);
+    glBindTextureUnit(3, 0);
 }
 
 } // namespace splatfx::gl::detail

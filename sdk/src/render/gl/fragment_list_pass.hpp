@@ -41,6 +41,7 @@
 #include <vector>
 
 #include "splatfx/camera.hpp"
+#include "splatfx/materials.hpp"
 #include "splatfx/result.hpp"
 #include "splatfx/splats.hpp"
 
@@ -60,6 +61,8 @@ struct FragmentListStats {
     std::uint64_t sectionOverflow = 0;  // splat fragments (or their parts) behind more surfaces than sections (merged into the last)
     std::uint64_t overflowPixels = 0;   // pixels with more nodes than fragmentsPerPixel
     std::uint64_t mergedNodes = 0;      // nodes merged into a pixel's farthest slot
+    bool cut = false;                   // the sections were weighted by the kernel's partial line integral
+    std::uint64_t eyeCrossing = 0;      // splats whose polygon crosses the eye plane: not drawn by this pass
     std::size_t bytes = 0;              // GPU bytes of the pool, heads, counts, counters and the section targets in use
     std::size_t poolNodes = 0;          // capacity of the pool
 };
@@ -73,6 +76,8 @@ public:
     FragmentListPass& operator=(FragmentListPass&&) noexcept;
     ~FragmentListPass();
 
+    // The footprint's partial-integral table and the cut programs (when it changed).
+    Status upload(const Materials& materials);
     // Sizes the lists to the target, empties them and binds them where
     // transparentGlsl() expects them; then runs drawSurfaces with the
     // target's framebuffer bound, premultiplied "over" blending, depth test
@@ -82,7 +87,10 @@ public:
     // layerTexture: the splat pass's GL_TEXTURE_2D_ARRAY; cut, trimCorners:
     // RendererDesc's. Reads the surface counters back first (one GPU sync)
     // to choose how many section targets the frame needs.
-    void insertSplats(const std::vector<Splat>& splats, const Camera& camera, unsigned layerTexture, float cut, bool trimCorners,
+    // depthCut (RendererDesc::depthCut): sections weighted by the kernel's
+    // partial line integral and cut at the near plane and the host depth;
+    // false: the kernel as a step at its plane.
+    void insertSplats(const std::vector<Splat>& splats, const Camera& camera, unsigned layerTexture, float cut, bool trimCorners, bool depthCut,
                       const FragmentListTarget& target);
     // Sorts every pixel's surfaces, interleaves the sections, composites
     // over the framebuffer, unbinds the lists, reads the counters back.

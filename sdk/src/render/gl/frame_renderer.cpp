@@ -79,7 +79,9 @@ FrameRenderer& FrameRenderer::operator=(FrameRenderer&&) noexcept = default;
 FrameRenderer::~FrameRenderer() = default;
 
 Status FrameRenderer::upload(const Materials& materials) {
-    return mImpl->full ? mImpl->full->upload(materials) : mImpl->reduced->upload(materials);
+    Status s = mImpl->full ? mImpl->full->upload(materials) : mImpl->reduced->upload(materials);
+    if (s && mImpl->lists) s = mImpl->lists->upload(materials); // [oit] the sections' partial-integral table
+    return s;
 }
 
 const FrameRendererDesc& FrameRenderer::desc() const { return mImpl->desc; }
@@ -190,7 +192,8 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         const Status s = r.lists->collectSurfaces(lt, target.drawTransparent);
         if (s) {
             if (splatsInLists) {
-                r.lists->insertSplats(frame.splats(), camera, r.full->layerTexture(), r.desc.splats.footprintCut, r.desc.splats.trimCorners, lt);
+                r.lists->insertSplats(frame.splats(), camera, r.full->layerTexture(), r.desc.splats.footprintCut, r.desc.splats.trimCorners,
+                                      r.desc.splats.depthCut, lt);
                 r.stats.drawCalls = frame.splats().empty() ? 0 : 1;
             }
             r.lists->resolve(lt);
@@ -205,6 +208,8 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         r.stats.transparentSectionOverflow = ls.sectionOverflow;
         r.stats.transparentMaxSurfaces = ls.maxSurfaces;
         r.stats.transparentSections = ls.sections;
+        r.stats.transparentCut = ls.cut;
+        r.stats.transparentEyeCrossing = ls.eyeCrossing;
         r.stats.transparentBytes = ls.bytes;
         if (r.desc.splats.restoreState) saved.restore();
     } else if (target.drawTransparent) {
