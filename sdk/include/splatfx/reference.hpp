@@ -6,7 +6,8 @@
 // conventions: pixel (x, y) of the output (top row first) is sampled at its
 // centre, x + 0.5, and GL row height - 1 - y + 0.5, through camera.proj * view
 // over a viewport of camera.viewport pixels; fragments outside [near, far]
-// are clipped and a host depth image is tested with LEQUAL.
+// are clipped and a host depth image is tested with LEQUAL (or, with
+// SplatExactDesc::depthCut, the default, every splat is cut exactly there).
 //
 //  * Splat-exact (renderSplatExact): the splat model with every approximation
 //    of the real-time path removed. Each splat's footprint is evaluated
@@ -96,6 +97,15 @@ struct SplatExactDesc {
     double fogTimeSec = 0.0;    // the fog's time; default 0
     double fogTolerance = 1e-9; // absolute tolerance on each optical depth; default 1e-9
     bool fogHost = true;        // fog the background too (false: as a frame drawn without the host fog pass); default true
+    // The depth cut (issue 15, as gl::RendererDesc::depthCut): each fragment
+    // keeps the share of its kernel's line integral between the near plane
+    // and the host depth (or the far plane) on its pixel ray, exactly
+    // (Footprint::exactFractionBefore), r = R |(u, v)|, s = (t - t_plane) / l
+    // with l = splatRayScale(splat); the splat plane is met by the pixel's
+    // line, so planes just behind the eye or the near plane still give the
+    // tail in front. false: the plain test at the splat plane (fragments
+    // outside [near, min(far, host depth)] are dropped whole). Default true.
+    bool depthCut = true;
 };
 
 struct SplatExactStats {

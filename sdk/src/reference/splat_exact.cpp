@@ -90,6 +90,7 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
     const double R = fp.radius();
     const double F0 = fp.exact(0.0);
     const bool exactWindow = desc.window == ReferenceWindow::Exact;
+    const bool cut = desc.depthCut;
 
     std::vector<RefLayer> layers;
     {
@@ -174,7 +175,8 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                 const double denom = glm::dot(ray.dir, n);
                 if (!(nLen > 0.0) || std::abs(denom) <= 1e-12 * nLen) continue; // edge-on: GL rasterizes nothing
                 const double t = glm::dot(c - ray.origin, n) / denom;
-                if (!(t >= 0.0) || t > ray.tLimit) continue; // clipped by near/far or hidden by host depth
+                if (!std::isfinite(t)) continue;
+                if (!cut && (!(t >= 0.0) || t > ray.tLimit)) continue; // clipped by near/far or hidden by host depth
                 const glm::dvec3 r = ray.origin + t * ray.dir - c;
                 const double g00 = glm::dot(au, au), g01 = glm::dot(au, av), g11 = glm::dot(av, av);
                 const double b0 = glm::dot(au, r), b1 = glm::dot(av, r);
@@ -194,6 +196,19 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                 if (exactWindow) {
                     const double rr = R * std::sqrt(u * u + v * v);
                     detail *= rr < R ? fp.exact(rr) / F0 : 0.0;
+                }
+                if (cut) {
+                    // The depth cut (issue 15): the share of the kernel's line
+                    // integral between the near plane (t = 0 on this ray) and
+                    // the host surface or far plane (tLimit), exactly
+                    // (Footprint::exactFractionBefore); s in kernel units from
+                    // the splat plane along the ray, l the along-ray scale.
+                    const double l = double(splatRayScale(s, float(R)));
+                    if (!(l > 0.0)) continue;
+                    const double rr = R * std::sqrt(u * u + v * v);
+                    const double share = fp.exactFractionBefore(rr, (ray.tLimit - t) / l) - fp.exactFractionBefore(rr, -t / l);
+                    if (!(share > 0.0)) continue;
+                    detail *= share;
                 }
                 // alpha = 1 - 2^(-density * detail), accurate for tiny products.
                 const double alpha = -std::expm1(-kLn2 * double(s.density) * detail);
