@@ -109,21 +109,27 @@ void main() {
             cuts[j] = d;
             fracs[j] = f;
         }
+        // Bounded loop, no continue: llvmpipe dropped the last trip of the
+        // data-dependent form of this loop (the section behind the last cut).
         float before = 0.0;
-        for (int k = 0; k <= n; ++k) {
+        for (int k = 0; k <= SECTIONS; ++k) {
+            if (k > n) break;
             float F = k < n ? fracs[k] : total;
             float frac = max(F - before, 0.0);
             before = max(before, F);
-            if (frac <= 0.0) continue;
-            // A section's alpha from its share: the sections' transmittances
-            // multiply back to the (cut) splat's.
-            float a = 1.0 - exp2(-tau * frac);
-            int s = base + k;
-            if (s >= SECTIONS) {
-                s = SECTIONS - 1;
-                atomicAdd(splatfx_sectionOverflow, 1u);
+            if (frac > 0.0) {
+                // A section's alpha from its share: the sections' transmittances
+                // multiply back to the (cut) splat's.
+                float a = 1.0 - exp2(-tau * frac);
+                int s = base + k;
+                if (s >= SECTIONS) {
+                    s = SECTIONS - 1;
+                    atomicAdd(splatfx_sectionOverflow, 1u);
+                }
+                // Nearer parts first; a constant index per target.
+                for (int q = 0; q < SECTIONS; ++q)
+                    if (q == s) acc[q] += (1.0 - acc[q].a) * vec4(colour * a, a);
             }
-            acc[s] += (1.0 - acc[s].a) * vec4(colour * a, a); // nearer parts first
         }
     }
     for (int k = 0; k < SECTIONS; ++k) oSection[k] = acc[k];
