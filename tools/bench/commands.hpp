@@ -10,7 +10,8 @@ int runScheduling(int argc, char** argv); // scheduling.cpp: 1000 effects, 10 in
 int runShadows(int argc, char** argv);    // shadows.cpp: Ebert & Parent 1990 Table 2, shadow tables vs tracing (issue 16)
 int runFog(int argc, char** argv);        // fog.cpp: Biri et al. 2002 Table 1, fog cost per pixel and per fog texture (issue 14)
 int runClouds(int argc, char** argv);     // clouds.cpp: LOD volumes as projected tetrahedra, flight, popping (issue 17)
-int runSoak(int argc, char** argv);       // soak.cpp: every preset for an hour of scene time; finite, flat bounds and memory (issue 13)
+int runSoak(int argc, char** argv);
+int runTransparency(int argc, char** argv); // transparency.cpp: glass panes among the fire, fragment lists vs ordered blend (issue 15)       // soak.cpp: every preset for an hour of scene time; finite, flat bounds and memory (issue 13)
 
 struct BenchCommand {
     const char* name;
@@ -25,5 +26,6 @@ inline constexpr BenchCommand kCommands[] = {
     {"scheduling", "a level of 1000 effects with 10 in view vs those 10 alone; camera sweep; catch-up error", runScheduling},
     {"shadows", "Ebert & Parent 1990 Table 2: steam from a glass, no/geometry/traced/table shadowing, table error", runShadows},
     {"fog", "Biri et al. 2002 Table 1: no fog, per-pixel fog, reduced fog textures at 800x600; error vs per pixel", runFog},
+    {"transparency", "glass panes among the 1560-voxel fire: fragment lists vs ordered blend vs opaque only, budget, memory", runTransparency},
     {"soak", "every preset stepped at 60 Hz for an hour of scene time: no NaN/Inf, bounds and memory flat", runSoak},
 };
