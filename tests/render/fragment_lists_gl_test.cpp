@@ -433,9 +433,11 @@ TEST_F(FragmentListsGL, BudgetOfOneFragmentPerPixel) {
     EXPECT_EQ(s.transparentNodes, pixels);
     EXPECT_EQ(s.transparentFallback, pixels);
     EXPECT_GE(s.transparentSections, 2);
-    // Pool, heads and counts, the resolved RGBA16F image, the section targets, the counters.
+    // Pool, heads and counts, the resolved RGBA16F image, the section targets,
+    // the sorted depths (R32F, one layer fewer than sections), the counters.
     EXPECT_EQ(s.transparentBytes, std::size_t(pixels) * (kTransparentNodeBytes + kTransparentHeadBytesPerPixel + 8 +
-                                                         std::size_t(s.transparentSections) * kTransparentSectionBytesPerPixel) + 48);
+                                                         std::size_t(s.transparentSections) * kTransparentSectionBytesPerPixel +
+                                                         4 * std::size_t(s.transparentSections - 1)) + 48);
     const Image got = fb->read();
     // The alpha of the three in any order: the ordered blend (pane, fire, pane).
     Frame empty;

@@ -188,7 +188,9 @@ int runTransparency(int argc, char** argv) {
 
     std::vector<splatfx::gl::FrameRenderer> renderers;
     for (const Config& c : configs) {
-        auto fr = splatfx::gl::FrameRenderer::create({.fragmentsPerPixel = c.budget});
+        splatfx::gl::FrameRendererDesc rd{.fragmentsPerPixel = c.budget};
+        rd.splats.depthCut = std::getenv("OIT_NOCUT") == nullptr;
+        auto fr = splatfx::gl::FrameRenderer::create(rd);
         if (!fr || !fr->upload(materials)) {
             std::fprintf(stderr, "transparency: %s\n", fr ? "upload failed" : fr.error().c_str());
             return 1;
@@ -221,11 +223,14 @@ int runTransparency(int argc, char** argv) {
             }
             std::sort(ms.begin(), ms.end());
             configs[i].ms = std::min(configs[i].ms, ms[ms.size() / 2]);
+            std::printf("  round %d  %-44s %9.2f ms\n", round + 1, configs[i].name.c_str(), ms[ms.size() / 2]);
+            std::fflush(stdout);
         }
     // Errors against the exact reference on the same input.
     std::printf("transparency on %s: 1560-voxel fire (%zu splats) at %dx%d, least of %d rounds' medians of %d frames (glFinish)\n",
                 ctx->renderer().c_str(), frame.splats().size(), size.x, size.y, rounds, frames);
     std::printf("computing the exact references (seconds each) ...\n");
+    std::fflush(stdout);
     auto reference = [&](const std::vector<Pane>* panes) {
         std::vector<splatfx::ReferenceSurface> surfaces;
         if (panes)

@@ -19,7 +19,12 @@
 //      projected tetrahedra (the ray segment ended at the host depth, read
 //      from HostTarget::depthTexture) interleaved with the splats in
 //      Frame::drawOrder (at reduced resolution: all tetrahedra, then splats)
-//   3. the host's transparent pass (HostTarget::drawTransparent), blended over
+//   3. the host's transparent pass (HostTarget::drawTransparent), blended over;
+//      or, with HostTarget::transparentToLists ([oit] issue 15), the order-exact
+//      path: the hook's fragments go into per-pixel lists (transparentGlsl()),
+//      the splats (not drawn in step 2 then) are composited per section
+//      between those surfaces (Ebert & Parent 1990, Fig. 1), and a resolve
+//      sorts each pixel and composites it over the image (fragment_list_pass)
 // The passes of the systems still being built (fog of the host image, shadow
 // tables before the opaque pass, exact ordering among transparent surfaces,
 // projected tetrahedra) join this list here, not in callers.
@@ -159,7 +164,7 @@ struct FrameRenderStats {
     std::uint64_t transparentMergedNodes = 0;    // surface nodes merged so
     std::uint64_t transparentMaxSurfaces = 0;    // most surfaces stored on one pixel
     int transparentSections = 0;                 // section targets the splats were composited into (2, 4 or 8; 0: none)
-    std::uint64_t transparentSectionOverflow = 0; // splat fragment parts behind more surfaces than sections (merged into the last)
+    std::uint64_t transparentSectionOverflow = 0; // pixels with more surfaces than sections - 1 (7 at most): the gas behind the extra ones merged into the last section
     bool transparentCut = false;          // sections weighted by the kernel's partial line integral (RendererDesc::depthCut)
     std::uint64_t transparentEyeCrossing = 0; // splats whose polygon crosses the eye plane: not drawn in the lists (camera inside a kernel)
     std::size_t transparentBytes = 0;     // GPU bytes of the lists (pool, heads, counts, counters, section targets)

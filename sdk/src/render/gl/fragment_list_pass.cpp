@@ -31,9 +31,7 @@ constexpr GLsizeiptr kCounterBytes = kCounterWords * 4;
 // (CUT 1) and transparentGlsl().
 constexpr const char* kSectionFragment = R"(
 layout(binding = 0) uniform sampler2DArray uLayers;
-// The surface heads read as a texture, not an image: the lists are complete
-// before this pass (a barrier), so a plain fetch is all it needs.
-layout(binding = 2) uniform usampler2D uHeads;
+layout(binding = 2) uniform sampler2DArray uDepths; // the pixel's nearest SECTIONS - 1 surface depths, sorted; 2.0: none
 uniform ivec2 uOrigin; // the lists' viewport origin
 in vec2 vTex;
 flat in float vDensity;
@@ -94,20 +92,19 @@ void main() {
         int base = 0, n = 0;
         float cuts[SECTIONS];
         float fracs[SECTIONS];
-        for (uint i = texelFetch(uHeads, p, 0).x; i != splatfx_kEnd; i = splatfx_nodes[i].next) {
-            float d = uintBitsToFloat(splatfx_nodes[i].depthBits);
+        // The pixel's surfaces, nearest first, from the depth layers the
+        // prepare pass sorted (a texture: on Mesa's llvmpipe a fragment
+        // shader's storage-buffer reads return wrong data in partially
+        // covered blocks, so the lists are walked only in compute shaders).
+        for (int k = 0; k < SECTIONS - 1; ++k) {
+            float d = texelFetch(uDepths, ivec3(p, k), 0).r;
+            if (d > 1.5) break; // no more surfaces
             float f = sectionFraction(d);
             if (f <= 0.0) { ++base; continue; }
-            if (f >= total) continue;
-            if (n == SECTIONS) { atomicAdd(splatfx_sectionOverflow, 1u); continue; }
-            int j = n++;
-            while (j > 0 && cuts[j - 1] > d) {
-                cuts[j] = cuts[j - 1];
-                fracs[j] = fracs[j - 1];
-                --j;
-            }
-            cuts[j] = d;
-            fracs[j] = f;
+            if (f >= total) break; // this and every farther surface lie behind the kernel
+            cuts[n] = d;
+            fracs[n] = f;
+            ++n;
         }
         // Bounded loop, no continue: llvmpipe dropped the last trip of the
         // data-dependent form of this loop (the section behind the last cut).
@@ -121,11 +118,7 @@ void main() {
                 // A section's alpha from its share: the sections' transmittances
                 // multiply back to the (cut) splat's.
                 float a = 1.0 - exp2(-tau * frac);
-                int s = base + k;
-                if (s >= SECTIONS) {
-                    s = SECTIONS - 1;
-                    atomicAdd(splatfx_sectionOverflow, 1u);
-                }
+                int s = min(base + k, SECTIONS - 1); // base + n <= SECTIONS - 1 by construction
                 // Nearer parts first; a constant index per target.
                 for (int q = 0; q < SECTIONS; ++q)
                     if (q == s) acc[q] += (1.0 - acc[q].a) * vec4(colour * a, a);
@@ -133,6 +126,37 @@ void main() {
         }
     }
     for (int k = 0; k < SECTIONS; ++k) oSection[k] = acc[k];
+}
+)";
+
+// The prepare pass: each pixel's nearest `layers` surface depths, sorted,
+// into a texture array for the section shader (2.0 past the last).
+constexpr const char* kPrepareCompute = R"(
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 2) uniform usampler2D uHeads;
+layout(r32f, binding = 5) writeonly uniform image2DArray uDepthsOut;
+uniform ivec2 uSize;
+uniform int uLayers;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= uSize.x || p.y >= uSize.y) return;
+    float d[7];
+    int n = 0, all = 0;
+    for (uint i = texelFetch(uHeads, p, 0).x; i != splatfx_kEnd; i = splatfx_nodes[i].next) {
+        float z = uintBitsToFloat(splatfx_nodes[i].depthBits);
+        ++all;
+        if (n == uLayers && z >= d[n - 1]) continue;
+        int j = n < uLayers ? n++ : n - 1; // full: the farthest kept one drops out
+        while (j > 0 && z < d[j - 1]) {
+            d[j] = d[j - 1];
+            --j;
+        }
+        d[j] = z;
+    }
+    for (int k = 0; k < uLayers; ++k) imageStore(uDepthsOut, ivec3(p, k), vec4(k < n ? d[k] : 2.0));
+    // More surfaces than the section targets separate: the gas behind the
+    // extra ones is composited after the last kept surface (counted).
+    if (all > uLayers) atomicAdd(splatfx_sectionOverflow, 1u);
 }
 )";
 
@@ -272,7 +296,10 @@ struct FragmentListPass::Impl {
         }
         return true;
     }
-    GLuint resolveProgram = 0, compositeProgram = 0;
+    GLuint resolveProgram = 0, compositeProgram = 0, prepareProgram = 0;
+    GLuint depths = 0; // R32F array: each pixel's nearest surface depths
+    int depthLayers = 0;
+    glm::ivec2 depthSize{0};
     GLuint resolved = 0; // RGBA16F, the lists' viewport
     GLuint vao = 0, instances = 0, emptyVao = 0;
     std::size_t instanceCapacity = 0;
@@ -292,6 +319,8 @@ struct FragmentListPass::Impl {
                 if (p.id) glDeleteProgram(p.id);
         if (resolveProgram) glDeleteProgram(resolveProgram);
         if (compositeProgram) glDeleteProgram(compositeProgram);
+        if (prepareProgram) glDeleteProgram(prepareProgram);
+        if (depths) glDeleteTextures(1, &depths);
         GLuint vaos[2] = {vao, emptyVao};
         glDeleteVertexArrays(2, vaos);
         GLuint bufs[3] = {instances, pool, counters};
@@ -370,6 +399,9 @@ Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
     auto resolve = linkComputeProgram({"#version 450 core\n", k.c_str(), computeInclude.c_str(), kResolveCompute}, "fragment lists (resolve)");
     if (!resolve) return makeError(resolve.error());
     impl->resolveProgram = *resolve;
+    auto prepare = linkComputeProgram({"#version 450 core\n", computeInclude.c_str(), kPrepareCompute}, "fragment lists (prepare)");
+    if (!prepare) return makeError(prepare.error());
+    impl->prepareProgram = *prepare;
     auto composite = linkProgram({kFullscreenVertex}, {kListCompositeFragment}, "fragment lists (composite)");
     if (!composite) return makeError(composite.error());
     impl->compositeProgram = *composite;
@@ -453,6 +485,25 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& splats, const Came
             break;
         }
     r.sectionsThisFrame = prog->sections;
+    // The sorted depths the section shader reads (grown only).
+    const int layers = prog->sections - 1;
+    if (!r.depths || layers > r.depthLayers || r.depthSize != glm::ivec2(target.width, target.height)) {
+        if (r.depths) glDeleteTextures(1, &r.depths);
+        glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &r.depths);
+        glTextureStorage3D(r.depths, 1, GL_R32F, target.width, target.height, layers);
+        glTextureParameteri(r.depths, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(r.depths, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        r.depthLayers = layers;
+        r.depthSize = {target.width, target.height};
+    }
+    glUseProgram(r.prepareProgram);
+    glUniform2i(glGetUniformLocation(r.prepareProgram, "uSize"), target.width, target.height);
+    glUniform1i(glGetUniformLocation(r.prepareProgram, "uLayers"), layers);
+    glBindTextureUnit(2, r.heads);
+    glBindImageTexture(5, r.depths, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+    glDispatchCompute(GLuint((target.width + 7) / 8), GLuint((target.height + 7) / 8), 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     r.sizeSections({target.x + target.width, target.y + target.height}, prog->sections, target.depthTexture);
 
     if (splats.size() > r.instanceCapacity) {
@@ -510,7 +561,7 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& splats, const Came
         r.stats.eyeCrossing = crossing;
     }
     glBindTextureUnit(0, layerTexture);
-    glBindTextureUnit(2, r.heads);
+    glBindTextureUnit(2, r.depths);
     glBindVertexArray(r.vao);
     glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, trimCorners ? 8 : 4, GLsizei(splats.size()));
 }
@@ -551,7 +602,7 @@ void FragmentListPass::resolve(const FragmentListTarget& target) {
     r.stats.overflowPixels = c[8];
     r.stats.mergedNodes = c[9];
     r.stats.sections = r.sectionsThisFrame;
-    r.stats.bytes = r.poolNodes * kTransparentNodeBytes + std::size_t(r.width) * r.height * kTransparentHeadBytesPerPixel +
+    r.stats.bytes = std::size_t(r.depthSize.x) * r.depthSize.y * 4 * std::size_t(r.depthLayers) /* sorted depths */ + r.poolNodes * kTransparentNodeBytes + std::size_t(r.width) * r.height * kTransparentHeadBytesPerPixel +
                     std::size_t(kCounterBytes) + std::size_t(r.width) * r.height * 8 /* resolved RGBA16F */ +
                     std::size_t(r.sectionSize.x) * r.sectionSize.y * kTransparentSectionBytesPerPixel * std::size_t(r.sectionLayers);
     // Leave nothing of ours bound where the host's own buffers may live.

@@ -58,7 +58,7 @@ struct FragmentListStats {
     std::uint64_t fallback = 0;         // surface fragments that found the pool full (blended directly instead)
     std::uint64_t maxSurfaces = 0;      // most surfaces stored on one pixel
     int sections = 0;                   // section targets the splats were drawn into (0: no splats in the lists)
-    std::uint64_t sectionOverflow = 0;  // splat fragments (or their parts) behind more surfaces than sections (merged into the last)
+    std::uint64_t sectionOverflow = 0;  // pixels with more surfaces than sections - 1 (the gas behind the extra ones merged into the last section)
     std::uint64_t overflowPixels = 0;   // pixels with more nodes than fragmentsPerPixel
     std::uint64_t mergedNodes = 0;      // nodes merged into a pixel's farthest slot
     bool cut = false;                   // the sections were weighted by the kernel's partial line integral
