@@ -296,7 +296,8 @@ struct FragmentListPass::Impl {
         }
         return true;
     }
-    GLuint resolveProgram = 0, compositeProgram = 0, prepareProgram = 0;
+    std::vector<std::pair<int, GLuint>> resolvePrograms; // (K, program), K ascending
+    GLuint compositeProgram = 0, prepareProgram = 0;
     GLuint depths = 0; // R32F array: each pixel's nearest surface depths
     int depthLayers = 0;
     glm::ivec2 depthSize{0};
@@ -317,7 +318,7 @@ struct FragmentListPass::Impl {
         for (const auto& kind : sectionPrograms)
             for (const SectionProgram& p : kind)
                 if (p.id) glDeleteProgram(p.id);
-        if (resolveProgram) glDeleteProgram(resolveProgram);
+        for (const auto& rp : resolvePrograms) glDeleteProgram(rp.second);
         if (compositeProgram) glDeleteProgram(compositeProgram);
         if (prepareProgram) glDeleteProgram(prepareProgram);
         if (depths) glDeleteTextures(1, &depths);
@@ -389,16 +390,22 @@ Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
     impl->perPixel = std::clamp(fragmentsPerPixel, 1, kMaxFragmentsPerPixel);
     if (!impl->buildSections(false)) return makeError(impl->programError);
     const std::string include = transparentGlsl();
-    const std::string k = "#define K " + std::to_string(impl->perPixel) + "\n";
     std::string computeInclude = include;
     const std::string early = "layout(early_fragment_tests) in;\n";
     if (const std::size_t at = computeInclude.find(early); at != std::string::npos) computeInclude.erase(at, early.size());
     // ... and without the emit function (gl_FragCoord: fragment shaders only).
     const std::size_t fn = computeInclude.find("vec4 splatfx_emitTransparent("), fnEnd = computeInclude.find("// ---- end splatfx");
     if (fn != std::string::npos && fnEnd != std::string::npos) computeInclude.erase(fn, fnEnd - fn);
-    auto resolve = linkComputeProgram({"#version 450 core\n", k.c_str(), computeInclude.c_str(), kResolveCompute}, "fragment lists (resolve)");
-    if (!resolve) return makeError(resolve.error());
-    impl->resolveProgram = *resolve;
+    // Resolve variants for K = 1, 2, 4, ... below the budget and the budget
+    // itself: a frame with few surfaces per pixel runs the smallest that holds
+    // them (the per-pixel arrays cost in proportion to K on a CPU rasterizer).
+    for (int k = 1;; k = std::min(2 * k, impl->perPixel)) {
+        const std::string def = "#define K " + std::to_string(k) + "\n";
+        auto resolve = linkComputeProgram({"#version 450 core\n", def.c_str(), computeInclude.c_str(), kResolveCompute}, "fragment lists (resolve)");
+        if (!resolve) return makeError(resolve.error());
+        impl->resolvePrograms.push_back({k, *resolve});
+        if (k == impl->perPixel) break;
+    }
     auto prepare = linkComputeProgram({"#version 450 core\n", computeInclude.c_str(), kPrepareCompute}, "fragment lists (prepare)");
     if (!prepare) return makeError(prepare.error());
     impl->prepareProgram = *prepare;
@@ -569,10 +576,18 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& splats, const Came
 void FragmentListPass::resolve(const FragmentListTarget& target) {
     Impl& r = *mImpl;
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-    glUseProgram(r.resolveProgram);
-    glUniform1i(glGetUniformLocation(r.resolveProgram, "uSectionCount"), r.sectionsThisFrame);
-    glUniform2i(glGetUniformLocation(r.resolveProgram, "uOrigin"), target.x, target.y);
-    glUniform2i(glGetUniformLocation(r.resolveProgram, "uSize"), target.width, target.height);
+    GLuint maxSurfaces = 0;
+    glGetNamedBufferSubData(r.counters, 6 * 4, 4, &maxSurfaces);
+    GLuint program = r.resolvePrograms.back().second;
+    for (const auto& rp : r.resolvePrograms)
+        if (GLuint(rp.first) >= maxSurfaces) {
+            program = rp.second;
+            break;
+        }
+    glUseProgram(program);
+    glUniform1i(glGetUniformLocation(program, "uSectionCount"), r.sectionsThisFrame);
+    glUniform2i(glGetUniformLocation(program, "uOrigin"), target.x, target.y);
+    glUniform2i(glGetUniformLocation(program, "uSize"), target.width, target.height);
     if (r.sectionsThisFrame > 0) glBindTextureUnit(1, r.sections);
     glBindTextureUnit(2, r.heads);
     glBindImageTexture(5, r.resolved, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
