@@ -521,3 +521,30 @@ TEST_F(FragmentListsGL, SplatStraddlingAPaneIsCutIntoSections) {
         EXPECT_LE(err, base + 2.0 * std::log(2.0) * tau * delta + 4.0 * std::ldexp(1.0, -12)) << "pane at z = centre + " << dz;
     }
 }
+
+// With a fog the splats are not drawn into sections (fogged sections are not
+// implemented): the frame says so and draws them first with the ordered blend,
+// the surfaces still sorted in the lists over them, never dropped.
+TEST_F(FragmentListsGL, WithAFogTheSplatsTakeTheOrderedBlendAndTheFrameSaysWhy) {
+    Fire f;
+    Glass glass;
+    ASSERT_TRUE(glass.error().empty()) << glass.error();
+    FogDesc fd;
+    fd.terms.push_back(FogTerm::constant(0.02));
+    auto fog = Fog::create(fd);
+    ASSERT_TRUE(fog) << fog.error();
+    f.frame.setFog(std::make_shared<const Fog>(*fog));
+    auto fr = gl::FrameRenderer::create();
+    ASSERT_TRUE(fr && fr->upload(f.materials));
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y});
+    ASSERT_TRUE(fb);
+    const std::vector<Pane> pane{{.z = Fire::kFront + 1.0f, .premultiplied = glm::vec4(0.05f, 0.1f, 0.15f, 0.3f)}};
+    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
+                         .drawTransparent = [&] { glass.draw(pane, f.frame.camera()); }, .transparentToLists = true});
+    const gl::FrameRenderStats& s = fr->stats();
+    EXPECT_TRUE(s.transparentLists);
+    EXPECT_FALSE(s.splatsInLists);
+    EXPECT_NE(s.transparentNote.find("fog"), std::string::npos) << s.transparentNote;
+    EXPECT_EQ(s.transparentNodes, std::uint64_t(kSize.x) * kSize.y);
+    EXPECT_GT(s.splats, 0u);
+}

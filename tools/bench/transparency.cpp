@@ -119,14 +119,16 @@ Error compare(const splatfx::Image& a, const splatfx::Image& b) {
 int runTransparency(int argc, char** argv) {
     glm::ivec2 size{640, 480};
     int frames = 15, rounds = 3;
+    bool cut = true; // RendererDesc::depthCut: sections weighted by the partial integral
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--size" && i + 2 < argc) size = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2])}, i += 2;
         else if (a == "--frames" && i + 1 < argc) frames = std::max(3, std::atoi(argv[++i]));
         else if (a == "--rounds" && i + 1 < argc) rounds = std::max(1, std::atoi(argv[++i]));
         else if (a == "--quick") frames = 5, rounds = 1, size = {320, 240};
+        else if (a == "--no-cut") cut = false;
         else if (a == "--help" || a == "-h") {
-            std::printf("usage: splatfx-bench transparency [--size W H (640 480)] [--frames N (15)] [--rounds R (3)] [--quick]\n"
+            std::printf("usage: splatfx-bench transparency [--size W H (640 480)] [--frames N (15)] [--rounds R (3)] [--quick] [--no-cut]\n"
                         "Glass panes among the 1560-voxel Table I fire: opaque-only frame, ordered blend and fragment lists,\n"
                         "time and error against the exact reference; the fragment budget knob; list memory.\n");
             return 0;
@@ -189,7 +191,7 @@ int runTransparency(int argc, char** argv) {
     std::vector<splatfx::gl::FrameRenderer> renderers;
     for (const Config& c : configs) {
         splatfx::gl::FrameRendererDesc rd{.fragmentsPerPixel = c.budget};
-        rd.splats.depthCut = std::getenv("OIT_NOCUT") == nullptr;
+        rd.splats.depthCut = cut;
         auto fr = splatfx::gl::FrameRenderer::create(rd);
         if (!fr || !fr->upload(materials)) {
             std::fprintf(stderr, "transparency: %s\n", fr ? "upload failed" : fr.error().c_str());
