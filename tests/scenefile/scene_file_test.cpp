@@ -296,3 +296,14 @@ TEST(SceneFile, RaisedBudgetsLetTheSameFileLoad) {
     ASSERT_FALSE(fire);
     EXPECT_NE(fire.error().find("needs 700 cells, over the budget of 500 (raise Budgets::effectCells)"), std::string::npos) << fire.error();
 }
+
+// [oit, issue 15] Geometry opacity: transparent surfaces (default opaque), range-checked.
+TEST(SceneFile, GeometryOpacityMarksTransparentSurfaces) {
+    auto r = parse(R"("geometry": [{"type": "box"}, {"name": "glass", "type": "box", "opacity": 0.25}])");
+    ASSERT_TRUE(r.ok()) << r.error();
+    ASSERT_EQ(r->geometry.size(), 2u);
+    EXPECT_EQ(r->geometry[0].opacity, 1.0f);
+    EXPECT_EQ(r->geometry[1].opacity, 0.25f);
+    expectError(R"("geometry": [{"type": "box", "opacity": 1.5}])", {"opacity"});
+    expectError(R"("geometry": [{"type": "box", "opacity": -0.1}])", {"opacity"});
+}

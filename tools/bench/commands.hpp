@@ -12,6 +12,7 @@ int runFog(int argc, char** argv);        // fog.cpp: Biri et al. 2002 Table 1, 
 int runClouds(int argc, char** argv);     // clouds.cpp: LOD volumes as projected tetrahedra, flight, popping (issue 17)
 int runCut(int argc, char** argv);        // cut.cpp: splats cut by the host depth and the near plane: cost, accuracy, popping (issue 15)
 int runSoak(int argc, char** argv);       // soak.cpp: every preset for an hour of scene time; finite, flat bounds and memory (issue 13)
+int runTransparency(int argc, char** argv); // transparency.cpp: glass panes among the fire, fragment lists vs ordered blend (issue 15)
 
 struct BenchCommand {
     const char* name;
@@ -27,5 +28,6 @@ inline constexpr BenchCommand kCommands[] = {
     {"shadows", "Ebert & Parent 1990 Table 2: steam from a glass, no/geometry/traced/table shadowing, table error", runShadows},
     {"fog", "Biri et al. 2002 Table 1: no fog, per-pixel fog, reduced fog textures at 800x600; error vs per pixel", runFog},
     {"cut", "splats cut exactly by depth: cost vs plain on Table I rows, error per table size, popping of a moving wall and the cow", runCut},
+    {"transparency", "glass panes among the 1560-voxel fire: fragment lists vs ordered blend vs opaque only, budget, memory", runTransparency},
     {"soak", "every preset stepped at 60 Hz for an hour of scene time: no NaN/Inf, bounds and memory flat", runSoak},
 };

@@ -4,6 +4,8 @@
 #include <string>
 
 #include <epoxy/gl.h>
+
+#include "splatfx/transparency.hpp"
 #include <glm/gtc/type_ptr.hpp>
 
 #include "splatfx/gl/program.hpp"
@@ -49,6 +51,27 @@ void main() {
 }
 )";
 
+// [oit, issue 15] Transparent objects (GeometryDesc::opacity < 1): the same
+// shading, premultiplied, emitted into the frame's fragment lists through the
+// SDK's include (transparentGlsl(); docs/integration.md, "Transparent surfaces").
+const char* kTransparentBody = R"(
+in vec3 vNormal;
+in vec3 vWorld;
+uniform vec3 uColor;
+uniform float uOpacity;
+uniform vec3 uEye;
+uniform vec4 uLight;
+uniform vec3 uLightColor;
+out vec4 fragColor;
+void main() {
+    vec3 n = normalize(vNormal);
+    if (dot(n, uEye - vWorld) < 0.0) n = -n;
+    vec3 toLight = normalize(uLight.w == 0.0 ? uLight.xyz : uLight.xyz - vWorld);
+    vec3 lit = uColor * (0.25 + 0.75 * max(dot(n, toLight), 0.0) * uLightColor);
+    fragColor = splatfx_emitTransparent(vec4(lit * uOpacity, uOpacity), gl_FragCoord.z);
+}
+)";
+
 } // namespace
 
 struct GeometryRenderer::Impl {
@@ -59,6 +82,7 @@ struct GeometryRenderer::Impl {
         splatfx::Aabb localBounds;
     };
     GLuint program = 0;
+    GLuint transparentProgram = 0; // [oit]
     std::vector<Object> objects;
     GeometryStats stats;
     ~Impl() {
@@ -68,6 +92,7 @@ struct GeometryRenderer::Impl {
             glDeleteBuffers(1, &o.ibo);
         }
         if (program) glDeleteProgram(program);
+        if (transparentProgram) glDeleteProgram(transparentProgram);
     }
 };
 
@@ -80,6 +105,12 @@ splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<spl
         splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n", shadow.c_str(), kFragmentBody}, "GeometryRenderer");
     if (!program) return splatfx::makeError(program.error());
     impl->program = *program;
+    { // [oit]
+        const std::string include = splatfx::transparentGlsl();
+        auto tp = splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n", include.c_str(), kTransparentBody}, "GeometryRenderer (transparent)");
+        if (!tp) return splatfx::makeError(tp.error());
+        impl->transparentProgram = *tp;
+    }
 
     std::map<std::string, Mesh> meshes; // each file loaded once
     for (const splatfx::GeometryDesc& g : geometry) {
@@ -168,7 +199,7 @@ void GeometryRenderer::draw(double t, const splatfx::Camera& camera, const Geome
     splatfx::gl::setShadowUniforms(r.program, lighting.shadow);
     const GLint model = glGetUniformLocation(r.program, "uModel"), color = glGetUniformLocation(r.program, "uColor");
     for (const Impl::Object& o : r.objects) {
-        if (!o.vao) continue;
+        if (!o.vao || o.desc.opacity < 1.0f) continue; // [oit] transparent ones: drawTransparent
         // Object to world: its motion (own or shared) after its static placement.
         const glm::mat4 m = o.desc.motion.matrix(t) * o.desc.transform;
         glUniformMatrix4fv(model, 1, GL_FALSE, glm::value_ptr(m));
@@ -177,6 +208,37 @@ void GeometryRenderer::draw(double t, const splatfx::Camera& camera, const Geome
         glDrawElements(GL_TRIANGLES, o.indexCount, GL_UNSIGNED_INT, nullptr);
         ++r.stats.objects;
         r.stats.triangles += std::size_t(o.indexCount) / 3;
+    }
+    glBindVertexArray(0);
+    glUseProgram(0);
+}
+
+// [oit, issue 15]
+bool GeometryRenderer::hasTransparent() const {
+    for (const Impl::Object& o : mImpl->objects)
+        if (o.vao && o.desc.opacity < 1.0f) return true;
+    return false;
+}
+
+void GeometryRenderer::drawTransparent(double t, const splatfx::Camera& camera, const GeometryLighting& lighting) {
+    Impl& r = *mImpl;
+    glUseProgram(r.transparentProgram);
+    const GLuint p = r.transparentProgram;
+    const glm::mat4 viewProj = camera.proj * camera.view;
+    const glm::vec3 eye = camera.eye();
+    glUniformMatrix4fv(glGetUniformLocation(p, "uViewProj"), 1, GL_FALSE, glm::value_ptr(viewProj));
+    glUniform3fv(glGetUniformLocation(p, "uEye"), 1, glm::value_ptr(eye));
+    glUniform4fv(glGetUniformLocation(p, "uLight"), 1, glm::value_ptr(lighting.light));
+    glUniform3fv(glGetUniformLocation(p, "uLightColor"), 1, glm::value_ptr(lighting.lightColor));
+    const GLint model = glGetUniformLocation(p, "uModel"), color = glGetUniformLocation(p, "uColor"), opacity = glGetUniformLocation(p, "uOpacity");
+    for (const Impl::Object& o : r.objects) {
+        if (!o.vao || !(o.desc.opacity < 1.0f)) continue;
+        const glm::mat4 m = o.desc.motion.matrix(t) * o.desc.transform;
+        glUniformMatrix4fv(model, 1, GL_FALSE, glm::value_ptr(m));
+        glUniform3fv(color, 1, glm::value_ptr(o.desc.color));
+        glUniform1f(opacity, o.desc.opacity);
+        glBindVertexArray(o.vao);
+        glDrawElements(GL_TRIANGLES, o.indexCount, GL_UNSIGNED_INT, nullptr);
     }
     glBindVertexArray(0);
     glUseProgram(0);

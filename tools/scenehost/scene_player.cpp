@@ -129,7 +129,13 @@ void ScenePlayer::renderFrame(double t, const splatfx::Camera& camera, unsigned 
         if (options.drawGeometry) p.geometry->draw(t, camera, geometryLighting(f.scene, *p.renderer));
     };
     const auto t0 = Clock::now();
-    p.renderer->render(p.frame, {.framebuffer = framebuffer, .drawOpaque = drawOpaque});
+    splatfx::gl::HostTarget target{.framebuffer = framebuffer, .drawOpaque = drawOpaque};
+    // [oit, issue 15] Glass: sorted per pixel with the gas through the fragment lists.
+    if (options.drawGeometry && p.geometry->hasTransparent()) {
+        target.drawTransparent = [&] { p.geometry->drawTransparent(t, camera, geometryLighting(f.scene, *p.renderer)); };
+        target.transparentToLists = true;
+    }
+    p.renderer->render(p.frame, target);
     s.renderMs = msSince(t0);
 }
 

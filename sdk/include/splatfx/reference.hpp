@@ -82,6 +82,21 @@ struct ReferenceHost {
                                         // (as gl::Framebuffer::readDepth returns); fragments behind it are dropped
 };
 
+// ---- [oit, issue 15] A transparent surface the reference composites exactly
+// among the splats (what a host sends through transparentGlsl()): triangles,
+// each crossing of a pixel ray one layer of the premultiplied colour (both
+// faces of a box count, like glass drawn without culling). Hidden behind the
+// host depth like the splats.
+struct ReferenceSurface {
+    std::vector<glm::dvec3> triangles;  // three world points per triangle
+    glm::dvec4 premultiplied{0.0};      // premultiplied RGBA of one crossing; default zero (invisible)
+    // The quad a, b, c, d (in order around its edge) as two triangles.
+    static ReferenceSurface quad(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d, glm::dvec4 premultiplied);
+    // An axis-aligned box's six faces (12 triangles).
+    static ReferenceSurface box(glm::dvec3 lo, glm::dvec3 hi, glm::dvec4 premultiplied);
+};
+// ---- end [oit] ----
+
 struct SplatExactDesc {
     ReferenceHost host{};                           // default: transparent black, no depth
     ReferenceWindow window = ReferenceWindow::Exact; // default Exact
@@ -112,6 +127,13 @@ struct SplatExactDesc {
     // tail in front. false: the plain test at the splat plane (fragments
     // outside [near, min(far, host depth)] are dropped whole). Default true.
     bool depthCut = true;
+    // ---- [oit, issue 15] transparent surfaces, composited per pixel in exact
+    // depth order with the splats; each splat fragment is cut at the surface
+    // crossings of its pixel ray into sections (Ebert & Parent 1990, Fig. 1),
+    // each with its exact share of the kernel's line integral (depthCut; false:
+    // the whole fragment at its plane). With a fog a surface layer is fogged
+    // like a splat fragment at its crossing. Default none.
+    std::vector<ReferenceSurface> surfaces{};
 };
 
 struct SplatExactStats {

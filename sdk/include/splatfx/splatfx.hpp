@@ -33,4 +33,5 @@
 #include "splatfx/solver.hpp"
 #include "splatfx/splats.hpp"
 #include "splatfx/texture_set.hpp"
+#include "splatfx/transparency.hpp"
 #include "splatfx/volume.hpp"

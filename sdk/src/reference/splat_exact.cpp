@@ -77,10 +77,45 @@ RefLayer makeLayer(const Materials& m, std::uint32_t index, const std::vector<fl
 struct Fragment {
     double t;
     double alpha;
-    glm::dvec3 color; // straight (not premultiplied)
+    glm::dvec3 color; // premultiplied
+    int side = 1;     // [oit] at equal t: 0 in front of a surface, 1 at it, 2 behind it
 };
 
+// [oit] Ray parameters where the ray crosses a triangle (Moller-Trumbore), in (0, tMax].
+void crossings(const ReferenceSurface& s, const glm::dvec3& o, const glm::dvec3& d, double tMax, std::vector<double>& out) {
+    for (std::size_t i = 0; i + 2 < s.triangles.size(); i += 3) {
+        const glm::dvec3 a = s.triangles[i], e1 = s.triangles[i + 1] - a, e2 = s.triangles[i + 2] - a;
+        const glm::dvec3 p = glm::cross(d, e2);
+        const double det = glm::dot(e1, p);
+        if (!(std::abs(det) > 1e-300)) continue;
+        const glm::dvec3 q = o - a;
+        const double u = glm::dot(q, p) / det;
+        // u > 0: a ray through a quad's diagonal crosses it once (its second triangle has v = 0 there).
+        if (u <= 0.0 || u > 1.0) continue;
+        const glm::dvec3 qe = glm::cross(q, e1);
+        const double v = glm::dot(d, qe) / det;
+        if (v < 0.0 || u + v > 1.0) continue;
+        const double t = glm::dot(e2, qe) / det;
+        if (t > 0.0 && t <= tMax && std::isfinite(t)) out.push_back(t);
+    }
+}
+
 } // namespace
+
+// [oit, issue 15]
+ReferenceSurface ReferenceSurface::quad(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d, glm::dvec4 premultiplied) {
+    return {{a, b, c, a, c, d}, premultiplied};
+}
+ReferenceSurface ReferenceSurface::box(glm::dvec3 lo, glm::dvec3 hi, glm::dvec4 premultiplied) {
+    ReferenceSurface s{{}, premultiplied};
+    auto corner = [&](int i) { return glm::dvec3(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z); };
+    const int faces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+    for (const auto& f : faces) {
+        const ReferenceSurface q = quad(corner(f[0]), corner(f[1]), corner(f[2]), corner(f[3]), premultiplied);
+        s.triangles.insert(s.triangles.end(), q.triangles.begin(), q.triangles.end());
+    }
+    return s;
+}
 
 Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& camera, const Materials& materials,
                                const SplatExactDesc& desc, SplatExactStats* statsOut) {
@@ -161,12 +196,29 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
 
     reference::parallelRows(H, desc.threads, [&](int y) {
         std::vector<Fragment> frags;
+        std::vector<double> cuts;          // [oit]
+        std::vector<glm::dvec4> cutColour; // [oit]
         std::uint64_t fragCount = 0, maxOverlap = 0;
         double fogTauMax = 0.0, fogErrMax = 0.0;
         std::uint64_t fogBad = 0;
         for (int x = 0; x < W; ++x) {
             const reference::PixelRay ray = mapper.ray(x, y, reference::hostDepth(desc.host, x, y));
             frags.clear();
+            // [oit] This ray's surface crossings, near to far, and their colours.
+            cuts.clear();
+            cutColour.clear();
+            if (!desc.surfaces.empty()) {
+                std::vector<std::pair<double, glm::dvec4>> hits;
+                for (const ReferenceSurface& surf : desc.surfaces) {
+                    const std::size_t before = cuts.size();
+                    crossings(surf, ray.origin, ray.dir, ray.tLimit, cuts);
+                    for (std::size_t k = before; k < cuts.size(); ++k) hits.push_back({cuts[k], surf.premultiplied});
+                }
+                std::stable_sort(hits.begin(), hits.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+                cuts.clear();
+                for (const auto& h : hits)
+                    if (h.second != glm::dvec4(0.0)) cuts.push_back(h.first), cutColour.push_back(h.second);
+            }
             for (std::uint32_t idx : tiles[size_t(y / kTile) * tilesX + x / kTile]) {
                 const Splat& s = splats[idx];
                 const glm::dvec3 c(s.center), au(s.axisU), av(s.axisV);
@@ -197,6 +249,46 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                     const double rr = R * std::sqrt(u * u + v * v);
                     detail *= rr < R ? fp.exact(rr) / F0 : 0.0;
                 }
+                const std::uint32_t row = std::uint32_t(std::lround(s.colorRow));
+                const glm::dvec3 base = desc.packedColor
+                                            ? glm::dvec3(double(s.color & 255u), double((s.color >> 8) & 255u), double((s.color >> 16) & 255u)) / 255.0
+                                        : row < materials.colorTableCount() ? reference::rowColor(materials.colorRow(row), s.colorCoord)
+                                                                            : glm::dvec3(1.0);
+                const glm::dvec3 col = base * glm::dvec3(tex);
+                if (!cuts.empty()) {
+                    // [oit, issue 15] Sections at the surface crossings: each
+                    // keeps its share of the kernel's line integral (depthCut)
+                    // or, without the cut, the whole fragment sits at its plane.
+                    double l = 1.0, rr = 0.0;
+                    if (cut) {
+                        l = double(splatRayScale(s, float(R)));
+                        if (!(l > 0.0)) continue;
+                        rr = R * std::sqrt(u * u + v * v);
+                    }
+                    auto before = [&](double tc) { // share in front of ray parameter tc
+                        return cut ? fp.exactFractionBefore(rr, (tc - t) / l) : (t <= tc ? 1.0 : 0.0);
+                    };
+                    const double lo = cut ? before(0.0) : 0.0, hi = cut ? std::max(before(ray.tLimit), lo) : 1.0;
+                    if (!cut && (!(t >= 0.0) || t > ray.tLimit)) continue;
+                    double prev = lo, prevT = 0.0;
+                    for (std::size_t k = 0; k <= cuts.size(); ++k) {
+                        const double tk = k < cuts.size() ? cuts[k] : ray.tLimit;
+                        const double F = k < cuts.size() ? std::clamp(before(tk), lo, hi) : hi;
+                        const double share = F - prev;
+                        prev = std::max(prev, F);
+                        const double lowT = prevT;
+                        prevT = tk;
+                        if (!(share > 0.0)) continue;
+                        const double a = -std::expm1(-kLn2 * double(s.density) * detail * share);
+                        if (!(a > 0.0)) continue;
+                        double key = t;
+                        int side = 1;
+                        if (k > 0 && key <= lowT) key = lowT, side = 2;
+                        else if (k < cuts.size() && key >= tk) key = tk, side = 0;
+                        frags.push_back({key, std::min(a, 1.0), col * std::min(a, 1.0), side});
+                    }
+                    continue;
+                }
                 if (cut) {
                     // The depth cut (issue 15): the share of the kernel's line
                     // integral between the near plane (t = 0 on this ray) and
@@ -211,21 +303,17 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                     detail *= share;
                 }
                 // alpha = 1 - 2^(-density * detail), accurate for tiny products.
-                const double alpha = -std::expm1(-kLn2 * double(s.density) * detail);
+                const double alpha = std::min(-std::expm1(-kLn2 * double(s.density) * detail), 1.0);
                 if (!(alpha > 0.0)) continue;
-                const std::uint32_t row = std::uint32_t(std::lround(s.colorRow));
-                const glm::dvec3 base = desc.packedColor
-                                            ? glm::dvec3(double(s.color & 255u), double((s.color >> 8) & 255u), double((s.color >> 16) & 255u)) / 255.0
-                                        : row < materials.colorTableCount() ? reference::rowColor(materials.colorRow(row), s.colorCoord)
-                                                                            : glm::dvec3(1.0);
-                const glm::dvec3 col = base * glm::dvec3(tex);
-                frags.push_back({t, std::min(alpha, 1.0), col});
+                frags.push_back({t, alpha, col * alpha});
             }
-            // Per-pixel exact order: farthest plane crossing first.
-            std::stable_sort(frags.begin(), frags.end(), [](const Fragment& a, const Fragment& b) { return a.t > b.t; });
+            // [oit] The surfaces' layers at their crossings.
+            for (std::size_t k = 0; k < cuts.size(); ++k) frags.push_back({cuts[k], std::clamp(cutColour[k].a, 0.0, 1.0), glm::dvec3(cutColour[k]), 1});
+            // Per-pixel exact order: farthest first (at equal depth, the far side of a surface first).
+            std::stable_sort(frags.begin(), frags.end(), [](const Fragment& a, const Fragment& b) { return a.t != b.t ? a.t > b.t : a.side > b.side; });
             glm::dvec4 acc = reference::background(desc.host, x, y);
             if (!fog) {
-                for (const Fragment& f : frags) acc = glm::dvec4(f.color * f.alpha, f.alpha) + (1.0 - f.alpha) * acc;
+                for (const Fragment& f : frags) acc = glm::dvec4(f.color, f.alpha) + (1.0 - f.alpha) * acc;
             } else {
                 // Transmittance from the eye to each fragment, nearest first.
                 std::vector<double> trans(frags.size(), 1.0);
@@ -259,7 +347,7 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                 for (size_t k = 0; k < frags.size(); ++k) {
                     const Fragment& f = frags[k];
                     const double fk = trans[k];
-                    const glm::dvec3 c = fk * f.color * f.alpha + (1.0 - fk) * f.alpha * fogColour;
+                    const glm::dvec3 c = fk * f.color + (1.0 - fk) * f.alpha * fogColour;
                     acc = glm::dvec4(c, f.alpha) + (1.0 - f.alpha) * acc;
                 }
                 fogErrMax = std::max(fogErrMax, err);

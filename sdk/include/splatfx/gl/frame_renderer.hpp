@@ -21,7 +21,12 @@
 //      Frame::drawOrder (at reduced resolution: all tetrahedra, then splats)
 //      and, with a fog, every tetrahedron's segment fogged like a splat fragment
 //      (f from the eye to the segment's opacity centroid; docs/fog.md, "Tetrahedra")
-//   3. the host's transparent pass (HostTarget::drawTransparent), blended over
+//   3. the host's transparent pass (HostTarget::drawTransparent), blended over;
+//      or, with HostTarget::transparentToLists (issue 15), the order-exact
+//      path: the hook's fragments go into per-pixel lists (transparentGlsl()),
+//      the splats (not drawn in step 2 then) are composited per section
+//      between those surfaces (Ebert & Parent 1990, Fig. 1), and a resolve
+//      sorts each pixel and composites it over the image (fragment_list_pass)
 // The passes of the systems still being built (fog of the host image, shadow
 // tables before the opaque pass, exact ordering among transparent surfaces,
 // projected tetrahedra) join this list here, not in callers.
@@ -79,6 +84,16 @@ struct FrameRendererDesc {
     float fogDepthThreshold = 0.05f;      // fog texture: relative distance still one surface; default 0.05
     bool fogHost = true;                  // fog the host's opaque image (false: only the splats); default true
     // --- end fog ---
+    // ---- [oit, issue 15] order-exact transparency (HostTarget::transparentToLists) ----
+    // The fragment budget for the host's transparent surfaces: the node pool
+    // holds viewport pixels x this many nodes (16 bytes each, plus 8 bytes of
+    // head and count per pixel: at 8 and 640x480, 41.8 MB), and a pixel
+    // resolves this many surfaces exactly (more: the farthest are merged,
+    // counted in FrameRenderStats). The splats take no nodes: they are
+    // composited per section into 2, 4 or 8 RGBA16F targets (8 bytes a pixel
+    // each). [1, 128]. Default 8.
+    int fragmentsPerPixel = 8;
+    // ---- end [oit] ----
 };
 
 // ---- lighting (issue 16): what a host surface shader with shadowGlsl()
@@ -113,6 +128,17 @@ struct HostTarget {
     // The host's transparent surfaces, blended after the volumes (ordered
     // blend; exact interleaving with the volumes is issue 15's pass). Default empty.
     std::function<void()> drawTransparent{};
+    // ---- [oit, issue 15] ----
+    // drawTransparent emits its fragments into per-pixel lists through
+    // transparentGlsl()'s splatfx_emitTransparent (transparency.hpp) instead
+    // of blending them: the splats are then cut into sections at those
+    // surfaces and every pixel is sorted and composited exactly (the
+    // order-exact path, docs/integration.md "Transparent surfaces"). The hook
+    // runs with the lists bound, premultiplied "over" blending and the depth
+    // test on without writes. false (or no hook): today's ordered blend at
+    // today's cost. Default false.
+    bool transparentToLists = false;
+    // ---- end [oit] ----
 };
 
 struct FrameRenderStats {
@@ -131,6 +157,21 @@ struct FrameRenderStats {
     std::uint64_t tetrahedraTransparent = 0; // skipped by the table's zero-opacity test
     std::uint64_t batches = 0;               // runs of the interleaved splat/tetrahedron sequence
     std::size_t tableBytes = 0;              // GPU bytes of the uploaded pre-integration tables
+    // ---- [oit, issue 15] order-exact transparency (last frame) ----
+    bool transparentLists = false;        // the host's surfaces went through the fragment lists
+    bool splatsInLists = false;           // ... and the splats too (false: drawn before them, ordered blend; see transparentNote)
+    std::string transparentNote;          // empty, or why the splats took the ordered blend in a list frame
+    std::uint64_t transparentNodes = 0;   // surface fragments stored in the lists
+    std::uint64_t transparentFallback = 0;     // surface fragments that found the pool full: blended directly by the include, unsorted
+    std::uint64_t transparentOverflowPixels = 0; // pixels with more surfaces than fragmentsPerPixel (their farthest merged)
+    std::uint64_t transparentMergedNodes = 0;    // surface nodes merged so
+    std::uint64_t transparentMaxSurfaces = 0;    // most surfaces stored on one pixel
+    int transparentSections = 0;                 // section targets the splats were composited into (2, 4 or 8; 0: none)
+    std::uint64_t transparentSectionOverflow = 0; // pixels with more surfaces than sections - 1 (7 at most): the gas behind the extra ones merged into the last section
+    bool transparentCut = false;          // sections weighted by the kernel's partial line integral (RendererDesc::depthCut)
+    std::uint64_t transparentEyeCrossing = 0; // splats whose polygon crosses the eye plane: not drawn in the lists (camera inside a kernel)
+    std::size_t transparentBytes = 0;     // GPU bytes of the lists (pool, heads, counts, counters, section targets)
+    // ---- end [oit] ----
 };
 
 class FrameRenderer {

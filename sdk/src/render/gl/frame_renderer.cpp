@@ -12,6 +12,8 @@
 #include "fog_pass.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
 #include "tetra_pass.hpp"
+#include "fragment_list_pass.hpp" // [oit]
+#include "saved_state.hpp"        // [oit]
 
 namespace splatfx::gl {
 
@@ -26,6 +28,7 @@ struct FrameRenderer::Impl {
     // [clouds] Projected tetrahedra, and the splats of one interleaved batch.
     std::optional<detail::TetraPass> tetra;
     std::vector<Splat> batch;
+    std::optional<detail::FragmentListPass> lists; // [oit, issue 15] order-exact transparency
 };
 
 Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
@@ -58,6 +61,15 @@ Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
         if (!t) return makeError(t.error());
         impl->tetra.emplace(std::move(*t));
     }
+    { // [oit, issue 15]
+        if (desc.fragmentsPerPixel < 1 || desc.fragmentsPerPixel > detail::FragmentListPass::kMaxFragmentsPerPixel)
+            return makeError("FrameRendererDesc::fragmentsPerPixel must be in [1, " +
+                             std::to_string(detail::FragmentListPass::kMaxFragmentsPerPixel) + "], got " +
+                             std::to_string(desc.fragmentsPerPixel));
+        auto l = detail::FragmentListPass::create(desc.fragmentsPerPixel);
+        if (!l) return makeError(l.error());
+        impl->lists.emplace(std::move(*l));
+    }
     return FrameRenderer(std::move(impl));
 }
 
@@ -67,7 +79,9 @@ FrameRenderer& FrameRenderer::operator=(FrameRenderer&&) noexcept = default;
 FrameRenderer::~FrameRenderer() = default;
 
 Status FrameRenderer::upload(const Materials& materials) {
-    return mImpl->full ? mImpl->full->upload(materials) : mImpl->reduced->upload(materials);
+    Status s = mImpl->full ? mImpl->full->upload(materials) : mImpl->reduced->upload(materials);
+    if (s && mImpl->lists) s = mImpl->lists->upload(materials); // [oit] the sections' partial-integral table
+    return s;
 }
 
 const FrameRendererDesc& FrameRenderer::desc() const { return mImpl->desc; }
@@ -131,9 +145,34 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         if (!s) r.stats.fogError = s.error();
         r.stats.fogTetrahedra = fog && s;
     }
+    // ---- [oit, issue 15] The order-exact path: the splats go into the fragment
+    // lists with the host's transparent surfaces (step 3) when nothing this
+    // pass cannot draw is in the frame; otherwise they are drawn here as
+    // usual and only the surfaces are sorted (among themselves) in step 3.
+    const bool lists = target.transparentToLists && bool(target.drawTransparent);
+    unsigned listDepth = target.depthTexture; // the section targets are depth-tested against the host's depth
+    if (lists && !listDepth && target.framebuffer != 0) {
+        GLint type = GL_NONE, name = 0;
+        glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
+        if (type == GL_TEXTURE)
+            glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &name);
+        listDepth = unsigned(name);
+    }
+    const bool splatsInLists = lists && r.full && !anyTets && !fog && listDepth != 0;
+    r.stats.transparentLists = lists;
+    r.stats.splatsInLists = splatsInLists;
+    r.stats.transparentNote = !lists || splatsInLists ? std::string()
+                              : !r.full              ? "reduced resolution: the splats take the ordered blend under the surfaces"
+                              : anyTets              ? "tetrahedra in the frame: the volumes take the ordered blend under the surfaces"
+                              : fog                  ? "fog: the splats take the ordered blend under the surfaces (fogged sections not implemented)"
+                                                     : "no host depth texture (HostTarget::depthTexture or a texture depth attachment): "
+                                                       "the splats take the ordered blend under the surfaces";
+    // ---- end [oit] ----
 
     // 2. The volumes, back to front.
-    if (anyTets) {
+    if (splatsInLists) {
+        // [oit] drawn in step 3
+    } else if (anyTets) {
         // [clouds] Splats and tetrahedra interleaved by Frame::drawOrder (frame.hpp).
         drawInterleaved(frame, target);
     } else if (r.full) {
@@ -150,7 +189,37 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
     if (!anyTets) r.stats.tetrahedra = r.stats.tetrahedraTransparent = r.stats.batches = 0;
 
     // 3. The host's transparent surfaces, over the volumes.
-    if (target.drawTransparent) {
+    if (lists) {
+        // [oit, issue 15] Surfaces into the lists, the splats cut into
+        // sections at them, every pixel sorted and composited.
+        detail::SavedState saved;
+        if (r.desc.splats.restoreState) saved.save({.texture2DUnits = 0, .scissor = false});
+        const detail::FragmentListTarget lt{.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
+                                            .depthTexture = listDepth};
+        const Status s = r.lists->collectSurfaces(lt, target.drawTransparent);
+        if (s) {
+            if (splatsInLists) {
+                r.lists->insertSplats(frame.splats(), camera, r.full->layerTexture(), r.desc.splats.footprintCut, r.desc.splats.trimCorners,
+                                      r.desc.splats.depthCut, lt);
+                r.stats.drawCalls = frame.splats().empty() ? 0 : 1;
+            }
+            r.lists->resolve(lt);
+        } else {
+            r.stats.transparentNote = s.error();
+        }
+        const detail::FragmentListStats& ls = r.lists->stats();
+        r.stats.transparentNodes = ls.nodes;
+        r.stats.transparentFallback = ls.fallback;
+        r.stats.transparentOverflowPixels = ls.overflowPixels;
+        r.stats.transparentMergedNodes = ls.mergedNodes;
+        r.stats.transparentSectionOverflow = ls.sectionOverflow;
+        r.stats.transparentMaxSurfaces = ls.maxSurfaces;
+        r.stats.transparentSections = ls.sections;
+        r.stats.transparentCut = ls.cut;
+        r.stats.transparentEyeCrossing = ls.eyeCrossing;
+        r.stats.transparentBytes = ls.bytes;
+        if (r.desc.splats.restoreState) saved.restore();
+    } else if (target.drawTransparent) {
         glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
         glViewport(target.x, target.y, w, h);
         target.drawTransparent();

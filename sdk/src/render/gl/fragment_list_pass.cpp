@@ -1,0 +1,633 @@
+// [oit, issue 15] Per-pixel fragment lists: surfaces, splat sections, resolve
+// (fragment_list_pass.hpp). The node layout is transparentGlsl()'s.
+#include "fragment_list_pass.hpp"
+
+#include <algorithm>
+#include <cstddef>
+#include <string>
+
+#include <epoxy/gl.h>
+
+#include <glm/gtc/type_ptr.hpp>
+
+#include "context_check.hpp"
+#include "partial_texture.hpp"
+#include "scaled_shaders.hpp"
+#include "shaders.hpp"
+#include "splatfx/gl/program.hpp"
+#include "splatfx/footprint.hpp"
+#include "splatfx/transparency.hpp"
+
+namespace splatfx::gl::detail {
+namespace {
+
+constexpr GLuint kEnd = 0xffffffffu;
+constexpr int kCounterWords = 12;
+constexpr GLsizeiptr kCounterBytes = kCounterWords * 4;
+
+// Splat fragments into their sections. Compiled after "#version 450 core",
+// the splat vertex shader's defines (FOG 0, CUT 0|1 with HOST_DEPTH and
+// NEAR_CUT equal to CUT, GENERAL 0), "#define SECTIONS n", partialGlsl()
+// (CUT 1) and transparentGlsl().
+constexpr const char* kSectionFragment = R"(
+layout(binding = 0) uniform sampler2DArray uLayers;
+layout(binding = 2) uniform sampler2DArray uDepths; // the pixel's nearest SECTIONS - 1 surface depths, sorted; 2.0: none
+uniform ivec2 uOrigin; // the lists' viewport origin
+in vec2 vTex;
+flat in float vDensity;
+flat in vec3 vLayers;
+flat in vec3 vColor;
+layout(location = 0) out vec4 oSection[SECTIONS];
+
+#if CUT
+// The kernel's partial line integral (issue 15 item 1; PARTIAL_API.md and
+// the splat pass's shader, whose vertex stage this program shares).
+uniform vec3 uForward;
+uniform float uNearZ;
+uniform int uPersp;
+uniform float uKernelRadius;
+layout(binding = 1) uniform sampler2D uHostDepth;
+uniform vec4 uDepthToView; // inverse projection's (z, w) rows at (z, w) columns
+flat in float vScale;
+in vec3 vRel;
+float gR, gTP, gInvCos, gInvL, gLo, gHi;
+float viewDepth(float windowDepth) {
+    float nz = windowDepth * 2.0 - 1.0;
+    return abs((uDepthToView.x * nz + uDepthToView.y) / (uDepthToView.z * nz + uDepthToView.w));
+}
+// Share of the kernel's line integral on this ray in front of view depth z.
+float beforeView(float z) { return splatfx_partial_before(gR, (z * gInvCos - gTP) * gInvL); }
+// The share of this fragment's optical depth (between the near plane and the
+// host's opaque surface) in front of window depth d: non-decreasing in d.
+float sectionFraction(float d) { return clamp(beforeView(viewDepth(d)), gLo, gHi) - gLo; }
+#else
+// Without the cut the kernel is concentrated on its plane: a step at the
+// plane's depth (LEQUAL, as the ordered blend's depth test).
+float sectionFraction(float d) { return gl_FragCoord.z <= d ? 1.0 : 0.0; }
+#endif
+
+void main() {
+    vec4 acc[SECTIONS];
+    for (int k = 0; k < SECTIONS; ++k) acc[k] = vec4(0.0);
+    vec4 t = texture(uLayers, vec3(vTex, vLayers.x));
+    if (vLayers.z > 0.0) t = mix(t, texture(uLayers, vec3(vTex, vLayers.y)), vLayers.z);
+#if CUT
+    vec2 uvk = vec2(2.0 * vTex.x - 1.0, 1.0 - 2.0 * vTex.y);
+    float zP = dot(vRel, uForward);
+    gR = uKernelRadius * length(uvk);
+    gTP = uPersp != 0 ? length(vRel) : zP; // along the ray from the eye (ortho: from its plane)
+    gInvCos = uPersp != 0 ? gTP / zP : 1.0;
+    gInvL = 1.0 / vScale;
+    gLo = beforeView(uNearZ);
+    gHi = max(beforeView(viewDepth(texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r)), gLo);
+    float total = gHi - gLo;
+#else
+    float total = 1.0;
+#endif
+    float tau = vDensity * t.a; // log2 optical depth of the whole (uncut) fragment
+    vec3 colour = vColor * t.rgb;
+    if (tau > 0.0 && total > 0.0) {
+        ivec2 p = ivec2(gl_FragCoord.xy) - uOrigin;
+        // base: surfaces wholly in front; cuts: those inside the kernel, near to far.
+        int base = 0, n = 0;
+        float cuts[SECTIONS];
+        float fracs[SECTIONS];
+        // The pixel's surfaces, nearest first, from the depth layers the
+        // prepare pass sorted (a texture: on Mesa's llvmpipe a fragment
+        // shader's storage-buffer reads return wrong data in partially
+        // covered blocks, so the lists are walked only in compute shaders).
+        for (int k = 0; k < SECTIONS - 1; ++k) {
+            float d = texelFetch(uDepths, ivec3(p, k), 0).r;
+            if (d > 1.5) break; // no more surfaces
+            float f = sectionFraction(d);
+            if (f <= 0.0) { ++base; continue; }
+            if (f >= total) break; // this and every farther surface lie behind the kernel
+            cuts[n] = d;
+            fracs[n] = f;
+            ++n;
+        }
+        // Bounded loop, no continue: llvmpipe dropped the last trip of the
+        // data-dependent form of this loop (the section behind the last cut).
+        float before = 0.0;
+        for (int k = 0; k <= SECTIONS; ++k) {
+            if (k > n) break;
+            float F = k < n ? fracs[k] : total;
+            float frac = max(F - before, 0.0);
+            before = max(before, F);
+            if (frac > 0.0) {
+                // A section's alpha from its share: the sections' transmittances
+                // multiply back to the (cut) splat's.
+                float a = 1.0 - exp2(-tau * frac);
+                int s = min(base + k, SECTIONS - 1); // base + n <= SECTIONS - 1 by construction
+                // Nearer parts first; a constant index per target.
+                for (int q = 0; q < SECTIONS; ++q)
+                    if (q == s) acc[q] += (1.0 - acc[q].a) * vec4(colour * a, a);
+            }
+        }
+    }
+    for (int k = 0; k < SECTIONS; ++k) oSection[k] = acc[k];
+}
+)";
+
+// The prepare pass: each pixel's nearest `layers` surface depths, sorted,
+// into a texture array for the section shader (2.0 past the last).
+constexpr const char* kPrepareCompute = R"(
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 2) uniform usampler2D uHeads;
+layout(r32f, binding = 5) writeonly uniform image2DArray uDepthsOut;
+uniform ivec2 uSize;
+uniform int uLayers;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= uSize.x || p.y >= uSize.y) return;
+    float d[7];
+    int n = 0, all = 0;
+    for (uint i = texelFetch(uHeads, p, 0).x; i != splatfx_kEnd; i = splatfx_nodes[i].next) {
+        float z = uintBitsToFloat(splatfx_nodes[i].depthBits);
+        ++all;
+        if (n == uLayers && z >= d[n - 1]) continue;
+        int j = n < uLayers ? n++ : n - 1; // full: the farthest kept one drops out
+        while (j > 0 && z < d[j - 1]) {
+            d[j] = d[j - 1];
+            --j;
+        }
+        d[j] = z;
+    }
+    for (int k = 0; k < uLayers; ++k) imageStore(uDepthsOut, ivec3(p, k), vec4(k < n ? d[k] : 2.0));
+    // More surfaces than the section targets separate: the gas behind the
+    // extra ones is composited after the last kept surface (counted).
+    if (all > uLayers) atomicAdd(splatfx_sectionOverflow, 1u);
+}
+)";
+
+// The resolve, one invocation per pixel. Compiled after "#version 450
+// core", "#define K n" and transparentGlsl() without its
+// early_fragment_tests line. A compute shader, not a full-screen draw: on
+// Mesa's llvmpipe the fragment version read wrong list data in the partially
+// covered blocks along its triangles' edges (a band of wrong pixels).
+constexpr const char* kResolveCompute = R"(
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(binding = 1) uniform sampler2DArray uSections;
+layout(binding = 2) uniform usampler2D uHeads;
+layout(rgba16f, binding = 5) writeonly uniform image2D uResolved;
+uniform ivec2 uOrigin;      // the lists' viewport origin in the section targets
+uniform ivec2 uSize;        // the lists' viewport size
+uniform int uSectionCount;  // 0: the splats were not drawn into sections
+
+vec4 over(vec4 front, vec4 back) { return front + (1.0 - front.a) * back; }
+vec4 section(ivec2 p, int k) { return k < uSectionCount ? texelFetch(uSections, ivec3(p + uOrigin, k), 0) : vec4(0.0); }
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= uSize.x || p.y >= uSize.y) return;
+    float eDepth[K];
+    vec4 eColour[K];
+    int n = 0;
+    uint merged = 0u;
+    uint i = texelFetch(uHeads, p, 0).x;
+    while (i != splatfx_kEnd) {
+        splatfx_Node node = splatfx_nodes[i];
+        i = node.next;
+        float d = uintBitsToFloat(node.depthBits);
+        vec4 c = vec4(unpackHalf2x16(node.rg), unpackHalf2x16(node.ba));
+        if (n == K) {
+            // Full: the farthest two of the K + 1 become one ("over").
+            ++merged;
+            if (d >= eDepth[K - 1]) {
+                eColour[K - 1] = over(eColour[K - 1], c);
+                continue;
+            }
+            vec4 last = eColour[K - 1];
+            int j = K - 1;
+            while (j > 0 && d < eDepth[j - 1]) {
+                eDepth[j] = eDepth[j - 1];
+                eColour[j] = eColour[j - 1];
+                --j;
+            }
+            eDepth[j] = d;
+            eColour[j] = c;
+            eColour[K - 1] = over(eColour[K - 1], last);
+            continue;
+        }
+        int j = n++;
+        while (j > 0 && d < eDepth[j - 1]) {
+            eDepth[j] = eDepth[j - 1];
+            eColour[j] = eColour[j - 1];
+            --j;
+        }
+        eDepth[j] = d;
+        eColour[j] = c;
+    }
+    if (merged > 0u) {
+        atomicAdd(splatfx_overflowPixels, 1u);
+        atomicAdd(splatfx_mergedNodes, merged);
+    }
+    // Front to back: section 0, surface 0, section 1, ... The sections past
+    // the last kept surface (more surfaces than sections or than K) follow it.
+    vec4 acc = section(p, 0);
+    for (int k = 0; k < n; ++k) {
+        acc = over(acc, eColour[k]);
+        if (k + 1 < n) acc = over(acc, section(p, k + 1));
+    }
+    for (int k = max(n, 1); k < uSectionCount; ++k) acc = over(acc, section(p, k));
+    imageStore(uResolved, p, acc);
+}
+)";
+
+// The resolved image "over" the framebuffer.
+constexpr const char* kListCompositeFragment = R"(#version 450 core
+layout(binding = 1) uniform sampler2D uResolved;
+uniform ivec2 uOrigin;
+layout(location = 0) out vec4 oColor;
+void main() {
+    vec4 c = texelFetch(uResolved, ivec2(gl_FragCoord.xy) - uOrigin, 0);
+    if (c == vec4(0.0)) discard;
+    oColor = c;
+}
+)";
+
+} // namespace
+
+struct FragmentListPass::Impl {
+    int perPixel = 8;
+    struct SectionProgram {
+        int sections = 0;
+        GLuint id = 0;
+        GLint uViewProj = -1, uOctagon = -1, uCut = -1, uOrigin = -1;
+        GLint uEye = -1, uForward = -1, uNearZ = -1, uPersp = -1, uKernelRadius = -1, uDepthToView = -1;
+    };
+    SectionProgram sectionPrograms[2][3]; // [plain, cut][2, 4, 8 sections]
+    PartialTexture partial;               // the footprint's partial-integral table (cut programs)
+    std::string partialSource;            // partialGlsl() the cut programs were built from
+    float kernelRadius = 1.0f;
+    std::string programError;
+
+    // Builds the three section programs of one kind (cut: with the partial integral).
+    bool buildSections(bool cut) {
+        const std::string include = transparentGlsl();
+        const int counts[3] = {2, 4, kTransparentMaxSections};
+        const std::string head = std::string("#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n") +
+                                 (cut ? "#define CUT 1\n#define HOST_DEPTH 1\n#define NEAR_CUT 1\n" : "#define CUT 0\n#define HOST_DEPTH 0\n#define NEAR_CUT 0\n") +
+                                 "#define GENERAL 0\n#define CROSSFADE 1\n";
+        const char* partialSrc = cut ? partialSource.c_str() : "";
+        for (int v = 0; v < 3; ++v) {
+            SectionProgram& p = sectionPrograms[cut][v];
+            if (p.id) glDeleteProgram(p.id), p = {};
+            const std::string def = "#define SECTIONS " + std::to_string(counts[v]) + "\n";
+            auto linked = linkProgram({head.c_str(), partialSrc, kSplatVertex},
+                                      {head.c_str(), def.c_str(), partialSrc, include.c_str(), kSectionFragment}, "fragment lists (splat sections)");
+            if (!linked) {
+                programError = linked.error();
+                return false;
+            }
+            p.sections = counts[v];
+            p.id = *linked;
+            auto loc = [&](const char* name) { return glGetUniformLocation(p.id, name); };
+            p.uViewProj = loc("uViewProj");
+            p.uOctagon = loc("uOctagon");
+            p.uCut = loc("uCut");
+            p.uOrigin = loc("uOrigin");
+            p.uEye = loc("uEye");
+            p.uForward = loc("uForward");
+            p.uNearZ = loc("uNearZ");
+            p.uPersp = loc("uPersp");
+            p.uKernelRadius = loc("uKernelRadius");
+            p.uDepthToView = loc("uDepthToView");
+        }
+        return true;
+    }
+    std::vector<std::pair<int, GLuint>> resolvePrograms; // (K, program), K ascending
+    GLuint compositeProgram = 0, prepareProgram = 0;
+    GLuint depths = 0; // R32F array: each pixel's nearest surface depths
+    int depthLayers = 0;
+    glm::ivec2 depthSize{0};
+    GLuint resolved = 0; // RGBA16F, the lists' viewport
+    GLuint vao = 0, instances = 0, emptyVao = 0;
+    std::size_t instanceCapacity = 0;
+    GLuint heads = 0, counts = 0, pool = 0, counters = 0;
+    GLuint sections = 0, sectionFbo = 0, attachedDepth = 0;
+    glm::ivec2 sectionSize{0};
+    int sectionLayers = 0;
+    int width = 0, height = 0;
+    std::size_t poolNodes = 0;
+    int sectionsThisFrame = 0;
+    FragmentListStats stats;
+
+    ~Impl() {
+        if (!contextIsCurrent()) return;
+        for (const auto& kind : sectionPrograms)
+            for (const SectionProgram& p : kind)
+                if (p.id) glDeleteProgram(p.id);
+        for (const auto& rp : resolvePrograms) glDeleteProgram(rp.second);
+        if (compositeProgram) glDeleteProgram(compositeProgram);
+        if (prepareProgram) glDeleteProgram(prepareProgram);
+        if (depths) glDeleteTextures(1, &depths);
+        GLuint vaos[2] = {vao, emptyVao};
+        glDeleteVertexArrays(2, vaos);
+        GLuint bufs[3] = {instances, pool, counters};
+        glDeleteBuffers(3, bufs);
+        GLuint tex[4] = {heads, counts, sections, resolved};
+        glDeleteTextures(4, tex);
+        if (sectionFbo) glDeleteFramebuffers(1, &sectionFbo);
+    }
+
+    void resize(int w, int h) {
+        if (w == width && h == height && pool) return;
+        GLuint tex[3] = {heads, counts, resolved};
+        glDeleteTextures(3, tex);
+        glCreateTextures(GL_TEXTURE_2D, 1, &resolved);
+        glTextureStorage2D(resolved, 1, GL_RGBA16F, w, h);
+        glTextureParameteri(resolved, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(resolved, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glCreateTextures(GL_TEXTURE_2D, 1, &heads);
+        glCreateTextures(GL_TEXTURE_2D, 1, &counts);
+        glTextureStorage2D(heads, 1, GL_R32UI, w, h);
+        glTextureStorage2D(counts, 1, GL_R32UI, w, h);
+        // Integer textures are complete only with nearest filtering.
+        glTextureParameteri(heads, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(heads, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        if (pool) glDeleteBuffers(1, &pool);
+        poolNodes = std::size_t(w) * std::size_t(h) * std::size_t(perPixel);
+        glCreateBuffers(1, &pool);
+        glNamedBufferStorage(pool, GLsizeiptr(poolNodes * kTransparentNodeBytes), nullptr, 0);
+        width = w;
+        height = h;
+        stats.poolNodes = poolNodes;
+    }
+
+    // Section targets covering [0, x + w) x [0, y + h), so that the host's
+    // viewport and depth texture coordinates apply unchanged.
+    // Grows only (layers: the sections this frame needs).
+    void sizeSections(glm::ivec2 size, int layers, GLuint depth) {
+        if (size != sectionSize || !sections || layers > sectionLayers) {
+            if (sections) glDeleteTextures(1, &sections);
+            glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &sections);
+            glTextureStorage3D(sections, 1, GL_RGBA16F, size.x, size.y, layers);
+            glTextureParameteri(sections, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+            glTextureParameteri(sections, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+            if (!sectionFbo) glCreateFramebuffers(1, &sectionFbo);
+            for (int k = 0; k < kTransparentMaxSections; ++k)
+                if (k < layers) glNamedFramebufferTextureLayer(sectionFbo, GL_COLOR_ATTACHMENT0 + GLenum(k), sections, 0, k);
+                else glNamedFramebufferTexture(sectionFbo, GL_COLOR_ATTACHMENT0 + GLenum(k), 0, 0);
+            sectionSize = size;
+            sectionLayers = layers;
+        }
+        if (depth != attachedDepth) {
+            glNamedFramebufferTexture(sectionFbo, GL_DEPTH_ATTACHMENT, depth, 0);
+            attachedDepth = depth;
+        }
+    }
+};
+
+FragmentListPass::FragmentListPass(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
+FragmentListPass::FragmentListPass(FragmentListPass&&) noexcept = default;
+FragmentListPass& FragmentListPass::operator=(FragmentListPass&&) noexcept = default;
+FragmentListPass::~FragmentListPass() = default;
+const FragmentListStats& FragmentListPass::stats() const { return mImpl->stats; }
+
+Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
+    auto impl = std::make_unique<Impl>();
+    impl->perPixel = std::clamp(fragmentsPerPixel, 1, kMaxFragmentsPerPixel);
+    if (!impl->buildSections(false)) return makeError(impl->programError);
+    const std::string include = transparentGlsl();
+    std::string computeInclude = include;
+    const std::string early = "layout(early_fragment_tests) in;\n";
+    if (const std::size_t at = computeInclude.find(early); at != std::string::npos) computeInclude.erase(at, early.size());
+    // ... and without the emit function (gl_FragCoord: fragment shaders only).
+    const std::size_t fn = computeInclude.find("vec4 splatfx_emitTransparent("), fnEnd = computeInclude.find("// ---- end splatfx");
+    if (fn != std::string::npos && fnEnd != std::string::npos) computeInclude.erase(fn, fnEnd - fn);
+    // Resolve variants for K = 1, 2, 4, ... below the budget and the budget
+    // itself: a frame with few surfaces per pixel runs the smallest that holds
+    // them (the per-pixel arrays cost in proportion to K on a CPU rasterizer).
+    for (int k = 1;; k = std::min(2 * k, impl->perPixel)) {
+        const std::string def = "#define K " + std::to_string(k) + "\n";
+        auto resolve = linkComputeProgram({"#version 450 core\n", def.c_str(), computeInclude.c_str(), kResolveCompute}, "fragment lists (resolve)");
+        if (!resolve) return makeError(resolve.error());
+        impl->resolvePrograms.push_back({k, *resolve});
+        if (k == impl->perPixel) break;
+    }
+    auto prepare = linkComputeProgram({"#version 450 core\n", computeInclude.c_str(), kPrepareCompute}, "fragment lists (prepare)");
+    if (!prepare) return makeError(prepare.error());
+    impl->prepareProgram = *prepare;
+    auto composite = linkProgram({kFullscreenVertex}, {kListCompositeFragment}, "fragment lists (composite)");
+    if (!composite) return makeError(composite.error());
+    impl->compositeProgram = *composite;
+
+    glCreateVertexArrays(1, &impl->vao);
+    glCreateVertexArrays(1, &impl->emptyVao);
+    glVertexArrayBindingDivisor(impl->vao, 0, 1);
+    // The Splat struct as gl::Renderer reads it (renderer.cpp).
+    for (GLuint a = 0; a < 3; ++a) glVertexArrayAttribFormat(impl->vao, a, 4, GL_FLOAT, GL_FALSE, a * 16);
+    glVertexArrayAttribIFormat(impl->vao, 3, 2, GL_UNSIGNED_SHORT, offsetof(Splat, layer));
+    glVertexArrayAttribFormat(impl->vao, 4, 1, GL_FLOAT, GL_FALSE, offsetof(Splat, blend));
+    glVertexArrayAttribFormat(impl->vao, 5, 4, GL_UNSIGNED_BYTE, GL_TRUE, offsetof(Splat, color));
+    for (GLuint a = 0; a < 6; ++a) {
+        glEnableVertexArrayAttrib(impl->vao, a);
+        glVertexArrayAttribBinding(impl->vao, a, 0);
+    }
+    glCreateBuffers(1, &impl->counters);
+    glNamedBufferStorage(impl->counters, kCounterBytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
+    return FragmentListPass(std::move(impl));
+}
+
+Status FragmentListPass::upload(const Materials& materials) {
+    Impl& r = *mImpl;
+    r.partial.update(materials.footprint());
+    r.kernelRadius = materials.footprint().radius();
+    const std::string partial = partialGlsl(materials.footprint(), 3);
+    if (partial == r.partialSource) return {};
+    r.partialSource = partial;
+    if (!r.buildSections(true)) {
+        r.partialSource.clear();
+        return makeError("fragment lists: " + r.programError);
+    }
+    return {};
+}
+
+Status FragmentListPass::collectSurfaces(const FragmentListTarget& target, const std::function<void()>& drawSurfaces) {
+    Impl& r = *mImpl;
+    if (target.width <= 0 || target.height <= 0) return makeError("fragment lists: the viewport must be positive");
+    r.resize(target.width, target.height);
+    r.sectionsThisFrame = 0;
+    r.stats.eyeCrossing = 0;
+    r.stats.cut = false;
+    const GLuint end = kEnd, zero = 0;
+    glClearTexImage(r.heads, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &end);
+    glClearTexImage(r.counts, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
+    const GLint header[kCounterWords] = {0, 0, target.x, target.y, target.width, target.height, 0, 0, 0, 0, 0, 0};
+    glNamedBufferSubData(r.counters, 0, sizeof(header), header);
+    glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kTransparentNodeBinding, r.pool, 0, GLsizeiptr(r.poolNodes * kTransparentNodeBytes));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTransparentCounterBinding, r.counters);
+    glBindImageTexture(kTransparentHeadImageUnit, r.heads, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glBindImageTexture(kTransparentCountImageUnit, r.counts, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    if (drawSurfaces) {
+        glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+        glViewport(target.x, target.y, target.width, target.height);
+        glEnable(GL_BLEND);
+        glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+        glBlendEquation(GL_FUNC_ADD);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LEQUAL);
+        glDepthMask(GL_FALSE);
+        drawSurfaces();
+    }
+    return {};
+}
+
+void FragmentListPass::insertSplats(const std::vector<Splat>& splats, const Camera& camera, unsigned layerTexture, float cut, bool trimCorners,
+                                    bool depthCut, const FragmentListTarget& target) {
+    Impl& r = *mImpl;
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    if (splats.empty() || !layerTexture || !target.depthTexture) return;
+    // How many sections the frame needs: one more than the most surfaces on a pixel.
+    GLuint maxSurfaces = 0;
+    glGetNamedBufferSubData(r.counters, 6 * 4, 4, &maxSurfaces);
+    const bool partial = depthCut && !r.partialSource.empty();
+    r.stats.cut = partial;
+    const Impl::SectionProgram* prog = &r.sectionPrograms[partial][2];
+    for (const Impl::SectionProgram& p : r.sectionPrograms[partial])
+        if (GLuint(p.sections) >= maxSurfaces + 1) {
+            prog = &p;
+            break;
+        }
+    r.sectionsThisFrame = prog->sections;
+    // The sorted depths the section shader reads (grown only).
+    const int layers = prog->sections - 1;
+    if (!r.depths || layers > r.depthLayers || r.depthSize != glm::ivec2(target.width, target.height)) {
+        if (r.depths) glDeleteTextures(1, &r.depths);
+        glCreateTextures(GL_TEXTURE_2D_ARRAY, 1, &r.depths);
+        glTextureStorage3D(r.depths, 1, GL_R32F, target.width, target.height, layers);
+        glTextureParameteri(r.depths, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(r.depths, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        r.depthLayers = layers;
+        r.depthSize = {target.width, target.height};
+    }
+    glUseProgram(r.prepareProgram);
+    glUniform2i(glGetUniformLocation(r.prepareProgram, "uSize"), target.width, target.height);
+    glUniform1i(glGetUniformLocation(r.prepareProgram, "uLayers"), layers);
+    glBindTextureUnit(2, r.heads);
+    glBindImageTexture(5, r.depths, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
+    glDispatchCompute(GLuint((target.width + 7) / 8), GLuint((target.height + 7) / 8), 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT);
+    glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    r.sizeSections({target.x + target.width, target.y + target.height}, prog->sections, target.depthTexture);
+
+    if (splats.size() > r.instanceCapacity) {
+        if (r.instances) glDeleteBuffers(1, &r.instances);
+        r.instanceCapacity = std::max<std::size_t>(splats.size() + splats.size() / 2, 1024);
+        glCreateBuffers(1, &r.instances);
+        glNamedBufferStorage(r.instances, GLsizeiptr(r.instanceCapacity * sizeof(Splat)), nullptr, GL_DYNAMIC_STORAGE_BIT);
+        glVertexArrayVertexBuffer(r.vao, 0, r.instances, 0, sizeof(Splat));
+    }
+    glNamedBufferSubData(r.instances, 0, GLsizeiptr(splats.size() * sizeof(Splat)), splats.data());
+
+    GLenum bufs[kTransparentMaxSections];
+    for (int k = 0; k < kTransparentMaxSections; ++k) bufs[k] = k < prog->sections ? GL_COLOR_ATTACHMENT0 + GLenum(k) : GL_NONE;
+    glNamedFramebufferDrawBuffers(r.sectionFbo, kTransparentMaxSections, bufs);
+    glBindFramebuffer(GL_FRAMEBUFFER, r.sectionFbo);
+    glViewport(target.x, target.y, target.width, target.height);
+    glDisable(GL_SCISSOR_TEST);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    const GLfloat clear[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    for (int k = 0; k < prog->sections; ++k) glClearNamedFramebufferfv(r.sectionFbo, GL_COLOR, k, clear);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    glBlendEquation(GL_FUNC_ADD);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(prog->id);
+    const glm::mat4 vp = camera.proj * camera.view;
+    glUniformMatrix4fv(prog->uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
+    glUniform1i(prog->uOctagon, trimCorners ? 1 : 0);
+    glUniform1f(prog->uCut, std::clamp(cut, 0.05f, 1.0f));
+    glUniform2i(prog->uOrigin, target.x, target.y);
+    if (partial) {
+        const glm::vec3 eye = camera.eye(), fwd = camera.forward();
+        const glm::mat4 invProj = glm::inverse(camera.proj);
+        glUniform3f(prog->uEye, eye.x, eye.y, eye.z);
+        glUniform3f(prog->uForward, fwd.x, fwd.y, fwd.z);
+        glUniform1f(prog->uNearZ, camera.nearPlane());
+        glUniform1i(prog->uPersp, camera.perspective() ? 1 : 0);
+        glUniform1f(prog->uKernelRadius, r.kernelRadius);
+        glUniform4f(prog->uDepthToView, invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+        glBindTextureUnit(1, target.depthTexture);
+        glBindTextureUnit(3, r.partial.texture());
+        // The vertex shader drops a polygon that crosses the eye plane (the
+        // splat pass draws those with its general variant; not here): counted.
+        std::uint64_t crossing = 0;
+        const float nearZ = camera.nearPlane(), extent = std::clamp(cut, 0.05f, 1.0f);
+        if (camera.perspective())
+            for (const Splat& sp : splats) {
+                const float a = std::abs(glm::dot(sp.axisU, fwd)), b = std::abs(glm::dot(sp.axisV, fwd));
+                const float reach = trimCorners ? std::max(a + 0.41421356f * b, 0.41421356f * a + b) : a + b;
+                if (!(glm::dot(sp.center - eye, fwd) - extent * reach >= 0.25f * nearZ)) ++crossing;
+            }
+        r.stats.eyeCrossing = crossing;
+    }
+    glBindTextureUnit(0, layerTexture);
+    glBindTextureUnit(2, r.depths);
+    glBindVertexArray(r.vao);
+    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, trimCorners ? 8 : 4, GLsizei(splats.size()));
+}
+
+void FragmentListPass::resolve(const FragmentListTarget& target) {
+    Impl& r = *mImpl;
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+    GLuint maxSurfaces = 0;
+    glGetNamedBufferSubData(r.counters, 6 * 4, 4, &maxSurfaces);
+    GLuint program = r.resolvePrograms.back().second;
+    for (const auto& rp : r.resolvePrograms)
+        if (GLuint(rp.first) >= maxSurfaces) {
+            program = rp.second;
+            break;
+        }
+    glUseProgram(program);
+    glUniform1i(glGetUniformLocation(program, "uSectionCount"), r.sectionsThisFrame);
+    glUniform2i(glGetUniformLocation(program, "uOrigin"), target.x, target.y);
+    glUniform2i(glGetUniformLocation(program, "uSize"), target.width, target.height);
+    if (r.sectionsThisFrame > 0) glBindTextureUnit(1, r.sections);
+    glBindTextureUnit(2, r.heads);
+    glBindImageTexture(5, r.resolved, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+    glDispatchCompute(GLuint((target.width + 7) / 8), GLuint((target.height + 7) / 8), 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+
+    glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+    glViewport(target.x, target.y, target.width, target.height);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+    glBlendEquation(GL_FUNC_ADD);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_FALSE);
+    glUseProgram(r.compositeProgram);
+    glUniform2i(glGetUniformLocation(r.compositeProgram, "uOrigin"), target.x, target.y);
+    glBindTextureUnit(1, r.resolved);
+    glBindVertexArray(r.emptyVao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    GLuint c[kCounterWords] = {};
+    glGetNamedBufferSubData(r.counters, 0, sizeof(c), c);
+    r.stats.nodes = std::min<std::uint64_t>(c[0], r.poolNodes);
+    r.stats.fallback = c[1];
+    r.stats.maxSurfaces = c[6];
+    r.stats.sectionOverflow = c[7];
+    r.stats.overflowPixels = c[8];
+    r.stats.mergedNodes = c[9];
+    r.stats.sections = r.sectionsThisFrame;
+    r.stats.bytes = std::size_t(r.depthSize.x) * r.depthSize.y * 4 * std::size_t(r.depthLayers) /* sorted depths */ + r.poolNodes * kTransparentNodeBytes + std::size_t(r.width) * r.height * kTransparentHeadBytesPerPixel +
+                    std::size_t(kCounterBytes) + std::size_t(r.width) * r.height * 8 /* resolved RGBA16F */ +
+                    std::size_t(r.sectionSize.x) * r.sectionSize.y * kTransparentSectionBytesPerPixel * std::size_t(r.sectionLayers);
+    // Leave nothing of ours bound where the host's own buffers may live.
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTransparentNodeBinding, 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTransparentCounterBinding, 0);
+    glBindImageTexture(kTransparentHeadImageUnit, 0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glBindImageTexture(kTransparentCountImageUnit, 0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glBindTextureUnit(1, 0);
+    glBindTextureUnit(2, 0);
+    glBindTextureUnit(3, 0);
+}
+
+} // namespace splatfx::gl::detail

@@ -1,0 +1,107 @@
+// [oit, issue 15] The order-exact transparency pass (private to the GL
+// backend, owned by gl::FrameRenderer): per-pixel linked fragment lists.
+//
+// Method (Ebert & Parent 1990, "Combining A-buffer and Volume Rendering",
+// Fig. 1: "the volume to be rendered must be broken into sections that lie
+// between, in front of, and behind the a-buffer fragments"):
+//  1. the host's transparent fragments are appended to one linked list per
+//     pixel (head image + node pool, transparentGlsl()), counting the
+//     surfaces per pixel and the most on any pixel;
+//  2. every splat fragment walks its pixel's surface list: the surfaces
+//     wholly in front of it give its section index, the ones that cut it
+//     split it into consecutive sections, each weighted by the fraction of
+//     the kernel's line integral it holds (sectionFraction in the shader:
+//     one function); section k is composited "over" into colour target k.
+//     The splats arrive back to front, so each section is the ordered blend
+//     of the gas between two surfaces: one A-buffer fragment per volume
+//     section, as in the paper, and no per-splat node;
+//  3. a resolve pass sorts each pixel's surfaces, interleaves them with its
+//     sections (section 0, surface 0, section 1, ...) and composites the
+//     result "over" the image already in the framebuffer (the host's opaque
+//     image).
+//
+// Memory: a pool of width * height * fragmentsPerPixel surface nodes (16
+// bytes) shared by all pixels, 8 bytes of head and count per pixel, and one
+// RGBA16F target per section in use (2, 4 or 8, from the most surfaces on a
+// pixel: 1 pane takes 2). A surface fragment that finds the pool full is
+// blended by the host directly (the include returns its colour) and counted;
+// a pixel with more surfaces than fragmentsPerPixel keeps the nearest ones
+// and merges the farthest into its last slot (counted); splat fragments
+// behind more than 7 surfaces go into the last section (counted).
+//
+// It does not draw tetrahedra, work at reduced resolution or fog the splat
+// sections (the frame renderer takes the ordered blend then and says why).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "splatfx/camera.hpp"
+#include "splatfx/materials.hpp"
+#include "splatfx/result.hpp"
+#include "splatfx/splats.hpp"
+
+namespace splatfx::gl::detail {
+
+struct FragmentListTarget {
+    unsigned framebuffer = 0;
+    int x = 0, y = 0, width = 0, height = 0;
+    unsigned depthTexture = 0; // the host's depth texture (splat sections are depth-tested against it); 0: none
+};
+
+struct FragmentListStats {
+    std::uint64_t nodes = 0;            // surface nodes stored
+    std::uint64_t fallback = 0;         // surface fragments that found the pool full (blended directly instead)
+    std::uint64_t maxSurfaces = 0;      // most surfaces stored on one pixel
+    int sections = 0;                   // section targets the splats were drawn into (0: no splats in the lists)
+    std::uint64_t sectionOverflow = 0;  // pixels with more surfaces than sections - 1 (the gas behind the extra ones merged into the last section)
+    std::uint64_t overflowPixels = 0;   // pixels with more nodes than fragmentsPerPixel
+    std::uint64_t mergedNodes = 0;      // nodes merged into a pixel's farthest slot
+    bool cut = false;                   // the sections were weighted by the kernel's partial line integral
+    std::uint64_t eyeCrossing = 0;      // splats whose polygon crosses the eye plane: not drawn by this pass
+    std::size_t bytes = 0;              // GPU bytes of the pool, heads, counts, counters and the section targets in use
+    std::size_t poolNodes = 0;          // capacity of the pool
+};
+
+class FragmentListPass {
+public:
+    // fragmentsPerPixel in [1, kMaxFragmentsPerPixel] (checked by the caller).
+    static constexpr int kMaxFragmentsPerPixel = 128;
+    static Result<FragmentListPass> create(int fragmentsPerPixel);
+    FragmentListPass(FragmentListPass&&) noexcept;
+    FragmentListPass& operator=(FragmentListPass&&) noexcept;
+    ~FragmentListPass();
+
+    // The footprint's partial-integral table and the cut programs (when it changed).
+    Status upload(const Materials& materials);
+    // Sizes the lists to the target, empties them and binds them where
+    // transparentGlsl() expects them; then runs drawSurfaces with the
+    // target's framebuffer bound, premultiplied "over" blending, depth test
+    // LEQUAL without writes.
+    Status collectSurfaces(const FragmentListTarget& target, const std::function<void()>& drawSurfaces);
+    // Composites the splats (sorted back to front) into their sections.
+    // layerTexture: the splat pass's GL_TEXTURE_2D_ARRAY; cut, trimCorners:
+    // RendererDesc's. Reads the surface counters back first (one GPU sync)
+    // to choose how many section targets the frame needs.
+    // depthCut (RendererDesc::depthCut): sections weighted by the kernel's
+    // partial line integral and cut at the near plane and the host depth;
+    // false: the kernel as a step at its plane.
+    void insertSplats(const std::vector<Splat>& splats, const Camera& camera, unsigned layerTexture, float cut, bool trimCorners, bool depthCut,
+                      const FragmentListTarget& target);
+    // Sorts every pixel's surfaces, interleaves the sections, composites
+    // over the framebuffer, unbinds the lists, reads the counters back.
+    void resolve(const FragmentListTarget& target);
+
+    const FragmentListStats& stats() const;
+
+private:
+    struct Impl;
+    explicit FragmentListPass(std::unique_ptr<Impl> impl);
+    std::unique_ptr<Impl> mImpl;
+};
+
+} // namespace splatfx::gl::detail

@@ -1,0 +1,550 @@
+// [oit, issue 15] The order-exact transparency path: host surfaces through
+// transparentGlsl() (the docs/integration.md snippet), splats sorted among
+// them per pixel, the fragment budget and its overflow, and the hard cases.
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <epoxy/gl.h>
+#include <glm/gtc/type_ptr.hpp>
+#include <gtest/gtest.h>
+
+#include "gl_fixture.hpp"
+#include "image_compare.hpp"
+#include "scenes.hpp"
+#include "splatfx/transparency.hpp"
+
+using namespace splatfx;
+
+namespace {
+
+constexpr glm::ivec2 kSize{96, 72};
+const glm::vec4 kBackground{0.02f, 0.02f, 0.04f, 1.0f};
+
+// The two ```glsl blocks between the transparent-snippet markers of docs/integration.md.
+std::vector<std::string> snippetShaders() {
+    std::ifstream in(test::sourcePath("docs/integration.md"));
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const std::string doc = ss.str();
+    const std::size_t a = doc.find("<!-- transparent-snippet-begin"), b = doc.find("<!-- transparent-snippet-end");
+    std::vector<std::string> out;
+    if (a == std::string::npos || b == std::string::npos) return out;
+    std::size_t p = a;
+    while ((p = doc.find("```glsl\n", p)) != std::string::npos && p < b) {
+        const std::size_t start = p + 8, end = doc.find("```", start);
+        out.push_back(doc.substr(start, end - start));
+        p = end + 3;
+    }
+    return out;
+}
+
+// A pane: the square |x - centre.x|, |y - centre.y| <= half at world z, one
+// premultiplied colour. The default covers the campfire camera's view from
+// z = 5 to z = -5 while its corners stay near the viewport: far outside, the
+// rasterizer clips the two triangles separately and their shared edge may
+// gain or lose pixels, which is not what these tests measure.
+struct Pane {
+    float z = 0.0f;
+    glm::vec4 premultiplied{0.0f};
+    float half = 12.0f;
+    glm::vec2 centre{0.0f, 4.6f};
+};
+
+// The host's transparent geometry, drawn with the integration snippet.
+class Glass {
+public:
+    Glass() {
+        std::vector<std::string> sh = snippetShaders();
+        if (sh.size() != 2) {
+            mError = "docs/integration.md must hold the vertex and fragment snippet between the transparent-snippet markers";
+            return;
+        }
+        std::string& frag = sh[1];
+        const std::size_t marker = frag.find("// SPLATFX_TRANSPARENT");
+        if (marker == std::string::npos) {
+            mError = "no // SPLATFX_TRANSPARENT marker in the snippet";
+            return;
+        }
+        frag.replace(marker, frag.find('\n', marker) - marker, transparentGlsl());
+        auto prog = gl::linkProgram({sh[0].c_str()}, {frag.c_str()}, "integration snippet (transparent)");
+        if (!prog) {
+            mError = prog.error();
+            return;
+        }
+        mProgram = *prog;
+        glCreateVertexArrays(1, &mVao);
+        glCreateBuffers(1, &mVbo);
+        glNamedBufferStorage(mVbo, 6 * 3 * sizeof(float), nullptr, GL_DYNAMIC_STORAGE_BIT);
+        glVertexArrayVertexBuffer(mVao, 0, mVbo, 0, 3 * sizeof(float));
+        glVertexArrayAttribFormat(mVao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribBinding(mVao, 0, 0);
+        glEnableVertexArrayAttrib(mVao, 0);
+    }
+    ~Glass() {
+        if (mProgram) glDeleteProgram(mProgram);
+        glDeleteVertexArrays(1, &mVao);
+        glDeleteBuffers(1, &mVbo);
+    }
+    const std::string& error() const { return mError; }
+    void draw(const std::vector<Pane>& panes, const Camera& camera) const {
+        const glm::mat4 vp = camera.proj * camera.view;
+        glUseProgram(mProgram);
+        glUniformMatrix4fv(glGetUniformLocation(mProgram, "uViewProj"), 1, GL_FALSE, glm::value_ptr(vp));
+        glBindVertexArray(mVao);
+        for (const Pane& p : panes) {
+            const float h = p.half, cx = p.centre.x, cy = p.centre.y;
+            const float v[18] = {cx - h, cy - h, p.z, cx + h, cy - h, p.z, cx + h, cy + h, p.z,
+                                 cx - h, cy - h, p.z, cx + h, cy + h, p.z, cx - h, cy + h, p.z};
+            glNamedBufferSubData(mVbo, 0, sizeof(v), v);
+            glUniform4fv(glGetUniformLocation(mProgram, "uPremultiplied"), 1, glm::value_ptr(p.premultiplied));
+            glDrawArrays(GL_TRIANGLES, 0, 6);
+        }
+    }
+
+private:
+    std::string mError;
+    GLuint mProgram = 0, mVao = 0, mVbo = 0;
+};
+
+struct Fire {
+    Materials materials{Footprint{}};
+    Frame frame;
+    Fire() {
+        const std::uint32_t set = materials.addTextureSet(TextureSet::turbulence({.count = 8, .size = 32, .seed = 3}));
+        const std::uint32_t table = materials.addColorTable(ColorTable::fire());
+        frame.begin(0.0, test::campfireCamera(kSize));
+        frame.builder().add(test::campfireGrid(3), materials, {.textureSet = set, .colorTable = table});
+        frame.end();
+    }
+    // The fire's z extent in world space (campfireGrid: 5 cells of 0.5, centred at 0).
+    static constexpr float kFront = 1.25f, kBack = -1.25f;
+};
+
+auto clearTo(glm::vec4 colour) {
+    return [colour] {
+        glClearColor(colour.r, colour.g, colour.b, colour.a);
+        glClearDepth(1.0);
+        glDepthMask(GL_TRUE);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    };
+}
+
+glm::vec4 over(glm::vec4 front, glm::vec4 back) { return front + (1.0f - front.a) * back; }
+
+// Readback is 8-bit (gl::Framebuffer's default RGBA8): one half step of
+// rounding per read, and the list stores premultiplied colours as halves
+// (relative error 2^-11, below 1/255 for values <= 1).
+constexpr double kEightBit = 1.0 / 255.0;
+
+// The splats' sections are composited in RGBA16F targets and the resolve
+// writes RGBA16F: every blend rounds each channel (<= 1) by at most half an
+// ulp, 2^-12, and later blends only attenuate earlier errors (factor <= 1),
+// so a pixel with m splat fragments differs from an F32 ordered blend by at
+// most (m + 2) 2^-12 (+2: the resolve's image and the surface's half colour).
+// m is the most fragments on one pixel, from the reference's count.
+double halfTolerance(const Frame& frame, const Materials& materials) {
+    SplatExactStats st;
+    auto ref = renderSplatExact(frame.splats(), frame.camera(), materials, {.threads = 2}, &st);
+    return ref ? double(st.maxOverlap + 2) * std::ldexp(1.0, -12) : 0.0;
+}
+
+class FragmentListsGL : public test::GLTest {};
+
+} // namespace
+
+// The frame flags the path: without transparentToLists (or with no hook) the
+// frame is today's ordered blend, pixel for pixel and with no list stats.
+TEST_F(FragmentListsGL, WithoutTransparentSurfacesTheFrameTakesTheOrderedPath) {
+    Fire f;
+    auto fr = gl::FrameRenderer::create();
+    ASSERT_TRUE(fr && fr->upload(f.materials));
+    auto a = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y});
+    auto b = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y});
+    ASSERT_TRUE(a && b);
+    fr->render(f.frame, {.framebuffer = a->handle(), .drawOpaque = clearTo(kBackground)});
+    fr->render(f.frame, {.framebuffer = b->handle(), .drawOpaque = clearTo(kBackground), .transparentToLists = true});
+    EXPECT_FALSE(fr->stats().transparentLists);
+    const test::ImageDiff d = test::compareImages(b->read(), a->read(), 0.0);
+    EXPECT_EQ(d.maxAbs, 0.0) << test::writeFailureImages(b->read(), d);
+}
+
+// A pane wholly in front of the fire gives what the ordered blend gives (the
+// pane after the splats); wholly behind, what drawing the pane first gives.
+// Both orders are unambiguous, so the lists must reproduce them.
+TEST_F(FragmentListsGL, PanesInFrontOfAndBehindTheFireSortLikeTheUnambiguousOrder) {
+    Fire f;
+    Glass glass;
+    ASSERT_TRUE(glass.error().empty()) << glass.error();
+    auto fr = gl::FrameRenderer::create();
+    ASSERT_TRUE(fr && fr->upload(f.materials));
+    auto lists = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    auto ordered = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(lists && ordered);
+    const double tol = halfTolerance(f.frame, f.materials);
+    ASSERT_GT(tol, 0.0);
+    const Camera& cam = f.frame.camera();
+    const glm::vec4 tint{0.05f, 0.15f, 0.2f, 0.35f};
+    // A blending copy of the pane for the ordered reference: the snippet's
+    // shader with no lists bound would be undefined, so draw it through the
+    // lists path with an empty frame instead (pane over whatever is there).
+    Frame empty;
+    empty.begin(0.0, cam);
+    empty.end();
+    for (const float z : {Fire::kFront + 2.0f, Fire::kBack - 2.0f}) {
+        const bool inFront = z > 0.0f;
+        const std::vector<Pane> pane{{.z = z, .premultiplied = tint}};
+        fr->render(f.frame, {.framebuffer = lists->handle(), .drawOpaque = clearTo(kBackground),
+                             .drawTransparent = [&] { glass.draw(pane, cam); }, .transparentToLists = true});
+        EXPECT_TRUE(fr->stats().transparentLists && fr->stats().splatsInLists);
+        EXPECT_EQ(fr->stats().transparentFallback, 0u);
+        EXPECT_EQ(fr->stats().transparentOverflowPixels, 0u);
+        EXPECT_GE(fr->stats().transparentNodes, std::uint64_t(kSize.x) * kSize.y); // the pane covers every pixel
+        const Image got = lists->read();
+        EXPECT_EQ(fr->stats().transparentSections, 2);
+        if (inFront) {
+            fr->render(f.frame, {.framebuffer = ordered->handle(), .drawOpaque = clearTo(kBackground)});
+            fr->render(empty, {.framebuffer = ordered->handle(), .drawTransparent = [&] { glass.draw(pane, cam); },
+                               .transparentToLists = true});
+        } else {
+            fr->render(empty, {.framebuffer = ordered->handle(), .drawOpaque = clearTo(kBackground),
+                               .drawTransparent = [&] { glass.draw(pane, cam); }, .transparentToLists = true});
+            fr->render(f.frame, {.framebuffer = ordered->handle()});
+        }
+        // F32 targets: the two differ only by the sections' half rounding.
+        const test::ImageDiff d = test::compareImages(got, ordered->read(), tol);
+        EXPECT_LE(d.maxAbs, tol) << (inFront ? "in front: " : "behind: ") << test::writeFailureImages(got, d);
+    }
+}
+
+// Three panes at once, drawn out of depth order: one in front of the fire,
+// two behind it: each splat finds its section from the surfaces of its pixel
+// (two sections in use need the 4-target variant). Against the ordered blend
+// in the unambiguous order (both far panes, the fire, the front pane).
+TEST_F(FragmentListsGL, ThreePanesAroundTheFireSortPerSplat) {
+    Fire f;
+    Glass glass;
+    ASSERT_TRUE(glass.error().empty()) << glass.error();
+    auto fr = gl::FrameRenderer::create();
+    ASSERT_TRUE(fr && fr->upload(f.materials));
+    auto lists = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    auto ordered = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(lists && ordered);
+    const double tol = halfTolerance(f.frame, f.materials) + 3 * std::ldexp(1.0, -12); // + three half pane colours
+    const Camera& cam = f.frame.camera();
+    const std::vector<Pane> panes{{.z = Fire::kBack - 3.0f, .premultiplied = glm::vec4(0.2f, 0.05f, 0.0f, 0.3f)},
+                                  {.z = Fire::kFront + 2.0f, .premultiplied = glm::vec4(0.0f, 0.1f, 0.2f, 0.35f)},
+                                  {.z = Fire::kBack - 1.0f, .premultiplied = glm::vec4(0.05f, 0.2f, 0.05f, 0.25f)}};
+    fr->render(f.frame, {.framebuffer = lists->handle(), .drawOpaque = clearTo(kBackground),
+                         .drawTransparent = [&] { glass.draw(panes, cam); }, .transparentToLists = true});
+    EXPECT_TRUE(fr->stats().splatsInLists);
+    EXPECT_EQ(fr->stats().transparentSections, 4);
+    const Image got = lists->read();
+    Frame empty;
+    empty.begin(0.0, cam);
+    empty.end();
+    fr->render(empty, {.framebuffer = ordered->handle(), .drawOpaque = clearTo(kBackground),
+                       .drawTransparent = [&] { glass.draw({panes[0], panes[2]}, cam); }, .transparentToLists = true});
+    fr->render(f.frame, {.framebuffer = ordered->handle()});
+    fr->render(empty, {.framebuffer = ordered->handle(), .drawTransparent = [&] { glass.draw({panes[1]}, cam); }, .transparentToLists = true});
+    const test::ImageDiff d = test::compareImages(got, ordered->read(), tol);
+    EXPECT_LE(d.maxAbs, tol) << test::writeFailureImages(got, d);
+}
+
+// 64 layers on every pixel, drawn in a scrambled order: the resolve sorts them
+// (closed form: front-to-back "over" of the 64 colours by depth). With a
+// budget of 8 the pool (8 per pixel) fills: the other 56 layers of each pixel
+// are blended directly and counted, never dropped; alpha is still exact (the
+// product of (1 - a_i) does not depend on the order) and colour within [0, 1].
+TEST_F(FragmentListsGL, SixtyFourLayersOnOnePixel) {
+    Glass glass;
+    ASSERT_TRUE(glass.error().empty()) << glass.error();
+    const Camera cam = test::campfireCamera(kSize);
+    std::vector<Pane> panes;
+    for (int i = 0; i < 64; ++i) {
+        const int k = (i * 37) % 64; // a permutation of 0..63: drawn out of depth order
+        const float a = 0.05f + 0.01f * float(k % 7);
+        const glm::vec3 c{0.5f + 0.5f * std::sin(float(k)), 0.5f + 0.5f * std::cos(float(k) * 1.3f), float(k) / 63.0f};
+        panes.push_back({.z = 5.0f - 0.15f * float(k), .premultiplied = glm::vec4(c * a, a)});
+    }
+    std::vector<Pane> sorted = panes; // front (largest z: nearest the eye at z = 15) first
+    std::sort(sorted.begin(), sorted.end(), [](const Pane& a, const Pane& b) { return a.z > b.z; });
+    glm::vec4 expect = kBackground;
+    for (auto it = sorted.rbegin(); it != sorted.rend(); ++it) expect = over(it->premultiplied, expect);
+    Frame empty;
+    empty.begin(0.0, cam);
+    empty.end();
+    Materials materials{Footprint{}};
+    materials.addTextureSet(TextureSet::turbulence({.count = 1, .size = 16, .seed = 1}));
+    const std::uint64_t pixels = std::uint64_t(kSize.x) * kSize.y;
+    for (const int budget : {72, 8}) {
+        auto fr = gl::FrameRenderer::create({.fragmentsPerPixel = budget});
+        ASSERT_TRUE(fr && fr->upload(materials));
+        auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y});
+        ASSERT_TRUE(fb);
+        fr->render(empty, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
+                           .drawTransparent = [&] { glass.draw(panes, cam); }, .transparentToLists = true});
+        const Image img = fb->read();
+        const gl::FrameRenderStats& s = fr->stats();
+        double maxErr = 0.0, maxAlphaErr = 0.0;
+        bool sane = true;
+        for (int y = 0; y < kSize.y; ++y)
+            for (int x = 0; x < kSize.x; ++x) {
+                for (int ch = 0; ch < 4; ++ch) {
+                    const double v = img.at(x, y, ch);
+                    sane = sane && std::isfinite(v) && v >= 0.0 && v <= 1.0;
+                    maxErr = std::max(maxErr, std::abs(v - double(expect[ch])));
+                }
+                maxAlphaErr = std::max(maxAlphaErr, std::abs(double(img.at(x, y, 3)) - double(expect.a)));
+            }
+        EXPECT_TRUE(sane);
+        // Half-float colours: each of 64 layers rounds its premultiplied
+        // colour (<= 0.11) by at most 2^-11 relative: 64 * 0.11 * 2^-11 < 0.0035;
+        // plus one 8-bit step of the readback.
+        const double tol = kEightBit + 64 * 0.11 * std::ldexp(1.0, -11);
+        EXPECT_LE(maxAlphaErr, tol) << budget;
+        EXPECT_EQ(s.transparentNodes + s.transparentFallback, 64 * pixels) << budget; // every fragment stored or blended
+        if (budget >= 64) {
+            EXPECT_LE(maxErr, tol) << test::writeFailureImages(img, test::compareImages(img, img, 0.0));
+            EXPECT_EQ(s.transparentFallback, 0u);
+            EXPECT_EQ(s.transparentOverflowPixels, 0u);
+            EXPECT_EQ(s.transparentMaxSurfaces, 64u);
+        } else {
+            // The pool is shared: it fills after 8 per pixel on average, some
+            // pixels holding more than 8 (those merge their farthest).
+            EXPECT_EQ(s.transparentNodes, pixels * std::uint64_t(budget));
+            EXPECT_EQ(s.transparentFallback, pixels * std::uint64_t(64 - budget));
+        }
+    }
+}
+
+// More nodes on a pixel than its budget while the pool has room: 16 small
+// panes over the image centre with a budget of 4 per pixel. The centre pixel
+// keeps 3 nodes exactly and merges the rest into its farthest slot: counted,
+// alpha exact, colour within [0, 1].
+TEST_F(FragmentListsGL, MorePixelNodesThanTheBudgetMergeTheFarthest) {
+    Glass glass;
+    ASSERT_TRUE(glass.error().empty()) << glass.error();
+    Camera cam = test::campfireCamera(kSize);
+    cam = Camera::lookAt({0.0f, 0.0f, 15.0f}, {0.0f, 0.0f, 0.0f}, {0, 1, 0}, 0.7853982f, kSize);
+    std::vector<Pane> panes;
+    double transmit = 1.0;
+    for (int i = 0; i < 16; ++i) {
+        const int k = (i * 5) % 16;
+        const float a = 0.1f + 0.02f * float(k % 5);
+        panes.push_back({.z = 2.0f - 0.2f * float(k), .premultiplied = glm::vec4(0.3f * a, 0.6f * a, float(k) / 15.0f * a, a), .half = 1.0f,
+                         .centre = {0.0f, 0.0f}});
+        transmit *= 1.0 - double(a);
+    }
+    Frame empty;
+    empty.begin(0.0, cam);
+    empty.end();
+    Materials materials{Footprint{}};
+    materials.addTextureSet(TextureSet::turbulence({.count = 1, .size = 16, .seed = 1}));
+    auto fr = gl::FrameRenderer::create({.fragmentsPerPixel = 4});
+    ASSERT_TRUE(fr && fr->upload(materials));
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y});
+    ASSERT_TRUE(fb);
+    fr->render(empty, {.framebuffer = fb->handle(), .drawOpaque = clearTo(glm::vec4(0.0f)),
+                       .drawTransparent = [&] { glass.draw(panes, cam); }, .transparentToLists = true});
+    const gl::FrameRenderStats& s = fr->stats();
+    EXPECT_EQ(s.transparentFallback, 0u);
+    EXPECT_GT(s.transparentOverflowPixels, 0u);
+    EXPECT_GE(s.transparentMergedNodes, 12u * s.transparentOverflowPixels / 2); // most overflowing pixels hold all 16
+    const Image img = fb->read();
+    const int cx = kSize.x / 2, cy = kSize.y / 2;
+    EXPECT_NEAR(img.at(cx, cy, 3), 1.0 - transmit, kEightBit + 16 * std::ldexp(1.0, -11));
+    for (int ch = 0; ch < 3; ++ch) EXPECT_TRUE(img.at(cx, cy, ch) >= 0.0f && img.at(cx, cy, ch) <= 1.0f);
+}
+
+// A zero surface stores nothing and changes nothing; a fully opaque surface
+// in front of the fire hides it (the pane's colour exactly); behind the fire
+// the fire composites over it.
+TEST_F(FragmentListsGL, ZeroAlphaAndFullyOpaqueSurfaces) {
+    Fire f;
+    Glass glass;
+    ASSERT_TRUE(glass.error().empty()) << glass.error();
+    auto fr = gl::FrameRenderer::create();
+    ASSERT_TRUE(fr && fr->upload(f.materials));
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    auto plain = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(fb && plain);
+    const double tol = halfTolerance(f.frame, f.materials);
+    ASSERT_GT(tol, 0.0);
+    const Camera& cam = f.frame.camera();
+    fr->render(f.frame, {.framebuffer = plain->handle(), .drawOpaque = clearTo(kBackground)});
+    const Image fire = plain->read();
+
+    std::vector<Pane> zero{{.z = 0.0f, .premultiplied = glm::vec4(0.0f)}};
+    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
+                         .drawTransparent = [&] { glass.draw(zero, cam); }, .transparentToLists = true});
+    EXPECT_EQ(fr->stats().transparentNodes, 0u); // nothing stored
+    test::ImageDiff d = test::compareImages(fb->read(), fire, tol);
+    EXPECT_LE(d.maxAbs, tol) << "zero pane changed the image: " << test::writeFailureImages(fb->read(), d);
+
+    const glm::vec4 wall{0.7f, 0.2f, 0.1f, 1.0f};
+    std::vector<Pane> front{{.z = Fire::kFront + 1.0f, .premultiplied = wall}};
+    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
+                         .drawTransparent = [&] { glass.draw(front, cam); }, .transparentToLists = true});
+    const Image hidden = fb->read();
+    double worst = 0.0;
+    for (int y = 0; y < kSize.y; ++y)
+        for (int x = 0; x < kSize.x; ++x)
+            for (int ch = 0; ch < 4; ++ch) worst = std::max(worst, std::abs(double(hidden.at(x, y, ch)) - double(wall[ch])));
+    EXPECT_LE(worst, std::ldexp(1.0, -10)) << "an opaque pane in front must hide the fire"; // the pane's half colour
+
+    std::vector<Pane> back{{.z = Fire::kBack - 1.0f, .premultiplied = wall}};
+    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
+                         .drawTransparent = [&] { glass.draw(back, cam); }, .transparentToLists = true});
+    const Image behind = fb->read();
+    // The fire over the wall: the ordered blend of the fire over an opaque clear of the wall's colour.
+    fr->render(f.frame, {.framebuffer = plain->handle(), .drawOpaque = clearTo(wall)});
+    d = test::compareImages(behind, plain->read(), tol);
+    EXPECT_LE(d.maxAbs, tol) << "fire over an opaque pane behind it: " << test::writeFailureImages(behind, d);
+}
+
+// A budget of one node per pixel with two panes over the whole image, one in
+// front of the fire and one behind it: the first pane drawn takes the pool,
+// the second finds it full and is blended by the include at once (counted,
+// never dropped); the splats need no nodes. The image stays sane: finite, in
+// [0, 1], and its alpha is the exact alpha of fire and both panes (the
+// product of transmittances does not depend on the order).
+TEST_F(FragmentListsGL, BudgetOfOneFragmentPerPixel) {
+    Fire f;
+    Glass glass;
+    ASSERT_TRUE(glass.error().empty()) << glass.error();
+    auto fr = gl::FrameRenderer::create({.fragmentsPerPixel = 1});
+    ASSERT_TRUE(fr && fr->upload(f.materials));
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    auto ordered = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(fb && ordered);
+    const double tol = halfTolerance(f.frame, f.materials);
+    const Camera& cam = f.frame.camera();
+    const std::vector<Pane> panes{{.z = Fire::kFront + 1.0f, .premultiplied = glm::vec4(0.05f, 0.1f, 0.15f, 0.3f)},
+                                  {.z = Fire::kBack - 1.0f, .premultiplied = glm::vec4(0.2f, 0.1f, 0.0f, 0.4f)}};
+    const glm::vec4 clear{0.0f};
+    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(clear),
+                         .drawTransparent = [&] { glass.draw(panes, cam); }, .transparentToLists = true});
+    const gl::FrameRenderStats s = fr->stats();
+    const std::uint64_t pixels = std::uint64_t(kSize.x) * kSize.y;
+    EXPECT_EQ(s.transparentNodes, pixels);
+    EXPECT_EQ(s.transparentFallback, pixels);
+    EXPECT_GE(s.transparentSections, 2);
+    // Pool, heads and counts, the resolved RGBA16F image, the section targets,
+    // the sorted depths (R32F, one layer fewer than sections), the counters.
+    EXPECT_EQ(s.transparentBytes, std::size_t(pixels) * (kTransparentNodeBytes + kTransparentHeadBytesPerPixel + 8 +
+                                                         std::size_t(s.transparentSections) * kTransparentSectionBytesPerPixel +
+                                                         4 * std::size_t(s.transparentSections - 1)) + 48);
+    const Image got = fb->read();
+    // The alpha of the three in any order: the ordered blend (pane, fire, pane).
+    Frame empty;
+    empty.begin(0.0, cam);
+    empty.end();
+    auto one = gl::FrameRenderer::create({.fragmentsPerPixel = 1});
+    ASSERT_TRUE(one && one->upload(f.materials));
+    one->render(empty, {.framebuffer = ordered->handle(), .drawOpaque = clearTo(clear),
+                        .drawTransparent = [&] { glass.draw({panes[1]}, cam); }, .transparentToLists = true});
+    one->render(f.frame, {.framebuffer = ordered->handle()});
+    one->render(empty, {.framebuffer = ordered->handle(), .drawTransparent = [&] { glass.draw({panes[0]}, cam); }, .transparentToLists = true});
+    const Image want = ordered->read();
+    bool sane = true;
+    double alphaErr = 0.0;
+    for (int y = 0; y < kSize.y; ++y)
+        for (int x = 0; x < kSize.x; ++x) {
+            for (int ch = 0; ch < 4; ++ch) sane = sane && std::isfinite(got.at(x, y, ch)) && got.at(x, y, ch) >= 0.0f && got.at(x, y, ch) <= 1.0f;
+            alphaErr = std::max(alphaErr, std::abs(double(got.at(x, y, 3)) - double(want.at(x, y, 3))));
+        }
+    EXPECT_TRUE(sane);
+    EXPECT_LE(alphaErr, tol);
+}
+
+// One splat with a pane through its kernel, just in front of its plane and
+// just behind it: the splat is cut into the part in front of the pane and
+// the part behind (Ebert & Parent's sections), each with its share of the
+// kernel's line integral. Against the reference with the same pane: the GL
+// image may differ from it by what it differs without the pane, plus what
+// the partial table's interpolation moves the two shares.
+TEST_F(FragmentListsGL, SplatStraddlingAPaneIsCutIntoSections) {
+    Materials materials{Footprint{}};
+    materials.addTextureSet(TextureSet::turbulence({.count = 1, .size = 32, .seed = 5}));
+    materials.addColorTable(ColorTable::constant({0.9f, 0.6f, 0.3f, 1.0f}));
+    const Camera cam = Camera::lookAt({0.0f, 0.0f, 6.0f}, {0.0f, 0.0f, 0.0f}, {0, 1, 0}, 0.7853982f, kSize);
+    Grid g = *Grid::box({1, 1, 1}, glm::vec3(2.0f));
+    g.voxels[0].opacity = 0.9f;
+    Frame frame;
+    frame.begin(0.0, cam);
+    frame.builder().add(g, materials, {.textured = false});
+    frame.end();
+    ASSERT_EQ(frame.splats().size(), 1u);
+    const glm::vec3 centre = frame.splats()[0].center;
+    Glass glass;
+    ASSERT_TRUE(glass.error().empty()) << glass.error();
+    auto fr = gl::FrameRenderer::create();
+    ASSERT_TRUE(fr && fr->upload(materials));
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(fb);
+    // The partial table's largest error against the exact fraction.
+    const Footprint& fp = materials.footprint();
+    double delta = 0.0;
+    for (int i = 0; i <= 200; ++i)
+        for (int j = 0; j <= 200; ++j) {
+            const double r = fp.radius() * i / 200.0, sg = -1.0 + 2.0 * j / 200.0;
+            const double sMax = std::sqrt(std::max(fp.radius() * fp.radius() - r * r, 0.0));
+            delta = std::max(delta, std::abs(double(fp.fractionBefore(float(r), float(sg * sMax))) - fp.exactFractionBefore(r, sg * sMax)));
+        }
+    // A share off by delta moves a section's alpha 1 - 2^(-tau f) by at most
+    // ln2 tau delta (and its colour, <= 1 times that); two sections.
+    const double tau = frame.splats()[0].density;
+    auto errorAgainstReference = [&](const std::vector<Pane>& panes) {
+        fr->render(frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(glm::vec4(0.0f)),
+                           .drawTransparent = [&] { glass.draw(panes, cam); }, .transparentToLists = true});
+        std::vector<ReferenceSurface> surfaces;
+        for (const Pane& p : panes)
+            surfaces.push_back(ReferenceSurface::quad({p.centre.x - p.half, p.centre.y - p.half, p.z}, {p.centre.x + p.half, p.centre.y - p.half, p.z},
+                                                      {p.centre.x + p.half, p.centre.y + p.half, p.z}, {p.centre.x - p.half, p.centre.y + p.half, p.z},
+                                                      glm::dvec4(p.premultiplied)));
+        auto ref = renderSplatExact(frame.splats(), cam, materials, {.threads = 2, .surfaces = surfaces});
+        const Image got = fb->read();
+        double worst = 0.0;
+        for (std::size_t i = 0; i < got.pixels.size(); ++i) worst = std::max(worst, std::abs(double(got.pixels[i]) - double(ref->pixels[i])));
+        return worst;
+    };
+    const glm::vec4 tint{0.1f, 0.2f, 0.3f, 0.4f};
+    const double base = errorAgainstReference({{.z = 40.0f, .premultiplied = glm::vec4(0.0f)}}); // no visible pane
+    EXPECT_TRUE(fr->stats().transparentCut);
+    for (const float dz : {0.3f, -0.3f}) {
+        const double err = errorAgainstReference({{.z = centre.z + dz, .premultiplied = tint}});
+        EXPECT_EQ(fr->stats().transparentSections, 2);
+        EXPECT_LE(err, base + 2.0 * std::log(2.0) * tau * delta + 4.0 * std::ldexp(1.0, -12)) << "pane at z = centre + " << dz;
+    }
+}
+
+// With a fog the splats are not drawn into sections (fogged sections are not
+// implemented): the frame says so and draws them first with the ordered blend,
+// the surfaces still sorted in the lists over them, never dropped.
+TEST_F(FragmentListsGL, WithAFogTheSplatsTakeTheOrderedBlendAndTheFrameSaysWhy) {
+    Fire f;
+    Glass glass;
+    ASSERT_TRUE(glass.error().empty()) << glass.error();
+    FogDesc fd;
+    fd.terms.push_back(FogTerm::constant(0.02));
+    auto fog = Fog::create(fd);
+    ASSERT_TRUE(fog) << fog.error();
+    f.frame.setFog(std::make_shared<const Fog>(*fog));
+    auto fr = gl::FrameRenderer::create();
+    ASSERT_TRUE(fr && fr->upload(f.materials));
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y});
+    ASSERT_TRUE(fb);
+    const std::vector<Pane> pane{{.z = Fire::kFront + 1.0f, .premultiplied = glm::vec4(0.05f, 0.1f, 0.15f, 0.3f)}};
+    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
+                         .drawTransparent = [&] { glass.draw(pane, f.frame.camera()); }, .transparentToLists = true});
+    const gl::FrameRenderStats& s = fr->stats();
+    EXPECT_TRUE(s.transparentLists);
+    EXPECT_FALSE(s.splatsInLists);
+    EXPECT_NE(s.transparentNote.find("fog"), std::string::npos) << s.transparentNote;
+    EXPECT_EQ(s.transparentNodes, std::uint64_t(kSize.x) * kSize.y);
+    EXPECT_GT(s.splats, 0u);
+}
