@@ -1,4 +1,4 @@
-// [oit, issue 15] The reference's transparent surfaces: panes and boxes
+// (issue 15) The reference's transparent surfaces: panes and boxes
 // composited per pixel in exact depth order with the splats, each splat cut
 // into sections at the surfaces with its exact share of the kernel integral.
 #include <cmath>

@@ -1,4 +1,4 @@
-// [oit, issue 15] The order-exact transparency path: host surfaces through
+// (issue 15) The order-exact transparency path: host surfaces through
 // transparentGlsl() (the docs/integration.md snippet), splats sorted among
 // them per pixel, the fragment budget and its overflow, and the hard cases.
 #include <algorithm>

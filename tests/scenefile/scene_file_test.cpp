@@ -297,7 +297,7 @@ TEST(SceneFile, RaisedBudgetsLetTheSameFileLoad) {
     EXPECT_NE(fire.error().find("needs 700 cells, over the budget of 500 (raise Budgets::effectCells)"), std::string::npos) << fire.error();
 }
 
-// [oit, issue 15] Geometry opacity: transparent surfaces (default opaque), range-checked.
+// (issue 15) Geometry opacity: transparent surfaces (default opaque), range-checked.
 TEST(SceneFile, GeometryOpacityMarksTransparentSurfaces) {
     auto r = parse(R"("geometry": [{"type": "box"}, {"name": "glass", "type": "box", "opacity": 0.25}])");
     ASSERT_TRUE(r.ok()) << r.error();

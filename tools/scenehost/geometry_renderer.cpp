@@ -51,7 +51,7 @@ void main() {
 }
 )";
 
-// [oit, issue 15] Transparent objects (GeometryDesc::opacity < 1): the same
+// (issue 15) Transparent objects (GeometryDesc::opacity < 1): the same
 // shading, premultiplied, emitted into the frame's fragment lists through the
 // SDK's include (transparentGlsl(); docs/integration.md, "Transparent surfaces").
 const char* kTransparentBody = R"(
@@ -82,7 +82,7 @@ struct GeometryRenderer::Impl {
         splatfx::Aabb localBounds;
     };
     GLuint program = 0;
-    GLuint transparentProgram = 0; // [oit]
+    GLuint transparentProgram = 0;
     std::vector<Object> objects;
     GeometryStats stats;
     ~Impl() {
@@ -105,7 +105,7 @@ splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<spl
         splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n", shadow.c_str(), kFragmentBody}, "GeometryRenderer");
     if (!program) return splatfx::makeError(program.error());
     impl->program = *program;
-    { // [oit]
+    {
         const std::string include = splatfx::transparentGlsl();
         auto tp = splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n", include.c_str(), kTransparentBody}, "GeometryRenderer (transparent)");
         if (!tp) return splatfx::makeError(tp.error());
@@ -199,7 +199,7 @@ void GeometryRenderer::draw(double t, const splatfx::Camera& camera, const Geome
     splatfx::gl::setShadowUniforms(r.program, lighting.shadow);
     const GLint model = glGetUniformLocation(r.program, "uModel"), color = glGetUniformLocation(r.program, "uColor");
     for (const Impl::Object& o : r.objects) {
-        if (!o.vao || o.desc.opacity < 1.0f) continue; // [oit] transparent ones: drawTransparent
+        if (!o.vao || o.desc.opacity < 1.0f) continue; // transparent ones: drawTransparent
         // Object to world: its motion (own or shared) after its static placement.
         const glm::mat4 m = o.desc.motion.matrix(t) * o.desc.transform;
         glUniformMatrix4fv(model, 1, GL_FALSE, glm::value_ptr(m));
@@ -213,7 +213,7 @@ void GeometryRenderer::draw(double t, const splatfx::Camera& camera, const Geome
     glUseProgram(0);
 }
 
-// [oit, issue 15]
+// (issue 15)
 bool GeometryRenderer::hasTransparent() const {
     for (const Impl::Object& o : mImpl->objects)
         if (o.vao && o.desc.opacity < 1.0f) return true;

@@ -55,7 +55,7 @@ public:
     // Call it inside FrameRenderer's opaque hook when `lighting.shadow` is set
     // (the table is bound to its unit only there).
     void draw(double timeSec, const splatfx::Camera& camera, const GeometryLighting& lighting = {});
-    // [oit, issue 15] Objects with GeometryDesc::opacity < 1 are not drawn by
+    // (issue 15) Objects with GeometryDesc::opacity < 1 are not drawn by
     // draw() but by drawTransparent(), inside FrameRenderer's transparent hook
     // with HostTarget::transparentToLists (they emit into the fragment lists).
     bool hasTransparent() const;

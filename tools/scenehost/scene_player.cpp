@@ -130,7 +130,7 @@ void ScenePlayer::renderFrame(double t, const splatfx::Camera& camera, unsigned 
     };
     const auto t0 = Clock::now();
     splatfx::gl::HostTarget target{.framebuffer = framebuffer, .drawOpaque = drawOpaque};
-    // [oit, issue 15] Glass: sorted per pixel with the gas through the fragment lists.
+    // (issue 15) Glass: sorted per pixel with the gas through the fragment lists.
     if (options.drawGeometry && p.geometry->hasTransparent()) {
         target.drawTransparent = [&] { p.geometry->drawTransparent(t, camera, geometryLighting(f.scene, *p.renderer)); };
         target.transparentToLists = true;

@@ -82,7 +82,7 @@ struct ReferenceHost {
                                         // (as gl::Framebuffer::readDepth returns); fragments behind it are dropped
 };
 
-// ---- [oit, issue 15] A transparent surface the reference composites exactly
+// ---- (issue 15) A transparent surface the reference composites exactly
 // among the splats (what a host sends through transparentGlsl()): triangles,
 // each crossing of a pixel ray one layer of the premultiplied colour (both
 // faces of a box count, like glass drawn without culling). Hidden behind the
@@ -95,7 +95,7 @@ struct ReferenceSurface {
     // An axis-aligned box's six faces (12 triangles).
     static ReferenceSurface box(glm::dvec3 lo, glm::dvec3 hi, glm::dvec4 premultiplied);
 };
-// ---- end [oit] ----
+// ---- end (issue 15) ----
 
 struct SplatExactDesc {
     ReferenceHost host{};                           // default: transparent black, no depth
@@ -127,7 +127,7 @@ struct SplatExactDesc {
     // tail in front. false: the plain test at the splat plane (fragments
     // outside [near, min(far, host depth)] are dropped whole). Default true.
     bool depthCut = true;
-    // ---- [oit, issue 15] transparent surfaces, composited per pixel in exact
+    // ---- (issue 15) transparent surfaces, composited per pixel in exact
     // depth order with the splats; each splat fragment is cut at the surface
     // crossings of its pixel ray into sections (Ebert & Parent 1990, Fig. 1),
     // each with its exact share of the kernel's line integral (depthCut; false:

@@ -72,7 +72,7 @@ struct GeometryDesc {
     Motion motion;                  // default at rest
     std::string attachedTo;         // name of the object whose motion it shares; default empty
     glm::vec3 color{0.6f};          // linear RGB albedo; default grey
-    // ---- [oit, issue 15] below 1: a transparent surface (glass), premultiplied
+    // ---- (issue 15) below 1: a transparent surface (glass), premultiplied
     // (lit colour x opacity, opacity) per layer, which a host draws through
     // transparentGlsl() into the fragment lists (tools/scenehost does). [0, 1]; default 1 (opaque).
     float opacity = 1.0f;

@@ -78,10 +78,10 @@ struct Fragment {
     double t;
     double alpha;
     glm::dvec3 color; // premultiplied
-    int side = 1;     // [oit] at equal t: 0 in front of a surface, 1 at it, 2 behind it
+    int side = 1;     // at equal t: 0 in front of a surface, 1 at it, 2 behind it
 };
 
-// [oit] Ray parameters where the ray crosses a triangle (Moller-Trumbore), in (0, tMax].
+// Ray parameters where the ray crosses a triangle (Moller-Trumbore), in (0, tMax].
 void crossings(const ReferenceSurface& s, const glm::dvec3& o, const glm::dvec3& d, double tMax, std::vector<double>& out) {
     for (std::size_t i = 0; i + 2 < s.triangles.size(); i += 3) {
         const glm::dvec3 a = s.triangles[i], e1 = s.triangles[i + 1] - a, e2 = s.triangles[i + 2] - a;
@@ -102,7 +102,7 @@ void crossings(const ReferenceSurface& s, const glm::dvec3& o, const glm::dvec3&
 
 } // namespace
 
-// [oit, issue 15]
+// (issue 15)
 ReferenceSurface ReferenceSurface::quad(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d, glm::dvec4 premultiplied) {
     return {{a, b, c, a, c, d}, premultiplied};
 }
@@ -196,15 +196,15 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
 
     reference::parallelRows(H, desc.threads, [&](int y) {
         std::vector<Fragment> frags;
-        std::vector<double> cuts;          // [oit]
-        std::vector<glm::dvec4> cutColour; // [oit]
+        std::vector<double> cuts;         
+        std::vector<glm::dvec4> cutColour;
         std::uint64_t fragCount = 0, maxOverlap = 0;
         double fogTauMax = 0.0, fogErrMax = 0.0;
         std::uint64_t fogBad = 0;
         for (int x = 0; x < W; ++x) {
             const reference::PixelRay ray = mapper.ray(x, y, reference::hostDepth(desc.host, x, y));
             frags.clear();
-            // [oit] This ray's surface crossings, near to far, and their colours.
+            // This ray's surface crossings, near to far, and their colours.
             cuts.clear();
             cutColour.clear();
             if (!desc.surfaces.empty()) {
@@ -256,7 +256,7 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                                                                             : glm::dvec3(1.0);
                 const glm::dvec3 col = base * glm::dvec3(tex);
                 if (!cuts.empty()) {
-                    // [oit, issue 15] Sections at the surface crossings: each
+                    // (issue 15) Sections at the surface crossings: each
                     // keeps its share of the kernel's line integral (depthCut)
                     // or, without the cut, the whole fragment sits at its plane.
                     double l = 1.0, rr = 0.0;
@@ -307,7 +307,7 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                 if (!(alpha > 0.0)) continue;
                 frags.push_back({t, alpha, col * alpha});
             }
-            // [oit] The surfaces' layers at their crossings.
+            // The surfaces' layers at their crossings.
             for (std::size_t k = 0; k < cuts.size(); ++k) frags.push_back({cuts[k], std::clamp(cutColour[k].a, 0.0, 1.0), glm::dvec3(cutColour[k]), 1});
             // Per-pixel exact order: farthest first (at equal depth, the far side of a surface first).
             std::stable_sort(frags.begin(), frags.end(), [](const Fragment& a, const Fragment& b) { return a.t != b.t ? a.t > b.t : a.side > b.side; });

@@ -62,7 +62,7 @@ std::vector<RawGeometry> readGeometryList(Context& c, const std::string& path, c
         o.vec3("size", g.desc.size, 1e-4, kMaxCoord, true);
         g.desc.transform = readPlacement(o, true);
         o.color3("color", g.desc.color);
-        o.number("opacity", g.desc.opacity, 0.0, 1.0); // [oit, issue 15] transparent surfaces
+        o.number("opacity", g.desc.opacity, 0.0, 1.0); // (issue 15) transparent surfaces
         if (const Json* m = o.get("motion")) {
             g.hasOwnMotion = true;
             if (auto mo = readMotion(c, o.at("motion"), *m)) g.desc.motion = std::move(*mo);

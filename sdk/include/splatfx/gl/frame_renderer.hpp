@@ -84,7 +84,7 @@ struct FrameRendererDesc {
     float fogDepthThreshold = 0.05f;      // fog texture: relative distance still one surface; default 0.05
     bool fogHost = true;                  // fog the host's opaque image (false: only the splats); default true
     // --- end fog ---
-    // ---- [oit, issue 15] order-exact transparency (HostTarget::transparentToLists) ----
+    // ---- (issue 15) order-exact transparency (HostTarget::transparentToLists) ----
     // The fragment budget for the host's transparent surfaces: the node pool
     // holds viewport pixels x this many nodes (16 bytes each, plus 8 bytes of
     // head and count per pixel: at 8 and 640x480, 41.8 MB), and a pixel
@@ -93,7 +93,7 @@ struct FrameRendererDesc {
     // composited per section into 2, 4 or 8 RGBA16F targets (8 bytes a pixel
     // each). [1, 128]. Default 8.
     int fragmentsPerPixel = 8;
-    // ---- end [oit] ----
+    // ---- end (issue 15) ----
 };
 
 // ---- lighting (issue 16): what a host surface shader with shadowGlsl()
@@ -128,7 +128,7 @@ struct HostTarget {
     // The host's transparent surfaces, blended after the volumes (ordered
     // blend; exact interleaving with the volumes is issue 15's pass). Default empty.
     std::function<void()> drawTransparent{};
-    // ---- [oit, issue 15] ----
+    // ---- (issue 15) ----
     // drawTransparent emits its fragments into per-pixel lists through
     // transparentGlsl()'s splatfx_emitTransparent (transparency.hpp) instead
     // of blending them: the splats are then cut into sections at those
@@ -138,7 +138,7 @@ struct HostTarget {
     // test on without writes. false (or no hook): today's ordered blend at
     // today's cost. Default false.
     bool transparentToLists = false;
-    // ---- end [oit] ----
+    // ---- end (issue 15) ----
 };
 
 struct FrameRenderStats {
@@ -157,7 +157,7 @@ struct FrameRenderStats {
     std::uint64_t tetrahedraTransparent = 0; // skipped by the table's zero-opacity test
     std::uint64_t batches = 0;               // runs of the interleaved splat/tetrahedron sequence
     std::size_t tableBytes = 0;              // GPU bytes of the uploaded pre-integration tables
-    // ---- [oit, issue 15] order-exact transparency (last frame) ----
+    // ---- (issue 15) order-exact transparency (last frame) ----
     bool transparentLists = false;        // the host's surfaces went through the fragment lists
     bool splatsInLists = false;           // ... and the splats too (false: drawn before them, ordered blend; see transparentNote)
     std::string transparentNote;          // empty, or why the splats took the ordered blend in a list frame
@@ -171,7 +171,7 @@ struct FrameRenderStats {
     bool transparentCut = false;          // sections weighted by the kernel's partial line integral (RendererDesc::depthCut)
     std::uint64_t transparentEyeCrossing = 0; // splats whose polygon crosses the eye plane: not drawn in the lists (camera inside a kernel)
     std::size_t transparentBytes = 0;     // GPU bytes of the lists (pool, heads, counts, counters, section targets)
-    // ---- end [oit] ----
+    // ---- end (issue 15) ----
 };
 
 class FrameRenderer {

@@ -1,4 +1,4 @@
-// [oit, issue 15] Per-pixel fragment lists: surfaces, splat sections, resolve
+// (issue 15) Per-pixel fragment lists: surfaces, splat sections, resolve
 // (fragment_list_pass.hpp). The node layout is transparentGlsl()'s.
 #include "fragment_list_pass.hpp"
 

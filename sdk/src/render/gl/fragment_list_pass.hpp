@@ -1,4 +1,4 @@
-// [oit, issue 15] The order-exact transparency pass (private to the GL
+// (issue 15) The order-exact transparency pass (private to the GL
 // backend, owned by gl::FrameRenderer): per-pixel linked fragment lists.
 //
 // Method (Ebert & Parent 1990, "Combining A-buffer and Volume Rendering",

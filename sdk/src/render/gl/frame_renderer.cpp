@@ -12,8 +12,8 @@
 #include "fog_pass.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
 #include "tetra_pass.hpp"
-#include "fragment_list_pass.hpp" // [oit]
-#include "saved_state.hpp"        // [oit]
+#include "fragment_list_pass.hpp"
+#include "saved_state.hpp"       
 
 namespace splatfx::gl {
 
@@ -28,7 +28,7 @@ struct FrameRenderer::Impl {
     // [clouds] Projected tetrahedra, and the splats of one interleaved batch.
     std::optional<detail::TetraPass> tetra;
     std::vector<Splat> batch;
-    std::optional<detail::FragmentListPass> lists; // [oit, issue 15] order-exact transparency
+    std::optional<detail::FragmentListPass> lists; // (issue 15) order-exact transparency
 };
 
 Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
@@ -61,7 +61,7 @@ Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
         if (!t) return makeError(t.error());
         impl->tetra.emplace(std::move(*t));
     }
-    { // [oit, issue 15]
+    { // (issue 15)
         if (desc.fragmentsPerPixel < 1 || desc.fragmentsPerPixel > detail::FragmentListPass::kMaxFragmentsPerPixel)
             return makeError("FrameRendererDesc::fragmentsPerPixel must be in [1, " +
                              std::to_string(detail::FragmentListPass::kMaxFragmentsPerPixel) + "], got " +
@@ -80,7 +80,7 @@ FrameRenderer::~FrameRenderer() = default;
 
 Status FrameRenderer::upload(const Materials& materials) {
     Status s = mImpl->full ? mImpl->full->upload(materials) : mImpl->reduced->upload(materials);
-    if (s && mImpl->lists) s = mImpl->lists->upload(materials); // [oit] the sections' partial-integral table
+    if (s && mImpl->lists) s = mImpl->lists->upload(materials); // the sections' partial-integral table
     return s;
 }
 
@@ -145,7 +145,7 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         if (!s) r.stats.fogError = s.error();
         r.stats.fogTetrahedra = fog && s;
     }
-    // ---- [oit, issue 15] The order-exact path: the splats go into the fragment
+    // ---- (issue 15) The order-exact path: the splats go into the fragment
     // lists with the host's transparent surfaces (step 3) when nothing this
     // pass cannot draw is in the frame; otherwise they are drawn here as
     // usual and only the surfaces are sorted (among themselves) in step 3.
@@ -167,11 +167,11 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
                               : fog                  ? "fog: the splats take the ordered blend under the surfaces (fogged sections not implemented)"
                                                      : "no host depth texture (HostTarget::depthTexture or a texture depth attachment): "
                                                        "the splats take the ordered blend under the surfaces";
-    // ---- end [oit] ----
+    // ---- end (issue 15) ----
 
     // 2. The volumes, back to front.
     if (splatsInLists) {
-        // [oit] drawn in step 3
+        // drawn in step 3
     } else if (anyTets) {
         // [clouds] Splats and tetrahedra interleaved by Frame::drawOrder (frame.hpp).
         drawInterleaved(frame, target);
@@ -190,7 +190,7 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
 
     // 3. The host's transparent surfaces, over the volumes.
     if (lists) {
-        // [oit, issue 15] Surfaces into the lists, the splats cut into
+        // (issue 15) Surfaces into the lists, the splats cut into
         // sections at them, every pixel sorted and composited.
         detail::SavedState saved;
         if (r.desc.splats.restoreState) saved.save({.texture2DUnits = 0, .scissor = false});
