@@ -177,7 +177,7 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         drawInterleaved(frame, target);
     } else if (r.full) {
         r.full->draw(frame.splats(), camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
-                                              .depthTexture = target.depthTexture}); // [cut] the host depth the splats are cut by
+                                              .depthTexture = target.depthTexture}); // the host depth the splats are cut by (issue 15)
         r.stats.drawCalls = r.full->stats().drawCalls;
     } else {
         r.reduced->draw(frame.splats(), camera,
@@ -255,7 +255,7 @@ void FrameRenderer::drawInterleaved(const Frame& frame, const HostTarget& target
             const auto& all = frame.splats();
             r.batch.assign(all.begin() + std::ptrdiff_t(b.begin), all.begin() + std::ptrdiff_t(b.end));
             r.full->draw(r.batch, camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
-                                           .depthTexture = target.depthTexture}); // [cut]
+                                           .depthTexture = target.depthTexture});
             calls += r.full->stats().drawCalls;
         }
     }
