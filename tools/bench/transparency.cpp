@@ -3,6 +3,8 @@
 // of the fragment lists against the opaque-only frame and the ordered blend,
 // error of each against the exact reference (ReferenceSurface panes, splats
 // cut into exact sections), the fragment budget knob, list memory.
+// --images DIR also writes the fire with one pane in front of it, through it
+// and behind it, GL (fragment lists) above the exact reference, as one PNG.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -120,6 +122,7 @@ int runTransparency(int argc, char** argv) {
     glm::ivec2 size{640, 480};
     int frames = 15, rounds = 3;
     bool cut = true; // RendererDesc::depthCut: sections weighted by the partial integral
+    std::string imagesDir; // --images: the GL-vs-reference still
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--size" && i + 2 < argc) size = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2])}, i += 2;
@@ -127,10 +130,13 @@ int runTransparency(int argc, char** argv) {
         else if (a == "--rounds" && i + 1 < argc) rounds = std::max(1, std::atoi(argv[++i]));
         else if (a == "--quick") frames = 5, rounds = 1, size = {320, 240};
         else if (a == "--no-cut") cut = false;
+        else if (a == "--images" && i + 1 < argc) imagesDir = argv[++i];
         else if (a == "--help" || a == "-h") {
-            std::printf("usage: splatfx-bench transparency [--size W H (640 480)] [--frames N (15)] [--rounds R (3)] [--quick] [--no-cut]\n"
+            std::printf("usage: splatfx-bench transparency [--size W H (640 480)] [--frames N (15)] [--rounds R (3)] [--quick] [--no-cut] [--images DIR]\n"
                         "Glass panes among the 1560-voxel Table I fire: opaque-only frame, ordered blend and fragment lists,\n"
-                        "time and error against the exact reference; the fragment budget knob; list memory.\n");
+                        "time and error against the exact reference; the fragment budget knob; list memory.\n"
+                        "--images DIR: DIR/transparency_gl_vs_reference.png, a pane in front of, through and behind the fire,\n"
+                        "GL (fragment lists) above the exact reference.\n");
             return 0;
         } else {
             std::fprintf(stderr, "transparency: unknown option '%s'\n", a.c_str());
@@ -169,6 +175,7 @@ int runTransparency(int argc, char** argv) {
     // The fire spans z in [-1.25, 1.25].
     const std::vector<Pane> front{{2.5f, glassTint}};
     const std::vector<Pane> middle{{0.0f, glassTint}};
+    const std::vector<Pane> behind{{-2.5f, glassTint}};
     const std::vector<Pane> three{{2.5f, glassTint}, {0.0f, {0.08f, 0.03f, 0.02f, 0.2f}}, {-0.6f, {0.02f, 0.07f, 0.03f, 0.2f}}};
 
     struct Config {
@@ -184,7 +191,8 @@ int runTransparency(int argc, char** argv) {
                                 {"pane in front, ordered blend", &front, false, 8},
                                 {"pane in front, fragment lists", &front, true, 8},
                                 {"pane through the middle, ordered blend", &middle, false, 8},
-                                {"pane through the middle, fragment lists", &middle, true, 8}};
+                                {"pane through the middle, fragment lists", &middle, true, 8},
+                                {"pane behind, fragment lists", &behind, true, 8}};
     for (int b : {1, 2, 4, 8, 16}) configs.push_back({"3 panes, fragment lists, budget " + std::to_string(b), &three, true, b});
     configs.push_back({"3 panes, ordered blend", &three, false, 8});
 
@@ -240,13 +248,42 @@ int runTransparency(int argc, char** argv) {
         return *splatfx::renderSplatExact(frame.splats(), cam, materials,
                                           {.host = {.background = kBackground}, .surfaces = surfaces});
     };
-    const splatfx::Image refOpaque = reference(nullptr), refFront = reference(&front), refMiddle = reference(&middle), refThree = reference(&three);
+    const splatfx::Image refOpaque = reference(nullptr), refFront = reference(&front), refMiddle = reference(&middle),
+                         refBehind = reference(&behind), refThree = reference(&three);
+    std::vector<const splatfx::Image*> mosaicRefs;
+    std::vector<splatfx::Image> mosaicGl;
     for (std::size_t i = 0; i < configs.size(); ++i) {
         renderOnce(i);
         const Config& c = configs[i];
-        const splatfx::Image& ref = !c.panes ? refOpaque : c.panes == &front ? refFront : c.panes == &middle ? refMiddle : refThree;
-        configs[i].error = compare(fb->read(), ref);
+        const splatfx::Image& ref = !c.panes             ? refOpaque
+                                    : c.panes == &front  ? refFront
+                                    : c.panes == &middle ? refMiddle
+                                    : c.panes == &behind ? refBehind
+                                                         : refThree;
+        const splatfx::Image img = fb->read();
+        configs[i].error = compare(img, ref);
         configs[i].stats = renderers[i].stats();
+        if (c.lists && (c.panes == &front || c.panes == &middle || c.panes == &behind)) mosaicGl.push_back(img), mosaicRefs.push_back(&ref);
+    }
+    if (!imagesDir.empty()) {
+        // Columns: pane in front, through, behind; rows: GL (fragment lists), exact reference.
+        splatfx::Image m;
+        m.width = size.x * int(mosaicGl.size()), m.height = size.y * 2, m.channels = 4;
+        m.pixels.assign(std::size_t(m.width) * m.height * 4, 1.0f);
+        for (std::size_t k = 0; k < mosaicGl.size(); ++k)
+            for (int row = 0; row < 2; ++row) {
+                const splatfx::Image& src = row == 0 ? mosaicGl[k] : *mosaicRefs[k];
+                // Framebuffer::read and the reference are both top row first, like the PNG.
+                for (int y = 0; y < size.y; ++y)
+                    for (int x = 0; x < size.x; ++x)
+                        for (int ch = 0; ch < 4; ++ch) m.at(int(k) * size.x + x, row * size.y + y, ch) = src.at(x, y, ch);
+            }
+        const std::string path = imagesDir + "/transparency_gl_vs_reference.png";
+        if (auto s = splatfx::writeImage(path, m); !s) {
+            std::fprintf(stderr, "transparency: %s\n", s.error().c_str());
+            return 1;
+        }
+        std::printf("wrote %s (columns: pane in front, through, behind the fire; rows: GL fragment lists, exact reference)\n", path.c_str());
     }
     const double opaqueMs = configs[0].ms;
     std::printf("\n%-44s %9s %9s %9s %8s %10s %10s %12s %9s\n", "configuration", "ms/frame", "vs opaque", "RMSE", "max", "fallback", "merged px",
