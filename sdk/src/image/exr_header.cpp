@@ -48,10 +48,13 @@ bool looksLikeExr(const unsigned char* head, std::size_t size) {
 
 Status checkExrHeader(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
+    unsigned char magic[4] = {};
+    in.read(reinterpret_cast<char*>(magic), 4);
+    if (!looksLikeExr(magic, std::size_t(in.gcount()))) return {}; // not OpenEXR: only four bytes read
     std::vector<unsigned char> buf(kMaxHeaderBytes);
-    in.read(reinterpret_cast<char*>(buf.data()), std::streamsize(buf.size()));
-    const std::size_t n = std::size_t(in.gcount());
-    if (!looksLikeExr(buf.data(), n)) return {};
+    std::copy(magic, magic + 4, buf.begin());
+    in.read(reinterpret_cast<char*>(buf.data() + 4), std::streamsize(buf.size() - 4));
+    const std::size_t n = 4 + std::size_t(in.gcount());
     const std::string what = "cannot read image '" + path + "': OpenEXR header ";
     if (n < 8) return makeError(what + "is truncated");
     const std::uint32_t flags = std::uint32_t(readInt32(&buf[4]));
