@@ -35,12 +35,12 @@ public:
     void update(double t) override {
         assert(std::isfinite(t) && t >= 0.0 && "Effect::update: timeSec must be finite and >= 0");
         time = t;
-        // Object dynamics move the lattice (the gas's space moves with it); the
-        // density is sampled in the lattice's world placement at that pose.
+        // Object dynamics move the lattice through the gas's world (the gas is
+        // defined in world coordinates): what is sampled is what the pose covers.
         const Pose pose = desc.motion.sample(desc.enabled.object ? t : 0.0);
         Grid placed = mLattice;
         placed.transform = pose.matrix() * mLattice.transform;
-        // The gas itself is the object dynamics' animation; frozen with them.
+        // The gas's own motion is object dynamics too: switched off, it freezes at t = 0.
         Result<Grid> g = sampleProceduralGas(mGas, placed, float(desc.enabled.object ? t : 0.0));
         grid = g ? std::move(*g) : placed; // the desc was validated at creation: only a non-finite t fails
         const bool local = desc.enabled.local;
