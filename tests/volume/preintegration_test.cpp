@@ -193,3 +193,14 @@ TEST(PreIntegration, BadDescIsRejected) {
     ASSERT_FALSE(b);
     EXPECT_NE(b.error().find("maxLengthWorld"), std::string::npos);
 }
+
+// A NaN scalar (a degenerate segment's 0/0) holds no material: zero colour and
+// extinction, and no look-up past the table's end (found by ASan through the
+// one-medium reference on a ray grazing a face).
+TEST(TransferFunction, ANanScalarHasNoMaterial) {
+    const TransferFunction tf = *TransferFunction::create(
+        {{0.0f, {0, 0, 0}, 0.0f}, {0.3f, {1.0f, 0.9f, 0.8f}, 2.0f}, {0.7f, {0.5f, 0.5f, 0.5f}, 4.0f}, {1.0f, {0, 0, 1}, 1.0f}});
+    EXPECT_EQ(tf.extinction(std::nan("")), 0.0);
+    EXPECT_EQ(tf.color(std::nan("")), glm::dvec3(0.0));
+    EXPECT_DOUBLE_EQ(tf.extinction(0.5), 3.0); // and ordinary look-ups are unchanged
+}

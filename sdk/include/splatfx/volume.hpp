@@ -59,6 +59,7 @@ public:
     // ascending, or negative extinction; the message names the point.
     static Result<TransferFunction> create(std::vector<TransferPoint> points);
 
+    // A NaN scalar has no material: colour and extinction 0.
     glm::dvec3 color(double scalar) const;
     double extinction(double scalar) const;
     // Exact: is extinction zero everywhere on [lo, hi]? (the zero-opacity

@@ -93,6 +93,7 @@ struct Integrator {
     // (1 - e^-(tc + tf)) times the extinction-weighted colour (exact for a
     // colour constant over the step; second order in the step otherwise).
     RayState combined(RayState s, double a, double b, int steps, double sa, double sb, double ma, double mb) const {
+        if (!(b > a)) return s; // an empty piece (the ray grazes a face): nothing to integrate, and u would be 0/0
         const double h = (b - a) / steps;
         const glm::dvec3 fc = fogColour();
         for (int k = 0; k < steps; ++k) {

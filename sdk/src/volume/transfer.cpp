@@ -18,6 +18,7 @@ struct TfPiece {
 
 TfPiece pieceAt(const std::vector<TransferPoint>& p, double s) {
     TfPiece out;
+    if (std::isnan(s)) return out; // no material (and no search past the end: every comparison with NaN is false)
     if (p.size() == 1 || s <= double(p.front().scalar)) {
         // Constant below the first point (or everywhere for one point).
         const TransferPoint& q = (s <= double(p.front().scalar)) ? p.front() : p.back();
@@ -81,11 +82,13 @@ Result<TransferFunction> TransferFunction::create(std::vector<TransferPoint> poi
 }
 
 glm::dvec3 TransferFunction::color(double s) const {
+    if (std::isnan(s)) return glm::dvec3(0.0); // no material
     const TfPiece p = pieceAt(mPoints, s);
     return p.c0 + p.c1 * s;
 }
 
 double TransferFunction::extinction(double s) const {
+    if (std::isnan(s)) return 0.0; // no material
     const TfPiece p = pieceAt(mPoints, s);
     return std::max(0.0, p.t0 + p.t1 * s);
 }
