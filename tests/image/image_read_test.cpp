@@ -164,3 +164,28 @@ TEST(ImageRead, AnExrWithinTheBudgetsStillReads) {
     EXPECT_EQ(back->channels, 4);
     EXPECT_FLOAT_EQ(back->at(4, 2, 3), 0.25f);
 }
+
+TEST(ImageRead, AGifClaimingAHugeScreenIsRefusedBeforeTheDecoderSeesIt) {
+    // OpenImageIO's GIF reader allocates its canvas from the logical screen
+    // when the file is opened: 68 bytes claiming 25964x19827 cost 2 GB there
+    // (tools/fuzz.sh found it; the input is a fuzz regression).
+    const fs::path p = dir() / "screen.gif";
+    std::string gif("GIF89a", 6);
+    gif += std::string("\x6c\x65\x73\x4d", 4); // 25964 x 19827, little-endian
+    gif += std::string("\x00\x00\x00", 3);     // no global colour table
+    gif += std::string("\x3b", 1);             // trailer
+    std::ofstream(p, std::ios::binary) << gif;
+    expectRefused(p.string(), "GIF logical screen claims 25964x19827 pixels, over the image budget");
+}
+
+TEST(ImageRead, AGifWithinTheBudgetsStillReads) {
+    const fs::path p = dir() / "small.gif";
+    Image img;
+    img.width = 6, img.height = 4, img.channels = 3;
+    img.pixels.assign(6 * 4 * 3, 1.0f);
+    ASSERT_TRUE(writeImage(p.string(), img));
+    auto back = readImage(p.string());
+    ASSERT_TRUE(back) << back.error();
+    EXPECT_EQ(back->width, 6);
+    EXPECT_EQ(back->height, 4);
+}

@@ -9,7 +9,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "checked_file.hpp"
-#include "exr_header.hpp"
+#include "header_checks.hpp"
 
 namespace splatfx {
 
@@ -32,7 +32,7 @@ Status checkImageFile(const std::string& path) {
     if (bytes == 0) return makeError(what + "the file is empty");
     if (bytes > kMaxImageFileBytes)
         return makeError(what + std::to_string(bytes) + " bytes, over the image-file budget of " + std::to_string(kMaxImageFileBytes) + " bytes");
-    return detail::checkExrHeader(path);
+    return detail::checkImageHeader(path);
 }
 
 } // namespace

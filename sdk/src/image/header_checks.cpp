@@ -1,4 +1,4 @@
-#include "exr_header.hpp"
+#include "header_checks.hpp"
 
 #include <algorithm>
 #include <cstring>
@@ -41,6 +41,9 @@ std::int64_t linesPerChunk(unsigned char compression) {
 }
 
 } // namespace
+
+Status checkExrHeader(const std::string& path);
+Status checkGifHeader(const std::string& path);
 
 bool looksLikeExr(const unsigned char* head, std::size_t size) {
     return size >= 4 && head[0] == 0x76 && head[1] == 0x2f && head[2] == 0x31 && head[3] == 0x01;
@@ -120,6 +123,55 @@ Status checkExrHeader(const std::string& path) {
         if (partIndex > 64) return makeError(what + "has more than 64 parts");
     }
     return {};
+}
+
+Status checkGifHeader(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::vector<unsigned char> buf(kMaxHeaderBytes);
+    in.read(reinterpret_cast<char*>(buf.data()), std::streamsize(buf.size()));
+    const std::size_t n = std::size_t(in.gcount());
+    if (n < 6 || std::memcmp(buf.data(), "GIF8", 4) != 0) return {};
+    const std::string what = "cannot read image '" + path + "': GIF ";
+    auto u16 = [&](std::size_t at) { return std::int64_t(buf[at]) | std::int64_t(buf[at + 1]) << 8; };
+    auto within = [&](const char* which, std::int64_t w, std::int64_t h) -> Status {
+        if (w > kMaxImageSide || h > kMaxImageSide || w * h > kMaxImagePixels)
+            return makeError(what + which + " claims " + std::to_string(w) + "x" + std::to_string(h) + " pixels, over the image budget (" +
+                             std::to_string(kMaxImageSide) + " on a side, " + std::to_string(kMaxImagePixels) + " in all)");
+        return {};
+    };
+    if (n < 13) return makeError(what + "header is truncated");
+    if (Status s = within("logical screen", u16(6), u16(8)); !s) return s;
+    std::size_t at = 13;
+    if (buf[10] & 0x80) at += 3u << ((buf[10] & 7) + 1); // global colour table
+    // Walk the blocks within what was read: image descriptors state their size.
+    auto skipSubBlocks = [&]() {
+        while (at < n && buf[at] != 0) at += 1 + std::size_t(buf[at]);
+        ++at;
+    };
+    while (at < n) {
+        const unsigned char b = buf[at];
+        if (b == 0x3B) break; // trailer
+        if (b == 0x21) {      // extension: label, then sub-blocks
+            at += 2;
+            skipSubBlocks();
+        } else if (b == 0x2C) { // image descriptor
+            if (at + 10 > n) break;
+            if (Status s = within("frame", u16(at + 5), u16(at + 7)); !s) return s;
+            const unsigned char flags = buf[at + 9];
+            at += 10;
+            if (flags & 0x80) at += 3u << ((flags & 7) + 1); // local colour table
+            ++at;                                           // LZW minimum code size
+            skipSubBlocks();
+        } else {
+            break; // not a block: the decoder reports the corrupt file
+        }
+    }
+    return {};
+}
+
+Status checkImageHeader(const std::string& path) {
+    if (Status s = checkExrHeader(path); !s) return s;
+    return checkGifHeader(path);
 }
 
 } // namespace splatfx::detail
