@@ -130,7 +130,8 @@ Status checkGifHeader(const std::string& path) {
     std::vector<unsigned char> buf(kMaxHeaderBytes);
     in.read(reinterpret_cast<char*>(buf.data()), std::streamsize(buf.size()));
     const std::size_t n = std::size_t(in.gcount());
-    if (n < 6 || std::memcmp(buf.data(), "GIF8", 4) != 0) return {};
+    // giflib (and so OpenImageIO) takes any file starting "GIF" as one, whatever follows.
+    if (n < 3 || std::memcmp(buf.data(), "GIF", 3) != 0) return {};
     const std::string what = "cannot read image '" + path + "': GIF ";
     auto u16 = [&](std::size_t at) { return std::int64_t(buf[at]) | std::int64_t(buf[at + 1]) << 8; };
     auto within = [&](const char* which, std::int64_t w, std::int64_t h) -> Status {
