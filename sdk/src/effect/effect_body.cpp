@@ -1,5 +1,6 @@
-// What the grid and solver kinds of Effect share: desc checks, the layers'
-// height split (EffectLayer), emit, and the splat extent of bounds.
+// What the kinds of Effect share: desc checks, the layers' height split
+// (EffectLayer), emit, the splat extent of bounds, and the stateless kinds'
+// stepping and swept bounds.
 #include "effect_body.hpp"
 
 #include <algorithm>
@@ -134,6 +135,36 @@ Aabb EffectBody::withSplatExtent(const Aabb& world, float motionScale, const glm
     const float extent = desc.footprintRadius * motionScale * kernelNormBound(transform, spacing, maxStretch);
     // A little slack for float rounding in the builder's matrix products.
     return world.expanded(extent * (1.0f + 1e-4f) + 1e-5f);
+}
+
+void StatelessBody::step(double dtSec) {
+    assert(std::isfinite(dtSec) && dtSec >= 0.0 && "Effect::step: dtSec must be finite and >= 0");
+    update(time + dtSec);
+}
+
+// A pure function of time: evaluate t, nothing to catch up.
+AdvanceResult StatelessBody::advanceTo(double timeSec, const AdvanceContext&) {
+    update(timeSec);
+    return {.steps = 1, .caughtUp = false};
+}
+
+Aabb StatelessBody::sweptBounds(const Aabb& localBox, const glm::mat4& latticeTransform, glm::vec3 spacing, float maxStretch,
+                                double t0, double t1) const {
+    if (t1 < t0) std::swap(t0, t1);
+    if (localBox.empty()) return {};
+    // Object space: the lattice transform's image of the local box (its corners bound it).
+    const Aabb object = transformBox(localBox, latticeTransform);
+    Aabb world;
+    float scale = 1.0f;
+    if (desc.enabled.object) {
+        world = desc.motion.sweep(object, t0, t1);
+        scale = desc.motion.maxScale(t0, t1);
+    } else {
+        const Pose p = desc.motion.sample(0.0);
+        world = transformBox(object, p.matrix());
+        scale = std::max({p.scale.x, p.scale.y, p.scale.z});
+    }
+    return withSplatExtent(world, scale, latticeTransform, spacing, maxStretch);
 }
 
 } // namespace splatfx::detail

@@ -1,7 +1,8 @@
-// The inside of an Effect: what both shipped kinds share (desc, layers, the
+// The inside of an Effect: what every kind shares (desc, layers, the
 // current grid and its height split into layers, emit, the splat-extent part
 // of bounds) and the virtual functions each kind implements
-// (grid_effect.cpp and gas_effect.cpp: stateless; solver_effect.cpp: stateful).
+// (grid_effect.cpp, gas_effect.cpp, sequence_effect.cpp: StatelessBody;
+// solver_effect.cpp: stateful).
 // Private to the SDK: the public extension point is EffectKind.
 #pragma once
 
@@ -53,6 +54,22 @@ public:
     int latticeLoY = 0, latticeHiY = 0;
     double time = 0.0;
     EffectCounters counters;
+};
+
+// A kind whose frame t is a pure function of t (grid, gas, sequence): a step
+// is the evaluation of a later time, and frames may be evaluated in any order.
+class StatelessBody : public EffectBody {
+public:
+    bool stateless() const final { return true; }
+    void step(double dtSec) override;
+    AdvanceResult advanceTo(double timeSec, const AdvanceContext& context) override;
+
+protected:
+    // Bounds over [t0, t1] of the lattice points in `localBox` (lattice-local),
+    // placed by `latticeTransform` and swept by the desc's motion (frozen at
+    // t = 0 when object dynamics are off), grown by the largest splat.
+    Aabb sweptBounds(const Aabb& localBox, const glm::mat4& latticeTransform, glm::vec3 spacing, float maxStretch, double t0,
+                     double t1) const;
 };
 
 std::unique_ptr<EffectBody> makeGridBody(Grid base, EffectDesc desc);

@@ -16,7 +16,7 @@
 namespace splatfx::detail {
 namespace {
 
-class GasBody final : public EffectBody {
+class GasBody final : public StatelessBody {
 public:
     GasBody(ProceduralGasDesc gas, Grid lattice, EffectDesc d) : mGas(std::move(gas)), mLattice(std::move(lattice)) {
         mLattice.voxels.clear();
@@ -26,7 +26,6 @@ public:
     }
 
     std::unique_ptr<EffectBody> clone() const override { return std::make_unique<GasBody>(*this); }
-    bool stateless() const override { return true; }
     const TextureDynamics& textureDynamics() const override { return mNoTextureDynamics; }
     std::uint64_t costCells() const override {
         return std::uint64_t(mLattice.dims.x) * std::uint64_t(mLattice.dims.y) * std::uint64_t(mLattice.dims.z);
@@ -56,11 +55,7 @@ public:
         splitLayers();
     }
 
-    void step(double dt) override {
-        assert(std::isfinite(dt) && dt >= 0.0 && "Effect::step: dtSec must be finite and >= 0");
-        update(time + dt);
-    }
-
+    // Sampling the turbulence is this kind's whole cost: a frame already at t is not sampled again.
     AdvanceResult advanceTo(double t, const AdvanceContext&) override {
         if (t == time && counters.updates > 0) return {};
         update(t);
@@ -73,23 +68,11 @@ public:
     }
 
     Aabb bounds(double t0, double t1) const override {
-        if (t1 < t0) std::swap(t0, t1);
         // Every sampled cell is a lattice point: the lattice box under the motion bounds them.
         Aabb local;
         local.extend(mLattice.localPosition({0, 0, 0}));
         local.extend(mLattice.localPosition(mLattice.dims - 1));
-        const Aabb object = transformBox(local, mLattice.transform);
-        Aabb world;
-        float scale = 1.0f;
-        if (desc.enabled.object) {
-            world = desc.motion.sweep(object, t0, t1);
-            scale = desc.motion.maxScale(t0, t1);
-        } else {
-            const Pose p = desc.motion.sample(0.0);
-            world = transformBox(object, p.matrix());
-            scale = std::max({p.scale.x, p.scale.y, p.scale.z});
-        }
-        return withSplatExtent(world, scale, mLattice.transform, mLattice.spacing, 0.0f);
+        return sweptBounds(local, mLattice.transform, mLattice.spacing, 0.0f, t0, t1);
     }
 
 private:

@@ -11,7 +11,7 @@
 namespace splatfx::detail {
 namespace {
 
-class GridBody final : public EffectBody {
+class GridBody final : public StatelessBody {
 public:
     GridBody(Grid base, EffectDesc d) : mBase(std::move(base)) {
         int loY = 0, hiY = 0;
@@ -45,7 +45,6 @@ public:
     }
 
     std::unique_ptr<EffectBody> clone() const override { return std::make_unique<GridBody>(*this); }
-    bool stateless() const override { return true; }
     const TextureDynamics& textureDynamics() const override { return mTexDyn; }
     void togglesChanged() override { rebuildTextureDynamics(); }
     std::uint64_t costCells() const override { return mBase.voxels.size(); }
@@ -77,17 +76,6 @@ public:
         splitLayers();
     }
 
-    void step(double dt) override {
-        assert(std::isfinite(dt) && dt >= 0.0 && "Effect::step: dtSec must be finite and >= 0");
-        update(time + dt);
-    }
-
-    // A pure function of time: evaluate t, nothing to catch up.
-    AdvanceResult advanceTo(double t, const AdvanceContext&) override {
-        update(t);
-        return {.steps = 1, .caughtUp = false};
-    }
-
     // Material is present unless the object's fade or growth is at zero now.
     bool alive(double t, const AliveHints&) const override {
         const Pose pose = desc.motion.sample(t);
@@ -95,21 +83,7 @@ public:
     }
 
     Aabb bounds(double t0, double t1) const override {
-        if (t1 < t0) std::swap(t0, t1);
-        if (mBaseBox.empty()) return {};
-        // Object space: the base transform's image of the local box (its corners bound it).
-        const Aabb object = transformBox(mBaseBox, mBase.transform);
-        Aabb world;
-        float scale = 1.0f;
-        if (desc.enabled.object) {
-            world = desc.motion.sweep(object, t0, t1);
-            scale = desc.motion.maxScale(t0, t1);
-        } else {
-            const Pose p = desc.motion.sample(0.0);
-            world = transformBox(object, p.matrix());
-            scale = std::max({p.scale.x, p.scale.y, p.scale.z});
-        }
-        return withSplatExtent(world, scale, mBase.transform, mBase.spacing, mBaseMaxStretch);
+        return sweptBounds(mBaseBox, mBase.transform, mBase.spacing, mBaseMaxStretch, t0, t1);
     }
 
 private:

@@ -20,7 +20,7 @@
 namespace splatfx::detail {
 namespace {
 
-class SequenceBody final : public EffectBody {
+class SequenceBody final : public StatelessBody {
 public:
     SequenceBody(GridSequence seq, EffectDesc d) : mSeq(std::move(seq)) {
         init(std::move(d), 0, mSeq.dims.y - 1);
@@ -33,8 +33,7 @@ public:
     }
 
     std::unique_ptr<EffectBody> clone() const override { return std::make_unique<SequenceBody>(*this); }
-    // update(t) depends on t alone (see the file comment), so Scene may evaluate frames in any order.
-    bool stateless() const override { return true; }
+    // Stateless: update(t) depends on t alone (see the file comment), so Scene may evaluate frames in any order.
     const TextureDynamics& textureDynamics() const override { return mNoTextureDynamics; }
     void togglesChanged() override { reset(); }
     std::uint64_t costCells() const override { return mSeq.cellCount(); }
@@ -63,36 +62,12 @@ public:
         splitLayers();
     }
 
-    void step(double dt) override {
-        assert(std::isfinite(dt) && dt >= 0.0 && "Effect::step: dtSec must be finite and >= 0");
-        update(time + dt);
-    }
-
-    AdvanceResult advanceTo(double t, const AdvanceContext&) override {
-        update(t);
-        return {.steps = 1, .caughtUp = false};
-    }
-
     bool alive(double t, const AliveHints&) const override {
         return mPeakDepth > 0.0f && desc.motion.sample(desc.enabled.object ? t : 0.0).opacity > 0.0f;
     }
 
-    Aabb bounds(double t0, double t1) const override {
-        if (t1 < t0) std::swap(t0, t1);
-        // The whole lattice: material may be anywhere in it at some frame.
-        const Aabb object = transformBox(mLocalBox, mSeq.transform);
-        Aabb world;
-        float scale = 1.0f;
-        if (desc.enabled.object) {
-            world = desc.motion.sweep(object, t0, t1);
-            scale = desc.motion.maxScale(t0, t1);
-        } else {
-            const Pose p = desc.motion.sample(0.0);
-            world = transformBox(object, p.matrix());
-            scale = std::max({p.scale.x, p.scale.y, p.scale.z});
-        }
-        return withSplatExtent(world, scale, mSeq.transform, mSeq.spacing, 0.0f);
-    }
+    // The whole lattice: material may be anywhere in it at some frame.
+    Aabb bounds(double t0, double t1) const override { return sweptBounds(mLocalBox, mSeq.transform, mSeq.spacing, 0.0f, t0, t1); }
 
 private:
     glm::vec3 latticePoint(glm::ivec3 c) const {
