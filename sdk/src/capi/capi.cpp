@@ -1,6 +1,8 @@
 // splatfx_c.h, the GL-free half: errors, materials, texture sets, the scene and its presets, cameras, frames.
 #include <cmath>
 #include <limits>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <glm/gtc/type_ptr.hpp>
@@ -148,6 +150,142 @@ Camera toCamera(const splatfx_camera& c) {
     return Camera::fromMatrices(glm::make_mat4(c.view), glm::make_mat4(c.proj), {c.viewport[0], c.viewport[1]});
 }
 
+// ---- presets ----
+//
+// Each preset's C fields are listed once (FireFields and the others below); the list drives
+// both directions: desc_init copies the C++ descriptor's defaults out
+// (DefaultsOut), add copies the C fields in (FieldsIn), checking that every
+// float is finite and every handle valid. The presets validate their own
+// ranges (messages name the C++ field, FireDesc.textureCount for
+// texture_count); the C layer adds what the C++ types cannot carry wrong.
+
+// C++ defaults into a C desc.
+struct DefaultsOut {
+    void operator()(const char*, std::int32_t (&c)[3], glm::ivec3 d) { store3(c, d); }
+    void operator()(const char*, float (&c)[3], glm::vec3 d) { store3(c, d); }
+    void operator()(const char*, const splatfx_texture_set*& c, const std::optional<TextureSet>&) { c = nullptr; }
+    template <class C, class D>
+    void operator()(const char*, C& c, const D& d) { c = C(d); }
+    void motion(const char*, const splatfx_keyframe*& keys, std::uint32_t& count, const Motion&) { keys = nullptr, count = 0; }
+};
+
+// A C desc into its C++ descriptor; the first bad field is kept in `bad`.
+struct FieldsIn {
+    std::optional<Outcome> bad;
+    static std::string field(const char* name) { return std::string("desc.") + name; }
+    void operator()(const char*, const std::int32_t (&c)[3], glm::ivec3& d) { d = ivec3Of(c); }
+    void operator()(const char* name, const float (&c)[3], glm::vec3& d) {
+        if (!bad) bad = checkFinite3(field(name), c);
+        d = vec3Of(c);
+    }
+    void operator()(const char* name, const splatfx_texture_set* const& c, std::optional<TextureSet>& d) {
+        if (!bad) bad = setTextureSet(field(name), c, d);
+    }
+    template <class C, class D>
+    void operator()(const char* name, const C& c, D& d) {
+        if constexpr (std::is_floating_point_v<C>)
+            if (!bad) bad = checkFinite(field(name), c);
+        d = D(c);
+    }
+    void motion(const char* name, const splatfx_keyframe* const& keys, const std::uint32_t& count, Motion& d) {
+        if (!bad) bad = toMotion(field(name), keys, count, d);
+    }
+};
+
+// <Preset>Fields{}(v, c, d) visits every C field of one preset with its C++
+// counterpart; C and D are the C and C++ descs, either of them const.
+struct FireFields {
+    template <class V, class C, class D> void operator()(V& v, C& c, D& d) const {
+        v("dims", c.dims, d.dims), v("spacing", c.spacing, d.spacing), v("position", c.position, d.position);
+        v("texture_set", c.texture_set, d.textureSet), v("texture_count", c.texture_count, d.textureCount);
+        v("opacity", c.opacity, d.opacity), v("propagation_steps_per_sec", c.propagation_steps_per_sec, d.propagationStepsPerSec);
+        v("textures_per_sec", c.textures_per_sec, d.texturesPerSec), v("crossfade", c.crossfade, d.crossfade);
+        v.motion("motion", c.motion_keys, c.motion_key_count, d.motion);
+        v("seed", c.seed, d.seed), v("texture_seed", c.texture_seed, d.textureSeed);
+    }
+};
+struct SmokeFields {
+    template <class V, class C, class D> void operator()(V& v, C& c, D& d) const {
+        v("dims", c.dims, d.dims), v("spacing", c.spacing, d.spacing), v("position", c.position, d.position);
+        v("source_offset", c.source_offset, d.sourceOffset), v("source_radius", c.source_radius, d.sourceRadius);
+        v("wind_world", c.wind_world, d.windWorld), v("dissipation", c.dissipation, d.dissipation);
+        v("texture_set", c.texture_set, d.textureSet), v("texture_count", c.texture_count, d.textureCount);
+        v("textures_per_sec", c.textures_per_sec, d.texturesPerSec), v("substeps", c.substeps, d.substeps);
+        v.motion("source_motion", c.source_motion_keys, c.source_motion_key_count, d.sourceMotion);
+        v("seed", c.seed, d.seed), v("texture_seed", c.texture_seed, d.textureSeed);
+    }
+};
+struct SteamFields {
+    template <class V, class C, class D> void operator()(V& v, C& c, D& d) const {
+        v("dims", c.dims, d.dims), v("spacing", c.spacing, d.spacing), v("position", c.position, d.position);
+        v("texture_set", c.texture_set, d.textureSet), v("texture_count", c.texture_count, d.textureCount);
+        v("opacity", c.opacity, d.opacity), v("propagation_steps_per_sec", c.propagation_steps_per_sec, d.propagationStepsPerSec);
+        v("textures_per_sec", c.textures_per_sec, d.texturesPerSec);
+        v.motion("motion", c.motion_keys, c.motion_key_count, d.motion);
+        v("seed", c.seed, d.seed), v("texture_seed", c.texture_seed, d.textureSeed);
+    }
+};
+struct DustFields {
+    template <class V, class C, class D> void operator()(V& v, C& c, D& d) const {
+        v("dims", c.dims, d.dims), v("spacing", c.spacing, d.spacing), v("position", c.position, d.position);
+        v("source_offset", c.source_offset, d.sourceOffset), v("source_radius", c.source_radius, d.sourceRadius);
+        v("wind_world", c.wind_world, d.windWorld), v("settle", c.settle, d.settle), v("dissipation", c.dissipation, d.dissipation);
+        v("texture_set", c.texture_set, d.textureSet), v("texture_count", c.texture_count, d.textureCount);
+        v.motion("source_motion", c.source_motion_keys, c.source_motion_key_count, d.sourceMotion);
+        v("seed", c.seed, d.seed), v("texture_seed", c.texture_seed, d.textureSeed);
+    }
+};
+struct FireToSmokeFields {
+    template <class V, class C, class D> void operator()(V& v, C& c, D& d) const {
+        v("dims", c.dims, d.dims), v("spacing", c.spacing, d.spacing), v("position", c.position, d.position);
+        v("split", c.split, d.split), v("blend", c.blend, d.blend);
+        v("fire_texture_set", c.fire_texture_set, d.fireTextureSet), v("smoke_texture_set", c.smoke_texture_set, d.smokeTextureSet);
+        v("propagation_steps_per_sec", c.propagation_steps_per_sec, d.propagationStepsPerSec);
+        v("textures_per_sec", c.textures_per_sec, d.texturesPerSec);
+        v.motion("motion", c.motion_keys, c.motion_key_count, d.motion);
+        v("seed", c.seed, d.seed), v("texture_seed", c.texture_seed, d.textureSeed);
+    }
+};
+struct GhostsFields {
+    template <class V, class C, class D> void operator()(V& v, C& c, D& d) const {
+        v("head_radius_cells", c.head_radius_cells, d.headRadiusCells), v("plume_cells", c.plume_cells, d.plumeCells);
+        v("spacing", c.spacing, d.spacing), v("position", c.position, d.position);
+        v("texture_set", c.texture_set, d.textureSet), v("texture_count", c.texture_count, d.textureCount);
+        v("opacity", c.opacity, d.opacity), v("textures_per_sec", c.textures_per_sec, d.texturesPerSec);
+        v("propagation_steps_per_sec", c.propagation_steps_per_sec, d.propagationStepsPerSec);
+        v("seed", c.seed, d.seed), v("texture_seed", c.texture_seed, d.textureSeed);
+    }
+};
+
+template <class CDesc, class Desc, class Fields>
+void initPresetDesc(CDesc* desc, Fields fields) {
+    if (!desc) return;
+    const Desc d{};
+    DefaultsOut out;
+    fields(out, *desc, d);
+}
+
+// The body of every splatfx_scene_add_<preset>: defaults, the caller's desc
+// in, `extra` checks (a std::optional<Outcome>(const Desc&)), build, add.
+template <class Desc, class CDesc, class Init, class Fields, class Build, class Extra>
+splatfx_status addPresetC(const char* function, splatfx_error* error, splatfx_scene* scene, splatfx_materials* materials,
+                          const CDesc* desc, const splatfx_effect_options* options, std::uint32_t* outId, Init init,
+                          Fields fields, Build build, Extra extra) {
+    return guard(function, error, [&] {
+        CDesc c;
+        init(&c);
+        if (desc) c = *desc;
+        Desc d;
+        FieldsIn in;
+        fields(in, std::as_const(c), d);
+        if (in.bad) return *in.bad;
+        if (auto bad = extra(d)) return *bad;
+        return addPreset(scene, materials, options, outId, [&](Materials& m, Outcome& failed) { return fromResult(build(m, d), failed); });
+    });
+}
+
+constexpr auto kNoExtraCheck = [](const auto&) { return std::optional<Outcome>(); };
+
 } // namespace
 
 extern "C" {
@@ -282,290 +420,66 @@ void splatfx_keyframe_init(splatfx_keyframe* key) {
 }
 
 void splatfx_fire_desc_init(splatfx_fire_desc* desc) {
-    if (!desc) return;
-    const presets::FireDesc d{};
-    store3(desc->dims, d.dims);
-    store3(desc->spacing, d.spacing);
-    store3(desc->position, d.position);
-    desc->texture_set = nullptr;
-    desc->texture_count = d.textureCount;
-    desc->opacity = d.opacity;
-    desc->propagation_steps_per_sec = d.propagationStepsPerSec;
-    desc->textures_per_sec = d.texturesPerSec;
-    desc->crossfade = d.crossfade ? 1 : 0;
-    desc->motion_keys = nullptr;
-    desc->motion_key_count = 0;
-    desc->seed = d.seed;
-    desc->texture_seed = d.textureSeed;
+    initPresetDesc<splatfx_fire_desc, presets::FireDesc>(desc, FireFields{});
 }
-
 void splatfx_smoke_desc_init(splatfx_smoke_desc* desc) {
-    if (!desc) return;
-    const presets::SmokeDesc d{};
-    store3(desc->dims, d.dims);
-    store3(desc->spacing, d.spacing);
-    store3(desc->position, d.position);
-    store3(desc->source_offset, d.sourceOffset);
-    desc->source_radius = d.sourceRadius;
-    store3(desc->wind_world, d.windWorld);
-    desc->dissipation = d.dissipation;
-    desc->texture_set = nullptr;
-    desc->texture_count = d.textureCount;
-    desc->textures_per_sec = d.texturesPerSec;
-    desc->substeps = d.substeps;
-    desc->source_motion_keys = nullptr;
-    desc->source_motion_key_count = 0;
-    desc->seed = d.seed;
-    desc->texture_seed = d.textureSeed;
+    initPresetDesc<splatfx_smoke_desc, presets::SmokeDesc>(desc, SmokeFields{});
 }
-
 void splatfx_steam_desc_init(splatfx_steam_desc* desc) {
-    if (!desc) return;
-    const presets::SteamDesc d{};
-    store3(desc->dims, d.dims);
-    store3(desc->spacing, d.spacing);
-    store3(desc->position, d.position);
-    desc->texture_set = nullptr;
-    desc->texture_count = d.textureCount;
-    desc->opacity = d.opacity;
-    desc->propagation_steps_per_sec = d.propagationStepsPerSec;
-    desc->textures_per_sec = d.texturesPerSec;
-    desc->motion_keys = nullptr;
-    desc->motion_key_count = 0;
-    desc->seed = d.seed;
-    desc->texture_seed = d.textureSeed;
+    initPresetDesc<splatfx_steam_desc, presets::SteamDesc>(desc, SteamFields{});
 }
-
 void splatfx_dust_desc_init(splatfx_dust_desc* desc) {
-    if (!desc) return;
-    const presets::DustDesc d{};
-    store3(desc->dims, d.dims);
-    store3(desc->spacing, d.spacing);
-    store3(desc->position, d.position);
-    store3(desc->source_offset, d.sourceOffset);
-    desc->source_radius = d.sourceRadius;
-    store3(desc->wind_world, d.windWorld);
-    desc->settle = d.settle;
-    desc->dissipation = d.dissipation;
-    desc->texture_set = nullptr;
-    desc->texture_count = d.textureCount;
-    desc->source_motion_keys = nullptr;
-    desc->source_motion_key_count = 0;
-    desc->seed = d.seed;
-    desc->texture_seed = d.textureSeed;
+    initPresetDesc<splatfx_dust_desc, presets::DustDesc>(desc, DustFields{});
 }
-
 void splatfx_fire_to_smoke_desc_init(splatfx_fire_to_smoke_desc* desc) {
-    if (!desc) return;
-    const presets::FireToSmokeDesc d{};
-    store3(desc->dims, d.dims);
-    store3(desc->spacing, d.spacing);
-    store3(desc->position, d.position);
-    desc->split = d.split;
-    desc->blend = d.blend;
-    desc->fire_texture_set = nullptr;
-    desc->smoke_texture_set = nullptr;
-    desc->propagation_steps_per_sec = d.propagationStepsPerSec;
-    desc->textures_per_sec = d.texturesPerSec;
-    desc->motion_keys = nullptr;
-    desc->motion_key_count = 0;
-    desc->seed = d.seed;
-    desc->texture_seed = d.textureSeed;
+    initPresetDesc<splatfx_fire_to_smoke_desc, presets::FireToSmokeDesc>(desc, FireToSmokeFields{});
 }
-
 void splatfx_ghosts_desc_init(splatfx_ghosts_desc* desc) {
-    if (!desc) return;
-    const presets::GhostsDesc d{};
-    desc->head_radius_cells = d.headRadiusCells;
-    desc->plume_cells = d.plumeCells;
-    store3(desc->spacing, d.spacing);
-    store3(desc->position, d.position);
-    desc->texture_set = nullptr;
-    desc->texture_count = d.textureCount;
-    desc->opacity = d.opacity;
-    desc->textures_per_sec = d.texturesPerSec;
-    desc->propagation_steps_per_sec = d.propagationStepsPerSec;
-    desc->seed = d.seed;
-    desc->texture_seed = d.textureSeed;
+    initPresetDesc<splatfx_ghosts_desc, presets::GhostsDesc>(desc, GhostsFields{});
 }
 
-// The presets validate their own ranges (messages name the C++ field,
-// FireDesc.textureCount for texture_count); the C layer adds what the C++
-// types cannot carry wrong: NaN/Inf in every float field, bad handles.
 splatfx_status splatfx_scene_add_fire(splatfx_scene* scene, splatfx_materials* materials, const splatfx_fire_desc* desc,
                                       const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
-    return guard("splatfx_scene_add_fire", error, [&] {
-        splatfx_fire_desc c;
-        splatfx_fire_desc_init(&c);
-        if (desc) c = *desc;
-        for (auto bad : {checkFinite3("desc.spacing", c.spacing), checkFinite3("desc.position", c.position),
-                         checkFinite("desc.opacity", c.opacity), checkFinite("desc.propagation_steps_per_sec", c.propagation_steps_per_sec),
-                         checkFinite("desc.textures_per_sec", c.textures_per_sec)})
-            if (bad) return *bad;
-        presets::FireDesc d;
-        if (auto bad = setTextureSet("desc.texture_set", c.texture_set, d.textureSet)) return *bad;
-        d.dims = ivec3Of(c.dims);
-        d.spacing = vec3Of(c.spacing);
-        d.position = vec3Of(c.position);
-        d.textureCount = c.texture_count;
-        d.opacity = c.opacity;
-        d.propagationStepsPerSec = c.propagation_steps_per_sec;
-        d.texturesPerSec = c.textures_per_sec;
-        d.crossfade = c.crossfade != 0;
-        if (auto bad = toMotion("desc.motion", c.motion_keys, c.motion_key_count, d.motion)) return *bad;
-        d.seed = c.seed;
-        d.textureSeed = c.texture_seed;
-        return addPreset(scene, materials, options, out_id,
-                         [&](Materials& m, Outcome& failed) { return fromResult(presets::fire(m, d), failed); });
-    });
+    return addPresetC<presets::FireDesc>("splatfx_scene_add_fire", error, scene, materials, desc, options, out_id, splatfx_fire_desc_init,
+                                         FireFields{}, presets::fire, kNoExtraCheck);
 }
 
 splatfx_status splatfx_scene_add_smoke(splatfx_scene* scene, splatfx_materials* materials, const splatfx_smoke_desc* desc,
                                        const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
-    return guard("splatfx_scene_add_smoke", error, [&] {
-        splatfx_smoke_desc c;
-        splatfx_smoke_desc_init(&c);
-        if (desc) c = *desc;
-        for (auto bad : {checkFinite3("desc.spacing", c.spacing), checkFinite3("desc.position", c.position),
-                         checkFinite3("desc.source_offset", c.source_offset), checkFinite("desc.source_radius", c.source_radius),
-                         checkFinite3("desc.wind_world", c.wind_world), checkFinite("desc.dissipation", c.dissipation),
-                         checkFinite("desc.textures_per_sec", c.textures_per_sec)})
-            if (bad) return *bad;
-        if (c.substeps < 1 || c.substeps > 64)
-            return invalid("desc.substeps is " + std::to_string(c.substeps) + "; expected solver substeps in [1, 64]");
-        presets::SmokeDesc d;
-        if (auto bad = setTextureSet("desc.texture_set", c.texture_set, d.textureSet)) return *bad;
-        d.dims = ivec3Of(c.dims);
-        d.spacing = vec3Of(c.spacing);
-        d.position = vec3Of(c.position);
-        d.sourceOffset = vec3Of(c.source_offset);
-        d.sourceRadius = c.source_radius;
-        d.windWorld = vec3Of(c.wind_world);
-        d.dissipation = c.dissipation;
-        d.textureCount = c.texture_count;
-        d.texturesPerSec = c.textures_per_sec;
-        d.substeps = c.substeps;
-        if (auto bad = toMotion("desc.source_motion", c.source_motion_keys, c.source_motion_key_count, d.sourceMotion)) return *bad;
-        d.seed = c.seed;
-        d.textureSeed = c.texture_seed;
-        return addPreset(scene, materials, options, out_id,
-                         [&](Materials& m, Outcome& failed) { return fromResult(presets::smoke(m, d), failed); });
-    });
+    // presets::smoke takes any substep count; the C layer bounds it like the scene files do.
+    auto substeps = [](const presets::SmokeDesc& d) -> std::optional<Outcome> {
+        if (d.substeps < 1 || d.substeps > 64)
+            return invalid("desc.substeps is " + std::to_string(d.substeps) + "; expected solver substeps in [1, 64]");
+        return std::nullopt;
+    };
+    return addPresetC<presets::SmokeDesc>("splatfx_scene_add_smoke", error, scene, materials, desc, options, out_id,
+                                          splatfx_smoke_desc_init, SmokeFields{}, presets::smoke, substeps);
 }
 
 splatfx_status splatfx_scene_add_steam(splatfx_scene* scene, splatfx_materials* materials, const splatfx_steam_desc* desc,
                                        const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
-    return guard("splatfx_scene_add_steam", error, [&] {
-        splatfx_steam_desc c;
-        splatfx_steam_desc_init(&c);
-        if (desc) c = *desc;
-        for (auto bad : {checkFinite3("desc.spacing", c.spacing), checkFinite3("desc.position", c.position),
-                         checkFinite("desc.opacity", c.opacity), checkFinite("desc.propagation_steps_per_sec", c.propagation_steps_per_sec),
-                         checkFinite("desc.textures_per_sec", c.textures_per_sec)})
-            if (bad) return *bad;
-        presets::SteamDesc d;
-        if (auto bad = setTextureSet("desc.texture_set", c.texture_set, d.textureSet)) return *bad;
-        d.dims = ivec3Of(c.dims);
-        d.spacing = vec3Of(c.spacing);
-        d.position = vec3Of(c.position);
-        d.textureCount = c.texture_count;
-        d.opacity = c.opacity;
-        d.propagationStepsPerSec = c.propagation_steps_per_sec;
-        d.texturesPerSec = c.textures_per_sec;
-        if (auto bad = toMotion("desc.motion", c.motion_keys, c.motion_key_count, d.motion)) return *bad;
-        d.seed = c.seed;
-        d.textureSeed = c.texture_seed;
-        return addPreset(scene, materials, options, out_id,
-                         [&](Materials& m, Outcome& failed) { return fromResult(presets::steam(m, d), failed); });
-    });
+    return addPresetC<presets::SteamDesc>("splatfx_scene_add_steam", error, scene, materials, desc, options, out_id,
+                                          splatfx_steam_desc_init, SteamFields{}, presets::steam, kNoExtraCheck);
 }
 
 splatfx_status splatfx_scene_add_dust(splatfx_scene* scene, splatfx_materials* materials, const splatfx_dust_desc* desc,
                                       const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
-    return guard("splatfx_scene_add_dust", error, [&] {
-        splatfx_dust_desc c;
-        splatfx_dust_desc_init(&c);
-        if (desc) c = *desc;
-        for (auto bad : {checkFinite3("desc.spacing", c.spacing), checkFinite3("desc.position", c.position),
-                         checkFinite3("desc.source_offset", c.source_offset), checkFinite("desc.source_radius", c.source_radius),
-                         checkFinite3("desc.wind_world", c.wind_world), checkFinite("desc.settle", c.settle),
-                         checkFinite("desc.dissipation", c.dissipation)})
-            if (bad) return *bad;
-        presets::DustDesc d;
-        if (auto bad = setTextureSet("desc.texture_set", c.texture_set, d.textureSet)) return *bad;
-        d.dims = ivec3Of(c.dims);
-        d.spacing = vec3Of(c.spacing);
-        d.position = vec3Of(c.position);
-        d.sourceOffset = vec3Of(c.source_offset);
-        d.sourceRadius = c.source_radius;
-        d.windWorld = vec3Of(c.wind_world);
-        d.settle = c.settle;
-        d.dissipation = c.dissipation;
-        d.textureCount = c.texture_count;
-        if (auto bad = toMotion("desc.source_motion", c.source_motion_keys, c.source_motion_key_count, d.sourceMotion)) return *bad;
-        d.seed = c.seed;
-        d.textureSeed = c.texture_seed;
-        return addPreset(scene, materials, options, out_id,
-                         [&](Materials& m, Outcome& failed) { return fromResult(presets::dust(m, d), failed); });
-    });
+    return addPresetC<presets::DustDesc>("splatfx_scene_add_dust", error, scene, materials, desc, options, out_id,
+                                         splatfx_dust_desc_init, DustFields{}, presets::dust, kNoExtraCheck);
 }
 
 splatfx_status splatfx_scene_add_fire_to_smoke(splatfx_scene* scene, splatfx_materials* materials,
                                                const splatfx_fire_to_smoke_desc* desc, const splatfx_effect_options* options,
                                                uint32_t* out_id, splatfx_error* error) {
-    return guard("splatfx_scene_add_fire_to_smoke", error, [&] {
-        splatfx_fire_to_smoke_desc c;
-        splatfx_fire_to_smoke_desc_init(&c);
-        if (desc) c = *desc;
-        for (auto bad : {checkFinite3("desc.spacing", c.spacing), checkFinite3("desc.position", c.position),
-                         checkFinite("desc.split", c.split), checkFinite("desc.blend", c.blend),
-                         checkFinite("desc.propagation_steps_per_sec", c.propagation_steps_per_sec),
-                         checkFinite("desc.textures_per_sec", c.textures_per_sec)})
-            if (bad) return *bad;
-        presets::FireToSmokeDesc d;
-        if (auto bad = setTextureSet("desc.fire_texture_set", c.fire_texture_set, d.fireTextureSet)) return *bad;
-        if (auto bad = setTextureSet("desc.smoke_texture_set", c.smoke_texture_set, d.smokeTextureSet)) return *bad;
-        d.dims = ivec3Of(c.dims);
-        d.spacing = vec3Of(c.spacing);
-        d.position = vec3Of(c.position);
-        d.split = c.split;
-        d.blend = c.blend;
-        if (auto bad = toMotion("desc.motion", c.motion_keys, c.motion_key_count, d.motion)) return *bad;
-        d.propagationStepsPerSec = c.propagation_steps_per_sec;
-        d.texturesPerSec = c.textures_per_sec;
-        d.seed = c.seed;
-        d.textureSeed = c.texture_seed;
-        return addPreset(scene, materials, options, out_id,
-                         [&](Materials& m, Outcome& failed) { return fromResult(presets::fireToSmoke(m, d), failed); });
-    });
+    return addPresetC<presets::FireToSmokeDesc>("splatfx_scene_add_fire_to_smoke", error, scene, materials, desc, options, out_id,
+                                                splatfx_fire_to_smoke_desc_init, FireToSmokeFields{},
+                                                presets::fireToSmoke, kNoExtraCheck);
 }
 
 splatfx_status splatfx_scene_add_ghosts(splatfx_scene* scene, splatfx_materials* materials, const splatfx_ghosts_desc* desc,
                                         const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
-    return guard("splatfx_scene_add_ghosts", error, [&] {
-        splatfx_ghosts_desc c;
-        splatfx_ghosts_desc_init(&c);
-        if (desc) c = *desc;
-        for (auto bad : {checkFinite("desc.head_radius_cells", c.head_radius_cells), checkFinite3("desc.spacing", c.spacing),
-                         checkFinite3("desc.position", c.position), checkFinite("desc.opacity", c.opacity),
-                         checkFinite("desc.textures_per_sec", c.textures_per_sec),
-                         checkFinite("desc.propagation_steps_per_sec", c.propagation_steps_per_sec)})
-            if (bad) return *bad;
-        presets::GhostsDesc d;
-        if (auto bad = setTextureSet("desc.texture_set", c.texture_set, d.textureSet)) return *bad;
-        d.headRadiusCells = c.head_radius_cells;
-        d.plumeCells = c.plume_cells;
-        d.spacing = vec3Of(c.spacing);
-        d.position = vec3Of(c.position);
-        d.textureCount = c.texture_count;
-        d.opacity = c.opacity;
-        d.texturesPerSec = c.textures_per_sec;
-        d.propagationStepsPerSec = c.propagation_steps_per_sec;
-        d.seed = c.seed;
-        d.textureSeed = c.texture_seed;
-        return addPreset(scene, materials, options, out_id,
-                         [&](Materials& m, Outcome& failed) { return fromResult(presets::ghosts(m, d), failed); });
-    });
+    return addPresetC<presets::GhostsDesc>("splatfx_scene_add_ghosts", error, scene, materials, desc, options, out_id,
+                                           splatfx_ghosts_desc_init, GhostsFields{}, presets::ghosts, kNoExtraCheck);
 }
 
 splatfx_status splatfx_scene_load_file(const char* path, splatfx_materials* materials, const uint32_t* seed,
