@@ -72,6 +72,7 @@ struct Options {
     bool replotOnly = false; // --replot: only run gnuplot on an existing DIR/accuracy.gp
     bool plots = true;
     bool fogOnly = false;    // --fog-only: only the fog knobs (issue 14) and their reference
+    bool cloudsOnly = false; // --clouds-only: only the LOD clouds' knobs (issue 17, cloud_knobs.cpp)
 };
 
 // Texture slices: the truth set has kTruthCount textures along the noise loop
@@ -427,6 +428,9 @@ bool parse(int argc, char** argv, Options& o) {
             o.replotOnly = true;
         } else if (a == "--fog-only") {
             o.fogOnly = true;
+        } else if (a == "--clouds-only") {
+            o.cloudsOnly = true;
+            o.plots = false; // the clouds' table is printed, not plotted
         } else {
             return false;
         }
@@ -490,7 +494,8 @@ int runAccuracy(int argc, char** argv) {
                              "  --size WxH   frame size (default 320x240)\n"
                              "  --reps N     timed frames per setting, median reported (default 11)\n"
                              "  --replot     only run gnuplot again on DIR/accuracy.gp (after editing it)\n"
-                             "  --fog-only   only the fog knobs (host fog texture, per-splat fog, fog terms) and their reference\n");
+                             "  --fog-only   only the fog knobs (host fog texture, per-splat fog, fog terms) and their reference\n"
+                             "  --clouds-only  only the LOD clouds' knobs (table size, c, C, max vs average Delta) against the finest level\n");
         return 2;
     }
     if (b.opt.replotOnly) {
@@ -518,6 +523,9 @@ int runAccuracy(int argc, char** argv) {
     std::printf("splatfx-bench accuracy: %dx%d, %d timed frames per setting, GL renderer: %s\n", b.opt.size.x, b.opt.size.y,
                 b.opt.reps, ctx->renderer().c_str());
     std::printf("cores: %u, load average (1/5/15 min): %s\n", std::thread::hardware_concurrency(), loadAverage().c_str());
+    // The clouds' knobs: a 65x65x17 field (the popping run's) at 256x192, 9 frames a setting.
+    const auto cloudKnobs = [&] { return runCloudKnobs({65, 65, 17}, {256, 192}, 9); };
+    if (b.opt.cloudsOnly) return cloudKnobs();
     b.cam = camera(b.opt.size);
     std::string err;
     if (!b.host.init(err)) {
@@ -815,6 +823,10 @@ int runAccuracy(int argc, char** argv) {
         }
         std::printf("wrote %s/accuracy_knobs.png and %s/accuracy_pareto.png (data: accuracy.dat, script: accuracy.gp)\n", b.opt.out.c_str(),
                     b.opt.out.c_str());
+    }
+    if (!b.opt.fogOnly) {
+        std::printf("\n");
+        if (int rc = cloudKnobs(); rc != 0) return rc;
     }
     std::printf("accuracy: done in %.1f s; load average at the end: %s\n", ms(start, Clock::now()) / 1e3, loadAverage().c_str());
     return 0;

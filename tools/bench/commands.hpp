@@ -4,6 +4,8 @@
 // progress and a summary, and returns the process exit code.
 #pragma once
 
+#include <glm/glm.hpp>
+
 int runAccuracy(int argc, char** argv); // accuracy.cpp: error vs time per quality knob (issue 5)
 int runTable1(int argc, char** argv);   // table1.cpp: the paper's Table I, fill limit, CPU scaling (issue 7)
 int runScheduling(int argc, char** argv); // scheduling.cpp: 1000 effects, 10 in view; catch-up error (issue 6)
@@ -13,6 +15,10 @@ int runClouds(int argc, char** argv);     // clouds.cpp: LOD volumes as projecte
 int runCut(int argc, char** argv);        // cut.cpp: splats cut by the host depth and the near plane: cost, accuracy, popping (issue 15)
 int runSoak(int argc, char** argv);       // soak.cpp: every preset for an hour of scene time; finite, flat bounds and memory (issue 13)
 int runTransparency(int argc, char** argv); // transparency.cpp: glass panes among the fire, fragment lists vs ordered blend (issue 15)
+
+// cloud_knobs.cpp, run by accuracy (--clouds-only alone): the LOD clouds' table size, c, C and
+// max vs average Delta against the finest level integrated exactly (issue 17). Needs a current GL context.
+int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps);
 
 struct BenchCommand {
     const char* name;
