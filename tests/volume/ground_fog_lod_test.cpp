@@ -222,30 +222,54 @@ TEST(GroundFogLod, MorphingMakesARefinementThresholdContinuous) {
         if (jump > bestJump) bestJump = jump, s0 = lo, s1 = hi, fresh = changed;
     }
     ASSERT_GE(bestJump, 0.05) << "the path should cross a threshold that moves the terrain";
-    // Vertical rays just beside each new vertex (not on it: a ray along a
+    // The same layer with the affine density model (the scalar the same for
+    // any split of a prism): its thresholds are the same (Delta does not
+    // depend on density). The thickness here is at most 3 + 2.5 = 5.5 <= 6.
+    GroundFogDesc ad = d;
+    ad.densityDepthWorld = 6.0f;
+    auto affine = GroundFog::create(ad);
+    ASSERT_TRUE(affine) << affine.error();
+    // Vertical rays just beside each changed vertex (not on it: a ray along a
     // prism edge would count every tetrahedron sharing it).
-    auto change = [&](const LodRefineDesc& r) {
+    std::vector<glm::dvec2> at;
+    for (const auto& xz : fresh)
+        for (glm::dvec2 o2 : {glm::dvec2(0.013, 0.007), glm::dvec2(-0.011, 0.017), glm::dvec2(0.005, -0.019)}) at.push_back(glm::dvec2(xz[0], xz[1]) + o2);
+    auto change = [&](const GroundFog& layer, const LodRefineDesc& r, double* terrainChange) {
         LodFrame a, b;
-        EXPECT_TRUE(fog->update(camAt(s0), r, a));
-        EXPECT_TRUE(fog->update(camAt(s1), r, b));
+        std::vector<glm::vec3> ta, tb;
+        EXPECT_TRUE(layer.update(camAt(s0), r, a, &ta));
+        EXPECT_TRUE(layer.update(camAt(s1), r, b, &tb));
         double worst = 0.0;
-        for (const auto& xz : fresh)
-            for (glm::dvec2 off2 : {glm::dvec2(0.013, 0.007), glm::dvec2(-0.011, 0.017), glm::dvec2(0.005, -0.019)}) {
-                const glm::dvec3 o(xz[0] + off2.x, 100.0, xz[1] + off2.y), dir(0.0, -1.0, 0.0);
-                const double ia = integrateRay(a.tets, *tf, o, dir, 0.0, 300.0).a, ib = integrateRay(b.tets, *tf, o, dir, 0.0, 300.0).a;
-                worst = std::max(worst, std::abs(ia - ib));
-            }
+        *terrainChange = 0.0;
+        for (glm::dvec2 p : at) {
+            const glm::dvec3 o(p.x, 100.0, p.y), dir(0.0, -1.0, 0.0);
+            const double ia = integrateRay(a.tets, *tf, o, dir, 0.0, 300.0).a, ib = integrateRay(b.tets, *tf, o, dir, 0.0, 300.0).a;
+            worst = std::max(worst, std::abs(ia - ib));
+            *terrainChange = std::max(*terrainChange, std::abs(heightAt(ta, p.x, p.y) - heightAt(tb, p.x, p.y)));
+        }
         return worst;
     };
-    const double pop = change(off), smooth = change(on);
-    // The pop moves the terrain (and so the thickness) by bestJump next to the
-    // rays; alpha = 1 - exp(-0.4 thickness) changes by >= 0.4 exp(-2) ~ 0.05 per unit
-    // thickness here (thickness <= 5): a jump of 0.05 world gives >= 2.5e-3, 1e-3 is met with room.
+    double jumpOff = 0.0, jumpOn = 0.0, unused = 0.0;
+    const double pop = change(*affine, off, &jumpOff), smooth = change(*affine, on, &jumpOn);
+    const double popPaper = change(*fog, off, &unused), smoothPaper = change(*fog, on, &unused);
+    // The pop moves the terrain (and so the thickness) next to the rays by
+    // about bestJump >= 0.05; alpha = 1 - exp(-0.8 * 0.5 * density-weighted
+    // thickness) changes by well over 1e-3 for that.
+    EXPECT_GT(jumpOff, 0.02) << "the terrain next to the rays pops without morphing";
     EXPECT_GT(pop, 1e-3) << "jump " << bestJump;
     // With morphing w = e - 1 starts at 0 on the threshold and moves by
     // ~ e * step / distance ~ 1e-4 / 15 per step: the change is ~1e-5 of the
-    // pop and its descendants'; 1e-2 leaves room for rounding (float heights).
+    // pop and of its descendants'; 1e-2 leaves room for rounding (float heights).
+    EXPECT_LT(jumpOn, 1e-2 * jumpOff) << "the terrain (and the fog's bottom and top) morphs";
     EXPECT_LT(smooth, 1e-2 * pop) << "pop " << pop << " morphed " << smooth;
+    // The paper's density model (density at the terrain, 0 at the top,
+    // linear per tetrahedron) re-splits the prisms at a refinement: the fog
+    // changes there although the geometry does not (measured, not bounded:
+    // docs/volume.md).
+    RecordProperty("affinePop", std::to_string(pop));
+    RecordProperty("affineMorphed", std::to_string(smooth));
+    RecordProperty("paperModelPop", std::to_string(popPaper));
+    RecordProperty("paperModelMorphed", std::to_string(smoothPaper));
 }
 
 // Along any ray from the eye a tetrahedron later in the list is never behind
@@ -274,9 +298,11 @@ TEST(GroundFogLod, BackToFrontAlongRaysOutsideAndInside) {
                 lastIn = std::min(lastIn, iv.x);
             }
         }
-        EXPECT_GT(crossings, 100);
+        EXPECT_GT(crossings, 50); // the coarse mesh has fewer tetrahedra than the grid's test
         EXPECT_EQ(wrong, 0) << "camera " << ci;
-        if (ci == 1) EXPECT_GT(f.stats.clippedInput, 0u);
+        if (ci == 1) {
+            EXPECT_GT(f.stats.clippedInput, 0u);
+        }
     }
 }
 

@@ -350,6 +350,16 @@ struct GroundFogDesc {
     std::vector<float> terrainHeight; // dims.x * dims.y world heights (x fastest)
     std::vector<float> fogTop;        // same size: world height of the fog's top; <= terrain: no fog there
     float density = 1.0f;             // default 1: the scalar at the terrain (the top boundary has 0, sec. 6)
+    // Default 0: the scalar is `density` on the terrain and 0 at the top
+    // (sec. 6), linear within each tetrahedron, so inside a prism of varying
+    // thickness it depends on how the prism is split: refining the LOD
+    // re-splits prisms and the fog changes there even when the geometry is
+    // morphed (docs/volume.md measures it). > 0: the scalar is
+    // density * (fog top - y) / densityDepthWorld, affine in every prism, the
+    // same for any split: with morphing a refinement changes nothing at all.
+    // The fog then thins where it is shallow. create() fails if a thickness
+    // exceeds it (the scalar would pass 1).
+    float densityDepthWorld = 0.0f;
     // The paper's sort-free emissive model (sec. 6, eq. 10): true
     // emits the tetrahedra in grid order with no back-to-front sorting. With
     // one fog colour C (makeGroundFogTransfer) every segment blends as

@@ -129,14 +129,16 @@ struct Emitter {
         }
         if (h[0] <= 0.0f && h[1] <= 0.0f && h[2] <= 0.0f) return false; // zero-height prism dropped
         ++out.stats.fullResolution;
-        const float s = d.density;
+        // The scalar at each bottom vertex: `density`, or affine in height (densityDepthWorld > 0).
+        float sb[3];
+        for (int k = 0; k < 3; ++k) sb[k] = d.densityDepthWorld > 0.0f ? std::min(d.density * h[k] / d.densityDepthWorld, 1.0f) : d.density;
         Tetrahedron t[3];
         t[0].position = {B[0], B[1], B[2], T[0]};
-        t[0].scalar = {s, s, s, 0.0f};
+        t[0].scalar = {sb[0], sb[1], sb[2], 0.0f};
         t[1].position = {B[1], B[2], T[0], T[1]};
-        t[1].scalar = {s, s, 0.0f, 0.0f};
+        t[1].scalar = {sb[1], sb[2], 0.0f, 0.0f};
         t[2].position = {B[2], T[0], T[1], T[2]};
-        t[2].scalar = {s, 0.0f, 0.0f, 0.0f};
+        t[2].scalar = {sb[2], 0.0f, 0.0f, 0.0f};
         bool keep[3];
         // The prism's horizontal extent for the degenerate test (the grid spacing at full resolution).
         const double ext = std::max({std::abs(double(B[1].x) - B[0].x), std::abs(double(B[1].z) - B[0].z),
@@ -332,6 +334,13 @@ Result<GroundFog> GroundFog::create(const GroundFogDesc& desc) {
     if (!std::isfinite(desc.spacingWorld) || !(desc.spacingWorld > 0.0f)) return makeError("GroundFogDesc.spacingWorld must be finite and > 0");
     if (!std::isfinite(desc.density) || desc.density < 0.0f || desc.density > 1.0f) return makeError("GroundFogDesc.density must be in [0, 1]");
     if (!std::isfinite(desc.originWorld.x) || !std::isfinite(desc.originWorld.z)) return makeError("GroundFogDesc.originWorld must be finite");
+    if (!std::isfinite(desc.densityDepthWorld) || desc.densityDepthWorld < 0.0f)
+        return makeError("GroundFogDesc.densityDepthWorld must be finite and >= 0");
+    if (desc.densityDepthWorld > 0.0f)
+        for (std::size_t i = 0; i < n; ++i)
+            if (desc.fogTop[i] - desc.terrainHeight[i] > desc.densityDepthWorld * (1.0f + 1e-6f))
+                return makeError("GroundFogDesc.densityDepthWorld (" + std::to_string(desc.densityDepthWorld) + ") is below the fog thickness " +
+                                 std::to_string(desc.fogTop[i] - desc.terrainHeight[i]) + " at point " + std::to_string(i));
     if (desc.lod && (!std::isfinite(desc.minAccuracyC) || !(desc.minAccuracyC > 0.0f)))
         return makeError("GroundFogDesc.minAccuracyC must be finite and > 0, got " + std::to_string(desc.minAccuracyC));
     GroundFog fog;
