@@ -36,6 +36,7 @@ struct Options {
     float stepWorld = 1.0f; // world units per frame along the flight
     float detailC = 1.0f;
     float minAccuracyC = 4.0f;
+    std::string out; // --out DIR: the last frame of each mode as PNG
 };
 
 double percentile(std::vector<double> v, double p) {
@@ -46,7 +47,7 @@ double percentile(std::vector<double> v, double p) {
 
 int usage() {
     std::printf("usage: splatfx-bench groundfog [--dem FILE.pgm] [--size W H] [--frames N] [--step WORLD_PER_FRAME]\n"
-                "                               [--c DETAIL] [--C MIN_ACCURACY]\n");
+                "                               [--c DETAIL] [--C MIN_ACCURACY] [--out DIR]\n");
     return 2;
 }
 
@@ -87,6 +88,7 @@ int runGroundFog(int argc, char** argv) {
         else if (!std::strcmp(argv[i], "--step") && i + 1 < argc) o.stepWorld = float(std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--c") && i + 1 < argc) o.detailC = float(std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--C") && i + 1 < argc) o.minAccuracyC = float(std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) o.out = argv[++i];
         else return usage();
     }
     if (o.frames < 2 || o.size.x < 1 || o.size.y < 1 || !(o.stepWorld > 0.0f)) return usage();
@@ -170,6 +172,10 @@ int runGroundFog(int argc, char** argv) {
                     for (int k = 0; k < 4; ++k) e = std::max(e, double(std::abs(im.pixels[p + std::size_t(k)] - m.prev.pixels[p + std::size_t(k)])));
                     m.change.push_back(e);
                 }
+            if (!o.out.empty() && f == o.frames - 1) {
+                const std::string name = o.out + "/groundfog-" + std::to_string(&m - modes) + ".png";
+                if (auto st = splatfx::writeImage(name, im); !st) std::fprintf(stderr, "%s\n", st.error().c_str());
+            }
             m.prev = std::move(im);
         }
     }

@@ -395,6 +395,15 @@ Result<GroundFog> GroundFog::create(const GroundFogDesc& desc) {
                 const double h = fog.mHeight[km], hl = fog.mHeight[kl], hr = fog.mHeight[kr];
                 const double top = h + fog.mThickness[km], topL = hl + fog.mThickness[kl], topR = hr + fog.mThickness[kr];
                 double dlt = std::max(std::abs(h - 0.5 * (hl + hr)), std::abs(top - 0.5 * (topL + topR)));
+                // A triangle across the grid's last row or column carries fog
+                // into the padding (tapering to its padded corners' 0) until it
+                // splits: count that fog as deviation too, so the metric refines
+                // the boundary where fog reaches it.
+                const int dx = desc.dims.x - 1, dy = desc.dims.y - 1;
+                const int x0 = std::min({t.a.x, t.l.x, t.r.x}), x1 = std::max({t.a.x, t.l.x, t.r.x});
+                const int y0 = std::min({t.a.y, t.l.y, t.r.y}), y1 = std::max({t.a.y, t.l.y, t.r.y});
+                if ((x0 < dx && x1 > dx) || (y0 < dy && y1 > dy))
+                    dlt = std::max({dlt, double(fog.mThickness[g.at(t.a)]), double(fog.mThickness[kl]), double(fog.mThickness[kr])});
                 double rad = fog.mRadius[km];
                 if (depth + 1 < fog.mMaxDepth)
                     for (glm::ivec2 c : {(t.l + t.a) / 2, (t.a + t.r) / 2}) {
