@@ -37,6 +37,7 @@ struct Options {
     float detailC = 1.0f;
     float minAccuracyC = 4.0f;
     std::string out; // --out DIR: the last frame of each mode as PNG
+    float densityDepth = 0.0f; // --affine DEPTH: GroundFogDesc::densityDepthWorld (0: the paper's model)
 };
 
 double percentile(std::vector<double> v, double p) {
@@ -47,13 +48,14 @@ double percentile(std::vector<double> v, double p) {
 
 int usage() {
     std::printf("usage: splatfx-bench groundfog [--dem FILE.pgm] [--size W H] [--frames N] [--step WORLD_PER_FRAME]\n"
-                "                               [--c DETAIL] [--C MIN_ACCURACY] [--out DIR]\n");
+                "                               [--c DETAIL] [--C MIN_ACCURACY] [--out DIR] [--affine DEPTH]\n");
     return 2;
 }
 
 // Sample 22's layer: spacing 1, heightScale 1228.78, position y -4.69, fog top 5.
-splatfx::GroundFogDesc jacksboro(const splatfx::Image& img, bool lod, float minAccuracyC) {
+splatfx::GroundFogDesc jacksboro(const splatfx::Image& img, bool lod, float minAccuracyC, float densityDepth) {
     splatfx::GroundFogDesc d;
+    d.densityDepthWorld = densityDepth;
     const int w = img.width, h = img.height;
     d.dims = {w, h};
     d.originWorld = splatfx::heightmapPoint(0, 0, w, h, 0.0f, 1.0f, 0.0f);
@@ -89,6 +91,7 @@ int runGroundFog(int argc, char** argv) {
         else if (!std::strcmp(argv[i], "--c") && i + 1 < argc) o.detailC = float(std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--C") && i + 1 < argc) o.minAccuracyC = float(std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) o.out = argv[++i];
+        else if (!std::strcmp(argv[i], "--affine") && i + 1 < argc) o.densityDepth = float(std::atof(argv[++i]));
         else return usage();
     }
     if (o.frames < 2 || o.size.x < 1 || o.size.y < 1 || !(o.stepWorld > 0.0f)) return usage();
@@ -108,7 +111,7 @@ int runGroundFog(int argc, char** argv) {
     Layer layers[2];
     for (int k = 0; k < 2; ++k) {
         const auto t0 = Clock::now();
-        auto fog = splatfx::GroundFog::create(jacksboro(*img, k == 1, o.minAccuracyC));
+        auto fog = splatfx::GroundFog::create(jacksboro(*img, k == 1, o.minAccuracyC, o.densityDepth));
         layers[k].buildMs = ms(Clock::now() - t0);
         auto tf = splatfx::makeGroundFogTransfer({0.9f, 0.92f, 0.95f}, 0.5f);
         if (!fog || !tf) return std::fprintf(stderr, "%s\n", fog ? tf.error().c_str() : fog.error().c_str()), 1;
@@ -184,8 +187,10 @@ int runGroundFog(int argc, char** argv) {
         for (double x : v) s += x;
         return v.empty() ? 0.0 : s / double(v.size());
     };
-    std::printf("groundfog: Jacksboro DEM %dx%d (%s), fog top 5, %d frames at %dx%d, %.2f world units per frame, c = %.2f, C = %.2f\n",
-                img->width, img->height, o.dem.c_str(), o.frames, o.size.x, o.size.y, o.stepWorld, o.detailC, o.minAccuracyC);
+    std::printf("groundfog: Jacksboro DEM %dx%d (%s), fog top 5, %d frames at %dx%d, %.2f world units per frame, c = %.2f, C = %.2f, "
+                "density %s\n",
+                img->width, img->height, o.dem.c_str(), o.frames, o.size.x, o.size.y, o.stepWorld, o.detailC, o.minAccuracyC,
+                o.densityDepth > 0.0f ? ("affine, depth " + std::to_string(o.densityDepth)).c_str() : "the paper's (1 at the terrain, 0 at the top)");
     std::printf("full resolution: %llu tetrahedra; memory full %zu bytes (built %.1f ms), LOD %zu bytes (built %.1f ms)\n",
                 static_cast<unsigned long long>(full), layers[0].bytes, layers[0].buildMs, layers[1].bytes, layers[1].buildMs);
     const double finestMax = percentile(modes[0].change, 1.0), finestP99 = percentile(modes[0].change, 0.99);

@@ -70,6 +70,8 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     o.number("detailC", detailC, 0.0, 1e6);
     o.number("minAccuracyC", minAccuracyC, 1e-3, 1e6);
     o.boolean("morph", morph);
+    float densityDepth = 0.0f;
+    o.number("densityDepthWorld", densityDepth, 0.0, 1e6);
     if (!lod)
         for (const char* key : {"detailC", "minAccuracyC", "morph"})
             if (o.has(key)) c.d.error(o.at(key), std::string("only with \"lod\": true (the full-resolution layer has no LOD)"));
@@ -119,6 +121,7 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     gd.sortFree = sortFree;
     gd.lod = lod;
     gd.minAccuracyC = minAccuracyC;
+    gd.densityDepthWorld = densityDepth;
     gd.terrainHeight.resize(std::size_t(gd.dims.x) * gd.dims.y);
     gd.fogTop.resize(gd.terrainHeight.size());
     float lowest = 1e30f;
