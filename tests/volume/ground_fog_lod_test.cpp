@@ -107,52 +107,63 @@ TEST(GroundFogLod, FullRefinementEqualsTheFullResolutionLayer) {
 }
 
 // For random cameras and c the LOD terrain is a conforming triangulation of
-// the square: every edge not on the square's border is shared by exactly two
+// the grid's rectangle: every edge not on its border is shared by exactly two
 // triangles (a T-vertex or a crack leaves edges used once; a vertex morphed
 // differently by its two diamond triangles gives two positions, so unmatched
 // edges too), the triangles face up and their areas add up to the square's.
 TEST(GroundFogLod, MeshIsConformingForRandomCameras) {
-    const GroundFogDesc d = valleys({33, 33}, 0.8f);
-    auto fog = GroundFog::create(d);
-    ASSERT_TRUE(fog) << fog.error();
-    std::mt19937 rng(11);
-    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-    const float lo = -10.0f, hi = 10.0f;
-    std::uint64_t minTris = ~0ull, maxTris = 0;
-    for (int trial = 0; trial < 40; ++trial) {
-        const glm::vec3 eye{15.0f * u(rng), 3.0f + 6.0f * (u(rng) + 1.0f), 15.0f * u(rng)};
-        const Camera cam = Camera::lookAt(eye, {u(rng), 0.0f, u(rng)}, {0, 1, 0}, glm::radians(60.0f), {64, 48}, 0.1f, 500.0f);
-        LodRefineDesc r;
-        r.detailC = std::pow(10.0f, 2.0f * (u(rng) + 1.0f) - 1.0f); // 0.1 .. 1000
-        r.morph = trial % 3 != 0;
-        LodFrame f;
-        std::vector<glm::vec3> tri;
-        ASSERT_TRUE(fog->update(cam, r, f, &tri));
-        ASSERT_EQ(tri.size() % 3, 0u);
-        minTris = std::min<std::uint64_t>(minTris, tri.size() / 3);
-        maxTris = std::max<std::uint64_t>(maxTris, tri.size() / 3);
-        std::map<std::array<float, 6>, int> edges;
-        double area = 0.0;
-        for (std::size_t i = 0; i < tri.size(); i += 3) {
-            const glm::dvec3 a(tri[i]), b(tri[i + 1]), c(tri[i + 2]);
-            const double up = (b.z - a.z) * (c.x - a.x) - (b.x - a.x) * (c.z - a.z); // y of cross(b-a, c-a)
-            EXPECT_GT(up, 0.0) << "counter-clockwise from above";
-            area += 0.5 * up;
-            for (int k = 0; k < 3; ++k) {
-                glm::vec3 p = tri[i + std::size_t(k)], q = tri[i + std::size_t((k + 1) % 3)];
-                if (std::tie(q.x, q.y, q.z) < std::tie(p.x, p.y, p.z)) std::swap(p, q);
-                ++edges[{p.x, p.y, p.z, q.x, q.y, q.z}];
+    // 33x33 is a 2^n+1 grid; 33x21 is padded to 33x33 and its coarse
+    // triangles across the last row are cut at the grid's edge.
+    for (glm::ivec2 dims : {glm::ivec2(33, 33), glm::ivec2(33, 21)}) {
+        const GroundFogDesc d = valleys(dims, 0.8f);
+        auto fog = GroundFog::create(d);
+        ASSERT_TRUE(fog) << fog.error();
+        std::mt19937 rng(11);
+        std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+        const float lo = -10.0f, hiX = d.originWorld.x + float(dims.x - 1) * d.spacingWorld,
+                    hiZ = d.originWorld.z + float(dims.y - 1) * d.spacingWorld;
+        const double areaExact = double(hiX - lo) * double(hiZ - lo);
+        std::uint64_t minTris = ~0ull, maxTris = 0;
+        for (int trial = 0; trial < 40; ++trial) {
+            const glm::vec3 eye{15.0f * u(rng), 3.0f + 6.0f * (u(rng) + 1.0f), 15.0f * u(rng)};
+            const Camera cam = Camera::lookAt(eye, {u(rng), 0.0f, u(rng)}, {0, 1, 0}, glm::radians(60.0f), {64, 48}, 0.1f, 500.0f);
+            LodRefineDesc r;
+            r.detailC = std::pow(10.0f, 2.0f * (u(rng) + 1.0f) - 1.0f); // 0.1 .. 1000
+            r.morph = trial % 3 != 0;
+            LodFrame f;
+            std::vector<glm::vec3> tri;
+            ASSERT_TRUE(fog->update(cam, r, f, &tri));
+            ASSERT_EQ(tri.size() % 3, 0u);
+            minTris = std::min<std::uint64_t>(minTris, tri.size() / 3);
+            maxTris = std::max<std::uint64_t>(maxTris, tri.size() / 3);
+            std::map<std::array<float, 6>, int> edges;
+            double area = 0.0;
+            for (std::size_t i = 0; i < tri.size(); i += 3) {
+                const glm::dvec3 a(tri[i]), b(tri[i + 1]), c(tri[i + 2]);
+                const double up = (b.z - a.z) * (c.x - a.x) - (b.x - a.x) * (c.z - a.z); // y of cross(b-a, c-a)
+                EXPECT_GT(up, 0.0) << "counter-clockwise from above";
+                area += 0.5 * up;
+                for (int k = 0; k < 3; ++k) {
+                    glm::vec3 p = tri[i + std::size_t(k)], q = tri[i + std::size_t((k + 1) % 3)];
+                    EXPECT_TRUE(p.x >= lo && p.x <= hiX && p.z >= lo && p.z <= hiZ) << "a terrain vertex beyond the grid";
+                    if (std::tie(q.x, q.y, q.z) < std::tie(p.x, p.y, p.z)) std::swap(p, q);
+                    ++edges[{p.x, p.y, p.z, q.x, q.y, q.z}];
+                }
             }
+            // The grid's rectangle; cut points are float (x or z fractional): 1e-5 relative.
+            EXPECT_NEAR(area, areaExact, 1e-5 * areaExact);
+            int bad = 0;
+            for (const auto& [e, n] : edges) {
+                const bool border = (e[0] == e[3] && (e[0] == lo || e[0] == hiX)) || (e[2] == e[5] && (e[2] == lo || e[2] == hiZ));
+                if (n != (border ? 1 : 2)) ++bad;
+            }
+            EXPECT_EQ(bad, 0) << dims.x << "x" << dims.y << " trial " << trial;
+            // No fog beyond the grid either.
+            for (const Tetrahedron& t : f.tets)
+                for (const glm::vec3& p : t.position) ASSERT_TRUE(p.x <= hiX && p.z <= hiZ) << "fog beyond the grid";
         }
-        EXPECT_NEAR(area, 400.0, 1e-6 * 400.0); // the 20x20 square, in double from float corners on a 2^-k lattice
-        int bad = 0;
-        for (const auto& [e, n] : edges) {
-            const bool border = (e[0] == e[3] && (e[0] == lo || e[0] == hi)) || (e[2] == e[5] && (e[2] == lo || e[2] == hi));
-            if (n != (border ? 1 : 2)) ++bad;
-        }
-        EXPECT_EQ(bad, 0) << "trial " << trial;
+        EXPECT_LT(minTris, maxTris) << "the cameras should give different meshes";
     }
-    EXPECT_LT(minTris, maxTris) << "the cameras should give different meshes";
 }
 
 // Morphing (sec. 3): as the eye crosses a refinement threshold by a tiny

@@ -131,10 +131,12 @@ int runGroundFog(int argc, char** argv) {
         bool morph;
         std::vector<double> msFrame, msPrepare, drawn, change, rmse;
         splatfx::Image prev;
+        double worst = -1.0; // the largest per-pixel change so far, its frame and pixel
+        int worstFrame = -1, worstX = 0, worstY = 0;
     };
-    Mode modes[3] = {{"full resolution", 0, true, {}, {}, {}, {}, {}, {}},
-                     {"LOD, morphing", 1, true, {}, {}, {}, {}, {}, {}},
-                     {"LOD, no morphing", 1, false, {}, {}, {}, {}, {}, {}}};
+    Mode modes[3] = {{"full resolution", 0, true, {}, {}, {}, {}, {}, {}, {}},
+                     {"LOD, morphing", 1, true, {}, {}, {}, {}, {}, {}, {}},
+                     {"LOD, no morphing", 1, false, {}, {}, {}, {}, {}, {}, {}}};
     std::uint64_t full = 0;
     for (int f = -1; f < o.frames; ++f) { // one warm-up frame (shader compile, table upload)
         const splatfx::Camera cam = flight(std::max(f, 0), o.stepWorld, o.size);
@@ -174,6 +176,10 @@ int runGroundFog(int argc, char** argv) {
                     double e = 0;
                     for (int k = 0; k < 4; ++k) e = std::max(e, double(std::abs(im.pixels[p + std::size_t(k)] - m.prev.pixels[p + std::size_t(k)])));
                     m.change.push_back(e);
+                    if (e > m.worst) {
+                        const int px = int(p / 4);
+                        m.worst = e, m.worstFrame = f, m.worstX = px % o.size.x, m.worstY = px / o.size.x; // read() is top row first
+                    }
                 }
             if (!o.out.empty() && f == o.frames - 1) {
                 const std::string name = o.out + "/groundfog-" + std::to_string(&m - modes) + ".png";
@@ -201,6 +207,8 @@ int runGroundFog(int argc, char** argv) {
                     m.name, mean(m.drawn), double(full) / std::max(mean(m.drawn), 1.0), percentile(m.msFrame, 0.5),
                     percentile(m.msPrepare, 0.5), mean(m.rmse), m.rmse.empty() ? 0.0 : *std::max_element(m.rmse.begin(), m.rmse.end()),
                     mx, p99, mx / std::max(finestMax, 1e-12), p99 / std::max(finestP99, 1e-12));
+        std::printf("  %-17s largest change between frames %d and %d at pixel (%d, %d) from the top left\n", "", m.worstFrame - 1,
+                    m.worstFrame, m.worstX, m.worstY);
     }
     return 0;
 }

@@ -275,13 +275,108 @@ struct LodRefiner {
 
     void leaf(const Tri& t, Shown sa, Shown sl, Shown sr) {
         if (g.outside(t)) return;
-        auto pv = [&](glm::ivec2 p, Shown s) {
-            return Emitter::PV{std::uint64_t(p.x) + std::uint64_t(g.n) * std::uint64_t(p.y),
-                               glm::vec3(g.worldX(p.x), s.h, g.worldZ(p.y)), s.th};
+        auto key = [&](glm::ivec2 p) { return std::uint64_t(p.x) + std::uint64_t(g.n) * std::uint64_t(p.y); };
+        const int X = g.dims.x - 1, Z = g.dims.y - 1;
+        if (std::max({t.a.x, t.l.x, t.r.x}) <= X && std::max({t.a.y, t.l.y, t.r.y}) <= Z) {
+            auto pv = [&](glm::ivec2 p, Shown s) { return Emitter::PV{key(p), glm::vec3(g.worldX(p.x), s.h, g.worldZ(p.y)), s.th}; };
+            const Emitter::PV a = pv(t.a, sa), l = pv(t.l, sl), r = pv(t.r, sr);
+            em.terrainTri(a.bottom, l.bottom, r.bottom);
+            em.prismOf(a, l, r);
+            return;
+        }
+        clippedLeaf(t, sa, sl, sr, key);
+    }
+
+    // A leaf across the grid's last column or row: cut to the grid (x <= X,
+    // z <= Z, in grid coordinates) so no fog and no terrain reach into the
+    // padding; the convex piece is fanned and the fan drawn by a BSP through
+    // its apex. Cut points are computed from the original edge, from its
+    // lower-keyed end, and keyed by the edge, so the triangle across that
+    // edge makes the same point with the same key (conforming prisms).
+    template <class Key> void clippedLeaf(const Tri& t, Shown sa, Shown sl, Shown sr, Key&& key) {
+        struct CV {
+            glm::dvec2 p;
+            float h, th;
+            std::uint64_t key;
         };
-        const Emitter::PV a = pv(t.a, sa), l = pv(t.l, sl), r = pv(t.r, sr);
-        em.terrainTri(a.bottom, l.bottom, r.bottom);
-        em.prismOf(a, l, r);
+        const int X = g.dims.x - 1, Z = g.dims.y - 1;
+        const glm::ivec2 v[3] = {t.a, t.l, t.r};
+        const Shown sv[3] = {sa, sl, sr};
+        const std::uint64_t nn = std::uint64_t(g.n) * std::uint64_t(g.n);
+        CV pts[12];
+        int np = 0;
+        auto add = [&](const CV& c) {
+            for (int i = 0; i < np; ++i)
+                if (pts[i].p == c.p) {
+                    pts[i].key = std::min(pts[i].key, c.key);
+                    return;
+                }
+            pts[np++] = c;
+        };
+        for (int i = 0; i < 3; ++i)
+            if (v[i].x <= X && v[i].y <= Z) add({glm::dvec2(v[i]), sv[i].h, sv[i].th, key(v[i])});
+        for (int i = 0; i < 3; ++i) {
+            int u = i, w = (i + 1) % 3;
+            if (key(v[w]) < key(v[u])) std::swap(u, w);
+            const glm::dvec2 pu(v[u]), pw(v[w]);
+            const std::uint64_t ek = nn + 2 * (key(v[u]) * nn + key(v[w]));
+            auto cut = [&](double s, int line) {
+                const glm::dvec2 q = pu + s * (pw - pu);
+                const float fs = float(s);
+                add({line == 0 ? glm::dvec2(double(X), q.y) : glm::dvec2(q.x, double(Z)), sv[u].h + fs * (sv[w].h - sv[u].h),
+                     sv[u].th + fs * (sv[w].th - sv[u].th), ek + std::uint64_t(line)});
+            };
+            if ((pu.x - X) * (pw.x - X) < 0.0) {
+                const double s = (X - pu.x) / (pw.x - pu.x);
+                if (pu.y + s * (pw.y - pu.y) <= Z) cut(s, 0);
+            }
+            if ((pu.y - Z) * (pw.y - Z) < 0.0) {
+                const double s = (Z - pu.y) / (pw.y - pu.y);
+                if (pu.x + s * (pw.x - pu.x) <= X) cut(s, 1);
+            }
+        }
+        { // the grid's corner, if strictly inside the triangle
+            const glm::dvec2 c(X, Z), a(v[0]), b(v[1]), d(v[2]);
+            const double det = (b.x - a.x) * (d.y - a.y) - (d.x - a.x) * (b.y - a.y);
+            const double l1 = ((c.x - a.x) * (d.y - a.y) - (d.x - a.x) * (c.y - a.y)) / det;
+            const double l2 = ((b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y)) / det;
+            if (l1 > 0.0 && l2 > 0.0 && l1 + l2 < 1.0) {
+                const float f1 = float(l1), f2 = float(l2), f0 = 1.0f - f1 - f2;
+                add({c, f0 * sv[0].h + f1 * sv[1].h + f2 * sv[2].h, f0 * sv[0].th + f1 * sv[1].th + f2 * sv[2].th, ~std::uint64_t(0) - 1});
+            }
+        }
+        if (np < 3) return;
+        // Convex: sort by angle around the centroid.
+        glm::dvec2 cen(0.0);
+        for (int i = 0; i < np; ++i) cen += pts[i].p;
+        cen /= double(np);
+        double ang[12];
+        for (int i = 0; i < np; ++i) ang[i] = std::atan2(pts[i].p.y - cen.y, pts[i].p.x - cen.x);
+        for (int i = 1; i < np; ++i) // insertion sort: at most 7 points
+            for (int j = i; j > 0 && ang[j] < ang[j - 1]; --j) std::swap(ang[j], ang[j - 1]), std::swap(pts[j], pts[j - 1]);
+        auto world = [&](const CV& c) {
+            const float x = c.p.x == std::floor(c.p.x) ? g.worldX(int(c.p.x)) : float(double(g.origin.x) + c.p.x * double(g.spacing));
+            const float z = c.p.y == std::floor(c.p.y) ? g.worldZ(int(c.p.y)) : float(double(g.origin.z) + c.p.y * double(g.spacing));
+            return Emitter::PV{c.key, glm::vec3(x, c.h, z), c.th};
+        };
+        Emitter::PV wp[12];
+        for (int i = 0; i < np; ++i) wp[i] = world(pts[i]);
+        // Fan triangles (0, i+1, i+2), i in [lo, hi): split at the line 0 - (k+1), far half first.
+        auto emit = [&](auto&& self, int lo, int hi) -> void {
+            if (hi - lo == 1) {
+                em.terrainTri(wp[0].bottom, wp[lo + 1].bottom, wp[lo + 2].bottom);
+                em.prismOf(wp[0], wp[lo + 1], wp[lo + 2]);
+                return;
+            }
+            const int k = (lo + hi) / 2;
+            const glm::dvec3 p0(wp[0].bottom.x, 0.0, wp[0].bottom.z), pk(wp[k + 1].bottom.x, 0.0, wp[k + 1].bottom.z);
+            const glm::dvec3 side(wp[k].bottom.x, 0.0, wp[k].bottom.z); // in triangle k-1, the low half
+            const glm::dvec3 nrm = glm::cross(pk - p0, glm::dvec3(0.0, 1.0, 0.0));
+            const bool lowNear = (eyeSide(em.cam, p0, nrm) > 0.0) == (glm::dot(nrm, side - p0) > 0.0);
+            if (lowNear && !em.d.sortFree) self(self, k, hi), self(self, lo, k);
+            else self(self, lo, k), self(self, k, hi);
+        };
+        emit(emit, 0, np - 2);
     }
 
     void refine(const Tri& t, int depth, Shown sa, Shown sl, Shown sr) {
