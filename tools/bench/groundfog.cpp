@@ -38,6 +38,7 @@ struct Options {
     float minAccuracyC = 4.0f;
     std::string out; // --out DIR: the last frame of each mode as PNG
     float densityDepth = 0.0f; // --affine DEPTH: GroundFogDesc::densityDepthWorld (0: the paper's model)
+    glm::ivec2 probe{-1};      // --probe X Y: print the exact ray integral (integrateRay) of that pixel per frame and mode
 };
 
 double percentile(std::vector<double> v, double p) {
@@ -92,6 +93,7 @@ int runGroundFog(int argc, char** argv) {
         else if (!std::strcmp(argv[i], "--C") && i + 1 < argc) o.minAccuracyC = float(std::atof(argv[++i]));
         else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) o.out = argv[++i];
         else if (!std::strcmp(argv[i], "--affine") && i + 1 < argc) o.densityDepth = float(std::atof(argv[++i]));
+        else if (!std::strcmp(argv[i], "--probe") && i + 2 < argc) o.probe = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2])}, i += 2;
         else return usage();
     }
     if (o.frames < 2 || o.size.x < 1 || o.size.y < 1 || !(o.stepWorld > 0.0f)) return usage();
@@ -162,6 +164,17 @@ int runGroundFog(int argc, char** argv) {
             m.msPrepare.push_back(ms(b - a));
             m.drawn.push_back(double(l.renderer->stats().tetrahedra));
             splatfx::Image im = fb->read();
+            if (o.probe.x >= 0 && !frame.volumes().empty()) {
+                // The pixel's centre ray (55° vertical field of view, as flight()).
+                const double ty = std::tan(0.5 * double(glm::radians(55.0f)));
+                const double px = (2.0 * (o.probe.x + 0.5) / o.size.x - 1.0) * ty * double(o.size.x) / double(o.size.y);
+                const double py = (1.0 - 2.0 * (o.probe.y + 0.5) / o.size.y) * ty;
+                const glm::dvec3 dir = glm::dvec3(cam.forward()) + px * glm::dvec3(cam.right()) + py * glm::dvec3(cam.up());
+                auto tf = splatfx::makeGroundFogTransfer({0.9f, 0.92f, 0.95f}, 0.5f);
+                const glm::dvec4 exact = splatfx::integrateRay(frame.volumes()[0].lod.tets, *tf, glm::dvec3(cam.eye()), dir, 0.0, 1e4);
+                const std::size_t q = (std::size_t(o.probe.y) * std::size_t(o.size.x) + std::size_t(o.probe.x)) * 4;
+                std::printf("probe frame %d %-17s exact alpha %.4f  GL alpha %.4f\n", f, m.name, exact.a, double(im.pixels[q + 3]));
+            }
             if (m.layer == 0) fullImg = im;
             else {
                 double se = 0.0;
