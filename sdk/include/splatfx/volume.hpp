@@ -9,7 +9,10 @@
 // tetrahedra cut by the near plane clipped as volumes (sec. 4.3). The
 // pre-integration table (sec. 4, [35]) for a 1D transfer function is built
 // here for upload as a 3D texture; exact double-precision integrators (one
-// segment, one ray through the finest mesh) are the references.
+// segment, one ray through the finest mesh) are the references. GroundFog
+// (sec. 6) is a fog layer of prisms over a terrain height field, at full
+// resolution or over the paper's view-dependent LOD terrain with the fog top
+// geomorphed (GroundFogDesc::lod).
 //
 // It does NOT: draw anything (no GL here; the projected-tetrahedra pass reads
 // LodFrame::tets and PreIntegrationTable::data()), or model anisotropic scattering (the light field is precomputed, sec. 5).
