@@ -72,7 +72,8 @@ std::vector<TriKey> sortedTriangles(const std::vector<glm::vec3>& tri) {
     return out;
 }
 
-const LodRefineDesc kFull{.detailC = 1e9f}; // with minAccuracyC 1e9: e >= 2 everywhere, so w = 1
+// With minAccuracyC 1e9: e >= 2 everywhere, so w = 1; no culling (the full layer has none).
+const LodRefineDesc kFull{.detailC = 1e9f, .frustumCull = false};
 
 } // namespace
 
@@ -182,7 +183,8 @@ TEST(GroundFogLod, MorphingMakesARefinementThresholdContinuous) {
         const glm::vec3 eye = A + float(s) * (B - A);
         return Camera::lookAt(eye, {0.0f, 0.0f, 0.0f}, {0, 1, 0}, glm::radians(60.0f), {64, 48}, 0.1f, 500.0f);
     };
-    const LodRefineDesc on{.detailC = 3.0f, .morph = true}, off{.detailC = 3.0f, .morph = false};
+    // No culling: the rays are vertical, some of their prisms may be out of the camera's view.
+    const LodRefineDesc on{.detailC = 3.0f, .morph = true, .frustumCull = false}, off{.detailC = 3.0f, .morph = false, .frustumCull = false};
     auto splits = [&](double s) {
         LodFrame f;
         EXPECT_TRUE(fog->update(camAt(s), off, f));
@@ -452,4 +454,34 @@ TEST(GroundFogLod, MemoryIsStatedExactly) {
     }
     EXPECT_EQ(GroundFog::bytesFor({17, 13}, true), 16u * 17u * 17u);
     EXPECT_EQ(GroundFog::bytesFor({18, 2}, true), 16u * 33u * 33u);
+}
+
+// Frustum culling (LodRefineDesc::frustumCull) drops subtrees outside the
+// view only: along rays inside the frustum the fog is the same as without
+// culling (the same pieces, so the same double sum), with fewer tetrahedra;
+// the terrain output stays the whole mesh.
+TEST(GroundFogLod, FrustumCullingDropsOnlyWhatIsOutOfView) {
+    const GroundFogDesc d = valleys({33, 33}, 0.8f);
+    auto fog = GroundFog::create(d);
+    auto tf = makeGroundFogTransfer({1, 1, 1}, 0.8f);
+    ASSERT_TRUE(fog && tf);
+    const Camera cam = Camera::lookAt({-6.0f, 3.0f, -6.0f}, {4.0f, 0.0f, 0.0f}, {0, 1, 0}, glm::radians(40.0f), {64, 48}, 0.1f, 500.0f);
+    LodFrame culled, all;
+    std::vector<glm::vec3> tc, ta;
+    ASSERT_TRUE(fog->update(cam, LodRefineDesc{.detailC = 10.0f, .frustumCull = true}, culled, &tc));
+    ASSERT_TRUE(fog->update(cam, LodRefineDesc{.detailC = 10.0f, .frustumCull = false}, all, &ta));
+    EXPECT_GT(culled.stats.nodesCulled, 0u);
+    EXPECT_LT(culled.tets.size(), all.tets.size());
+    EXPECT_EQ(sortedTriangles(tc), sortedTriangles(ta));
+    std::mt19937 rng(9);
+    std::uniform_real_distribution<double> u(-0.3, 0.3); // tan(20 deg) = 0.36 vertically: inside the frustum
+    int hits = 0;
+    for (int r = 0; r < 120; ++r) {
+        const glm::dvec3 dir = glm::dvec3(cam.forward()) + u(rng) * glm::dvec3(cam.right()) + u(rng) * glm::dvec3(cam.up());
+        const glm::dvec4 a = integrateRay(culled.tets, *tf, glm::dvec3(cam.eye()), dir, 0.0, 1e4);
+        const glm::dvec4 b = integrateRay(all.tets, *tf, glm::dvec3(cam.eye()), dir, 0.0, 1e4);
+        hits += b.a > 1e-3;
+        EXPECT_EQ(a, b) << "ray " << r;
+    }
+    EXPECT_GT(hits, 30);
 }

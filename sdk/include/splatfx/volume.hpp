@@ -428,9 +428,10 @@ public:
     Status update(const Camera& camera, LodFrame& out) const;
     // Emits into out.tets (cleared first), back to front, with out.stats
     // (emitted, fullResolution = 3 x the prisms of the full grid with fog,
-    // nodesRefined = LOD splits, clipping). refine.detailC and refine.morph
+    // nodesRefined = LOD splits, nodesCulled = LOD subtrees outside the
+    // frustum, clipping). refine.detailC, refine.morph and refine.frustumCull
     // drive the LOD (ignored at full resolution), refine.clipNear the
-    // near-plane clipping; the other fields are ignored. If terrainTriangles is
+    // near-plane clipping; zeroOpacityTest is ignored. If terrainTriangles is
     // not null it receives (cleared first) the terrain the prisms stand on,
     // 3 positions per triangle, counter-clockwise seen from above (+y), the
     // LOD mesh morphed exactly as the fog's bottom (draw the host's terrain
@@ -452,6 +453,7 @@ private:
     std::uint64_t mPrisms = 0;
     // LOD (desc.lod): padded mN x mN grid, x fastest.
     int mN = 0, mMaxDepth = 0;
+    double mMaxThickness = 0.0;
     std::vector<float> mHeight, mThickness, mDelta, mRadius;
 };
 

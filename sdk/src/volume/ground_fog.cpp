@@ -272,16 +272,38 @@ struct LodRefiner {
     glm::dvec3 eye;
     double C, c;
     bool morph;
+    bool cull = false;            // LodRefineDesc::frustumCull
+    glm::dvec4 planes[6]{};       // the view frustum, normalized (Gribb & Hartmann), inside >= 0
+    double maxThickness = 0.0;    // the layer's thickest fog
+    bool prisms = true;           // false below a culled triangle: terrain only
+
+    // Is a sphere around triangle t holding everything drawn below it outside
+    // the frustum? Its descendants lie within r(m) of m (true heights); the
+    // morphed heights are between the region's true ones, so sqrt(2) of that
+    // radius covers them; the fog adds at most maxThickness above.
+    bool culled(const Tri& t, bool splittable) const {
+        const glm::dvec3 pa = g.point(t.a), pl = g.point(t.l), pr = g.point(t.r), c0 = (pa + pl + pr) / 3.0;
+        double rad = std::max({glm::length(pa - c0), glm::length(pl - c0), glm::length(pr - c0)});
+        if (splittable) {
+            const glm::ivec2 m = (t.l + t.r) / 2;
+            rad = std::max(rad, glm::length(g.point(m) - c0) + double(g.radius[g.at(m)]));
+        }
+        rad = rad * std::sqrt(2.0) * (1.0 + 1e-6) + maxThickness;
+        for (const glm::dvec4& pl4 : planes)
+            if (glm::dot(glm::dvec3(pl4), c0) + pl4.w < -rad) return true;
+        return false;
+    }
 
     void leaf(const Tri& t, Shown sa, Shown sl, Shown sr) {
         if (g.outside(t)) return;
+        if (!prisms && !em.terrain) return;
         auto key = [&](glm::ivec2 p) { return std::uint64_t(p.x) + std::uint64_t(g.n) * std::uint64_t(p.y); };
         const int X = g.dims.x - 1, Z = g.dims.y - 1;
         if (std::max({t.a.x, t.l.x, t.r.x}) <= X && std::max({t.a.y, t.l.y, t.r.y}) <= Z) {
             auto pv = [&](glm::ivec2 p, Shown s) { return Emitter::PV{key(p), glm::vec3(g.worldX(p.x), s.h, g.worldZ(p.y)), s.th}; };
             const Emitter::PV a = pv(t.a, sa), l = pv(t.l, sl), r = pv(t.r, sr);
             em.terrainTri(a.bottom, l.bottom, r.bottom);
-            em.prismOf(a, l, r);
+            if (prisms) em.prismOf(a, l, r);
             return;
         }
         clippedLeaf(t, sa, sl, sr, key);
@@ -365,7 +387,7 @@ struct LodRefiner {
         auto emit = [&](auto&& self, int lo, int hi) -> void {
             if (hi - lo == 1) {
                 em.terrainTri(wp[0].bottom, wp[lo + 1].bottom, wp[lo + 2].bottom);
-                em.prismOf(wp[0], wp[lo + 1], wp[lo + 2]);
+                if (prisms) em.prismOf(wp[0], wp[lo + 1], wp[lo + 2]);
                 return;
             }
             const int k = (lo + hi) / 2;
@@ -380,6 +402,14 @@ struct LodRefiner {
     }
 
     void refine(const Tri& t, int depth, Shown sa, Shown sl, Shown sr) {
+        if (cull && prisms && culled(t, depth < g.maxDepth)) {
+            ++em.out.stats.nodesCulled;
+            if (!em.terrain) return; // nothing below is drawn
+            prisms = false;          // the host's terrain still wants the whole mesh
+            refine(t, depth, sa, sl, sr);
+            prisms = true;
+            return;
+        }
         if (depth < g.maxDepth) {
             const glm::ivec2 m = (t.l + t.r) / 2;
             const std::size_t k = g.at(m);
@@ -472,6 +502,7 @@ Result<GroundFog> GroundFog::create(const GroundFogDesc& desc) {
             const bool inside = i < desc.dims.x && j < desc.dims.y;
             fog.mHeight[dst] = desc.terrainHeight[src];
             fog.mThickness[dst] = inside ? std::max(desc.fogTop[src] - desc.terrainHeight[src], 0.0f) : 0.0f;
+            fog.mMaxThickness = std::max(fog.mMaxThickness, double(fog.mThickness[dst]));
         }
     LodGrid g;
     g.n = side, g.maxDepth = fog.mMaxDepth, g.dims = desc.dims, g.origin = desc.originWorld, g.spacing = desc.spacingWorld;
@@ -553,6 +584,16 @@ Status GroundFog::update(const Camera& camera, const LodRefineDesc& refine, LodF
         g.n = mN, g.maxDepth = mMaxDepth, g.dims = mDesc.dims, g.origin = mDesc.originWorld, g.spacing = mDesc.spacingWorld;
         g.height = mHeight.data(), g.thickness = mThickness.data(), g.delta = mDelta.data(), g.radius = mRadius.data();
         LodRefiner r{g, em, glm::dvec3(e), double(mDesc.minAccuracyC), double(refine.detailC), refine.morph};
+        r.cull = refine.frustumCull;
+        r.maxThickness = mMaxThickness;
+        const glm::dmat4 vp = glm::dmat4(camera.proj) * glm::dmat4(camera.view);
+        for (int i = 0; i < 3; ++i)
+            for (int sign = 0; sign < 2; ++sign) {
+                glm::dvec4 pl = glm::dvec4(vp[0][3], vp[1][3], vp[2][3], vp[3][3]) +
+                                (sign ? -1.0 : 1.0) * glm::dvec4(vp[0][i], vp[1][i], vp[2][i], vp[3][i]);
+                const double len = glm::length(glm::dvec3(pl));
+                r.planes[2 * i + sign] = len > 0.0 ? pl / len : glm::dvec4(0.0, 0.0, 0.0, 1.0); // degenerate: never culls
+            }
         const int s = mN - 1;
         const Tri roots[2] = {{{s, 0}, {0, 0}, {s, s}}, {{0, s}, {s, s}, {0, 0}}};
         auto shown = [&](glm::ivec2 p) { return Shown{mHeight[g.at(p)], mThickness[g.at(p)]}; };
