@@ -410,7 +410,8 @@ struct GroundFogDesc {
 // value, w), computed top down, so a new vertex starts on the coarse edge.
 // The bintree is the BSP: the two children of a triangle are separated by the
 // vertical plane through its apex and hypotenuse midpoint, far child first
-// (exact for vertical prisms). Fully refined (e >= 2 everywhere, e.g. huge
+// (exact for vertical prisms); subtrees outside the view frustum emit no
+// prisms (LodRefineDesc::frustumCull). Fully refined (e >= 2 everywhere, e.g. huge
 // detailC and C) the mesh is the alternating-diagonal grid and the output is
 // the full-resolution one. Coarse triangles that reach into the padding carry
 // fog tapering to 0 beyond the grid's edge (within one such triangle).
