@@ -434,6 +434,18 @@ TEST(GroundFogLod, BadInputIsAnError) {
     LodFrame f;
     EXPECT_FALSE(fog->update(farCamera(), LodRefineDesc{.detailC = std::numeric_limits<float>::quiet_NaN()}, f));
     EXPECT_FALSE(fog->update(farCamera(), LodRefineDesc{.detailC = -1.0f}, f));
+    // The affine density must cover the deepest fog (else the scalar would pass 1).
+    d = valleys({9, 9}, 1.0f);
+    d.densityDepthWorld = 0.1f;
+    auto shallow = GroundFog::create(d);
+    ASSERT_FALSE(shallow);
+    EXPECT_NE(shallow.error().find("densityDepthWorld"), std::string::npos);
+    d.densityDepthWorld = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_FALSE(GroundFog::create(d));
+    d.densityDepthWorld = -1.0f;
+    EXPECT_FALSE(GroundFog::create(d));
+    d.densityDepthWorld = 10.0f; // the valleys' fog is at most 1 + 2.5 deep
+    EXPECT_TRUE(GroundFog::create(d));
 }
 
 // Memory: 16 bytes per padded point (bytesFor is what memoryBytes reports);
@@ -484,4 +496,22 @@ TEST(GroundFogLod, FrustumCullingDropsOnlyWhatIsOutOfView) {
         EXPECT_EQ(a, b) << "ray " << r;
     }
     EXPECT_GT(hits, 30);
+}
+
+// The sort-free model (eq. 10) on the LOD terrain: the same tetrahedra as
+// the sorted LOD layer, in a fixed (view-independent) order.
+TEST(GroundFogLod, SortFreeEmitsTheSameTetrahedra) {
+    GroundFogDesc d = valleys({33, 33}, 0.8f);
+    GroundFogDesc free = d;
+    free.sortFree = true;
+    auto sorted = GroundFog::create(d);
+    auto unsorted = GroundFog::create(free);
+    ASSERT_TRUE(sorted && unsorted);
+    for (const Camera& cam : {farCamera(), insideCamera()}) {
+        LodFrame a, b;
+        ASSERT_TRUE(sorted->update(cam, LodRefineDesc{.detailC = 3.0f}, a));
+        ASSERT_TRUE(unsorted->update(cam, LodRefineDesc{.detailC = 3.0f}, b));
+        ASSERT_GT(a.tets.size(), 0u);
+        EXPECT_EQ(sortedKeys(a.tets), sortedKeys(b.tets));
+    }
 }
