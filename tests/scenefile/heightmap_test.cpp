@@ -124,6 +124,10 @@ TEST(SceneFileHeightmap, BadInputNamesTheField) {
     expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "fogTop": 1, "lod": true, "minAccuracyC": 0}])",
                 "volumes[0].minAccuracyC");
     expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "fogTop": 1, "lod": 3}])", "volumes[0].lod");
+    expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "fogTop": 1, "lod": true, "terrainGeometry": "nope"}])",
+                "volumes[0].terrainGeometry: names no heightmap geometry ('nope')");
+    expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "fogTop": 1, "terrainGeometry": "t"}])",
+                R"(volumes[0].terrainGeometry: only with "lod": true)");
 }
 
 // "lod": true builds the LOD layer with the file's C, and detailC / morph
@@ -138,6 +142,7 @@ TEST(SceneFileHeightmap, GroundFogLodKeys) {
     auto full = t.parse(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "spacing": 2, "heightScale": 100, "fogTop": 200}])", m);
     ASSERT_TRUE(lod) << lod.error();
     ASSERT_TRUE(full) << full.error();
+    EXPECT_TRUE(lod->groundFogTerrain.empty());
     const splatfx::VolumeOptions& o = lod->scene.groundFogOptions(0);
     EXPECT_FLOAT_EQ(o.refine.detailC, 0.5f);
     EXPECT_FALSE(o.refine.morph);

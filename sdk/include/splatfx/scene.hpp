@@ -223,6 +223,8 @@ public:
     VolumeId addGroundFog(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, VolumeOptions options = {});
     std::size_t groundFogCount() const { return mGroundFogs.size(); }
     VolumeOptions& groundFogOptions(VolumeId id) { return mGroundFogs.at(id)->options; }
+    // The layer itself (e.g. for its LOD terrain: GroundFog::update's terrainTriangles).
+    const GroundFog& groundFog(VolumeId id) const { return mGroundFogs.at(id)->fog; }
     // ---- end ----
 
 private:

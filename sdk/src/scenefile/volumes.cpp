@@ -72,8 +72,15 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     o.boolean("morph", morph);
     float densityDepth = 0.0f;
     o.number("densityDepthWorld", densityDepth, 0.0, 1e6);
+    std::string terrainGeometry;
+    o.string("terrainGeometry", terrainGeometry);
+    if (!terrainGeometry.empty()) { // the geometry block is read before the volumes
+        const auto g = std::find_if(out.geometry.begin(), out.geometry.end(), [&](const GeometryDesc& x) { return x.name == terrainGeometry; });
+        if (g == out.geometry.end() || g->type != GeometryType::Heightmap)
+            c.d.error(o.at("terrainGeometry"), "names no heightmap geometry ('" + terrainGeometry + "')");
+    }
     if (!lod)
-        for (const char* key : {"detailC", "minAccuracyC", "morph"})
+        for (const char* key : {"detailC", "minAccuracyC", "morph", "terrainGeometry"})
             if (o.has(key)) c.d.error(o.at(key), std::string("only with \"lod\": true (the full-resolution layer has no LOD)"));
     o.finish();
     if (c.d.count() != before || file.empty()) return;
@@ -154,7 +161,8 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     LodRefineDesc refine;
     refine.detailC = detailC;
     refine.morph = morph;
-    out.scene.addGroundFog(std::move(*layer), std::move(*tf), std::move(*table), {.name = name, .enabled = enabled, .refine = refine});
+    const VolumeId id = out.scene.addGroundFog(std::move(*layer), std::move(*tf), std::move(*table), {.name = name, .enabled = enabled, .refine = refine});
+    if (!terrainGeometry.empty()) out.groundFogTerrain.push_back({terrainGeometry, id});
 }
 
 } // namespace
