@@ -420,7 +420,8 @@ struct GroundFogDesc {
 // 16 bytes per padded point (terrain, thickness, Delta, r as floats) and not
 // the desc's arrays; bytesFor() is exact.
 // In a Scene: Scene::addGroundFog (VolumeOptions::refine is the refine desc);
-// in scene files: volumes kind "groundFog" (keys "lod", "detailC", "minAccuracyC", "morph").
+// in scene files: volumes kind "groundFog" (keys "lod", "detailC", "minAccuracyC", "morph",
+// "terrainGeometry", "densityDepthWorld").
 class GroundFog {
 public:
     // Fails on dims < 2, size mismatches, non-finite heights or a bad field.
