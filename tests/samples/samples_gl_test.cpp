@@ -145,3 +145,23 @@ TEST_F(SamplesGL, RendererSettingsChangeOnALoadedScene) {
     EXPECT_GT(peak, 0.0) << "the new settings must take effect";
     EXPECT_LT(sum / double(bilinear.pixels.size()), 2.0 / 255.0) << "same scene, same frame";
 }
+
+// [issue 17] Sample 23 draws its heightmap terrain from the LOD ground fog's
+// mesh ("terrainGeometry"): the host draws exactly the triangles
+// GroundFog::update gives for that camera (the fog's bottom), fewer than the
+// full-resolution heightmap's.
+TEST_F(SamplesGL, LodGroundFogTerrainIsTheHostsTerrain) {
+    auto player = scenehost::ScenePlayer::load(splatfx::test::sourcePath("samples/23-jacksboro-flight/scene.json"));
+    ASSERT_TRUE(player.ok()) << player.error();
+    ASSERT_EQ(player->file().groundFogTerrain.size(), 1u);
+    const double t = 1.0;
+    const glm::ivec2 size{160, 120};
+    render(*player, {t}, size);
+    const splatfx::VolumeId id = player->file().groundFogTerrain[0].fog;
+    splatfx::LodFrame scratch;
+    std::vector<glm::vec3> tris;
+    ASSERT_TRUE(player->file().scene.groundFog(id).update(player->cameraAt(t, size), player->file().scene.groundFogOptions(id).refine, scratch, &tris));
+    ASSERT_GT(tris.size(), 0u);
+    EXPECT_EQ(player->geometry().stats().triangles, tris.size() / 3);
+    EXPECT_LT(tris.size() / 3, 2u * 200u * 170u) << "the 201x171 heightmap at full resolution";
+}

@@ -117,4 +117,42 @@ TEST(SceneFileHeightmap, BadInputNamesTheField) {
     expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "gone.pgm", "fogTop": 1}])", "volumes[0].heightmap:");
     expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "fogTop": 1, "colour": [2, 0, 0]}])", "volumes[0].colour");
     expectError(R"("volumes": [{"kind": "fogg"}])", "unknown kind 'fogg' (known: clouds, groundFog)");
+    // The LOD keys: only with "lod", in range.
+    expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "fogTop": 1, "detailC": 2}])",
+                R"(volumes[0].detailC: only with "lod": true)");
+    expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "fogTop": 1, "lod": true, "detailC": -1}])", "volumes[0].detailC");
+    expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "fogTop": 1, "lod": true, "minAccuracyC": 0}])",
+                "volumes[0].minAccuracyC");
+    expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "fogTop": 1, "lod": 3}])", "volumes[0].lod");
+    expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "fogTop": 1, "lod": true, "terrainGeometry": "nope"}])",
+                "volumes[0].terrainGeometry: names no heightmap geometry ('nope')");
+    expectError(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "fogTop": 1, "terrainGeometry": "t"}])",
+                R"(volumes[0].terrainGeometry: only with "lod": true)");
+}
+
+// "lod": true builds the LOD layer with the file's C, and detailC / morph
+// reach the per-frame refinement: the fog's bottom then lies on the LOD
+// terrain, fewer tetrahedra from afar than at full resolution.
+TEST(SceneFileHeightmap, GroundFogLodKeys) {
+    const TempTerrain t(15, 9, "lod"); // codes stay below 65536
+    splatfx::Materials m(splatfx::Footprint{});
+    auto lod = t.parse(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "spacing": 2, "heightScale": 100,
+                          "fogTop": 200, "lod": true, "detailC": 0.5, "minAccuracyC": 3, "morph": false}])",
+                       m);
+    auto full = t.parse(R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "spacing": 2, "heightScale": 100, "fogTop": 200}])", m);
+    ASSERT_TRUE(lod) << lod.error();
+    ASSERT_TRUE(full) << full.error();
+    EXPECT_TRUE(lod->groundFogTerrain.empty());
+    const splatfx::VolumeOptions& o = lod->scene.groundFogOptions(0);
+    EXPECT_FLOAT_EQ(o.refine.detailC, 0.5f);
+    EXPECT_FALSE(o.refine.morph);
+    const splatfx::Camera cam = splatfx::Camera::lookAt({0, 600, 900}, {0, 0, 0}, {0, 1, 0}, glm::radians(40.0f), {64, 48}, 0.5f, 5000.0f);
+    splatfx::Frame a, b;
+    lod->scene.prepare(0.0, cam, m, a);
+    full->scene.prepare(0.0, cam, m, b);
+    ASSERT_EQ(a.volumes().size(), 1u);
+    ASSERT_EQ(b.volumes().size(), 1u);
+    EXPECT_EQ(a.volumes()[0].lod.stats.fullResolution, b.volumes()[0].lod.tets.size());
+    EXPECT_LT(a.volumes()[0].lod.tets.size(), b.volumes()[0].lod.tets.size());
+    EXPECT_GT(a.volumes()[0].lod.tets.size(), 0u);
 }

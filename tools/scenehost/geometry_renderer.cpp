@@ -80,6 +80,7 @@ struct GeometryRenderer::Impl {
         GLuint vao = 0, vbo = 0, ibo = 0;
         GLsizei indexCount = 0;
         splatfx::Aabb localBounds;
+        bool worldSpace = false; // setWorldTriangles: no placement, no motion
     };
     GLuint program = 0;
     GLuint transparentProgram = 0;
@@ -172,10 +173,53 @@ GeometryRenderer::~GeometryRenderer() = default;
 
 const GeometryStats& GeometryRenderer::stats() const { return mImpl->stats; }
 
+// [issue 17]
+long GeometryRenderer::find(const std::string& name) const {
+    for (std::size_t i = 0; i < mImpl->objects.size(); ++i)
+        if (mImpl->objects[i].desc.name == name) return long(i);
+    return -1;
+}
+
+void GeometryRenderer::setWorldTriangles(std::size_t i, const std::vector<glm::vec3>& triangles) {
+    Impl::Object& o = mImpl->objects.at(i);
+    std::vector<float> interleaved;
+    interleaved.reserve(triangles.size() * 6);
+    std::vector<std::uint32_t> indices(triangles.size());
+    o.localBounds = {};
+    for (std::size_t k = 0; k + 2 < triangles.size(); k += 3) {
+        const glm::vec3 a = triangles[k], b = triangles[k + 1], c = triangles[k + 2];
+        glm::vec3 n = glm::cross(b - a, c - a);
+        const float len = glm::length(n);
+        n = len > 0.0f ? n / len : glm::vec3(0.0f, 1.0f, 0.0f);
+        for (const glm::vec3& p : {a, b, c}) {
+            interleaved.insert(interleaved.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
+            o.localBounds.extend(p);
+        }
+    }
+    for (std::size_t k = 0; k < indices.size(); ++k) indices[k] = std::uint32_t(k);
+    glDeleteBuffers(1, &o.vbo);
+    glDeleteBuffers(1, &o.ibo);
+    if (!o.vao) glCreateVertexArrays(1, &o.vao);
+    glCreateBuffers(1, &o.vbo);
+    glCreateBuffers(1, &o.ibo);
+    if (!interleaved.empty()) glNamedBufferStorage(o.vbo, GLsizeiptr(interleaved.size() * sizeof(float)), interleaved.data(), 0);
+    if (!indices.empty()) glNamedBufferStorage(o.ibo, GLsizeiptr(indices.size() * sizeof(std::uint32_t)), indices.data(), 0);
+    glVertexArrayVertexBuffer(o.vao, 0, o.vbo, 0, 6 * sizeof(float));
+    glVertexArrayElementBuffer(o.vao, o.ibo);
+    for (GLuint a = 0; a < 2; ++a) {
+        glEnableVertexArrayAttrib(o.vao, a);
+        glVertexArrayAttribFormat(o.vao, a, 3, GL_FLOAT, GL_FALSE, a * 3 * sizeof(float));
+        glVertexArrayAttribBinding(o.vao, a, 0);
+    }
+    o.indexCount = GLsizei(indices.size());
+    o.worldSpace = true;
+}
+
 splatfx::Aabb GeometryRenderer::worldBounds(std::size_t i, double t) const {
     const Impl::Object& o = mImpl->objects.at(i);
     splatfx::Aabb out;
     if (o.localBounds.empty()) return out;
+    if (o.worldSpace) return o.localBounds;
     const glm::mat4 m = o.desc.motion.matrix(t) * o.desc.transform;
     for (int c = 0; c < 8; ++c) out.extend(glm::vec3(m * glm::vec4(o.localBounds.corner(c), 1.0f)));
     return out;
@@ -201,7 +245,7 @@ void GeometryRenderer::draw(double t, const splatfx::Camera& camera, const Geome
     for (const Impl::Object& o : r.objects) {
         if (!o.vao || o.desc.opacity < 1.0f) continue; // transparent ones: drawTransparent
         // Object to world: its motion (own or shared) after its static placement.
-        const glm::mat4 m = o.desc.motion.matrix(t) * o.desc.transform;
+        const glm::mat4 m = o.worldSpace ? glm::mat4(1.0f) : o.desc.motion.matrix(t) * o.desc.transform;
         glUniformMatrix4fv(model, 1, GL_FALSE, glm::value_ptr(m));
         glUniform3fv(color, 1, glm::value_ptr(o.desc.color));
         glBindVertexArray(o.vao);
@@ -233,7 +277,7 @@ void GeometryRenderer::drawTransparent(double t, const splatfx::Camera& camera, 
     const GLint model = glGetUniformLocation(p, "uModel"), color = glGetUniformLocation(p, "uColor"), opacity = glGetUniformLocation(p, "uOpacity");
     for (const Impl::Object& o : r.objects) {
         if (!o.vao || !(o.desc.opacity < 1.0f)) continue;
-        const glm::mat4 m = o.desc.motion.matrix(t) * o.desc.transform;
+        const glm::mat4 m = o.worldSpace ? glm::mat4(1.0f) : o.desc.motion.matrix(t) * o.desc.transform;
         glUniformMatrix4fv(model, 1, GL_FALSE, glm::value_ptr(m));
         glUniform3fv(color, 1, glm::value_ptr(o.desc.color));
         glUniform1f(opacity, o.desc.opacity);

@@ -16,6 +16,10 @@ struct ScenePlayer::Impl {
     std::optional<splatfx::gl::FrameRenderer> renderer;
     splatfx::Frame frame;
     FrameStats stats;
+    // [issue 17] heightmap objects drawn from a LOD ground fog's terrain mesh (groundFog "terrainGeometry")
+    std::vector<std::pair<std::size_t, splatfx::VolumeId>> lodTerrain;
+    splatfx::LodFrame scratch;
+    std::vector<glm::vec3> terrain;
 };
 
 namespace {
@@ -44,6 +48,11 @@ splatfx::Status ScenePlayer::setupGl(Impl& impl, const std::string& path, const 
     auto geo = GeometryRenderer::create(impl.file->geometry, options.budgets);
     if (!geo) return splatfx::makeError(path + ": " + geo.error());
     impl.geometry.emplace(std::move(*geo));
+    for (const splatfx::GroundFogTerrain& link : impl.file->groundFogTerrain) {
+        const long i = impl.geometry->find(link.geometry); // the scene file checked it names a heightmap
+        if (i < 0) return splatfx::makeError(path + ": groundFog terrainGeometry '" + link.geometry + "' not found");
+        impl.lodTerrain.emplace_back(std::size_t(i), link.fog);
+    }
     // A scene of geometry only still needs one row for the renderer to upload.
     if (impl.materials.colorTableCount() == 0) impl.materials.addColorTable(splatfx::ColorTable::constant(glm::vec4(1.0f)));
     return installRenderer(impl, options.renderer);
@@ -117,6 +126,13 @@ void ScenePlayer::renderFrame(double t, const splatfx::Camera& camera, unsigned 
     Impl& p = *mImpl;
     splatfx::SceneFile& f = *p.file;
     FrameStats& s = p.stats;
+
+    // [issue 17] The LOD terrain of ground-fog layers replaces their heightmap
+    // objects' meshes (the same morphed triangulation as the fog's bottom).
+    for (const auto& [object, fog] : p.lodTerrain)
+        if (options.drawGeometry &&
+            f.scene.groundFog(fog).update(camera, f.scene.groundFogOptions(fog).refine, p.scratch, &p.terrain))
+            p.geometry->setWorldTriangles(object, p.terrain);
 
     // This host's opaque pass: background, then geometry with depth writes.
     auto drawOpaque = [&] {

@@ -219,10 +219,12 @@ public:
     // ---- (issue 17) Ground fog (prisms over a terrain, volume.hpp GroundFog) ----
     // prepare() emits every enabled layer (GroundFog::update: back to front,
     // near-clipped) as one more Frame volume, drawn by the same pass as the
-    // clouds (options.refine is unused: the layer is at full resolution).
+    // clouds; options.refine is the LOD refinement (detailC, morph, clipNear) of a layer made with GroundFogDesc::lod.
     VolumeId addGroundFog(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, VolumeOptions options = {});
     std::size_t groundFogCount() const { return mGroundFogs.size(); }
     VolumeOptions& groundFogOptions(VolumeId id) { return mGroundFogs.at(id)->options; }
+    // The layer itself (e.g. for its LOD terrain: GroundFog::update's terrainTriangles).
+    const GroundFog& groundFog(VolumeId id) const { return mGroundFogs.at(id)->fog; }
     // ---- end ----
 
 private:

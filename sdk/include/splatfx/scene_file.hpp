@@ -125,6 +125,14 @@ struct SceneEffectInfo {
     bool traditional = false;         // drawn with plain footprints (Fig. 1a); default false
 };
 
+// [issue 17] A LOD ground-fog layer whose terrain mesh the host draws in
+// place of a heightmap geometry (groundFog key "terrainGeometry"), so the
+// terrain and the fog's bottom are one mesh.
+struct GroundFogTerrain {
+    std::string geometry; // the heightmap geometry's name
+    VolumeId fog = 0;     // Scene::groundFog(fog)
+};
+
 struct SceneFile {
     std::string path;                 // the file as given
     std::string title;                // default empty
@@ -134,6 +142,7 @@ struct SceneFile {
     std::vector<GeometryDesc> geometry;
     CameraPath camera;
     OutputSettings output;
+    std::vector<GroundFogTerrain> groundFogTerrain; // [issue 17] default none
 };
 
 struct SceneFileOptions {

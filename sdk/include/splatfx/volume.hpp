@@ -9,11 +9,13 @@
 // tetrahedra cut by the near plane clipped as volumes (sec. 4.3). The
 // pre-integration table (sec. 4, [35]) for a 1D transfer function is built
 // here for upload as a 3D texture; exact double-precision integrators (one
-// segment, one ray through the finest mesh) are the references.
+// segment, one ray through the finest mesh) are the references. GroundFog
+// (sec. 6) is a fog layer of prisms over a terrain height field, at full
+// resolution or over the paper's view-dependent LOD terrain with the fog top
+// geomorphed (GroundFogDesc::lod).
 //
 // It does NOT: draw anything (no GL here; the projected-tetrahedra pass reads
-// LodFrame::tets and PreIntegrationTable::data()), LOD ground fog (sec. 6: GroundFog is the full-resolution prism layer),
-// or model anisotropic scattering (the light field is precomputed, sec. 5).
+// LodFrame::tets and PreIntegrationTable::data()), or model anisotropic scattering (the light field is precomputed, sec. 5).
 //
 //   auto vol = splatfx::LodVolume::create(*splatfx::makeCloudVolume({}), {});
 //   splatfx::LodFrame frame;
@@ -351,6 +353,16 @@ struct GroundFogDesc {
     std::vector<float> terrainHeight; // dims.x * dims.y world heights (x fastest)
     std::vector<float> fogTop;        // same size: world height of the fog's top; <= terrain: no fog there
     float density = 1.0f;             // default 1: the scalar at the terrain (the top boundary has 0, sec. 6)
+    // Default 0: the scalar is `density` on the terrain and 0 at the top
+    // (sec. 6), linear within each tetrahedron, so inside a prism of varying
+    // thickness it depends on how the prism is split: refining the LOD
+    // re-splits prisms and the fog changes there even when the geometry is
+    // morphed (docs/volume.md measures it). > 0: the scalar is
+    // density * (fog top - y) / densityDepthWorld, affine in every prism, the
+    // same for any split: with morphing a refinement changes nothing at all.
+    // The fog then thins where it is shallow. create() fails if a thickness
+    // exceeds it (the scalar would pass 1).
+    float densityDepthWorld = 0.0f;
     // The paper's sort-free emissive model (sec. 6, eq. 10): true
     // emits the tetrahedra in grid order with no back-to-front sorting. With
     // one fog colour C (makeGroundFogTransfer) every segment blends as
@@ -361,31 +373,90 @@ struct GroundFogDesc {
     // volumes interleave with the layer (their order then is per batch only).
     // Default false (sorted).
     bool sortFree = false;
+    // The paper's LOD terrain (sec. 6, see GroundFog): true refines a 4-8
+    // mesh per frame by the deviations of both the terrain and the fog top,
+    // geomorphed; false draws every grid cell. Default false.
+    bool lod = false;
+    // C of the LOD metric (like eq. 1, see GroundFog), > 0; only with lod. Default 4.
+    float minAccuracyC = 4.0f;
 };
 
 // A fog layer over a terrain height field as vertical prisms of three
-// tetrahedra (sec. 6): every grid cell is two triangles (diagonals
-// alternating), every triangle a prism from the terrain to the fog top,
-// split into three tetrahedra by the global vertex order so neighbouring
+// tetrahedra (sec. 6): every triangle a prism from the terrain to the fog
+// top, split into three tetrahedra by the global vertex order so neighbouring
 // prisms share their split faces (conforming). Prisms of zero height are
 // dropped; the scalar is `density` on the terrain and 0 on the top, linear in
-// between. update() emits them back to front for a camera (a BSP over the
-// grid, far half first, with MPVO inside a prism), clipped at the near plane.
-// Not done: the paper's LOD terrain and geomorphing of the fog top (the grid
-// is drawn at full resolution), and the sort-free emissive model. In a Scene:
-// Scene::addGroundFog; in scene files: volumes kind "groundFog".
+// between. update() emits them back to front for a camera, clipped at the
+// near plane (MPVO order of the pieces), or in grid order (sortFree, eq. 10).
+//
+// Full resolution (desc.lod false): every grid cell is two triangles
+// (diagonals alternating), ordered by a BSP over the grid.
+//
+// LOD (desc.lod true, sec. 6 with the metric of sec. 2.2 and the morphing of
+// sec. 3): the grid is padded to (2^n+1)^2 points (terrain clamped to the
+// edge, no fog in the padding) and triangulated as a right-triangle bintree
+// (a 4-8 mesh) from two root triangles. Every vertex but the four corners is
+// the hypotenuse midpoint of its diamond; its local error Delta is the larger
+// deviation, in world units, of the terrain and of the fog top from the
+// average of the hypotenuse's ends, saturated upward (Delta >= Delta of its
+// children, bounding radius r >= r(child) + |v - child|) so the metric never
+// grows toward finer levels: a child active means its parents are, and the
+// mesh is conforming (no T-vertices). Per frame, top down, a triangle splits
+// where e = l C max(c Delta, 1) / (|eye - v| - r) > 1 (l its hypotenuse
+// length, C = desc.minAccuracyC, c = LodRefineDesc::detailC per world unit;
+// e is infinite within r). A split vertex is geomorphed with w = clamp(e - 1,
+// 0, 1): its terrain height and fog thickness (so the fog top with the
+// terrain) are lerp(average of the hypotenuse ends' displayed values, true
+// value, w), computed top down, so a new vertex starts on the coarse edge.
+// The bintree is the BSP: the two children of a triangle are separated by the
+// vertical plane through its apex and hypotenuse midpoint, far child first
+// (exact for vertical prisms); subtrees outside the view frustum emit no
+// prisms (LodRefineDesc::frustumCull). Fully refined (e >= 2 everywhere, e.g. huge
+// detailC and C) the mesh is the alternating-diagonal grid and the output is
+// the full-resolution one. Coarse triangles that reach into the padding carry
+// fog tapering to 0 beyond the grid's edge (within one such triangle).
+//
+// Memory: full resolution keeps the desc (8 bytes per grid point). LOD keeps
+// 16 bytes per padded point (terrain, thickness, Delta, r as floats) and not
+// the desc's arrays; bytesFor() is exact.
+// In a Scene: Scene::addGroundFog (VolumeOptions::refine is the refine desc);
+// in scene files: volumes kind "groundFog" (keys "lod", "detailC", "minAccuracyC", "morph",
+// "terrainGeometry", "densityDepthWorld").
 class GroundFog {
 public:
     // Fails on dims < 2, size mismatches, non-finite heights or a bad field.
     static Result<GroundFog> create(const GroundFogDesc& desc);
-    // Emits into out.tets (cleared first), back to front, with out.stats
-    // (emitted, fullResolution = prisms x 3, clipping). Fails on a non-finite camera.
+    // update(camera, LodRefineDesc{}, out).
     Status update(const Camera& camera, LodFrame& out) const;
+    // Emits into out.tets (cleared first), back to front, with out.stats
+    // (emitted, fullResolution = 3 x the prisms of the full grid with fog,
+    // nodesRefined = LOD splits, nodesCulled = LOD subtrees outside the
+    // frustum, clipping). refine.detailC, refine.morph and refine.frustumCull
+    // drive the LOD (ignored at full resolution), refine.clipNear the
+    // near-plane clipping; zeroOpacityTest is ignored. If terrainTriangles is
+    // not null it receives (cleared first) the terrain the prisms stand on,
+    // 3 positions per triangle, counter-clockwise seen from above (+y), the
+    // LOD mesh morphed exactly as the fog's bottom (draw the host's terrain
+    // with it so the two agree); triangles wholly in the padding are left out.
+    // Fails on a non-finite camera or a bad refine field.
+    Status update(const Camera& camera, const LodRefineDesc& refine, LodFrame& out,
+                  std::vector<glm::vec3>* terrainTriangles = nullptr) const;
+    // Prisms with fog at full resolution (the LOD emits fewer).
     std::uint64_t prismCount() const { return mPrisms; }
+    bool lod() const { return mDesc.lod; }
+    // Points per side of the LOD's padded grid (2^n + 1); 0 at full resolution.
+    int lodPointsPerSide() const { return mN; }
+    // The bytes create() keeps for a layer of `dims` points (exact; the vectors' payload).
+    static std::size_t bytesFor(glm::ivec2 dims, bool lod);
+    std::size_t memoryBytes() const;
 
 private:
     GroundFogDesc mDesc;
     std::uint64_t mPrisms = 0;
+    // LOD (desc.lod): padded mN x mN grid, x fastest.
+    int mN = 0, mMaxDepth = 0;
+    double mMaxThickness = 0.0;
+    std::vector<float> mHeight, mThickness, mDelta, mRadius;
 };
 
 // A fog transfer function: constant colour, extinction linear in the scalar

@@ -164,7 +164,7 @@ void Scene::prepareVolumes(const Camera& camera, Frame& frame) {
         FrameVolume& fv = frame.volumes().emplace_back();
         fv.table = &e.table;
         fv.tableVersion = 1;
-        if (!e.fog.update(camera, fv.lod)) frame.volumes().pop_back();
+        if (!e.fog.update(camera, e.options.refine, fv.lod)) frame.volumes().pop_back(); // refine: the LOD terrain's c, morphing
     }
 }
 

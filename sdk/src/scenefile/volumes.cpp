@@ -63,6 +63,25 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     o.integer("tableLengths", lengthRes, 2, 512);
     bool sortFree = false;
     o.boolean("sortFree", sortFree);
+    // The LOD terrain (GroundFogDesc::lod; c and morphing are per frame, VolumeOptions::refine).
+    bool lod = false, morph = true;
+    float detailC = 1.0f, minAccuracyC = 4.0f;
+    o.boolean("lod", lod);
+    o.number("detailC", detailC, 0.0, 1e6);
+    o.number("minAccuracyC", minAccuracyC, 1e-3, 1e6);
+    o.boolean("morph", morph);
+    float densityDepth = 0.0f;
+    o.number("densityDepthWorld", densityDepth, 0.0, 1e6);
+    std::string terrainGeometry;
+    o.string("terrainGeometry", terrainGeometry);
+    if (!terrainGeometry.empty()) { // the geometry block is read before the volumes
+        const auto g = std::find_if(out.geometry.begin(), out.geometry.end(), [&](const GeometryDesc& x) { return x.name == terrainGeometry; });
+        if (g == out.geometry.end() || g->type != GeometryType::Heightmap)
+            c.d.error(o.at("terrainGeometry"), "names no heightmap geometry ('" + terrainGeometry + "')");
+    }
+    if (!lod)
+        for (const char* key : {"detailC", "minAccuracyC", "morph", "terrainGeometry"})
+            if (o.has(key)) c.d.error(o.at(key), std::string("only with \"lod\": true (the full-resolution layer has no LOD)"));
     o.finish();
     if (c.d.count() != before || file.empty()) return;
     const std::string path = resolvePath(c, file);
@@ -107,6 +126,9 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     gd.spacingWorld = spacing * float(step);
     gd.density = density;
     gd.sortFree = sortFree;
+    gd.lod = lod;
+    gd.minAccuracyC = minAccuracyC;
+    gd.densityDepthWorld = densityDepth;
     gd.terrainHeight.resize(std::size_t(gd.dims.x) * gd.dims.y);
     gd.fogTop.resize(gd.terrainHeight.size());
     float lowest = 1e30f;
@@ -136,7 +158,11 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
         c.d.error(p, table.error());
         return;
     }
-    out.scene.addGroundFog(std::move(*layer), std::move(*tf), std::move(*table), {.name = name, .enabled = enabled});
+    LodRefineDesc refine;
+    refine.detailC = detailC;
+    refine.morph = morph;
+    const VolumeId id = out.scene.addGroundFog(std::move(*layer), std::move(*tf), std::move(*table), {.name = name, .enabled = enabled, .refine = refine});
+    if (!terrainGeometry.empty()) out.groundFogTerrain.push_back({terrainGeometry, id});
 }
 
 } // namespace
