@@ -204,7 +204,12 @@ TEST_F(FragmentListsGL, PanesInFrontOfAndBehindTheFireSortLikeTheUnambiguousOrde
         EXPECT_EQ(fr->stats().transparentOverflowPixels, 0u);
         EXPECT_GE(fr->stats().transparentNodes, std::uint64_t(kSize.x) * kSize.y); // the pane covers every pixel
         const Image got = lists->read();
-        EXPECT_EQ(fr->stats().transparentSections, 2);
+        // Every splat lies wholly behind (or in front of) the pane: none
+        // needs a section; all take the ordinary splat pass, before (after)
+        // the resolve (FragmentListPass::split).
+        EXPECT_EQ(fr->stats().transparentSections, 0);
+        EXPECT_EQ(fr->stats().transparentSplatsSectioned, 0u);
+        EXPECT_EQ(inFront ? fr->stats().transparentSplatsBehind : fr->stats().transparentSplatsFront, f.frame.splats().size());
         if (inFront) {
             fr->render(f.frame, {.framebuffer = ordered->handle(), .drawOpaque = clearTo(kBackground)});
             fr->render(empty, {.framebuffer = ordered->handle(), .drawTransparent = [&] { glass.draw(pane, cam); },
@@ -437,7 +442,8 @@ TEST_F(FragmentListsGL, BudgetOfOneFragmentPerPixel) {
     // the sorted depths (R32F, one layer fewer than sections), the counters.
     EXPECT_EQ(s.transparentBytes, std::size_t(pixels) * (kTransparentNodeBytes + kTransparentHeadBytesPerPixel + 8 +
                                                          std::size_t(s.transparentSections) * kTransparentSectionBytesPerPixel +
-                                                         4 * std::size_t(s.transparentSections - 1)) + 48);
+                                                         4 * std::size_t(s.transparentSections - 1)) + 48 +
+                                      8 * std::size_t((kSize.x + 15) / 16) * std::size_t((kSize.y + 15) / 16)); // + the 16 x 16 tiles' depth ranges
     const Image got = fb->read();
     // The alpha of the three in any order: the ordered blend (pane, fire, pane).
     Frame empty;
@@ -514,9 +520,10 @@ TEST_F(FragmentListsGL, SplatStraddlingAPaneIsCutIntoSections) {
     };
     const glm::vec4 tint{0.1f, 0.2f, 0.3f, 0.4f};
     const double base = errorAgainstReference({{.z = 40.0f, .premultiplied = glm::vec4(0.0f)}}); // no visible pane
-    EXPECT_TRUE(fr->stats().transparentCut);
     for (const float dz : {0.3f, -0.3f}) {
         const double err = errorAgainstReference({{.z = centre.z + dz, .premultiplied = tint}});
+        EXPECT_TRUE(fr->stats().transparentCut);
+        EXPECT_EQ(fr->stats().transparentSplatsSectioned, 1u); // the pane meets its kernel: sections, not the ordinary pass
         EXPECT_EQ(fr->stats().transparentSections, 2);
         EXPECT_LE(err, base + 2.0 * std::log(2.0) * tau * delta + 4.0 * std::ldexp(1.0, -12)) << "pane at z = centre + " << dz;
     }

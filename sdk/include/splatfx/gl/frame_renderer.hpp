@@ -170,6 +170,12 @@ struct FrameRenderStats {
     std::uint64_t transparentSectionOverflow = 0; // pixels with more surfaces than sections - 1 (7 at most): the gas behind the extra ones merged into the last section
     bool transparentCut = false;          // sections weighted by the kernel's partial line integral (RendererDesc::depthCut)
     std::uint64_t transparentEyeCrossing = 0; // splats whose polygon crosses the eye plane: not drawn in the lists (camera inside a kernel)
+    // How the splats of a list frame were drawn: behind every surface they
+    // cover (the ordinary splat pass, before the resolve), in front of every
+    // one (the ordinary pass, after it), or cut into sections (the rest).
+    std::uint64_t transparentSplatsBehind = 0;
+    std::uint64_t transparentSplatsFront = 0;
+    std::uint64_t transparentSplatsSectioned = 0;
     std::size_t transparentBytes = 0;     // GPU bytes of the lists (pool, heads, counts, counters, section targets)
     // ---- end (issue 15) ----
 };

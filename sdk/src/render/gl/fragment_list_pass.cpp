@@ -3,7 +3,11 @@
 #include "fragment_list_pass.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstddef>
+#include <cstring>
+#include <span>
 #include <string>
 
 #include <epoxy/gl.h>
@@ -160,16 +164,65 @@ void main() {
 }
 )";
 
+// Run after the host's surfaces, one invocation per 16 x 16 tile (an
+// invocation per pixel costs llvmpipe more in dispatch than the walk): the
+// most surfaces on one pixel, and per tile the nearest and farthest surface
+// window depth stored on any of its pixels (as float bits: window depths are
+// in [0, 1], where the bits order like the values; an empty tile reads
+// (0xffffffff, 0)). Read back so the CPU can send the splats that lie wholly
+// behind, or wholly in front of, every surface they cover to the ordinary
+// splat pass (FragmentListPass::split). One work group per tile.
+constexpr int kRangeTile = 16;
+constexpr const char* kTileRangeCompute = R"(
+layout(local_size_x = 8, local_size_y = 1) in;
+layout(binding = 2) uniform usampler2D uHeads;
+layout(rg32ui, binding = 5) writeonly uniform uimage2D uTileRange;
+uniform ivec2 uSize;
+uniform ivec2 uTiles;
+void main() {
+    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
+    if (t.x >= uTiles.x) return;
+    ivec2 first = t * 16, last = min(first + 16, uSize);
+    uint lo = 0xffffffffu, hi = 0u, most = 0u;
+    for (int y = first.y; y < last.y; ++y)
+        for (int x = first.x; x < last.x; ++x) {
+            uint count = 0u;
+            for (uint i = texelFetch(uHeads, ivec2(x, y), 0).x; i != splatfx_kEnd; i = splatfx_nodes[i].next) {
+                uint z = floatBitsToUint(abs(uintBitsToFloat(splatfx_nodes[i].depthBits))); // -0 as +0
+                lo = min(lo, z);
+                hi = max(hi, z);
+                ++count;
+            }
+            most = max(most, count);
+        }
+    imageStore(uTileRange, t, uvec4(lo, hi, 0u, 0u));
+    // The most surfaces on one pixel (here rather than per fragment in the
+    // include: one atomic per tile instead of two per surface fragment).
+    if (most > 0u) atomicMax(splatfx_maxSurfaces, most);
+}
+)";
+
 // The resolve, one invocation per pixel. Compiled after "#version 450
 // core", "#define K n" and transparentGlsl() without its
 // early_fragment_tests line. A compute shader, not a full-screen draw: on
 // Mesa's llvmpipe the fragment version read wrong list data in the partially
 // covered blocks along its triangles' edges (a band of wrong pixels).
 constexpr const char* kResolveCompute = R"(
+#if FRAG
+// The fragment variant: nodes through a texture buffer view of the pool
+// (RGBA32UI: rg, ba, depth bits, next), composited "over" the framebuffer
+// by the blend unit. No storage-buffer access (see above).
+layout(binding = 4) uniform usamplerBuffer uNodes;
+layout(location = 0) out vec4 oColor;
+const uint splatfx_kEnd = 0xffffffffu;
+#define NODE(i) texelFetch(uNodes, int(i))
+#else
 layout(local_size_x = 8, local_size_y = 8) in;
+layout(rgba16f, binding = 5) writeonly uniform image2D uResolved;
+#define NODE(i) uvec4(splatfx_nodes[i].rg, splatfx_nodes[i].ba, splatfx_nodes[i].depthBits, splatfx_nodes[i].next)
+#endif
 layout(binding = 1) uniform sampler2DArray uSections;
 layout(binding = 2) uniform usampler2D uHeads;
-layout(rgba16f, binding = 5) writeonly uniform image2D uResolved;
 uniform ivec2 uOrigin;      // the lists' viewport origin in the section targets
 uniform ivec2 uSize;        // the lists' viewport size
 uniform int uSectionCount;  // 0: the splats were not drawn into sections
@@ -178,18 +231,23 @@ vec4 over(vec4 front, vec4 back) { return front + (1.0 - front.a) * back; }
 vec4 section(ivec2 p, int k) { return k < uSectionCount ? texelFetch(uSections, ivec3(p + uOrigin, k), 0) : vec4(0.0); }
 
 void main() {
+#if FRAG
+    ivec2 p = ivec2(gl_FragCoord.xy) - uOrigin;
+    if (p.x < 0 || p.y < 0 || p.x >= uSize.x || p.y >= uSize.y) discard;
+#else
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (p.x >= uSize.x || p.y >= uSize.y) return;
+#endif
     float eDepth[K];
     vec4 eColour[K];
     int n = 0;
     uint merged = 0u;
     uint i = texelFetch(uHeads, p, 0).x;
     while (i != splatfx_kEnd) {
-        splatfx_Node node = splatfx_nodes[i];
-        i = node.next;
-        float d = uintBitsToFloat(node.depthBits);
-        vec4 c = vec4(unpackHalf2x16(node.rg), unpackHalf2x16(node.ba));
+        uvec4 node = NODE(i);
+        i = node.w;
+        float d = uintBitsToFloat(node.z);
+        vec4 c = vec4(unpackHalf2x16(node.x), unpackHalf2x16(node.y));
         if (n == K) {
             // Full: the farthest two of the K + 1 become one ("over").
             ++merged;
@@ -218,10 +276,12 @@ void main() {
         eDepth[j] = d;
         eColour[j] = c;
     }
+#if !FRAG
     if (merged > 0u) {
         atomicAdd(splatfx_overflowPixels, 1u);
         atomicAdd(splatfx_mergedNodes, merged);
     }
+#endif
     // Front to back: section 0, surface 0, section 1, ... The sections past
     // the last kept surface (more surfaces than sections or than K) follow it.
     vec4 acc = section(p, 0);
@@ -230,7 +290,12 @@ void main() {
         if (k + 1 < n) acc = over(acc, section(p, k + 1));
     }
     for (int k = max(n, 1); k < uSectionCount; ++k) acc = over(acc, section(p, k));
+#if FRAG
+    if (acc == vec4(0.0)) discard;
+    oColor = acc;
+#else
     imageStore(uResolved, p, acc);
+#endif
 }
 )";
 
@@ -297,14 +362,34 @@ struct FragmentListPass::Impl {
         return true;
     }
     std::vector<std::pair<int, GLuint>> resolvePrograms; // (K, program), K ascending
-    GLuint compositeProgram = 0, prepareProgram = 0;
+    // The fragment resolve by K (built on first use), reading the pool
+    // through a texture buffer view when it fits GL_MAX_TEXTURE_BUFFER_SIZE.
+    std::vector<std::pair<int, GLuint>> fragmentResolvePrograms;
+    GLuint poolView = 0;
+    bool poolViewed = false;
+    GLuint fragmentResolve(int k) {
+        for (const auto& fp : fragmentResolvePrograms)
+            if (fp.first == k) return fp.second;
+        const std::string def = "#version 450 core\n#define FRAG 1\n#define K " + std::to_string(k) + "\n";
+        auto prog = linkProgram({kFullscreenVertex}, {def.c_str(), kResolveCompute}, "fragment lists (resolve, fragment)");
+        const GLuint id = prog ? *prog : 0; // 0: this GL cannot build it; the compute resolve is used
+        fragmentResolvePrograms.push_back({k, id});
+        return id;
+    }
+    GLuint compositeProgram = 0, prepareProgram = 0, rangeProgram = 0;
+    // The surface depth range per kRangeTile tile (RG32UI float bits), read back by split().
+    GLuint tileRange = 0;
+    glm::ivec2 tileSize{0};
+    std::vector<GLuint> tileBits;
+    std::vector<float> tileView; // tileBits as view depth
+    std::array<float, 256> rho{}; // rayScaleRho by code (the kernel's reach along the rays)
     GLuint depths = 0; // R32F array: each pixel's nearest surface depths
     int depthLayers = 0;
     glm::ivec2 depthSize{0};
     GLuint resolved = 0; // RGBA16F, the lists' viewport
     GLuint vao = 0, instances = 0, emptyVao = 0;
     std::size_t instanceCapacity = 0;
-    GLuint heads = 0, counts = 0, pool = 0, counters = 0;
+    GLuint heads = 0, pool = 0, counters = 0;
     GLuint sections = 0, sectionFbo = 0, attachedDepth = 0;
     glm::ivec2 sectionSize{0};
     int sectionLayers = 0;
@@ -319,30 +404,33 @@ struct FragmentListPass::Impl {
             for (const SectionProgram& p : kind)
                 if (p.id) glDeleteProgram(p.id);
         for (const auto& rp : resolvePrograms) glDeleteProgram(rp.second);
+        for (const auto& fp : fragmentResolvePrograms)
+            if (fp.second) glDeleteProgram(fp.second);
+        if (poolView) glDeleteTextures(1, &poolView);
         if (compositeProgram) glDeleteProgram(compositeProgram);
         if (prepareProgram) glDeleteProgram(prepareProgram);
+        if (rangeProgram) glDeleteProgram(rangeProgram);
+        if (tileRange) glDeleteTextures(1, &tileRange);
         if (depths) glDeleteTextures(1, &depths);
         GLuint vaos[2] = {vao, emptyVao};
         glDeleteVertexArrays(2, vaos);
         GLuint bufs[3] = {instances, pool, counters};
         glDeleteBuffers(3, bufs);
-        GLuint tex[4] = {heads, counts, sections, resolved};
-        glDeleteTextures(4, tex);
+        GLuint tex[3] = {heads, sections, resolved};
+        glDeleteTextures(3, tex);
         if (sectionFbo) glDeleteFramebuffers(1, &sectionFbo);
     }
 
     void resize(int w, int h) {
         if (w == width && h == height && pool) return;
-        GLuint tex[3] = {heads, counts, resolved};
-        glDeleteTextures(3, tex);
+        GLuint tex[2] = {heads, resolved};
+        glDeleteTextures(2, tex);
         glCreateTextures(GL_TEXTURE_2D, 1, &resolved);
         glTextureStorage2D(resolved, 1, GL_RGBA16F, w, h);
         glTextureParameteri(resolved, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTextureParameteri(resolved, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
         glCreateTextures(GL_TEXTURE_2D, 1, &heads);
-        glCreateTextures(GL_TEXTURE_2D, 1, &counts);
         glTextureStorage2D(heads, 1, GL_R32UI, w, h);
-        glTextureStorage2D(counts, 1, GL_R32UI, w, h);
         // Integer textures are complete only with nearest filtering.
         glTextureParameteri(heads, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTextureParameteri(heads, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
@@ -350,6 +438,15 @@ struct FragmentListPass::Impl {
         poolNodes = std::size_t(w) * std::size_t(h) * std::size_t(perPixel);
         glCreateBuffers(1, &pool);
         glNamedBufferStorage(pool, GLsizeiptr(poolNodes * kTransparentNodeBytes), nullptr, 0);
+        if (poolView) glDeleteTextures(1, &poolView);
+        poolView = 0;
+        GLint maxTexels = 0;
+        glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &maxTexels);
+        poolViewed = poolNodes <= std::size_t(std::max(maxTexels, 0));
+        if (poolViewed) {
+            glCreateTextures(GL_TEXTURE_BUFFER, 1, &poolView);
+            glTextureBuffer(poolView, GL_RGBA32UI, pool); // one node per texel (kTransparentNodeBytes = 16)
+        }
         width = w;
         height = h;
         stats.poolNodes = poolNodes;
@@ -401,7 +498,7 @@ Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
     // them (the per-pixel arrays cost in proportion to K on a CPU rasterizer).
     for (int k = 1;; k = std::min(2 * k, impl->perPixel)) {
         const std::string def = "#define K " + std::to_string(k) + "\n";
-        auto resolve = linkComputeProgram({"#version 450 core\n", def.c_str(), computeInclude.c_str(), kResolveCompute}, "fragment lists (resolve)");
+        auto resolve = linkComputeProgram({"#version 450 core\n#define FRAG 0\n", def.c_str(), computeInclude.c_str(), kResolveCompute}, "fragment lists (resolve)");
         if (!resolve) return makeError(resolve.error());
         impl->resolvePrograms.push_back({k, *resolve});
         if (k == impl->perPixel) break;
@@ -409,6 +506,10 @@ Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
     auto prepare = linkComputeProgram({"#version 450 core\n", computeInclude.c_str(), kPrepareCompute}, "fragment lists (prepare)");
     if (!prepare) return makeError(prepare.error());
     impl->prepareProgram = *prepare;
+    auto range = linkComputeProgram({"#version 450 core\n", computeInclude.c_str(), kTileRangeCompute}, "fragment lists (tile depth range)");
+    if (!range) return makeError(range.error());
+    impl->rangeProgram = *range;
+    for (int c = 0; c < 256; ++c) impl->rho[std::size_t(c)] = rayScaleRho(std::uint8_t(c));
     auto composite = linkProgram({kFullscreenVertex}, {kListCompositeFragment}, "fragment lists (composite)");
     if (!composite) return makeError(composite.error());
     impl->compositeProgram = *composite;
@@ -451,15 +552,14 @@ Status FragmentListPass::collectSurfaces(const FragmentListTarget& target, const
     r.sectionsThisFrame = 0;
     r.stats.eyeCrossing = 0;
     r.stats.cut = false;
-    const GLuint end = kEnd, zero = 0;
+    r.stats.splatsBehind = r.stats.splatsFront = r.stats.splatsSectioned = 0;
+    const GLuint end = kEnd;
     glClearTexImage(r.heads, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &end);
-    glClearTexImage(r.counts, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     const GLint header[kCounterWords] = {0, 0, target.x, target.y, target.width, target.height, 0, 0, 0, 0, 0, 0};
     glNamedBufferSubData(r.counters, 0, sizeof(header), header);
     glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kTransparentNodeBinding, r.pool, 0, GLsizeiptr(r.poolNodes * kTransparentNodeBytes));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTransparentCounterBinding, r.counters);
     glBindImageTexture(kTransparentHeadImageUnit, r.heads, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
-    glBindImageTexture(kTransparentCountImageUnit, r.counts, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     if (drawSurfaces) {
         glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
@@ -472,14 +572,113 @@ Status FragmentListPass::collectSurfaces(const FragmentListTarget& target, const
         glDepthMask(GL_FALSE);
         drawSurfaces();
     }
+    // The survey of the lists (kTileRangeCompute).
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    const int tilesX = (target.width + kRangeTile - 1) / kRangeTile, tilesY = (target.height + kRangeTile - 1) / kRangeTile;
+    if (!r.tileRange || r.tileSize != glm::ivec2(tilesX, tilesY)) {
+        if (r.tileRange) glDeleteTextures(1, &r.tileRange);
+        glCreateTextures(GL_TEXTURE_2D, 1, &r.tileRange);
+        glTextureStorage2D(r.tileRange, 1, GL_RG32UI, tilesX, tilesY);
+        r.tileSize = {tilesX, tilesY};
+    }
+    glUseProgram(r.rangeProgram);
+    glUniform2i(glGetUniformLocation(r.rangeProgram, "uSize"), target.width, target.height);
+    glUniform2i(glGetUniformLocation(r.rangeProgram, "uTiles"), tilesX, tilesY);
+    glBindTextureUnit(2, r.heads);
+    glBindImageTexture(5, r.tileRange, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32UI);
+    glDispatchCompute(GLuint((tilesX + 7) / 8), GLuint(tilesY), 1);
+    glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32UI);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     return {};
 }
 
-void FragmentListPass::insertSplats(const std::vector<Splat>& splats, const Camera& camera, unsigned layerTexture, float cut, bool trimCorners,
-                                    bool depthCut, const FragmentListTarget& target) {
+FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats, const Camera& camera, float cut, bool trimCorners, bool depthCut,
+                                                const FragmentListTarget& target) {
+    Impl& r = *mImpl;
+    r.stats.splatsBehind = r.stats.splatsFront = r.stats.splatsSectioned = 0;
+    const std::size_t n = splats.size();
+    if (n == 0) return {};
+    const int tile = kRangeTile;
+    const int tilesX = r.tileSize.x, tilesY = r.tileSize.y;
+    glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+    r.tileBits.resize(std::size_t(tilesX) * std::size_t(tilesY) * 2);
+    glGetTextureImage(r.tileRange, 0, GL_RG_INTEGER, GL_UNSIGNED_INT, GLsizei(r.tileBits.size() * sizeof(GLuint)), r.tileBits.data());
+    // Window depth to view depth, as the shaders do (monotonic: the range maps to the range).
+    const glm::mat4 invProj = glm::inverse(camera.proj);
+    auto viewDepth = [&](GLuint bits) {
+        float d;
+        std::memcpy(&d, &bits, 4);
+        const float nz = d * 2.0f - 1.0f;
+        return std::abs((invProj[2][2] * nz + invProj[3][2]) / (invProj[2][3] * nz + invProj[3][3]));
+    };
+    std::vector<float>& range = r.tileView;
+    range.resize(r.tileBits.size());
+    bool any = false;
+    for (std::size_t t = 0; t < r.tileBits.size(); t += 2) {
+        const bool empty = r.tileBits[t] > r.tileBits[t + 1];
+        any |= !empty;
+        range[t] = empty ? 3.4e38f : viewDepth(r.tileBits[t]);
+        range[t + 1] = empty ? -3.4e38f : viewDepth(r.tileBits[t + 1]);
+    }
+    if (!any) { // no surface stored: every splat is in the only section
+        r.stats.splatsBehind = n;
+        return {n, n};
+    }
+    // Per splat: the view-depth interval its contribution can come from (the
+    // polygon's, widened by the kernel's reach along the rays with the cut),
+    // and the surfaces' depth range over the tiles its screen rectangle meets
+    // (the same bound as the splat pass's tile test, renderer.cpp).
+    const bool persp = camera.perspective();
+    const glm::vec3 eye = camera.eye(), fwd = camera.forward();
+    const float nearZ = camera.nearPlane(), extent = std::clamp(cut, 0.05f, 1.0f);
+    const glm::mat4 vp = camera.proj * camera.view;
+    const float focalY = std::abs(camera.proj[1][1]) * 0.5f * float(target.height), focalX = std::abs(camera.proj[0][0]) * 0.5f * float(target.width);
+    // 0: between (sections), 1: behind every surface it covers, 2: in front of every one.
+    auto classify = [&](const Splat& sp) -> int {
+        const float a = std::abs(glm::dot(sp.axisU, fwd)), b = std::abs(glm::dot(sp.axisV, fwd));
+        const float reach = extent * (trimCorners ? std::max(a + 0.41421356f * b, 0.41421356f * a + b) : a + b);
+        const float zc = glm::dot(sp.center - eye, fwd);
+        const float minZ = zc - reach, maxZ = zc + reach;
+        const float depthReach = depthCut ? 1.01f * r.rho[sp.color >> 24] * std::sqrt(glm::length(glm::cross(sp.axisU, sp.axisV))) : 0.0f;
+        float lo = 3.4e38f, hi = -3.4e38f;
+        const glm::vec4 cc = vp * glm::vec4(sp.center, 1.0f);
+        const float ext = extent * (glm::length(sp.axisU) + glm::length(sp.axisV)) * 1.01f;
+        const float px = (cc.x / cc.w * 0.5f + 0.5f) * float(target.width), py = (cc.y / cc.w * 0.5f + 0.5f) * float(target.height);
+        const float hx = persp ? ext * focalX / minZ : ext * focalX, hy = persp ? ext * focalY / minZ : ext * focalY;
+        int x0 = 0, x1 = tilesX - 1, y0 = 0, y1 = tilesY - 1; // near or across the eye plane, or not finite: every tile
+        if ((!persp || minZ >= 0.5f * nearZ) && std::isfinite(px) && std::isfinite(py) && std::isfinite(hx) && std::isfinite(hy)) {
+            x0 = std::clamp(int(std::floor((px - hx) / float(tile))), 0, tilesX - 1), x1 = std::clamp(int(std::floor((px + hx) / float(tile))), 0, tilesX - 1);
+            y0 = std::clamp(int(std::floor((py - hy) / float(tile))), 0, tilesY - 1), y1 = std::clamp(int(std::floor((py + hy) / float(tile))), 0, tilesY - 1);
+        }
+        for (int ty = y0; ty <= y1; ++ty)
+            for (int tx = x0; tx <= x1; ++tx) {
+                const float* t = &range[(std::size_t(ty) * std::size_t(tilesX) + std::size_t(tx)) * 2];
+                lo = std::min(lo, t[0]);
+                hi = std::max(hi, t[1]);
+            }
+        if (lo > hi) return 1; // no surface on its tiles: its only section is the last
+        if (minZ - depthReach > hi * 1.01f + 1e-6f) return 1;
+        if (maxZ + depthReach < lo * 0.99f) return 2;
+        return 0;
+    };
+    Split s;
+    while (s.behindEnd < n && classify(splats[s.behindEnd]) == 1) ++s.behindEnd;
+    s.frontBegin = n;
+    while (s.frontBegin > s.behindEnd && classify(splats[s.frontBegin - 1]) == 2) --s.frontBegin;
+    r.stats.splatsBehind = s.behindEnd;
+    r.stats.splatsFront = n - s.frontBegin;
+    return s;
+}
+
+void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t begin, std::size_t end, const Camera& camera, unsigned layerTexture,
+                                    float cut, bool trimCorners, bool depthCut, const FragmentListTarget& target) {
     Impl& r = *mImpl;
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    if (splats.empty() || !layerTexture || !target.depthTexture) return;
+    end = std::min(end, all.size());
+    if (begin >= end || !layerTexture || !target.depthTexture) return;
+    const Splat* splats = all.data() + begin;
+    const std::size_t count = end - begin;
+    r.stats.splatsSectioned = count;
     // How many sections the frame needs: one more than the most surfaces on a pixel.
     GLuint maxSurfaces = 0;
     glGetNamedBufferSubData(r.counters, 6 * 4, 4, &maxSurfaces);
@@ -513,14 +712,14 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& splats, const Came
     glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     r.sizeSections({target.x + target.width, target.y + target.height}, prog->sections, target.depthTexture);
 
-    if (splats.size() > r.instanceCapacity) {
+    if (count > r.instanceCapacity) {
         if (r.instances) glDeleteBuffers(1, &r.instances);
-        r.instanceCapacity = std::max<std::size_t>(splats.size() + splats.size() / 2, 1024);
+        r.instanceCapacity = std::max<std::size_t>(count + count / 2, 1024);
         glCreateBuffers(1, &r.instances);
         glNamedBufferStorage(r.instances, GLsizeiptr(r.instanceCapacity * sizeof(Splat)), nullptr, GL_DYNAMIC_STORAGE_BIT);
         glVertexArrayVertexBuffer(r.vao, 0, r.instances, 0, sizeof(Splat));
     }
-    glNamedBufferSubData(r.instances, 0, GLsizeiptr(splats.size() * sizeof(Splat)), splats.data());
+    glNamedBufferSubData(r.instances, 0, GLsizeiptr(count * sizeof(Splat)), splats);
 
     GLenum bufs[kTransparentMaxSections];
     for (int k = 0; k < kTransparentMaxSections; ++k) bufs[k] = k < prog->sections ? GL_COLOR_ATTACHMENT0 + GLenum(k) : GL_NONE;
@@ -560,7 +759,7 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& splats, const Came
         std::uint64_t crossing = 0;
         const float nearZ = camera.nearPlane(), extent = std::clamp(cut, 0.05f, 1.0f);
         if (camera.perspective())
-            for (const Splat& sp : splats) {
+            for (const Splat& sp : std::span<const Splat>(splats, count)) {
                 const float a = std::abs(glm::dot(sp.axisU, fwd)), b = std::abs(glm::dot(sp.axisV, fwd));
                 const float reach = trimCorners ? std::max(a + 0.41421356f * b, 0.41421356f * a + b) : a + b;
                 if (!(glm::dot(sp.center - eye, fwd) - extent * reach >= 0.25f * nearZ)) ++crossing;
@@ -570,7 +769,7 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& splats, const Came
     glBindTextureUnit(0, layerTexture);
     glBindTextureUnit(2, r.depths);
     glBindVertexArray(r.vao);
-    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, trimCorners ? 8 : 4, GLsizei(splats.size()));
+    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, trimCorners ? 8 : 4, GLsizei(count));
 }
 
 void FragmentListPass::resolve(const FragmentListTarget& target) {
@@ -579,11 +778,37 @@ void FragmentListPass::resolve(const FragmentListTarget& target) {
     GLuint maxSurfaces = 0;
     glGetNamedBufferSubData(r.counters, 6 * 4, 4, &maxSurfaces);
     GLuint program = r.resolvePrograms.back().second;
+    int programK = r.resolvePrograms.back().first;
     for (const auto& rp : r.resolvePrograms)
         if (GLuint(rp.first) >= maxSurfaces) {
             program = rp.second;
+            programK = rp.first;
             break;
         }
+    // Every pixel's list fits the variant (nothing to merge, so nothing to
+    // count): one full-screen draw resolves and composites at once. A
+    // compute dispatch costs llvmpipe several times a draw per pixel, and
+    // the RGBA16F image between the two goes.
+    const GLuint fragmentProgram = GLuint(programK) >= maxSurfaces && r.poolViewed ? r.fragmentResolve(programK) : 0;
+    if (fragmentProgram) {
+        glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+        glViewport(target.x, target.y, target.width, target.height);
+        glEnable(GL_BLEND);
+        glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+        glBlendEquation(GL_FUNC_ADD);
+        glDisable(GL_DEPTH_TEST);
+        glDepthMask(GL_FALSE);
+        glUseProgram(fragmentProgram);
+        glUniform1i(glGetUniformLocation(fragmentProgram, "uSectionCount"), r.sectionsThisFrame);
+        glUniform2i(glGetUniformLocation(fragmentProgram, "uOrigin"), target.x, target.y);
+        glUniform2i(glGetUniformLocation(fragmentProgram, "uSize"), target.width, target.height);
+        if (r.sectionsThisFrame > 0) glBindTextureUnit(1, r.sections);
+        glBindTextureUnit(2, r.heads);
+        glBindTextureUnit(4, r.poolView);
+        glBindVertexArray(r.emptyVao);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glBindTextureUnit(4, 0);
+    } else {
     glUseProgram(program);
     glUniform1i(glGetUniformLocation(program, "uSectionCount"), r.sectionsThisFrame);
     glUniform2i(glGetUniformLocation(program, "uOrigin"), target.x, target.y);
@@ -607,6 +832,7 @@ void FragmentListPass::resolve(const FragmentListTarget& target) {
     glBindTextureUnit(1, r.resolved);
     glBindVertexArray(r.emptyVao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     GLuint c[kCounterWords] = {};
     glGetNamedBufferSubData(r.counters, 0, sizeof(c), c);
@@ -619,12 +845,12 @@ void FragmentListPass::resolve(const FragmentListTarget& target) {
     r.stats.sections = r.sectionsThisFrame;
     r.stats.bytes = std::size_t(r.depthSize.x) * r.depthSize.y * 4 * std::size_t(r.depthLayers) /* sorted depths */ + r.poolNodes * kTransparentNodeBytes + std::size_t(r.width) * r.height * kTransparentHeadBytesPerPixel +
                     std::size_t(kCounterBytes) + std::size_t(r.width) * r.height * 8 /* resolved RGBA16F */ +
-                    std::size_t(r.sectionSize.x) * r.sectionSize.y * kTransparentSectionBytesPerPixel * std::size_t(r.sectionLayers);
+                    std::size_t(r.sectionSize.x) * r.sectionSize.y * kTransparentSectionBytesPerPixel * std::size_t(r.sectionLayers) +
+                    std::size_t(r.tileSize.x) * std::size_t(r.tileSize.y) * 8 /* the survey's tile depth ranges (RG32UI) */;
     // Leave nothing of ours bound where the host's own buffers may live.
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTransparentNodeBinding, 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTransparentCounterBinding, 0);
     glBindImageTexture(kTransparentHeadImageUnit, 0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
-    glBindImageTexture(kTransparentCountImageUnit, 0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glBindTextureUnit(1, 0);
     glBindTextureUnit(2, 0);
     glBindTextureUnit(3, 0);

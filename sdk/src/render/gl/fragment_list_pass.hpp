@@ -63,6 +63,9 @@ struct FragmentListStats {
     std::uint64_t mergedNodes = 0;      // nodes merged into a pixel's farthest slot
     bool cut = false;                   // the sections were weighted by the kernel's partial line integral
     std::uint64_t eyeCrossing = 0;      // splats whose polygon crosses the eye plane: not drawn by this pass
+    std::uint64_t splatsBehind = 0;     // split(): splats behind every surface they cover (ordinary pass, before the resolve)
+    std::uint64_t splatsFront = 0;      // split(): splats in front of every surface they cover (ordinary pass, after it)
+    std::uint64_t splatsSectioned = 0;  // splats drawn into the section targets
     std::size_t bytes = 0;              // GPU bytes of the pool, heads, counts, counters and the section targets in use
     std::size_t poolNodes = 0;          // capacity of the pool
 };
@@ -83,14 +86,29 @@ public:
     // target's framebuffer bound, premultiplied "over" blending, depth test
     // LEQUAL without writes.
     Status collectSurfaces(const FragmentListTarget& target, const std::function<void()>& drawSurfaces);
-    // Composites the splats (sorted back to front) into their sections.
+    // After collectSurfaces: the sorted splats (back to front) as three runs.
+    // [0, behindEnd) lie behind every surface stored on every pixel they may
+    // cover, [frontBegin, size) in front of every one, the rest between.
+    // On every pixel the first run falls into the last section and the last
+    // run into the first, so drawing the first run over the opaque image
+    // before the resolve and the last run over the result after it gives
+    // what the sections give ("over" is associative, the runs keep the
+    // back-to-front order): the frame renderer draws both with the ordinary
+    // splat pass, and only the middle run needs the section pass. Conservative
+    // (per 16 x 16 tile and with the kernel's whole reach along the rays, 1 %
+    // margin). One GPU sync: the tiles' surface depth range is read back.
+    struct Split {
+        std::size_t behindEnd = 0, frontBegin = 0;
+    };
+    Split split(const std::vector<Splat>& splats, const Camera& camera, float cut, bool trimCorners, bool depthCut, const FragmentListTarget& target);
+    // Composites the splats [begin, end) (sorted back to front) into their sections.
     // layerTexture: the splat pass's GL_TEXTURE_2D_ARRAY; cut, trimCorners:
     // RendererDesc's. Reads the surface counters back first (one GPU sync)
     // to choose how many section targets the frame needs.
     // depthCut (RendererDesc::depthCut): sections weighted by the kernel's
     // partial line integral and cut at the near plane and the host depth;
     // false: the kernel as a step at its plane.
-    void insertSplats(const std::vector<Splat>& splats, const Camera& camera, unsigned layerTexture, float cut, bool trimCorners, bool depthCut,
+    void insertSplats(const std::vector<Splat>& splats, std::size_t begin, std::size_t end, const Camera& camera, unsigned layerTexture, float cut, bool trimCorners, bool depthCut,
                       const FragmentListTarget& target);
     // Sorts every pixel's surfaces, interleaves the sections, composites
     // over the framebuffer, unbinds the lists, reads the counters back.

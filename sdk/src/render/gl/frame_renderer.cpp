@@ -198,12 +198,28 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
                                             .depthTexture = listDepth};
         const Status s = r.lists->collectSurfaces(lt, target.drawTransparent);
         if (s) {
+            detail::FragmentListPass::Split split{};
+            const std::vector<Splat>& all = frame.splats();
+            // The splats behind every surface they cover, and those in front
+            // of every one, take the ordinary splat pass (before and after
+            // the resolve: FragmentListPass::split); the rest, sections.
+            auto ordinary = [&](std::size_t begin, std::size_t end) {
+                if (begin >= end) return;
+                r.batch.assign(all.begin() + std::ptrdiff_t(begin), all.begin() + std::ptrdiff_t(end));
+                r.full->draw(r.batch, camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
+                                               .depthTexture = target.depthTexture});
+                r.stats.drawCalls += r.full->stats().drawCalls;
+            };
             if (splatsInLists) {
-                r.lists->insertSplats(frame.splats(), camera, r.full->layerTexture(), r.desc.splats.footprintCut, r.desc.splats.trimCorners,
-                                      r.desc.splats.depthCut, lt);
-                r.stats.drawCalls = frame.splats().empty() ? 0 : 1;
+                r.stats.drawCalls = 0;
+                split = r.lists->split(all, camera, r.desc.splats.footprintCut, r.desc.splats.trimCorners, r.desc.splats.depthCut, lt);
+                ordinary(0, split.behindEnd);
+                r.lists->insertSplats(all, split.behindEnd, split.frontBegin, camera, r.full->layerTexture(), r.desc.splats.footprintCut,
+                                      r.desc.splats.trimCorners, r.desc.splats.depthCut, lt);
+                if (split.frontBegin > split.behindEnd) ++r.stats.drawCalls;
             }
             r.lists->resolve(lt);
+            if (splatsInLists) ordinary(split.frontBegin, all.size());
         } else {
             r.stats.transparentNote = s.error();
         }
@@ -217,6 +233,9 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         r.stats.transparentSections = ls.sections;
         r.stats.transparentCut = ls.cut;
         r.stats.transparentEyeCrossing = ls.eyeCrossing;
+        r.stats.transparentSplatsBehind = ls.splatsBehind;
+        r.stats.transparentSplatsFront = ls.splatsFront;
+        r.stats.transparentSplatsSectioned = ls.splatsSectioned;
         r.stats.transparentBytes = ls.bytes;
         if (r.desc.splats.restoreState) saved.restore();
     } else if (target.drawTransparent) {
