@@ -169,7 +169,7 @@ struct FrameRenderStats {
     int transparentSections = 0;                 // section targets the splats were composited into (2, 4 or 8; 0: none)
     std::uint64_t transparentSectionOverflow = 0; // pixels with more surfaces than sections - 1 (7 at most): the gas behind the extra ones merged into the last section
     bool transparentCut = false;          // sections weighted by the kernel's partial line integral (RendererDesc::depthCut)
-    std::uint64_t transparentEyeCrossing = 0; // splats whose polygon crosses the eye plane: not drawn in the lists (camera inside a kernel)
+    std::uint64_t transparentGeneral = 0; // sectioned splats whose polygon crosses the eye plane (camera inside a kernel): drawn screen-covering, exact
     // How the splats of a list frame were drawn: behind every surface they
     // cover (the ordinary splat pass, before the resolve), in front of every
     // one (the ordinary pass, after it), or cut into sections (the rest).

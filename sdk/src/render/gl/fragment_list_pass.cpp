@@ -54,6 +54,19 @@ layout(binding = 1) uniform sampler2D uHostDepth;
 uniform vec4 uDepthToView; // inverse projection's (z, w) rows at (z, w) columns
 flat in float vScale;
 in vec3 vRel;
+#if GENERAL
+// The polygon crosses the eye plane (the camera inside the kernel): the
+// vertex stage covers the screen and each fragment meets its ray with the
+// splat plane, as the splat pass's general variant does (shaders.hpp).
+uniform mat4 uInvViewProj;
+uniform vec4 uViewport; // x, y, width, height
+uniform vec3 uEye;
+uniform float uCut;
+uniform int uOctagon;
+flat in vec3 vCenter;
+flat in vec3 vAxisU;
+flat in vec3 vAxisV;
+#endif
 float gR, gTP, gInvCos, gInvL, gLo, gHi;
 float viewDepth(float windowDepth) {
     float nz = windowDepth * 2.0 - 1.0;
@@ -73,14 +86,36 @@ float sectionFraction(float d) { return gl_FragCoord.z <= d ? 1.0 : 0.0; }
 void main() {
     vec4 acc[SECTIONS];
     for (int k = 0; k < SECTIONS; ++k) acc[k] = vec4(0.0);
-    vec4 t = texture(uLayers, vec3(vTex, vLayers.x));
-    if (vLayers.z > 0.0) t = mix(t, texture(uLayers, vec3(vTex, vLayers.y)), vLayers.z);
+#if CUT && GENERAL
+    vec2 ndc = (gl_FragCoord.xy - uViewport.xy) / uViewport.zw * 2.0 - 1.0;
+    vec4 farPoint = uInvViewProj * vec4(ndc, 1.0, 1.0);
+    vec3 dir = normalize(farPoint.xyz / farPoint.w - uEye);
+    vec3 nrm = cross(vAxisU, vAxisV);
+    float dn = dot(dir, nrm);
+    if (abs(dn) <= 1e-6 * length(nrm)) discard; // edge-on
+    float tPlane = dot(vCenter - uEye, nrm) / dn; // the line, so a plane just behind the eye still gives its tail in front
+    vec3 g = uEye + tPlane * dir - vCenter;
+    float g00 = dot(vAxisU, vAxisU), g01 = dot(vAxisU, vAxisV), g11 = dot(vAxisV, vAxisV);
+    float b0 = dot(vAxisU, g), b1 = dot(vAxisV, g);
+    vec2 uvk = vec2(g11 * b0 - g01 * b1, g00 * b1 - g01 * b0) / (g00 * g11 - g01 * g01);
+    if (max(abs(uvk.x), abs(uvk.y)) > uCut || (uOctagon != 0 && abs(uvk.x) + abs(uvk.y) > uCut * 1.41421356)) discard;
+    vec2 tex = vec2(0.5 + 0.5 * uvk.x, 0.5 - 0.5 * uvk.y);
+#else
+    vec2 tex = vTex;
+#endif
+    vec4 t = texture(uLayers, vec3(tex, vLayers.x));
+    if (vLayers.z > 0.0) t = mix(t, texture(uLayers, vec3(tex, vLayers.y)), vLayers.z);
 #if CUT
+#if GENERAL
+    gTP = tPlane;
+    gInvCos = 1.0 / dot(dir, uForward);
+#else
     vec2 uvk = vec2(2.0 * vTex.x - 1.0, 1.0 - 2.0 * vTex.y);
     float zP = dot(vRel, uForward);
-    gR = uKernelRadius * length(uvk);
     gTP = uPersp != 0 ? length(vRel) : zP; // along the ray from the eye (ortho: from its plane)
     gInvCos = uPersp != 0 ? gTP / zP : 1.0;
+#endif
+    gR = uKernelRadius * length(uvk);
     gInvL = 1.0 / vScale;
     gLo = beforeView(uNearZ);
     gHi = max(beforeView(viewDepth(texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r)), gLo);
@@ -320,23 +355,26 @@ struct FragmentListPass::Impl {
         GLuint id = 0;
         GLint uViewProj = -1, uOctagon = -1, uCut = -1, uOrigin = -1;
         GLint uEye = -1, uForward = -1, uNearZ = -1, uPersp = -1, uKernelRadius = -1, uDepthToView = -1;
+        GLint uInvViewProj = -1, uViewport = -1; // general variant
     };
-    SectionProgram sectionPrograms[2][3]; // [plain, cut][2, 4, 8 sections]
+    SectionProgram sectionPrograms[3][3]; // [plain, cut, cut general (the polygon crosses the eye plane)][2, 4, 8 sections]
     PartialTexture partial;               // the footprint's partial-integral table (cut programs)
     std::string partialSource;            // partialGlsl() the cut programs were built from
     float kernelRadius = 1.0f;
     std::string programError;
 
-    // Builds the three section programs of one kind (cut: with the partial integral).
-    bool buildSections(bool cut) {
+    // Builds the three section programs of one kind (kind 0: plain; 1: cut
+    // with the partial integral; 2: cut, general: the polygon crosses the eye plane).
+    bool buildSections(int kind) {
+        const bool cut = kind > 0;
         const std::string include = transparentGlsl();
         const int counts[3] = {2, 4, kTransparentMaxSections};
         const std::string head = std::string("#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n") +
                                  (cut ? "#define CUT 1\n#define HOST_DEPTH 1\n#define NEAR_CUT 1\n" : "#define CUT 0\n#define HOST_DEPTH 0\n#define NEAR_CUT 0\n") +
-                                 "#define GENERAL 0\n#define CROSSFADE 1\n";
+                                 (kind == 2 ? "#define GENERAL 1\n" : "#define GENERAL 0\n") + "#define CROSSFADE 1\n";
         const char* partialSrc = cut ? partialSource.c_str() : "";
         for (int v = 0; v < 3; ++v) {
-            SectionProgram& p = sectionPrograms[cut][v];
+            SectionProgram& p = sectionPrograms[kind][v];
             if (p.id) glDeleteProgram(p.id), p = {};
             const std::string def = "#define SECTIONS " + std::to_string(counts[v]) + "\n";
             auto linked = linkProgram({head.c_str(), partialSrc, kSplatVertex},
@@ -358,6 +396,8 @@ struct FragmentListPass::Impl {
             p.uPersp = loc("uPersp");
             p.uKernelRadius = loc("uKernelRadius");
             p.uDepthToView = loc("uDepthToView");
+            p.uInvViewProj = loc("uInvViewProj");
+            p.uViewport = loc("uViewport");
         }
         return true;
     }
@@ -485,7 +525,7 @@ const FragmentListStats& FragmentListPass::stats() const { return mImpl->stats; 
 Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
     auto impl = std::make_unique<Impl>();
     impl->perPixel = std::clamp(fragmentsPerPixel, 1, kMaxFragmentsPerPixel);
-    if (!impl->buildSections(false)) return makeError(impl->programError);
+    if (!impl->buildSections(0)) return makeError(impl->programError);
     const std::string include = transparentGlsl();
     std::string computeInclude = include;
     const std::string early = "layout(early_fragment_tests) in;\n";
@@ -538,7 +578,7 @@ Status FragmentListPass::upload(const Materials& materials) {
     const std::string partial = partialGlsl(materials.footprint(), 3);
     if (partial == r.partialSource) return {};
     r.partialSource = partial;
-    if (!r.buildSections(true)) {
+    if (!r.buildSections(1) || !r.buildSections(2)) {
         r.partialSource.clear();
         return makeError("fragment lists: " + r.programError);
     }
@@ -550,7 +590,7 @@ Status FragmentListPass::collectSurfaces(const FragmentListTarget& target, const
     if (target.width <= 0 || target.height <= 0) return makeError("fragment lists: the viewport must be positive");
     r.resize(target.width, target.height);
     r.sectionsThisFrame = 0;
-    r.stats.eyeCrossing = 0;
+    r.stats.generalSplats = 0;
     r.stats.cut = false;
     r.stats.splatsBehind = r.stats.splatsFront = r.stats.splatsSectioned = 0;
     const GLuint end = kEnd;
@@ -737,39 +777,60 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t b
     glDepthFunc(GL_LEQUAL);
     glDepthMask(GL_FALSE);
     glDisable(GL_CULL_FACE);
-    glUseProgram(prog->id);
+    // Perspective with the cut: a polygon that crosses (or nearly) the eye
+    // plane takes the general variant (screen-covering, each fragment meets
+    // its ray with the splat plane), as in the splat pass: the vertex stage
+    // of the other variant drops it below 0.25 near, the CPU routes below
+    // 0.5 near (margin against float arithmetic).
+    const glm::vec3 eye = camera.eye(), fwd = camera.forward();
+    const float nearZ = camera.nearPlane(), extent = std::clamp(cut, 0.05f, 1.0f);
+    auto crossesEyePlane = [&](const Splat& sp) {
+        const float a = std::abs(glm::dot(sp.axisU, fwd)), b = std::abs(glm::dot(sp.axisV, fwd));
+        const float reach = trimCorners ? std::max(a + 0.41421356f * b, 0.41421356f * a + b) : a + b;
+        return !(glm::dot(sp.center - eye, fwd) - extent * reach >= 0.5f * nearZ); // also NaN
+    };
+    const bool general = partial && camera.perspective();
     const glm::mat4 vp = camera.proj * camera.view;
-    glUniformMatrix4fv(prog->uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
-    glUniform1i(prog->uOctagon, trimCorners ? 1 : 0);
-    glUniform1f(prog->uCut, std::clamp(cut, 0.05f, 1.0f));
-    glUniform2i(prog->uOrigin, target.x, target.y);
+    const glm::mat4 invProj = glm::inverse(camera.proj), invVp = glm::inverse(vp);
+    const Impl::SectionProgram* generalProg = &r.sectionPrograms[2][std::size_t(prog - &r.sectionPrograms[partial][0])];
+    auto setUniforms = [&](const Impl::SectionProgram& p) {
+        glUseProgram(p.id);
+        glUniformMatrix4fv(p.uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
+        glUniform1i(p.uOctagon, trimCorners ? 1 : 0);
+        glUniform1f(p.uCut, extent);
+        glUniform2i(p.uOrigin, target.x, target.y);
+        if (!partial) return;
+        glUniform3f(p.uEye, eye.x, eye.y, eye.z);
+        glUniform3f(p.uForward, fwd.x, fwd.y, fwd.z);
+        glUniform1f(p.uNearZ, nearZ);
+        glUniform1i(p.uPersp, camera.perspective() ? 1 : 0);
+        glUniform1f(p.uKernelRadius, r.kernelRadius);
+        glUniform4f(p.uDepthToView, invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+        glUniformMatrix4fv(p.uInvViewProj, 1, GL_FALSE, glm::value_ptr(invVp));
+        glUniform4f(p.uViewport, float(target.x), float(target.y), float(target.width), float(target.height));
+    };
     if (partial) {
-        const glm::vec3 eye = camera.eye(), fwd = camera.forward();
-        const glm::mat4 invProj = glm::inverse(camera.proj);
-        glUniform3f(prog->uEye, eye.x, eye.y, eye.z);
-        glUniform3f(prog->uForward, fwd.x, fwd.y, fwd.z);
-        glUniform1f(prog->uNearZ, camera.nearPlane());
-        glUniform1i(prog->uPersp, camera.perspective() ? 1 : 0);
-        glUniform1f(prog->uKernelRadius, r.kernelRadius);
-        glUniform4f(prog->uDepthToView, invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
         glBindTextureUnit(1, target.depthTexture);
         glBindTextureUnit(3, r.partial.texture());
-        // The vertex shader drops a polygon that crosses the eye plane (the
-        // splat pass draws those with its general variant; not here): counted.
-        std::uint64_t crossing = 0;
-        const float nearZ = camera.nearPlane(), extent = std::clamp(cut, 0.05f, 1.0f);
-        if (camera.perspective())
-            for (const Splat& sp : std::span<const Splat>(splats, count)) {
-                const float a = std::abs(glm::dot(sp.axisU, fwd)), b = std::abs(glm::dot(sp.axisV, fwd));
-                const float reach = trimCorners ? std::max(a + 0.41421356f * b, 0.41421356f * a + b) : a + b;
-                if (!(glm::dot(sp.center - eye, fwd) - extent * reach >= 0.25f * nearZ)) ++crossing;
-            }
-        r.stats.eyeCrossing = crossing;
     }
     glBindTextureUnit(0, layerTexture);
     glBindTextureUnit(2, r.depths);
     glBindVertexArray(r.vao);
-    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, trimCorners ? 8 : 4, GLsizei(count));
+    // Runs in back-to-front order, each with its variant.
+    const GLsizei corners = trimCorners ? 8 : 4;
+    const Impl::SectionProgram* bound = nullptr;
+    std::uint64_t crossing = 0;
+    for (std::size_t i = 0; i < count;) {
+        const bool g = general && crossesEyePlane(splats[i]);
+        std::size_t j = i + 1;
+        while (j < count && (general && crossesEyePlane(splats[j])) == g) ++j;
+        const Impl::SectionProgram* p = g ? generalProg : prog;
+        if (p != bound) setUniforms(*p), bound = p;
+        glDrawArraysInstancedBaseInstance(GL_TRIANGLE_STRIP, 0, corners, GLsizei(j - i), GLuint(i));
+        if (g) crossing += j - i;
+        i = j;
+    }
+    r.stats.generalSplats = crossing;
 }
 
 void FragmentListPass::resolve(const FragmentListTarget& target) {

@@ -29,6 +29,9 @@
 // and merges the farthest into its last slot (counted); splat fragments
 // behind more than 7 surfaces go into the last section (counted).
 //
+// A splat whose polygon crosses the eye plane (the camera inside its
+// kernel) takes the general variant, as in the splat pass.
+//
 // It does not draw tetrahedra, work at reduced resolution or fog the splat
 // sections (the frame renderer takes the ordered blend then and says why).
 #pragma once
@@ -62,7 +65,7 @@ struct FragmentListStats {
     std::uint64_t overflowPixels = 0;   // pixels with more nodes than fragmentsPerPixel
     std::uint64_t mergedNodes = 0;      // nodes merged into a pixel's farthest slot
     bool cut = false;                   // the sections were weighted by the kernel's partial line integral
-    std::uint64_t eyeCrossing = 0;      // splats whose polygon crosses the eye plane: not drawn by this pass
+    std::uint64_t generalSplats = 0;    // sectioned splats whose polygon crosses the eye plane: drawn with the general (screen-covering) variant
     std::uint64_t splatsBehind = 0;     // split(): splats behind every surface they cover (ordinary pass, before the resolve)
     std::uint64_t splatsFront = 0;      // split(): splats in front of every surface they cover (ordinary pass, after it)
     std::uint64_t splatsSectioned = 0;  // splats drawn into the section targets

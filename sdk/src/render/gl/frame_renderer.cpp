@@ -232,7 +232,7 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         r.stats.transparentMaxSurfaces = ls.maxSurfaces;
         r.stats.transparentSections = ls.sections;
         r.stats.transparentCut = ls.cut;
-        r.stats.transparentEyeCrossing = ls.eyeCrossing;
+        r.stats.transparentGeneral = ls.generalSplats;
         r.stats.transparentSplatsBehind = ls.splatsBehind;
         r.stats.transparentSplatsFront = ls.splatsFront;
         r.stats.transparentSplatsSectioned = ls.splatsSectioned;
