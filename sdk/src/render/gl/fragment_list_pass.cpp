@@ -273,6 +273,17 @@ void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (p.x >= uSize.x || p.y >= uSize.y) return;
 #endif
+#if FRAG && K == 1
+    // At most one surface on any pixel (the variant is chosen so): no walk, no sort.
+    uint i = texelFetch(uHeads, p, 0).x;
+    vec4 acc = section(p, 0);
+    if (i != splatfx_kEnd) {
+        uvec4 node = NODE(i);
+        acc = over(over(acc, vec4(unpackHalf2x16(node.x), unpackHalf2x16(node.y))), section(p, 1));
+    } else {
+        acc = over(acc, section(p, 1));
+    }
+#else
     float eDepth[K];
     vec4 eColour[K];
     int n = 0;
@@ -325,6 +336,7 @@ void main() {
         if (k + 1 < n) acc = over(acc, section(p, k + 1));
     }
     for (int k = max(n, 1); k < uSectionCount; ++k) acc = over(acc, section(p, k));
+#endif
 #if FRAG
     if (acc == vec4(0.0)) discard;
     oColor = acc;
