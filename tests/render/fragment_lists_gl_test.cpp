@@ -530,10 +530,14 @@ TEST_F(FragmentListsGL, SplatStraddlingAPaneIsCutIntoSections) {
     }
 }
 
-// With a fog the splats are not drawn into sections (fogged sections are not
-// implemented): the frame says so and draws them first with the ordered blend,
-// the surfaces still sorted in the lists over them, never dropped.
-TEST_F(FragmentListsGL, WithAFogTheSplatsTakeTheOrderedBlendAndTheFrameSaysWhy) {
+// With a fog, splats that lie wholly behind (or in front of) every surface
+// they cover take the ordinary splat pass, which fogs every fragment: a pane
+// in front of the fogged fire gives what the ordered blend gives (fire, then
+// pane), up to the pane's half colour. Splats that meet a surface are not
+// sectioned (fogged sections are not implemented): they take the ordered
+// blend under the surfaces, and the frame says so; the surfaces are still
+// sorted in the lists, never dropped.
+TEST_F(FragmentListsGL, WithAFogSplatsClearOfTheSurfacesAreExactAndTheRestSaySo) {
     Fire f;
     Glass glass;
     ASSERT_TRUE(glass.error().empty()) << glass.error();
@@ -544,15 +548,37 @@ TEST_F(FragmentListsGL, WithAFogTheSplatsTakeTheOrderedBlendAndTheFrameSaysWhy) 
     f.frame.setFog(std::make_shared<const Fog>(*fog));
     auto fr = gl::FrameRenderer::create();
     ASSERT_TRUE(fr && fr->upload(f.materials));
-    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y});
-    ASSERT_TRUE(fb);
-    const std::vector<Pane> pane{{.z = Fire::kFront + 1.0f, .premultiplied = glm::vec4(0.05f, 0.1f, 0.15f, 0.3f)}};
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    auto ordered = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(fb && ordered);
+    const Camera& cam = f.frame.camera();
+    const glm::vec4 tint{0.05f, 0.1f, 0.15f, 0.3f};
+    const std::vector<Pane> front{{.z = Fire::kFront + 1.0f, .premultiplied = tint}};
     fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
-                         .drawTransparent = [&] { glass.draw(pane, f.frame.camera()); }, .transparentToLists = true});
-    const gl::FrameRenderStats& s = fr->stats();
-    EXPECT_TRUE(s.transparentLists);
-    EXPECT_FALSE(s.splatsInLists);
+                         .drawTransparent = [&] { glass.draw(front, cam); }, .transparentToLists = true});
+    gl::FrameRenderStats s = fr->stats();
+    EXPECT_TRUE(s.transparentLists && s.splatsInLists && s.fogSplats);
+    EXPECT_TRUE(s.transparentNote.empty()) << s.transparentNote;
+    EXPECT_EQ(s.transparentSplatsBehind, f.frame.splats().size());
+    EXPECT_EQ(s.transparentNodes, std::uint64_t(kSize.x) * kSize.y);
+    const Image got = fb->read();
+    Frame empty;
+    empty.begin(0.0, cam);
+    empty.end();
+    fr->render(f.frame, {.framebuffer = ordered->handle(), .drawOpaque = clearTo(kBackground)});
+    fr->render(empty, {.framebuffer = ordered->handle(), .drawTransparent = [&] { glass.draw(front, cam); }, .transparentToLists = true});
+    // The same ordinary pass in both; the pane's colour is stored as halves
+    // in the lists (2^-11 relative, colour <= 1) and composited once.
+    const test::ImageDiff d = test::compareImages(got, ordered->read(), std::ldexp(1.0, -11));
+    EXPECT_LE(d.maxAbs, std::ldexp(1.0, -11)) << test::writeFailureImages(got, d);
+
+    const std::vector<Pane> through{{.z = 0.0f, .premultiplied = tint}};
+    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
+                         .drawTransparent = [&] { glass.draw(through, cam); }, .transparentToLists = true});
+    s = fr->stats();
     EXPECT_NE(s.transparentNote.find("fog"), std::string::npos) << s.transparentNote;
+    EXPECT_EQ(s.transparentSplatsSectioned, 0u);
+    EXPECT_LT(s.transparentSplatsBehind + s.transparentSplatsFront, f.frame.splats().size()); // some meet the pane
     EXPECT_EQ(s.transparentNodes, std::uint64_t(kSize.x) * kSize.y);
     EXPECT_GT(s.splats, 0u);
 }

@@ -159,7 +159,7 @@ struct FrameRenderStats {
     std::size_t tableBytes = 0;              // GPU bytes of the uploaded pre-integration tables
     // ---- (issue 15) order-exact transparency (last frame) ----
     bool transparentLists = false;        // the host's surfaces went through the fragment lists
-    bool splatsInLists = false;           // ... and the splats too (false: drawn before them, ordered blend; see transparentNote)
+    bool splatsInLists = false;           // ... and the splats too (false: drawn before them, ordered blend; see transparentNote; with a fog, the splats that meet a surface take the ordered blend, also noted)
     std::string transparentNote;          // empty, or why the splats took the ordered blend in a list frame
     std::uint64_t transparentNodes = 0;   // surface fragments stored in the lists
     std::uint64_t transparentFallback = 0;     // surface fragments that found the pool full: blended directly by the include, unsorted

@@ -158,13 +158,16 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
             glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &name);
         listDepth = unsigned(name);
     }
-    const bool splatsInLists = lists && r.full && !anyTets && !fog && listDepth != 0;
+    // With a fog the splats still go through the split (the ordinary pass
+    // fogs each fragment); only the ones that meet a surface cannot be
+    // sectioned (fogged sections are not implemented): they take the
+    // ordered blend under the surfaces, and the frame says so.
+    const bool splatsInLists = lists && r.full && !anyTets && listDepth != 0;
     r.stats.transparentLists = lists;
     r.stats.splatsInLists = splatsInLists;
     r.stats.transparentNote = !lists || splatsInLists ? std::string()
                               : !r.full              ? "reduced resolution: the splats take the ordered blend under the surfaces"
                               : anyTets              ? "tetrahedra in the frame: the volumes take the ordered blend under the surfaces"
-                              : fog                  ? "fog: the splats take the ordered blend under the surfaces (fogged sections not implemented)"
                                                      : "no host depth texture (HostTarget::depthTexture or a texture depth attachment): "
                                                        "the splats take the ordered blend under the surfaces";
     // ---- end (issue 15) ----
@@ -213,10 +216,16 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
             if (splatsInLists) {
                 r.stats.drawCalls = 0;
                 split = r.lists->split(all, camera, r.desc.splats.footprintCut, r.desc.splats.trimCorners, r.desc.splats.depthCut, lt);
-                ordinary(0, split.behindEnd);
-                r.lists->insertSplats(all, split.behindEnd, split.frontBegin, camera, r.full->layerTexture(), r.desc.splats.footprintCut,
-                                      r.desc.splats.trimCorners, r.desc.splats.depthCut, lt);
-                if (split.frontBegin > split.behindEnd) ++r.stats.drawCalls;
+                if (fog && split.frontBegin > split.behindEnd) {
+                    ordinary(0, split.frontBegin);
+                    r.stats.transparentNote = "fog: " + std::to_string(split.frontBegin - split.behindEnd) +
+                                              " splats that meet a surface take the ordered blend under the surfaces (fogged sections not implemented)";
+                } else {
+                    ordinary(0, split.behindEnd);
+                    r.lists->insertSplats(all, split.behindEnd, split.frontBegin, camera, r.full->layerTexture(), r.desc.splats.footprintCut,
+                                          r.desc.splats.trimCorners, r.desc.splats.depthCut, lt);
+                    if (split.frontBegin > split.behindEnd) ++r.stats.drawCalls;
+                }
             }
             r.lists->resolve(lt);
             if (splatsInLists) ordinary(split.frontBegin, all.size());
