@@ -117,8 +117,18 @@ void main() {
 #endif
     gR = uKernelRadius * length(uvk);
     gInvL = 1.0 / vScale;
+    // The near and host cuts only where the CPU found the support may meet
+    // them (per-draw variants: a software rasterizer runs masked branches).
+#if NEAR_CUT
     gLo = beforeView(uNearZ);
+#else
+    gLo = 0.0;
+#endif
+#if HOST_DEPTH
     gHi = max(beforeView(viewDepth(texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r)), gLo);
+#else
+    gHi = 1.0;
+#endif
     float total = gHi - gLo;
 #else
     float total = 1.0;
@@ -202,7 +212,7 @@ void main() {
 // Run after the host's surfaces, one invocation per 16 x 16 tile (an
 // invocation per pixel costs llvmpipe more in dispatch than the walk): the
 // most surfaces on one pixel, and per tile the nearest and farthest surface
-// window depth stored on any of its pixels (as float bits: window depths are
+// window depth stored on any of its pixels and the nearest host opaque depth (as float bits: window depths are
 // in [0, 1], where the bits order like the values; an empty tile reads
 // (0xffffffff, 0)). Read back so the CPU can send the splats that lie wholly
 // behind, or wholly in front of, every surface they cover to the ordinary
@@ -211,7 +221,9 @@ constexpr int kRangeTile = 16;
 constexpr const char* kTileRangeCompute = R"(
 layout(local_size_x = 8, local_size_y = 1) in;
 layout(binding = 2) uniform usampler2D uHeads;
-layout(rg32ui, binding = 5) writeonly uniform uimage2D uTileRange;
+layout(rgba32ui, binding = 5) writeonly uniform uimage2D uTileRange;
+layout(binding = 3) uniform sampler2D uHostDepth; // the host's opaque depth (window depth)
+uniform ivec2 uOrigin; // the lists' viewport origin in it
 uniform ivec2 uSize;
 uniform ivec2 uTiles;
 void main() {
@@ -219,9 +231,11 @@ void main() {
     if (t.x >= uTiles.x) return;
     ivec2 first = t * 16, last = min(first + 16, uSize);
     uint lo = 0xffffffffu, hi = 0u, most = 0u;
+    float host = 1.0;
     for (int y = first.y; y < last.y; ++y)
         for (int x = first.x; x < last.x; ++x) {
             uint count = 0u;
+            host = min(host, texelFetch(uHostDepth, ivec2(x, y) + uOrigin, 0).r);
             for (uint i = texelFetch(uHeads, ivec2(x, y), 0).x; i != splatfx_kEnd; i = splatfx_nodes[i].next) {
                 uint z = floatBitsToUint(abs(uintBitsToFloat(splatfx_nodes[i].depthBits))); // -0 as +0
                 lo = min(lo, z);
@@ -230,7 +244,7 @@ void main() {
             }
             most = max(most, count);
         }
-    imageStore(uTileRange, t, uvec4(lo, hi, 0u, 0u));
+    imageStore(uTileRange, t, uvec4(lo, hi, floatBitsToUint(max(host, 0.0)), 0u));
     // The most surfaces on one pixel (here rather than per fragment in the
     // include: one atomic per tile instead of two per surface fragment).
     if (most > 0u) atomicMax(splatfx_maxSurfaces, most);
@@ -369,7 +383,12 @@ struct FragmentListPass::Impl {
         GLint uEye = -1, uForward = -1, uNearZ = -1, uPersp = -1, uKernelRadius = -1, uDepthToView = -1;
         GLint uInvViewProj = -1, uViewport = -1; // general variant
     };
-    SectionProgram sectionPrograms[3][3]; // [plain, cut, cut general (the polygon crosses the eye plane)][2, 4, 8 sections]
+    // [kind][2, 4, 8 sections]; kinds: 0 plain; cut with 1 near and host
+    // cuts, 2 the same general (the polygon crosses the eye plane), 3 no
+    // near or host cut, 4 near only, 5 host only (3-5 built on first use).
+    static constexpr int kKinds = 6;
+    SectionProgram sectionPrograms[kKinds][3];
+    static int cutKind(unsigned needs) { return needs == 3 ? 1 : needs == 0 ? 3 : needs == 1 ? 4 : 5; }
     PartialTexture partial;               // the footprint's partial-integral table (cut programs)
     std::string partialSource;            // partialGlsl() the cut programs were built from
     float kernelRadius = 1.0f;
@@ -381,8 +400,9 @@ struct FragmentListPass::Impl {
         const bool cut = kind > 0;
         const std::string include = transparentGlsl();
         const int counts[3] = {2, 4, kTransparentMaxSections};
-        const std::string head = std::string("#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n") +
-                                 (cut ? "#define CUT 1\n#define HOST_DEPTH 1\n#define NEAR_CUT 1\n" : "#define CUT 0\n#define HOST_DEPTH 0\n#define NEAR_CUT 0\n") +
+        const bool nearCut = kind == 1 || kind == 2 || kind == 4, hostCut = kind == 1 || kind == 2 || kind == 5;
+        const std::string head = std::string("#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n") + (cut ? "#define CUT 1\n" : "#define CUT 0\n") +
+                                 (hostCut ? "#define HOST_DEPTH 1\n" : "#define HOST_DEPTH 0\n") + (nearCut ? "#define NEAR_CUT 1\n" : "#define NEAR_CUT 0\n") +
                                  (kind == 2 ? "#define GENERAL 1\n" : "#define GENERAL 0\n") + "#define CROSSFADE 1\n";
         const char* partialSrc = cut ? partialSource.c_str() : "";
         for (int v = 0; v < 3; ++v) {
@@ -433,7 +453,10 @@ struct FragmentListPass::Impl {
     GLuint tileRange = 0;
     glm::ivec2 tileSize{0};
     std::vector<GLuint> tileBits;
-    std::vector<float> tileView; // tileBits as view depth
+    std::vector<float> tileView; // tileBits' surface depth range as view depth
+    std::vector<float> tileHost; // tileBits' nearest host depth as view depth
+    std::vector<std::uint8_t> classes; // insertSplats(): per splat, its variant
+    std::vector<std::uint8_t> needs; // split(): per splat of the middle run, the cuts its section variant needs (1 near, 2 host)
     std::array<float, 256> rho{}; // rayScaleRho by code (the kernel's reach along the rays)
     GLuint depths = 0; // R32F array: each pixel's nearest surface depths
     int depthLayers = 0;
@@ -590,6 +613,9 @@ Status FragmentListPass::upload(const Materials& materials) {
     const std::string partial = partialGlsl(materials.footprint(), 3);
     if (partial == r.partialSource) return {};
     r.partialSource = partial;
+    for (int kind = 3; kind < Impl::kKinds; ++kind)
+        for (Impl::SectionProgram& p : r.sectionPrograms[kind])
+            if (p.id) glDeleteProgram(p.id), p = {};
     if (!r.buildSections(1) || !r.buildSections(2)) {
         r.partialSource.clear();
         return makeError("fragment lists: " + r.programError);
@@ -630,16 +656,19 @@ Status FragmentListPass::collectSurfaces(const FragmentListTarget& target, const
     if (!r.tileRange || r.tileSize != glm::ivec2(tilesX, tilesY)) {
         if (r.tileRange) glDeleteTextures(1, &r.tileRange);
         glCreateTextures(GL_TEXTURE_2D, 1, &r.tileRange);
-        glTextureStorage2D(r.tileRange, 1, GL_RG32UI, tilesX, tilesY);
+        glTextureStorage2D(r.tileRange, 1, GL_RGBA32UI, tilesX, tilesY);
         r.tileSize = {tilesX, tilesY};
     }
     glUseProgram(r.rangeProgram);
     glUniform2i(glGetUniformLocation(r.rangeProgram, "uSize"), target.width, target.height);
     glUniform2i(glGetUniformLocation(r.rangeProgram, "uTiles"), tilesX, tilesY);
     glBindTextureUnit(2, r.heads);
-    glBindImageTexture(5, r.tileRange, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32UI);
+    glUniform2i(glGetUniformLocation(r.rangeProgram, "uOrigin"), target.x, target.y);
+    glBindTextureUnit(3, target.depthTexture); // 0: none (reads 0: every splat gets the host cut, exact)
+    glBindImageTexture(5, r.tileRange, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32UI);
     glDispatchCompute(GLuint((tilesX + 7) / 8), GLuint(tilesY), 1);
-    glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RG32UI);
+    glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32UI);
+    glBindTextureUnit(3, 0);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     return {};
 }
@@ -648,13 +677,14 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
                                                 const FragmentListTarget& target) {
     Impl& r = *mImpl;
     r.stats.splatsBehind = r.stats.splatsFront = r.stats.splatsSectioned = 0;
+    r.needs.clear();
     const std::size_t n = splats.size();
     if (n == 0) return {};
     const int tile = kRangeTile;
     const int tilesX = r.tileSize.x, tilesY = r.tileSize.y;
     glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
-    r.tileBits.resize(std::size_t(tilesX) * std::size_t(tilesY) * 2);
-    glGetTextureImage(r.tileRange, 0, GL_RG_INTEGER, GL_UNSIGNED_INT, GLsizei(r.tileBits.size() * sizeof(GLuint)), r.tileBits.data());
+    r.tileBits.resize(std::size_t(tilesX) * std::size_t(tilesY) * 4);
+    glGetTextureImage(r.tileRange, 0, GL_RGBA_INTEGER, GL_UNSIGNED_INT, GLsizei(r.tileBits.size() * sizeof(GLuint)), r.tileBits.data());
     // Window depth to view depth, as the shaders do (monotonic: the range maps to the range).
     const glm::mat4 invProj = glm::inverse(camera.proj);
     auto viewDepth = [&](GLuint bits) {
@@ -664,13 +694,16 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
         return std::abs((invProj[2][2] * nz + invProj[3][2]) / (invProj[2][3] * nz + invProj[3][3]));
     };
     std::vector<float>& range = r.tileView;
-    range.resize(r.tileBits.size());
+    const std::size_t tiles = std::size_t(tilesX) * std::size_t(tilesY);
+    range.resize(tiles * 2);
+    r.tileHost.resize(tiles);
     bool any = false;
-    for (std::size_t t = 0; t < r.tileBits.size(); t += 2) {
-        const bool empty = r.tileBits[t] > r.tileBits[t + 1];
+    for (std::size_t t = 0; t < tiles; ++t) {
+        const bool empty = r.tileBits[4 * t] > r.tileBits[4 * t + 1];
         any |= !empty;
-        range[t] = empty ? 3.4e38f : viewDepth(r.tileBits[t]);
-        range[t + 1] = empty ? -3.4e38f : viewDepth(r.tileBits[t + 1]);
+        range[2 * t] = empty ? 3.4e38f : viewDepth(r.tileBits[4 * t]);
+        range[2 * t + 1] = empty ? -3.4e38f : viewDepth(r.tileBits[4 * t + 1]);
+        r.tileHost[t] = viewDepth(r.tileBits[4 * t + 2]); // nearest host opaque depth on the tile
     }
     if (!any) { // no surface stored: every splat is in the only section
         r.stats.splatsBehind = n;
@@ -686,6 +719,7 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
     const glm::mat4 vp = camera.proj * camera.view;
     const float focalY = std::abs(camera.proj[1][1]) * 0.5f * float(target.height), focalX = std::abs(camera.proj[0][0]) * 0.5f * float(target.width);
     // 0: between (sections), 1: behind every surface it covers, 2: in front of every one.
+    int needs = 3;
     auto classify = [&](const Splat& sp) -> int {
         const float a = std::abs(glm::dot(sp.axisU, fwd)), b = std::abs(glm::dot(sp.axisV, fwd));
         const float reach = extent * (trimCorners ? std::max(a + 0.41421356f * b, 0.41421356f * a + b) : a + b);
@@ -702,12 +736,18 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
             x0 = std::clamp(int(std::floor((px - hx) / float(tile))), 0, tilesX - 1), x1 = std::clamp(int(std::floor((px + hx) / float(tile))), 0, tilesX - 1);
             y0 = std::clamp(int(std::floor((py - hy) / float(tile))), 0, tilesY - 1), y1 = std::clamp(int(std::floor((py + hy) / float(tile))), 0, tilesY - 1);
         }
+        float host = 3.4e38f;
         for (int ty = y0; ty <= y1; ++ty)
             for (int tx = x0; tx <= x1; ++tx) {
-                const float* t = &range[(std::size_t(ty) * std::size_t(tilesX) + std::size_t(tx)) * 2];
-                lo = std::min(lo, t[0]);
-                hi = std::max(hi, t[1]);
+                const std::size_t at = std::size_t(ty) * std::size_t(tilesX) + std::size_t(tx);
+                lo = std::min(lo, range[2 * at]);
+                hi = std::max(hi, range[2 * at + 1]);
+                host = std::min(host, r.tileHost[at]);
             }
+        // The section program's variant: the near cut where the support may
+        // reach the near plane, the host cut where it may reach the nearest
+        // host depth on its tiles (the splat pass's tests, renderer.cpp).
+        needs = (minZ - depthReach < nearZ * 1.01f + 1e-6f ? 1 : 0) | (maxZ + depthReach < host * 0.99f ? 0 : 2);
         if (lo > hi) return 1; // no surface on its tiles: its only section is the last
         if (minZ - depthReach > hi * 1.01f + 1e-6f) return 1;
         if (maxZ + depthReach < lo * 0.99f) return 2;
@@ -719,6 +759,12 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
     while (s.frontBegin > s.behindEnd && classify(splats[s.frontBegin - 1]) == 2) --s.frontBegin;
     r.stats.splatsBehind = s.behindEnd;
     r.stats.splatsFront = n - s.frontBegin;
+    // The middle run's section variants (bit 0: near cut, bit 1: host cut).
+    r.needs.resize(s.frontBegin - s.behindEnd);
+    for (std::size_t i = s.behindEnd; i < s.frontBegin; ++i) {
+        classify(splats[i]);
+        r.needs[i - s.behindEnd] = std::uint8_t(needs);
+    }
     return s;
 }
 
@@ -804,7 +850,8 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t b
     const bool general = partial && camera.perspective();
     const glm::mat4 vp = camera.proj * camera.view;
     const glm::mat4 invProj = glm::inverse(camera.proj), invVp = glm::inverse(vp);
-    const Impl::SectionProgram* generalProg = &r.sectionPrograms[2][std::size_t(prog - &r.sectionPrograms[partial][0])];
+    const std::size_t variant = std::size_t(prog - &r.sectionPrograms[partial][0]);
+    const Impl::SectionProgram* generalProg = &r.sectionPrograms[2][variant];
     auto setUniforms = [&](const Impl::SectionProgram& p) {
         glUseProgram(p.id);
         glUniformMatrix4fv(p.uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
@@ -832,11 +879,33 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t b
     const GLsizei corners = trimCorners ? 8 : 4;
     const Impl::SectionProgram* bound = nullptr;
     std::uint64_t crossing = 0;
+    // Per splat: 4 general, else the cuts it needs (split(): 1 near, 2 host).
+    std::vector<std::uint8_t>& cls = r.classes;
+    cls.resize(count);
+    const bool planned = r.needs.size() == count;
+    for (std::size_t i = 0; i < count; ++i) cls[i] = general && crossesEyePlane(splats[i]) ? 4 : planned ? r.needs[i] : 3;
+    constexpr std::size_t kMerge = 24; // a shorter run takes the next one's cuts too rather than a draw of its own
     for (std::size_t i = 0; i < count;) {
-        const bool g = general && crossesEyePlane(splats[i]);
+        unsigned need = cls[i];
         std::size_t j = i + 1;
-        while (j < count && (general && crossesEyePlane(splats[j])) == g) ++j;
-        const Impl::SectionProgram* p = g ? generalProg : prog;
+        for (;;) {
+            while (j < count && cls[j] == need) ++j;
+            if (j >= count || need == 4 || cls[j] == 4) break;
+            if (j - i < kMerge) { // a short run takes on the next one's cuts
+                need |= cls[j];
+                continue;
+            }
+            // A long run absorbs a short run of splats that need less.
+            std::size_t k = j;
+            while (k < count && cls[k] == cls[j]) ++k;
+            if ((cls[j] & ~need) != 0 || k - j >= kMerge) break;
+            j = k;
+        }
+        const bool g = need == 4;
+        const Impl::SectionProgram* p = g ? generalProg : partial ? &r.sectionPrograms[Impl::cutKind(need)][variant] : prog;
+        if (!p->id) {
+            if (!r.buildSections(Impl::cutKind(need))) p = prog; // never expected: the full cut program is exact for any splat
+        }
         if (p != bound) setUniforms(*p), bound = p;
         glDrawArraysInstancedBaseInstance(GL_TRIANGLE_STRIP, 0, corners, GLsizei(j - i), GLuint(i));
         if (g) crossing += j - i;
@@ -919,7 +988,7 @@ void FragmentListPass::resolve(const FragmentListTarget& target) {
     r.stats.bytes = std::size_t(r.depthSize.x) * r.depthSize.y * 4 * std::size_t(r.depthLayers) /* sorted depths */ + r.poolNodes * kTransparentNodeBytes + std::size_t(r.width) * r.height * kTransparentHeadBytesPerPixel +
                     std::size_t(kCounterBytes) + std::size_t(r.width) * r.height * 8 /* resolved RGBA16F */ +
                     std::size_t(r.sectionSize.x) * r.sectionSize.y * kTransparentSectionBytesPerPixel * std::size_t(r.sectionLayers) +
-                    std::size_t(r.tileSize.x) * std::size_t(r.tileSize.y) * 8 /* the survey's tile depth ranges (RG32UI) */;
+                    std::size_t(r.tileSize.x) * std::size_t(r.tileSize.y) * 16 /* the survey's tiles (RGBA32UI) */;
     // Leave nothing of ours bound where the host's own buffers may live.
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTransparentNodeBinding, 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTransparentCounterBinding, 0);
