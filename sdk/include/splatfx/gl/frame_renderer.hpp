@@ -26,7 +26,9 @@
 //      path: the hook's fragments go into per-pixel lists (transparentGlsl()),
 //      the splats (not drawn in step 2 then) are composited per section
 //      between those surfaces (Ebert & Parent 1990, Fig. 1), and a resolve
-//      sorts each pixel and composites it over the image (fragment_list_pass)
+//      sorts each pixel and composites it over the image (fragment_list_pass);
+//      splats behind (in front of) every surface they cover take the
+//      ordinary splat pass before (after) the resolve instead
 // The passes of the systems still being built (fog of the host image, shadow
 // tables before the opaque pass, exact ordering among transparent surfaces,
 // projected tetrahedra) join this list here, not in callers.
