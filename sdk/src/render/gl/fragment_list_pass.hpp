@@ -5,9 +5,13 @@
 // Fig. 1: "the volume to be rendered must be broken into sections that lie
 // between, in front of, and behind the a-buffer fragments"):
 //  1. the host's transparent fragments are appended to one linked list per
-//     pixel (head image + node pool, transparentGlsl()), counting the
-//     surfaces per pixel and the most on any pixel;
-//  2. every splat fragment walks its pixel's surface list: the surfaces
+//     pixel (head image + node pool, transparentGlsl()); a survey of the
+//     lists then finds, per 16 x 16 tile, the surfaces' depth range, the
+//     nearest host depth and the most surfaces on a pixel (read back);
+//  1b. split(): the splats behind every surface they cover, and those in
+//     front of every one, need no sections (the frame renderer draws them
+//     with the ordinary splat pass before and after the resolve);
+//  2. every other splat fragment walks its pixel's surface list: the surfaces
 //     wholly in front of it give its section index, the ones that cut it
 //     split it into consecutive sections, each weighted by the fraction of
 //     the kernel's line integral it holds (sectionFraction in the shader:
@@ -21,9 +25,10 @@
 //     image).
 //
 // Memory: a pool of width * height * fragmentsPerPixel surface nodes (16
-// bytes) shared by all pixels, 8 bytes of head and count per pixel, and one
-// RGBA16F target per section in use (2, 4 or 8, from the most surfaces on a
-// pixel: 1 pane takes 2). A surface fragment that finds the pool full is
+// bytes) shared by all pixels, 4 bytes of list head per pixel, 16 per tile
+// for the survey, and one RGBA16F target per section in use (none when no
+// splat needs sections, else 2, 4 or 8, from the most surfaces on a pixel:
+// 1 pane takes 2). A surface fragment that finds the pool full is
 // blended by the host directly (the include returns its colour) and counted;
 // a pixel with more surfaces than fragmentsPerPixel keeps the nearest ones
 // and merges the farthest into its last slot (counted); splat fragments
@@ -33,7 +38,8 @@
 // kernel) takes the general variant, as in the splat pass.
 //
 // It does not draw tetrahedra, work at reduced resolution or fog the splat
-// sections (the frame renderer takes the ordered blend then and says why).
+// sections (the frame renderer takes the ordered blend then and says why;
+// with a fog, only for the splats that would need sections).
 #pragma once
 
 #include <cstddef>
