@@ -718,7 +718,7 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
     const float nearZ = camera.nearPlane(), extent = std::clamp(cut, 0.05f, 1.0f);
     const glm::mat4 vp = camera.proj * camera.view;
     const float focalY = std::abs(camera.proj[1][1]) * 0.5f * float(target.height), focalX = std::abs(camera.proj[0][0]) * 0.5f * float(target.width);
-    // 0: between (sections), 1: behind every surface it covers, 2: in front of every one.
+    // 0: between (sections), 1: behind every surface it covers, 2: in front of every one, 3: no surface on its tiles.
     int needs = 3;
     auto classify = [&](const Splat& sp) -> int {
         const float a = std::abs(glm::dot(sp.axisU, fwd)), b = std::abs(glm::dot(sp.axisV, fwd));
@@ -748,15 +748,15 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
         // reach the near plane, the host cut where it may reach the nearest
         // host depth on its tiles (the splat pass's tests, renderer.cpp).
         needs = (minZ - depthReach < nearZ * 1.01f + 1e-6f ? 1 : 0) | (maxZ + depthReach < host * 0.99f ? 0 : 2);
-        if (lo > hi) return 1; // no surface on its tiles: its only section is the last
+        if (lo > hi) return 3; // no surface on its tiles: its only section is the first and the last
         if (minZ - depthReach > hi * 1.01f + 1e-6f) return 1;
         if (maxZ + depthReach < lo * 0.99f) return 2;
         return 0;
     };
     Split s;
-    while (s.behindEnd < n && classify(splats[s.behindEnd]) == 1) ++s.behindEnd;
+    while (s.behindEnd < n && (classify(splats[s.behindEnd]) & 1)) ++s.behindEnd;
     s.frontBegin = n;
-    while (s.frontBegin > s.behindEnd && classify(splats[s.frontBegin - 1]) == 2) --s.frontBegin;
+    while (s.frontBegin > s.behindEnd && (classify(splats[s.frontBegin - 1]) & 2)) --s.frontBegin;
     r.stats.splatsBehind = s.behindEnd;
     r.stats.splatsFront = n - s.frontBegin;
     // The middle run's section variants (bit 0: near cut, bit 1: host cut).
