@@ -891,8 +891,9 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t b
         for (;;) {
             while (j < count && cls[j] == need) ++j;
             if (j >= count || need == 4 || cls[j] == 4) break;
-            if (j - i < kMerge) { // a short run takes on the next one's cuts
+            if (j - i < kMerge) { // a short run takes on the next splat's cuts, and the splat
                 need |= cls[j];
+                ++j;
                 continue;
             }
             // A long run absorbs a short run of splats that need less.
