@@ -444,7 +444,7 @@ TEST_F(FragmentListsGL, BudgetOfOneFragmentPerPixel) {
     EXPECT_EQ(s.transparentBytes, std::size_t(pixels) * (kTransparentNodeBytes + kTransparentHeadBytesPerPixel + 8 +
                                                          std::size_t(s.transparentSections) * kTransparentSectionBytesPerPixel +
                                                          4 * std::size_t(s.transparentSections - 1)) + 48 +
-                                      16 * std::size_t((kSize.x + 15) / 16) * std::size_t((kSize.y + 15) / 16)); // + the survey's 16 x 16 tiles (RGBA32UI)
+                                      (16 + 4) * std::size_t((kSize.x + 15) / 16) * std::size_t((kSize.y + 15) / 16)); // + per 16 x 16 tile the survey (RGBA32UI) and, with sections, the host depth (R32F)
     const Image got = fb->read();
     // The alpha of the three in any order: the ordered blend (pane, fire, pane).
     Frame empty;

@@ -212,7 +212,7 @@ void main() {
 // Run after the host's surfaces, one invocation per 16 x 16 tile (an
 // invocation per pixel costs llvmpipe more in dispatch than the walk): the
 // most surfaces on one pixel, and per tile the nearest and farthest surface
-// window depth stored on any of its pixels and the nearest host opaque depth (as float bits: window depths are
+// window depth stored on any of its pixels (as float bits: window depths are
 // in [0, 1], where the bits order like the values; an empty tile reads
 // (0xffffffff, 0)). Read back so the CPU can send the splats that lie wholly
 // behind, or wholly in front of, every surface they cover to the ordinary
@@ -222,8 +222,6 @@ constexpr const char* kTileRangeCompute = R"(
 layout(local_size_x = 8, local_size_y = 1) in;
 layout(binding = 2) uniform usampler2D uHeads;
 layout(rgba32ui, binding = 5) writeonly uniform uimage2D uTileRange;
-layout(binding = 3) uniform sampler2D uHostDepth; // the host's opaque depth (window depth)
-uniform ivec2 uOrigin; // the lists' viewport origin in it
 uniform ivec2 uSize;
 uniform ivec2 uTiles;
 void main() {
@@ -231,11 +229,9 @@ void main() {
     if (t.x >= uTiles.x) return;
     ivec2 first = t * 16, last = min(first + 16, uSize);
     uint lo = 0xffffffffu, hi = 0u, most = 0u;
-    float host = 1.0;
     for (int y = first.y; y < last.y; ++y)
         for (int x = first.x; x < last.x; ++x) {
             uint count = 0u;
-            host = min(host, texelFetch(uHostDepth, ivec2(x, y) + uOrigin, 0).r);
             for (uint i = texelFetch(uHeads, ivec2(x, y), 0).x; i != splatfx_kEnd; i = splatfx_nodes[i].next) {
                 uint z = floatBitsToUint(abs(uintBitsToFloat(splatfx_nodes[i].depthBits))); // -0 as +0
                 lo = min(lo, z);
@@ -244,10 +240,29 @@ void main() {
             }
             most = max(most, count);
         }
-    imageStore(uTileRange, t, uvec4(lo, hi, floatBitsToUint(max(host, 0.0)), 0u));
+    imageStore(uTileRange, t, uvec4(lo, hi, most, 0u));
     // The most surfaces on one pixel (here rather than per fragment in the
     // include: one atomic per tile instead of two per surface fragment).
     if (most > 0u) atomicMax(splatfx_maxSurfaces, most);
+}
+)";
+
+// Per 16 x 16 tile, the nearest host opaque depth (window depth), one
+// invocation per tile: only for frames with splats to section (their
+// near / host cut variants, FragmentListPass::split).
+constexpr const char* kHostTileCompute = R"(
+layout(local_size_x = 8, local_size_y = 1) in;
+layout(binding = 3) uniform sampler2D uHostDepth;
+layout(r32f, binding = 5) writeonly uniform image2D uHostTiles;
+uniform ivec2 uSize, uTiles, uOrigin; // the lists' viewport size, the tiles, its origin in the depth texture
+void main() {
+    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
+    if (t.x >= uTiles.x) return;
+    ivec2 first = t * 16, last = min(first + 16, uSize);
+    float host = 1.0;
+    for (int y = first.y; y < last.y; ++y)
+        for (int x = first.x; x < last.x; ++x) host = min(host, texelFetch(uHostDepth, ivec2(x, y) + uOrigin, 0).r);
+    imageStore(uHostTiles, t, vec4(max(host, 0.0)));
 }
 )";
 
@@ -448,7 +463,10 @@ struct FragmentListPass::Impl {
         fragmentResolvePrograms.push_back({k, id});
         return id;
     }
-    GLuint compositeProgram = 0, prepareProgram = 0, rangeProgram = 0;
+    GLuint compositeProgram = 0, prepareProgram = 0, rangeProgram = 0, hostTileProgram = 0;
+    GLuint hostTiles = 0; // R32F per tile: the nearest host depth (split(), frames with sections only)
+    glm::ivec2 hostTileSize{0};
+    std::vector<float> hostTileDepth;
     // The surface depth range per kRangeTile tile (RG32UI float bits), read back by split().
     GLuint tileRange = 0;
     glm::ivec2 tileSize{0};
@@ -485,6 +503,8 @@ struct FragmentListPass::Impl {
         if (compositeProgram) glDeleteProgram(compositeProgram);
         if (prepareProgram) glDeleteProgram(prepareProgram);
         if (rangeProgram) glDeleteProgram(rangeProgram);
+        if (hostTileProgram) glDeleteProgram(hostTileProgram);
+        if (hostTiles) glDeleteTextures(1, &hostTiles);
         if (tileRange) glDeleteTextures(1, &tileRange);
         if (depths) glDeleteTextures(1, &depths);
         GLuint vaos[2] = {vao, emptyVao};
@@ -584,6 +604,9 @@ Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
     auto range = linkComputeProgram({"#version 450 core\n", computeInclude.c_str(), kTileRangeCompute}, "fragment lists (tile depth range)");
     if (!range) return makeError(range.error());
     impl->rangeProgram = *range;
+    auto hostTile = linkComputeProgram({"#version 450 core\n", kHostTileCompute}, "fragment lists (host depth tiles)");
+    if (!hostTile) return makeError(hostTile.error());
+    impl->hostTileProgram = *hostTile;
     for (int c = 0; c < 256; ++c) impl->rho[std::size_t(c)] = rayScaleRho(std::uint8_t(c));
     auto composite = linkProgram({kFullscreenVertex}, {kListCompositeFragment}, "fragment lists (composite)");
     if (!composite) return makeError(composite.error());
@@ -663,12 +686,9 @@ Status FragmentListPass::collectSurfaces(const FragmentListTarget& target, const
     glUniform2i(glGetUniformLocation(r.rangeProgram, "uSize"), target.width, target.height);
     glUniform2i(glGetUniformLocation(r.rangeProgram, "uTiles"), tilesX, tilesY);
     glBindTextureUnit(2, r.heads);
-    glUniform2i(glGetUniformLocation(r.rangeProgram, "uOrigin"), target.x, target.y);
-    glBindTextureUnit(3, target.depthTexture); // 0: none (reads 0: every splat gets the host cut, exact)
     glBindImageTexture(5, r.tileRange, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32UI);
     glDispatchCompute(GLuint((tilesX + 7) / 8), GLuint(tilesY), 1);
     glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32UI);
-    glBindTextureUnit(3, 0);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     return {};
 }
@@ -696,14 +716,12 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
     std::vector<float>& range = r.tileView;
     const std::size_t tiles = std::size_t(tilesX) * std::size_t(tilesY);
     range.resize(tiles * 2);
-    r.tileHost.resize(tiles);
     bool any = false;
     for (std::size_t t = 0; t < tiles; ++t) {
         const bool empty = r.tileBits[4 * t] > r.tileBits[4 * t + 1];
         any |= !empty;
         range[2 * t] = empty ? 3.4e38f : viewDepth(r.tileBits[4 * t]);
         range[2 * t + 1] = empty ? -3.4e38f : viewDepth(r.tileBits[4 * t + 1]);
-        r.tileHost[t] = viewDepth(r.tileBits[4 * t + 2]); // nearest host opaque depth on the tile
     }
     if (!any) { // no surface stored: every splat is in the only section
         r.stats.splatsBehind = n;
@@ -742,7 +760,8 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
                 const std::size_t at = std::size_t(ty) * std::size_t(tilesX) + std::size_t(tx);
                 lo = std::min(lo, range[2 * at]);
                 hi = std::max(hi, range[2 * at + 1]);
-                host = std::min(host, r.tileHost[at]);
+                if (!r.tileHost.empty()) host = std::min(host, r.tileHost[at]);
+                else host = 0.0f; // not surveyed: assume the host cut may be needed
             }
         // The section program's variant: the near cut where the support may
         // reach the near plane, the host cut where it may reach the nearest
@@ -759,7 +778,36 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
     while (s.frontBegin > s.behindEnd && (classify(splats[s.frontBegin - 1]) & 2)) --s.frontBegin;
     r.stats.splatsBehind = s.behindEnd;
     r.stats.splatsFront = n - s.frontBegin;
-    // The middle run's section variants (bit 0: near cut, bit 1: host cut).
+    // The middle run's section variants (bit 0: near cut, bit 1: host cut),
+    // from the nearest host depth per tile (surveyed only now: frames with
+    // no splat to section do not pay for it).
+    r.tileHost.clear();
+    if (s.frontBegin > s.behindEnd && depthCut && target.depthTexture) {
+        if (!r.hostTiles || r.hostTileSize != glm::ivec2(tilesX, tilesY)) {
+            if (r.hostTiles) glDeleteTextures(1, &r.hostTiles);
+            glCreateTextures(GL_TEXTURE_2D, 1, &r.hostTiles);
+            glTextureStorage2D(r.hostTiles, 1, GL_R32F, tilesX, tilesY);
+            r.hostTileSize = {tilesX, tilesY};
+        }
+        glUseProgram(r.hostTileProgram);
+        glUniform2i(glGetUniformLocation(r.hostTileProgram, "uSize"), target.width, target.height);
+        glUniform2i(glGetUniformLocation(r.hostTileProgram, "uTiles"), tilesX, tilesY);
+        glUniform2i(glGetUniformLocation(r.hostTileProgram, "uOrigin"), target.x, target.y);
+        glBindTextureUnit(3, target.depthTexture);
+        glBindImageTexture(5, r.hostTiles, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glDispatchCompute(GLuint((tilesX + 7) / 8), GLuint(tilesY), 1);
+        glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindTextureUnit(3, 0);
+        glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+        r.hostTileDepth.resize(std::size_t(tilesX) * std::size_t(tilesY));
+        glGetTextureImage(r.hostTiles, 0, GL_RED, GL_FLOAT, GLsizei(r.hostTileDepth.size() * sizeof(float)), r.hostTileDepth.data());
+        r.tileHost.resize(r.hostTileDepth.size());
+        for (std::size_t t = 0; t < r.tileHost.size(); ++t) {
+            GLuint bits;
+            std::memcpy(&bits, &r.hostTileDepth[t], 4);
+            r.tileHost[t] = viewDepth(bits);
+        }
+    }
     r.needs.resize(s.frontBegin - s.behindEnd);
     for (std::size_t i = s.behindEnd; i < s.frontBegin; ++i) {
         classify(splats[i]);
@@ -989,7 +1037,8 @@ void FragmentListPass::resolve(const FragmentListTarget& target) {
     r.stats.bytes = std::size_t(r.depthSize.x) * r.depthSize.y * 4 * std::size_t(r.depthLayers) /* sorted depths */ + r.poolNodes * kTransparentNodeBytes + std::size_t(r.width) * r.height * kTransparentHeadBytesPerPixel +
                     std::size_t(kCounterBytes) + std::size_t(r.width) * r.height * 8 /* resolved RGBA16F */ +
                     std::size_t(r.sectionSize.x) * r.sectionSize.y * kTransparentSectionBytesPerPixel * std::size_t(r.sectionLayers) +
-                    std::size_t(r.tileSize.x) * std::size_t(r.tileSize.y) * 16 /* the survey's tiles (RGBA32UI) */;
+                    std::size_t(r.tileSize.x) * std::size_t(r.tileSize.y) * 16 /* the survey's tiles (RGBA32UI) */ +
+                    std::size_t(r.hostTileSize.x) * std::size_t(r.hostTileSize.y) * 4 /* the host depth tiles (R32F) */;
     // Leave nothing of ours bound where the host's own buffers may live.
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTransparentNodeBinding, 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTransparentCounterBinding, 0);
