@@ -3,6 +3,7 @@
 // them per pixel, the fragment budget and its overflow, and the hard cases.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -204,7 +205,12 @@ TEST_F(FragmentListsGL, PanesInFrontOfAndBehindTheFireSortLikeTheUnambiguousOrde
         EXPECT_EQ(fr->stats().transparentOverflowPixels, 0u);
         EXPECT_GE(fr->stats().transparentNodes, std::uint64_t(kSize.x) * kSize.y); // the pane covers every pixel
         const Image got = lists->read();
-        EXPECT_EQ(fr->stats().transparentSections, 2);
+        // Every splat lies wholly behind (or in front of) the pane: none
+        // needs a section; all take the ordinary splat pass, before (after)
+        // the resolve (FragmentListPass::split).
+        EXPECT_EQ(fr->stats().transparentSections, 0);
+        EXPECT_EQ(fr->stats().transparentSplatsSectioned, 0u);
+        EXPECT_EQ(inFront ? fr->stats().transparentSplatsBehind : fr->stats().transparentSplatsFront, f.frame.splats().size());
         if (inFront) {
             fr->render(f.frame, {.framebuffer = ordered->handle(), .drawOpaque = clearTo(kBackground)});
             fr->render(empty, {.framebuffer = ordered->handle(), .drawTransparent = [&] { glass.draw(pane, cam); },
@@ -437,7 +443,8 @@ TEST_F(FragmentListsGL, BudgetOfOneFragmentPerPixel) {
     // the sorted depths (R32F, one layer fewer than sections), the counters.
     EXPECT_EQ(s.transparentBytes, std::size_t(pixels) * (kTransparentNodeBytes + kTransparentHeadBytesPerPixel + 8 +
                                                          std::size_t(s.transparentSections) * kTransparentSectionBytesPerPixel +
-                                                         4 * std::size_t(s.transparentSections - 1)) + 48);
+                                                         4 * std::size_t(s.transparentSections - 1)) + 48 +
+                                      (16 + 4) * std::size_t((kSize.x + 15) / 16) * std::size_t((kSize.y + 15) / 16)); // + per 16 x 16 tile the survey (RGBA32UI) and, with sections, the host depth (R32F)
     const Image got = fb->read();
     // The alpha of the three in any order: the ordered blend (pane, fire, pane).
     Frame empty;
@@ -514,18 +521,23 @@ TEST_F(FragmentListsGL, SplatStraddlingAPaneIsCutIntoSections) {
     };
     const glm::vec4 tint{0.1f, 0.2f, 0.3f, 0.4f};
     const double base = errorAgainstReference({{.z = 40.0f, .premultiplied = glm::vec4(0.0f)}}); // no visible pane
-    EXPECT_TRUE(fr->stats().transparentCut);
     for (const float dz : {0.3f, -0.3f}) {
         const double err = errorAgainstReference({{.z = centre.z + dz, .premultiplied = tint}});
+        EXPECT_TRUE(fr->stats().transparentCut);
+        EXPECT_EQ(fr->stats().transparentSplatsSectioned, 1u); // the pane meets its kernel: sections, not the ordinary pass
         EXPECT_EQ(fr->stats().transparentSections, 2);
         EXPECT_LE(err, base + 2.0 * std::log(2.0) * tau * delta + 4.0 * std::ldexp(1.0, -12)) << "pane at z = centre + " << dz;
     }
 }
 
-// With a fog the splats are not drawn into sections (fogged sections are not
-// implemented): the frame says so and draws them first with the ordered blend,
-// the surfaces still sorted in the lists over them, never dropped.
-TEST_F(FragmentListsGL, WithAFogTheSplatsTakeTheOrderedBlendAndTheFrameSaysWhy) {
+// With a fog, splats that lie wholly behind (or in front of) every surface
+// they cover take the ordinary splat pass, which fogs every fragment: a pane
+// in front of the fogged fire gives what the ordered blend gives (fire, then
+// pane), up to the pane's half colour. Splats that meet a surface are not
+// sectioned (fogged sections are not implemented): they take the ordered
+// blend under the surfaces, and the frame says so; the surfaces are still
+// sorted in the lists, never dropped.
+TEST_F(FragmentListsGL, WithAFogSplatsClearOfTheSurfacesAreExactAndTheRestSaySo) {
     Fire f;
     Glass glass;
     ASSERT_TRUE(glass.error().empty()) << glass.error();
@@ -536,15 +548,144 @@ TEST_F(FragmentListsGL, WithAFogTheSplatsTakeTheOrderedBlendAndTheFrameSaysWhy) 
     f.frame.setFog(std::make_shared<const Fog>(*fog));
     auto fr = gl::FrameRenderer::create();
     ASSERT_TRUE(fr && fr->upload(f.materials));
-    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y});
-    ASSERT_TRUE(fb);
-    const std::vector<Pane> pane{{.z = Fire::kFront + 1.0f, .premultiplied = glm::vec4(0.05f, 0.1f, 0.15f, 0.3f)}};
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    auto ordered = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(fb && ordered);
+    const Camera& cam = f.frame.camera();
+    const glm::vec4 tint{0.05f, 0.1f, 0.15f, 0.3f};
+    const std::vector<Pane> front{{.z = Fire::kFront + 1.0f, .premultiplied = tint}};
     fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
-                         .drawTransparent = [&] { glass.draw(pane, f.frame.camera()); }, .transparentToLists = true});
-    const gl::FrameRenderStats& s = fr->stats();
-    EXPECT_TRUE(s.transparentLists);
-    EXPECT_FALSE(s.splatsInLists);
+                         .drawTransparent = [&] { glass.draw(front, cam); }, .transparentToLists = true});
+    gl::FrameRenderStats s = fr->stats();
+    EXPECT_TRUE(s.transparentLists && s.splatsInLists && s.fogSplats);
+    EXPECT_TRUE(s.transparentNote.empty()) << s.transparentNote;
+    EXPECT_EQ(s.transparentSplatsBehind, f.frame.splats().size());
+    EXPECT_EQ(s.transparentNodes, std::uint64_t(kSize.x) * kSize.y);
+    const Image got = fb->read();
+    Frame empty;
+    empty.begin(0.0, cam);
+    empty.end();
+    fr->render(f.frame, {.framebuffer = ordered->handle(), .drawOpaque = clearTo(kBackground)});
+    fr->render(empty, {.framebuffer = ordered->handle(), .drawTransparent = [&] { glass.draw(front, cam); }, .transparentToLists = true});
+    // The same ordinary pass in both; the pane's colour is stored as halves
+    // in the lists (2^-11 relative, colour <= 1) and composited once.
+    const test::ImageDiff d = test::compareImages(got, ordered->read(), std::ldexp(1.0, -11));
+    EXPECT_LE(d.maxAbs, std::ldexp(1.0, -11)) << test::writeFailureImages(got, d);
+
+    const std::vector<Pane> through{{.z = 0.0f, .premultiplied = tint}};
+    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
+                         .drawTransparent = [&] { glass.draw(through, cam); }, .transparentToLists = true});
+    s = fr->stats();
     EXPECT_NE(s.transparentNote.find("fog"), std::string::npos) << s.transparentNote;
+    EXPECT_EQ(s.transparentSplatsSectioned, 0u);
+    EXPECT_LT(s.transparentSplatsBehind + s.transparentSplatsFront, f.frame.splats().size()); // some meet the pane
     EXPECT_EQ(s.transparentNodes, std::uint64_t(kSize.x) * kSize.y);
     EXPECT_GT(s.splats, 0u);
+}
+
+// The camera inside the gas with a pane in front of it: the kernels around
+// the eye cross the eye plane, and the one holding the eye is cut by a pane
+// at view depth 0.2 (inside its support: 0.3 x 1.6 = 0.48). Such splats take
+// the general (screen-covering) variant of the section pass, as in the splat
+// pass (before, they were not drawn in the lists). Against the exact
+// reference with the same pane, the error may exceed the error of the same
+// frame without a visible pane (the ordinary pass: every splat behind no
+// surface) by what the sections add per fragment: two more partial-table
+// lookups (each off by at most delta, which moves a section's alpha by at
+// most ln2 tau delta), for each of the n fragments on a pixel, plus the
+// sections' and the resolve's half rounding ((n + 2) 2^-12) and the pane's
+// half colour (2^-11).
+namespace {
+
+// Renders the 5^3 block (spacing 0.3, opacity 0.4, one colour) seen by cam
+// with one pane at each view depth in turn (the camera looks along -z),
+// against the exact reference with the same pane; the bound as explained
+// above. Returns the stats of the last frame.
+gl::FrameRenderStats blockAgainstReference(const Camera& cam, const std::vector<float>& depths, const char* what) {
+    Materials materials{Footprint{}};
+    materials.addColorTable(ColorTable::constant({0.9f, 0.6f, 0.3f, 1.0f}));
+    Grid g = *Grid::box({5, 5, 5}, glm::vec3(0.3f));
+    for (Voxel& v : g.voxels) v.opacity = 0.4f;
+    Frame frame;
+    frame.begin(0.0, cam);
+    frame.builder().add(g, materials, {.textured = false});
+    frame.end();
+    EXPECT_GT(frame.splats().size(), 10u);
+    Glass glass;
+    EXPECT_TRUE(glass.error().empty()) << glass.error();
+    auto fr = gl::FrameRenderer::create();
+    EXPECT_TRUE(fr && fr->upload(materials));
+    auto fb = gl::Framebuffer::create({.width = cam.viewport.x, .height = cam.viewport.y, .color = gl::Precision::F32});
+    EXPECT_TRUE(fb);
+    if (!fr || !fb || !glass.error().empty()) return {};
+    const Footprint& fp = materials.footprint();
+    double delta = 0.0;
+    for (int i = 0; i <= 200; ++i)
+        for (int j = 0; j <= 200; ++j) {
+            const double r = fp.radius() * i / 200.0, sg = -1.0 + 2.0 * j / 200.0;
+            const double sMax = std::sqrt(std::max(fp.radius() * fp.radius() - r * r, 0.0));
+            delta = std::max(delta, std::abs(double(fp.fractionBefore(float(r), float(sg * sMax))) - fp.exactFractionBefore(r, sg * sMax)));
+        }
+    double tau = 0.0;
+    for (const Splat& s : frame.splats()) tau = std::max(tau, double(s.density));
+    SplatExactStats st;
+    EXPECT_TRUE(renderSplatExact(frame.splats(), cam, materials, {.threads = 2}, &st));
+    const double n = double(st.maxOverlap);
+    const glm::vec4 clear{0.1f, 0.15f, 0.2f, 1.0f};
+    const glm::vec3 eye = cam.eye();
+    auto errorAgainstReference = [&](const std::vector<Pane>& panes) {
+        fr->render(frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(clear),
+                           .drawTransparent = [&] { glass.draw(panes, cam); }, .transparentToLists = true});
+        std::vector<ReferenceSurface> surfaces;
+        for (const Pane& p : panes)
+            surfaces.push_back(ReferenceSurface::quad({p.centre.x - p.half, p.centre.y - p.half, p.z}, {p.centre.x + p.half, p.centre.y - p.half, p.z},
+                                                      {p.centre.x + p.half, p.centre.y + p.half, p.z}, {p.centre.x - p.half, p.centre.y + p.half, p.z},
+                                                      glm::dvec4(p.premultiplied)));
+        auto ref = renderSplatExact(frame.splats(), cam, materials, {.host = {.background = clear}, .threads = 2, .surfaces = surfaces});
+        const Image got = fb->read();
+        double worst = 0.0;
+        for (std::size_t i = 0; i < got.pixels.size(); ++i) {
+            EXPECT_TRUE(std::isfinite(got.pixels[i]));
+            worst = std::max(worst, std::abs(double(got.pixels[i]) - double(ref->pixels[i])));
+        }
+        return worst;
+    };
+    // A pane behind the camera: stored nowhere, every splat in the ordinary pass.
+    const double base = errorAgainstReference({{.z = eye.z + 5.0f, .premultiplied = glm::vec4(0.0f), .half = 1.0f, .centre = {eye.x, eye.y}}});
+    const double bound = base + n * 2.0 * std::log(2.0) * tau * delta + (n + 2.0) * std::ldexp(1.0, -12) + std::ldexp(1.0, -11);
+    const glm::vec4 tint{0.1f, 0.2f, 0.3f, 0.4f};
+    gl::FrameRenderStats s;
+    for (const float depth : depths) {
+        const double err = errorAgainstReference({{.z = eye.z - depth, .premultiplied = tint, .half = 1.0f, .centre = {eye.x, eye.y}}});
+        s = fr->stats();
+        EXPECT_TRUE(s.splatsInLists);
+        EXPECT_GT(s.transparentSplatsSectioned, 0u) << what << depth;
+        std::printf("  %s, pane at view depth %.2f: error %.3e (bound %.3e; no pane %.3e), general %llu, sectioned %llu\n", what, depth, err, bound,
+                    base, (unsigned long long)s.transparentGeneral, (unsigned long long)s.transparentSplatsSectioned);
+        EXPECT_LE(err, bound) << what << ", pane at view depth " << depth;
+    }
+    return s;
+}
+
+} // namespace
+
+TEST_F(FragmentListsGL, CameraInsideTheGasInFrontOfAPaneIsExact) {
+    const Grid g = *Grid::box({5, 5, 5}, glm::vec3(0.3f));
+    const glm::vec3 eye = g.worldPosition({2, 2, 2}) + glm::vec3(0.02f, -0.01f, 0.03f);
+    const Camera cam = Camera::lookAt(eye, eye + glm::vec3(0.0f, 0.0f, -1.0f), {0, 1, 0}, 1.2f, {40, 32}, 0.02f, 50.0f);
+    // Through the eye's kernel; beyond it, among the others.
+    const gl::FrameRenderStats s = blockAgainstReference(cam, {0.6f, 0.2f}, "camera inside");
+    EXPECT_GT(s.transparentGeneral, 0u) << "the eye's kernel is cut by the pane: sections, general variant";
+}
+
+// The camera just outside the gas with the near plane through the front
+// kernels and a pane through the block: the sectioned splats need the near
+// cut or not (the cheaper variant), interleaved in the back-to-front order;
+// the runs of variants must still cover every splat once, in order.
+TEST_F(FragmentListsGL, SectionVariantsWithAndWithoutTheNearCutAreExact) {
+    const Grid g = *Grid::box({5, 5, 5}, glm::vec3(0.3f));
+    const glm::vec3 front = g.worldPosition({2, 2, 4});
+    const glm::vec3 eye = front + glm::vec3(0.05f, 0.03f, 0.35f); // 0.35 in front of the front layer: inside its kernels' reach (0.48)
+    const Camera cam = Camera::lookAt(eye, eye + glm::vec3(0.0f, 0.0f, -1.0f), {0, 1, 0}, 1.2f, {40, 32}, 0.2f, 50.0f);
+    blockAgainstReference(cam, {0.5f, 0.95f}, "near plane through the front kernels");
 }

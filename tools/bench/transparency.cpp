@@ -123,6 +123,7 @@ int runTransparency(int argc, char** argv) {
     int frames = 15, rounds = 3;
     bool cut = true; // RendererDesc::depthCut: sections weighted by the partial integral
     std::string imagesDir; // --images: the GL-vs-reference still
+    std::string only;      // --only TEXT: the opaque-only frame and the configurations whose name contains TEXT
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         if (a == "--size" && i + 2 < argc) size = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2])}, i += 2;
@@ -130,11 +131,13 @@ int runTransparency(int argc, char** argv) {
         else if (a == "--rounds" && i + 1 < argc) rounds = std::max(1, std::atoi(argv[++i]));
         else if (a == "--quick") frames = 5, rounds = 1, size = {320, 240};
         else if (a == "--no-cut") cut = false;
+        else if (a == "--only" && i + 1 < argc) only = argv[++i];
         else if (a == "--images" && i + 1 < argc) imagesDir = argv[++i];
         else if (a == "--help" || a == "-h") {
-            std::printf("usage: splatfx-bench transparency [--size W H (640 480)] [--frames N (15)] [--rounds R (3)] [--quick] [--no-cut] [--images DIR]\n"
+            std::printf("usage: splatfx-bench transparency [--size W H (640 480)] [--frames N (15)] [--rounds R (3)] [--quick] [--no-cut] [--only TEXT] [--images DIR]\n"
                         "Glass panes among the 1560-voxel Table I fire: opaque-only frame, ordered blend and fragment lists,\n"
                         "time and error against the exact reference; the fragment budget knob; list memory.\n"
+                        "--only TEXT: the opaque-only frame and the configurations whose name contains TEXT.\n"
                         "--images DIR: DIR/transparency_gl_vs_reference.png, a pane in front of, through and behind the fire,\n"
                         "GL (fragment lists) above the exact reference.\n");
             return 0;
@@ -195,6 +198,9 @@ int runTransparency(int argc, char** argv) {
                                 {"pane behind, fragment lists", &behind, true, 8}};
     for (int b : {1, 2, 4, 8, 16}) configs.push_back({"3 panes, fragment lists, budget " + std::to_string(b), &three, true, b});
     configs.push_back({"3 panes, ordered blend", &three, false, 8});
+    if (!only.empty())
+        configs.erase(std::remove_if(configs.begin() + 1, configs.end(), [&](const Config& c) { return c.name.find(only) == std::string::npos; }),
+                      configs.end());
 
     std::vector<splatfx::gl::FrameRenderer> renderers;
     for (const Config& c : configs) {
@@ -294,6 +300,13 @@ int runTransparency(int argc, char** argv) {
                     (unsigned long long)c.stats.transparentFallback, (unsigned long long)c.stats.transparentOverflowPixels, c.lists ? mb : 0.0,
                     c.lists ? double(c.stats.transparentBytes) / double(size.x * size.y) : 0.0);
     }
+    std::printf("\nHow the splats of the list frames were drawn (FrameRenderStats): behind every surface they cover / in front of\n"
+                "every one (both: the ordinary splat pass) / cut into sections / of those, by the general (eye-plane) variant\n");
+    for (const Config& c : configs)
+        if (c.lists)
+            std::printf("%-44s %6llu %6llu %6llu %6llu\n", c.name.c_str(), (unsigned long long)c.stats.transparentSplatsBehind,
+                        (unsigned long long)c.stats.transparentSplatsFront, (unsigned long long)c.stats.transparentSplatsSectioned,
+                        (unsigned long long)c.stats.transparentGeneral);
     std::printf("\nRMSE / max: linear RGB of the RGBA8 frame against renderSplatExact with the same panes (ReferenceSurface),\n"
                 "each splat cut into exact sections at the panes; 1/255 = 0.0039.\n"
                 "Targets (issue 15): one pane in front, lists <= 2x the opaque-only frame, error within the opaque-only error.\n");

@@ -29,13 +29,12 @@ namespace splatfx {
 inline constexpr int kTransparentNodeBinding = 6;    // shader storage buffer: the node pool
 inline constexpr int kTransparentCounterBinding = 7; // shader storage buffer: counters and the viewport
 inline constexpr int kTransparentHeadImageUnit = 6;  // image unit: the surface list heads (r32ui)
-inline constexpr int kTransparentCountImageUnit = 7; // image unit: surfaces per pixel (r32ui)
 
 // Bytes one surface node takes on the GPU: premultiplied RGBA as four
 // halves (8), the window depth (4), the link (4).
 inline constexpr std::size_t kTransparentNodeBytes = 16;
-// Bytes per pixel beside the nodes: the list head and the surface count (4 + 4).
-inline constexpr std::size_t kTransparentHeadBytesPerPixel = 8;
+// Bytes per pixel beside the nodes: the list head.
+inline constexpr std::size_t kTransparentHeadBytesPerPixel = 4;
 // The splats are not stored per fragment: each pixel's splat sections (in
 // front of, between and behind its surfaces: Ebert & Parent 1990, Fig. 1)
 // are composited in the splats' back-to-front order into one RGBA16F target

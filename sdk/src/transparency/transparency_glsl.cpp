@@ -9,7 +9,6 @@ std::string transparentGlsl() {
     s += "#define SPLATFX_NODE_BINDING " + std::to_string(kTransparentNodeBinding) + "\n";
     s += "#define SPLATFX_COUNTER_BINDING " + std::to_string(kTransparentCounterBinding) + "\n";
     s += "#define SPLATFX_HEAD_UNIT " + std::to_string(kTransparentHeadImageUnit) + "\n";
-    s += "#define SPLATFX_COUNT_UNIT " + std::to_string(kTransparentCountImageUnit) + "\n";
     s += R"(
 // ---- splatfx transparent-surface include (splatfx/transparency.hpp) ----
 layout(early_fragment_tests) in;
@@ -23,11 +22,10 @@ layout(std430, binding = SPLATFX_COUNTER_BINDING) coherent buffer splatfx_Counte
     uint splatfx_allocated;    // nodes handed out this frame (may pass the pool's size: those were not stored)
     uint splatfx_fallback;     // fragments that found the pool full (blended by the caller instead)
     int splatfx_originX, splatfx_originY, splatfx_width, splatfx_height; // the lists' viewport
-    uint splatfx_maxSurfaces;  // most surfaces stored on one pixel
+    uint splatfx_maxSurfaces;  // most surfaces stored on one pixel (counted after the hook, from the lists)
     uint splatfx_sectionOverflow, splatfx_overflowPixels, splatfx_mergedNodes;
 };
 layout(r32ui, binding = SPLATFX_HEAD_UNIT) coherent uniform uimage2D splatfx_surfaceHeads;
-layout(r32ui, binding = SPLATFX_COUNT_UNIT) coherent uniform uimage2D splatfx_surfaceCounts;
 const uint splatfx_kEnd = 0xffffffffu;
 
 vec4 splatfx_emitTransparent(vec4 premultipliedColour, float windowDepth) {
@@ -39,11 +37,10 @@ vec4 splatfx_emitTransparent(vec4 premultipliedColour, float windowDepth) {
     if (inside && !gl_HelperInvocation && any(notEqual(premultipliedColour, vec4(0.0)))) {
         uint i = atomicAdd(splatfx_allocated, 1u);
         if (i < uint(splatfx_nodes.length())) {
-            splatfx_nodes[i].rg = packHalf2x16(premultipliedColour.rg);
-            splatfx_nodes[i].ba = packHalf2x16(premultipliedColour.ba);
-            splatfx_nodes[i].depthBits = floatBitsToUint(clamp(windowDepth, 0.0, 1.0));
-            splatfx_nodes[i].next = imageAtomicExchange(splatfx_surfaceHeads, p, i);
-            atomicMax(splatfx_maxSurfaces, imageAtomicAdd(splatfx_surfaceCounts, p, 1u) + 1u);
+            // One 16-byte store (a software rasterizer scatters each store per lane).
+            uint next = imageAtomicExchange(splatfx_surfaceHeads, p, i);
+            splatfx_nodes[i] = splatfx_Node(packHalf2x16(premultipliedColour.rg), packHalf2x16(premultipliedColour.ba),
+                                            floatBitsToUint(clamp(windowDepth, 0.0, 1.0)), next);
         } else {
             atomicAdd(splatfx_fallback, 1u);
             result = premultipliedColour;

@@ -26,7 +26,9 @@
 //      path: the hook's fragments go into per-pixel lists (transparentGlsl()),
 //      the splats (not drawn in step 2 then) are composited per section
 //      between those surfaces (Ebert & Parent 1990, Fig. 1), and a resolve
-//      sorts each pixel and composites it over the image (fragment_list_pass)
+//      sorts each pixel and composites it over the image (fragment_list_pass);
+//      splats behind (in front of) every surface they cover take the
+//      ordinary splat pass before (after) the resolve instead
 // The passes of the systems still being built (fog of the host image, shadow
 // tables before the opaque pass, exact ordering among transparent surfaces,
 // projected tetrahedra) join this list here, not in callers.
@@ -159,7 +161,7 @@ struct FrameRenderStats {
     std::size_t tableBytes = 0;              // GPU bytes of the uploaded pre-integration tables
     // ---- (issue 15) order-exact transparency (last frame) ----
     bool transparentLists = false;        // the host's surfaces went through the fragment lists
-    bool splatsInLists = false;           // ... and the splats too (false: drawn before them, ordered blend; see transparentNote)
+    bool splatsInLists = false;           // ... and the splats too (false: drawn before them, ordered blend; see transparentNote; with a fog, the splats that meet a surface take the ordered blend, also noted)
     std::string transparentNote;          // empty, or why the splats took the ordered blend in a list frame
     std::uint64_t transparentNodes = 0;   // surface fragments stored in the lists
     std::uint64_t transparentFallback = 0;     // surface fragments that found the pool full: blended directly by the include, unsorted
@@ -169,7 +171,13 @@ struct FrameRenderStats {
     int transparentSections = 0;                 // section targets the splats were composited into (2, 4 or 8; 0: none)
     std::uint64_t transparentSectionOverflow = 0; // pixels with more surfaces than sections - 1 (7 at most): the gas behind the extra ones merged into the last section
     bool transparentCut = false;          // sections weighted by the kernel's partial line integral (RendererDesc::depthCut)
-    std::uint64_t transparentEyeCrossing = 0; // splats whose polygon crosses the eye plane: not drawn in the lists (camera inside a kernel)
+    std::uint64_t transparentGeneral = 0; // sectioned splats whose polygon crosses the eye plane (camera inside a kernel): drawn screen-covering, exact
+    // How the splats of a list frame were drawn: behind every surface they
+    // cover (the ordinary splat pass, before the resolve), in front of every
+    // one (the ordinary pass, after it), or cut into sections (the rest).
+    std::uint64_t transparentSplatsBehind = 0;
+    std::uint64_t transparentSplatsFront = 0;
+    std::uint64_t transparentSplatsSectioned = 0;
     std::size_t transparentBytes = 0;     // GPU bytes of the lists (pool, heads, counts, counters, section targets)
     // ---- end (issue 15) ----
 };

@@ -3,7 +3,11 @@
 #include "fragment_list_pass.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstddef>
+#include <cstring>
+#include <span>
 #include <string>
 
 #include <epoxy/gl.h>
@@ -50,6 +54,19 @@ layout(binding = 1) uniform sampler2D uHostDepth;
 uniform vec4 uDepthToView; // inverse projection's (z, w) rows at (z, w) columns
 flat in float vScale;
 in vec3 vRel;
+#if GENERAL
+// The polygon crosses the eye plane (the camera inside the kernel): the
+// vertex stage covers the screen and each fragment meets its ray with the
+// splat plane, as the splat pass's general variant does (shaders.hpp).
+uniform mat4 uInvViewProj;
+uniform vec4 uViewport; // x, y, width, height
+uniform vec3 uEye;
+uniform float uCut;
+uniform int uOctagon;
+flat in vec3 vCenter;
+flat in vec3 vAxisU;
+flat in vec3 vAxisV;
+#endif
 float gR, gTP, gInvCos, gInvL, gLo, gHi;
 float viewDepth(float windowDepth) {
     float nz = windowDepth * 2.0 - 1.0;
@@ -69,17 +86,49 @@ float sectionFraction(float d) { return gl_FragCoord.z <= d ? 1.0 : 0.0; }
 void main() {
     vec4 acc[SECTIONS];
     for (int k = 0; k < SECTIONS; ++k) acc[k] = vec4(0.0);
-    vec4 t = texture(uLayers, vec3(vTex, vLayers.x));
-    if (vLayers.z > 0.0) t = mix(t, texture(uLayers, vec3(vTex, vLayers.y)), vLayers.z);
+#if CUT && GENERAL
+    vec2 ndc = (gl_FragCoord.xy - uViewport.xy) / uViewport.zw * 2.0 - 1.0;
+    vec4 farPoint = uInvViewProj * vec4(ndc, 1.0, 1.0);
+    vec3 dir = normalize(farPoint.xyz / farPoint.w - uEye);
+    vec3 nrm = cross(vAxisU, vAxisV);
+    float dn = dot(dir, nrm);
+    if (abs(dn) <= 1e-6 * length(nrm)) discard; // edge-on
+    float tPlane = dot(vCenter - uEye, nrm) / dn; // the line, so a plane just behind the eye still gives its tail in front
+    vec3 g = uEye + tPlane * dir - vCenter;
+    float g00 = dot(vAxisU, vAxisU), g01 = dot(vAxisU, vAxisV), g11 = dot(vAxisV, vAxisV);
+    float b0 = dot(vAxisU, g), b1 = dot(vAxisV, g);
+    vec2 uvk = vec2(g11 * b0 - g01 * b1, g00 * b1 - g01 * b0) / (g00 * g11 - g01 * g01);
+    if (max(abs(uvk.x), abs(uvk.y)) > uCut || (uOctagon != 0 && abs(uvk.x) + abs(uvk.y) > uCut * 1.41421356)) discard;
+    vec2 tex = vec2(0.5 + 0.5 * uvk.x, 0.5 - 0.5 * uvk.y);
+#else
+    vec2 tex = vTex;
+#endif
+    vec4 t = texture(uLayers, vec3(tex, vLayers.x));
+    if (vLayers.z > 0.0) t = mix(t, texture(uLayers, vec3(tex, vLayers.y)), vLayers.z);
 #if CUT
+#if GENERAL
+    gTP = tPlane;
+    gInvCos = 1.0 / dot(dir, uForward);
+#else
     vec2 uvk = vec2(2.0 * vTex.x - 1.0, 1.0 - 2.0 * vTex.y);
     float zP = dot(vRel, uForward);
-    gR = uKernelRadius * length(uvk);
     gTP = uPersp != 0 ? length(vRel) : zP; // along the ray from the eye (ortho: from its plane)
     gInvCos = uPersp != 0 ? gTP / zP : 1.0;
+#endif
+    gR = uKernelRadius * length(uvk);
     gInvL = 1.0 / vScale;
+    // The near and host cuts only where the CPU found the support may meet
+    // them (per-draw variants: a software rasterizer runs masked branches).
+#if NEAR_CUT
     gLo = beforeView(uNearZ);
+#else
+    gLo = 0.0;
+#endif
+#if HOST_DEPTH
     gHi = max(beforeView(viewDepth(texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r)), gLo);
+#else
+    gHi = 1.0;
+#endif
     float total = gHi - gLo;
 #else
     float total = 1.0;
@@ -160,16 +209,84 @@ void main() {
 }
 )";
 
+// Run after the host's surfaces, one invocation per 16 x 16 tile (an
+// invocation per pixel costs llvmpipe more in dispatch than the walk): the
+// most surfaces on one pixel, and per tile the nearest and farthest surface
+// window depth stored on any of its pixels (as float bits: window depths are
+// in [0, 1], where the bits order like the values; an empty tile reads
+// (0xffffffff, 0)). Read back so the CPU can send the splats that lie wholly
+// behind, or wholly in front of, every surface they cover to the ordinary
+// splat pass (FragmentListPass::split). One work group per tile.
+constexpr int kRangeTile = 16;
+constexpr const char* kTileRangeCompute = R"(
+layout(local_size_x = 8, local_size_y = 1) in;
+layout(binding = 2) uniform usampler2D uHeads;
+layout(rgba32ui, binding = 5) writeonly uniform uimage2D uTileRange;
+uniform ivec2 uSize;
+uniform ivec2 uTiles;
+void main() {
+    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
+    if (t.x >= uTiles.x) return;
+    ivec2 first = t * 16, last = min(first + 16, uSize);
+    uint lo = 0xffffffffu, hi = 0u, most = 0u;
+    for (int y = first.y; y < last.y; ++y)
+        for (int x = first.x; x < last.x; ++x) {
+            uint count = 0u;
+            for (uint i = texelFetch(uHeads, ivec2(x, y), 0).x; i != splatfx_kEnd; i = splatfx_nodes[i].next) {
+                uint z = floatBitsToUint(abs(uintBitsToFloat(splatfx_nodes[i].depthBits))); // -0 as +0
+                lo = min(lo, z);
+                hi = max(hi, z);
+                ++count;
+            }
+            most = max(most, count);
+        }
+    imageStore(uTileRange, t, uvec4(lo, hi, most, 0u));
+    // The most surfaces on one pixel (here rather than per fragment in the
+    // include: one atomic per tile instead of two per surface fragment).
+    if (most > 0u) atomicMax(splatfx_maxSurfaces, most);
+}
+)";
+
+// Per 16 x 16 tile, the nearest host opaque depth (window depth), one
+// invocation per tile: only for frames with splats to section (their
+// near / host cut variants, FragmentListPass::split).
+constexpr const char* kHostTileCompute = R"(
+layout(local_size_x = 8, local_size_y = 1) in;
+layout(binding = 3) uniform sampler2D uHostDepth;
+layout(r32f, binding = 5) writeonly uniform image2D uHostTiles;
+uniform ivec2 uSize, uTiles, uOrigin; // the lists' viewport size, the tiles, its origin in the depth texture
+void main() {
+    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
+    if (t.x >= uTiles.x) return;
+    ivec2 first = t * 16, last = min(first + 16, uSize);
+    float host = 1.0;
+    for (int y = first.y; y < last.y; ++y)
+        for (int x = first.x; x < last.x; ++x) host = min(host, texelFetch(uHostDepth, ivec2(x, y) + uOrigin, 0).r);
+    imageStore(uHostTiles, t, vec4(max(host, 0.0)));
+}
+)";
+
 // The resolve, one invocation per pixel. Compiled after "#version 450
 // core", "#define K n" and transparentGlsl() without its
 // early_fragment_tests line. A compute shader, not a full-screen draw: on
 // Mesa's llvmpipe the fragment version read wrong list data in the partially
 // covered blocks along its triangles' edges (a band of wrong pixels).
 constexpr const char* kResolveCompute = R"(
+#if FRAG
+// The fragment variant: nodes through a texture buffer view of the pool
+// (RGBA32UI: rg, ba, depth bits, next), composited "over" the framebuffer
+// by the blend unit. No storage-buffer access (see above).
+layout(binding = 4) uniform usamplerBuffer uNodes;
+layout(location = 0) out vec4 oColor;
+const uint splatfx_kEnd = 0xffffffffu;
+#define NODE(i) texelFetch(uNodes, int(i))
+#else
 layout(local_size_x = 8, local_size_y = 8) in;
+layout(rgba16f, binding = 5) writeonly uniform image2D uResolved;
+#define NODE(i) uvec4(splatfx_nodes[i].rg, splatfx_nodes[i].ba, splatfx_nodes[i].depthBits, splatfx_nodes[i].next)
+#endif
 layout(binding = 1) uniform sampler2DArray uSections;
 layout(binding = 2) uniform usampler2D uHeads;
-layout(rgba16f, binding = 5) writeonly uniform image2D uResolved;
 uniform ivec2 uOrigin;      // the lists' viewport origin in the section targets
 uniform ivec2 uSize;        // the lists' viewport size
 uniform int uSectionCount;  // 0: the splats were not drawn into sections
@@ -178,18 +295,34 @@ vec4 over(vec4 front, vec4 back) { return front + (1.0 - front.a) * back; }
 vec4 section(ivec2 p, int k) { return k < uSectionCount ? texelFetch(uSections, ivec3(p + uOrigin, k), 0) : vec4(0.0); }
 
 void main() {
+#if FRAG
+    ivec2 p = ivec2(gl_FragCoord.xy) - uOrigin;
+    if (p.x < 0 || p.y < 0 || p.x >= uSize.x || p.y >= uSize.y) discard;
+#else
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (p.x >= uSize.x || p.y >= uSize.y) return;
+#endif
+#if FRAG && K == 1
+    // At most one surface on any pixel (the variant is chosen so): no walk, no sort.
+    uint i = texelFetch(uHeads, p, 0).x;
+    vec4 acc = section(p, 0);
+    if (i != splatfx_kEnd) {
+        uvec4 node = NODE(i);
+        acc = over(over(acc, vec4(unpackHalf2x16(node.x), unpackHalf2x16(node.y))), section(p, 1));
+    } else {
+        acc = over(acc, section(p, 1));
+    }
+#else
     float eDepth[K];
     vec4 eColour[K];
     int n = 0;
     uint merged = 0u;
     uint i = texelFetch(uHeads, p, 0).x;
     while (i != splatfx_kEnd) {
-        splatfx_Node node = splatfx_nodes[i];
-        i = node.next;
-        float d = uintBitsToFloat(node.depthBits);
-        vec4 c = vec4(unpackHalf2x16(node.rg), unpackHalf2x16(node.ba));
+        uvec4 node = NODE(i);
+        i = node.w;
+        float d = uintBitsToFloat(node.z);
+        vec4 c = vec4(unpackHalf2x16(node.x), unpackHalf2x16(node.y));
         if (n == K) {
             // Full: the farthest two of the K + 1 become one ("over").
             ++merged;
@@ -218,10 +351,12 @@ void main() {
         eDepth[j] = d;
         eColour[j] = c;
     }
+#if !FRAG
     if (merged > 0u) {
         atomicAdd(splatfx_overflowPixels, 1u);
         atomicAdd(splatfx_mergedNodes, merged);
     }
+#endif
     // Front to back: section 0, surface 0, section 1, ... The sections past
     // the last kept surface (more surfaces than sections or than K) follow it.
     vec4 acc = section(p, 0);
@@ -230,7 +365,13 @@ void main() {
         if (k + 1 < n) acc = over(acc, section(p, k + 1));
     }
     for (int k = max(n, 1); k < uSectionCount; ++k) acc = over(acc, section(p, k));
+#endif
+#if FRAG
+    if (acc == vec4(0.0)) discard;
+    oColor = acc;
+#else
     imageStore(uResolved, p, acc);
+#endif
 }
 )";
 
@@ -255,23 +396,32 @@ struct FragmentListPass::Impl {
         GLuint id = 0;
         GLint uViewProj = -1, uOctagon = -1, uCut = -1, uOrigin = -1;
         GLint uEye = -1, uForward = -1, uNearZ = -1, uPersp = -1, uKernelRadius = -1, uDepthToView = -1;
+        GLint uInvViewProj = -1, uViewport = -1; // general variant
     };
-    SectionProgram sectionPrograms[2][3]; // [plain, cut][2, 4, 8 sections]
+    // [kind][2, 4, 8 sections]; kinds: 0 plain; cut with 1 near and host
+    // cuts, 2 the same general (the polygon crosses the eye plane), 3 no
+    // near or host cut, 4 near only, 5 host only (3-5 built on first use).
+    static constexpr int kKinds = 6;
+    SectionProgram sectionPrograms[kKinds][3];
+    static int cutKind(unsigned needs) { return needs == 3 ? 1 : needs == 0 ? 3 : needs == 1 ? 4 : 5; }
     PartialTexture partial;               // the footprint's partial-integral table (cut programs)
     std::string partialSource;            // partialGlsl() the cut programs were built from
     float kernelRadius = 1.0f;
     std::string programError;
 
-    // Builds the three section programs of one kind (cut: with the partial integral).
-    bool buildSections(bool cut) {
+    // Builds the three section programs of one kind (kind 0: plain; 1: cut
+    // with the partial integral; 2: cut, general: the polygon crosses the eye plane).
+    bool buildSections(int kind) {
+        const bool cut = kind > 0;
         const std::string include = transparentGlsl();
         const int counts[3] = {2, 4, kTransparentMaxSections};
-        const std::string head = std::string("#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n") +
-                                 (cut ? "#define CUT 1\n#define HOST_DEPTH 1\n#define NEAR_CUT 1\n" : "#define CUT 0\n#define HOST_DEPTH 0\n#define NEAR_CUT 0\n") +
-                                 "#define GENERAL 0\n#define CROSSFADE 1\n";
+        const bool nearCut = kind == 1 || kind == 2 || kind == 4, hostCut = kind == 1 || kind == 2 || kind == 5;
+        const std::string head = std::string("#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n") + (cut ? "#define CUT 1\n" : "#define CUT 0\n") +
+                                 (hostCut ? "#define HOST_DEPTH 1\n" : "#define HOST_DEPTH 0\n") + (nearCut ? "#define NEAR_CUT 1\n" : "#define NEAR_CUT 0\n") +
+                                 (kind == 2 ? "#define GENERAL 1\n" : "#define GENERAL 0\n") + "#define CROSSFADE 1\n";
         const char* partialSrc = cut ? partialSource.c_str() : "";
         for (int v = 0; v < 3; ++v) {
-            SectionProgram& p = sectionPrograms[cut][v];
+            SectionProgram& p = sectionPrograms[kind][v];
             if (p.id) glDeleteProgram(p.id), p = {};
             const std::string def = "#define SECTIONS " + std::to_string(counts[v]) + "\n";
             auto linked = linkProgram({head.c_str(), partialSrc, kSplatVertex},
@@ -293,18 +443,46 @@ struct FragmentListPass::Impl {
             p.uPersp = loc("uPersp");
             p.uKernelRadius = loc("uKernelRadius");
             p.uDepthToView = loc("uDepthToView");
+            p.uInvViewProj = loc("uInvViewProj");
+            p.uViewport = loc("uViewport");
         }
         return true;
     }
     std::vector<std::pair<int, GLuint>> resolvePrograms; // (K, program), K ascending
-    GLuint compositeProgram = 0, prepareProgram = 0;
+    // The fragment resolve by K (built on first use), reading the pool
+    // through a texture buffer view when it fits GL_MAX_TEXTURE_BUFFER_SIZE.
+    std::vector<std::pair<int, GLuint>> fragmentResolvePrograms;
+    GLuint poolView = 0;
+    bool poolViewed = false;
+    GLuint fragmentResolve(int k) {
+        for (const auto& fp : fragmentResolvePrograms)
+            if (fp.first == k) return fp.second;
+        const std::string def = "#version 450 core\n#define FRAG 1\n#define K " + std::to_string(k) + "\n";
+        auto prog = linkProgram({kFullscreenVertex}, {def.c_str(), kResolveCompute}, "fragment lists (resolve, fragment)");
+        const GLuint id = prog ? *prog : 0; // 0: this GL cannot build it; the compute resolve is used
+        fragmentResolvePrograms.push_back({k, id});
+        return id;
+    }
+    GLuint compositeProgram = 0, prepareProgram = 0, rangeProgram = 0, hostTileProgram = 0;
+    GLuint hostTiles = 0; // R32F per tile: the nearest host depth (split(), frames with sections only)
+    glm::ivec2 hostTileSize{0};
+    std::vector<float> hostTileDepth;
+    // The surface depth range per kRangeTile tile (RG32UI float bits), read back by split().
+    GLuint tileRange = 0;
+    glm::ivec2 tileSize{0};
+    std::vector<GLuint> tileBits;
+    std::vector<float> tileView; // tileBits' surface depth range as view depth
+    std::vector<float> tileHost; // tileBits' nearest host depth as view depth
+    std::vector<std::uint8_t> classes; // insertSplats(): per splat, its variant
+    std::vector<std::uint8_t> needs; // split(): per splat of the middle run, the cuts its section variant needs (1 near, 2 host)
+    std::array<float, 256> rho{}; // rayScaleRho by code (the kernel's reach along the rays)
     GLuint depths = 0; // R32F array: each pixel's nearest surface depths
     int depthLayers = 0;
     glm::ivec2 depthSize{0};
     GLuint resolved = 0; // RGBA16F, the lists' viewport
     GLuint vao = 0, instances = 0, emptyVao = 0;
     std::size_t instanceCapacity = 0;
-    GLuint heads = 0, counts = 0, pool = 0, counters = 0;
+    GLuint heads = 0, pool = 0, counters = 0;
     GLuint sections = 0, sectionFbo = 0, attachedDepth = 0;
     glm::ivec2 sectionSize{0};
     int sectionLayers = 0;
@@ -319,30 +497,35 @@ struct FragmentListPass::Impl {
             for (const SectionProgram& p : kind)
                 if (p.id) glDeleteProgram(p.id);
         for (const auto& rp : resolvePrograms) glDeleteProgram(rp.second);
+        for (const auto& fp : fragmentResolvePrograms)
+            if (fp.second) glDeleteProgram(fp.second);
+        if (poolView) glDeleteTextures(1, &poolView);
         if (compositeProgram) glDeleteProgram(compositeProgram);
         if (prepareProgram) glDeleteProgram(prepareProgram);
+        if (rangeProgram) glDeleteProgram(rangeProgram);
+        if (hostTileProgram) glDeleteProgram(hostTileProgram);
+        if (hostTiles) glDeleteTextures(1, &hostTiles);
+        if (tileRange) glDeleteTextures(1, &tileRange);
         if (depths) glDeleteTextures(1, &depths);
         GLuint vaos[2] = {vao, emptyVao};
         glDeleteVertexArrays(2, vaos);
         GLuint bufs[3] = {instances, pool, counters};
         glDeleteBuffers(3, bufs);
-        GLuint tex[4] = {heads, counts, sections, resolved};
-        glDeleteTextures(4, tex);
+        GLuint tex[3] = {heads, sections, resolved};
+        glDeleteTextures(3, tex);
         if (sectionFbo) glDeleteFramebuffers(1, &sectionFbo);
     }
 
     void resize(int w, int h) {
         if (w == width && h == height && pool) return;
-        GLuint tex[3] = {heads, counts, resolved};
-        glDeleteTextures(3, tex);
+        GLuint tex[2] = {heads, resolved};
+        glDeleteTextures(2, tex);
         glCreateTextures(GL_TEXTURE_2D, 1, &resolved);
         glTextureStorage2D(resolved, 1, GL_RGBA16F, w, h);
         glTextureParameteri(resolved, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTextureParameteri(resolved, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
         glCreateTextures(GL_TEXTURE_2D, 1, &heads);
-        glCreateTextures(GL_TEXTURE_2D, 1, &counts);
         glTextureStorage2D(heads, 1, GL_R32UI, w, h);
-        glTextureStorage2D(counts, 1, GL_R32UI, w, h);
         // Integer textures are complete only with nearest filtering.
         glTextureParameteri(heads, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTextureParameteri(heads, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
@@ -350,6 +533,15 @@ struct FragmentListPass::Impl {
         poolNodes = std::size_t(w) * std::size_t(h) * std::size_t(perPixel);
         glCreateBuffers(1, &pool);
         glNamedBufferStorage(pool, GLsizeiptr(poolNodes * kTransparentNodeBytes), nullptr, 0);
+        if (poolView) glDeleteTextures(1, &poolView);
+        poolView = 0;
+        GLint maxTexels = 0;
+        glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &maxTexels);
+        poolViewed = poolNodes <= std::size_t(std::max(maxTexels, 0));
+        if (poolViewed) {
+            glCreateTextures(GL_TEXTURE_BUFFER, 1, &poolView);
+            glTextureBuffer(poolView, GL_RGBA32UI, pool); // one node per texel (kTransparentNodeBytes = 16)
+        }
         width = w;
         height = h;
         stats.poolNodes = poolNodes;
@@ -388,7 +580,7 @@ const FragmentListStats& FragmentListPass::stats() const { return mImpl->stats; 
 Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
     auto impl = std::make_unique<Impl>();
     impl->perPixel = std::clamp(fragmentsPerPixel, 1, kMaxFragmentsPerPixel);
-    if (!impl->buildSections(false)) return makeError(impl->programError);
+    if (!impl->buildSections(0)) return makeError(impl->programError);
     const std::string include = transparentGlsl();
     std::string computeInclude = include;
     const std::string early = "layout(early_fragment_tests) in;\n";
@@ -401,7 +593,7 @@ Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
     // them (the per-pixel arrays cost in proportion to K on a CPU rasterizer).
     for (int k = 1;; k = std::min(2 * k, impl->perPixel)) {
         const std::string def = "#define K " + std::to_string(k) + "\n";
-        auto resolve = linkComputeProgram({"#version 450 core\n", def.c_str(), computeInclude.c_str(), kResolveCompute}, "fragment lists (resolve)");
+        auto resolve = linkComputeProgram({"#version 450 core\n#define FRAG 0\n", def.c_str(), computeInclude.c_str(), kResolveCompute}, "fragment lists (resolve)");
         if (!resolve) return makeError(resolve.error());
         impl->resolvePrograms.push_back({k, *resolve});
         if (k == impl->perPixel) break;
@@ -409,6 +601,13 @@ Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
     auto prepare = linkComputeProgram({"#version 450 core\n", computeInclude.c_str(), kPrepareCompute}, "fragment lists (prepare)");
     if (!prepare) return makeError(prepare.error());
     impl->prepareProgram = *prepare;
+    auto range = linkComputeProgram({"#version 450 core\n", computeInclude.c_str(), kTileRangeCompute}, "fragment lists (tile depth range)");
+    if (!range) return makeError(range.error());
+    impl->rangeProgram = *range;
+    auto hostTile = linkComputeProgram({"#version 450 core\n", kHostTileCompute}, "fragment lists (host depth tiles)");
+    if (!hostTile) return makeError(hostTile.error());
+    impl->hostTileProgram = *hostTile;
+    for (int c = 0; c < 256; ++c) impl->rho[std::size_t(c)] = rayScaleRho(std::uint8_t(c));
     auto composite = linkProgram({kFullscreenVertex}, {kListCompositeFragment}, "fragment lists (composite)");
     if (!composite) return makeError(composite.error());
     impl->compositeProgram = *composite;
@@ -437,7 +636,10 @@ Status FragmentListPass::upload(const Materials& materials) {
     const std::string partial = partialGlsl(materials.footprint(), 3);
     if (partial == r.partialSource) return {};
     r.partialSource = partial;
-    if (!r.buildSections(true)) {
+    for (int kind = 3; kind < Impl::kKinds; ++kind)
+        for (Impl::SectionProgram& p : r.sectionPrograms[kind])
+            if (p.id) glDeleteProgram(p.id), p = {};
+    if (!r.buildSections(1) || !r.buildSections(2)) {
         r.partialSource.clear();
         return makeError("fragment lists: " + r.programError);
     }
@@ -449,17 +651,16 @@ Status FragmentListPass::collectSurfaces(const FragmentListTarget& target, const
     if (target.width <= 0 || target.height <= 0) return makeError("fragment lists: the viewport must be positive");
     r.resize(target.width, target.height);
     r.sectionsThisFrame = 0;
-    r.stats.eyeCrossing = 0;
+    r.stats.generalSplats = 0;
     r.stats.cut = false;
-    const GLuint end = kEnd, zero = 0;
+    r.stats.splatsBehind = r.stats.splatsFront = r.stats.splatsSectioned = 0;
+    const GLuint end = kEnd;
     glClearTexImage(r.heads, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &end);
-    glClearTexImage(r.counts, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &zero);
     const GLint header[kCounterWords] = {0, 0, target.x, target.y, target.width, target.height, 0, 0, 0, 0, 0, 0};
     glNamedBufferSubData(r.counters, 0, sizeof(header), header);
     glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kTransparentNodeBinding, r.pool, 0, GLsizeiptr(r.poolNodes * kTransparentNodeBytes));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTransparentCounterBinding, r.counters);
     glBindImageTexture(kTransparentHeadImageUnit, r.heads, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
-    glBindImageTexture(kTransparentCountImageUnit, r.counts, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     if (drawSurfaces) {
         glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
@@ -472,14 +673,158 @@ Status FragmentListPass::collectSurfaces(const FragmentListTarget& target, const
         glDepthMask(GL_FALSE);
         drawSurfaces();
     }
+    // The survey of the lists (kTileRangeCompute).
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    const int tilesX = (target.width + kRangeTile - 1) / kRangeTile, tilesY = (target.height + kRangeTile - 1) / kRangeTile;
+    if (!r.tileRange || r.tileSize != glm::ivec2(tilesX, tilesY)) {
+        if (r.tileRange) glDeleteTextures(1, &r.tileRange);
+        glCreateTextures(GL_TEXTURE_2D, 1, &r.tileRange);
+        glTextureStorage2D(r.tileRange, 1, GL_RGBA32UI, tilesX, tilesY);
+        r.tileSize = {tilesX, tilesY};
+    }
+    glUseProgram(r.rangeProgram);
+    glUniform2i(glGetUniformLocation(r.rangeProgram, "uSize"), target.width, target.height);
+    glUniform2i(glGetUniformLocation(r.rangeProgram, "uTiles"), tilesX, tilesY);
+    glBindTextureUnit(2, r.heads);
+    glBindImageTexture(5, r.tileRange, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32UI);
+    glDispatchCompute(GLuint((tilesX + 7) / 8), GLuint(tilesY), 1);
+    glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32UI);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     return {};
 }
 
-void FragmentListPass::insertSplats(const std::vector<Splat>& splats, const Camera& camera, unsigned layerTexture, float cut, bool trimCorners,
-                                    bool depthCut, const FragmentListTarget& target) {
+FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats, const Camera& camera, float cut, bool trimCorners, bool depthCut,
+                                                const FragmentListTarget& target) {
+    Impl& r = *mImpl;
+    r.stats.splatsBehind = r.stats.splatsFront = r.stats.splatsSectioned = 0;
+    r.needs.clear();
+    const std::size_t n = splats.size();
+    if (n == 0) return {};
+    const int tile = kRangeTile;
+    const int tilesX = r.tileSize.x, tilesY = r.tileSize.y;
+    glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+    r.tileBits.resize(std::size_t(tilesX) * std::size_t(tilesY) * 4);
+    glGetTextureImage(r.tileRange, 0, GL_RGBA_INTEGER, GL_UNSIGNED_INT, GLsizei(r.tileBits.size() * sizeof(GLuint)), r.tileBits.data());
+    // Window depth to view depth, as the shaders do (monotonic: the range maps to the range).
+    const glm::mat4 invProj = glm::inverse(camera.proj);
+    auto viewDepth = [&](GLuint bits) {
+        float d;
+        std::memcpy(&d, &bits, 4);
+        const float nz = d * 2.0f - 1.0f;
+        return std::abs((invProj[2][2] * nz + invProj[3][2]) / (invProj[2][3] * nz + invProj[3][3]));
+    };
+    std::vector<float>& range = r.tileView;
+    const std::size_t tiles = std::size_t(tilesX) * std::size_t(tilesY);
+    range.resize(tiles * 2);
+    bool any = false;
+    for (std::size_t t = 0; t < tiles; ++t) {
+        const bool empty = r.tileBits[4 * t] > r.tileBits[4 * t + 1];
+        any |= !empty;
+        range[2 * t] = empty ? 3.4e38f : viewDepth(r.tileBits[4 * t]);
+        range[2 * t + 1] = empty ? -3.4e38f : viewDepth(r.tileBits[4 * t + 1]);
+    }
+    if (!any) { // no surface stored: every splat is in the only section
+        r.stats.splatsBehind = n;
+        return {n, n};
+    }
+    // Per splat: the view-depth interval its contribution can come from (the
+    // polygon's, widened by the kernel's reach along the rays with the cut),
+    // and the surfaces' depth range over the tiles its screen rectangle meets
+    // (the same bound as the splat pass's tile test, renderer.cpp).
+    const bool persp = camera.perspective();
+    const glm::vec3 eye = camera.eye(), fwd = camera.forward();
+    const float nearZ = camera.nearPlane(), extent = std::clamp(cut, 0.05f, 1.0f);
+    const glm::mat4 vp = camera.proj * camera.view;
+    const float focalY = std::abs(camera.proj[1][1]) * 0.5f * float(target.height), focalX = std::abs(camera.proj[0][0]) * 0.5f * float(target.width);
+    // 0: between (sections), 1: behind every surface it covers, 2: in front of every one, 3: no surface on its tiles.
+    int needs = 3;
+    auto classify = [&](const Splat& sp) -> int {
+        const float a = std::abs(glm::dot(sp.axisU, fwd)), b = std::abs(glm::dot(sp.axisV, fwd));
+        const float reach = extent * (trimCorners ? std::max(a + 0.41421356f * b, 0.41421356f * a + b) : a + b);
+        const float zc = glm::dot(sp.center - eye, fwd);
+        const float minZ = zc - reach, maxZ = zc + reach;
+        const float depthReach = depthCut ? 1.01f * r.rho[sp.color >> 24] * std::sqrt(glm::length(glm::cross(sp.axisU, sp.axisV))) : 0.0f;
+        float lo = 3.4e38f, hi = -3.4e38f;
+        const glm::vec4 cc = vp * glm::vec4(sp.center, 1.0f);
+        const float ext = extent * (glm::length(sp.axisU) + glm::length(sp.axisV)) * 1.01f;
+        const float px = (cc.x / cc.w * 0.5f + 0.5f) * float(target.width), py = (cc.y / cc.w * 0.5f + 0.5f) * float(target.height);
+        const float hx = persp ? ext * focalX / minZ : ext * focalX, hy = persp ? ext * focalY / minZ : ext * focalY;
+        int x0 = 0, x1 = tilesX - 1, y0 = 0, y1 = tilesY - 1; // near or across the eye plane, or not finite: every tile
+        if ((!persp || minZ >= 0.5f * nearZ) && std::isfinite(px) && std::isfinite(py) && std::isfinite(hx) && std::isfinite(hy)) {
+            x0 = std::clamp(int(std::floor((px - hx) / float(tile))), 0, tilesX - 1), x1 = std::clamp(int(std::floor((px + hx) / float(tile))), 0, tilesX - 1);
+            y0 = std::clamp(int(std::floor((py - hy) / float(tile))), 0, tilesY - 1), y1 = std::clamp(int(std::floor((py + hy) / float(tile))), 0, tilesY - 1);
+        }
+        float host = 3.4e38f;
+        for (int ty = y0; ty <= y1; ++ty)
+            for (int tx = x0; tx <= x1; ++tx) {
+                const std::size_t at = std::size_t(ty) * std::size_t(tilesX) + std::size_t(tx);
+                lo = std::min(lo, range[2 * at]);
+                hi = std::max(hi, range[2 * at + 1]);
+                if (!r.tileHost.empty()) host = std::min(host, r.tileHost[at]);
+                else host = 0.0f; // not surveyed: assume the host cut may be needed
+            }
+        // The section program's variant: the near cut where the support may
+        // reach the near plane, the host cut where it may reach the nearest
+        // host depth on its tiles (the splat pass's tests, renderer.cpp).
+        needs = (minZ - depthReach < nearZ * 1.01f + 1e-6f ? 1 : 0) | (maxZ + depthReach < host * 0.99f ? 0 : 2);
+        if (lo > hi) return 3; // no surface on its tiles: its only section is the first and the last
+        if (minZ - depthReach > hi * 1.01f + 1e-6f) return 1;
+        if (maxZ + depthReach < lo * 0.99f) return 2;
+        return 0;
+    };
+    Split s;
+    while (s.behindEnd < n && (classify(splats[s.behindEnd]) & 1)) ++s.behindEnd;
+    s.frontBegin = n;
+    while (s.frontBegin > s.behindEnd && (classify(splats[s.frontBegin - 1]) & 2)) --s.frontBegin;
+    r.stats.splatsBehind = s.behindEnd;
+    r.stats.splatsFront = n - s.frontBegin;
+    // The middle run's section variants (bit 0: near cut, bit 1: host cut),
+    // from the nearest host depth per tile (surveyed only now: frames with
+    // no splat to section do not pay for it).
+    r.tileHost.clear();
+    if (s.frontBegin > s.behindEnd && depthCut && target.depthTexture) {
+        if (!r.hostTiles || r.hostTileSize != glm::ivec2(tilesX, tilesY)) {
+            if (r.hostTiles) glDeleteTextures(1, &r.hostTiles);
+            glCreateTextures(GL_TEXTURE_2D, 1, &r.hostTiles);
+            glTextureStorage2D(r.hostTiles, 1, GL_R32F, tilesX, tilesY);
+            r.hostTileSize = {tilesX, tilesY};
+        }
+        glUseProgram(r.hostTileProgram);
+        glUniform2i(glGetUniformLocation(r.hostTileProgram, "uSize"), target.width, target.height);
+        glUniform2i(glGetUniformLocation(r.hostTileProgram, "uTiles"), tilesX, tilesY);
+        glUniform2i(glGetUniformLocation(r.hostTileProgram, "uOrigin"), target.x, target.y);
+        glBindTextureUnit(3, target.depthTexture);
+        glBindImageTexture(5, r.hostTiles, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glDispatchCompute(GLuint((tilesX + 7) / 8), GLuint(tilesY), 1);
+        glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindTextureUnit(3, 0);
+        glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+        r.hostTileDepth.resize(std::size_t(tilesX) * std::size_t(tilesY));
+        glGetTextureImage(r.hostTiles, 0, GL_RED, GL_FLOAT, GLsizei(r.hostTileDepth.size() * sizeof(float)), r.hostTileDepth.data());
+        r.tileHost.resize(r.hostTileDepth.size());
+        for (std::size_t t = 0; t < r.tileHost.size(); ++t) {
+            GLuint bits;
+            std::memcpy(&bits, &r.hostTileDepth[t], 4);
+            r.tileHost[t] = viewDepth(bits);
+        }
+    }
+    r.needs.resize(s.frontBegin - s.behindEnd);
+    for (std::size_t i = s.behindEnd; i < s.frontBegin; ++i) {
+        classify(splats[i]);
+        r.needs[i - s.behindEnd] = std::uint8_t(needs);
+    }
+    return s;
+}
+
+void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t begin, std::size_t end, const Camera& camera, unsigned layerTexture,
+                                    float cut, bool trimCorners, bool depthCut, const FragmentListTarget& target) {
     Impl& r = *mImpl;
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    if (splats.empty() || !layerTexture || !target.depthTexture) return;
+    end = std::min(end, all.size());
+    if (begin >= end || !layerTexture || !target.depthTexture) return;
+    const Splat* splats = all.data() + begin;
+    const std::size_t count = end - begin;
+    r.stats.splatsSectioned = count;
     // How many sections the frame needs: one more than the most surfaces on a pixel.
     GLuint maxSurfaces = 0;
     glGetNamedBufferSubData(r.counters, 6 * 4, 4, &maxSurfaces);
@@ -513,14 +858,14 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& splats, const Came
     glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     r.sizeSections({target.x + target.width, target.y + target.height}, prog->sections, target.depthTexture);
 
-    if (splats.size() > r.instanceCapacity) {
+    if (count > r.instanceCapacity) {
         if (r.instances) glDeleteBuffers(1, &r.instances);
-        r.instanceCapacity = std::max<std::size_t>(splats.size() + splats.size() / 2, 1024);
+        r.instanceCapacity = std::max<std::size_t>(count + count / 2, 1024);
         glCreateBuffers(1, &r.instances);
         glNamedBufferStorage(r.instances, GLsizeiptr(r.instanceCapacity * sizeof(Splat)), nullptr, GL_DYNAMIC_STORAGE_BIT);
         glVertexArrayVertexBuffer(r.vao, 0, r.instances, 0, sizeof(Splat));
     }
-    glNamedBufferSubData(r.instances, 0, GLsizeiptr(splats.size() * sizeof(Splat)), splats.data());
+    glNamedBufferSubData(r.instances, 0, GLsizeiptr(count * sizeof(Splat)), splats);
 
     GLenum bufs[kTransparentMaxSections];
     for (int k = 0; k < kTransparentMaxSections; ++k) bufs[k] = k < prog->sections ? GL_COLOR_ATTACHMENT0 + GLenum(k) : GL_NONE;
@@ -538,39 +883,84 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& splats, const Came
     glDepthFunc(GL_LEQUAL);
     glDepthMask(GL_FALSE);
     glDisable(GL_CULL_FACE);
-    glUseProgram(prog->id);
+    // Perspective with the cut: a polygon that crosses (or nearly) the eye
+    // plane takes the general variant (screen-covering, each fragment meets
+    // its ray with the splat plane), as in the splat pass: the vertex stage
+    // of the other variant drops it below 0.25 near, the CPU routes below
+    // 0.5 near (margin against float arithmetic).
+    const glm::vec3 eye = camera.eye(), fwd = camera.forward();
+    const float nearZ = camera.nearPlane(), extent = std::clamp(cut, 0.05f, 1.0f);
+    auto crossesEyePlane = [&](const Splat& sp) {
+        const float a = std::abs(glm::dot(sp.axisU, fwd)), b = std::abs(glm::dot(sp.axisV, fwd));
+        const float reach = trimCorners ? std::max(a + 0.41421356f * b, 0.41421356f * a + b) : a + b;
+        return !(glm::dot(sp.center - eye, fwd) - extent * reach >= 0.5f * nearZ); // also NaN
+    };
+    const bool general = partial && camera.perspective();
     const glm::mat4 vp = camera.proj * camera.view;
-    glUniformMatrix4fv(prog->uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
-    glUniform1i(prog->uOctagon, trimCorners ? 1 : 0);
-    glUniform1f(prog->uCut, std::clamp(cut, 0.05f, 1.0f));
-    glUniform2i(prog->uOrigin, target.x, target.y);
+    const glm::mat4 invProj = glm::inverse(camera.proj), invVp = glm::inverse(vp);
+    const std::size_t variant = std::size_t(prog - &r.sectionPrograms[partial][0]);
+    const Impl::SectionProgram* generalProg = &r.sectionPrograms[2][variant];
+    auto setUniforms = [&](const Impl::SectionProgram& p) {
+        glUseProgram(p.id);
+        glUniformMatrix4fv(p.uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
+        glUniform1i(p.uOctagon, trimCorners ? 1 : 0);
+        glUniform1f(p.uCut, extent);
+        glUniform2i(p.uOrigin, target.x, target.y);
+        if (!partial) return;
+        glUniform3f(p.uEye, eye.x, eye.y, eye.z);
+        glUniform3f(p.uForward, fwd.x, fwd.y, fwd.z);
+        glUniform1f(p.uNearZ, nearZ);
+        glUniform1i(p.uPersp, camera.perspective() ? 1 : 0);
+        glUniform1f(p.uKernelRadius, r.kernelRadius);
+        glUniform4f(p.uDepthToView, invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+        glUniformMatrix4fv(p.uInvViewProj, 1, GL_FALSE, glm::value_ptr(invVp));
+        glUniform4f(p.uViewport, float(target.x), float(target.y), float(target.width), float(target.height));
+    };
     if (partial) {
-        const glm::vec3 eye = camera.eye(), fwd = camera.forward();
-        const glm::mat4 invProj = glm::inverse(camera.proj);
-        glUniform3f(prog->uEye, eye.x, eye.y, eye.z);
-        glUniform3f(prog->uForward, fwd.x, fwd.y, fwd.z);
-        glUniform1f(prog->uNearZ, camera.nearPlane());
-        glUniform1i(prog->uPersp, camera.perspective() ? 1 : 0);
-        glUniform1f(prog->uKernelRadius, r.kernelRadius);
-        glUniform4f(prog->uDepthToView, invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
         glBindTextureUnit(1, target.depthTexture);
         glBindTextureUnit(3, r.partial.texture());
-        // The vertex shader drops a polygon that crosses the eye plane (the
-        // splat pass draws those with its general variant; not here): counted.
-        std::uint64_t crossing = 0;
-        const float nearZ = camera.nearPlane(), extent = std::clamp(cut, 0.05f, 1.0f);
-        if (camera.perspective())
-            for (const Splat& sp : splats) {
-                const float a = std::abs(glm::dot(sp.axisU, fwd)), b = std::abs(glm::dot(sp.axisV, fwd));
-                const float reach = trimCorners ? std::max(a + 0.41421356f * b, 0.41421356f * a + b) : a + b;
-                if (!(glm::dot(sp.center - eye, fwd) - extent * reach >= 0.25f * nearZ)) ++crossing;
-            }
-        r.stats.eyeCrossing = crossing;
     }
     glBindTextureUnit(0, layerTexture);
     glBindTextureUnit(2, r.depths);
     glBindVertexArray(r.vao);
-    glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, trimCorners ? 8 : 4, GLsizei(splats.size()));
+    // Runs in back-to-front order, each with its variant.
+    const GLsizei corners = trimCorners ? 8 : 4;
+    const Impl::SectionProgram* bound = nullptr;
+    std::uint64_t crossing = 0;
+    // Per splat: 4 general, else the cuts it needs (split(): 1 near, 2 host).
+    std::vector<std::uint8_t>& cls = r.classes;
+    cls.resize(count);
+    const bool planned = r.needs.size() == count;
+    for (std::size_t i = 0; i < count; ++i) cls[i] = general && crossesEyePlane(splats[i]) ? 4 : planned ? r.needs[i] : 3;
+    constexpr std::size_t kMerge = 24; // a shorter run takes the next one's cuts too rather than a draw of its own
+    for (std::size_t i = 0; i < count;) {
+        unsigned need = cls[i];
+        std::size_t j = i + 1;
+        for (;;) {
+            while (j < count && cls[j] == need) ++j;
+            if (j >= count || need == 4 || cls[j] == 4) break;
+            if (j - i < kMerge) { // a short run takes on the next splat's cuts, and the splat
+                need |= cls[j];
+                ++j;
+                continue;
+            }
+            // A long run absorbs a short run of splats that need less.
+            std::size_t k = j;
+            while (k < count && cls[k] == cls[j]) ++k;
+            if ((cls[j] & ~need) != 0 || k - j >= kMerge) break;
+            j = k;
+        }
+        const bool g = need == 4;
+        const Impl::SectionProgram* p = g ? generalProg : partial ? &r.sectionPrograms[Impl::cutKind(need)][variant] : prog;
+        if (!p->id) {
+            if (!r.buildSections(Impl::cutKind(need))) p = prog; // never expected: the full cut program is exact for any splat
+        }
+        if (p != bound) setUniforms(*p), bound = p;
+        glDrawArraysInstancedBaseInstance(GL_TRIANGLE_STRIP, 0, corners, GLsizei(j - i), GLuint(i));
+        if (g) crossing += j - i;
+        i = j;
+    }
+    r.stats.generalSplats = crossing;
 }
 
 void FragmentListPass::resolve(const FragmentListTarget& target) {
@@ -579,11 +969,37 @@ void FragmentListPass::resolve(const FragmentListTarget& target) {
     GLuint maxSurfaces = 0;
     glGetNamedBufferSubData(r.counters, 6 * 4, 4, &maxSurfaces);
     GLuint program = r.resolvePrograms.back().second;
+    int programK = r.resolvePrograms.back().first;
     for (const auto& rp : r.resolvePrograms)
         if (GLuint(rp.first) >= maxSurfaces) {
             program = rp.second;
+            programK = rp.first;
             break;
         }
+    // Every pixel's list fits the variant (nothing to merge, so nothing to
+    // count): one full-screen draw resolves and composites at once. A
+    // compute dispatch costs llvmpipe several times a draw per pixel, and
+    // the RGBA16F image between the two goes.
+    const GLuint fragmentProgram = GLuint(programK) >= maxSurfaces && r.poolViewed ? r.fragmentResolve(programK) : 0;
+    if (fragmentProgram) {
+        glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+        glViewport(target.x, target.y, target.width, target.height);
+        glEnable(GL_BLEND);
+        glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+        glBlendEquation(GL_FUNC_ADD);
+        glDisable(GL_DEPTH_TEST);
+        glDepthMask(GL_FALSE);
+        glUseProgram(fragmentProgram);
+        glUniform1i(glGetUniformLocation(fragmentProgram, "uSectionCount"), r.sectionsThisFrame);
+        glUniform2i(glGetUniformLocation(fragmentProgram, "uOrigin"), target.x, target.y);
+        glUniform2i(glGetUniformLocation(fragmentProgram, "uSize"), target.width, target.height);
+        if (r.sectionsThisFrame > 0) glBindTextureUnit(1, r.sections);
+        glBindTextureUnit(2, r.heads);
+        glBindTextureUnit(4, r.poolView);
+        glBindVertexArray(r.emptyVao);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glBindTextureUnit(4, 0);
+    } else {
     glUseProgram(program);
     glUniform1i(glGetUniformLocation(program, "uSectionCount"), r.sectionsThisFrame);
     glUniform2i(glGetUniformLocation(program, "uOrigin"), target.x, target.y);
@@ -607,6 +1023,7 @@ void FragmentListPass::resolve(const FragmentListTarget& target) {
     glBindTextureUnit(1, r.resolved);
     glBindVertexArray(r.emptyVao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
+    }
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     GLuint c[kCounterWords] = {};
     glGetNamedBufferSubData(r.counters, 0, sizeof(c), c);
@@ -619,12 +1036,13 @@ void FragmentListPass::resolve(const FragmentListTarget& target) {
     r.stats.sections = r.sectionsThisFrame;
     r.stats.bytes = std::size_t(r.depthSize.x) * r.depthSize.y * 4 * std::size_t(r.depthLayers) /* sorted depths */ + r.poolNodes * kTransparentNodeBytes + std::size_t(r.width) * r.height * kTransparentHeadBytesPerPixel +
                     std::size_t(kCounterBytes) + std::size_t(r.width) * r.height * 8 /* resolved RGBA16F */ +
-                    std::size_t(r.sectionSize.x) * r.sectionSize.y * kTransparentSectionBytesPerPixel * std::size_t(r.sectionLayers);
+                    std::size_t(r.sectionSize.x) * r.sectionSize.y * kTransparentSectionBytesPerPixel * std::size_t(r.sectionLayers) +
+                    std::size_t(r.tileSize.x) * std::size_t(r.tileSize.y) * 16 /* the survey's tiles (RGBA32UI) */ +
+                    std::size_t(r.hostTileSize.x) * std::size_t(r.hostTileSize.y) * 4 /* the host depth tiles (R32F) */;
     // Leave nothing of ours bound where the host's own buffers may live.
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTransparentNodeBinding, 0);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTransparentCounterBinding, 0);
     glBindImageTexture(kTransparentHeadImageUnit, 0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
-    glBindImageTexture(kTransparentCountImageUnit, 0, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glBindTextureUnit(1, 0);
     glBindTextureUnit(2, 0);
     glBindTextureUnit(3, 0);

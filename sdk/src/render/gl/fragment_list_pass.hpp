@@ -5,9 +5,13 @@
 // Fig. 1: "the volume to be rendered must be broken into sections that lie
 // between, in front of, and behind the a-buffer fragments"):
 //  1. the host's transparent fragments are appended to one linked list per
-//     pixel (head image + node pool, transparentGlsl()), counting the
-//     surfaces per pixel and the most on any pixel;
-//  2. every splat fragment walks its pixel's surface list: the surfaces
+//     pixel (head image + node pool, transparentGlsl()); a survey of the
+//     lists then finds, per 16 x 16 tile, the surfaces' depth range, the
+//     nearest host depth and the most surfaces on a pixel (read back);
+//  1b. split(): the splats behind every surface they cover, and those in
+//     front of every one, need no sections (the frame renderer draws them
+//     with the ordinary splat pass before and after the resolve);
+//  2. every other splat fragment walks its pixel's surface list: the surfaces
 //     wholly in front of it give its section index, the ones that cut it
 //     split it into consecutive sections, each weighted by the fraction of
 //     the kernel's line integral it holds (sectionFraction in the shader:
@@ -21,16 +25,21 @@
 //     image).
 //
 // Memory: a pool of width * height * fragmentsPerPixel surface nodes (16
-// bytes) shared by all pixels, 8 bytes of head and count per pixel, and one
-// RGBA16F target per section in use (2, 4 or 8, from the most surfaces on a
-// pixel: 1 pane takes 2). A surface fragment that finds the pool full is
+// bytes) shared by all pixels, 4 bytes of list head per pixel, 16 per tile
+// for the survey, and one RGBA16F target per section in use (none when no
+// splat needs sections, else 2, 4 or 8, from the most surfaces on a pixel:
+// 1 pane takes 2). A surface fragment that finds the pool full is
 // blended by the host directly (the include returns its colour) and counted;
 // a pixel with more surfaces than fragmentsPerPixel keeps the nearest ones
 // and merges the farthest into its last slot (counted); splat fragments
 // behind more than 7 surfaces go into the last section (counted).
 //
+// A splat whose polygon crosses the eye plane (the camera inside its
+// kernel) takes the general variant, as in the splat pass.
+//
 // It does not draw tetrahedra, work at reduced resolution or fog the splat
-// sections (the frame renderer takes the ordered blend then and says why).
+// sections (the frame renderer takes the ordered blend then and says why;
+// with a fog, only for the splats that would need sections).
 #pragma once
 
 #include <cstddef>
@@ -62,7 +71,10 @@ struct FragmentListStats {
     std::uint64_t overflowPixels = 0;   // pixels with more nodes than fragmentsPerPixel
     std::uint64_t mergedNodes = 0;      // nodes merged into a pixel's farthest slot
     bool cut = false;                   // the sections were weighted by the kernel's partial line integral
-    std::uint64_t eyeCrossing = 0;      // splats whose polygon crosses the eye plane: not drawn by this pass
+    std::uint64_t generalSplats = 0;    // sectioned splats whose polygon crosses the eye plane: drawn with the general (screen-covering) variant
+    std::uint64_t splatsBehind = 0;     // split(): splats behind every surface they cover (ordinary pass, before the resolve)
+    std::uint64_t splatsFront = 0;      // split(): splats in front of every surface they cover (ordinary pass, after it)
+    std::uint64_t splatsSectioned = 0;  // splats drawn into the section targets
     std::size_t bytes = 0;              // GPU bytes of the pool, heads, counts, counters and the section targets in use
     std::size_t poolNodes = 0;          // capacity of the pool
 };
@@ -83,14 +95,29 @@ public:
     // target's framebuffer bound, premultiplied "over" blending, depth test
     // LEQUAL without writes.
     Status collectSurfaces(const FragmentListTarget& target, const std::function<void()>& drawSurfaces);
-    // Composites the splats (sorted back to front) into their sections.
+    // After collectSurfaces: the sorted splats (back to front) as three runs.
+    // [0, behindEnd) lie behind every surface stored on every pixel they may
+    // cover, [frontBegin, size) in front of every one, the rest between.
+    // On every pixel the first run falls into the last section and the last
+    // run into the first, so drawing the first run over the opaque image
+    // before the resolve and the last run over the result after it gives
+    // what the sections give ("over" is associative, the runs keep the
+    // back-to-front order): the frame renderer draws both with the ordinary
+    // splat pass, and only the middle run needs the section pass. Conservative
+    // (per 16 x 16 tile and with the kernel's whole reach along the rays, 1 %
+    // margin). One GPU sync: the tiles' surface depth range is read back.
+    struct Split {
+        std::size_t behindEnd = 0, frontBegin = 0;
+    };
+    Split split(const std::vector<Splat>& splats, const Camera& camera, float cut, bool trimCorners, bool depthCut, const FragmentListTarget& target);
+    // Composites the splats [begin, end) (sorted back to front) into their sections.
     // layerTexture: the splat pass's GL_TEXTURE_2D_ARRAY; cut, trimCorners:
     // RendererDesc's. Reads the surface counters back first (one GPU sync)
     // to choose how many section targets the frame needs.
     // depthCut (RendererDesc::depthCut): sections weighted by the kernel's
     // partial line integral and cut at the near plane and the host depth;
     // false: the kernel as a step at its plane.
-    void insertSplats(const std::vector<Splat>& splats, const Camera& camera, unsigned layerTexture, float cut, bool trimCorners, bool depthCut,
+    void insertSplats(const std::vector<Splat>& splats, std::size_t begin, std::size_t end, const Camera& camera, unsigned layerTexture, float cut, bool trimCorners, bool depthCut,
                       const FragmentListTarget& target);
     // Sorts every pixel's surfaces, interleaves the sections, composites
     // over the framebuffer, unbinds the lists, reads the counters back.

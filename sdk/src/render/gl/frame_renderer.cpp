@@ -158,13 +158,16 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
             glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &name);
         listDepth = unsigned(name);
     }
-    const bool splatsInLists = lists && r.full && !anyTets && !fog && listDepth != 0;
+    // With a fog the splats still go through the split (the ordinary pass
+    // fogs each fragment); only the ones that meet a surface cannot be
+    // sectioned (fogged sections are not implemented): they take the
+    // ordered blend under the surfaces, and the frame says so.
+    const bool splatsInLists = lists && r.full && !anyTets && listDepth != 0;
     r.stats.transparentLists = lists;
     r.stats.splatsInLists = splatsInLists;
     r.stats.transparentNote = !lists || splatsInLists ? std::string()
                               : !r.full              ? "reduced resolution: the splats take the ordered blend under the surfaces"
                               : anyTets              ? "tetrahedra in the frame: the volumes take the ordered blend under the surfaces"
-                              : fog                  ? "fog: the splats take the ordered blend under the surfaces (fogged sections not implemented)"
                                                      : "no host depth texture (HostTarget::depthTexture or a texture depth attachment): "
                                                        "the splats take the ordered blend under the surfaces";
     // ---- end (issue 15) ----
@@ -198,12 +201,34 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
                                             .depthTexture = listDepth};
         const Status s = r.lists->collectSurfaces(lt, target.drawTransparent);
         if (s) {
+            detail::FragmentListPass::Split split{};
+            const std::vector<Splat>& all = frame.splats();
+            // The splats behind every surface they cover, and those in front
+            // of every one, take the ordinary splat pass (before and after
+            // the resolve: FragmentListPass::split); the rest, sections.
+            auto ordinary = [&](std::size_t begin, std::size_t end) {
+                if (begin >= end) return;
+                r.batch.assign(all.begin() + std::ptrdiff_t(begin), all.begin() + std::ptrdiff_t(end));
+                r.full->draw(r.batch, camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
+                                               .depthTexture = target.depthTexture});
+                r.stats.drawCalls += r.full->stats().drawCalls;
+            };
             if (splatsInLists) {
-                r.lists->insertSplats(frame.splats(), camera, r.full->layerTexture(), r.desc.splats.footprintCut, r.desc.splats.trimCorners,
-                                      r.desc.splats.depthCut, lt);
-                r.stats.drawCalls = frame.splats().empty() ? 0 : 1;
+                r.stats.drawCalls = 0;
+                split = r.lists->split(all, camera, r.desc.splats.footprintCut, r.desc.splats.trimCorners, r.desc.splats.depthCut, lt);
+                if (fog && split.frontBegin > split.behindEnd) {
+                    ordinary(0, split.frontBegin);
+                    r.stats.transparentNote = "fog: " + std::to_string(split.frontBegin - split.behindEnd) +
+                                              " splats that meet a surface take the ordered blend under the surfaces (fogged sections not implemented)";
+                } else {
+                    ordinary(0, split.behindEnd);
+                    r.lists->insertSplats(all, split.behindEnd, split.frontBegin, camera, r.full->layerTexture(), r.desc.splats.footprintCut,
+                                          r.desc.splats.trimCorners, r.desc.splats.depthCut, lt);
+                    if (split.frontBegin > split.behindEnd) ++r.stats.drawCalls;
+                }
             }
             r.lists->resolve(lt);
+            if (splatsInLists) ordinary(split.frontBegin, all.size());
         } else {
             r.stats.transparentNote = s.error();
         }
@@ -216,7 +241,10 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         r.stats.transparentMaxSurfaces = ls.maxSurfaces;
         r.stats.transparentSections = ls.sections;
         r.stats.transparentCut = ls.cut;
-        r.stats.transparentEyeCrossing = ls.eyeCrossing;
+        r.stats.transparentGeneral = ls.generalSplats;
+        r.stats.transparentSplatsBehind = ls.splatsBehind;
+        r.stats.transparentSplatsFront = ls.splatsFront;
+        r.stats.transparentSplatsSectioned = ls.splatsSectioned;
         r.stats.transparentBytes = ls.bytes;
         if (r.desc.splats.restoreState) saved.restore();
     } else if (target.drawTransparent) {
