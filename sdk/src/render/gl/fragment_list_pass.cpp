@@ -387,6 +387,15 @@ void main() {
 }
 )";
 
+// A per-tile texture of `tiles` texels in `format`, (re)made when the target's tile grid changes.
+void fitTileTexture(GLuint& texture, glm::ivec2& size, glm::ivec2 tiles, GLenum format) {
+    if (texture && size == tiles) return;
+    if (texture) glDeleteTextures(1, &texture);
+    glCreateTextures(GL_TEXTURE_2D, 1, &texture);
+    glTextureStorage2D(texture, 1, format, tiles.x, tiles.y);
+    size = tiles;
+}
+
 } // namespace
 
 struct FragmentListPass::Impl {
@@ -676,12 +685,7 @@ Status FragmentListPass::collectSurfaces(const FragmentListTarget& target, const
     // The survey of the lists (kTileRangeCompute).
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     const int tilesX = (target.width + kRangeTile - 1) / kRangeTile, tilesY = (target.height + kRangeTile - 1) / kRangeTile;
-    if (!r.tileRange || r.tileSize != glm::ivec2(tilesX, tilesY)) {
-        if (r.tileRange) glDeleteTextures(1, &r.tileRange);
-        glCreateTextures(GL_TEXTURE_2D, 1, &r.tileRange);
-        glTextureStorage2D(r.tileRange, 1, GL_RGBA32UI, tilesX, tilesY);
-        r.tileSize = {tilesX, tilesY};
-    }
+    fitTileTexture(r.tileRange, r.tileSize, {tilesX, tilesY}, GL_RGBA32UI);
     glUseProgram(r.rangeProgram);
     glUniform2i(glGetUniformLocation(r.rangeProgram, "uSize"), target.width, target.height);
     glUniform2i(glGetUniformLocation(r.rangeProgram, "uTiles"), tilesX, tilesY);
@@ -783,12 +787,7 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
     // no splat to section do not pay for it).
     r.tileHost.clear();
     if (s.frontBegin > s.behindEnd && depthCut && target.depthTexture) {
-        if (!r.hostTiles || r.hostTileSize != glm::ivec2(tilesX, tilesY)) {
-            if (r.hostTiles) glDeleteTextures(1, &r.hostTiles);
-            glCreateTextures(GL_TEXTURE_2D, 1, &r.hostTiles);
-            glTextureStorage2D(r.hostTiles, 1, GL_R32F, tilesX, tilesY);
-            r.hostTileSize = {tilesX, tilesY};
-        }
+        fitTileTexture(r.hostTiles, r.hostTileSize, {tilesX, tilesY}, GL_R32F);
         glUseProgram(r.hostTileProgram);
         glUniform2i(glGetUniformLocation(r.hostTileProgram, "uSize"), target.width, target.height);
         glUniform2i(glGetUniformLocation(r.hostTileProgram, "uTiles"), tilesX, tilesY);
