@@ -16,6 +16,7 @@
 
 #include <epoxy/gl.h>
 
+#include "bench_stats.hpp"
 #include "commands.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/gl/framebuffer.hpp"
@@ -24,6 +25,7 @@
 
 namespace {
 
+using bench::median;
 using Clock = std::chrono::steady_clock;
 
 struct Knobs {
@@ -44,10 +46,6 @@ struct View {
     splatfx::Image exact; // the finest level, no table, RGBA premultiplied over black
 };
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v.empty() ? 0.0 : v[v.size() / 2];
-}
 
 // The ray through a pixel centre (x right, y top row first, as Framebuffer::read orders rows).
 glm::dvec3 pixelRay(const splatfx::Camera& cam, int x, int y) {

@@ -16,6 +16,7 @@
 
 #include <epoxy/gl.h>
 
+#include "bench_stats.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/gl/framebuffer.hpp"
@@ -26,6 +27,7 @@
 
 namespace {
 
+using bench::percentile;
 using Clock = std::chrono::steady_clock;
 double ms(Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
 
@@ -41,11 +43,6 @@ struct Options {
     glm::ivec2 probe{-1};      // --probe X Y: print the exact ray integral (integrateRay) of that pixel per frame and mode
 };
 
-double percentile(std::vector<double> v, double p) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    return v[std::min(v.size() - 1, std::size_t(p * double(v.size() - 1) + 0.5))];
-}
 
 int usage() {
     std::printf("usage: splatfx-bench groundfog [--dem FILE.pgm] [--size W H] [--frames N] [--step WORLD_PER_FRAME]\n"

@@ -13,6 +13,7 @@
 
 #include <epoxy/gl.h>
 
+#include "bench_stats.hpp"
 #include "cli.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
@@ -23,6 +24,7 @@
 
 namespace {
 
+using bench::median;
 using Clock = std::chrono::steady_clock;
 
 // Effects are simulated and drawn up to this far from the camera (world units).
@@ -79,10 +81,6 @@ double frameCost(splatfx::Scene& scene, splatfx::Materials& m, int frames, doubl
     return t[t.size() / 2];
 }
 
-double median(std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-}
 
 } // namespace
 
