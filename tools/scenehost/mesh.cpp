@@ -34,6 +34,15 @@ namespace {
 // refused when it exceeds the budget, or when the file is too short to hold
 // that many elements at their smallest encoding (ASCII "0 0 0\n" is 6 bytes a
 // vertex, binary is 12; a face is at least 4 bytes either way).
+// The OFF keyword with its optional prefixes (ST, C, N, 4, n: texture, colour,
+// normals, homogeneous, dimension), as assimp's OFF reader accepts it.
+bool isOffKeyword(const std::string& word) {
+    std::size_t i = word.rfind("ST", 0) == 0 ? 2 : 0;
+    for (char prefix : {'C', 'N', '4', 'n'})
+        if (i < word.size() && word[i] == prefix) ++i;
+    return word.compare(i, std::string::npos, "OFF") == 0;
+}
+
 splatfx::Status checkHeaderCounts(const std::string& path, std::uintmax_t fileBytes, const splatfx::Budgets& budgets) {
     std::ifstream in(path, std::ios::binary);
     std::string line;
@@ -65,12 +74,13 @@ splatfx::Status checkHeaderCounts(const std::string& path, std::uintmax_t fileBy
             ended = line == "end_header";
         }
         if (!ended) return splatfx::makeError(path + ": the PLY header has no \"end_header\" line in its first 64 KiB (truncated or not a PLY file)");
-    } else if (line.find("OFF") != std::string::npos || ext == ".off") {
+    } else if (isOffKeyword(line.substr(0, line.find_first_of(" \t"))) || ext == ".off") {
         // assimp reads an OFF's counts as the first numbers after the keyword, across line
         // breaks (a count alone on a later line is still the face count: found by fuzz_mesh).
         // The first three numbers (vertices, faces, edges; nOFF puts its dimension first) are
         // read the same way, each saturating, so no count assimp would allocate from escapes.
-        std::string head = line.substr(std::min(line.find("OFF") == std::string::npos ? 0 : line.find("OFF") + 3, line.size()));
+        const std::size_t keyword = line.find("OFF");
+        std::string head = keyword == std::string::npos ? line : line.substr(keyword + 3);
         for (std::string more; head.size() < 4096 && std::getline(in, more);) head += "\n" + more;
         std::uint64_t numbers[3] = {};
         int found = 0;
