@@ -1,5 +1,6 @@
 // Reading images refuses what could hang or exhaust memory (issue 13), with
 // messages naming the file and the reason.
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 
@@ -176,6 +177,43 @@ TEST(ImageRead, AGifClaimingAHugeScreenIsRefusedBeforeTheDecoderSeesIt) {
     gif += std::string("\x3b", 1);             // trailer
     std::ofstream(p, std::ios::binary) << gif;
     expectRefused(p.string(), "GIF logical screen claims 25964x19827 pixels, over the image budget");
+}
+
+// OpenImageIO 2.4 decodes a run-length BMP when it is opened, into a buffer
+// sized from the header: RLE8 runs at 24 bits a pixel threw length_error
+// through open (found by tools/fuzz.sh in CI; the input is a fuzz regression).
+static std::string bmpHeader(std::int32_t w, std::int32_t h, std::uint16_t bpp, std::uint32_t compression) {
+    auto le = [](std::uint64_t v, int bytes) {
+        std::string out;
+        for (int i = 0; i < bytes; ++i) out += char((v >> (8 * i)) & 0xff);
+        return out;
+    };
+    std::string b = "BM" + le(14 + 40 + 64, 4) + le(0, 4) + le(14 + 40, 4);
+    b += le(40, 4) + le(std::uint32_t(w), 4) + le(std::uint32_t(h), 4) + le(1, 2) + le(bpp, 2) + le(compression, 4);
+    b += le(0, 4) + le(2835, 4) + le(2835, 4) + le(0, 4) + le(0, 4);
+    return b + std::string(64, '\0');
+}
+
+TEST(ImageRead, ABmpWhoseRunLengthDepthOrSizeIsImpossibleIsRefusedBeforeTheDecoder) {
+    const fs::path rle = dir() / "rle24.bmp", huge = dir() / "huge.bmp", flat = dir() / "flat.bmp";
+    std::ofstream(rle, std::ios::binary) << bmpHeader(8, 6, 24, 1);
+    std::ofstream(huge, std::ios::binary) << bmpHeader(536870920, 6, 24, 0);
+    std::ofstream(flat, std::ios::binary) << bmpHeader(8, 0, 24, 0);
+    expectRefused(rle.string(), "BMP claims RLE8 compression with 24 bits per pixel");
+    expectRefused(huge.string(), "BMP claims 536870920x6 pixels, over the image budget");
+    expectRefused(flat.string(), "BMP claims 8x0 pixels");
+}
+
+TEST(ImageRead, ABmpWithinTheBudgetsStillReads) {
+    const fs::path p = dir() / "small.bmp";
+    Image img;
+    img.width = 6, img.height = 4, img.channels = 3;
+    img.pixels.assign(6 * 4 * 3, 1.0f);
+    ASSERT_TRUE(writeImage(p.string(), img));
+    auto back = readImage(p.string());
+    ASSERT_TRUE(back) << back.error();
+    EXPECT_EQ(back->width, 6);
+    EXPECT_EQ(back->height, 4);
 }
 
 TEST(ImageRead, AGifWithinTheBudgetsStillReads) {

@@ -44,6 +44,7 @@ std::int64_t linesPerChunk(unsigned char compression) {
 
 Status checkExrHeader(const std::string& path);
 Status checkGifHeader(const std::string& path);
+Status checkBmpHeader(const std::string& path);
 
 bool looksLikeExr(const unsigned char* head, std::size_t size) {
     return size >= 4 && head[0] == 0x76 && head[1] == 0x2f && head[2] == 0x31 && head[3] == 0x01;
@@ -170,8 +171,41 @@ Status checkGifHeader(const std::string& path) {
     return {};
 }
 
+Status checkBmpHeader(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    unsigned char buf[34] = {};
+    in.read(reinterpret_cast<char*>(buf), std::streamsize(sizeof buf));
+    const std::size_t n = std::size_t(in.gcount());
+    if (n < 2 || buf[0] != 'B' || buf[1] != 'M') return {};
+    const std::string what = "cannot read image '" + path + "': BMP ";
+    auto u16 = [&](std::size_t at) { return std::uint32_t(buf[at]) | std::uint32_t(buf[at + 1]) << 8; };
+    auto u32 = [&](std::size_t at) { return u16(at) | u16(at + 2) << 16; };
+    if (n < 18) return makeError(what + "header is truncated");
+    std::int64_t w = 0, h = 0;
+    std::uint32_t bpp = 0, compression = 0;
+    if (u32(14) == 12) { // OS/2 core header: 16-bit sizes, no compression
+        if (n < 26) return makeError(what + "header is truncated");
+        w = u16(18), h = u16(20), bpp = u16(24);
+    } else {
+        if (n < 34) return makeError(what + "header is truncated");
+        w = std::int32_t(u32(18)), h = std::int32_t(u32(22)), bpp = u16(28), compression = u32(30);
+    }
+    const std::int64_t rows = h < 0 ? -h : h; // negative height: rows stored top down
+    if (w <= 0 || rows == 0) return makeError(what + "claims " + std::to_string(w) + "x" + std::to_string(h) + " pixels");
+    if (w > kMaxImageSide || rows > kMaxImageSide || w * rows > kMaxImagePixels)
+        return makeError(what + "claims " + std::to_string(w) + "x" + std::to_string(rows) + " pixels, over the image budget (" +
+                         std::to_string(kMaxImageSide) + " on a side, " + std::to_string(kMaxImagePixels) + " in all)");
+    // Run-length data is 8 or 4 bits a pixel by definition; OpenImageIO 2.4 decodes any other
+    // depth's runs into a buffer it sizes wrongly (a length_error thrown through open).
+    if ((compression == 1 && bpp != 8) || (compression == 2 && bpp != 4))
+        return makeError(what + "claims RLE" + std::string(compression == 1 ? "8" : "4") + " compression with " + std::to_string(bpp) +
+                         " bits per pixel");
+    return {};
+}
+
 Status checkImageHeader(const std::string& path) {
     if (Status s = checkExrHeader(path); !s) return s;
+    if (Status s = checkBmpHeader(path); !s) return s;
     return checkGifHeader(path);
 }
 

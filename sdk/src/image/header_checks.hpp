@@ -10,6 +10,10 @@
 //  - OpenImageIO's GIF reader allocates its canvas from the logical screen
 //    size: a 68-byte GIF claiming 25964x19827 costs 2 GB. The screen and every
 //    image descriptor are checked.
+//  - OpenImageIO's BMP reader decodes run-length images when the file is
+//    opened, into a buffer sized from the header: an 87-byte BMP claiming
+//    RLE8 data at 24 bits a pixel threw std::length_error through open. The
+//    size and the compression's pixel depth are checked.
 #pragma once
 
 #include <cstddef>
@@ -26,7 +30,7 @@ namespace splatfx::detail {
 inline constexpr std::uint64_t kMaxExrChunks = 1ull << 22;
 
 bool looksLikeExr(const unsigned char* head, std::size_t size);
-// OK for a file that is neither OpenEXR nor GIF (the decoders judge it), or
+// OK for a file that is neither OpenEXR, BMP nor GIF (the decoders judge it), or
 // one whose header's claims are within the budgets; otherwise why not.
 Status checkImageHeader(const std::string& path);
 
