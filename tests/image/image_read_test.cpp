@@ -204,8 +204,9 @@ TEST(ImageRead, ABmpWhoseRunLengthDepthOrSizeIsImpossibleIsRefusedBeforeTheDecod
     expectRefused(flat.string(), "BMP claims 8x0 pixels");
 }
 
-TEST(ImageRead, ABmpWithinTheBudgetsStillReads) {
-    const fs::path p = dir() / "small.bmp";
+// A small image of a checked format written by OpenImageIO reads back whole.
+static void expectSmallImageReads(const std::string& name) {
+    const fs::path p = dir() / name;
     Image img;
     img.width = 6, img.height = 4, img.channels = 3;
     img.pixels.assign(6 * 4 * 3, 1.0f);
@@ -216,14 +217,6 @@ TEST(ImageRead, ABmpWithinTheBudgetsStillReads) {
     EXPECT_EQ(back->height, 4);
 }
 
-TEST(ImageRead, AGifWithinTheBudgetsStillReads) {
-    const fs::path p = dir() / "small.gif";
-    Image img;
-    img.width = 6, img.height = 4, img.channels = 3;
-    img.pixels.assign(6 * 4 * 3, 1.0f);
-    ASSERT_TRUE(writeImage(p.string(), img));
-    auto back = readImage(p.string());
-    ASSERT_TRUE(back) << back.error();
-    EXPECT_EQ(back->width, 6);
-    EXPECT_EQ(back->height, 4);
-}
+TEST(ImageRead, ABmpWithinTheBudgetsStillReads) { expectSmallImageReads("small.bmp"); }
+
+TEST(ImageRead, AGifWithinTheBudgetsStillReads) { expectSmallImageReads("small.gif"); }
