@@ -95,6 +95,24 @@ struct GeometryRenderer::Impl {
         if (program) glDeleteProgram(program);
         if (transparentProgram) glDeleteProgram(transparentProgram);
     }
+    // (Re)places an object's buffers: interleaved position + normal, triangle indices.
+    static void upload(Object& o, const std::vector<float>& interleaved, const std::vector<std::uint32_t>& indices) {
+        glDeleteBuffers(1, &o.vbo);
+        glDeleteBuffers(1, &o.ibo);
+        if (!o.vao) glCreateVertexArrays(1, &o.vao);
+        glCreateBuffers(1, &o.vbo);
+        glCreateBuffers(1, &o.ibo);
+        if (!interleaved.empty()) glNamedBufferStorage(o.vbo, GLsizeiptr(interleaved.size() * sizeof(float)), interleaved.data(), 0);
+        if (!indices.empty()) glNamedBufferStorage(o.ibo, GLsizeiptr(indices.size() * sizeof(std::uint32_t)), indices.data(), 0);
+        glVertexArrayVertexBuffer(o.vao, 0, o.vbo, 0, 6 * sizeof(float));
+        glVertexArrayElementBuffer(o.vao, o.ibo);
+        for (GLuint a = 0; a < 2; ++a) {
+            glEnableVertexArrayAttrib(o.vao, a);
+            glVertexArrayAttribFormat(o.vao, a, 3, GL_FLOAT, GL_FALSE, a * 3 * sizeof(float));
+            glVertexArrayAttribBinding(o.vao, a, 0);
+        }
+        o.indexCount = GLsizei(indices.size());
+    }
 };
 
 splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<splatfx::GeometryDesc>& geometry, const splatfx::Budgets& budgets) {
@@ -148,19 +166,7 @@ splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<spl
             const glm::vec3 p = mesh.positions[i], n = mesh.normals[i];
             interleaved.insert(interleaved.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
         }
-        glCreateVertexArrays(1, &o.vao);
-        glCreateBuffers(1, &o.vbo);
-        glCreateBuffers(1, &o.ibo);
-        glNamedBufferStorage(o.vbo, GLsizeiptr(interleaved.size() * sizeof(float)), interleaved.data(), 0);
-        glNamedBufferStorage(o.ibo, GLsizeiptr(mesh.indices.size() * sizeof(std::uint32_t)), mesh.indices.data(), 0);
-        glVertexArrayVertexBuffer(o.vao, 0, o.vbo, 0, 6 * sizeof(float));
-        glVertexArrayElementBuffer(o.vao, o.ibo);
-        for (GLuint a = 0; a < 2; ++a) {
-            glEnableVertexArrayAttrib(o.vao, a);
-            glVertexArrayAttribFormat(o.vao, a, 3, GL_FLOAT, GL_FALSE, a * 3 * sizeof(float));
-            glVertexArrayAttribBinding(o.vao, a, 0);
-        }
-        o.indexCount = GLsizei(mesh.indices.size());
+        Impl::upload(o, interleaved, mesh.indices);
         impl->objects.push_back(std::move(o));
     }
     return GeometryRenderer(std::move(impl));
@@ -197,21 +203,7 @@ void GeometryRenderer::setWorldTriangles(std::size_t i, const std::vector<glm::v
         }
     }
     for (std::size_t k = 0; k < indices.size(); ++k) indices[k] = std::uint32_t(k);
-    glDeleteBuffers(1, &o.vbo);
-    glDeleteBuffers(1, &o.ibo);
-    if (!o.vao) glCreateVertexArrays(1, &o.vao);
-    glCreateBuffers(1, &o.vbo);
-    glCreateBuffers(1, &o.ibo);
-    if (!interleaved.empty()) glNamedBufferStorage(o.vbo, GLsizeiptr(interleaved.size() * sizeof(float)), interleaved.data(), 0);
-    if (!indices.empty()) glNamedBufferStorage(o.ibo, GLsizeiptr(indices.size() * sizeof(std::uint32_t)), indices.data(), 0);
-    glVertexArrayVertexBuffer(o.vao, 0, o.vbo, 0, 6 * sizeof(float));
-    glVertexArrayElementBuffer(o.vao, o.ibo);
-    for (GLuint a = 0; a < 2; ++a) {
-        glEnableVertexArrayAttrib(o.vao, a);
-        glVertexArrayAttribFormat(o.vao, a, 3, GL_FLOAT, GL_FALSE, a * 3 * sizeof(float));
-        glVertexArrayAttribBinding(o.vao, a, 0);
-    }
-    o.indexCount = GLsizei(indices.size());
+    Impl::upload(o, interleaved, indices);
     o.worldSpace = true;
 }
 
