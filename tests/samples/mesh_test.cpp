@@ -1,8 +1,12 @@
 // The example host's mesh loader refuses hostile files cleanly (issue 13):
 // out-of-range indices, headers claiming more elements than the file can
 // hold or than the budget allows, and non-regular files.
+#include <chrono>
+#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
+#include <future>
+#include <unistd.h>
 #include <vector>
 
 #include <sys/stat.h>
@@ -93,6 +97,48 @@ TEST(SceneHostMesh, AFifoIsNotRead) {
     fs::remove(fifo);
     ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
     expectRefused(fifo, "not a regular file");
+}
+
+// Files a mesh names (an OBJ's mtllib here) are opened only when they are regular files in
+// the mesh's own folder. Each library named below is a FIFO, which would block the load
+// forever if it were opened: one beside the mesh, one in the folder above (a path that
+// escapes), one through a symlink beside the mesh. The mesh still loads, without them.
+TEST(SceneHostMesh, FilesAMeshNamesAreReadOnlyFromItsFolderAndOnlyIfRegular) {
+    const fs::path dir = fs::path(splatfx::test::outputDir()) / "confined";
+    fs::remove_all(dir);
+    fs::create_directories(dir / "mesh");
+    std::vector<std::string> fifos = {(dir / "mesh" / "beside.mtl").string(), (dir / "outside.mtl").string()};
+    for (const std::string& f : fifos) ASSERT_EQ(mkfifo(f.c_str(), 0600), 0) << f;
+    fs::create_symlink("../outside.mtl", dir / "mesh" / "link.mtl");
+    const std::string obj = (dir / "mesh" / "tri.obj").string();
+    std::ofstream(obj) << "mtllib beside.mtl\nmtllib ../outside.mtl\nmtllib link.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    auto load = std::async(std::launch::async, [&] { return scenehost::loadMesh(obj); });
+    if (load.wait_for(std::chrono::seconds(20)) != std::future_status::ready) {
+        // Unblock the reader (once for each FIFO it reaches) so the test fails instead of hanging.
+        while (load.wait_for(std::chrono::milliseconds(50)) != std::future_status::ready)
+            for (const std::string& f : fifos)
+                if (const int fd = open(f.c_str(), O_WRONLY | O_NONBLOCK); fd >= 0) close(fd);
+        FAIL() << "loading the mesh opened a FIFO it names";
+    }
+    auto m = load.get();
+    ASSERT_TRUE(m) << m.error();
+    EXPECT_EQ(m->indices.size(), 3u);
+}
+
+// assimp runs in a child process held to Budgets::meshImportBytes: this PLY (found by
+// fuzz_mesh) makes Debian's assimp 5.2 ask for 31.5 GB in one allocation. The load is an
+// error naming the file, and this process is untouched.
+TEST(SceneHostMesh, AFileThatMakesTheMeshLibraryAllocateWithoutBoundIsAnError) {
+    const std::string path = std::string(SPLATFX_SOURCE_DIR) + "/tests/fuzz/regressions/mesh/ply-31gb-allocation.ply";
+    splatfx::Budgets budgets;
+    budgets.meshImportBytes = 256ull << 20;
+    auto m = scenehost::loadMesh(path, budgets);
+    ASSERT_FALSE(m) << path << " loaded";
+    EXPECT_NE(m.error().find(path), std::string::npos) << m.error();
+    EXPECT_NE(m.error().find("memory budget of 268435456 bytes"), std::string::npos) << m.error();
+    // A good file still loads afterwards, in the same process.
+    auto good = scenehost::loadMesh(writeFile("after_bomb.ply", std::string(kPlyHeader) + "3 0 1 2\n"));
+    EXPECT_TRUE(good) << good.error();
 }
 
 // The "heightmap" geometry: every 16-bit sample becomes

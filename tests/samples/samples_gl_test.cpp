@@ -163,5 +163,8 @@ TEST_F(SamplesGL, LodGroundFogTerrainIsTheHostsTerrain) {
     ASSERT_TRUE(player->file().scene.groundFog(id).update(player->cameraAt(t, size), player->file().scene.groundFogOptions(id).refine, scratch, &tris));
     ASSERT_GT(tris.size(), 0u);
     EXPECT_EQ(player->geometry().stats().triangles, tris.size() / 3);
+    // The host drew the terrain prepare() refined (VolumeOptions::keepTerrain), not a second refinement.
+    EXPECT_TRUE(player->file().scene.groundFogOptions(id).keepTerrain);
+    EXPECT_EQ(player->file().scene.groundFogTerrain(id), tris);
     EXPECT_LT(tris.size() / 3, 2u * 200u * 170u) << "the 201x171 heightmap at full resolution";
 }

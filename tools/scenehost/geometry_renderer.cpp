@@ -1,7 +1,9 @@
 #include "geometry_renderer.hpp"
 
+#include <bit>
 #include <map>
 #include <string>
+#include <unordered_map>
 
 #include <epoxy/gl.h>
 
@@ -29,6 +31,20 @@ void main() {
 }
 )";
 
+// Two-sided shading, whatever the mesh's winding: the interpolated normal is
+// turned to the side of the triangle the eye sees (the triangle's own normal,
+// from the position's screen derivatives, decides). Testing the smooth normal
+// itself against the eye flips it wrongly near silhouettes, where it may lean
+// away from the eye on a triangle that faces it (dark specks on ridges).
+const char* kHostNormal = R"(
+vec3 twoSidedNormal(vec3 normal, vec3 world, vec3 eye) {
+    vec3 n = normalize(normal);
+    vec3 face = cross(dFdx(world), dFdy(world));
+    if (dot(face, eye - world) < 0.0) face = -face;
+    return dot(n, face) < 0.0 ? -n : n;
+}
+)";
+
 // The host's surface shader with the SDK's shadow include (shadowGlsl(),
 // lighting.hpp): the gas's shadow table, bound by gl::FrameRenderer for the
 // opaque hook, darkens the direct light on the ground and the objects.
@@ -41,9 +57,7 @@ uniform vec4 uLight;      // xyz: direction towards the light (w = 0) or its pos
 uniform vec3 uLightColor;
 out vec4 fragColor;
 void main() {
-    vec3 n = normalize(vNormal);
-    // Two-sided: face the normal towards the eye, whatever the mesh's winding.
-    if (dot(n, uEye - vWorld) < 0.0) n = -n;
+    vec3 n = twoSidedNormal(vNormal, vWorld, uEye);
     vec3 toLight = normalize(uLight.w == 0.0 ? uLight.xyz : uLight.xyz - vWorld);
     float diffuse = max(dot(n, toLight), 0.0) * splatfx_shadow(vWorld);
     vec3 lit = uColor * (0.25 + 0.75 * diffuse * uLightColor);
@@ -64,8 +78,7 @@ uniform vec4 uLight;
 uniform vec3 uLightColor;
 out vec4 fragColor;
 void main() {
-    vec3 n = normalize(vNormal);
-    if (dot(n, uEye - vWorld) < 0.0) n = -n;
+    vec3 n = twoSidedNormal(vNormal, vWorld, uEye);
     vec3 toLight = normalize(uLight.w == 0.0 ? uLight.xyz : uLight.xyz - vWorld);
     vec3 lit = uColor * (0.25 + 0.75 * max(dot(n, toLight), 0.0) * uLightColor);
     fragColor = splatfx_emitTransparent(vec4(lit * uOpacity, uOpacity), gl_FragCoord.z);
@@ -121,12 +134,12 @@ splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<spl
     auto impl = std::make_unique<Impl>();
     const std::string shadow = splatfx::shadowGlsl();
     splatfx::Result<GLuint> program =
-        splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n", shadow.c_str(), kFragmentBody}, "GeometryRenderer");
+        splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n", shadow.c_str(), kHostNormal, kFragmentBody}, "GeometryRenderer");
     if (!program) return splatfx::makeError(program.error());
     impl->program = *program;
     {
         const std::string include = splatfx::transparentGlsl();
-        auto tp = splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n", include.c_str(), kTransparentBody}, "GeometryRenderer (transparent)");
+        auto tp = splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n", include.c_str(), kHostNormal, kTransparentBody}, "GeometryRenderer (transparent)");
         if (!tp) return splatfx::makeError(tp.error());
         impl->transparentProgram = *tp;
     }
@@ -188,22 +201,38 @@ long GeometryRenderer::find(const std::string& name) const {
 
 void GeometryRenderer::setWorldTriangles(std::size_t i, const std::vector<glm::vec3>& triangles) {
     Impl::Object& o = mImpl->objects.at(i);
-    std::vector<float> interleaved;
-    interleaved.reserve(triangles.size() * 6);
-    std::vector<std::uint32_t> indices(triangles.size());
-    o.localBounds = {};
-    for (std::size_t k = 0; k + 2 < triangles.size(); k += 3) {
-        const glm::vec3 a = triangles[k], b = triangles[k + 1], c = triangles[k + 2];
-        glm::vec3 n = glm::cross(b - a, c - a);
-        const float len = glm::length(n);
-        n = len > 0.0f ? n / len : glm::vec3(0.0f, 1.0f, 0.0f);
-        for (const glm::vec3& p : {a, b, c}) {
-            interleaved.insert(interleaved.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
-            o.localBounds.extend(p);
+    // Corners are welded by exact position so triangles that meet share a smooth normal, as on
+    // the heightmap mesh this replaces (the LOD terrain is conforming: corners that meet are
+    // bit-identical).
+    struct Key {
+        std::uint32_t x, y, z;
+        bool operator==(const Key&) const = default;
+    };
+    struct KeyHash {
+        std::size_t operator()(const Key& k) const { return (std::size_t(k.x) * 73856093u) ^ (std::size_t(k.y) * 19349663u) ^ (std::size_t(k.z) * 83492791u); }
+    };
+    std::unordered_map<Key, std::uint32_t, KeyHash> corner;
+    corner.reserve(triangles.size() / 2);
+    Mesh welded;
+    welded.indices.reserve(triangles.size());
+    for (std::size_t k = 0; k + 2 < triangles.size(); k += 3)
+        for (std::size_t c = 0; c < 3; ++c) {
+            const glm::vec3& p = triangles[k + c];
+            const Key key{std::bit_cast<std::uint32_t>(p.x), std::bit_cast<std::uint32_t>(p.y), std::bit_cast<std::uint32_t>(p.z)};
+            auto [it, added] = corner.try_emplace(key, std::uint32_t(welded.positions.size()));
+            if (added) welded.positions.push_back(p);
+            welded.indices.push_back(it->second);
         }
+    computeNormals(welded);
+    std::vector<float> interleaved;
+    interleaved.reserve(welded.positions.size() * 6);
+    o.localBounds = {};
+    for (std::size_t v = 0; v < welded.positions.size(); ++v) {
+        const glm::vec3 p = welded.positions[v], n = welded.normals[v];
+        interleaved.insert(interleaved.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
+        o.localBounds.extend(p);
     }
-    for (std::size_t k = 0; k < indices.size(); ++k) indices[k] = std::uint32_t(k);
-    Impl::upload(o, interleaved, indices);
+    Impl::upload(o, interleaved, welded.indices);
     o.worldSpace = true;
 }
 

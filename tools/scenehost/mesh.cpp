@@ -1,9 +1,13 @@
 #include "mesh.hpp"
 
 #include <cctype>
+#include <cerrno>
+#include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -12,6 +16,13 @@
 #include "splatfx/image.hpp"
 #include "splatfx/scene_file.hpp"
 
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <assimp/DefaultIOSystem.h>
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -112,6 +123,40 @@ splatfx::Status checkHeaderCounts(const std::string& path, std::uintmax_t fileBy
     return {};
 }
 
+// Every file assimp opens goes through this: the mesh itself and whatever it names (an
+// OBJ's mtllib, a glTF's buffers, a Collada's images). Only regular files inside the
+// mesh's own folder, each within the file budget, are opened; anything else reads as
+// missing. Without it a crafted reference reached any file on the machine, and what it
+// found there decided what happened (a CI fuzz run met a 16.9 GB allocation that a second
+// machine, with other files, never saw).
+class ConfinedIOSystem : public Assimp::DefaultIOSystem {
+public:
+    ConfinedIOSystem(std::filesystem::path folder, std::uintmax_t maxBytes) : folder_(std::move(folder)), maxBytes_(maxBytes) {}
+
+    bool Exists(const char* file) const override { return allowed(file); }
+
+    Assimp::IOStream* Open(const char* file, const char* mode) override {
+        const std::string m = mode ? mode : "rb";
+        if (m.find_first_of("wa+") != std::string::npos || !allowed(file)) return nullptr;
+        return Assimp::DefaultIOSystem::Open(file, mode);
+    }
+
+private:
+    bool allowed(const char* file) const {
+        if (!file || !*file) return false;
+        std::error_code ec;
+        const std::filesystem::path p = std::filesystem::canonical(file, ec); // symlinks resolved
+        if (ec || !std::filesystem::is_regular_file(p, ec)) return false;
+        const std::filesystem::path rel = p.lexically_relative(folder_);
+        if (rel.empty() || *rel.begin() == "..") return false;
+        const std::uintmax_t bytes = std::filesystem::file_size(p, ec);
+        return !ec && bytes <= maxBytes_;
+    }
+
+    std::filesystem::path folder_;
+    std::uintmax_t maxBytes_;
+};
+
 void appendNode(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, Mesh& out) {
     const aiMatrix4x4 m = parent * node->mTransformation;
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
@@ -124,28 +169,17 @@ void appendNode(const aiScene* scene, const aiNode* node, const aiMatrix4x4& par
         for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
             const aiFace& face = mesh->mFaces[f];
             if (face.mNumIndices != 3) continue; // points and lines (aiProcess_Triangulate leaves only these)
-            // aiProcess_ValidateDataStructure has checked the indices; a face that still points
-            // past its mesh is dropped rather than read out of bounds.
-            if (face.mIndices[0] >= mesh->mNumVertices || face.mIndices[1] >= mesh->mNumVertices || face.mIndices[2] >= mesh->mNumVertices)
-                continue;
             for (int k = 0; k < 3; ++k) out.indices.push_back(base + face.mIndices[k]);
         }
     }
     for (unsigned c = 0; c < node->mNumChildren; ++c) appendNode(scene, node->mChildren[c], m, out);
 }
 
-} // namespace
-
-splatfx::Result<Mesh> loadMesh(const std::string& path, const splatfx::Budgets& budgets) {
-    std::error_code ec;
-    if (!std::filesystem::exists(path, ec)) return splatfx::makeError(path + ": mesh file not found");
-    if (!std::filesystem::is_regular_file(path, ec)) return splatfx::makeError(path + ": not a regular file (a folder, FIFO or device is never read as a mesh)");
-    const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
-    if (ec) return splatfx::makeError(path + ": cannot read its size: " + ec.message());
-    if (auto s = splatfx::checkBudget(path + ": the mesh file", bytes, "bytes", budgets.meshFileBytes, "meshFileBytes"); !s)
-        return splatfx::makeError(s.error());
-    if (auto s = checkHeaderCounts(path, bytes, budgets); !s) return splatfx::makeError(s.error());
+// assimp itself: positions and triangle indices, or why not.
+splatfx::Result<Mesh> importWithAssimp(const std::string& path, const splatfx::Budgets& budgets) {
     Assimp::Importer importer;
+    std::error_code ec;
+    importer.SetIOHandler(new ConfinedIOSystem(std::filesystem::canonical(path, ec).parent_path(), budgets.meshFileBytes)); // the importer owns it
     // Validation makes assimp refuse out-of-range indices and other broken structure instead of handing them on.
     const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
     if (!scene || !scene->mRootNode) return splatfx::makeError(path + ": cannot load mesh: " + importer.GetErrorString());
@@ -160,7 +194,179 @@ splatfx::Result<Mesh> loadMesh(const std::string& path, const splatfx::Budgets& 
     if (!scene || !scene->mRootNode) return splatfx::makeError(path + ": cannot load mesh: " + importer.GetErrorString());
     Mesh out;
     appendNode(scene, scene->mRootNode, aiMatrix4x4(), out);
+    return out;
+}
+
+// assimp runs in a child process. Fuzzing Debian's assimp 5.2 keeps finding files that make
+// it corrupt its heap, abort, hang or allocate tens of GB (each session's header checks above
+// caught some; the next run found more), so the host no longer trusts it with its own address
+// space: the child is held to Budgets::meshImportBytes of new address space and
+// meshImportSeconds, and sends back plain arrays that this process checks before using.
+// The child leaves with _exit: no atexit handler or static destructor of the parent runs twice.
+constexpr std::uint32_t kWireMagic = 0x31485353; // "SSH1"
+struct WireHeader {
+    std::uint32_t magic = kWireMagic;
+    std::uint32_t ok = 0;
+    std::uint64_t positions = 0; // or the message's length when !ok
+    std::uint64_t indices = 0;
+};
+
+bool writeAll(int fd, const void* data, std::size_t bytes) {
+    const char* p = static_cast<const char*>(data);
+    while (bytes > 0) {
+        const ssize_t n = ::write(fd, p, bytes);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) return false;
+        p += n, bytes -= std::size_t(n);
+    }
+    return true;
+}
+
+// Defined only when a sanitizer runtime is linked (the fuzz and sanitizer builds).
+extern "C" __attribute__((weak)) void __sanitizer_set_death_callback(void (*)(void));
+
+[[noreturn]] void childImport(int fd, const std::string& path, const splatfx::Budgets& budgets) {
+    // What goes wrong in here is reported by the parent, from the exit status: the child drops
+    // the handlers it inherited (a fuzzer's would file the input as its own crash), writes no
+    // core file and prints nothing.
+    if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(nullptr);
+    for (int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGILL, SIGFPE, SIGXCPU, SIGALRM, SIGINT, SIGTERM, SIGUSR1, SIGUSR2})
+        std::signal(sig, SIG_DFL);
+    const rlimit noCore{0, 0};
+    setrlimit(RLIMIT_CORE, &noCore);
+    if (const int devNull = ::open("/dev/null", O_WRONLY); devNull >= 0) ::dup2(devNull, STDERR_FILENO), ::dup2(devNull, STDOUT_FILENO);
+    // New address space, beyond what the child holds now (the parent's mappings, an
+    // AddressSanitizer's shadow), is what the budget limits.
+    long pages = 0;
+    if (std::FILE* statm = std::fopen("/proc/self/statm", "r")) {
+        if (std::fscanf(statm, "%ld", &pages) != 1) pages = 0;
+        std::fclose(statm);
+    }
+    const std::uint64_t held = std::uint64_t(pages) * std::uint64_t(sysconf(_SC_PAGESIZE));
+    if (pages > 0 && budgets.meshImportBytes < UINT64_MAX - held) {
+        const rlimit as{rlim_t(held + budgets.meshImportBytes), rlim_t(held + budgets.meshImportBytes)};
+        setrlimit(RLIMIT_AS, &as);
+    }
+    const rlimit cpu{rlim_t(budgets.meshImportSeconds + 1), rlim_t(budgets.meshImportSeconds + 1)};
+    setrlimit(RLIMIT_CPU, &cpu);
+    WireHeader h;
+    std::string message;
+    Mesh mesh;
+    const std::string outOfMemory = path + ": the mesh library went over its memory budget of " + std::to_string(budgets.meshImportBytes) +
+                                    " bytes (raise Budgets::meshImportBytes)";
+    try {
+        auto r = importWithAssimp(path, budgets);
+        if (r) mesh = std::move(*r), h.ok = 1, h.positions = mesh.positions.size(), h.indices = mesh.indices.size();
+        // assimp catches the allocation failure itself and reports its name.
+        else message = r.error().find("bad_alloc") != std::string::npos ? outOfMemory : r.error();
+    } catch (const std::bad_alloc&) {
+        message = outOfMemory;
+    } catch (const std::exception& e) {
+        message = path + ": cannot load mesh: " + e.what();
+    }
+    if (!h.ok) h.positions = message.size();
+    const bool sent = writeAll(fd, &h, sizeof h) &&
+                      (h.ok ? writeAll(fd, mesh.positions.data(), mesh.positions.size() * sizeof(glm::vec3)) &&
+                                  writeAll(fd, mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t))
+                            : writeAll(fd, message.data(), message.size()));
+    _exit(sent ? 0 : 1);
+}
+
+// Reads exactly `bytes` from the child by the deadline; false on end of file, error or time out.
+bool readAll(int fd, void* data, std::size_t bytes, std::chrono::steady_clock::time_point deadline) {
+    char* p = static_cast<char*>(data);
+    while (bytes > 0) {
+        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now()).count();
+        if (left <= 0) return false;
+        pollfd pfd{fd, POLLIN, 0};
+        const int ready = ::poll(&pfd, 1, int(std::min<long long>(left, 1000)));
+        if (ready < 0 && errno == EINTR) continue;
+        if (ready < 0) return false;
+        if (ready == 0) continue;
+        const ssize_t n = ::read(fd, p, bytes);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) return false;
+        p += n, bytes -= std::size_t(n);
+    }
+    return true;
+}
+
+splatfx::Result<Mesh> importIsolated(const std::string& path, const splatfx::Budgets& budgets) {
+    int fds[2];
+    if (::pipe2(fds, O_CLOEXEC) != 0) return splatfx::makeError(path + ": cannot start the mesh library's process: " + std::strerror(errno));
+    std::fflush(nullptr); // nothing buffered is written twice
+    const pid_t child = ::fork();
+    if (child < 0) {
+        const int err = errno;
+        ::close(fds[0]), ::close(fds[1]);
+        return splatfx::makeError(path + ": cannot start the mesh library's process: " + std::strerror(err));
+    }
+    if (child == 0) {
+        ::close(fds[0]);
+        childImport(fds[1], path, budgets);
+    }
+    ::close(fds[1]);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(std::min<std::uint64_t>(budgets.meshImportSeconds, 1u << 30));
+    WireHeader h;
+    std::string message;
+    Mesh mesh;
+    bool received = readAll(fds[0], &h, sizeof h, deadline) && h.magic == kWireMagic;
+    if (received && !h.ok) {
+        message.resize(std::size_t(std::min<std::uint64_t>(h.positions, 1u << 16)));
+        received = readAll(fds[0], message.data(), message.size(), deadline);
+    } else if (received) {
+        // The counts come from another process: checked before anything is allocated.
+        if (auto s = splatfx::checkBudget(path + ": the mesh", std::max(h.positions, h.indices / 3), "vertices or faces",
+                                          budgets.meshElements, "meshElements");
+            !s) {
+            ::kill(child, SIGKILL);
+            message = s.error();
+        } else {
+            mesh.positions.resize(std::size_t(h.positions));
+            mesh.indices.resize(std::size_t(h.indices));
+            received = readAll(fds[0], mesh.positions.data(), mesh.positions.size() * sizeof(glm::vec3), deadline) &&
+                       readAll(fds[0], mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t), deadline);
+        }
+    }
+    const bool timedOut = std::chrono::steady_clock::now() >= deadline;
+    if (!received) ::kill(child, SIGKILL);
+    ::close(fds[0]);
+    int status = 0;
+    while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (!message.empty()) return splatfx::makeError(message);
+    if (received && h.ok) return mesh;
+    if (timedOut)
+        return splatfx::makeError(path + ": the mesh library did not finish within " + std::to_string(budgets.meshImportSeconds) +
+                                  " s (raise Budgets::meshImportSeconds)");
+    if (WIFSIGNALED(status))
+        return splatfx::makeError(path + ": the mesh library crashed on this file (signal " + std::to_string(WTERMSIG(status)) + ": " +
+                                  strsignal(WTERMSIG(status)) + "); the file is malformed or crafted");
+    return splatfx::makeError(path + ": the mesh library failed on this file (exit status " + std::to_string(WEXITSTATUS(status)) +
+                              "; it may have gone over its memory budget of " + std::to_string(budgets.meshImportBytes) +
+                              " bytes: raise Budgets::meshImportBytes)");
+}
+
+} // namespace
+
+splatfx::Result<Mesh> loadMesh(const std::string& path, const splatfx::Budgets& budgets) {
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) return splatfx::makeError(path + ": mesh file not found");
+    if (!std::filesystem::is_regular_file(path, ec)) return splatfx::makeError(path + ": not a regular file (a folder, FIFO or device is never read as a mesh)");
+    const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+    if (ec) return splatfx::makeError(path + ": cannot read its size: " + ec.message());
+    if (auto s = splatfx::checkBudget(path + ": the mesh file", bytes, "bytes", budgets.meshFileBytes, "meshFileBytes"); !s)
+        return splatfx::makeError(s.error());
+    if (auto s = checkHeaderCounts(path, bytes, budgets); !s) return splatfx::makeError(s.error());
+    auto imported = importIsolated(path, budgets);
+    if (!imported) return imported;
+    Mesh out = std::move(*imported);
     if (out.indices.empty()) return splatfx::makeError(path + ": the file holds no triangles");
+    // A face pointing past the vertices (assimp's validation checks this; the arrays crossed a
+    // process boundary) would be read out of bounds by the renderer: the file is refused.
+    for (std::uint32_t i : out.indices)
+        if (i >= out.positions.size())
+            return splatfx::makeError(path + ": a face refers to vertex " + std::to_string(i) + " of " + std::to_string(out.positions.size()));
     for (const glm::vec3& p : out.positions)
         if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
             return splatfx::makeError(path + ": the mesh has non-finite vertex positions");

@@ -33,6 +33,9 @@ struct Mesh {
 };
 
 // Every mesh of the file, node transforms applied, merged. Errors name the file.
+// assimp runs in a child process (fork) held to budgets.meshImportBytes and
+// meshImportSeconds, and opens only regular files in the mesh's own folder, so
+// a file that crashes, hangs or exhausts it is an error here.
 splatfx::Result<Mesh> loadMesh(const std::string& path, const splatfx::Budgets& budgets = {});
 // A terrain grid from an image's channel 0 (splatfx::heightmapPoint
 // for each sample, two triangles a cell, facing +y). Errors name the file.

@@ -128,11 +128,17 @@ void ScenePlayer::renderFrame(double t, const splatfx::Camera& camera, unsigned 
     FrameStats& s = p.stats;
 
     // [issue 17] The LOD terrain of ground-fog layers replaces their heightmap
-    // objects' meshes (the same morphed triangulation as the fog's bottom).
-    for (const auto& [object, fog] : p.lodTerrain)
-        if (options.drawGeometry &&
-            f.scene.groundFog(fog).update(camera, f.scene.groundFogOptions(fog).refine, p.scratch, &p.terrain))
+    // objects' meshes (the same morphed triangulation as the fog's bottom): the
+    // one prepare() refined (VolumeOptions::keepTerrain, set by the scene file),
+    // or, for a layer switched off, refined here for the terrain alone.
+    for (const auto& [object, fog] : p.lodTerrain) {
+        if (!options.drawGeometry) continue;
+        if (f.scene.groundFogOptions(fog).enabled) {
+            if (!f.scene.groundFogTerrain(fog).empty()) p.geometry->setWorldTriangles(object, f.scene.groundFogTerrain(fog));
+        } else if (f.scene.groundFog(fog).update(camera, f.scene.groundFogOptions(fog).refine, p.scratch, &p.terrain)) {
             p.geometry->setWorldTriangles(object, p.terrain);
+        }
+    }
 
     // This host's opaque pass: background, then geometry with depth writes.
     auto drawOpaque = [&] {

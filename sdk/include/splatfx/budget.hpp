@@ -47,6 +47,11 @@ struct Budgets {
     std::uint64_t meshElements = 20'000'000;
     // Bytes of one mesh file. Default 512 MiB.
     std::uint64_t meshFileBytes = 512ull << 20;
+    // Memory and wall-clock seconds the mesh library may use on one file: it
+    // runs in a child process held to these, so a file that makes it crash,
+    // hang or allocate without bound is an error. Defaults 4 GiB and 60 s.
+    std::uint64_t meshImportBytes = 4ull << 30;
+    std::uint64_t meshImportSeconds = 60;
 };
 
 // The fields by name, in declaration order, for messages and command lines.

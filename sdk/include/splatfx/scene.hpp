@@ -141,6 +141,10 @@ struct VolumeOptions {
     std::string name;          // for messages; default empty
     bool enabled = true;       // default true
     LodRefineDesc refine{};    // per-frame refinement (c, morphing, culling); default LodRefineDesc{}
+    // Ground fog only: prepare() keeps the frame's terrain triangles
+    // (groundFogTerrain), so a host draws its terrain from the same LOD mesh
+    // without refining it twice. Default false.
+    bool keepTerrain = false;
 };
 // ---- end [clouds] ----
 
@@ -225,6 +229,10 @@ public:
     VolumeOptions& groundFogOptions(VolumeId id) { return mGroundFogs.at(id)->options; }
     // The layer itself (e.g. for its LOD terrain: GroundFog::update's terrainTriangles).
     const GroundFog& groundFog(VolumeId id) const { return mGroundFogs.at(id)->fog; }
+    // The terrain the last prepare() refined for a layer with options.keepTerrain
+    // (GroundFog::update's terrainTriangles); empty otherwise, and when the layer is
+    // disabled or its update failed.
+    const std::vector<glm::vec3>& groundFogTerrain(VolumeId id) const { return mGroundFogs.at(id)->terrain; }
     // ---- end ----
 
 private:
@@ -263,6 +271,7 @@ private:
         TransferFunction transfer;
         PreIntegrationTable table;
         VolumeOptions options;
+        std::vector<glm::vec3> terrain; // options.keepTerrain
     };
     std::vector<std::unique_ptr<GroundFogEntry>> mGroundFogs;
     void prepareVolumes(const Camera& camera, Frame& frame); // [clouds]

@@ -13,6 +13,7 @@ constexpr Field kFields[] = {
     {"effectCells", &Budgets::effectCells},     {"solverCells", &Budgets::solverCells},
     {"sampledTexels", &Budgets::sampledTexels}, {"textureLayers", &Budgets::textureLayers},
     {"meshElements", &Budgets::meshElements},   {"meshFileBytes", &Budgets::meshFileBytes},
+    {"meshImportBytes", &Budgets::meshImportBytes}, {"meshImportSeconds", &Budgets::meshImportSeconds},
 };
 
 } // namespace

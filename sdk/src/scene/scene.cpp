@@ -160,17 +160,22 @@ void Scene::prepareVolumes(const Camera& camera, Frame& frame) {
     }
     for (auto& owned : mGroundFogs) { // ground fog layers
         GroundFogEntry& e = *owned;
+        e.terrain.clear();
         if (!e.options.enabled) continue;
         FrameVolume& fv = frame.volumes().emplace_back();
         fv.table = &e.table;
         fv.tableVersion = 1;
-        if (!e.fog.update(camera, e.options.refine, fv.lod)) frame.volumes().pop_back(); // refine: the LOD terrain's c, morphing
+        // refine: the LOD terrain's c, morphing
+        if (!e.fog.update(camera, e.options.refine, fv.lod, e.options.keepTerrain ? &e.terrain : nullptr)) {
+            frame.volumes().pop_back();
+            e.terrain.clear();
+        }
     }
 }
 
 //
 VolumeId Scene::addGroundFog(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, VolumeOptions options) {
-    mGroundFogs.push_back(std::make_unique<GroundFogEntry>(GroundFogEntry{std::move(fog), std::move(transfer), std::move(table), std::move(options)}));
+    mGroundFogs.push_back(std::make_unique<GroundFogEntry>(GroundFogEntry{std::move(fog), std::move(transfer), std::move(table), std::move(options), {}}));
     return VolumeId(mGroundFogs.size() - 1);
 }
 

@@ -161,7 +161,7 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     LodRefineDesc refine;
     refine.detailC = detailC;
     refine.morph = morph;
-    const VolumeId id = out.scene.addGroundFog(std::move(*layer), std::move(*tf), std::move(*table), {.name = name, .enabled = enabled, .refine = refine});
+    const VolumeId id = out.scene.addGroundFog(std::move(*layer), std::move(*tf), std::move(*table), {.name = name, .enabled = enabled, .refine = refine, .keepTerrain = !terrainGeometry.empty()});
     if (!terrainGeometry.empty()) out.groundFogTerrain.push_back({terrainGeometry, id});
 }
 
