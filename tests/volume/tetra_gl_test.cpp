@@ -555,6 +555,62 @@ TEST_F(TetraPassGL, ReducedResolutionSplatsLeaveTheTetrahedraAtFullResolution) {
     EXPECT_EQ(half->stats().tetrahedra, full->stats().tetrahedra);
 }
 
+// FrameRendererDesc::reduceTetrahedra: the tetrahedra go into the splats'
+// reduced image in the frame's one back-to-front order. With the cloud in
+// front of the fire the reduced frame is closer to the full-resolution frame
+// in the right order than to the one in the wrong order (the fire drawn over
+// the cloud); the per-pass path
+// (tetrahedra at full resolution, then all splats) is closer to the wrong one.
+TEST_F(TetraPassGL, ReducedTetrahedraKeepTheOneOrderWithTheSplats) {
+    Cloud cl;
+    Materials materials{Footprint{}};
+    const std::uint32_t set = materials.addTextureSet(TextureSet::turbulence({.count = 4, .size = 16, .seed = 3}));
+    const std::uint32_t colors = materials.addColorTable(ColorTable::fire());
+    const Camera cam = test::campfireCamera(kSize);
+    auto full = gl::FrameRenderer::create();
+    auto oneOrder = gl::FrameRenderer::create({.resolutionScale = 2, .reduceTetrahedra = true});
+    auto perPass = gl::FrameRenderer::create({.resolutionScale = 2});
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(full && oneOrder && perPass && fb);
+    for (gl::FrameRenderer* r : {&*full, &*oneOrder, &*perPass}) ASSERT_TRUE(r->upload(materials));
+    auto vol = LodVolume::create(cl.field, {.originWorld = {-8.0f, -4.0f, 4.0f}}); // between the fire and the eye
+    ASSERT_TRUE(vol);
+    Frame frame;
+    frame.begin(0.0, cam);
+    frame.builder().add(test::campfireGrid(3), materials, {.textureSet = set, .colorTable = colors});
+    FrameVolume& fv = frame.volumes().emplace_back();
+    fv.table = &*cl.table;
+    ASSERT_TRUE(vol->update(cam, {.detailC = 20.0f}, &*cl.transfer, fv.lod));
+    frame.end();
+    ASSERT_EQ(frame.drawOrder().size(), 2u);
+    ASSERT_EQ(frame.drawOrder()[0].kind, DrawBatch::Kind::Splats); // the fire first: the cloud is nearer
+    // Full resolution in the right order, and in the wrong one (the batches swapped).
+    renderFrame(*full, *fb, frame, 1.0);
+    const Image right = fb->read();
+    Frame cloudOnly;
+    cloudOnly.begin(0.0, cam);
+    cloudOnly.volumes().push_back(fv);
+    cloudOnly.end();
+    auto splatsOnly = gl::Renderer::create();
+    ASSERT_TRUE(splatsOnly && splatsOnly->upload(materials));
+    fb->clear({0, 0, 0, 0});
+    full->render(cloudOnly, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture()});
+    splatsOnly->draw(frame.splats(), cam, {.framebuffer = fb->handle(), .width = kSize.x, .height = kSize.y});
+    const Image wrong = fb->read(); // the fire over the cloud
+    auto distance = [](const Image& a, const Image& b) {
+        double d = 0.0;
+        for (std::size_t i = 0; i < a.pixels.size(); ++i) d += std::abs(double(a.pixels[i]) - double(b.pixels[i]));
+        return d;
+    };
+    ASSERT_GT(distance(right, wrong), 0.0);
+    renderFrame(*oneOrder, *fb, frame, 1.0);
+    const Image reduced = fb->read();
+    EXPECT_LT(distance(reduced, right), distance(reduced, wrong));
+    renderFrame(*perPass, *fb, frame, 1.0);
+    const Image split = fb->read();
+    EXPECT_GT(distance(split, right), distance(split, wrong)) << "the per-pass path draws the splats last";
+}
+
 // (issue 17 item 8) The camera inside one tetrahedron: cut at the
 // near plane as a volume (clipTetrahedron: the tip left by three vertices
 // behind the plane, and a prism of three pieces when one is), the pass draws

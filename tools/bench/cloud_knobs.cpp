@@ -5,6 +5,8 @@
 // premultiplied over black) against the finest level integrated exactly
 // (LodVolume::integrateRay: every linear piece of the finest mesh integrated
 // by integrateSegment, no table), per pixel the largest channel difference.
+// Also the resolution scale: the tetrahedra drawn at 1/2 or 1/4 resolution per
+// axis and upsampled (FrameRendererDesc::reduceTetrahedra).
 // Time: the GL frame (prepare + render + glFinish) as a median of repeats.
 // Two views: outside the field with all of it in view, and inside it.
 #include <algorithm>
@@ -33,6 +35,7 @@ struct Knobs {
     float detailC = 10.0f;     // LodRefineDesc::detailC default
     float minC = 4.0f;         // LodVolumeDesc::minAccuracyC default
     splatfx::DeltaMode delta = splatfx::DeltaMode::Max;
+    int scale = 1; // FrameRendererDesc::resolutionScale, the tetrahedra reduced with it (reduceTetrahedra)
 };
 
 struct Row {
@@ -58,9 +61,15 @@ glm::dvec3 pixelRay(const splatfx::Camera& cam, int x, int y) {
 } // namespace
 
 int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
-    auto fr = splatfx::gl::FrameRenderer::create({.fogHost = false});
+    // One renderer per resolution scale (1, 2, 4).
+    std::vector<splatfx::gl::FrameRenderer> renderers;
+    for (int scale : {1, 2, 4}) {
+        auto fr = splatfx::gl::FrameRenderer::create({.resolutionScale = scale, .reduceTetrahedra = true, .fogHost = false});
+        if (!fr) return std::fprintf(stderr, "clouds knobs: %s\n", fr.error().c_str()), 1;
+        renderers.push_back(std::move(*fr));
+    }
     auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y, .color = splatfx::gl::Precision::F32});
-    if (!fr || !fb) return std::fprintf(stderr, "clouds knobs: GL setup failed\n"), 1;
+    if (!fb) return std::fprintf(stderr, "clouds knobs: %s\n", fb.error().c_str()), 1;
     splatfx::CloudDesc cd;
     cd.dims = dims;
     auto field = splatfx::makeCloudVolume(cd);
@@ -111,6 +120,7 @@ int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
     for (float c : {2.0f, 5.0f, 20.0f, 50.0f}) rows.push_back({"c", std::to_string(int(c)), {.detailC = c}});
     for (float C : {2.0f, 8.0f, 16.0f}) rows.push_back({"C", std::to_string(int(C)), {.minC = C}});
     rows.push_back({"delta", "average", {.delta = splatfx::DeltaMode::Average}});
+    for (int scale : {2, 4}) rows.push_back({"resolution scale", std::to_string(scale), {.scale = scale}});
 
     std::printf("LOD clouds knobs: field %dx%dx%d (full %llu tetrahedra), %dx%d RGBA32F, median of %d frames; defaults: "
                 "table 64x64x128, c = 10, C = 4, Delta max\n"
@@ -121,6 +131,7 @@ int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
     for (const Row& r : rows) {
         splatfx::Scene scene;
         if (!makeScene(r.k, scene)) return 1;
+        splatfx::gl::FrameRenderer* fr = &renderers[r.k.scale == 4 ? 2 : std::size_t(r.k.scale - 1)];
         for (const View& v : views) {
             splatfx::Frame frame;
             std::vector<double> t;

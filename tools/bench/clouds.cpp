@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <string>
+#include <optional>
 #include <vector>
 
 #include <epoxy/gl.h>
@@ -46,6 +47,7 @@ struct Options {
     glm::ivec2 fogSize{128, 96};
     int fogFrames = 41;
     bool fogOnly = false; // --fog-only: skip the flight and the popping runs
+    int scale = 2;        // the flight also at this resolution scale (tetrahedra reduced); 1: only full resolution
 };
 
 struct CloudSet {
@@ -102,7 +104,8 @@ int usage() {
     std::printf("usage: splatfx-bench clouds [--dims X Y Z] [--c DETAIL] [--frames N] [--size W H]\n"
                 "                            [--pop-dims X Y Z] [--pop-frames N] [--pop-size W H] [--pop-c DETAIL]\n"
                 "                            [--pop-step WORLD_PER_FRAME]\n"
-                "                            [--fog-dims X Y Z] [--fog-size W H] [--fog-frames N] [--fog-only]\n");
+                "                            [--fog-dims X Y Z] [--fog-size W H] [--fog-frames N] [--fog-only]\n"
+                "                            [--scale 1|2|4]   (the flight also with the tetrahedra at 1/scale resolution; default 2)\n");
     return 2;
 }
 
@@ -125,9 +128,11 @@ int runClouds(int argc, char** argv) {
         else if (!std::strcmp(argv[i], "--fog-size") && i + 2 < argc) next2(o.fogSize);
         else if (!std::strcmp(argv[i], "--fog-frames") && i + 1 < argc) o.fogFrames = std::atoi(argv[++i]);
         else if (!std::strcmp(argv[i], "--fog-only")) o.fogOnly = true;
+        else if (!std::strcmp(argv[i], "--scale") && i + 1 < argc) o.scale = std::atoi(argv[++i]);
         else if (!std::strcmp(argv[i], "--pop-frames") && i + 1 < argc) o.popFrames = std::atoi(argv[++i]);
         else return usage();
     }
+    if (o.scale != 1 && o.scale != 2 && o.scale != 4) return usage();
     if (o.frames < 2 || o.popFrames < 2 || o.size.x < 1 || o.size.y < 1 || o.popSize.x < 1 || o.popSize.y < 1) return usage();
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) return std::fprintf(stderr, "%s\n", ctx.error().c_str()), 1;
@@ -144,26 +149,59 @@ int runClouds(int argc, char** argv) {
                     o.detailC, ms(Clock::now() - t0));
         auto fb = splatfx::gl::Framebuffer::create({.width = o.size.x, .height = o.size.y});
         if (!fb) return std::fprintf(stderr, "%s\n", fb.error().c_str()), 1;
+        // Each frame drawn at full resolution and, with --scale, again with the tetrahedra
+        // at 1/scale per axis (FrameRendererDesc::reduceTetrahedra): ratios from one run.
+        struct Pass {
+            int scale;
+            splatfx::gl::FrameRenderer* renderer;
+            std::vector<double> tOut, tIn, prepOut, prepIn, errOut, errIn;
+        };
+        std::optional<splatfx::gl::FrameRenderer> reduced;
+        if (o.scale != 1) {
+            auto r = splatfx::gl::FrameRenderer::create({.resolutionScale = o.scale, .reduceTetrahedra = true});
+            if (!r) return std::fprintf(stderr, "%s\n", r.error().c_str()), 1;
+            reduced.emplace(std::move(*r));
+        }
+        std::vector<Pass> passes{{1, &*fr, {}, {}, {}, {}, {}, {}}};
+        if (reduced) passes.push_back({o.scale, &*reduced, {}, {}, {}, {}, {}, {}});
         splatfx::Frame frame;
-        std::vector<double> tOut, tIn, prepOut, prepIn, drawnOut, drawnIn;
+        std::vector<double> drawnOut, drawnIn;
         std::size_t maxFrameBytes = 0;
         for (int f = -2; f < o.frames; ++f) { // two warm-up frames (table upload, shader compile)
             const splatfx::Camera cam = flight(cs.ext, std::max(f, 0), o.frames, o.size);
-            const auto a = Clock::now();
-            cs.scene.prepare(f / 60.0 + 1.0, cam, materials, frame);
-            const auto b = Clock::now();
-            fr->render(frame, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture(), .drawOpaque = [] {
-                               glClearColor(0.45f, 0.6f, 0.85f, 1.0f);
-                               glClearDepth(1.0);
-                               glDepthMask(GL_TRUE);
-                               glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-                           }});
-            glFinish();
-            const auto c = Clock::now();
-            if (f < 0) continue;
             const bool in = inside(cs.ext, cam);
-            (in ? tIn : tOut).push_back(ms(c - a));
-            (in ? prepIn : prepOut).push_back(ms(b - a));
+            splatfx::Image fullImage;
+            for (Pass& pass : passes) {
+                const auto a = Clock::now();
+                cs.scene.prepare(f / 60.0 + 1.0, cam, materials, frame);
+                const auto b = Clock::now();
+                pass.renderer->render(frame, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture(), .drawOpaque = [] {
+                                              glClearColor(0.45f, 0.6f, 0.85f, 1.0f);
+                                              glClearDepth(1.0);
+                                              glDepthMask(GL_TRUE);
+                                              glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+                                          }});
+                glFinish();
+                const auto c = Clock::now();
+                if (f < 0) continue;
+                (in ? pass.tIn : pass.tOut).push_back(ms(c - a));
+                (in ? pass.prepIn : pass.prepOut).push_back(ms(b - a));
+                if (passes.size() > 1) { // against this frame at full resolution: mean per-pixel max |d channel|
+                    splatfx::Image img = fb->read();
+                    if (pass.scale == 1) {
+                        fullImage = std::move(img);
+                    } else {
+                        double sum = 0.0;
+                        for (std::size_t p = 0; p < img.pixels.size(); p += 4) {
+                            double e = 0.0;
+                            for (std::size_t k = 0; k < 3; ++k) e = std::max(e, double(std::abs(img.pixels[p + k] - fullImage.pixels[p + k])));
+                            sum += e;
+                        }
+                        (in ? pass.errIn : pass.errOut).push_back(sum / double(img.pixels.size() / 4));
+                    }
+                }
+            }
+            if (f < 0) continue;
             (in ? drawnIn : drawnOut).push_back(double(fr->stats().tetrahedra));
             std::size_t bytes = 0;
             for (const auto& v : frame.volumes()) bytes += v.lod.tets.size() * (sizeof(splatfx::Tetrahedron) + 160);
@@ -175,17 +213,23 @@ int runClouds(int argc, char** argv) {
             return v.empty() ? 0.0 : s / double(v.size());
         };
         std::printf("full resolution: %llu tetrahedra\n", static_cast<unsigned long long>(cs.full));
-        for (int in = 0; in < 2; ++in) {
-            const auto& t = in ? tIn : tOut;
-            const auto& d = in ? drawnIn : drawnOut;
-            const auto& p = in ? prepIn : prepOut;
-            if (t.empty()) continue;
-            const double dm = mean(d), med = percentile(t, 0.5);
-            std::printf("%s (%zu frames, %dx%d): drawn mean %.0f max %.0f (%.0fx fewer than full); frame ms median %.1f "
-                        "(%.1f Hz) mean %.1f p90 %.1f; of it prepare (LOD update) median %.1f ms\n",
-                        in ? "inside " : "outside", t.size(), o.size.x, o.size.y, dm, *std::max_element(d.begin(), d.end()),
-                        double(cs.full) / std::max(dm, 1.0), med, 1000.0 / med, mean(t), percentile(t, 0.9), percentile(p, 0.5));
-        }
+        for (const Pass& pass : passes)
+            for (int in = 0; in < 2; ++in) {
+                const auto& t = in ? pass.tIn : pass.tOut;
+                const auto& d = in ? drawnIn : drawnOut;
+                const auto& p = in ? pass.prepIn : pass.prepOut;
+                if (t.empty()) continue;
+                const double dm = mean(d), med = percentile(t, 0.5);
+                std::printf("%s (%zu frames, %dx%d, tetrahedra at 1/%d): drawn mean %.0f max %.0f (%.0fx fewer than full); frame ms "
+                            "median %.1f (%.1f Hz) mean %.1f p90 %.1f; of it prepare (LOD update) median %.1f ms",
+                            in ? "inside " : "outside", t.size(), o.size.x, o.size.y, pass.scale, dm, *std::max_element(d.begin(), d.end()),
+                            double(cs.full) / std::max(dm, 1.0), med, 1000.0 / med, mean(t), percentile(t, 0.9), percentile(p, 0.5));
+                const auto& e = in ? pass.errIn : pass.errOut;
+                if (pass.scale != 1 && !e.empty())
+                    std::printf("; vs full resolution: %.2fx the time, mean |d| per pixel %.4f (worst frame %.4f)", med / percentile(in ? passes[0].tIn : passes[0].tOut, 0.5),
+                                mean(e), *std::max_element(e.begin(), e.end()));
+                std::printf("\n");
+            }
         std::printf("memory: LOD volume %zu bytes, table %zu bytes (CPU) + %zu (GPU, RGBA32F), per-frame tetrahedra up to %zu bytes "
                     "(CPU list + GPU records)\n",
                     cs.volumeBytes, cs.tableBytes, fr->stats().tableBytes, maxFrameBytes);

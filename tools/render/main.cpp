@@ -64,7 +64,8 @@ void usage() {
         "  --fps F          animation rate; frame i shows time i / F (default: the scene's output.fps)\n"
         "  --seed S         scene seed (every effect's random choices derive from it; default: the file's)\n"
         "  --traditional    draw every effect with plain footprints, no textures (the paper's Fig. 1a)\n"
-        "  --scale N        draw the effects at 1/N resolution per axis (1, 2 or 4; default 1) with depth-aware upsampling\n"
+        "  --scale N        draw the effects and volumes (splats, clouds, ground fog) at 1/N resolution per axis\n"
+        "                   (1, 2 or 4; default 1) with depth-aware upsampling\n"
         "  --sampling M     texture sampling: auto (default), bilinear, nearest, upsampled, upsampledN (N = 2..16)\n"
         "  --fog-texture WxH  fog the host image through a reduced WxH fog texture (default: per pixel)\n"
         "  --range A-B[:STEP]  render-farm task: write only frames A..B (every STEP-th; indices from 0), exactly\n"
@@ -118,6 +119,7 @@ bool parse(int argc, char** argv, Args& a) {
                 return false;
             }
             a.renderer.resolutionScale = int(n);
+            a.renderer.reduceTetrahedra = true; // every volume at the reduced resolution, in one order
         } else if (s == "--sampling") {
             if (!(v = value())) return false;
             using splatfx::gl::TextureSampling;

@@ -150,7 +150,8 @@ struct Viewer {
 
     splatfx::gl::FrameRendererDesc rendererDesc() const {
         return {.splats = {.sampling = kSamplings[sampling].mode, .upsample = kSamplings[sampling].upsample},
-                .resolutionScale = resolutionScale};
+                .resolutionScale = resolutionScale,
+                .reduceTetrahedra = true};
     }
 
     void load(const std::string& p, const std::string* text = nullptr) {

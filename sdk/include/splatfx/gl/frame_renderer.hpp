@@ -72,6 +72,11 @@ struct FrameRendererDesc {
     // 1: splats at full resolution; 2 or 4: at 1/scale per axis, composited
     // with depth-aware upsampling (gl::ScaledRenderer). Default 1.
     int resolutionScale = 1;
+    // [clouds] With resolutionScale 2 or 4: true draws the tetrahedra (clouds,
+    // ground fog) into the same reduced image as the splats, in one back-to-front
+    // order with them, so their fill cost falls with the splats'; false keeps
+    // them at full resolution, all drawn before the splats. Default false.
+    bool reduceTetrahedra = false;
     Precision reducedPrecision = Precision::F16; // reduced-resolution colour format; default F16
     float depthThreshold = 0.1f;          // reduced resolution: relative view depth still one surface; default 0.1
     // ---- lighting (issue 16): the texture unit the frame's shadow table is

@@ -61,6 +61,16 @@ struct ScaledTarget {
     unsigned depthTexture = 0;
 };
 
+// The reduced-resolution image between ScaledRenderer::begin and composite:
+// a framebuffer of width x height pixels, premultiplied RGBA cleared to 0,
+// whose depth attachment (depthTexture) holds the host depth downsampled
+// (farthest of each block; 1.0 without a host depth).
+struct ReducedLayer {
+    unsigned framebuffer = 0;
+    int width = 0, height = 0;
+    unsigned depthTexture = 0;
+};
+
 class ScaledRenderer {
 public:
     // Fails when no GL 4.5 context is current or scale is not 1, 2 or 4 (the message names desc.scale).
@@ -72,6 +82,18 @@ public:
     Status upload(const Materials& materials);
     // Expects upload() first and a target of positive size.
     void draw(const std::vector<Splat>& splats, const Camera& camera, const ScaledTarget& target);
+
+    // draw() in steps, for more than one pass into the reduced image (gl::FrameRenderer
+    // draws a frame's tetrahedra and splats into it in one back-to-front order):
+    // begin() clears the reduced image and downsamples the host depth into it; draw
+    // into the layer it returns (premultiplied "over", back to front; drawSplats for
+    // splats); composite() upsamples it over the target once. `box` is the
+    // full-resolution rectangle (x0, y0, x1, y1, viewport-relative) the passes can
+    // touch: the composite is scissored to it. Expects scale 2 or 4, begin and
+    // composite paired; GL state as draw() (saved at begin, restored at composite).
+    ReducedLayer begin(const ScaledTarget& target, glm::ivec4 box);
+    void drawSplats(const std::vector<Splat>& splats, const Camera& camera);
+    void composite(const Camera& camera);
 
     const ScaledRendererDesc& desc() const;
     const Renderer& renderer() const;

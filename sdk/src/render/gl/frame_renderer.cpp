@@ -263,7 +263,28 @@ void FrameRenderer::drawInterleaved(const Frame& frame, const HostTarget& target
     const detail::TetraTarget tt{.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
                                  .depthTexture = target.depthTexture};
     std::uint64_t calls = 0, batches = 0;
-    if (r.reduced) {
+    if (r.reduced && r.desc.reduceTetrahedra) {
+        // Both into one reduced image, in draw order, composited once (an "over"
+        // sequence drawn into a cleared layer and then over the host is the same sequence).
+        const ScaledTarget st{.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
+                              .depthTexture = target.depthTexture};
+        const ReducedLayer layer = r.reduced->begin(st, {0, 0, w, h});
+        // The tetrahedra cut at the downsampled depth, as the splats are tested against it.
+        const detail::TetraTarget lowTets{.framebuffer = layer.framebuffer, .width = layer.width, .height = layer.height,
+                                          .depthTexture = layer.depthTexture};
+        for (const DrawBatch& b : frame.drawOrder()) {
+            ++batches;
+            if (b.kind == DrawBatch::Kind::Tetrahedra) {
+                r.tetra->draw(frame, b.volume, b.begin, b.end, lowTets);
+                continue;
+            }
+            const auto& all = frame.splats();
+            r.batch.assign(all.begin() + std::ptrdiff_t(b.begin), all.begin() + std::ptrdiff_t(b.end));
+            r.reduced->drawSplats(r.batch, camera);
+            calls += r.reduced->renderer().stats().drawCalls;
+        }
+        r.reduced->composite(camera);
+    } else if (r.reduced) {
         // Reduced-resolution splats are composited in one pass, so the order
         // is per pass: every tetrahedron (full resolution), then the splats.
         for (const DrawBatch& b : frame.drawOrder())

@@ -47,6 +47,11 @@ struct ScaledRenderer::Impl {
     GLuint hostCopy = 0;
     int copyW = 0, copyH = 0;
     GLenum copyFormat = 0;
+    // Between begin() and composite().
+    bool open = false, useDepth = false;
+    ScaledTarget target;
+    glm::ivec4 lowBox{0}, fullBox{0};
+    detail::SavedState saved;
 
     ~Impl() {
         if (!detail::contextIsCurrent()) return; // the context took our objects with it
@@ -118,28 +123,39 @@ Status ScaledRenderer::upload(const Materials& materials) { return mImpl->inner-
 void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera, const ScaledTarget& target) {
     Impl& r = *mImpl;
     assert(target.width > 0 && target.height > 0 && "ScaledTarget::width and height must be positive");
-    const bool restore = r.desc.renderer.restoreState;
-    // The three passes bind GL_TEXTURE_2D on units 0-2 (colour, depth, host
-    // depth copy), the texture array on unit 0, and scissor to the splats.
-    detail::SavedState saved;
-    if (restore) saved.save({.texture2DUnits = 3, .scissor = true});
     if (r.desc.scale == 1) {
+        detail::SavedState saved;
+        if (r.desc.renderer.restoreState) saved.save({.texture2DUnits = 3, .scissor = true});
         r.inner->draw(splats, camera, {target.framebuffer, target.x, target.y, target.width, target.height});
-        if (restore) saved.restore();
+        if (r.desc.renderer.restoreState) saved.restore();
         return;
     }
-    const int s = r.desc.scale;
-    r.ensureTarget((target.width + s - 1) / s, (target.height + s - 1) / s);
     // The passes at full resolution only touch the splats' screen rectangle
     // (grown by a low-resolution texel for the bilinear taps): on a CPU
     // rasterizer a full-screen pass costs as much as the effect itself.
     const glm::ivec4 box = splatBounds(splats, camera, target.width, target.height);
-    if (box.z <= box.x || box.w <= box.y) {
-        if (restore) saved.restore();
-        return;
-    }
-    const glm::ivec4 lowBox{std::max(box.x / s - 1, 0), std::max(box.y / s - 1, 0), std::min(box.z / s + 2, r.lowW), std::min(box.w / s + 2, r.lowH)};
-    const glm::ivec4 fullBox{std::max(lowBox.x * s, 0), std::max(lowBox.y * s, 0), std::min(lowBox.z * s, target.width), std::min(lowBox.w * s, target.height)};
+    if (box.z <= box.x || box.w <= box.y) return;
+    begin(target, box);
+    drawSplats(splats, camera);
+    composite(camera);
+}
+
+ReducedLayer ScaledRenderer::begin(const ScaledTarget& target, glm::ivec4 box) {
+    Impl& r = *mImpl;
+    assert(target.width > 0 && target.height > 0 && "ScaledTarget::width and height must be positive");
+    assert(!r.open && "ScaledRenderer::begin: composite() the previous layer first");
+    // The passes bind GL_TEXTURE_2D on units 0-2 (colour, depth, host depth
+    // copy), the texture array on unit 0, and scissor to the box.
+    if (r.desc.renderer.restoreState) r.saved.save({.texture2DUnits = 3, .scissor = true});
+    r.open = true;
+    r.target = target;
+    const int s = r.desc.scale;
+    r.ensureTarget((target.width + s - 1) / s, (target.height + s - 1) / s);
+    box = {std::clamp(box.x, 0, target.width), std::clamp(box.y, 0, target.height), std::clamp(box.z, 0, target.width),
+           std::clamp(box.w, 0, target.height)};
+    r.lowBox = {std::max(box.x / s - 1, 0), std::max(box.y / s - 1, 0), std::min(box.z / s + 2, r.lowW), std::min(box.w / s + 2, r.lowH)};
+    r.fullBox = {std::max(r.lowBox.x * s, 0), std::max(r.lowBox.y * s, 0), std::min(r.lowBox.z * s, target.width),
+                 std::min(r.lowBox.w * s, target.height)};
 
     GLuint hostDepth = target.depthTexture;
     if (hostDepth == 0 && target.framebuffer != 0) {
@@ -150,8 +166,8 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
             hostDepth = GLuint(name);
         }
     }
-    const bool useDepth = hostDepth != 0;
-    if (useDepth) {
+    r.useDepth = hostDepth != 0;
+    if (r.useDepth) {
         GLint format = 0;
         glGetTextureLevelParameteriv(hostDepth, 0, GL_TEXTURE_INTERNAL_FORMAT, &format);
         if (!r.hostCopy || r.copyW != target.width || r.copyH != target.height || r.copyFormat != GLenum(format)) {
@@ -177,9 +193,9 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
     glClearNamedFramebufferfv(r.fbo, GL_COLOR, 0, clear);
     glClearNamedFramebufferfv(r.fbo, GL_DEPTH, 0, &farDepth);
     glBindVertexArray(r.emptyVao);
-    glEnable(GL_SCISSOR_TEST);
-    glScissor(lowBox.x, lowBox.y, lowBox.z - lowBox.x, lowBox.w - lowBox.y);
-    if (useDepth) {
+    if (r.useDepth) {
+        glEnable(GL_SCISSOR_TEST);
+        glScissor(r.lowBox.x, r.lowBox.y, r.lowBox.z - r.lowBox.x, r.lowBox.w - r.lowBox.y);
         glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_ALWAYS);
@@ -189,13 +205,25 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
         glBindTextureUnit(2, r.hostCopy);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glDisable(GL_SCISSOR_TEST);
     }
-    // The splats, into the low-resolution target (transparent black, premultiplied).
-    glDisable(GL_SCISSOR_TEST);
-    r.inner->draw(splats, camera, {r.fbo, 0, 0, r.lowW, r.lowH});
-    glEnable(GL_SCISSOR_TEST);
-    glScissor(target.x + fullBox.x, target.y + fullBox.y, fullBox.z - fullBox.x, fullBox.w - fullBox.y);
+    return {.framebuffer = r.fbo, .width = r.lowW, .height = r.lowH, .depthTexture = r.depth};
+}
 
+void ScaledRenderer::drawSplats(const std::vector<Splat>& splats, const Camera& camera) {
+    Impl& r = *mImpl;
+    assert(r.open && "ScaledRenderer::drawSplats: begin() first");
+    // Into the low-resolution target (transparent black, premultiplied).
+    r.inner->draw(splats, camera, {r.fbo, 0, 0, r.lowW, r.lowH});
+}
+
+void ScaledRenderer::composite(const Camera& camera) {
+    Impl& r = *mImpl;
+    assert(r.open && "ScaledRenderer::composite: begin() first");
+    const ScaledTarget& target = r.target;
+    const GLint hostRect[4] = {0, 0, target.width, target.height};
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(target.x + r.fullBox.x, target.y + r.fullBox.y, r.fullBox.z - r.fullBox.x, r.fullBox.w - r.fullBox.y);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
     glViewport(target.x, target.y, target.width, target.height);
     glEnable(GL_BLEND);
@@ -208,18 +236,19 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
     glUseProgram(r.composite);
     glUniform4iv(glGetUniformLocation(r.composite, "uHostRect"), 1, hostRect);
     glUniform2i(glGetUniformLocation(r.composite, "uViewportOrigin"), target.x, target.y);
-    glUniform1i(glGetUniformLocation(r.composite, "uScale"), s);
-    glUniform1i(glGetUniformLocation(r.composite, "uUseDepth"), useDepth ? 1 : 0);
+    glUniform1i(glGetUniformLocation(r.composite, "uScale"), r.desc.scale);
+    glUniform1i(glGetUniformLocation(r.composite, "uUseDepth"), r.useDepth ? 1 : 0);
     glUniform1f(glGetUniformLocation(r.composite, "uThreshold"), r.desc.depthThreshold);
     const glm::mat4 invProj = glm::inverse(camera.proj);
     glUniform4f(glGetUniformLocation(r.composite, "uDepthToView"), invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
     glBindTextureUnit(0, r.color);
     glBindTextureUnit(1, r.depth);
-    if (useDepth) glBindTextureUnit(2, r.hostCopy);
+    if (r.useDepth) glBindTextureUnit(2, r.hostCopy);
     glBindVertexArray(r.emptyVao);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glDisable(GL_SCISSOR_TEST);
-    if (restore) saved.restore();
+    r.open = false;
+    if (r.desc.renderer.restoreState) r.saved.restore();
 }
 
 } // namespace splatfx::gl

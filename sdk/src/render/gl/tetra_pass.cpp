@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include <epoxy/gl.h>
 
@@ -23,6 +25,10 @@ namespace {
 // and the scalar and length scale as linear functions of x.
 constexpr int kVec4PerTet = 10;
 
+// The faces wound counter-clockwise seen from outside a positively oriented
+// tetrahedron (dot(p1-p0, cross(p2-p0, p3-p0)) > 0): opposite 0, 1, 2, 3.
+constexpr std::uint32_t kTetraFaces[12] = {1, 2, 3, 0, 3, 2, 0, 1, 3, 0, 2, 1};
+
 constexpr const char* kTetraVertex = R"(
 layout(std430, binding = 0) readonly buffer Tets { vec4 uTets[]; };
 uniform mat4 uViewProjRel; // proj * view * translate(eye)
@@ -32,12 +38,12 @@ out vec3 vRel;
 flat out vec4 vPlane[4];
 flat out vec4 vScalar;
 flat out vec4 vLength;
-// The faces wound counter-clockwise seen from outside a positively oriented
-// tetrahedron (dot(p1-p0, cross(p2-p0, p3-p0)) > 0): opposite 0, 1, 2, 3.
-const int kFaces[12] = int[12](1, 2, 3, 0, 3, 2, 0, 1, 3, 0, 2, 1);
+// Vertex 4 t + k is corner k of the draw's tetrahedron t: the index buffer
+// (kTetraFaces) makes its four faces of the four corners, so each corner is
+// shaded once, not once per face.
 void main() {
-    int tet = uFirst + gl_InstanceID;
-    vec3 p = uTets[tet * 10 + kFaces[gl_VertexID]].xyz;
+    int tet = uFirst + gl_VertexID / 4;
+    vec3 p = uTets[tet * 10 + gl_VertexID % 4].xyz;
     vRel = p;
     for (int i = 0; i < 4; ++i) vPlane[i] = uTets[tet * 10 + 4 + i];
     vScalar = uTets[tet * 10 + 8];
@@ -162,6 +168,12 @@ struct TetraPass::Impl {
     double fogTimeSec = 0.0;
     GLuint vao = 0, ssbo = 0;
     std::size_t ssboBytes = 0;
+    // Indices for one indexed draw of many tetrahedra (4 t + kTetraFaces[k]),
+    // grown to the largest draw: vertices are shaded once per corner (an instanced
+    // draw of 12 vertices shaded each corner three times, the vertex work that
+    // bounds a CPU rasterizer at low resolution).
+    GLuint indices = 0;
+    std::uint32_t indexedTets = 0;
     struct Table {
         const PreIntegrationTable* source = nullptr;
         std::uint64_t version = 0;
@@ -186,6 +198,7 @@ struct TetraPass::Impl {
             if (p.id) glDeleteProgram(p.id);
         if (vao) glDeleteVertexArrays(1, &vao);
         if (ssbo) glDeleteBuffers(1, &ssbo);
+        if (indices) glDeleteBuffers(1, &indices);
     }
 };
 
@@ -472,8 +485,19 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, r.ssbo);
     glBindTextureUnit(1, hostDepth);
     glBindTextureUnit(2, tex.texture);
+    const std::uint32_t count = b - a;
+    if (count > r.indexedTets) { // grown by doubling, rebuilt rarely
+        r.indexedTets = std::max(count, 2 * r.indexedTets);
+        std::vector<std::uint32_t> idx(std::size_t(r.indexedTets) * 12);
+        for (std::uint32_t t = 0; t < r.indexedTets; ++t)
+            for (int k = 0; k < 12; ++k) idx[std::size_t(t) * 12 + std::size_t(k)] = 4 * t + kTetraFaces[k];
+        if (r.indices) glDeleteBuffers(1, &r.indices);
+        glCreateBuffers(1, &r.indices);
+        glNamedBufferStorage(r.indices, GLsizeiptr(idx.size() * sizeof(std::uint32_t)), idx.data(), 0);
+        glVertexArrayElementBuffer(r.vao, r.indices);
+    }
     glBindVertexArray(r.vao);
-    glDrawArraysInstanced(GL_TRIANGLES, 0, 12, GLsizei(b - a));
+    glDrawElements(GL_TRIANGLES, GLsizei(count) * 12, GL_UNSIGNED_INT, nullptr);
     ++r.stats.drawCalls;
     r.stats.tetrahedra += b - a;
 
