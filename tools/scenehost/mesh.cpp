@@ -131,7 +131,7 @@ splatfx::Status checkHeaderCounts(const std::string& path, std::uintmax_t fileBy
 // machine, with other files, never saw).
 class ConfinedIOSystem : public Assimp::DefaultIOSystem {
 public:
-    ConfinedIOSystem(std::filesystem::path folder, std::uintmax_t maxBytes) : folder_(std::move(folder)), maxBytes_(maxBytes) {}
+    ConfinedIOSystem(std::filesystem::path folder, std::uintmax_t maxBytes) : mFolder(std::move(folder)), mMaxBytes(maxBytes) {}
 
     bool Exists(const char* file) const override { return allowed(file); }
 
@@ -147,14 +147,14 @@ private:
         std::error_code ec;
         const std::filesystem::path p = std::filesystem::canonical(file, ec); // symlinks resolved
         if (ec || !std::filesystem::is_regular_file(p, ec)) return false;
-        const std::filesystem::path rel = p.lexically_relative(folder_);
+        const std::filesystem::path rel = p.lexically_relative(mFolder);
         if (rel.empty() || *rel.begin() == "..") return false;
         const std::uintmax_t bytes = std::filesystem::file_size(p, ec);
-        return !ec && bytes <= maxBytes_;
+        return !ec && bytes <= mMaxBytes;
     }
 
-    std::filesystem::path folder_;
-    std::uintmax_t maxBytes_;
+    std::filesystem::path mFolder;
+    std::uintmax_t mMaxBytes;
 };
 
 void appendNode(const aiScene* scene, const aiNode* node, const aiMatrix4x4& parent, Mesh& out) {

@@ -324,7 +324,7 @@ struct Viewer {
             }
             static const char* kScales[] = {"full resolution", "1/2 resolution", "1/4 resolution"};
             int scaleIndex = resolutionScale == 4 ? 2 : resolutionScale - 1;
-            if (ImGui::Combo("effects drawn at", &scaleIndex, kScales, 3)) {
+            if (ImGui::Combo("volumes drawn at", &scaleIndex, kScales, 3)) { // splats, clouds, ground fog
                 resolutionScale = scaleIndex == 2 ? 4 : scaleIndex + 1;
                 if (player)
                     if (auto st = player->setRenderer(rendererDesc()); !st) error = st.error();
