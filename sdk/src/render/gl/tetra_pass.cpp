@@ -19,7 +19,7 @@
 namespace splatfx::gl::detail {
 namespace {
 
-// Per instance, 10 vec4 (std430): the four vertices relative to the eye,
+// Per tetrahedron, 10 vec4 (std430): the four vertices relative to the eye,
 // the four barycentric planes lambda_i(x) = dot(B_i.xyz, x) + B_i.w (x
 // relative to the eye, lambda_i = 1 at vertex i, 0 on the opposite face),
 // and the scalar and length scale as linear functions of x.
@@ -332,7 +332,7 @@ void TetraPass::prepare(const Frame& frame) {
     }
     for (const auto& t : r.tables) r.stats.tableBytes += t.source ? t.source->bytes() : 0;
 
-    // Per-instance records, relative to the eye (float precision where it matters).
+    // Per-tetrahedron records, relative to the eye (float precision where it matters).
     const Camera& camera = frame.camera();
     r.eye = camera.eye();
     const glm::dvec3 eye(r.eye);

@@ -6,8 +6,8 @@
 // faces are drawn with back faces culled, so each covered pixel gets exactly
 // one fragment (the front faces of a convex cell tile its projection). The
 // fragment intersects its pixel's ray with the tetrahedron's four face planes
-// (per-instance barycentric planes), which gives the entry and exit distances;
-// the scalar and length scale at both ends come from per-instance linear
+// (per-tetrahedron barycentric planes), which gives the entry and exit distances;
+// the scalar and length scale at both ends come from per-tetrahedron linear
 // functions. The exit is cut at the host's depth (from HostTarget's depth
 // texture) before the lookup, so host geometry inside a cloud is exact. Near-
 // plane clipping is done on the CPU (clipTetrahedron) and GL's own near/far
@@ -59,7 +59,7 @@ public:
 
     // Step 0 of the frame: uploads the tables the frame's volumes use that
     // changed (new address or version), drops tables no longer used, and
-    // builds the per-instance data of every volume. Resets the frame stats.
+    // builds the per-tetrahedron data of every volume. Resets the frame stats.
     void prepare(const Frame& frame);
     // Draws tetrahedra [begin, end) of frame.volumes()[volume] (after prepare).
     void draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const TetraTarget& target);
