@@ -171,6 +171,44 @@ void renderFrame(gl::FrameRenderer& fr, gl::Framebuffer& fb, Frame& frame, doubl
                       }});
 }
 
+// The campfire's splats and the 16x16x8 cloud box (corner at `origin`) in one
+// frame, and the two drawn by hand in a chosen order: the volume alone through
+// a frame renderer, the splats alone through gl::Renderer.
+struct FireAndCloud {
+    Cloud cl;
+    Materials materials{Footprint{}};
+    std::uint32_t set = materials.addTextureSet(TextureSet::turbulence({.count = 4, .size = 16, .seed = 3}));
+    std::uint32_t colors = materials.addColorTable(ColorTable::fire());
+    Camera cam = test::campfireCamera(kSize);
+    Frame frame;
+
+    ::testing::AssertionResult build(glm::vec3 origin) {
+        auto vol = LodVolume::create(cl.field, {.originWorld = origin});
+        if (!vol) return ::testing::AssertionFailure() << vol.error();
+        frame.begin(0.0, cam);
+        frame.builder().add(test::campfireGrid(3), materials, {.textureSet = set, .colorTable = colors});
+        FrameVolume& fv = frame.volumes().emplace_back();
+        fv.table = &*cl.table;
+        if (!vol->update(cam, {.detailC = 20.0f}, &*cl.transfer, fv.lod)) return ::testing::AssertionFailure() << "update failed";
+        frame.end();
+        if (frame.splats().empty() || fv.lod.tets.empty()) return ::testing::AssertionFailure() << "no splats or no tetrahedra";
+        return ::testing::AssertionSuccess();
+    }
+
+    Image byHand(gl::FrameRenderer& volumes, gl::Renderer& splats, gl::Framebuffer& fb, bool splatsFirst) const {
+        Frame cloudOnly;
+        cloudOnly.begin(0.0, cam);
+        cloudOnly.volumes().push_back(frame.volumes()[0]);
+        cloudOnly.end();
+        fb.clear({0, 0, 0, 0});
+        auto drawSplats = [&] { splats.draw(frame.splats(), cam, {.framebuffer = fb.handle(), .width = kSize.x, .height = kSize.y}); };
+        if (splatsFirst) drawSplats();
+        volumes.render(cloudOnly, {.framebuffer = fb.handle(), .depthTexture = fb.depthTexture()});
+        if (!splatsFirst) drawSplats();
+        return fb.read();
+    }
+};
+
 // Outside the cloud, LOD refinement: the GL image equals the pass's CPU model
 // within the derived bound at every pixel, and so stays within the table's own
 // error of the exact integral through the same emitted mesh.
@@ -423,51 +461,22 @@ TEST_F(TetraPassGL, DegenerateNonFiniteAndTransparentTetrahedraAreSkipped) {
 // each equals drawing the two passes by hand in that order, and the wrong
 // order gives a visibly different image.
 TEST_F(TetraPassGL, SplatsAndTetrahedraCompositeInDepthOrder) {
-    Cloud cl;
-    Materials materials{Footprint{}};
-    const std::uint32_t set = materials.addTextureSet(TextureSet::turbulence({.count = 4, .size = 16, .seed = 3}));
-    const std::uint32_t colors = materials.addColorTable(ColorTable::fire());
-    const Camera cam = test::campfireCamera(kSize);
+    FireAndCloud fc;
     auto fr = gl::FrameRenderer::create();
     auto splatsOnly = gl::Renderer::create();
     auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
     ASSERT_TRUE(fr && splatsOnly && fb);
-    ASSERT_TRUE(fr->upload(materials));
-    ASSERT_TRUE(splatsOnly->upload(materials));
+    ASSERT_TRUE(fr->upload(fc.materials));
+    ASSERT_TRUE(splatsOnly->upload(fc.materials));
     for (const bool cloudInFront : {false, true}) {
         SCOPED_TRACE(cloudInFront ? "cloud in front" : "cloud behind");
-        // The 16x16x8 cloud box: behind the fire (z in [-20, -12]) or between it and the eye (z in [4, 12]).
-        auto vol = LodVolume::create(cl.field, {.originWorld = {-8.0f, -4.0f, cloudInFront ? 4.0f : -20.0f}});
-        ASSERT_TRUE(vol);
-        Frame frame;
-        frame.begin(0.0, cam);
-        frame.builder().add(test::campfireGrid(3), materials, {.textureSet = set, .colorTable = colors});
-        FrameVolume& fv = frame.volumes().emplace_back();
-        fv.table = &*cl.table;
-        ASSERT_TRUE(vol->update(cam, {.detailC = 20.0f}, &*cl.transfer, fv.lod));
-        frame.end();
-        ASSERT_GT(frame.splats().size(), 0u);
-        ASSERT_GT(fv.lod.tets.size(), 0u);
-        ASSERT_EQ(frame.drawOrder().size(), 2u); // the two lists do not overlap in depth here
-        EXPECT_EQ(frame.drawOrder()[0].kind, cloudInFront ? DrawBatch::Kind::Splats : DrawBatch::Kind::Tetrahedra);
-        renderFrame(*fr, *fb, frame, 1.0);
+        // The cloud box: behind the fire (z in [-20, -12]) or between it and the eye (z in [4, 12]).
+        ASSERT_TRUE(fc.build({-8.0f, -4.0f, cloudInFront ? 4.0f : -20.0f}));
+        ASSERT_EQ(fc.frame.drawOrder().size(), 2u); // the two lists do not overlap in depth here
+        EXPECT_EQ(fc.frame.drawOrder()[0].kind, cloudInFront ? DrawBatch::Kind::Splats : DrawBatch::Kind::Tetrahedra);
+        renderFrame(*fr, *fb, fc.frame, 1.0);
         const Image together = fb->read();
-        // By hand: the volume alone through the frame renderer, the splats alone through gl::Renderer.
-        Frame cloudOnly;
-        cloudOnly.begin(0.0, cam);
-        cloudOnly.volumes().push_back(fv);
-        cloudOnly.end();
-        auto byHand = [&](bool splatsFirst) {
-            fb->clear({0, 0, 0, 0});
-            auto splats = [&] {
-                splatsOnly->draw(frame.splats(), cam, {.framebuffer = fb->handle(), .width = kSize.x, .height = kSize.y});
-            };
-            if (splatsFirst) splats();
-            fr->render(cloudOnly, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture()});
-            if (!splatsFirst) splats();
-            return fb->read();
-        };
-        const Image right = byHand(cloudInFront), wrong = byHand(!cloudInFront);
+        const Image right = fc.byHand(*fr, *splatsOnly, *fb, cloudInFront), wrong = fc.byHand(*fr, *splatsOnly, *fb, !cloudInFront);
         double dRight = 0.0, dWrong = 0.0;
         for (std::size_t i = 0; i < together.pixels.size(); ++i) {
             dRight = std::max(dRight, double(std::abs(together.pixels[i] - right.pixels[i])));
@@ -562,51 +571,32 @@ TEST_F(TetraPassGL, ReducedResolutionSplatsLeaveTheTetrahedraAtFullResolution) {
 // the cloud); the per-pass path
 // (tetrahedra at full resolution, then all splats) is closer to the wrong one.
 TEST_F(TetraPassGL, ReducedTetrahedraKeepTheOneOrderWithTheSplats) {
-    Cloud cl;
-    Materials materials{Footprint{}};
-    const std::uint32_t set = materials.addTextureSet(TextureSet::turbulence({.count = 4, .size = 16, .seed = 3}));
-    const std::uint32_t colors = materials.addColorTable(ColorTable::fire());
-    const Camera cam = test::campfireCamera(kSize);
+    FireAndCloud fc;
     auto full = gl::FrameRenderer::create();
     auto oneOrder = gl::FrameRenderer::create({.resolutionScale = 2, .reduceTetrahedra = true});
     auto perPass = gl::FrameRenderer::create({.resolutionScale = 2});
-    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
-    ASSERT_TRUE(full && oneOrder && perPass && fb);
-    for (gl::FrameRenderer* r : {&*full, &*oneOrder, &*perPass}) ASSERT_TRUE(r->upload(materials));
-    auto vol = LodVolume::create(cl.field, {.originWorld = {-8.0f, -4.0f, 4.0f}}); // between the fire and the eye
-    ASSERT_TRUE(vol);
-    Frame frame;
-    frame.begin(0.0, cam);
-    frame.builder().add(test::campfireGrid(3), materials, {.textureSet = set, .colorTable = colors});
-    FrameVolume& fv = frame.volumes().emplace_back();
-    fv.table = &*cl.table;
-    ASSERT_TRUE(vol->update(cam, {.detailC = 20.0f}, &*cl.transfer, fv.lod));
-    frame.end();
-    ASSERT_EQ(frame.drawOrder().size(), 2u);
-    ASSERT_EQ(frame.drawOrder()[0].kind, DrawBatch::Kind::Splats); // the fire first: the cloud is nearer
-    // Full resolution in the right order, and in the wrong one (the batches swapped).
-    renderFrame(*full, *fb, frame, 1.0);
-    const Image right = fb->read();
-    Frame cloudOnly;
-    cloudOnly.begin(0.0, cam);
-    cloudOnly.volumes().push_back(fv);
-    cloudOnly.end();
     auto splatsOnly = gl::Renderer::create();
-    ASSERT_TRUE(splatsOnly && splatsOnly->upload(materials));
-    fb->clear({0, 0, 0, 0});
-    full->render(cloudOnly, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture()});
-    splatsOnly->draw(frame.splats(), cam, {.framebuffer = fb->handle(), .width = kSize.x, .height = kSize.y});
-    const Image wrong = fb->read(); // the fire over the cloud
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(full && oneOrder && perPass && splatsOnly && fb);
+    for (gl::FrameRenderer* r : {&*full, &*oneOrder, &*perPass}) ASSERT_TRUE(r->upload(fc.materials));
+    ASSERT_TRUE(splatsOnly->upload(fc.materials));
+    ASSERT_TRUE(fc.build({-8.0f, -4.0f, 4.0f})); // the cloud between the fire and the eye
+    ASSERT_EQ(fc.frame.drawOrder().size(), 2u);
+    ASSERT_EQ(fc.frame.drawOrder()[0].kind, DrawBatch::Kind::Splats); // the fire first: the cloud is nearer
+    // Full resolution in the right order, and by hand in the wrong one (the fire over the cloud).
+    renderFrame(*full, *fb, fc.frame, 1.0);
+    const Image right = fb->read();
+    const Image wrong = fc.byHand(*full, *splatsOnly, *fb, false);
     auto distance = [](const Image& a, const Image& b) {
         double d = 0.0;
         for (std::size_t i = 0; i < a.pixels.size(); ++i) d += std::abs(double(a.pixels[i]) - double(b.pixels[i]));
         return d;
     };
     ASSERT_GT(distance(right, wrong), 0.0);
-    renderFrame(*oneOrder, *fb, frame, 1.0);
+    renderFrame(*oneOrder, *fb, fc.frame, 1.0);
     const Image reduced = fb->read();
     EXPECT_LT(distance(reduced, right), distance(reduced, wrong));
-    renderFrame(*perPass, *fb, frame, 1.0);
+    renderFrame(*perPass, *fb, fc.frame, 1.0);
     const Image split = fb->read();
     EXPECT_GT(distance(split, right), distance(split, wrong)) << "the per-pass path draws the splats last";
 }

@@ -18,6 +18,7 @@
 
 #include <epoxy/gl.h>
 
+#include "bench_gl.hpp"
 #include "bench_stats.hpp"
 #include "commands.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
@@ -138,12 +139,7 @@ int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
             for (int f = -1; f < reps; ++f) { // one warm-up frame: the table upload, the shader
                 const auto a = Clock::now();
                 scene.prepare(1.0, v.camera, materials, frame);
-                fr->render(frame, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture(), .drawOpaque = [] {
-                                   glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-                                   glClearDepth(1.0);
-                                   glDepthMask(GL_TRUE);
-                                   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-                               }});
+                fr->render(frame, bench::clearedTarget(*fb, {0.0f, 0.0f, 0.0f, 0.0f}));
                 glFinish();
                 if (f >= 0) t.push_back(std::chrono::duration<double, std::milli>(Clock::now() - a).count());
             }

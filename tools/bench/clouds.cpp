@@ -17,6 +17,7 @@
 
 #include <epoxy/gl.h>
 
+#include "bench_gl.hpp"
 #include "bench_stats.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
@@ -175,12 +176,7 @@ int runClouds(int argc, char** argv) {
                 const auto a = Clock::now();
                 cs.scene.prepare(f / 60.0 + 1.0, cam, materials, frame);
                 const auto b = Clock::now();
-                pass.renderer->render(frame, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture(), .drawOpaque = [] {
-                                              glClearColor(0.45f, 0.6f, 0.85f, 1.0f);
-                                              glClearDepth(1.0);
-                                              glDepthMask(GL_TRUE);
-                                              glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-                                          }});
+                pass.renderer->render(frame, bench::clearedTarget(*fb, {0.45f, 0.6f, 0.85f, 1.0f}));
                 glFinish();
                 const auto c = Clock::now();
                 if (f < 0) continue;
@@ -260,12 +256,7 @@ int runClouds(int argc, char** argv) {
             for (int f = 0; f < o.popFrames; ++f) {
                 const splatfx::Camera cam = slowFlight(cs.ext, f, o.popStepWorld, o.popSize);
                 cs.scene.prepare(f / 60.0 + 1.0, cam, materials, frame);
-                fr->render(frame, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture(), .drawOpaque = [] {
-                                   glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-                                   glClearDepth(1.0);
-                                   glDepthMask(GL_TRUE);
-                                   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-                               }});
+                fr->render(frame, bench::clearedTarget(*fb, {0.0f, 0.0f, 0.0f, 0.0f}));
                 drawn += double(fr->stats().tetrahedra);
                 splatfx::Image img = fb->read();
                 if (f > 0)
@@ -305,12 +296,7 @@ int runClouds(int argc, char** argv) {
         auto shared = std::make_shared<const splatfx::Fog>(*fog);
         auto draw = [&](splatfx::gl::FrameRenderer& r, bool fogged) {
             frame.setFog(fogged ? shared : nullptr);
-            r.render(frame, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture(), .drawOpaque = [] {
-                             glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-                             glClearDepth(1.0);
-                             glDepthMask(GL_TRUE);
-                             glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-                         }});
+            r.render(frame, bench::clearedTarget(*fb, {0.0f, 0.0f, 0.0f, 0.0f}));
             glFinish();
         };
         std::vector<double> tNo, tYes;

@@ -16,6 +16,7 @@
 
 #include <epoxy/gl.h>
 
+#include "bench_gl.hpp"
 #include "bench_stats.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
@@ -147,12 +148,7 @@ int runGroundFog(int argc, char** argv) {
             const auto a = Clock::now();
             l.scene.prepare(1.0 + f / 24.0, cam, materials, frame);
             const auto b = Clock::now();
-            l.renderer->render(frame, {.framebuffer = fb->handle(), .depthTexture = fb->depthTexture(), .drawOpaque = [] {
-                                   glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
-                                   glClearDepth(1.0);
-                                   glDepthMask(GL_TRUE);
-                                   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-                               }});
+            l.renderer->render(frame, bench::clearedTarget(*fb, {0.0f, 0.0f, 0.0f, 0.0f}));
             glFinish();
             const auto c = Clock::now();
             if (f < 0) continue;

@@ -22,6 +22,7 @@
 #include <epoxy/gl.h>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "bench_gl.hpp"
 #include "geometry_renderer.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
@@ -331,10 +332,7 @@ int runShadows(int argc, char** argv) {
                 const std::clock_t c0 = std::clock();
                 scene.prepare(t, cam, m, frame);
                 fr->render(frame, {.framebuffer = fb->handle(), .drawOpaque = [&] {
-                                       glClearColor(0.1f, 0.1f, 0.12f, 1.0f);
-                                       glClearDepth(1.0);
-                                       glDepthMask(GL_TRUE);
-                                       glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+                                       bench::clearHost({0.1f, 0.1f, 0.12f, 1.0f});
                                        scenehost::GeometryLighting gl;
                                        gl.light = glm::vec4(-glm::normalize(light.direction), 0.0f);
                                        gl.shadow = fr->shadowBinding();

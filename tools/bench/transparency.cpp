@@ -17,6 +17,7 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "bench_gl.hpp"
 #include "splatfx/splatfx.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/transparency.hpp"
@@ -215,12 +216,7 @@ int runTransparency(int argc, char** argv) {
     }
     auto renderOnce = [&](std::size_t i) {
         const Config& c = configs[i];
-        splatfx::gl::HostTarget target{.framebuffer = fb->handle(), .depthTexture = fb->depthTexture(), .drawOpaque = [&] {
-                                           glClearColor(kBackground.r, kBackground.g, kBackground.b, kBackground.a);
-                                           glClearDepth(1.0);
-                                           glDepthMask(GL_TRUE);
-                                           glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-                                       }};
+        splatfx::gl::HostTarget target = bench::clearedTarget(*fb, kBackground);
         if (c.panes) {
             target.drawTransparent = [&] { glass.draw(*c.panes, cam, c.lists); };
             target.transparentToLists = c.lists;

@@ -263,28 +263,7 @@ void FrameRenderer::drawInterleaved(const Frame& frame, const HostTarget& target
     const detail::TetraTarget tt{.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
                                  .depthTexture = target.depthTexture};
     std::uint64_t calls = 0, batches = 0;
-    if (r.reduced && r.desc.reduceTetrahedra) {
-        // Both into one reduced image, in draw order, composited once (an "over"
-        // sequence drawn into a cleared layer and then over the host is the same sequence).
-        const ScaledTarget st{.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
-                              .depthTexture = target.depthTexture};
-        const ReducedLayer layer = r.reduced->begin(st, {0, 0, w, h});
-        // The tetrahedra cut at the downsampled depth, as the splats are tested against it.
-        const detail::TetraTarget lowTets{.framebuffer = layer.framebuffer, .width = layer.width, .height = layer.height,
-                                          .depthTexture = layer.depthTexture};
-        for (const DrawBatch& b : frame.drawOrder()) {
-            ++batches;
-            if (b.kind == DrawBatch::Kind::Tetrahedra) {
-                r.tetra->draw(frame, b.volume, b.begin, b.end, lowTets);
-                continue;
-            }
-            const auto& all = frame.splats();
-            r.batch.assign(all.begin() + std::ptrdiff_t(b.begin), all.begin() + std::ptrdiff_t(b.end));
-            r.reduced->drawSplats(r.batch, camera);
-            calls += r.reduced->renderer().stats().drawCalls;
-        }
-        r.reduced->composite(camera);
-    } else if (r.reduced) {
+    if (r.reduced && !r.desc.reduceTetrahedra) {
         // Reduced-resolution splats are composited in one pass, so the order
         // is per pass: every tetrahedron (full resolution), then the splats.
         for (const DrawBatch& b : frame.drawOrder())
@@ -295,18 +274,35 @@ void FrameRenderer::drawInterleaved(const Frame& frame, const HostTarget& target
         calls += r.reduced->renderer().stats().drawCalls;
         ++batches;
     } else {
+        // Every batch in draw order: into the host target, or (reduceTetrahedra)
+        // all into one reduced image composited once (an "over" sequence drawn
+        // into a cleared layer and then over the host is the same sequence).
+        detail::TetraTarget tets = tt;
+        if (r.reduced) {
+            const ReducedLayer layer = r.reduced->begin(
+                {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h, .depthTexture = target.depthTexture},
+                {0, 0, w, h});
+            // The tetrahedra cut at the downsampled depth, as the splats are tested against it.
+            tets = {.framebuffer = layer.framebuffer, .width = layer.width, .height = layer.height, .depthTexture = layer.depthTexture};
+        }
         for (const DrawBatch& b : frame.drawOrder()) {
             ++batches;
             if (b.kind == DrawBatch::Kind::Tetrahedra) {
-                r.tetra->draw(frame, b.volume, b.begin, b.end, tt);
+                r.tetra->draw(frame, b.volume, b.begin, b.end, tets);
                 continue;
             }
             const auto& all = frame.splats();
             r.batch.assign(all.begin() + std::ptrdiff_t(b.begin), all.begin() + std::ptrdiff_t(b.end));
-            r.full->draw(r.batch, camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
-                                           .depthTexture = target.depthTexture});
-            calls += r.full->stats().drawCalls;
+            if (r.reduced) {
+                r.reduced->drawSplats(r.batch, camera);
+                calls += r.reduced->renderer().stats().drawCalls;
+            } else {
+                r.full->draw(r.batch, camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
+                                               .depthTexture = target.depthTexture});
+                calls += r.full->stats().drawCalls;
+            }
         }
+        if (r.reduced) r.reduced->composite(camera);
     }
     const detail::TetraStats& ts = r.tetra->stats();
     r.stats.drawCalls = calls + ts.drawCalls;
