@@ -86,8 +86,7 @@ struct Campfire {
         both.pixels.resize(size_t(both.width) * both.height * 4);
         for (int y = 0; y < both.height; ++y)
             for (int x = 0; x < both.width; ++x)
-                for (int c = 0; c < 4; ++c)
-                    both.at(x, y, c) = halves[x / fc.size.x].at(x % fc.size.x, y, c);
+                for (int c = 0; c < 4; ++c) both.at(x, y, c) = halves[x / fc.size.x].at(x % fc.size.x, y, c);
         if (auto s = splatfx::writeImage(fc.outputs->path("campfire_figure1.png"), both); !s) return fail(s.error());
         fc.outputs->add("campfire_figure1.png");
         std::printf("campfire: %s/campfire_figure1.png (left: traditional splats, right: textured splats)\n", options.out.c_str());
@@ -99,8 +98,7 @@ struct Campfire {
 
 int main(int argc, char** argv) {
     Campfire app;
-    if (!samples::parseOptions(argc, argv, "campfire", "the paper's 7x20x5 fire as textured splats (Figure 1)", app.options))
-        return 2;
+    if (!samples::parseOptions(argc, argv, "campfire", "the paper's 7x20x5 fire as textured splats (Figure 1)", app.options)) return 2;
     return samples::run(
         app.options, "campfire", [&] { return app.setup(); }, [&](const samples::FrameContext& fc) { return app.frame(fc); });
 }

@@ -34,8 +34,9 @@ int run(int argc, char** argv) {
         else if (a == "--seed" && hasValue) s = cli::parseInt("--seed", argv[++i], 0u, 0xffffffffu, desc.seed);
         else if (a == "--time" && hasValue) s = cli::parseReal("--time", argv[++i], 0.0, 1.0e6, timeSec);
         else if (a == "--screenshot" && hasValue) screenshot = argv[++i];
-        else return fail("unknown or incomplete option '" + std::string(a) +
-                         "'; usage: ogre-campfire [--frames N] [--size WxH] [--scale 1|2|4] [--seed S] [--time SECONDS] [--screenshot out.png]");
+        else
+            return fail("unknown or incomplete option '" + std::string(a) +
+                        "'; usage: ogre-campfire [--frames N] [--size WxH] [--scale 1|2|4] [--seed S] [--time SECONDS] [--screenshot out.png]");
         if (!s) return fail(s.error());
     }
     auto app = ogrefx::OgreCampfire::create(desc);
@@ -48,10 +49,9 @@ int run(int argc, char** argv) {
     const ogrefx::HookInfo& h = (*app)->hook();
     std::printf("ogre-campfire: %s; %d frames; OGRE framebuffer %u (OGRE says %u), depth %s 0x%x %s, viewport %d %d %d %d, "
                 "scissor %s %d %d %d %d%s; %zu splats\n",
-                h.glRenderer.c_str(), frames, h.framebuffer, h.framebufferFromOgre,
-                h.depthObjectType == 0x8D41 ? "renderbuffer" : "texture", h.depthInternalFormat,
-                h.depthCopied ? "(copied to a texture)" : "(handed over as it is)", h.viewport[0], h.viewport[1], h.viewport[2],
-                h.viewport[3], h.scissor ? "on" : "off", h.scissorBox[0], h.scissorBox[1], h.scissorBox[2], h.scissorBox[3],
+                h.glRenderer.c_str(), frames, h.framebuffer, h.framebufferFromOgre, h.depthObjectType == 0x8D41 ? "renderbuffer" : "texture",
+                h.depthInternalFormat, h.depthCopied ? "(copied to a texture)" : "(handed over as it is)", h.viewport[0], h.viewport[1],
+                h.viewport[2], h.viewport[3], h.scissor ? "on" : "off", h.scissorBox[0], h.scissorBox[1], h.scissorBox[2], h.scissorBox[3],
                 h.flipped ? ", flipped" : "", h.splats);
     if (!screenshot.empty()) {
         auto image = (*app)->readColour();
@@ -64,4 +64,6 @@ int run(int argc, char** argv) {
 
 } // namespace
 
-int main(int argc, char** argv) { return cli::guardedMain("ogre-campfire", [&] { return run(argc, argv); }); }
+int main(int argc, char** argv) {
+    return cli::guardedMain("ogre-campfire", [&] { return run(argc, argv); });
+}

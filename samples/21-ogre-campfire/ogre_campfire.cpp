@@ -126,10 +126,10 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
     ~Impl() override {
         if (depthCopyFbo) glDeleteFramebuffers(1, &depthCopyFbo);
         if (depthCopy) glDeleteTextures(1, &depthCopy);
-        renderer.reset();                 // its GL objects live in OGRE's context: before the Root goes
+        renderer.reset(); // its GL objects live in OGRE's context: before the Root goes
         if (sceneManager) sceneManager->removeRenderQueueListener(this);
         colourTexture.reset();
-        root.reset();                     // destroys the window and the context
+        root.reset(); // destroys the window and the context
         logManager.reset();
     }
 
@@ -186,8 +186,8 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
             glNamedFramebufferReadBuffer(depthCopyFbo, GL_NONE);
             const GLenum status = glCheckNamedFramebufferStatus(depthCopyFbo, GL_DRAW_FRAMEBUFFER);
             if (status != GL_FRAMEBUFFER_COMPLETE) {
-                hookError = "the depth copy's framebuffer is incomplete (status " + std::to_string(status) + ", format " +
-                            std::to_string(format) + ")";
+                hookError =
+                    "the depth copy's framebuffer is incomplete (status " + std::to_string(status) + ", format " + std::to_string(format) + ")";
                 return 0;
             }
             depthCopyFormat = format;
@@ -219,9 +219,7 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
             Ogre::uint32 id = 0;
             target->getCustomAttribute("GL_FBOID", &id);
             info.framebufferFromOgre = id;
-        } catch (const Ogre::Exception&) {
-            info.framebufferFromOgre = 0;
-        }
+        } catch (const Ogre::Exception&) { info.framebufferFromOgre = 0; }
         GLint vp[4] = {};
         glGetIntegerv(GL_VIEWPORT, vp);
         std::copy(vp, vp + 4, info.viewport);
@@ -310,8 +308,8 @@ splatfx::Result<std::unique_ptr<OgreCampfire>> OgreCampfire::create(const OgreCa
         auto stone = material("splatfx/wall", {0.50f, 0.50f, 0.52f}, 0.0f);
 
         Ogre::SceneNode* rootNode = s.sceneManager->getRootSceneNode();
-        Ogre::MeshManager::getSingleton().createPlane("splatfx/groundPlane", group, Ogre::Plane(Ogre::Vector3::UNIT_Y, 0.0f),
-                                                      60.0f, 60.0f, 1, 1, true, 1, 1.0f, 1.0f, Ogre::Vector3::UNIT_Z);
+        Ogre::MeshManager::getSingleton().createPlane("splatfx/groundPlane", group, Ogre::Plane(Ogre::Vector3::UNIT_Y, 0.0f), 60.0f, 60.0f, 1, 1,
+                                                      true, 1, 1.0f, 1.0f, Ogre::Vector3::UNIT_Z);
         Ogre::Entity* groundEntity = s.sceneManager->createEntity("ground", "splatfx/groundPlane");
         groundEntity->setMaterial(ground);
         rootNode->createChildSceneNode()->attachObject(groundEntity);
@@ -337,23 +335,20 @@ splatfx::Result<std::unique_ptr<OgreCampfire>> OgreCampfire::create(const OgreCa
         camNode->attachObject(s.ogreCamera);
 
         // The render target OGRE draws into (as an engine with post-processing does).
-        s.colourTexture = Ogre::TextureManager::getSingleton().createManual(
-            "splatfx/frame", group, Ogre::TEX_TYPE_2D, Ogre::uint(desc.width), Ogre::uint(desc.height), 0, Ogre::PF_BYTE_RGBA,
-            Ogre::TU_RENDERTARGET);
+        s.colourTexture = Ogre::TextureManager::getSingleton().createManual("splatfx/frame", group, Ogre::TEX_TYPE_2D, Ogre::uint(desc.width),
+                                                                            Ogre::uint(desc.height), 0, Ogre::PF_BYTE_RGBA, Ogre::TU_RENDERTARGET);
         s.target = s.colourTexture->getBuffer()->getRenderTarget();
         s.viewport = s.target->addViewport(s.ogreCamera);
         s.viewport->setBackgroundColour(Ogre::ColourValue(0.05f, 0.06f, 0.10f, 1.0f));
         s.viewport->setClearEveryFrame(true);
         s.viewport->setOverlaysEnabled(false);
-    } catch (const Ogre::Exception& e) {
-        return makeError("OGRE: " + describe(e));
-    } catch (const std::exception& e) {
+    } catch (const Ogre::Exception& e) { return makeError("OGRE: " + describe(e)); } catch (const std::exception& e) {
         return makeError(std::string("OGRE: ") + e.what());
     }
 
     // splatfx, in OGRE's context (current on this thread since initialise()).
-    s.info.glRenderer = std::string(reinterpret_cast<const char*>(glGetString(GL_RENDERER))) + " / " +
-                        reinterpret_cast<const char*>(glGetString(GL_VERSION));
+    s.info.glRenderer =
+        std::string(reinterpret_cast<const char*>(glGetString(GL_RENDERER))) + " / " + reinterpret_cast<const char*>(glGetString(GL_VERSION));
     auto fire = splatfx::presets::fire(s.materials, {.dims = {7, 20, 5},
                                                      .spacing = glm::vec3(0.5f),
                                                      .propagationStepsPerSec = 8.0f,
@@ -382,9 +377,7 @@ splatfx::Status OgreCampfire::render(const FrameOptions& options) {
     try {
         s.logNode->setVisible(options.log);
         if (!s.root->renderOneFrame()) return splatfx::makeError("OGRE's renderOneFrame asked to stop");
-    } catch (const Ogre::Exception& e) {
-        return splatfx::makeError("OGRE: " + describe(e));
-    }
+    } catch (const Ogre::Exception& e) { return splatfx::makeError("OGRE: " + describe(e)); }
     if (!s.hookError.empty()) return splatfx::makeError(s.hookError);
     if (options.fire && s.info.calls != 1)
         return splatfx::makeError("the render-queue hook drew " + std::to_string(s.info.calls) + " times in one frame; expected 1");
@@ -396,9 +389,7 @@ splatfx::Result<splatfx::Image> OgreCampfire::readColour() const {
     Ogre::Image image;
     try {
         s.colourTexture->convertToImage(image);
-    } catch (const Ogre::Exception& e) {
-        return splatfx::makeError("OGRE: " + describe(e));
-    }
+    } catch (const Ogre::Exception& e) { return splatfx::makeError("OGRE: " + describe(e)); }
     splatfx::Image out;
     out.width = int(image.getWidth());
     out.height = int(image.getHeight());

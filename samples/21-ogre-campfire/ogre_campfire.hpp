@@ -33,37 +33,37 @@
 namespace ogrefx {
 
 struct OgreCampfireDesc {
-    int width = 640;             // render-texture size, pixels; default 640
-    int height = 360;            // default 360
-    std::uint32_t seed = 1;      // the fire's texture dynamics; default 1
-    int resolutionScale = 1;     // splatfx::gl::FrameRendererDesc::resolutionScale (1, 2, 4); default 1
+    int width = 640;         // render-texture size, pixels; default 640
+    int height = 360;        // default 360
+    std::uint32_t seed = 1;  // the fire's texture dynamics; default 1
+    int resolutionScale = 1; // splatfx::gl::FrameRendererDesc::resolutionScale (1, 2, 4); default 1
     // splatfx's GL-state guard (RendererDesc::restoreState). false only to
     // show what OGRE's state cache does without it (the test's negative
     // control); default true.
     bool restoreState = true;
-    std::string pluginDir{};     // OGRE's plugin folder; empty: the one OGRE's CMake package names; default empty
+    std::string pluginDir{}; // OGRE's plugin folder; empty: the one OGRE's CMake package names; default empty
 };
 
 struct FrameOptions {
-    double timeSec = 1.0;        // the fire's time; default 1
-    bool fire = true;            // draw splatfx in OGRE's frame; default true
-    bool log = true;             // OGRE draws the log in front of the fire; default true
+    double timeSec = 1.0; // the fire's time; default 1
+    bool fire = true;     // draw splatfx in OGRE's frame; default true
+    bool log = true;      // OGRE draws the log in front of the fire; default true
 };
 
 // What the render-queue hook saw in the last frame (for the docs and tests).
 struct HookInfo {
-    int calls = 0;                       // times the hook drew splatfx in the last frame
-    unsigned framebuffer = 0;            // OGRE's draw framebuffer at the hook
-    unsigned framebufferFromOgre = 0;    // the same, asked of OGRE (RenderTarget "GL_FBOID"/"FBO")
-    unsigned depthObjectType = 0;        // GL_RENDERBUFFER or GL_TEXTURE: what OGRE attached as depth
-    unsigned depthInternalFormat = 0;    // its GL internal format (the copy's)
-    bool depthCopied = false;            // the depth was blitted into a texture (renderbuffer depth)
-    int viewport[4] = {0, 0, 0, 0};      // the GL viewport OGRE set
-    bool scissor = false;                // OGRE left the scissor test on (it limits the depth blit)
-    int scissorBox[4] = {0, 0, 0, 0};    // and its box
-    bool flipped = false;                // OGRE renders this target upside down (requiresTextureFlipping)
-    std::size_t splats = 0;              // splats splatfx drew
-    std::string glRenderer;              // GL_RENDERER / GL_VERSION of OGRE's context
+    int calls = 0;                    // times the hook drew splatfx in the last frame
+    unsigned framebuffer = 0;         // OGRE's draw framebuffer at the hook
+    unsigned framebufferFromOgre = 0; // the same, asked of OGRE (RenderTarget "GL_FBOID"/"FBO")
+    unsigned depthObjectType = 0;     // GL_RENDERBUFFER or GL_TEXTURE: what OGRE attached as depth
+    unsigned depthInternalFormat = 0; // its GL internal format (the copy's)
+    bool depthCopied = false;         // the depth was blitted into a texture (renderbuffer depth)
+    int viewport[4] = {0, 0, 0, 0};   // the GL viewport OGRE set
+    bool scissor = false;             // OGRE left the scissor test on (it limits the depth blit)
+    int scissorBox[4] = {0, 0, 0, 0}; // and its box
+    bool flipped = false;             // OGRE renders this target upside down (requiresTextureFlipping)
+    std::size_t splats = 0;           // splats splatfx drew
+    std::string glRenderer;           // GL_RENDERER / GL_VERSION of OGRE's context
 };
 
 class OgreCampfire {

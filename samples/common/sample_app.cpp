@@ -71,15 +71,13 @@ bool parseOptions(int argc, char** argv, const char* name, const char* about, Op
 
 namespace {
 
-int runHeadless(const Options& o, const char* name, const std::function<bool()>& setup,
-                const std::function<bool(const FrameContext&)>& frame) {
+int runHeadless(const Options& o, const char* name, const std::function<bool()>& setup, const std::function<bool(const FrameContext&)>& frame) {
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) {
         std::fprintf(stderr, "%s: %s\n", name, ctx.error().c_str());
         return 1;
     }
-    std::printf("%s: headless on %s, %d frames at %dx%d -> %s/\n", name, ctx->renderer().c_str(), o.frames, o.size.x, o.size.y,
-                o.out.c_str());
+    std::printf("%s: headless on %s, %d frames at %dx%d -> %s/\n", name, ctx->renderer().c_str(), o.frames, o.size.x, o.size.y, o.out.c_str());
     auto fb = splatfx::gl::Framebuffer::create({.width = o.size.x, .height = o.size.y});
     if (!fb) {
         std::fprintf(stderr, "%s: %s\n", name, fb.error().c_str());
@@ -133,8 +131,7 @@ int runHeadless(const Options& o, const char* name, const std::function<bool()>&
     return 0;
 }
 
-int runWindowed(const Options& o, const char* name, const std::function<bool()>& setup,
-                const std::function<bool(const FrameContext&)>& frame) {
+int runWindowed(const Options& o, const char* name, const std::function<bool()>& setup, const std::function<bool(const FrameContext&)>& frame) {
     auto window = splatfx::Window::create({.width = o.size.x, .height = o.size.y, .title = std::string("splatfx: ") + name});
     if (!window) {
         std::fprintf(stderr, "%s: %s\n%s: without a display, run headless: %s --frames N --out DIR\n", name, window.error().c_str(), name, name);
@@ -160,8 +157,7 @@ int runWindowed(const Options& o, const char* name, const std::function<bool()>&
 
 } // namespace
 
-int run(const Options& o, const char* name, const std::function<bool()>& setup,
-        const std::function<bool(const FrameContext&)>& frame) {
+int run(const Options& o, const char* name, const std::function<bool()>& setup, const std::function<bool(const FrameContext&)>& frame) {
     // Any exception from a sample's setup or frame (std::bad_alloc at a huge --size) becomes a message and exit code 1.
     return cli::guardedMain(name, [&] { return o.frames > 0 ? runHeadless(o, name, setup, frame) : runWindowed(o, name, setup, frame); });
 }

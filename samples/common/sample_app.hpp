@@ -18,13 +18,13 @@
 namespace samples {
 
 struct Options {
-    int frames = 0;                 // > 0: headless, render this many frames then exit
-    std::string out = "out";        // output folder (headless)
+    int frames = 0;          // > 0: headless, render this many frames then exit
+    std::string out = "out"; // output folder (headless)
     glm::ivec2 size{640, 480};
     std::uint32_t seed = 1;
     float fps = 24.0f;
-    bool traditional = false;       // untextured splats (Fig. 1a)
-    std::string extra;              // sample-specific flag value (see each sample's --help)
+    bool traditional = false; // untextured splats (Fig. 1a)
+    std::string extra;        // sample-specific flag value (see each sample's --help)
 };
 
 // Parses argv; prints usage and returns false on --help or a bad flag.
@@ -44,7 +44,6 @@ struct FrameContext {
 // splats) and returns false to stop with an error it has printed.
 // Headless: writes DIR/<name>_NNNN.png and DIR/<name>.gif as one output set
 // (splatfx/output_set.hpp). Returns the process exit code.
-int run(const Options& options, const char* name, const std::function<bool()>& setup,
-        const std::function<bool(const FrameContext&)>& frame);
+int run(const Options& options, const char* name, const std::function<bool()>& setup, const std::function<bool(const FrameContext&)>& frame);
 
 } // namespace samples

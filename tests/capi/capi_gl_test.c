@@ -151,12 +151,12 @@ static void test_fire_against_host_depth(splatfx_error* err, int scale) {
     Host open = {{1.0f, 1.0f, 1.0f}, 0, 0, 0};
     target.user_data = &open;
     CHECK_OK(splatfx_renderer_render(r, m, frame, &target, err), err);
-    CHECK(open.opaque_calls == 1 && open.transparent_calls == 1 && open.transparent_after_opaque,
-          "hooks: opaque %d, transparent %d, in order %d", open.opaque_calls, open.transparent_calls, open.transparent_after_opaque);
+    CHECK(open.opaque_calls == 1 && open.transparent_calls == 1 && open.transparent_after_opaque, "hooks: opaque %d, transparent %d, in order %d",
+          open.opaque_calls, open.transparent_calls, open.transparent_after_opaque);
     splatfx_render_stats rs;
     CHECK_OK(splatfx_renderer_get_stats(r, &rs, err), err);
-    CHECK(rs.splats == fs.splats && rs.resolution_scale == scale, "drew %llu of %llu splats at scale %d",
-          (unsigned long long)rs.splats, (unsigned long long)fs.splats, rs.resolution_scale);
+    CHECK(rs.splats == fs.splats && rs.resolution_scale == scale, "drew %llu of %llu splats at scale %d", (unsigned long long)rs.splats,
+          (unsigned long long)fs.splats, rs.resolution_scale);
     static unsigned char reference[4 * W * H], walled[4 * W * H], background[4 * W * H];
     read_pixels(&t, reference);
 
@@ -180,14 +180,11 @@ static void test_fire_against_host_depth(splatfx_error* err, int scale) {
     const BandStats refB = band_stats(reference, bg, BAND + margin, 2 * BAND - margin);
     /* The fire must be there to be hidden: clearly visible (a red gain of 0.2, about 51/255, as the
      * C++ frame-renderer test asks of a fire over a wall) and fire-coloured (more red than blue). */
-    CHECK(refA.max_red_gain >= 51 && refA.red > refA.blue, "scale %d: no fire in the bottom band without a wall (gain %d)",
-          scale, refA.max_red_gain);
-    CHECK(refB.max_red_gain >= 51 && refB.red > refB.blue, "scale %d: no fire in the middle band without a wall (gain %d)",
-          scale, refB.max_red_gain);
+    CHECK(refA.max_red_gain >= 51 && refA.red > refA.blue, "scale %d: no fire in the bottom band without a wall (gain %d)", scale, refA.max_red_gain);
+    CHECK(refB.max_red_gain >= 51 && refB.red > refB.blue, "scale %d: no fire in the middle band without a wall (gain %d)", scale, refB.max_red_gain);
     const BandStats hidden = band_stats(walled, bg, 0, BAND - margin);
     CHECK(hidden.changed == 0, "scale %d: %d pixels of fire drawn over a wall in front of it", scale, hidden.changed);
-    CHECK(rows_equal(walled, reference, BAND + margin, 2 * BAND - margin),
-          "scale %d: a wall behind the fire changed the fire in front of it", scale);
+    CHECK(rows_equal(walled, reference, BAND + margin, 2 * BAND - margin), "scale %d: a wall behind the fire changed the fire in front of it", scale);
     CHECK(rows_equal(walled, reference, 2 * BAND + margin, H), "scale %d: the open band differs from the reference", scale);
     if (g_failures) {
         char name[64];
@@ -237,8 +234,7 @@ static void test_render_errors(splatfx_error* err) {
     CHECK_FAILS(splatfx_renderer_render(r, m, frame, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "target is NULL");
     splatfx_host_target bad = target;
     bad.framebuffer = 12345;
-    CHECK_FAILS(splatfx_renderer_render(r, m, frame, &bad, err), err, SPLATFX_ERROR_GL,
-                "target->framebuffer 12345 is not a framebuffer object");
+    CHECK_FAILS(splatfx_renderer_render(r, m, frame, &bad, err), err, SPLATFX_ERROR_GL, "target->framebuffer 12345 is not a framebuffer object");
     bad = target;
     bad.depth_texture = t.color;
     CHECK_FAILS(splatfx_renderer_render(r, m, frame, &bad, err), err, SPLATFX_ERROR_GL, "has no depth component");
@@ -248,8 +244,7 @@ static void test_render_errors(splatfx_error* err) {
     bad = target;
     bad.width = W / 2;
     bad.height = H;
-    CHECK_FAILS(splatfx_renderer_render(r, m, frame, &bad, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
-                "but the frame's camera viewport is 64, 96");
+    CHECK_FAILS(splatfx_renderer_render(r, m, frame, &bad, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "but the frame's camera viewport is 64, 96");
     bad = target;
     bad.x = -1;
     CHECK_FAILS(splatfx_renderer_render(r, m, frame, &bad, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "target->x, y are -1, 0");

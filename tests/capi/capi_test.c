@@ -19,8 +19,7 @@ static splatfx_camera front_camera(splatfx_error* err) {
 }
 
 static void test_version_and_error_object(void) {
-    CHECK(splatfx_c_api_version() == SPLATFX_C_API_VERSION, "library %u, header %u", splatfx_c_api_version(),
-          (unsigned)SPLATFX_C_API_VERSION);
+    CHECK(splatfx_c_api_version() == SPLATFX_C_API_VERSION, "library %u, header %u", splatfx_c_api_version(), (unsigned)SPLATFX_C_API_VERSION);
     splatfx_error* err = splatfx_error_create();
     CHECK(err != NULL, "no error object");
     CHECK(splatfx_error_status(err) == SPLATFX_OK, "a new error object must be clear");
@@ -61,8 +60,7 @@ static void test_fire_prepares(void) {
     uint32_t id = 99;
     splatfx_effect_options options;
     splatfx_effect_options_init(&options);
-    CHECK(isinf(options.range_world) && options.enabled == 1 && options.textured == 1 && options.opacity_scale == 1.0f,
-          "effect option defaults");
+    CHECK(isinf(options.range_world) && options.enabled == 1 && options.textured == 1 && options.opacity_scale == 1.0f, "effect option defaults");
     options.name = "campfire";
     CHECK_OK(splatfx_scene_add_fire(scene, m, NULL, &options, &id, err), err);
     CHECK(id == 0, "first effect id %u", id);
@@ -73,8 +71,8 @@ static void test_fire_prepares(void) {
     CHECK_OK(splatfx_scene_prepare(scene, 0.5, &cam, m, frame, err), err);
     splatfx_frame_stats st;
     CHECK_OK(splatfx_frame_get_stats(frame, &st, err), err);
-    CHECK(st.declared == 1 && st.needed == 1 && st.drawn == 1, "declared %llu needed %llu drawn %llu",
-          (unsigned long long)st.declared, (unsigned long long)st.needed, (unsigned long long)st.drawn);
+    CHECK(st.declared == 1 && st.needed == 1 && st.drawn == 1, "declared %llu needed %llu drawn %llu", (unsigned long long)st.declared,
+          (unsigned long long)st.needed, (unsigned long long)st.drawn);
     /* At most one splat per voxel of the 7x20x5 lattice; the fire's core voxels are never empty. */
     CHECK(st.splats > 0 && st.splats <= 7 * 20 * 5, "splats %llu", (unsigned long long)st.splats);
     CHECK(st.time_sec == 0.5, "time %g", st.time_sec);
@@ -82,10 +80,8 @@ static void test_fire_prepares(void) {
     CHECK_OK(splatfx_scene_set_effect_enabled(scene, id, 0, err), err);
     CHECK_OK(splatfx_scene_prepare(scene, 0.6, &cam, m, frame, err), err);
     CHECK_OK(splatfx_frame_get_stats(frame, &st, err), err);
-    CHECK(st.needed == 0 && st.splats == 0, "disabled: needed %llu splats %llu", (unsigned long long)st.needed,
-          (unsigned long long)st.splats);
-    CHECK_FAILS(splatfx_scene_set_effect_enabled(scene, 1, 1, err), err, SPLATFX_ERROR_NOT_FOUND,
-                "id 1 is not an effect of this scene (it has 1)");
+    CHECK(st.needed == 0 && st.splats == 0, "disabled: needed %llu splats %llu", (unsigned long long)st.needed, (unsigned long long)st.splats);
+    CHECK_FAILS(splatfx_scene_set_effect_enabled(scene, 1, 1, err), err, SPLATFX_ERROR_NOT_FOUND, "id 1 is not an effect of this scene (it has 1)");
     /* Out of range: a range of 1 world unit from 30 units away skips it. */
     options.range_world = 1.0f;
     CHECK_OK(splatfx_scene_add_fire(scene, m, NULL, &options, &id, err), err);
@@ -113,12 +109,42 @@ static void test_every_preset(void) {
         CHECK_OK(splatfx_scene_create(&scene, err), err);
         splatfx_status s = SPLATFX_ERROR_INTERNAL;
         switch (k) {
-        case 0: { splatfx_fire_desc d; splatfx_fire_desc_init(&d); s = splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err); break; }
-        case 1: { splatfx_smoke_desc d; splatfx_smoke_desc_init(&d); s = splatfx_scene_add_smoke(scene, m, &d, NULL, NULL, err); break; }
-        case 2: { splatfx_steam_desc d; splatfx_steam_desc_init(&d); s = splatfx_scene_add_steam(scene, m, &d, NULL, NULL, err); break; }
-        case 3: { splatfx_dust_desc d; splatfx_dust_desc_init(&d); s = splatfx_scene_add_dust(scene, m, &d, NULL, NULL, err); break; }
-        case 4: { splatfx_fire_to_smoke_desc d; splatfx_fire_to_smoke_desc_init(&d); s = splatfx_scene_add_fire_to_smoke(scene, m, &d, NULL, NULL, err); break; }
-        case 5: { splatfx_ghosts_desc d; splatfx_ghosts_desc_init(&d); s = splatfx_scene_add_ghosts(scene, m, &d, NULL, NULL, err); break; }
+        case 0: {
+            splatfx_fire_desc d;
+            splatfx_fire_desc_init(&d);
+            s = splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err);
+            break;
+        }
+        case 1: {
+            splatfx_smoke_desc d;
+            splatfx_smoke_desc_init(&d);
+            s = splatfx_scene_add_smoke(scene, m, &d, NULL, NULL, err);
+            break;
+        }
+        case 2: {
+            splatfx_steam_desc d;
+            splatfx_steam_desc_init(&d);
+            s = splatfx_scene_add_steam(scene, m, &d, NULL, NULL, err);
+            break;
+        }
+        case 3: {
+            splatfx_dust_desc d;
+            splatfx_dust_desc_init(&d);
+            s = splatfx_scene_add_dust(scene, m, &d, NULL, NULL, err);
+            break;
+        }
+        case 4: {
+            splatfx_fire_to_smoke_desc d;
+            splatfx_fire_to_smoke_desc_init(&d);
+            s = splatfx_scene_add_fire_to_smoke(scene, m, &d, NULL, NULL, err);
+            break;
+        }
+        case 5: {
+            splatfx_ghosts_desc d;
+            splatfx_ghosts_desc_init(&d);
+            s = splatfx_scene_add_ghosts(scene, m, &d, NULL, NULL, err);
+            break;
+        }
         }
         CHECK(s == SPLATFX_OK, "%s: %s", names[k], splatfx_error_message(err));
         /* Solver presets (smoke, dust) start empty and fill from their emitters: one second of
@@ -127,8 +153,7 @@ static void test_every_preset(void) {
         CHECK_OK(splatfx_scene_prepare(scene, 1.0, &cam, m, frame, err), err);
         splatfx_frame_stats st;
         CHECK_OK(splatfx_frame_get_stats(frame, &st, err), err);
-        CHECK(st.needed == 1 && st.splats > 0, "%s: needed %llu splats %llu", names[k], (unsigned long long)st.needed,
-              (unsigned long long)st.splats);
+        CHECK(st.needed == 1 && st.splats > 0, "%s: needed %llu splats %llu", names[k], (unsigned long long)st.needed, (unsigned long long)st.splats);
         /* Going back in time is allowed (stateless effects scrub; solvers hold their state). */
         CHECK_OK(splatfx_scene_prepare(scene, 0.5, &cam, m, frame, err), err);
         splatfx_scene_destroy(scene);
@@ -140,7 +165,9 @@ static void test_every_preset(void) {
         splatfx_fire_desc d;
         splatfx_fire_desc_init(&d);
         CHECK(d.dims[0] == 7 && d.dims[1] == 20 && d.dims[2] == 5 && d.opacity == 0.55f, "fire desc defaults");
-        d.dims[0] = 3; d.dims[1] = 4; d.dims[2] = 2;
+        d.dims[0] = 3;
+        d.dims[1] = 4;
+        d.dims[2] = 2;
         CHECK_OK(splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err), err);
         CHECK_OK(splatfx_scene_prepare(scene, 0.0, &cam, m, frame, err), err);
         splatfx_frame_stats st;
@@ -170,7 +197,8 @@ static void test_motion(void) {
     splatfx_keyframe_init(&keys[0]);
     splatfx_keyframe_init(&keys[1]);
     CHECK(keys[0].rotation[0] == 1.0f && keys[0].scale[1] == 1.0f && keys[0].opacity == 1.0f && keys[0].growth == 1.0f &&
-              keys[0].easing == SPLATFX_EASING_LINEAR, "keyframe defaults");
+              keys[0].easing == SPLATFX_EASING_LINEAR,
+          "keyframe defaults");
     keys[0].position[0] = -60.0f;
     keys[1].time_sec = 4.0;
     keys[1].position[0] = 60.0f;
@@ -193,14 +221,14 @@ static void test_motion(void) {
     }
     /* Bad tracks: the key and the field are named, nothing is added. */
     keys[1].time_sec = 0.0;
-    CHECK_FAILS(splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "desc.motion: keyframe 1: timeSec 0.000000 must be greater");
+    CHECK_FAILS(splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                "desc.motion: keyframe 1: timeSec 0.000000 must be greater");
     keys[1].time_sec = 4.0;
     keys[1].scale[2] = 0.0f;
     CHECK_FAILS(splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "pose.scale must be positive");
     keys[1].scale[2] = 1.0f;
     keys[1].easing = (splatfx_easing)7;
-    CHECK_FAILS(splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
-                "desc.motion_keys[1].easing is 7");
+    CHECK_FAILS(splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "desc.motion_keys[1].easing is 7");
     d.motion_keys = NULL;
     CHECK_FAILS(splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
                 "desc.motion_keys is NULL but desc.motion_key_count is 2");
@@ -235,8 +263,7 @@ static void test_files(void) {
     const uint32_t before = splatfx_materials_layer_count(m);
     CHECK_OK(splatfx_scene_add_fire(scene, m, &d, NULL, NULL, err), err);
     splatfx_texture_set_destroy(set); /* copied at add time */
-    CHECK(splatfx_materials_layer_count(m) == before + 8, "the folder's 8 textures registered: %u -> %u", before,
-          splatfx_materials_layer_count(m));
+    CHECK(splatfx_materials_layer_count(m) == before + 8, "the folder's 8 textures registered: %u -> %u", before, splatfx_materials_layer_count(m));
     splatfx_scene_destroy(scene);
 
     splatfx_texture_set* none = (splatfx_texture_set*)&err; /* must be overwritten with NULL */
@@ -255,17 +282,16 @@ static void test_files(void) {
     CHECK_OK(splatfx_scene_prepare(scene, 0.25, &cam, m, frame, err), err);
     splatfx_frame_stats st;
     CHECK_OK(splatfx_frame_get_stats(frame, &st, err), err);
-    CHECK(st.needed == 2 && st.drawn == 2 && st.splats > 0, "figure 1: needed %llu drawn %llu splats %llu",
-          (unsigned long long)st.needed, (unsigned long long)st.drawn, (unsigned long long)st.splats);
+    CHECK(st.needed == 2 && st.drawn == 2 && st.splats > 0, "figure 1: needed %llu drawn %llu splats %llu", (unsigned long long)st.needed,
+          (unsigned long long)st.drawn, (unsigned long long)st.splats);
     splatfx_scene_destroy(scene);
 
     splatfx_scene* missing = (splatfx_scene*)&err;
-    CHECK_FAILS(splatfx_scene_load_file("/nonexistent/scene.json", m, NULL, &missing, err), err, SPLATFX_ERROR_FILE,
-                "/nonexistent/scene.json");
+    CHECK_FAILS(splatfx_scene_load_file("/nonexistent/scene.json", m, NULL, &missing, err), err, SPLATFX_ERROR_FILE, "/nonexistent/scene.json");
     CHECK(missing == NULL, "a failed load leaves *out NULL");
     /* A file that exists but is not a scene: the message names the field. */
-    CHECK_FAILS(splatfx_scene_load_file(SPLATFX_SOURCE_DIR "/textures/photo-fire-8x32/manifest.json", m, NULL, &missing, err),
-                err, SPLATFX_ERROR_FILE, "format");
+    CHECK_FAILS(splatfx_scene_load_file(SPLATFX_SOURCE_DIR "/textures/photo-fire-8x32/manifest.json", m, NULL, &missing, err), err,
+                SPLATFX_ERROR_FILE, "format");
     splatfx_frame_destroy(frame);
     splatfx_materials_destroy(m);
     splatfx_error_destroy(err);
@@ -284,8 +310,7 @@ static void test_bad_input(void) {
     const uint32_t layers = splatfx_materials_layer_count(m);
 
     /* NULL handles. */
-    CHECK_FAILS(splatfx_scene_prepare(NULL, 0.0, &cam, m, frame, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
-                "splatfx_scene_prepare: scene is NULL");
+    CHECK_FAILS(splatfx_scene_prepare(NULL, 0.0, &cam, m, frame, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "splatfx_scene_prepare: scene is NULL");
     CHECK_FAILS(splatfx_scene_prepare(scene, 0.0, &cam, NULL, frame, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "materials is NULL");
     CHECK_FAILS(splatfx_scene_prepare(scene, 0.0, &cam, m, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "frame is NULL");
     CHECK_FAILS(splatfx_scene_prepare(scene, 0.0, NULL, m, frame, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "camera is NULL");
@@ -300,12 +325,12 @@ static void test_bad_input(void) {
     CHECK_FAILS(splatfx_texture_set_load(NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "out is NULL");
     CHECK_FAILS(splatfx_headless_context_make_current(NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "context is NULL");
     CHECK(splatfx_headless_context_renderer(NULL) == NULL, "renderer string of NULL");
-    CHECK(splatfx_scene_effect_count(NULL) == 0 && splatfx_materials_layer_count(NULL) == 0 &&
-          splatfx_texture_set_count(NULL) == 0, "counts of NULL handles");
+    CHECK(splatfx_scene_effect_count(NULL) == 0 && splatfx_materials_layer_count(NULL) == 0 && splatfx_texture_set_count(NULL) == 0,
+          "counts of NULL handles");
 
     /* A handle of another type (through an FFI every handle is a void*). */
-    CHECK_FAILS(splatfx_scene_prepare(scene, 0.0, &cam, (const splatfx_materials*)frame, frame, err), err,
-                SPLATFX_ERROR_INVALID_ARGUMENT, "materials is not a splatfx_materials");
+    CHECK_FAILS(splatfx_scene_prepare(scene, 0.0, &cam, (const splatfx_materials*)frame, frame, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                "materials is not a splatfx_materials");
     CHECK_FAILS(splatfx_scene_add_fire((splatfx_scene*)m, m, NULL, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
                 "scene is not a splatfx_scene");
 
@@ -323,10 +348,8 @@ static void test_bad_input(void) {
     CHECK_FAILS(splatfx_scene_prepare(scene, 0.0, &bad, m, frame, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "camera.viewport[0] is 0");
     float zero[16];
     memset(zero, 0, sizeof zero);
-    CHECK_FAILS(splatfx_camera_from_matrices(cam.view, zero, 64, 64, &bad, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
-                "camera.proj is singular");
-    CHECK_FAILS(splatfx_camera_from_matrices(cam.view, cam.proj, 64, -1, &bad, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
-                "camera.viewport[1] is -1");
+    CHECK_FAILS(splatfx_camera_from_matrices(cam.view, zero, 64, 64, &bad, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "camera.proj is singular");
+    CHECK_FAILS(splatfx_camera_from_matrices(cam.view, cam.proj, 64, -1, &bad, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "camera.viewport[1] is -1");
     CHECK_OK(splatfx_camera_from_matrices(cam.view, cam.proj, 160, 120, &bad, err), err);
     CHECK(memcmp(&bad, &cam, sizeof cam) == 0, "from_matrices copies the host's matrices as they are");
     const float p[3] = {1.0f, 2.0f, 3.0f}, up[3] = {0.0f, 1.0f, 0.0f}, upAlong[3] = {0.0f, 0.0f, 1.0f}, q[3] = {1.0f, 2.0f, 4.0f};
@@ -334,10 +357,8 @@ static void test_bad_input(void) {
                 "eye and target are the same point");
     CHECK_FAILS(splatfx_camera_look_at(p, q, upAlong, 0.8f, 64, 64, 0.1f, 100.0f, &bad, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
                 "up is zero or parallel");
-    CHECK_FAILS(splatfx_camera_look_at(p, q, up, NAN, 64, 64, 0.1f, 100.0f, &bad, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
-                "fov_y is nan");
-    CHECK_FAILS(splatfx_camera_look_at(p, q, up, 0.8f, 64, 64, 0.0f, 100.0f, &bad, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
-                "near_plane 0");
+    CHECK_FAILS(splatfx_camera_look_at(p, q, up, NAN, 64, 64, 0.1f, 100.0f, &bad, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "fov_y is nan");
+    CHECK_FAILS(splatfx_camera_look_at(p, q, up, 0.8f, 64, 64, 0.0f, 100.0f, &bad, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "near_plane 0");
 
     /* Desc fields, and nothing added on failure. */
     splatfx_materials_desc md;
@@ -351,8 +372,7 @@ static void test_bad_input(void) {
     splatfx_fire_desc_init(&fd);
     fd.dims[1] = 0;
     CHECK_FAILS(splatfx_scene_add_fire(scene, m, &fd, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "FireDesc.dims");
-    CHECK(splatfx_materials_layer_count(m) == layers, "a failed add registered layers: %u -> %u", layers,
-          splatfx_materials_layer_count(m));
+    CHECK(splatfx_materials_layer_count(m) == layers, "a failed add registered layers: %u -> %u", layers, splatfx_materials_layer_count(m));
     splatfx_fire_desc_init(&fd);
     fd.dims[0] = fd.dims[1] = fd.dims[2] = 1 << 20; /* 2^60 voxels: refused before anything is allocated */
     CHECK_FAILS(splatfx_scene_add_fire(scene, m, &fd, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "FireDesc.dims");
@@ -386,8 +406,7 @@ static void test_bad_input(void) {
     splatfx_smoke_desc sd;
     splatfx_smoke_desc_init(&sd);
     sd.wind_world[2] = INFINITY;
-    CHECK_FAILS(splatfx_scene_add_smoke(scene, m, &sd, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
-                "desc.wind_world[2] is inf");
+    CHECK_FAILS(splatfx_scene_add_smoke(scene, m, &sd, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "desc.wind_world[2] is inf");
     splatfx_effect_options o;
     splatfx_effect_options_init(&o);
     o.range_world = 0.0f;
@@ -395,8 +414,7 @@ static void test_bad_input(void) {
     splatfx_effect_options_init(&o);
     o.opacity_scale = NAN;
     CHECK_FAILS(splatfx_scene_add_ghosts(scene, m, NULL, &o, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "options.opacity_scale is nan");
-    CHECK(splatfx_scene_effect_count(scene) == effectsBefore, "failed adds added %u effects",
-          splatfx_scene_effect_count(scene) - effectsBefore);
+    CHECK(splatfx_scene_effect_count(scene) == effectsBefore, "failed adds added %u effects", splatfx_scene_effect_count(scene) - effectsBefore);
 
     /* A scene's effects index the materials they were built with. */
     {
@@ -425,8 +443,7 @@ static void test_bad_input(void) {
     splatfx_host_target target;
     splatfx_host_target_init(&target);
     CHECK_FAILS(splatfx_renderer_render(NULL, m, frame, &target, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "renderer is NULL");
-    CHECK_FAILS(splatfx_renderer_upload((splatfx_renderer*)scene, m, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
-                "renderer is not a splatfx_renderer");
+    CHECK_FAILS(splatfx_renderer_upload((splatfx_renderer*)scene, m, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "renderer is not a splatfx_renderer");
 
     splatfx_frame_destroy(frame);
     splatfx_scene_destroy(scene);

@@ -14,33 +14,32 @@ _Static_assert(sizeof(splatfx_easing) == sizeof(int32_t), "splatfx_easing is 32-
 /* Failed checks so far; main returns nonzero when any failed. */
 static int g_failures = 0; /* test-program state, not SDK state */
 
-#define CHECK(cond, ...)                                                            \
-    do {                                                                            \
-        if (!(cond)) {                                                              \
-            ++g_failures;                                                           \
-            fprintf(stderr, "%s:%d: CHECK(%s) failed: ", __FILE__, __LINE__, #cond); \
-            fprintf(stderr, __VA_ARGS__);                                           \
-            fprintf(stderr, "\n");                                                  \
-        }                                                                           \
+#define CHECK(cond, ...)                                                                                                                             \
+    do {                                                                                                                                             \
+        if (!(cond)) {                                                                                                                               \
+            ++g_failures;                                                                                                                            \
+            fprintf(stderr, "%s:%d: CHECK(%s) failed: ", __FILE__, __LINE__, #cond);                                                                 \
+            fprintf(stderr, __VA_ARGS__);                                                                                                            \
+            fprintf(stderr, "\n");                                                                                                                   \
+        }                                                                                                                                            \
     } while (0)
 
 /* A call must succeed; on failure prints the error object's message. */
-#define CHECK_OK(call, err)                                                                         \
-    do {                                                                                            \
-        splatfx_status s_ = (call);                                                                 \
-        CHECK(s_ == SPLATFX_OK, "%s returned %s: %s", #call, splatfx_status_name(s_), splatfx_error_message(err)); \
-        CHECK(splatfx_error_status(err) == s_, "the error object's status is not the returned one");  \
+#define CHECK_OK(call, err)                                                                                                                          \
+    do {                                                                                                                                             \
+        splatfx_status s_ = (call);                                                                                                                  \
+        CHECK(s_ == SPLATFX_OK, "%s returned %s: %s", #call, splatfx_status_name(s_), splatfx_error_message(err));                                   \
+        CHECK(splatfx_error_status(err) == s_, "the error object's status is not the returned one");                                                 \
     } while (0)
 
 /* A call must fail with `want`, the error object must say so, and its message must contain `needle`. */
-#define CHECK_FAILS(call, err, want, needle)                                                            \
-    do {                                                                                                \
-        splatfx_status s_ = (call);                                                                     \
-        CHECK(s_ == (want), "%s returned %s, expected %s (message: %s)", #call, splatfx_status_name(s_),  \
-              splatfx_status_name(want), splatfx_error_message(err));                                   \
-        CHECK(splatfx_error_status(err) == s_, "the error object's status is not the returned one");      \
-        CHECK(strstr(splatfx_error_message(err), (needle)) != NULL, "%s: message \"%s\" lacks \"%s\"", #call, \
-              splatfx_error_message(err), (needle));                                                     \
+#define CHECK_FAILS(call, err, want, needle)                                                                                                         \
+    do {                                                                                                                                             \
+        splatfx_status s_ = (call);                                                                                                                  \
+        CHECK(s_ == (want), "%s returned %s, expected %s (message: %s)", #call, splatfx_status_name(s_), splatfx_status_name(want),                  \
+              splatfx_error_message(err));                                                                                                           \
+        CHECK(splatfx_error_status(err) == s_, "the error object's status is not the returned one");                                                 \
+        CHECK(strstr(splatfx_error_message(err), (needle)) != NULL, "%s: message \"%s\" lacks \"%s\"", #call, splatfx_error_message(err), (needle)); \
     } while (0)
 
 #endif

@@ -29,8 +29,7 @@ void GLTest::SetUp() {
     Shared& s = shared();
     ASSERT_TRUE(s.ctx) << "headless OpenGL 4.5 is required for this test: " << s.error;
     s.ctx->makeCurrent();
-    while (glGetError() != GL_NO_ERROR) {
-    }
+    while (glGetError() != GL_NO_ERROR) {}
 }
 
 void GLTest::TearDown() {

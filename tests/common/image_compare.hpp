@@ -22,10 +22,10 @@ ImageDiff compareImages(const Image& actual, const Image& expected, double thres
 // A golden image's tolerances, kept as data beside it (tests/golden/<name>.json,
 // whose "why" explains each one). All values in 8-bit steps except the fraction.
 struct GoldenThresholds {
-    double pixelThreshold = 0.0; // a pixel "differs" beyond this, [0, 1]
-    double meanMax = 0.0;        // largest allowed mean difference, [0, 1]
+    double pixelThreshold = 0.0;  // a pixel "differs" beyond this, [0, 1]
+    double meanMax = 0.0;         // largest allowed mean difference, [0, 1]
     double fractionOverMax = 0.0; // largest allowed fraction of differing pixels
-    double maxAbs = 0.0;         // largest allowed single difference, [0, 1]
+    double maxAbs = 0.0;          // largest allowed single difference, [0, 1]
 };
 // Reads the thresholds file; an error names the file and the missing field.
 Result<GoldenThresholds> loadGoldenThresholds(const std::string& path);

@@ -23,8 +23,6 @@ inline Grid campfireGrid(std::uint32_t seed) {
     return g;
 }
 
-inline Camera campfireCamera(glm::ivec2 size) {
-    return Camera::lookAt({0.0f, 4.8f, 15.0f}, {0.0f, 4.6f, 0.0f}, {0, 1, 0}, 0.7853982f, size);
-}
+inline Camera campfireCamera(glm::ivec2 size) { return Camera::lookAt({0.0f, 4.8f, 15.0f}, {0.0f, 4.6f, 0.0f}, {0, 1, 0}, 0.7853982f, size); }
 
 } // namespace splatfx::test

@@ -15,7 +15,8 @@ std::vector<Keyframe> threeKeys() {
     return {
         {.timeSec = 0.0, .pose = {.position = {0, 0, 0}, .scale = glm::vec3(1), .opacity = 0.0f, .growth = 0.0f}},
         {.timeSec = 2.0,
-         .pose = {.position = {4, 2, 0}, .rotation = glm::angleAxis(1.0f, glm::vec3(0, 1, 0)), .scale = glm::vec3(2), .opacity = 1.0f, .growth = 1.0f},
+         .pose =
+             {.position = {4, 2, 0}, .rotation = glm::angleAxis(1.0f, glm::vec3(0, 1, 0)), .scale = glm::vec3(2), .opacity = 1.0f, .growth = 1.0f},
          .easing = Easing::Smooth},
         {.timeSec = 5.0, .pose = {.position = {4, 2, -6}, .rotation = glm::angleAxis(1.0f, glm::vec3(0, 1, 0)), .scale = glm::vec3(0.5f, 2, 1)}},
     };

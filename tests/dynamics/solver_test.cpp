@@ -83,8 +83,7 @@ TEST(Solver, IntegerShiftTransportIsExact) {
         EXPECT_EQ(s->totalDensity(), mass) << "step " << n;
         for (int z = 0; z < 8; ++z)
             for (int y = 0; y < 8; ++y)
-                for (int x = n; x < 16; ++x)
-                    ASSERT_EQ(s->density()[s->cellIndex({x, y, z})], start[s->cellIndex({x - n, y, z})]) << "step " << n;
+                for (int x = n; x < 16; ++x) ASSERT_EQ(s->density()[s->cellIndex({x, y, z})], start[s->cellIndex({x - n, y, z})]) << "step " << n;
     }
 }
 
@@ -138,12 +137,23 @@ TEST(Solver, StaysFiniteAndBoundedForAnyTimeStep) {
     const float slack = 1e-4f;
     for (double dt : {0.0, 1e-6, 1.0 / 30.0, 1.0, 10.0}) {
         for (bool fast : {false, true}) {
-            FluidSolverDesc d{.dims = {8, 12, 8}, .spacing = glm::vec3(0.5f), .buoyancy = 20.0f, .ambientTemperature = 0.5f,
-                              .windWorld = {5, 0, 0}, .windCoupling = 1.0f, .densityDissipation = 0.1f, .substeps = 2};
+            FluidSolverDesc d{.dims = {8, 12, 8},
+                              .spacing = glm::vec3(0.5f),
+                              .buoyancy = 20.0f,
+                              .ambientTemperature = 0.5f,
+                              .windWorld = {5, 0, 0},
+                              .windCoupling = 1.0f,
+                              .densityDissipation = 0.1f,
+                              .substeps = 2};
             auto s = FluidSolver::create(d);
             ASSERT_TRUE(s.ok());
-            s->addEmitter({.desc = {.offset = {0, 1, 0}, .radius = 1.0f, .density = 1.0f, .temperature = 3.0f, .rate = 50.0f,
-                                    .velocity = {0, 40, 0}, .injectVelocity = true}});
+            s->addEmitter({.desc = {.offset = {0, 1, 0},
+                                    .radius = 1.0f,
+                                    .density = 1.0f,
+                                    .temperature = 3.0f,
+                                    .rate = 50.0f,
+                                    .velocity = {0, 40, 0},
+                                    .injectVelocity = true}});
             addBlob(*s, {4, 6, 4}, 2.0f, 0.8f, 1.0f);
             if (fast) s->setUniformVelocity({3000.0f, -5000.0f, 2000.0f}); // thousands of cells per step
             for (int i = 0; i < 40; ++i) {
@@ -235,10 +245,8 @@ TEST(Solver, SparseOutputFollowsTheMaterial) {
 
 TEST(Solver, BadDescsAreReportedByField) {
     EXPECT_EQ(FluidSolver::create({.dims = {8, 0, 8}}).error(), "FluidSolverDesc.dims y must be at least 1, got 0");
-    EXPECT_EQ(FluidSolver::create({.dims = {1024, 1024, 1024}}).error(),
-              "FluidSolverDesc.dims asks for 1073741824 cells; the limit is 16777216");
-    EXPECT_EQ(FluidSolver::create({.velocityDamping = -1.0f}).error(),
-              "FluidSolverDesc.velocityDamping must be finite and >= 0, got -1.000000");
+    EXPECT_EQ(FluidSolver::create({.dims = {1024, 1024, 1024}}).error(), "FluidSolverDesc.dims asks for 1073741824 cells; the limit is 16777216");
+    EXPECT_EQ(FluidSolver::create({.velocityDamping = -1.0f}).error(), "FluidSolverDesc.velocityDamping must be finite and >= 0, got -1.000000");
     EXPECT_EQ(FluidSolver::create({.substeps = 0}).error(), "FluidSolverDesc.substeps must be in [1, 1000], got 0");
     EXPECT_EQ(FluidSolver::create({.conserveMass = true}).error(),
               "FluidSolverDesc.conserveMass needs a closed domain (closedFloor, closedWalls and closedCeiling all true); "

@@ -205,16 +205,14 @@ TEST(Cycling, RandomSelectionChangesEveryTickAndIsDeterministic) {
 
 TEST(TextureDynamics, CombinesPropagationAndCycling) {
     const Grid lattice = *Grid::box({2, 6, 2});
-    const TextureDynamicsDesc d{.propagation = {.mode = Propagation::Fixed, .stepsPerSec = 8.0f},
-                                .cycling = {.mode = Cycling::Ordered, .texturesPerSec = 3.0f},
-                                .seed = 4};
+    const TextureDynamicsDesc d{
+        .propagation = {.mode = Propagation::Fixed, .stepsPerSec = 8.0f}, .cycling = {.mode = Cycling::Ordered, .texturesPerSec = 3.0f}, .seed = 4};
     TextureDynamics tex(lattice, d);
     for (std::size_t i = 0; i < lattice.voxels.size(); ++i) {
         const glm::ivec3 c = lattice.voxels[i].cell;
         const double t = 2.7;
-        const std::uint32_t expected =
-            propagatedIndex(c, tex.chainLength(i), propagationStep(t, d.propagation), d.propagation, d.seed) +
-            cycleSample(c, t, d.cycling, d.seed).texture;
+        const std::uint32_t expected = propagatedIndex(c, tex.chainLength(i), propagationStep(t, d.propagation), d.propagation, d.seed) +
+                                       cycleSample(c, t, d.cycling, d.seed).texture;
         EXPECT_EQ(tex.sample(i, t).texture, expected);
         EXPECT_EQ(tex.chainLength(i), c.y) << "a full box column: every cell below is upwind";
     }

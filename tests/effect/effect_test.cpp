@@ -19,8 +19,7 @@ bool sameVoxels(const Grid& a, const Grid& b) {
     if (a.voxels.size() != b.voxels.size() || a.transform != b.transform) return false;
     for (std::size_t i = 0; i < a.voxels.size(); ++i) {
         const Voxel &x = a.voxels[i], &y = b.voxels[i];
-        if (x.cell != y.cell || x.opacity != y.opacity || x.texture != y.texture || x.phase != y.phase || x.colorCoord != y.colorCoord)
-            return false;
+        if (x.cell != y.cell || x.opacity != y.opacity || x.texture != y.texture || x.phase != y.phase || x.colorCoord != y.colorCoord) return false;
     }
     return true;
 }
@@ -31,25 +30,26 @@ void expectInside(const std::vector<Splat>& splats, const Aabb& box, const std::
     for (const Splat& s : splats) {
         const glm::vec3 r = glm::sqrt(s.axisU * s.axisU + s.axisV * s.axisV);
         ASSERT_TRUE(box.contains(s.center - r) && box.contains(s.center + r))
-            << what << ": splat at (" << s.center.x << ", " << s.center.y << ", " << s.center.z << ") extent (" << r.x << ", "
-            << r.y << ", " << r.z << ") outside [" << box.lo.x << " " << box.lo.y << " " << box.lo.z << "] - [" << box.hi.x
-            << " " << box.hi.y << " " << box.hi.z << "]";
+            << what << ": splat at (" << s.center.x << ", " << s.center.y << ", " << s.center.z << ") extent (" << r.x << ", " << r.y << ", " << r.z
+            << ") outside [" << box.lo.x << " " << box.lo.y << " " << box.lo.z << "] - [" << box.hi.x << " " << box.hi.y << " " << box.hi.z << "]";
     }
 }
 
 Camera cameraAt(double t) {
     // An orbiting camera, so splat ellipses are seen from many directions.
     const float a = float(t) * 0.7f;
-    return Camera::lookAt({14.0f * std::cos(a), 3.0f + 4.0f * std::sin(0.3f * a), 14.0f * std::sin(a)}, {0, 3, 0}, {0, 1, 0},
-                          glm::radians(50.0f), {320, 240});
+    return Camera::lookAt({14.0f * std::cos(a), 3.0f + 4.0f * std::sin(0.3f * a), 14.0f * std::sin(a)}, {0, 3, 0}, {0, 1, 0}, glm::radians(50.0f),
+                          {320, 240});
 }
 
 Motion wanderingMotion() {
-    return Motion({{.timeSec = 0, .pose = {.position = {-3, 0, 0}, .scale = glm::vec3(0.6f)}},
-                   {.timeSec = 4, .pose = {.position = {2, 1, 1}, .rotation = glm::angleAxis(0.8f, glm::normalize(glm::vec3(1, 1, 0))), .scale = {1.4f, 1.0f, 0.8f}},
-                    .easing = Easing::Smooth},
-                   {.timeSec = 9, .pose = {.position = {0, 0, -3}, .rotation = glm::angleAxis(-0.5f, glm::vec3(0, 0, 1))}}},
-                  {.velocity = {0.1f, 0, 0}, .spinRadPerSec = 0.9f, .bobAmplitude = {0, 0.4f, 0.2f}, .bobHz = 0.7f});
+    return Motion(
+        {{.timeSec = 0, .pose = {.position = {-3, 0, 0}, .scale = glm::vec3(0.6f)}},
+         {.timeSec = 4,
+          .pose = {.position = {2, 1, 1}, .rotation = glm::angleAxis(0.8f, glm::normalize(glm::vec3(1, 1, 0))), .scale = {1.4f, 1.0f, 0.8f}},
+          .easing = Easing::Smooth},
+         {.timeSec = 9, .pose = {.position = {0, 0, -3}, .rotation = glm::angleAxis(-0.5f, glm::vec3(0, 0, 1))}}},
+        {.velocity = {0.1f, 0, 0}, .spinRadPerSec = 0.9f, .bobAmplitude = {0, 0.4f, 0.2f}, .bobHz = 0.7f});
 }
 
 } // namespace

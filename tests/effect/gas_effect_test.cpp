@@ -76,8 +76,8 @@ TEST(GasEffect, TheFogRollsInAlongX) {
     };
     const auto [n1, x1] = maxX(1.0);
     const auto [n4, x4] = maxX(4.0);
-    EXPECT_LT(n1, n4);            // more of the lattice is fogged as the front advances
-    EXPECT_LT(x1, x4);            // and its leading edge has moved on
+    EXPECT_LT(n1, n4); // more of the lattice is fogged as the front advances
+    EXPECT_LT(x1, x4); // and its leading edge has moved on
     // It grows from nothing (chess_fog's min(frame / FULL_FOG, 1) at frame 0).
     EXPECT_EQ(maxX(0.0).first, 0u);
 }

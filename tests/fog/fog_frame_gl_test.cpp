@@ -46,8 +46,7 @@ double tauFloatBound(const Fog& fog, double lengthMax, double densityMax, double
     double b = 0.0;
     for (const FogTerm& t : fog.desc().terms) {
         const double amp = std::abs(t.weight) * (t.kind == FogTermKind::Point ? 1.0 / t.c : 1.0);
-        const double arg = t.kind == FogTermKind::Cosine ? glm::length(t.wave) * (lengthMax + 10.0) + std::abs(t.phase)
-                                                         : 4.0;
+        const double arg = t.kind == FogTermKind::Cosine ? glm::length(t.wave) * (lengthMax + 10.0) + std::abs(t.phase) : 4.0;
         b += amp * lengthMax * (arg * kEps + std::ldexp(1.0, -20) + 16.0 * kEps);
     }
     return b + densityMax * lengthMax * positionRel;
@@ -330,7 +329,8 @@ TEST_F(FogFrameGL, PerSplatFogStaysWithinTheFogsVariationAcrossASplat) {
     ASSERT_TRUE(refPlain && refFog);
     double radius = 0.0;
     for (const Splat& sp : s.frame.splats())
-        radius = std::max(radius, double(gl::RendererDesc{}.footprintCut) * std::sqrt(double(glm::dot(sp.axisU, sp.axisU) + glm::dot(sp.axisV, sp.axisV))));
+        radius = std::max(radius,
+                          double(gl::RendererDesc{}.footprintCut) * std::sqrt(double(glm::dot(sp.axisU, sp.axisU) + glm::dot(sp.axisV, sp.axisV))));
     const double splatError = maxDiff(plain, *refPlain);
     const double floatBound = 2.0 * tauFloatBound(fog, 36.0, k, 75.0 * 8.0 * kEps) + 2.0 * st.fogMaxErrorEstimate + 1e-6;
     EXPECT_LE(maxDiff(perFragment, *refFog), splatError + floatBound);

@@ -35,8 +35,7 @@ struct GpuResult {
 };
 
 // Runs the fog's GLSL on segments (relative to `ref`) and probes cos, atan and exp on the same device.
-GpuResult runGpu(const Fog& fog, const FogGlsl& glsl, double tSec, glm::dvec3 ref, const std::vector<Seg>& segs,
-                 std::string& error) {
+GpuResult runGpu(const Fog& fog, const FogGlsl& glsl, double tSec, glm::dvec3 ref, const std::vector<Seg>& segs, std::string& error) {
     const std::string src = "#version 450\nlayout(local_size_x = 64) in;\n"
                             "layout(std430, binding = 0) readonly buffer Segs { vec4 segs[]; };\n"
                             "layout(std430, binding = 1) writeonly buffer Outs { vec4 outs[]; };\n"
@@ -215,15 +214,15 @@ protected:
             const double tol = errorBound(*fog, segs[i], eye, tSec, g);
             const double err = std::abs(double(g.depth[i]) - exact);
             worst = std::max(worst, err / std::max(tol, 1e-300));
-            EXPECT_LE(err, tol) << what << " segment " << i << ": gpu " << g.depth[i] << " exact " << exact
-                                << " length " << glm::length(segs[i].p - segs[i].o);
+            EXPECT_LE(err, tol) << what << " segment " << i << ": gpu " << g.depth[i] << " exact " << exact << " length "
+                                << glm::length(segs[i].p - segs[i].o);
             // Transmittance: exp's measured relative error plus the depth error propagated (df = f dtau).
             const double f = fog->transmittance(segs[i].o, segs[i].p, tSec);
             EXPECT_NEAR(g.transmittance[i], f, f * (tol + 2 * g.expRelErr + 4 * kEps) + 1e-37) << what << " segment " << i;
             EXPECT_FALSE(std::isnan(g.depth[i]));
         }
-        std::printf("[ fog glsl ] %-28s worst error / bound %.3g (device cos abs err %.2g, atan rel err %.2g)\n", what,
-                    worst, g.cosErr, g.atanRelErr);
+        std::printf("[ fog glsl ] %-28s worst error / bound %.3g (device cos abs err %.2g, atan rel err %.2g)\n", what, worst, g.cosErr,
+                    g.atanRelErr);
     }
 };
 

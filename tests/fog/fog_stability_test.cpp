@@ -81,8 +81,7 @@ TEST(FogStability, CameraAtAnEquipotentialCentre) {
     const Fog fp = make(d);
     // From the centre along any direction: integral_0^L ds / (c + d s^2) = atan(L sqrt(d/c)) / sqrt(c d).
     const double L = 3.0, expected = std::atan(L * std::sqrt(4.0 / 0.25)) / std::sqrt(0.25 * 4.0);
-    EXPECT_NEAR(fp.opticalDepth({1, 2, 3}, glm::dvec3(1, 2, 3) + L * glm::normalize(glm::dvec3(1, -1, 2)), 0.0), expected,
-                1e-14);
+    EXPECT_NEAR(fp.opticalDepth({1, 2, 3}, glm::dvec3(1, 2, 3) + L * glm::normalize(glm::dvec3(1, -1, 2)), 0.0), expected, 1e-14);
     EXPECT_NEAR(fp.density({1, 2, 3}, 0.0), 4.0, 1e-15);
     FogDesc l;
     l.terms.push_back(FogTerm::line(1.0, {0, 0, 0}, {0, 0, 1}, 0.25, 4.0));

@@ -32,8 +32,7 @@ void expectMatchesQuadrature(const Fog& fog, double extent, double tSec = 0.0, i
         const FogQuadrature q = integrateFogNumerically(fog, o, p, tSec, tol);
         ASSERT_TRUE(q.converged) << "segment " << i;
         EXPECT_NEAR(closed, q.value, tol + 1e-13 * std::abs(q.value))
-            << "segment " << i << " from (" << o.x << ", " << o.y << ", " << o.z << ") to (" << p.x << ", " << p.y
-            << ", " << p.z << ")";
+            << "segment " << i << " from (" << o.x << ", " << o.y << ", " << o.z << ") to (" << p.x << ", " << p.y << ", " << p.z << ")";
     }
 }
 
@@ -341,8 +340,8 @@ TEST(FogValidation, BadFieldsAreNamed) {
 TEST(FogPaper, Figure6FormulaAndValidity) {
     const Fog fog = make(paperFig6Fog());
     auto K = [](double x, double y, double z) {
-        return 1 + 0.5 * std::cos(5 * kPi * y) + 0.2 * std::cos(7 * kPi * (y + 0.1 * x)) +
-               0.2 * std::cos(5 * kPi * (y - 0.05 * x)) + 0.1 * std::cos(kPi * x) * std::cos(kPi * z / 2);
+        return 1 + 0.5 * std::cos(5 * kPi * y) + 0.2 * std::cos(7 * kPi * (y + 0.1 * x)) + 0.2 * std::cos(5 * kPi * (y - 0.05 * x)) +
+               0.1 * std::cos(kPi * x) * std::cos(kPi * z / 2);
     };
     for (glm::dvec3 x : {glm::dvec3(0.1, 0.2, 0.3), glm::dvec3(-3.7, 1.25, 8.0), glm::dvec3(12.0, -0.4, -2.2)})
         EXPECT_NEAR(fog.density(x, 0.0), K(x.x, x.y, x.z), 1e-13);

@@ -28,8 +28,7 @@ double tableIntegral(const Footprint& fp) {
 double maxSecondDerivative(const Footprint& fp) {
     double m = 0.0;
     const double h = 1e-3;
-    for (double r = h; r < fp.radius() - h; r += 0.01)
-        m = std::max(m, std::abs(fp.exact(r + h) - 2.0 * fp.exact(r) + fp.exact(r - h)) / (h * h));
+    for (double r = h; r < fp.radius() - h; r += 0.01) m = std::max(m, std::abs(fp.exact(r + h) - 2.0 * fp.exact(r) + fp.exact(r - h)) / (h * h));
     return m;
 }
 

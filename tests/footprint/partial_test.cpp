@@ -47,9 +47,7 @@ Poly crawfisMaxAlongRay(double r) {
     return mul(cube, quad);
 }
 
-std::vector<FootprintDesc> kernels() {
-    return {FootprintDesc{.kernel = Kernel::CrawfisMax}, FootprintDesc{.kernel = Kernel::Gaussian}};
-}
+std::vector<FootprintDesc> kernels() { return {FootprintDesc{.kernel = Kernel::CrawfisMax}, FootprintDesc{.kernel = Kernel::Gaussian}}; }
 
 } // namespace
 
@@ -69,8 +67,7 @@ TEST(PartialIntegral, LimitsAndSymmetry) {
             EXPECT_NEAR(fp.exactBefore(r, 0.0), 0.5 * fp.exact(r), 1e-13 * F0) << "r " << r;
             EXPECT_NEAR(fp.exactFractionBefore(r, 0.0), 0.5, 1e-12) << "r " << r;
             // Odd symmetry of the front part: F(r, s) + F(r, -s) = F(r).
-            for (double s = 0.05; s < half; s += 0.1)
-                EXPECT_NEAR(fp.exactBefore(r, s) + fp.exactBefore(r, -s), fp.exact(r), 1e-12 * F0);
+            for (double s = 0.05; s < half; s += 0.1) EXPECT_NEAR(fp.exactBefore(r, s) + fp.exactBefore(r, -s), fp.exact(r), 1e-12 * F0);
         }
         // Outside the support, and bad input.
         EXPECT_EQ(fp.exactBefore(R * 1.01, 0.0), 0.0);
@@ -163,9 +160,7 @@ TEST(PartialIntegral, TableMatchesExact) {
                 }
             EXPECT_LE(worst, bound) << "size " << size;
             // A user-facing scale: at the default-ish size the cut is within 1 % of the kernel's weight.
-            if (size >= 32) {
-                EXPECT_LT(worst, 0.01) << "size " << size;
-            }
+            if (size >= 32) { EXPECT_LT(worst, 0.01) << "size " << size; }
         }
 }
 

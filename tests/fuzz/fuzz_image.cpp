@@ -10,15 +10,15 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using fuzz::startsWith;
-    const char* ext = startsWith(data, size, "\x89PNG")           ? ".png"
-                      : startsWith(data, size, "\xFF\xD8")        ? ".jpg"
-                      : startsWith(data, size, "\x76\x2F\x31\x01") ? ".exr"
-                      : startsWith(data, size, "GIF8")            ? ".gif"
-                      : startsWith(data, size, "BM")              ? ".bmp"
+    const char* ext = startsWith(data, size, "\x89PNG")                               ? ".png"
+                      : startsWith(data, size, "\xFF\xD8")                            ? ".jpg"
+                      : startsWith(data, size, "\x76\x2F\x31\x01")                    ? ".exr"
+                      : startsWith(data, size, "GIF8")                                ? ".gif"
+                      : startsWith(data, size, "BM")                                  ? ".bmp"
                       : startsWith(data, size, "II*") || startsWith(data, size, "MM") ? ".tif"
-                      : startsWith(data, size, "#?")              ? ".hdr"
-                      : startsWith(data, size, "P")               ? ".pnm"
-                                                                  : ".tga";
+                      : startsWith(data, size, "#?")                                  ? ".hdr"
+                      : startsWith(data, size, "P")                                   ? ".pnm"
+                                                                                      : ".tga";
     const std::string path = fuzz::writeFile(std::string("image") + ext, data, size);
     auto img = splatfx::readImage(path);
     if (!img && img.error().empty()) __builtin_trap();

@@ -10,10 +10,10 @@
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using fuzz::startsWith;
-    const char* ext = startsWith(data, size, "ply")                                   ? ".ply"
+    const char* ext = startsWith(data, size, "ply")                                     ? ".ply"
                       : startsWith(data, size, "OFF") || startsWith(data, size, "COFF") ? ".off"
                       : startsWith(data, size, "solid") || (size >= 84 && data[0] == 0) ? ".stl"
-                                                                                         : ".obj";
+                                                                                        : ".obj";
     const std::string path = fuzz::writeFile(std::string("mesh") + ext, data, size);
     // The mesh library's child process is held well inside libFuzzer's limits (-timeout=10,
     // -malloc_limit_mb=2048), so what it contains is never reported as this process's finding.

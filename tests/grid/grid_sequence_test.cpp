@@ -19,7 +19,8 @@ GridSequence line(int cells, int frames, float depth) {
     GridSequence s;
     s.dims = {cells, 1, 1};
     s.framesPerSec = 10.0;
-    for (int f = 0; f < frames; ++f) s.frames.push_back({.opticalDepth = std::vector<float>(std::size_t(cells), depth), .colorCoord = {}, .velocityCellsPerSec = {}});
+    for (int f = 0; f < frames; ++f)
+        s.frames.push_back({.opticalDepth = std::vector<float>(std::size_t(cells), depth), .colorCoord = {}, .velocityCellsPerSec = {}});
     return s;
 }
 

@@ -60,10 +60,10 @@ TEST(Shapes, SoftEdgeIsHalfWeightOnTheSurfaceAndRampsOverSoftCells) {
     ball.softCells = 2.0f;
     ball.opacity = 0.8f;
     EXPECT_NEAR(ball.insideCells({3, 0, 0}), 0.0f, kFloatTol);
-    EXPECT_NEAR(ball.weight({3, 0, 0}), 0.4f, kFloatTol);       // on the surface: opacity / 2
-    EXPECT_NEAR(ball.weight({2, 0, 0}), 0.8f, kFloatTol);       // softCells / 2 inside: full
-    EXPECT_NEAR(ball.weight({3.5f, 0, 0}), 0.2f, kFloatTol);    // a quarter of the ramp outside
-    EXPECT_EQ(ball.weight({4.0f, 0, 0}), 0.0f);                 // softCells / 2 outside: nothing
+    EXPECT_NEAR(ball.weight({3, 0, 0}), 0.4f, kFloatTol);    // on the surface: opacity / 2
+    EXPECT_NEAR(ball.weight({2, 0, 0}), 0.8f, kFloatTol);    // softCells / 2 inside: full
+    EXPECT_NEAR(ball.weight({3.5f, 0, 0}), 0.2f, kFloatTol); // a quarter of the ramp outside
+    EXPECT_EQ(ball.weight({4.0f, 0, 0}), 0.0f);              // softCells / 2 outside: nothing
 }
 
 TEST(Shapes, ConeRadiusVariesLinearlyAndCapsIncludeTheEndCells) {
@@ -107,8 +107,7 @@ TEST(Shapes, NoShapesFillsEveryCellAndFadeRunsAlongTheAxis) {
     // A diagonal axis: the colour coordinate is 0 at one corner and 1 at the opposite one.
     auto d = voxelizeShapes({}, {.dims = {4, 4, 4}, .fadeAxis = {1, 1, 1}});
     ASSERT_TRUE(d) << d.error();
-    for (const splatfx::Voxel& v : d->voxels)
-        EXPECT_NEAR(v.colorCoord, (v.cell.x + v.cell.y + v.cell.z) / 9.0, kFloatTol);
+    for (const splatfx::Voxel& v : d->voxels) EXPECT_NEAR(v.colorCoord, (v.cell.x + v.cell.y + v.cell.z) / 9.0, kFloatTol);
 }
 
 TEST(Shapes, CellsFadedToZeroAreLeftOut) {

@@ -56,7 +56,7 @@ TEST(CheckedWrites, AFailedImageWriteIsAnErrorAndKeepsThePreviousFile) {
     const auto before = fs::file_size(path);
     const int rc = withFileSizeLimit(64 * 1024, [&] {
         const Status s = writeImage(path, noise(512, 512)); // ~770 KB of PNG, past the 64 KB limit
-        if (s) return 1;                                   // reported success: the bug
+        if (s) return 1;                                    // reported success: the bug
         return s.error().find("frame") != std::string::npos && s.error().find("File too large") != std::string::npos ? 0 : 2;
     });
     EXPECT_EQ(rc, 0) << "1: a truncated write was reported as success; 2: the message names neither the file nor the reason";
@@ -73,7 +73,7 @@ TEST(CheckedWrites, AFailedAnimationLeavesNoGif) {
         AnimationWriter gif(path, 12.0);
         for (int i = 0; i < 8; ++i)
             if (!gif.add(noise(128, 128))) return 0; // reported while streaming: fine
-        return gif.finish() ? 1 : 0;                   // or at the end; success would be the bug
+        return gif.finish() ? 1 : 0;                 // or at the end; success would be the bug
     });
     EXPECT_EQ(rc, 0) << "a GIF past the size limit was reported as written";
     EXPECT_FALSE(fs::exists(path));

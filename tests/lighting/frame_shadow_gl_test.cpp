@@ -117,7 +117,6 @@ Drawn draw(gl::FrameRenderer& fr, const Frame& frame, GLuint prog) {
     return out;
 }
 
-
 } // namespace
 
 TEST_F(FrameShadowGL, HostGroundShaderDarkensUnderTheGasAsTheTableSays) {

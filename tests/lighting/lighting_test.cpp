@@ -62,8 +62,8 @@ TEST(GasLighting, AmbientAndMultipleScatteringTerms) {
         float transmittance(std::size_t, glm::vec3) const override { return 0.0f; }
     } opaque;
     std::vector<glm::vec3> out;
-    ASSERT_TRUE(lightVoxels(g, {0, 0, 5}, std::span(&sun, 1), &opaque,
-                            {.albedo = 0.8f, .multipleScattering = 0.25f, .ambient = glm::vec3(0.1f)}, out));
+    ASSERT_TRUE(
+        lightVoxels(g, {0, 0, 5}, std::span(&sun, 1), &opaque, {.albedo = 0.8f, .multipleScattering = 0.25f, .ambient = glm::vec3(0.1f)}, out));
     const glm::vec3 expected = 0.8f * (glm::vec3(0.1f) + glm::vec3(1.0f, 0.5f, 0.25f) * 2.0f * 0.25f);
     for (int a = 0; a < 3; ++a) EXPECT_NEAR(out[0][a], expected[a], 1e-6f);
 }
@@ -76,12 +76,8 @@ TEST(GasLighting, SpotLightsOnlyInsideTheirCone) {
     for (std::size_t i = 0; i < out.size(); ++i) {
         const glm::vec3 x = g.worldPosition(g.voxels[i].cell);
         const float angle = std::atan2(std::abs(x.x), 5.0f);
-        if (angle > 0.1f) {
-            EXPECT_EQ(out[i].r, 0.0f) << x.x;
-        }
-        if (angle < 0.05f) {
-            EXPECT_NEAR(out[i].r, 1.0f / glm::dot(x - spot.position, x - spot.position), 1e-6f) << x.x;
-        }
+        if (angle > 0.1f) { EXPECT_EQ(out[i].r, 0.0f) << x.x; }
+        if (angle < 0.05f) { EXPECT_NEAR(out[i].r, 1.0f / glm::dot(x - spot.position, x - spot.position), 1e-6f) << x.x; }
     }
 }
 

@@ -45,8 +45,8 @@ TEST(SceneLighting, UnlitEffectKeepsTableColoursAndBuildsNoTables) {
     s.prepare(0.0);
     ASSERT_GT(s.frame.splats().size(), 0u);
     // The builder's own packing of the constant table: round(c * 255).
-    const std::uint32_t expected = std::uint32_t(0.8f * 255 + 0.5f) | std::uint32_t(0.6f * 255 + 0.5f) << 8 |
-                                   std::uint32_t(0.4f * 255 + 0.5f) << 16 | 0xff000000u;
+    const std::uint32_t expected =
+        std::uint32_t(0.8f * 255 + 0.5f) | std::uint32_t(0.6f * 255 + 0.5f) << 8 | std::uint32_t(0.4f * 255 + 0.5f) << 16 | 0xff000000u;
     for (const Splat& sp : s.frame.splats()) ASSERT_EQ(sp.color, expected);
     EXPECT_EQ(s.frame.counters().litEffects, 0u);
     EXPECT_EQ(s.frame.counters().shadowTableBuilds, 0u);

@@ -80,8 +80,7 @@ int main(int argc, char** argv) {
             }
             std::vector<float> fromTable(grid.voxels.size());
             const Timing lookMs = medianMs(repeats, [&] {
-                for (std::size_t i = 0; i < grid.voxels.size(); ++i)
-                    fromTable[i] = table.transmittance(grid.worldPosition(grid.voxels[i].cell));
+                for (std::size_t i = 0; i < grid.voxels.size(); ++i) fromTable[i] = table.transmittance(grid.worldPosition(grid.voxels[i].cell));
             });
             double mean = 0.0, mx = 0.0;
             for (std::size_t i = 0; i < traced.size(); ++i) {

@@ -20,7 +20,6 @@ GLuint compileCompute(const std::string& src, std::string& log) {
     return *p;
 }
 
-
 class ShadowGlsl : public test::GLTest {};
 
 } // namespace
@@ -93,8 +92,8 @@ TEST_F(ShadowGlsl, IncludeCompilesAndMatchesTheCpuLookup) {
         for (GLuint i = 0; i < count; ++i) {
             const float cpu = table.transmittance(glm::vec3(points[i]));
             shadowed += cpu < 0.9f;
-            ASSERT_NEAR(gpu[i], cpu, tol) << "light " << li << " point " << i << " (" << points[i].x << ", " << points[i].y << ", "
-                                          << points[i].z << ")";
+            ASSERT_NEAR(gpu[i], cpu, tol) << "light " << li << " point " << i << " (" << points[i].x << ", " << points[i].y << ", " << points[i].z
+                                          << ")";
         }
         EXPECT_GT(shadowed, 20) << "light " << li; // the comparison covers real shadow, not only T = 1
     }

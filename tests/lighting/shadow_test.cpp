@@ -184,9 +184,7 @@ TEST(ShadowStability, LightExactlyAtTheDensestVoxelCentre) {
         for (float d : table.data()) ASSERT_TRUE(std::isfinite(d) && d >= 0.0f);
         // On a node the light sees no depth at itself (1e-5: the look-up's
         // coordinate rounding, times a neighbour's depth of ~2).
-        if (n == 17) {
-            EXPECT_LT(table.opticalDepth(peak), 1e-4f);
-        }
+        if (n == 17) { EXPECT_LT(table.opticalDepth(peak), 1e-4f); }
     }
     ShadowTracer tracer(*f, std::span(&bulb, 1));
     EXPECT_EQ(tracer.transmittance(0, peak), 1.0f); // zero-length path
@@ -247,9 +245,9 @@ TEST(ShadowTable, MeanErrorAgainstTracingIsBelowOneLevel) {
     ASSERT_TRUE(f);
     const glm::vec3 c = 0.5f * (f->boundsMin() + f->boundsMax());
     const Light lights[] = {
-        Light::directional({0.3f, -1.0f, 0.45f}),             // oblique sun
-        Light::point(c + glm::vec3(0.3f, 2.5f, -0.4f)),        // outside the table
-        Light::point(c + glm::vec3(0.35f, 0.27f, -0.18f)),     // inside the gas
+        Light::directional({0.3f, -1.0f, 0.45f}),          // oblique sun
+        Light::point(c + glm::vec3(0.3f, 2.5f, -0.4f)),    // outside the table
+        Light::point(c + glm::vec3(0.35f, 0.27f, -0.18f)), // inside the gas
     };
     for (const Light& l : lights) {
         const Errors e16 = tableError(g, *f, l, 16), e64 = tableError(g, *f, l, 64);
@@ -257,9 +255,7 @@ TEST(ShadowTable, MeanErrorAgainstTracingIsBelowOneLevel) {
         // Convergence of the recursive fill, for the lights outside the gas:
         // near the light inside it the table traces its nodes directly (8
         // node steps), which at 16^3 is most of this blob.
-        if (&l != &lights[2]) {
-            EXPECT_LT(e64.mean, e16.mean) << "light type " << int(l.type);
-        }
+        if (&l != &lights[2]) { EXPECT_LT(e64.mean, e16.mean) << "light type " << int(l.type); }
         // The traced shadow is not trivial here (else the bound says nothing).
         const glm::vec3 far = g.worldPosition({10, 1, 10});
         EXPECT_LT(std::exp2(-f->opticalDepthToLight(far, l)), 0.5f);

@@ -87,9 +87,7 @@ TEST_F(OgreCampfireTest, TheHookDrawsOnceIntoOgresRenderTargetWithItsDepth) {
     const ogrefx::HookInfo& h = sApp->hook();
     EXPECT_EQ(h.calls, 1);
     EXPECT_NE(h.framebuffer, 0u) << "a render texture is an FBO, never the default framebuffer";
-    if (h.framebufferFromOgre) {
-        EXPECT_EQ(h.framebufferFromOgre, h.framebuffer) << "the bound FBO is the target's own";
-    }
+    if (h.framebufferFromOgre) { EXPECT_EQ(h.framebufferFromOgre, h.framebuffer) << "the bound FBO is the target's own"; }
     EXPECT_EQ(h.viewport[2], kW);
     EXPECT_EQ(h.viewport[3], kH);
     EXPECT_GT(h.splats, 100u);
@@ -117,7 +115,7 @@ TEST_F(OgreCampfireTest, OgresDepthMatchesTheConvertedCameraOnTheGround) {
             const glm::dvec2 ndc(2.0 * (x + 0.5) / kW - 1.0, 2.0 * (y + 0.5) / kH - 1.0);
             glm::dvec4 a = inv * glm::dvec4(ndc, -1.0, 1.0), b = inv * glm::dvec4(ndc, 1.0, 1.0);
             const glm::dvec3 p0 = glm::dvec3(a) / a.w, p1 = glm::dvec3(b) / b.w;
-            if (p1.y >= p0.y) continue;                      // looks up: no ground
+            if (p1.y >= p0.y) continue; // looks up: no ground
             const double t = p0.y / (p0.y - p1.y);
             if (t <= 0.0 || t >= 1.0) continue;
             const glm::dvec3 hit = p0 + t * (p1 - p0);
@@ -230,8 +228,7 @@ void expectOccludedExactly(OgreApp<Scale>& t, int edge) {
     // The screenshot: frame B (fire and log), for a person looking at a failure.
     splatfx::Image image{.width = kW, .height = kH, .channels = 4, .pixels = {}};
     for (std::uint8_t v : b.rgba) image.pixels.push_back(float(v) / 255.0f);
-    const splatfx::Status st =
-        splatfx::writeImage(splatfx::test::outputDir() + "/ogre_campfire_scale" + std::to_string(Scale) + ".png", image);
+    const splatfx::Status st = splatfx::writeImage(splatfx::test::outputDir() + "/ogre_campfire_scale" + std::to_string(Scale) + ".png", image);
     EXPECT_TRUE(st) << st.error();
 }
 

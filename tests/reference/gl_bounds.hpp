@@ -34,8 +34,8 @@ inline double windowErrorBound(const Materials& mat, std::uint32_t layerIndex = 
             const double fx = (0.5 + 0.5 * u) * n - 0.5, fy = (0.5 - 0.5 * v) * n - 0.5;
             const int x0 = int(std::floor(fx)), y0 = int(std::floor(fy));
             const double ax = fx - x0, ay = fy - y0;
-            const double bil = (texel(x0, y0) * (1 - ax) + texel(x0 + 1, y0) * ax) * (1 - ay) +
-                               (texel(x0, y0 + 1) * (1 - ax) + texel(x0 + 1, y0 + 1) * ax) * ay;
+            const double bil =
+                (texel(x0, y0) * (1 - ax) + texel(x0 + 1, y0) * ax) * (1 - ay) + (texel(x0, y0 + 1) * (1 - ax) + texel(x0 + 1, y0 + 1) * ax) * ay;
             const double r = R * std::sqrt(u * u + v * v);
             worst = std::max(worst, std::abs(bil - (r < R ? fp.exact(r) / F0 : 0.0)));
         }

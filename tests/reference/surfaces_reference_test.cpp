@@ -32,9 +32,7 @@ struct Lone {
 };
 
 // A pane at world z, covering the view.
-ReferenceSurface pane(double z, glm::dvec4 c) {
-    return ReferenceSurface::quad({-9, -9, z}, {9, -9, z}, {9, 9, z}, {-9, 9, z}, c);
-}
+ReferenceSurface pane(double z, glm::dvec4 c) { return ReferenceSurface::quad({-9, -9, z}, {9, -9, z}, {9, 9, z}, {-9, 9, z}, c); }
 
 glm::dvec4 px(const Image& img, int x, int y) { return {img.at(x, y, 0), img.at(x, y, 1), img.at(x, y, 2), img.at(x, y, 3)}; }
 glm::dvec4 over(glm::dvec4 f, glm::dvec4 b) { return f + (1.0 - f.a) * b; }
@@ -75,8 +73,7 @@ TEST(ReferenceSurfaces, APaneThroughTheCentreSplitsTheKernelInHalves) {
     for (int c = 0; c < 4; ++c) EXPECT_NEAR(px(cutImg, 7, 5)[c], want[c], kFloat) << c;
     // Alpha does not depend on the order: 1 - (1 - a)(1 - p.a) everywhere.
     for (int y = 0; y < kSize.y; ++y)
-        for (int x = 0; x < kSize.x; ++x)
-            EXPECT_NEAR(px(cutImg, x, y).a, 1.0 - (1.0 - px(alone, x, y).a) * (1.0 - p.a), kFloat);
+        for (int x = 0; x < kSize.x; ++x) EXPECT_NEAR(px(cutImg, x, y).a, 1.0 - (1.0 - px(alone, x, y).a) * (1.0 - p.a), kFloat);
     // Without the cut the whole splat sits at its plane (the pane at the same depth: behind it, side 2 first).
     const Image plain = s.render({pane(0.001, p)}, false);
     for (int c = 0; c < 4; ++c) EXPECT_NEAR(px(plain, 7, 5)[c], over(p, a)[c], kFloat) << c;

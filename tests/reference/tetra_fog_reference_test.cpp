@@ -95,7 +95,8 @@ TEST(TetraFogReference, FarCutOffTurnsTheRestIntoFogColour) {
     s.chord(o, d, a, b);
     ASSERT_LT(b, 20.0);
     const double sc = s.sigmaC, sf = s.sigmaF, T1 = std::exp(-sf * a), T2 = T1 * std::exp(-(sc + sf) * (b - a));
-    const glm::dvec3 upToWall = s.fogColour * (1.0 - T1) + T1 * (sc * s.kappa + sf * s.fogColour) / (sc + sf) * (1.0 - std::exp(-(sc + sf) * (b - a))) +
+    const glm::dvec3 upToWall = s.fogColour * (1.0 - T1) +
+                                T1 * (sc * s.kappa + sf * s.fogColour) / (sc + sf) * (1.0 - std::exp(-(sc + sf) * (b - a))) +
                                 T2 * s.fogColour * (1.0 - std::exp(-sf * (20.0 - b)));
     const double Twall = T2 * std::exp(-sf * (20.0 - b));
     const glm::dvec4 r = integrateRayWithFog({s.tet}, *s.transfer, o, d, 0.0, 50.0, {.fog = &farFog, .tolerance = 1e-9});

@@ -158,12 +158,8 @@ TEST(VolumeReference, ErrorAtLeastHalvesWhenTheStepHalves) {
         double err = 0.0;
         for (size_t i = 0; i < img->pixels.size(); ++i) err = std::max(err, double(std::abs(img->pixels[i] - truth->pixels[i])));
         std::printf("step h0/%-2d  max error %.3e\n", 1 << k, err);
-        if (k > 0 && prev > 1e-6) {
-            EXPECT_GE(prev / err, 2.0) << "halving to h0/" << (1 << k);
-        }
-        if (k == 0) {
-            EXPECT_GT(err, 1e-5) << "the coarse step must show a measurable error, or the test proves nothing";
-        }
+        if (k > 0 && prev > 1e-6) { EXPECT_GE(prev / err, 2.0) << "halving to h0/" << (1 << k); }
+        if (k == 0) { EXPECT_GT(err, 1e-5) << "the coarse step must show a measurable error, or the test proves nothing"; }
         prev = err;
     }
 }

@@ -198,8 +198,10 @@ TEST_F(FragmentListsGL, PanesInFrontOfAndBehindTheFireSortLikeTheUnambiguousOrde
     for (const float z : {Fire::kFront + 2.0f, Fire::kBack - 2.0f}) {
         const bool inFront = z > 0.0f;
         const std::vector<Pane> pane{{.z = z, .premultiplied = tint}};
-        fr->render(f.frame, {.framebuffer = lists->handle(), .drawOpaque = clearTo(kBackground),
-                             .drawTransparent = [&] { glass.draw(pane, cam); }, .transparentToLists = true});
+        fr->render(f.frame, {.framebuffer = lists->handle(),
+                             .drawOpaque = clearTo(kBackground),
+                             .drawTransparent = [&] { glass.draw(pane, cam); },
+                             .transparentToLists = true});
         EXPECT_TRUE(fr->stats().transparentLists && fr->stats().splatsInLists);
         EXPECT_EQ(fr->stats().transparentFallback, 0u);
         EXPECT_EQ(fr->stats().transparentOverflowPixels, 0u);
@@ -213,11 +215,12 @@ TEST_F(FragmentListsGL, PanesInFrontOfAndBehindTheFireSortLikeTheUnambiguousOrde
         EXPECT_EQ(inFront ? fr->stats().transparentSplatsBehind : fr->stats().transparentSplatsFront, f.frame.splats().size());
         if (inFront) {
             fr->render(f.frame, {.framebuffer = ordered->handle(), .drawOpaque = clearTo(kBackground)});
-            fr->render(empty, {.framebuffer = ordered->handle(), .drawTransparent = [&] { glass.draw(pane, cam); },
-                               .transparentToLists = true});
+            fr->render(empty, {.framebuffer = ordered->handle(), .drawTransparent = [&] { glass.draw(pane, cam); }, .transparentToLists = true});
         } else {
-            fr->render(empty, {.framebuffer = ordered->handle(), .drawOpaque = clearTo(kBackground),
-                               .drawTransparent = [&] { glass.draw(pane, cam); }, .transparentToLists = true});
+            fr->render(empty, {.framebuffer = ordered->handle(),
+                               .drawOpaque = clearTo(kBackground),
+                               .drawTransparent = [&] { glass.draw(pane, cam); },
+                               .transparentToLists = true});
             fr->render(f.frame, {.framebuffer = ordered->handle()});
         }
         // F32 targets: the two differ only by the sections' half rounding.
@@ -244,16 +247,23 @@ TEST_F(FragmentListsGL, ThreePanesAroundTheFireSortPerSplat) {
     const std::vector<Pane> panes{{.z = Fire::kBack - 3.0f, .premultiplied = glm::vec4(0.2f, 0.05f, 0.0f, 0.3f)},
                                   {.z = Fire::kFront + 2.0f, .premultiplied = glm::vec4(0.0f, 0.1f, 0.2f, 0.35f)},
                                   {.z = Fire::kBack - 1.0f, .premultiplied = glm::vec4(0.05f, 0.2f, 0.05f, 0.25f)}};
-    fr->render(f.frame, {.framebuffer = lists->handle(), .drawOpaque = clearTo(kBackground),
-                         .drawTransparent = [&] { glass.draw(panes, cam); }, .transparentToLists = true});
+    fr->render(f.frame, {.framebuffer = lists->handle(),
+                         .drawOpaque = clearTo(kBackground),
+                         .drawTransparent = [&] { glass.draw(panes, cam); },
+                         .transparentToLists = true});
     EXPECT_TRUE(fr->stats().splatsInLists);
     EXPECT_EQ(fr->stats().transparentSections, 4);
     const Image got = lists->read();
     Frame empty;
     empty.begin(0.0, cam);
     empty.end();
-    fr->render(empty, {.framebuffer = ordered->handle(), .drawOpaque = clearTo(kBackground),
-                       .drawTransparent = [&] { glass.draw({panes[0], panes[2]}, cam); }, .transparentToLists = true});
+    fr->render(empty, {.framebuffer = ordered->handle(),
+                       .drawOpaque = clearTo(kBackground),
+                       .drawTransparent =
+                           [&] {
+                               glass.draw({panes[0], panes[2]}, cam);
+                           },
+                       .transparentToLists = true});
     fr->render(f.frame, {.framebuffer = ordered->handle()});
     fr->render(empty, {.framebuffer = ordered->handle(), .drawTransparent = [&] { glass.draw({panes[1]}, cam); }, .transparentToLists = true});
     const test::ImageDiff d = test::compareImages(got, ordered->read(), tol);
@@ -291,8 +301,10 @@ TEST_F(FragmentListsGL, SixtyFourLayersOnOnePixel) {
         ASSERT_TRUE(fr && fr->upload(materials));
         auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y});
         ASSERT_TRUE(fb);
-        fr->render(empty, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
-                           .drawTransparent = [&] { glass.draw(panes, cam); }, .transparentToLists = true});
+        fr->render(empty, {.framebuffer = fb->handle(),
+                           .drawOpaque = clearTo(kBackground),
+                           .drawTransparent = [&] { glass.draw(panes, cam); },
+                           .transparentToLists = true});
         const Image img = fb->read();
         const gl::FrameRenderStats& s = fr->stats();
         double maxErr = 0.0, maxAlphaErr = 0.0;
@@ -341,7 +353,9 @@ TEST_F(FragmentListsGL, MorePixelNodesThanTheBudgetMergeTheFarthest) {
     for (int i = 0; i < 16; ++i) {
         const int k = (i * 5) % 16;
         const float a = 0.1f + 0.02f * float(k % 5);
-        panes.push_back({.z = 2.0f - 0.2f * float(k), .premultiplied = glm::vec4(0.3f * a, 0.6f * a, float(k) / 15.0f * a, a), .half = 1.0f,
+        panes.push_back({.z = 2.0f - 0.2f * float(k),
+                         .premultiplied = glm::vec4(0.3f * a, 0.6f * a, float(k) / 15.0f * a, a),
+                         .half = 1.0f,
                          .centre = {0.0f, 0.0f}});
         transmit *= 1.0 - double(a);
     }
@@ -354,8 +368,10 @@ TEST_F(FragmentListsGL, MorePixelNodesThanTheBudgetMergeTheFarthest) {
     ASSERT_TRUE(fr && fr->upload(materials));
     auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y});
     ASSERT_TRUE(fb);
-    fr->render(empty, {.framebuffer = fb->handle(), .drawOpaque = clearTo(glm::vec4(0.0f)),
-                       .drawTransparent = [&] { glass.draw(panes, cam); }, .transparentToLists = true});
+    fr->render(empty, {.framebuffer = fb->handle(),
+                       .drawOpaque = clearTo(glm::vec4(0.0f)),
+                       .drawTransparent = [&] { glass.draw(panes, cam); },
+                       .transparentToLists = true});
     const gl::FrameRenderStats& s = fr->stats();
     EXPECT_EQ(s.transparentFallback, 0u);
     EXPECT_GT(s.transparentOverflowPixels, 0u);
@@ -385,16 +401,20 @@ TEST_F(FragmentListsGL, ZeroAlphaAndFullyOpaqueSurfaces) {
     const Image fire = plain->read();
 
     std::vector<Pane> zero{{.z = 0.0f, .premultiplied = glm::vec4(0.0f)}};
-    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
-                         .drawTransparent = [&] { glass.draw(zero, cam); }, .transparentToLists = true});
+    fr->render(f.frame, {.framebuffer = fb->handle(),
+                         .drawOpaque = clearTo(kBackground),
+                         .drawTransparent = [&] { glass.draw(zero, cam); },
+                         .transparentToLists = true});
     EXPECT_EQ(fr->stats().transparentNodes, 0u); // nothing stored
     test::ImageDiff d = test::compareImages(fb->read(), fire, tol);
     EXPECT_LE(d.maxAbs, tol) << "zero pane changed the image: " << test::writeFailureImages(fb->read(), d);
 
     const glm::vec4 wall{0.7f, 0.2f, 0.1f, 1.0f};
     std::vector<Pane> front{{.z = Fire::kFront + 1.0f, .premultiplied = wall}};
-    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
-                         .drawTransparent = [&] { glass.draw(front, cam); }, .transparentToLists = true});
+    fr->render(f.frame, {.framebuffer = fb->handle(),
+                         .drawOpaque = clearTo(kBackground),
+                         .drawTransparent = [&] { glass.draw(front, cam); },
+                         .transparentToLists = true});
     const Image hidden = fb->read();
     double worst = 0.0;
     for (int y = 0; y < kSize.y; ++y)
@@ -403,8 +423,10 @@ TEST_F(FragmentListsGL, ZeroAlphaAndFullyOpaqueSurfaces) {
     EXPECT_LE(worst, std::ldexp(1.0, -10)) << "an opaque pane in front must hide the fire"; // the pane's half colour
 
     std::vector<Pane> back{{.z = Fire::kBack - 1.0f, .premultiplied = wall}};
-    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
-                         .drawTransparent = [&] { glass.draw(back, cam); }, .transparentToLists = true});
+    fr->render(f.frame, {.framebuffer = fb->handle(),
+                         .drawOpaque = clearTo(kBackground),
+                         .drawTransparent = [&] { glass.draw(back, cam); },
+                         .transparentToLists = true});
     const Image behind = fb->read();
     // The fire over the wall: the ordered blend of the fire over an opaque clear of the wall's colour.
     fr->render(f.frame, {.framebuffer = plain->handle(), .drawOpaque = clearTo(wall)});
@@ -432,8 +454,9 @@ TEST_F(FragmentListsGL, BudgetOfOneFragmentPerPixel) {
     const std::vector<Pane> panes{{.z = Fire::kFront + 1.0f, .premultiplied = glm::vec4(0.05f, 0.1f, 0.15f, 0.3f)},
                                   {.z = Fire::kBack - 1.0f, .premultiplied = glm::vec4(0.2f, 0.1f, 0.0f, 0.4f)}};
     const glm::vec4 clear{0.0f};
-    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(clear),
-                         .drawTransparent = [&] { glass.draw(panes, cam); }, .transparentToLists = true});
+    fr->render(
+        f.frame,
+        {.framebuffer = fb->handle(), .drawOpaque = clearTo(clear), .drawTransparent = [&] { glass.draw(panes, cam); }, .transparentToLists = true});
     const gl::FrameRenderStats s = fr->stats();
     const std::uint64_t pixels = std::uint64_t(kSize.x) * kSize.y;
     EXPECT_EQ(s.transparentNodes, pixels);
@@ -441,10 +464,13 @@ TEST_F(FragmentListsGL, BudgetOfOneFragmentPerPixel) {
     EXPECT_GE(s.transparentSections, 2);
     // Pool, heads and counts, the resolved RGBA16F image, the section targets,
     // the sorted depths (R32F, one layer fewer than sections), the counters.
-    EXPECT_EQ(s.transparentBytes, std::size_t(pixels) * (kTransparentNodeBytes + kTransparentHeadBytesPerPixel + 8 +
-                                                         std::size_t(s.transparentSections) * kTransparentSectionBytesPerPixel +
-                                                         4 * std::size_t(s.transparentSections - 1)) + 48 +
-                                      (16 + 4) * std::size_t((kSize.x + 15) / 16) * std::size_t((kSize.y + 15) / 16)); // + per 16 x 16 tile the survey (RGBA32UI) and, with sections, the host depth (R32F)
+    EXPECT_EQ(s.transparentBytes,
+              std::size_t(pixels) *
+                      (kTransparentNodeBytes + kTransparentHeadBytesPerPixel + 8 +
+                       std::size_t(s.transparentSections) * kTransparentSectionBytesPerPixel + 4 * std::size_t(s.transparentSections - 1)) +
+                  48 +
+                  (16 + 4) * std::size_t((kSize.x + 15) / 16) *
+                      std::size_t((kSize.y + 15) / 16)); // + per 16 x 16 tile the survey (RGBA32UI) and, with sections, the host depth (R32F)
     const Image got = fb->read();
     // The alpha of the three in any order: the ordered blend (pane, fire, pane).
     Frame empty;
@@ -452,8 +478,10 @@ TEST_F(FragmentListsGL, BudgetOfOneFragmentPerPixel) {
     empty.end();
     auto one = gl::FrameRenderer::create({.fragmentsPerPixel = 1});
     ASSERT_TRUE(one && one->upload(f.materials));
-    one->render(empty, {.framebuffer = ordered->handle(), .drawOpaque = clearTo(clear),
-                        .drawTransparent = [&] { glass.draw({panes[1]}, cam); }, .transparentToLists = true});
+    one->render(empty, {.framebuffer = ordered->handle(),
+                        .drawOpaque = clearTo(clear),
+                        .drawTransparent = [&] { glass.draw({panes[1]}, cam); },
+                        .transparentToLists = true});
     one->render(f.frame, {.framebuffer = ordered->handle()});
     one->render(empty, {.framebuffer = ordered->handle(), .drawTransparent = [&] { glass.draw({panes[0]}, cam); }, .transparentToLists = true});
     const Image want = ordered->read();
@@ -506,13 +534,15 @@ TEST_F(FragmentListsGL, SplatStraddlingAPaneIsCutIntoSections) {
     // ln2 tau delta (and its colour, <= 1 times that); two sections.
     const double tau = frame.splats()[0].density;
     auto errorAgainstReference = [&](const std::vector<Pane>& panes) {
-        fr->render(frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(glm::vec4(0.0f)),
-                           .drawTransparent = [&] { glass.draw(panes, cam); }, .transparentToLists = true});
+        fr->render(frame, {.framebuffer = fb->handle(),
+                           .drawOpaque = clearTo(glm::vec4(0.0f)),
+                           .drawTransparent = [&] { glass.draw(panes, cam); },
+                           .transparentToLists = true});
         std::vector<ReferenceSurface> surfaces;
         for (const Pane& p : panes)
-            surfaces.push_back(ReferenceSurface::quad({p.centre.x - p.half, p.centre.y - p.half, p.z}, {p.centre.x + p.half, p.centre.y - p.half, p.z},
-                                                      {p.centre.x + p.half, p.centre.y + p.half, p.z}, {p.centre.x - p.half, p.centre.y + p.half, p.z},
-                                                      glm::dvec4(p.premultiplied)));
+            surfaces.push_back(ReferenceSurface::quad(
+                {p.centre.x - p.half, p.centre.y - p.half, p.z}, {p.centre.x + p.half, p.centre.y - p.half, p.z},
+                {p.centre.x + p.half, p.centre.y + p.half, p.z}, {p.centre.x - p.half, p.centre.y + p.half, p.z}, glm::dvec4(p.premultiplied)));
         auto ref = renderSplatExact(frame.splats(), cam, materials, {.threads = 2, .surfaces = surfaces});
         const Image got = fb->read();
         double worst = 0.0;
@@ -554,8 +584,10 @@ TEST_F(FragmentListsGL, WithAFogSplatsClearOfTheSurfacesAreExactAndTheRestSaySo)
     const Camera& cam = f.frame.camera();
     const glm::vec4 tint{0.05f, 0.1f, 0.15f, 0.3f};
     const std::vector<Pane> front{{.z = Fire::kFront + 1.0f, .premultiplied = tint}};
-    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
-                         .drawTransparent = [&] { glass.draw(front, cam); }, .transparentToLists = true});
+    fr->render(f.frame, {.framebuffer = fb->handle(),
+                         .drawOpaque = clearTo(kBackground),
+                         .drawTransparent = [&] { glass.draw(front, cam); },
+                         .transparentToLists = true});
     gl::FrameRenderStats s = fr->stats();
     EXPECT_TRUE(s.transparentLists && s.splatsInLists && s.fogSplats);
     EXPECT_TRUE(s.transparentNote.empty()) << s.transparentNote;
@@ -573,8 +605,10 @@ TEST_F(FragmentListsGL, WithAFogSplatsClearOfTheSurfacesAreExactAndTheRestSaySo)
     EXPECT_LE(d.maxAbs, std::ldexp(1.0, -11)) << test::writeFailureImages(got, d);
 
     const std::vector<Pane> through{{.z = 0.0f, .premultiplied = tint}};
-    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground),
-                         .drawTransparent = [&] { glass.draw(through, cam); }, .transparentToLists = true});
+    fr->render(f.frame, {.framebuffer = fb->handle(),
+                         .drawOpaque = clearTo(kBackground),
+                         .drawTransparent = [&] { glass.draw(through, cam); },
+                         .transparentToLists = true});
     s = fr->stats();
     EXPECT_NE(s.transparentNote.find("fog"), std::string::npos) << s.transparentNote;
     EXPECT_EQ(s.transparentSplatsSectioned, 0u);
@@ -634,13 +668,15 @@ gl::FrameRenderStats blockAgainstReference(const Camera& cam, const std::vector<
     const glm::vec4 clear{0.1f, 0.15f, 0.2f, 1.0f};
     const glm::vec3 eye = cam.eye();
     auto errorAgainstReference = [&](const std::vector<Pane>& panes) {
-        fr->render(frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(clear),
-                           .drawTransparent = [&] { glass.draw(panes, cam); }, .transparentToLists = true});
+        fr->render(frame, {.framebuffer = fb->handle(),
+                           .drawOpaque = clearTo(clear),
+                           .drawTransparent = [&] { glass.draw(panes, cam); },
+                           .transparentToLists = true});
         std::vector<ReferenceSurface> surfaces;
         for (const Pane& p : panes)
-            surfaces.push_back(ReferenceSurface::quad({p.centre.x - p.half, p.centre.y - p.half, p.z}, {p.centre.x + p.half, p.centre.y - p.half, p.z},
-                                                      {p.centre.x + p.half, p.centre.y + p.half, p.z}, {p.centre.x - p.half, p.centre.y + p.half, p.z},
-                                                      glm::dvec4(p.premultiplied)));
+            surfaces.push_back(ReferenceSurface::quad(
+                {p.centre.x - p.half, p.centre.y - p.half, p.z}, {p.centre.x + p.half, p.centre.y - p.half, p.z},
+                {p.centre.x + p.half, p.centre.y + p.half, p.z}, {p.centre.x - p.half, p.centre.y + p.half, p.z}, glm::dvec4(p.premultiplied)));
         auto ref = renderSplatExact(frame.splats(), cam, materials, {.host = {.background = clear}, .threads = 2, .surfaces = surfaces});
         const Image got = fb->read();
         double worst = 0.0;

@@ -100,9 +100,7 @@ TEST_F(FrameRendererGL, TransparentPassRunsAfterTheVolumes) {
     ASSERT_TRUE(fb);
     std::vector<float> seen(std::size_t(kSize.x) * kSize.y * 4, 0.0f);
     bool called = false;
-    fr->render(f.frame, {.framebuffer = fb->handle(),
-                         .drawOpaque = clearTo(kBackground, 1.0),
-                         .drawTransparent = [&] {
+    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground, 1.0), .drawTransparent = [&] {
                              called = true;
                              glReadPixels(0, 0, kSize.x, kSize.y, GL_RGBA, GL_FLOAT, seen.data());
                          }});

@@ -46,8 +46,7 @@ TEST_F(ProgramGL, AComputeProgramBuildsAndItsErrorsNameTheStage) {
 TEST_F(ProgramGL, ALinkErrorIsReportedToo) {
     // Both stages compile; linking fails because the fragment stage reads an
     // input no vertex output feeds (GLSL 4.50, sec. 4.3.4).
-    auto p = gl::linkProgram({kVersion, kVertex}, {kVersion, "in vec4 vMissing; out vec4 o; void main() { o = vMissing; }\n"},
-                             "mismatched pass");
+    auto p = gl::linkProgram({kVersion, kVertex}, {kVersion, "in vec4 vMissing; out vec4 o; void main() { o = vMissing; }\n"}, "mismatched pass");
     ASSERT_FALSE(p);
     EXPECT_EQ(p.error().rfind("mismatched pass program failed to link: ", 0), 0u) << p.error();
 }

@@ -84,9 +84,7 @@ TEST_F(RendererGL, CampfireMatchesGoldenImage) {
     // Bilinear sampling, named: the default (Auto) depends on the GL.
     const Image actual = renderCampfire(1, {160, 120}, {.sampling = gl::TextureSampling::Bilinear});
     const std::string goldenPath = test::sourcePath("tests/golden/campfire_160x120.png");
-    if (std::getenv("SPLATFX_UPDATE_GOLDEN")) {
-        ASSERT_TRUE(writeImage(goldenPath, actual));
-    }
+    if (std::getenv("SPLATFX_UPDATE_GOLDEN")) { ASSERT_TRUE(writeImage(goldenPath, actual)); }
     auto golden = readImage(goldenPath);
     ASSERT_TRUE(golden) << golden.error();
     // The tolerances live beside the golden, each explained there.
@@ -96,8 +94,8 @@ TEST_F(RendererGL, CampfireMatchesGoldenImage) {
     ASSERT_TRUE(d.sameSize);
     std::printf("golden diff: mean %.3f/255 max %.1f/255 over %.2f%%\n", d.meanAbs * 255, d.maxAbs * 255, d.fractionOver * 100);
     const bool ok = test::withinThresholds(d, *limits);
-    EXPECT_TRUE(ok) << "mean " << d.meanAbs * 255 << "/255, max " << d.maxAbs * 255 << "/255, over " << d.fractionOver * 100
-                    << "% -- " << test::writeFailureImages(actual, d);
+    EXPECT_TRUE(ok) << "mean " << d.meanAbs * 255 << "/255, max " << d.maxAbs * 255 << "/255, over " << d.fractionOver * 100 << "% -- "
+                    << test::writeFailureImages(actual, d);
 }
 
 // Upsampled layers sampled nearest stand in for bilinear sampling: the same
@@ -158,7 +156,7 @@ TEST_F(RendererGL, TexturedSplatsShowDetailTraditionalDoNot) {
         auto fb = gl::Framebuffer::create({.width = 160, .height = 120});
         auto r = gl::Renderer::create();
         const Status up = r->upload(f.materials);
-    EXPECT_TRUE(up) << up.error();
+        EXPECT_TRUE(up) << up.error();
         fb->clear({0, 0, 0, 1});
         const Camera cam = test::campfireCamera({160, 120});
         SplatBuilder b;
@@ -289,8 +287,7 @@ TEST_F(RendererGL, RestoringSurvivesAProgramTheHostDeleted) {
 }
 
 TEST_F(RendererGL, HostStateIsUnchangedAfterDraw) {
-    while (glGetError() != GL_NO_ERROR) {
-    } // start from a clean error state
+    while (glGetError() != GL_NO_ERROR) {} // start from a clean error state
     FireMaterials f(1);
     auto host = gl::Framebuffer::create({.width = 64, .height = 64});
     auto r = gl::Renderer::create();
@@ -328,7 +325,11 @@ TEST_F(RendererGL, HostStateIsUnchangedAfterDraw) {
     r->draw(b.splats(), cam, {.framebuffer = host->handle(), .width = 64, .height = 64});
     EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR)) << "draw";
 
-    auto geti = [](GLenum e) { GLint v = 0; glGetIntegerv(e, &v); return v; };
+    auto geti = [](GLenum e) {
+        GLint v = 0;
+        glGetIntegerv(e, &v);
+        return v;
+    };
     EXPECT_EQ(geti(GL_DRAW_FRAMEBUFFER_BINDING), GLint(host->handle()));
     EXPECT_EQ(geti(GL_CURRENT_PROGRAM), GLint(quad.program));
     EXPECT_EQ(geti(GL_VERTEX_ARRAY_BINDING), GLint(quad.vao));

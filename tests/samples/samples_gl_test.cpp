@@ -20,8 +20,7 @@ class SamplesGL : public splatfx::test::GLTest {};
 splatfx::Image render(scenehost::ScenePlayer& player, const std::vector<double>& times, glm::ivec2 size) {
     auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
     EXPECT_TRUE(fb.ok());
-    for (double t : times)
-        player.renderFrame(t, player.cameraAt(t, size), fb->handle());
+    for (double t : times) player.renderFrame(t, player.cameraAt(t, size), fb->handle());
     return fb->read();
 }
 
@@ -67,9 +66,13 @@ std::string cowScene(float z, bool fire, bool cow) {
     const std::string mesh = splatfx::test::sourcePath("samples/03-cow-through-fire/cow.off");
     return R"({"format": "splatfx-scene", "version": 1, "output": {"background": [0, 0, 0]},
       "camera": {"position": [0, 1.4, 9], "target": [0, 1.4, 0], "fovDeg": 40},
-      "geometry": [)" + std::string(cow ? R"({"type": "mesh", "mesh": ")" + mesh + R"(", "fitSize": 2.6, "position": [0, 0.4, )" +
-                                              std::to_string(z) + R"(], "color": [0.8, 0.8, 0.8]})" : "") + R"(],
-      "effects": [{"kind": "fire", "dims": [7, 20, 5], "spacing": 0.45, "enabled": )" + (fire ? "true" : "false") + "}]}";
+      "geometry": [)" +
+           std::string(cow ? R"({"type": "mesh", "mesh": ")" + mesh + R"(", "fitSize": 2.6, "position": [0, 0.4, )" + std::to_string(z) +
+                                 R"(], "color": [0.8, 0.8, 0.8]})"
+                           : "") +
+           R"(],
+      "effects": [{"kind": "fire", "dims": [7, 20, 5], "spacing": 0.45, "enabled": )" +
+           (fire ? "true" : "false") + "}]}";
 }
 
 splatfx::Image renderText(const std::string& text) {
@@ -160,7 +163,8 @@ TEST_F(SamplesGL, LodGroundFogTerrainIsTheHostsTerrain) {
     const splatfx::VolumeId id = player->file().groundFogTerrain[0].fog;
     splatfx::LodFrame scratch;
     std::vector<glm::vec3> tris;
-    ASSERT_TRUE(player->file().scene.groundFog(id).update(player->cameraAt(t, size), player->file().scene.groundFogOptions(id).refine, scratch, &tris));
+    ASSERT_TRUE(
+        player->file().scene.groundFog(id).update(player->cameraAt(t, size), player->file().scene.groundFogOptions(id).refine, scratch, &tris));
     ASSERT_GT(tris.size(), 0u);
     EXPECT_EQ(player->geometry().stats().triangles, tris.size() / 3);
     // The host drew the terrain prepare() refined (VolumeOptions::keepTerrain), not a second refinement.

@@ -16,9 +16,7 @@ using namespace splatfx;
 
 namespace {
 
-Camera lookingAt(glm::vec3 target, glm::vec3 from) {
-    return Camera::lookAt(from, target, {0, 1, 0}, glm::radians(50.0f), {320, 240}, 0.1f, 500.0f);
-}
+Camera lookingAt(glm::vec3 target, glm::vec3 from) { return Camera::lookAt(from, target, {0, 1, 0}, glm::radians(50.0f), {320, 240}, 0.1f, 500.0f); }
 
 // What the Scene asked of the test kind, kept outside it so the test can read
 // it after the Scene owns the kind.
@@ -80,8 +78,7 @@ TEST(EffectKind, ATestOnlyKindIsCulledOutOfViewAndEmittedInView) {
     ASSERT_LE(m.footprint().radius(), 2.0f) << "StaticCube::bounds assumes a footprint radius of at most 2";
     Calls calls;
     Scene scene;
-    const EffectId cube = scene.add(std::make_unique<StaticCube>(glm::vec3(0, 3, 0), 100.0, calls),
-                                    {.name = "cube", .draw = {.opacityScale = 0.5f}});
+    const EffectId cube = scene.add(std::make_unique<StaticCube>(glm::vec3(0, 3, 0), 100.0, calls), {.name = "cube", .draw = {.opacityScale = 0.5f}});
     EXPECT_EQ(scene.findEffect(cube), nullptr) << "a kind that is not an Effect has no Effect";
     EXPECT_EQ(scene.kind(cube).costCells(), 8u);
 

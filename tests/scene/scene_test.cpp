@@ -12,9 +12,7 @@ using namespace splatfx;
 
 namespace {
 
-Camera lookingAt(glm::vec3 target, glm::vec3 from) {
-    return Camera::lookAt(from, target, {0, 1, 0}, glm::radians(50.0f), {320, 240}, 0.1f, 500.0f);
-}
+Camera lookingAt(glm::vec3 target, glm::vec3 from) { return Camera::lookAt(from, target, {0, 1, 0}, glm::radians(50.0f), {320, 240}, 0.1f, 500.0f); }
 
 // Looks at x = +-40 alternately: an effect at +40 is hidden half the time.
 Camera sweeping(int frame) {

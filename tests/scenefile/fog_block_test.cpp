@@ -32,16 +32,18 @@ TEST(FogBlock, EveryTermKindIsReadAndMatchesTheApi) {
     EXPECT_DOUBLE_EQ(fog->desc().farDistanceWorld, 300.0);
     EXPECT_NEAR(fog->desc().colour.y, 0.6, 1e-7);
     splatfx::FogDesc d;
-    d.terms = {splatfx::FogTerm::constant(2), splatfx::FogTerm::cosine(0.5, 3, {0, 1, 0}, 0.1),
+    d.terms = {splatfx::FogTerm::constant(2),
+               splatfx::FogTerm::cosine(0.5, 3, {0, 1, 0}, 0.1),
                splatfx::FogTerm::cosineProduct(0.2, 1, {1, 0, 0}, 0, 0.5, {0, 0, 1}, 0),
-               splatfx::FogTerm::polynomial1D(0.3, 2, {0.8, -1, 0, 0, 1}, 10), splatfx::FogTerm::point(1, {1, 2, 3}, 1, 4),
-               splatfx::FogTerm::line(1, {0, 0, 0}, {0, 1, 0}, 2, 1), splatfx::FogTerm::sphere(1, {0, 1, 0}, 2, 1, 1)};
+               splatfx::FogTerm::polynomial1D(0.3, 2, {0.8, -1, 0, 0, 1}, 10),
+               splatfx::FogTerm::point(1, {1, 2, 3}, 1, 4),
+               splatfx::FogTerm::line(1, {0, 0, 0}, {0, 1, 0}, 2, 1),
+               splatfx::FogTerm::sphere(1, {0, 1, 0}, 2, 1, 1)};
     d.terms[4].windFactor = 0;
     d.wind = splatfx::FogWind::constant({1, 0, 0.5});
     auto api = splatfx::Fog::create(d);
     ASSERT_TRUE(api) << api.error();
-    for (double t : {0.0, 2.5})
-        EXPECT_NEAR(fog->opticalDepth({-3, 0.2, 1}, {4, 1.5, -7}, t), api->opticalDepth({-3, 0.2, 1}, {4, 1.5, -7}, t), 1e-9);
+    for (double t : {0.0, 2.5}) EXPECT_NEAR(fog->opticalDepth({-3, 0.2, 1}, {4, 1.5, -7}, t), api->opticalDepth({-3, 0.2, 1}, {4, 1.5, -7}, t), 1e-9);
 }
 
 TEST(FogBlock, ScaleKeepsTheOpticalDepthOfAScaledPath) {

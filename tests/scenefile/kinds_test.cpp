@@ -24,7 +24,8 @@ splatfx::Result<splatfx::SceneFile> parse(const std::string& body) {
 std::string minimalEffect(const std::string& kind) {
     if (kind == "grid") return R"({"kind": "grid", "dims": [3, 3, 3]})";
     if (kind == "smoke" || kind == "dust") return R"({"kind": ")" + kind + R"(", "dims": [4, 4, 4]})";
-    if (kind == "vdb") return R"({"kind": "vdb", "files": ")" SPLATFX_SOURCE_DIR R"(/samples/20-vdb-smoke/data/fluid_data_####.vdb", "lastFrame": 2})";
+    if (kind == "vdb")
+        return R"({"kind": "vdb", "files": ")" SPLATFX_SOURCE_DIR R"(/samples/20-vdb-smoke/data/fluid_data_####.vdb", "lastFrame": 2})";
     return R"({"kind": ")" + kind + R"("})";
 }
 
@@ -58,10 +59,12 @@ TEST(SceneFileKinds, AnUnknownKindNamesEveryKnownKind) {
     // The list is the documented one (docs/scene-format.md), in its order;
     // "vdb" only in builds with OpenVDB (splatfx::vdb).
     const std::string vdb = SPLATFX_WITH_VDB ? ", vdb" : "";
-    EXPECT_EQ(listed, std::string(R"("fire", "smoke", "steam", "dust", "fireToSmoke", "ghosts", "grid", "gas")") + (SPLATFX_WITH_VDB ? R"(, "vdb")" : ""));
+    EXPECT_EQ(listed,
+              std::string(R"("fire", "smoke", "steam", "dust", "fireToSmoke", "ghosts", "grid", "gas")") + (SPLATFX_WITH_VDB ? R"(, "vdb")" : ""));
     auto missing = parse(R"("effects": [{"name": "a"}])");
     ASSERT_FALSE(missing);
-    EXPECT_NE(missing.error().find("missing \"kind\" (one of fire, smoke, steam, dust, fireToSmoke, ghosts, grid, gas" + vdb + ")"), std::string::npos)
+    EXPECT_NE(missing.error().find("missing \"kind\" (one of fire, smoke, steam, dust, fireToSmoke, ghosts, grid, gas" + vdb + ")"),
+              std::string::npos)
         << missing.error();
 }
 

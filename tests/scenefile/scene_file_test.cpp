@@ -140,8 +140,8 @@ TEST(SceneFile, PresetTextureFoldersAreLoadedByTheReader) {
     const std::string set = std::string(SPLATFX_SOURCE_DIR) + "/textures/photo-fire-8x32";
     splatfx::Materials m(splatfx::Footprint{});
     const std::uint32_t sets = m.setCount(), layers = m.layerCount();
-    auto r = splatfx::parseSceneFile("{" + kHead + R"(, "effects": [{"kind": "fire", "textureSet": {"folder": ")" + set + R"("}}]})",
-                                     "dir/scene.json", m);
+    auto r =
+        splatfx::parseSceneFile("{" + kHead + R"(, "effects": [{"kind": "fire", "textureSet": {"folder": ")" + set + R"("}}]})", "dir/scene.json", m);
     ASSERT_TRUE(r.ok()) << r.error();
     auto direct = splatfx::TextureSet::load(set);
     ASSERT_TRUE(direct) << direct.error();
@@ -168,15 +168,18 @@ TEST(SceneFile, PresetTextureFoldersAreLoadedByTheReader) {
 TEST(SceneFile, AbsurdSizesAreRefusedBeforeAllocating) {
     expectError(R"("effects": [{"kind": "fire", "dims": [1000, 1000, 1000]}])",
                 {"effects[0].dims: 1000x1000x1000 (grid effects) needs 1000000000 cells, over the budget of 16777216 (raise Budgets::effectCells)"});
-    expectError(R"("effects": [{"kind": "smoke", "dims": [100, 100, 100]}])", {"effects[0].dims:", "over the budget of 262144", "solver", "Budgets::solverCells"});
+    expectError(R"("effects": [{"kind": "smoke", "dims": [100, 100, 100]}])",
+                {"effects[0].dims:", "over the budget of 262144", "solver", "Budgets::solverCells"});
     expectError(R"("effects": [{"kind": "grid", "dims": [5, 99999, 5]}])", {"effects[0].dims[1]: expected an integer in [1, 4096], got 99999"});
     expectError(R"("output": {"size": [100000, 10]})", {"output.size[0]: expected an integer in [16, 8192], got 100000"});
 }
 
 TEST(SceneFile, NonFiniteAndHugeValuesAreRefused) {
     // The library gives no position for an overflowing literal; the reader finds it (line 1, after the head).
-    expectError(R"("effects": [{"kind": "fire", "position": [0, 1e999, 0]}])", {"dir/scene.json:1:", ": number overflow parsing '1e999' (expected a finite number)"});
-    expectError(R"("effects": [{"kind": "fire", "position": [0, 1e30, 0]}])", {"effects[0].position[1]: expected a number in [-1e+06, 1e+06], got 1e+30"});
+    expectError(R"("effects": [{"kind": "fire", "position": [0, 1e999, 0]}])",
+                {"dir/scene.json:1:", ": number overflow parsing '1e999' (expected a finite number)"});
+    expectError(R"("effects": [{"kind": "fire", "position": [0, 1e30, 0]}])",
+                {"effects[0].position[1]: expected a number in [-1e+06, 1e+06], got 1e+30"});
     expectError(R"("camera": {"fovDeg": 0})", {"camera.fovDeg: expected a number in [1, 170], got 0"});
 }
 
@@ -266,12 +269,14 @@ TEST(SceneFile, PathsAreRelativeToTheFile) {
 // error names the effect that crosses the limit).
 TEST(SceneFile, TextureBudgetsAreCheckedBeforeBuilding) {
     expectError(R"("effects": [{"kind": "grid", "dims": [2, 2, 2], "textureSet": {"sampleImage": {"image": "x.png", "count": 256, "size": 1024}}}])",
-                {"effects[0].textureSet.sampleImage: count 256 x size 1024^2 needs 268435456 texels, over the budget of 16777216 (raise Budgets::sampledTexels)"});
+                {"effects[0].textureSet.sampleImage: count 256 x size 1024^2 needs 268435456 texels, over the budget of 16777216 (raise "
+                 "Budgets::sampledTexels)"});
     std::string effects;
     for (int i = 0; i < 300; ++i)
         effects += std::string(i ? ", " : "") + R"({"kind": "grid", "dims": [2, 2, 2], "textureSet": {"procedural": {"count": 16, "seed": )" +
                    std::to_string(i) + "}}}";
-    expectError(R"("effects": [)" + effects + "]", {"effects[127]: the scene, with this effect, needs 2049 layers, over the budget of 2048 (raise Budgets::textureLayers) in its distinct texture sets"});
+    expectError(R"("effects": [)" + effects + "]", {"effects[127]: the scene, with this effect, needs 2049 layers, over the budget of 2048 (raise "
+                                                    "Budgets::textureLayers) in its distinct texture sets"});
 }
 
 // The budgets are the user's to raise (budget.hpp): the same files load once

@@ -32,8 +32,8 @@ TEST(Materials, EqualTextureSetsAreRegisteredOnce) {
     const std::uint64_t version = m.version();
     const auto again = m.addTextureSet(TextureSet::turbulence({.count = 4, .seed = 7}));
     EXPECT_EQ(again, a);
-    EXPECT_EQ(m.layerCount(), layers);   // nothing added ...
-    EXPECT_EQ(m.version(), version);     // ... so renderers need not re-upload
+    EXPECT_EQ(m.layerCount(), layers); // nothing added ...
+    EXPECT_EQ(m.version(), version);   // ... so renderers need not re-upload
     const auto b = m.addTextureSet(TextureSet::turbulence({.count = 4, .seed = 8}));
     EXPECT_NE(b, a);
     EXPECT_EQ(m.layerCount(), layers + 4);

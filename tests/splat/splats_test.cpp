@@ -56,9 +56,7 @@ TEST(SplatBuilder, SortsBackToFrontForRandomSplatsAndCameras) {
         ASSERT_GT(s.size(), 0u);
         for (size_t i = 0; i < s.size(); ++i) {
             EXPECT_NEAR(s[i].depth, glm::length(s[i].center - eye), 1e-4f * s[i].depth);
-            if (i) {
-                EXPECT_GE(s[i - 1].depth, s[i].depth) << "trial " << trial << " at " << i;
-            }
+            if (i) { EXPECT_GE(s[i - 1].depth, s[i].depth) << "trial " << trial << " at " << i; }
         }
     }
 }
@@ -166,9 +164,7 @@ TEST(SplatBuilder, NearPlaneFadesInsteadOfPopping) {
         b.begin(Camera::lookAt({0, 0, z}, {0, 0, -1}, {0, 1, 0}, 1.0f, {64, 64}, 0.1f));
         b.add(g, m);
         const float d = b.splats().empty() ? 0.0f : b.splats()[0].density;
-        if (z < 5.9f) {
-            EXPECT_LE(std::abs(d - last), maxJump * 1.001f) << "jump at z " << z;
-        }
+        if (z < 5.9f) { EXPECT_LE(std::abs(d - last), maxJump * 1.001f) << "jump at z " << z; }
         last = d;
     }
     EXPECT_EQ(last, 0.0f);
@@ -194,9 +190,9 @@ TEST(SplatBuilder, ClampsOpacityAndDropsNonFiniteVoxels) {
 TEST(SplatBuilder, ThreadsGiveTheSameSplatsAsOneThread) {
     const Materials m = plainMaterials();
     Grid g = *Grid::box({40, 40, 40}, glm::vec3(0.25f));
-    for (size_t i = 0; i < g.voxels.size(); i += 7) g.voxels[i].opacity = 0.0f;              // some culled
+    for (size_t i = 0; i < g.voxels.size(); i += 7) g.voxels[i].opacity = 0.0f;                // some culled
     for (size_t i = 3; i < g.voxels.size(); i += 11) g.voxels[i].stretch = {0.0f, 0.5f, 0.0f}; // some stretched
-    g.voxels[5].opacity = std::nanf("");                                                     // one rejected
+    g.voxels[5].opacity = std::nanf("");                                                       // one rejected
     const Camera cam = Camera::lookAt({2, 6, 14}, {0, 4, 0}, {0, 1, 0}, 0.9f, {320, 240});
     auto build = [&](unsigned threads) {
         SplatBuilder b({.threads = threads});

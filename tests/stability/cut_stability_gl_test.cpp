@@ -94,9 +94,7 @@ protected:
         fb->clear(kBackground, depth);
         const Image depthImage = fb->readDepth();
         r->draw(splats, cam, {.framebuffer = fb->handle(), .width = cam.viewport.x, .height = cam.viewport.y});
-        if (cut) {
-            EXPECT_TRUE(r->stats().cutHostDepth) << "the framebuffer depth texture must be read";
-        }
+        if (cut) { EXPECT_TRUE(r->stats().cutHostDepth) << "the framebuffer depth texture must be read"; }
         f.gl = fb->read();
         SplatExactDesc rd;
         rd.host.background = kBackground;
@@ -142,8 +140,7 @@ protected:
     }
 
     // The continuity check around zCoincident (see the header), GL and reference.
-    void continuity(const std::vector<Splat>& splats, const Camera& cam, const Materials& mat, float zCoincident, float eps,
-                    bool plainPops = true) {
+    void continuity(const std::vector<Splat>& splats, const Camera& cam, const Materials& mat, float zCoincident, float eps, bool plainPops = true) {
         const Frame below = draw(splats, cam, mat, zCoincident - eps), above = draw(splats, cam, mat, zCoincident + eps),
                     further = draw(splats, cam, mat, zCoincident + 3.0f * eps);
         for (const Frame* f : {&below, &above, &further}) EXPECT_LE(f->worst, f->bound) << "GL against the reference";

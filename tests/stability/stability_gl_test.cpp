@@ -86,8 +86,8 @@ protected:
             EXPECT_TRUE(std::isfinite(r.ref.pixels[i]));
             r.worst = std::max(r.worst, double(std::abs(v - r.ref.pixels[i])));
         }
-        std::printf("  %llu splats, overlap %llu: max |GL - reference| %.2e, derived bound %.2e\n",
-                    static_cast<unsigned long long>(r.splats), static_cast<unsigned long long>(stats.maxOverlap), r.worst, r.bound);
+        std::printf("  %llu splats, overlap %llu: max |GL - reference| %.2e, derived bound %.2e\n", static_cast<unsigned long long>(r.splats),
+                    static_cast<unsigned long long>(stats.maxOverlap), r.worst, r.bound);
         return r;
     }
     static double visible(const Image& img) {
@@ -169,9 +169,7 @@ TEST_F(Stability, HundredThousandSplatsStackedOnOnePixel) {
             }
             prev = a;
         }
-        if (p == gl::Precision::F32) {
-            EXPECT_GT(prev, 0.99);
-        }
+        if (p == gl::Precision::F32) { EXPECT_GT(prev, 0.99); }
     }
 }
 
@@ -231,7 +229,8 @@ TEST_F(Stability, CameraHundredThousandUnitsAway) {
     for (int y = 0; y + 1 < size.y; ++y)
         for (int x = 0; x + 1 < size.x; ++x)
             for (int c = 0; c < 4; ++c)
-                grad = std::max({grad, double(std::abs(ref->at(x + 1, y, c) - ref->at(x, y, c))), double(std::abs(ref->at(x, y + 1, c) - ref->at(x, y, c)))});
+                grad = std::max(
+                    {grad, double(std::abs(ref->at(x + 1, y, c) - ref->at(x, y, c))), double(std::abs(ref->at(x, y + 1, c) - ref->at(x, y, c)))});
     const Result r = run(g, cam, plain(), {.textured = false}, gl::Precision::F32, 2.0 * shiftPx * grad);
     EXPECT_LE(r.worst, r.bound) << "shift " << shiftPx << " px";
     EXPECT_GT(visible(r.ref), 0.3);

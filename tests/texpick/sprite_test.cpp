@@ -134,8 +134,7 @@ TEST(TexpickSprites, SoftPuffAlphaIsReadAsDensityOnce) {
     EXPECT_EQ(cut->alpha, texpick::AlphaUse::Coverage);
     auto none = texpick::pickRandom(*cut, {.count = 8, .patch = 32, .seed = 1, .maxTries = 400});
     ASSERT_FALSE(none);
-    EXPECT_NE(none.error().find("of 400 candidates, 400 were rejected by --min-coverage 0.9 (mean alpha; alpha read as coverage)"),
-              std::string::npos)
+    EXPECT_NE(none.error().find("of 400 candidates, 400 were rejected by --min-coverage 0.9 (mean alpha; alpha read as coverage)"), std::string::npos)
         << none.error();
     EXPECT_NE(none.error().find("give --alpha density"), std::string::npos) << none.error();
 }
@@ -161,14 +160,12 @@ TEST(TexpickSprites, DarkLowContrastSpriteWorksWithTheDefaults) {
     absolute.relative = false;
     auto none = texpick::pickSpectral(*src, {.count = 8, .patch = 32, .accept = absolute});
     ASSERT_FALSE(none);
-    EXPECT_NE(none.error().find("of 169 candidates, 0 were rejected by --min-coverage 0.9 (mean alpha; alpha read as coverage), "),
-              std::string::npos)
+    EXPECT_NE(none.error().find("of 169 candidates, 0 were rejected by --min-coverage 0.9 (mean alpha; alpha read as coverage), "), std::string::npos)
         << none.error();
     // Most of the 169 candidates fail --min-std (a few bright-centre ones pass it and then crowd each other out).
     std::smatch hit;
     const std::string err = none.error();
-    ASSERT_TRUE(std::regex_search(err, hit, std::regex("0 by --min-mean 0\\.03 \\(absolute\\), ([0-9]+) by --min-std 0\\.03 \\(absolute\\)")))
-        << err;
+    ASSERT_TRUE(std::regex_search(err, hit, std::regex("0 by --min-mean 0\\.03 \\(absolute\\), ([0-9]+) by --min-std 0\\.03 \\(absolute\\)"))) << err;
     EXPECT_GT(std::stoi(hit[1].str()), 169 / 2) << err;
     EXPECT_NE(err.find("; lower --min-std"), std::string::npos) << err;
 

@@ -315,8 +315,8 @@ TEST(TexpickRandom, DeterministicPerSeed) {
 TEST(TexpickRandom, RejectsFlatPatches) {
     // Left half flat grey, right half textured.
     const texpick::Source noise = smoothNoise(256, 128, 9);
-    const texpick::Source src = texpick::sourceFromImage(
-        grayImage(256, 128, [&](int x, int y) { return x < 128 ? 0.5f : noise.luminance.at<float>(y, x); }), "half-flat");
+    const texpick::Source src =
+        texpick::sourceFromImage(grayImage(256, 128, [&](int x, int y) { return x < 128 ? 0.5f : noise.luminance.at<float>(y, x); }), "half-flat");
     const texpick::Acceptance accept{.minStd = 0.03f};
     auto sel = texpick::pickRandom(src, {.count = 12, .patch = 32, .seed = 3, .accept = accept});
     ASSERT_TRUE(sel) << sel.error();
@@ -495,12 +495,18 @@ TEST_F(TexpickErrors, AFailureHalfwayKeepsTheOldSetAndLeavesNoStaging) {
     ASSERT_TRUE(made);
     const fs::path target = dir / "set";
     ASSERT_TRUE(texpick::writeOutput(target.string(), made->set, "{\"run\": 1}", {.preview = false}));
-    const std::string before = [&] { std::ifstream in(target / "manifest.json"); return std::string(std::istreambuf_iterator<char>(in), {}); }();
+    const std::string before = [&] {
+        std::ifstream in(target / "manifest.json");
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    }();
     // The second run fails after the textures and contact sheet are staged: the preview size is invalid.
     auto s = texpick::writeOutput(target.string(), made->set, "{\"run\": 2}", {.preview = true, .previewSize = 8});
     ASSERT_FALSE(s);
     EXPECT_EQ(s.error(), "nothing written to '" + target.string() + "': --preview-size must be between 32 and 2048 pixels, got 8");
-    const std::string after = [&] { std::ifstream in(target / "manifest.json"); return std::string(std::istreambuf_iterator<char>(in), {}); }();
+    const std::string after = [&] {
+        std::ifstream in(target / "manifest.json");
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    }();
     EXPECT_EQ(before, after);
     EXPECT_EQ(entries(dir), std::vector<std::string>{"set"}) << joined(entries(dir));
 }
@@ -592,8 +598,12 @@ TEST(TexpickSets, ShippedTurbulenceRegenerates) {
     std::ifstream in(dir / "manifest.json");
     ASSERT_TRUE(in) << "missing " << dir.string();
     const auto p = nlohmann::json::parse(in)["provenance"]["parameters"];
-    const auto ref = splatfx::TextureSet::turbulence({.count = p["count"], .size = p["size"], .seed = p["seed"], .octaves = p["octaves"],
-                                                      .baseFrequency = p["baseFrequency"], .loopRadius = p["loopRadius"]});
+    const auto ref = splatfx::TextureSet::turbulence({.count = p["count"],
+                                                      .size = p["size"],
+                                                      .seed = p["seed"],
+                                                      .octaves = p["octaves"],
+                                                      .baseFrequency = p["baseFrequency"],
+                                                      .loopRadius = p["loopRadius"]});
     auto set = splatfx::TextureSet::load(dir.string());
     ASSERT_TRUE(set) << set.error();
     ASSERT_EQ(set->count(), ref.count());

@@ -147,8 +147,7 @@ TEST(TextureSet, WindowedColourSetsRoundTrip) {
             // Straight alpha: colour and alpha are each stored once in 8 bits,
             // so both come back within half a quantization step.
             EXPECT_NEAR(back->layers[size_t(k)][i + 3], a, 0.5 / 255 + 1e-6);
-            for (int c = 0; c < 3; ++c)
-                EXPECT_NEAR(back->layers[size_t(k)][i + size_t(c)], win.layers[size_t(k)][i + size_t(c)], 0.5 / 255 + 1e-6);
+            for (int c = 0; c < 3; ++c) EXPECT_NEAR(back->layers[size_t(k)][i + size_t(c)], win.layers[size_t(k)][i + size_t(c)], 0.5 / 255 + 1e-6);
         }
 }
 

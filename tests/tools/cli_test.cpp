@@ -125,8 +125,7 @@ TEST(CliSpawn, ExitCodesEnvironmentAndFailuresToStart) {
     EXPECT_EQ(env.output, "a b;c\n");
     auto missing = cli::spawn({.argv = {"splatfx-no-such-program-anywhere"}});
     EXPECT_FALSE(missing.started);
-    EXPECT_NE(missing.error.find("cannot run 'splatfx-no-such-program-anywhere': No such file or directory"), std::string::npos)
-        << missing.error;
+    EXPECT_NE(missing.error.find("cannot run 'splatfx-no-such-program-anywhere': No such file or directory"), std::string::npos) << missing.error;
     auto noDir = cli::spawn({.argv = {"true"}, .workingDir = "/nonexistent/splatfx"});
     EXPECT_FALSE(noDir.started);
     EXPECT_NE(noDir.error.find("cannot enter folder '/nonexistent/splatfx'"), std::string::npos) << noDir.error;
@@ -157,8 +156,8 @@ TEST(CliFrameRange, RefusesBackwardsZeroStepGarbageAndBeyondTheSequence) {
     EXPECT_EQ(cli::parseFrameRange("--range", "8-3", 99999, r).error(), head + "'8-3' (the last frame 3 comes before the first 8)");
     EXPECT_EQ(cli::parseFrameRange("--range", "0-7:0", 99999, r).error(), head + "'0-7:0' (STEP must be at least 1)");
     EXPECT_EQ(cli::parseFrameRange("--range", "0-100000", 99999, r).error(), head + "'0-100000' (frame indices go from 0 to 99999)");
-    for (const char* bad : {"", "7", "-", "3-", "-3", "-3-5", "3-+5", "+3-5", "3-5:", "3-5:x", "3-5:-1", "a-b", "1-2-3", " 1-2", "1-2 ",
-                            "0x1-2", "1.5-2", "1-2:1:1", "99999999999999999999-1"}) {
+    for (const char* bad : {"", "7", "-", "3-", "-3", "-3-5", "3-+5", "+3-5", "3-5:", "3-5:x", "3-5:-1", "a-b", "1-2-3", " 1-2", "1-2 ", "0x1-2",
+                            "1.5-2", "1-2:1:1", "99999999999999999999-1"}) {
         const splatfx::Status s = cli::parseFrameRange("--range", bad, 99999, r);
         ASSERT_FALSE(s) << "'" << bad << "'";
         EXPECT_EQ(s.error().rfind(head + "'" + bad + "'", 0), 0u) << s.error();
@@ -166,8 +165,7 @@ TEST(CliFrameRange, RefusesBackwardsZeroStepGarbageAndBeyondTheSequence) {
     EXPECT_EQ(r.first, 3) << "a refused range must not be stored";
     EXPECT_EQ(r.last, 4);
     const cli::FrameRange beyond{20, 30, 5};
-    EXPECT_EQ(cli::checkFrameRange("--range", beyond, 24).error(),
-              "--range 20-30:5 goes beyond the sequence: it has 24 frame(s), indices 0-23 "
-              "(set the sequence's length with --frames, the same for every task)");
+    EXPECT_EQ(cli::checkFrameRange("--range", beyond, 24).error(), "--range 20-30:5 goes beyond the sequence: it has 24 frame(s), indices 0-23 "
+                                                                   "(set the sequence's length with --frames, the same for every task)");
     EXPECT_TRUE(cli::checkFrameRange("--range", cli::FrameRange{20, 23, 1}, 24));
 }

@@ -93,8 +93,7 @@ TEST(VdbImport, BoxFilterPreservesEachCellsOpticalDepth) {
                 for (int k = 0; k < N; ++k)
                     for (int j = 0; j < N; ++j) {
                         double ray = 0.0;
-                        for (int i = 0; i < N; ++i)
-                            ray += acc.getValue({(cx - 2) * N + i, cy * N + j, cz * N + k});
+                        for (int i = 0; i < N; ++i) ray += acc.getValue({(cx - 2) * N + i, cy * N + j, cz * N + k});
                         raySum += extinction * ray * vs;
                     }
                 const double want = raySum / (N * N);
@@ -168,8 +167,9 @@ TEST(VdbImport, TemperatureAndVelocity) {
     EXPECT_NEAR(vel.z, -5.0f, 1e-5f);
 
     // In file voxels per second: 1 voxel/s x 2 = 0.2 world units/s = 1 cell/s.
-    auto voxels = loadVdb((dir / "tv.vdb").string(), {.temperatureGrid = "", .voxelsPerCell = 2,
-                                                       .velocityUnit = VdbImportDesc::VelocityUnit::VoxelsPerSec, .velocityScale = 2.0f});
+    auto voxels =
+        loadVdb((dir / "tv.vdb").string(),
+                {.temperatureGrid = "", .voxelsPerCell = 2, .velocityUnit = VdbImportDesc::VelocityUnit::VoxelsPerSec, .velocityScale = 2.0f});
     ASSERT_TRUE(voxels) << voxels.error();
     EXPECT_NEAR(voxels->frames[0].velocityCellsPerSec[0].x, 1.0f, 1e-6f);
 
@@ -331,9 +331,7 @@ TEST(VdbImport, BillionVoxelGridRefusedBeforeReading) {
         cut.open(false);
         auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(cut.readGrid("density"));
         treeUnreadable = !grid || grid->activeVoxelCount() != (openvdb::Index64(1) << 30);
-    } catch (const std::exception&) {
-        treeUnreadable = true;
-    }
+    } catch (const std::exception&) { treeUnreadable = true; }
     ASSERT_TRUE(treeUnreadable) << "the cut file must not hold a readable tree for this proof";
     auto c = loadVdb((dir / "cut.vdb").string(), {.temperatureGrid = "", .velocityGrid = ""});
     ASSERT_FALSE(c);

@@ -37,9 +37,7 @@ GroundFogDesc valleys(glm::ivec2 dims, float top, bool lod = true) {
 }
 
 Camera farCamera() { return Camera::lookAt({-30.0f, 25.0f, -24.0f}, {0.0f, 0.0f, 0.0f}, {0, 1, 0}, glm::radians(50.0f), {64, 48}, 0.1f, 500.0f); }
-Camera insideCamera() {
-    return Camera::lookAt({0.5f, 0.6f, 0.3f}, {8.0f, 0.2f, 3.0f}, {0, 1, 0}, glm::radians(60.0f), {64, 48}, 0.3f, 500.0f);
-}
+Camera insideCamera() { return Camera::lookAt({0.5f, 0.6f, 0.3f}, {8.0f, 0.2f, 3.0f}, {0, 1, 0}, glm::radians(60.0f), {64, 48}, 0.3f, 500.0f); }
 
 using TetKey = std::array<float, 28>;
 std::vector<TetKey> sortedKeys(const std::vector<Tetrahedron>& tets) {
@@ -246,7 +244,8 @@ TEST(GroundFogLod, MorphingMakesARefinementThresholdContinuous) {
     // prism edge would count every tetrahedron sharing it).
     std::vector<glm::dvec2> at;
     for (const auto& xz : fresh)
-        for (glm::dvec2 o2 : {glm::dvec2(0.013, 0.007), glm::dvec2(-0.011, 0.017), glm::dvec2(0.005, -0.019)}) at.push_back(glm::dvec2(xz[0], xz[1]) + o2);
+        for (glm::dvec2 o2 : {glm::dvec2(0.013, 0.007), glm::dvec2(-0.011, 0.017), glm::dvec2(0.005, -0.019)})
+            at.push_back(glm::dvec2(xz[0], xz[1]) + o2);
     auto change = [&](const GroundFog& layer, const LodRefineDesc& r, double* terrainChange) {
         LodFrame a, b;
         std::vector<glm::vec3> ta, tb;
@@ -313,9 +312,7 @@ TEST(GroundFogLod, BackToFrontAlongRaysOutsideAndInside) {
         }
         EXPECT_GT(crossings, 50); // the coarse mesh has fewer tetrahedra than the grid's test
         EXPECT_EQ(wrong, 0) << "camera " << ci;
-        if (ci == 1) {
-            EXPECT_GT(f.stats.clippedInput, 0u);
-        }
+        if (ci == 1) { EXPECT_GT(f.stats.clippedInput, 0u); }
     }
 }
 

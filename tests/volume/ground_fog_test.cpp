@@ -43,8 +43,7 @@ double exactVolume(const GroundFogDesc& d) {
         for (int i = 0; i + 1 < d.dims.x; ++i) {
             if (((i + j) & 1) == 0)
                 v += area / 3.0 * (h(i, j) + h(i + 1, j) + h(i + 1, j + 1)) + area / 3.0 * (h(i, j) + h(i + 1, j + 1) + h(i, j + 1));
-            else
-                v += area / 3.0 * (h(i, j) + h(i + 1, j) + h(i, j + 1)) + area / 3.0 * (h(i + 1, j) + h(i + 1, j + 1) + h(i, j + 1));
+            else v += area / 3.0 * (h(i, j) + h(i + 1, j) + h(i, j + 1)) + area / 3.0 * (h(i + 1, j) + h(i + 1, j + 1) + h(i, j + 1));
         }
     return v;
 }
@@ -130,9 +129,7 @@ TEST(GroundFog, BackToFrontAlongRaysOutsideAndInside) {
             }
         }
         EXPECT_GT(crossings, 100);
-        if (ci == 1) {
-            EXPECT_GT(f.stats.clippedInput, 0u) << "the eye is inside the fog: the near plane cuts it";
-        }
+        if (ci == 1) { EXPECT_GT(f.stats.clippedInput, 0u) << "the eye is inside the fog: the near plane cuts it"; }
     }
 }
 

@@ -44,9 +44,7 @@ bool meshValue(const std::vector<Tetrahedron>& tets, glm::dvec3 p, double& out) 
             lo = glm::min(lo, q);
             hi = glm::max(hi, q);
         }
-        if (p.x < lo.x - 1e-6 || p.y < lo.y - 1e-6 || p.z < lo.z - 1e-6 || p.x > hi.x + 1e-6 || p.y > hi.y + 1e-6 ||
-            p.z > hi.z + 1e-6)
-            continue;
+        if (p.x < lo.x - 1e-6 || p.y < lo.y - 1e-6 || p.z < lo.z - 1e-6 || p.x > hi.x + 1e-6 || p.y > hi.y + 1e-6 || p.z > hi.z + 1e-6) continue;
         const glm::dvec4 b = barycentric(t, p);
         if (b.x < -1e-9 || b.y < -1e-9 || b.z < -1e-9 || b.w < -1e-9) continue;
         out = b.x * t.scalar[0] + b.y * t.scalar[1] + b.z * t.scalar[2] + b.w * t.scalar[3];
@@ -147,7 +145,9 @@ TEST(LodVolume, AlternatingOrientationGivesAFaceToFaceFinestMesh) {
     for (const auto& [key, count] : faces) {
         bool boundary = false;
         for (int a = 0; a < 3; ++a) {
-            auto coord = [&](int i) { return a == 0 ? std::get<0>(key[std::size_t(i)]) : a == 1 ? std::get<1>(key[std::size_t(i)]) : std::get<2>(key[std::size_t(i)]); };
+            auto coord = [&](int i) {
+                return a == 0 ? std::get<0>(key[std::size_t(i)]) : a == 1 ? std::get<1>(key[std::size_t(i)]) : std::get<2>(key[std::size_t(i)]);
+            };
             if (coord(0) == coord(1) && coord(1) == coord(2) && (coord(0) == 0 || coord(0) == 8)) boundary = true;
         }
         EXPECT_EQ(count, boundary ? 1 : 2);
@@ -173,9 +173,7 @@ void expectConforming(const LodVolume& v, const std::vector<Tetrahedron>& tets, 
         for (int i = 0; i < 4; ++i) {
             const auto key = std::make_tuple(t.position[std::size_t(i)].x, t.position[std::size_t(i)].y, t.position[std::size_t(i)].z);
             auto [it, inserted] = value.insert({key, t.scalar[std::size_t(i)]});
-            if (!inserted) {
-                EXPECT_EQ(it->second, t.scalar[std::size_t(i)]) << "a vertex carries two values";
-            }
+            if (!inserted) { EXPECT_EQ(it->second, t.scalar[std::size_t(i)]) << "a vertex carries two values"; }
         }
     }
     const glm::dvec3 ext = glm::dvec3(v.pointDims() - 1) * double(v.spacingWorld());
@@ -285,8 +283,7 @@ namespace {
 // Later tetrahedra must be nearer: along any ray from the eye, a tetrahedron
 // emitted after another is not behind it (the octree's BSP order, sec. 4, is a
 // visibility order for convex cells).
-void expectBackToFront(const std::vector<Tetrahedron>& tets, glm::dvec3 eye, const std::vector<glm::dvec3>& dirs,
-                       int& overlaps) {
+void expectBackToFront(const std::vector<Tetrahedron>& tets, glm::dvec3 eye, const std::vector<glm::dvec3>& dirs, int& overlaps) {
     for (const glm::dvec3& d : dirs) {
         std::vector<std::pair<std::size_t, glm::dvec2>> hits;
         for (std::size_t i = 0; i < tets.size(); ++i) {
@@ -338,8 +335,8 @@ TEST(LodVolume, OrthographicViewsAreOrderedAlongTheViewDirection) {
     auto v = LodVolume::create(voltest::randomField({17, 17, 17}, 19), {});
     ASSERT_TRUE(v) << v.error();
     const glm::vec3 eye(-10, 30, 25), target(8, 8, 8);
-    const Camera cam = Camera::fromMatrices(glm::lookAt(eye, target, glm::vec3(0, 0, 1)),
-                                            glm::ortho(-15.0f, 15.0f, -12.0f, 12.0f, 0.5f, 200.0f), {64, 48});
+    const Camera cam =
+        Camera::fromMatrices(glm::lookAt(eye, target, glm::vec3(0, 0, 1)), glm::ortho(-15.0f, 15.0f, -12.0f, 12.0f, 0.5f, 200.0f), {64, 48});
     ASSERT_FALSE(cam.perspective());
     LodRefineDesc r;
     r.detailC = 2.0f;
@@ -350,8 +347,8 @@ TEST(LodVolume, OrthographicViewsAreOrderedAlongTheViewDirection) {
     // Parallel rays along the view direction from a grid of points on the near plane.
     int overlaps = 0;
     for (int i = 0; i < 30; ++i) {
-        const glm::dvec3 o = glm::dvec3(eye) + double((i % 6) - 2.5) * 2.0 * glm::dvec3(cam.right()) +
-                             double((i / 6) - 2.0) * 2.0 * glm::dvec3(cam.up());
+        const glm::dvec3 o =
+            glm::dvec3(eye) + double((i % 6) - 2.5) * 2.0 * glm::dvec3(cam.right()) + double((i / 6) - 2.0) * 2.0 * glm::dvec3(cam.up());
         expectBackToFront(f.tets, o, {glm::dvec3(cam.forward())}, overlaps);
     }
     EXPECT_GT(overlaps, 200);

@@ -31,8 +31,8 @@ struct Cloud {
         volume.emplace(*LodVolume::create(field, {.spacingWorld = 1.0f}));
         transfer.emplace(*makeCloudTransfer({.maxExtinctionPerWorld = maxExtinction}));
         // The longest segment: the cube's diagonal (length scales are <= 1).
-        table.emplace(*PreIntegrationTable::create(
-            *transfer, {.scalarResolution = 32, .lengthResolution = 64, .maxLengthWorld = std::sqrt(3.0f) * 16.0f}));
+        table.emplace(
+            *PreIntegrationTable::create(*transfer, {.scalarResolution = 32, .lengthResolution = 64, .maxLengthWorld = std::sqrt(3.0f) * 16.0f}));
     }
 };
 
@@ -62,8 +62,8 @@ struct FogModel {
     glm::dvec4 exactSegments{0.0}; // the same fogged composite of the exact segment integrals (no table)
 };
 
-glm::dvec4 passModel(const std::vector<Tetrahedron>& tets, const PreIntegrationTable& table, glm::dvec3 o, glm::dvec3 d,
-                     double tFar, double& bound, FogModel* fm = nullptr) {
+glm::dvec4 passModel(const std::vector<Tetrahedron>& tets, const PreIntegrationTable& table, glm::dvec3 o, glm::dvec3 d, double tFar, double& bound,
+                     FogModel* fm = nullptr) {
     struct Piece {
         double t0, t1;
         std::size_t tet;
@@ -97,8 +97,8 @@ glm::dvec4 passModel(const std::vector<Tetrahedron>& tets, const PreIntegrationT
         const auto [lo, hi] = std::minmax_element(t.scalar.begin(), t.scalar.end());
         if (table.zeroOpacity(*lo, *hi)) continue; // the pass skips these: their table entries are zero
         const glm::dvec3 p0(t.position[0]);
-        const glm::dmat3 inv = glm::inverse(glm::dmat3(glm::dvec3(t.position[1]) - p0, glm::dvec3(t.position[2]) - p0,
-                                                       glm::dvec3(t.position[3]) - p0));
+        const glm::dmat3 inv =
+            glm::inverse(glm::dmat3(glm::dvec3(t.position[1]) - p0, glm::dvec3(t.position[2]) - p0, glm::dvec3(t.position[3]) - p0));
         auto at = [&](double tt, const std::array<float, 4>& v) {
             const glm::dvec3 l = inv * (o + d * tt - p0);
             return (1.0 - l.x - l.y - l.z) * v[0] + l.x * v[1] + l.y * v[2] + l.z * v[3];
@@ -120,8 +120,7 @@ glm::dvec4 passModel(const std::vector<Tetrahedron>& tets, const PreIntegrationT
             const double ae = std::clamp(exactSeg.a, 0.0, 1.0), te = -std::log(std::max(1.0 - ae, 1e-30));
             const double we = te < 1e-2 ? 0.5 - te / 12.0 : 1.0 / te - 1.0 / std::expm1(std::min(te, 80.0));
             const double fe = fm->fog->transmittance(o, o + d * (pc.t0 + we * (pc.t1 - pc.t0)), 0.0);
-            fm->exactSegments += (1.0 - fm->exactSegments.a) *
-                                 glm::dvec4(fe * glm::dvec3(exactSeg) + (1.0 - fe) * ae * fm->fog->desc().colour, ae);
+            fm->exactSegments += (1.0 - fm->exactSegments.a) * glm::dvec4(fe * glm::dvec3(exactSeg) + (1.0 - fe) * ae * fm->fog->desc().colour, ae);
             // The shader's f in float: tau <= 4 here, summed from a few terms
             // with ~2^-20 relative error each, so |df| <= 2^-16; it moves the
             // layer by alpha df, the composite by twice that.
@@ -255,8 +254,8 @@ TEST_F(TetraPassGL, MatchesTheReferenceOnTheSameMeshWithinADerivedBound) {
     RecordProperty("max_gl_vs_model", std::to_string(r.maxGlVsModel));
     RecordProperty("max_gl_vs_exact", std::to_string(r.maxGlVsExact));
     RecordProperty("max_table_vs_exact", std::to_string(r.maxModelVsExact));
-    std::printf("GL vs model max %.2e (worst ratio to bound %.3f); GL vs exact max %.4f; table model vs exact max %.4f\n",
-                r.maxGlVsModel, r.worstRatio, r.maxGlVsExact, r.maxModelVsExact);
+    std::printf("GL vs model max %.2e (worst ratio to bound %.3f); GL vs exact max %.4f; table model vs exact max %.4f\n", r.maxGlVsModel,
+                r.worstRatio, r.maxGlVsExact, r.maxModelVsExact);
 }
 
 // The host's depth ends every segment: a plane through the middle of the
@@ -366,7 +365,6 @@ TEST_F(TetraPassGL, CameraInsideTheCloudRendersWithoutHoles) {
     EXPECT_GT(dense, kSize.x * kSize.y / 4) << "inside a cloud most pixels see cloud";
     EXPECT_EQ(over, 0) << "worst |GL - model| / bound " << worst;
 }
-
 
 // An orthographic camera: rays parallel to forward from the plane through the
 // eye; the pass's other shader variant, against the same model.
@@ -487,7 +485,6 @@ TEST_F(TetraPassGL, SplatsAndTetrahedraCompositeInDepthOrder) {
     }
 }
 
-
 // Ground fog (sec. 6) through the same pass: prisms over a wavy terrain with
 // the eye inside the fog; every pixel against the pass model within the bound.
 TEST_F(TetraPassGL, GroundFogDrawsThroughThePass) {
@@ -532,7 +529,6 @@ TEST_F(TetraPassGL, GroundFogDrawsThroughThePass) {
     EXPECT_GT(covered, kSize.x * kSize.y / 5);
     EXPECT_EQ(over, 0) << "worst |GL - model| / bound " << worst;
 }
-
 
 // With the splats at reduced resolution (FrameRendererDesc::resolutionScale)
 // the tetrahedra are still drawn at full resolution: a frame of tetrahedra
@@ -894,4 +890,3 @@ TEST_F(TetraPassGL, FogAttenuatesEveryTetrahedronAsOneMedium) {
 }
 
 } // namespace
-

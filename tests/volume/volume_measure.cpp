@@ -60,14 +60,14 @@ int main(int argc, char** argv) {
     auto t3 = Clock::now();
     std::size_t cloudy = 0;
     for (float s : field->scalar) cloudy += s > 0.0f;
-    std::printf("field %dx%dx%d (padded %dx%dx%d, %dx%dx%d roots of n=%d), %.1f%% of points cloudy\n", dims.x, dims.y,
-                dims.z, vol->pointDims().x, vol->pointDims().y, vol->pointDims().z, vol->roots().x, vol->roots().y,
-                vol->roots().z, vol->rootLevel(), 100.0 * double(cloudy) / double(field->scalar.size()));
+    std::printf("field %dx%dx%d (padded %dx%dx%d, %dx%dx%d roots of n=%d), %.1f%% of points cloudy\n", dims.x, dims.y, dims.z, vol->pointDims().x,
+                vol->pointDims().y, vol->pointDims().z, vol->roots().x, vol->roots().y, vol->roots().z, vol->rootLevel(),
+                100.0 * double(cloudy) / double(field->scalar.size()));
     const double points = double(vol->pointDims().x) * vol->pointDims().y * vol->pointDims().z;
-    std::printf("memory %zu bytes = %.3f bytes per grid point (scalar + light + Delta/e'/range per node)\n",
-                vol->memoryBytes(), double(vol->memoryBytes()) / points);
-    std::printf("cloud field %.0f ms, octree build %.0f ms, pre-integration table %dx%dx%d (%zu bytes) %.0f ms\n", ms(t1 - t0),
-                ms(t2 - t1), table->dims().x, table->dims().y, table->dims().z, table->bytes(), ms(t3 - t2));
+    std::printf("memory %zu bytes = %.3f bytes per grid point (scalar + light + Delta/e'/range per node)\n", vol->memoryBytes(),
+                double(vol->memoryBytes()) / points);
+    std::printf("cloud field %.0f ms, octree build %.0f ms, pre-integration table %dx%dx%d (%zu bytes) %.0f ms\n", ms(t1 - t0), ms(t2 - t1),
+                table->dims().x, table->dims().y, table->dims().z, table->bytes(), ms(t3 - t2));
 
     // Flight: in at mid height from outside the -x face, through the field, out the far side.
     const glm::vec3 ext = glm::vec3(vol->pointDims() - 1) * vol->spacingWorld();
@@ -128,11 +128,10 @@ int main(int argc, char** argv) {
     std::sort(sorted.begin(), sorted.end());
     const double full = double(vol->fullResolutionTets());
     std::printf("flight of %d frames, c = %.0f, C = %.2f, Delta %s\n", frames, double(detailC), double(minC), average ? "average" : "max");
-    std::printf("  full resolution %.0f tetrahedra; emitted mean %.0f (%.0fx fewer), max %.0f; inside the field mean %.0f\n", full,
-                sumN / frames, full / std::max(1.0, sumN / frames), maxTets,
-                framesInside ? double(emittedInside) / double(framesInside) : 0.0);
-    std::printf("  update() CPU time per frame: mean %.2f ms, median %.2f ms, max %.2f ms\n", sumT / frames,
-                sorted[sorted.size() / 2], sorted.back());
+    std::printf("  full resolution %.0f tetrahedra; emitted mean %.0f (%.0fx fewer), max %.0f; inside the field mean %.0f\n", full, sumN / frames,
+                full / std::max(1.0, sumN / frames), maxTets, framesInside ? double(emittedInside) / double(framesInside) : 0.0);
+    std::printf("  update() CPU time per frame: mean %.2f ms, median %.2f ms, max %.2f ms\n", sumT / frames, sorted[sorted.size() / 2],
+                sorted.back());
     std::printf("  near-plane clipping: %llu tetrahedra cut, %llu added (%.2f%% of emitted)\n", (unsigned long long)clipped,
                 (unsigned long long)extra, 100.0 * double(extra) / std::max(1.0, sumN));
     if (errRays) {

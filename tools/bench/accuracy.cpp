@@ -82,9 +82,9 @@ constexpr int kTruthLayer = 128;
 constexpr std::uint32_t kSeed = 1;
 
 struct Config {
-    int tableSize = 256;            // FootprintDesc::tableSize
-    int layerSize = 32;             // MaterialsDesc::layerSize
-    int count = 8;                  // textures in the set
+    int tableSize = 256; // FootprintDesc::tableSize
+    int layerSize = 32;  // MaterialsDesc::layerSize
+    int count = 8;       // textures in the set
     Precision precision = Precision::U8;
     splatfx::SortMode sort = splatfx::SortMode::Exact;
     std::uint32_t buckets = 64;
@@ -92,8 +92,8 @@ struct Config {
     bool textured = true;
     bool gaussian = false;
     float gaussianRadius = 2.0f;
-    float footprintCut = splatfx::gl::RendererDesc{}.footprintCut; // the SDK default
-    bool octagons = splatfx::gl::RendererDesc{}.trimCorners;        // the SDK default
+    float footprintCut = splatfx::gl::RendererDesc{}.footprintCut;                // the SDK default
+    bool octagons = splatfx::gl::RendererDesc{}.trimCorners;                      // the SDK default
     splatfx::gl::TextureSampling sampling = splatfx::gl::RendererDesc{}.sampling; // the SDK default
     int upsample = splatfx::gl::RendererDesc{}.upsample;
     // Fog knobs (issue 14): the bench fog's first `fogTerms` terms
@@ -264,7 +264,8 @@ struct Bench {
 
     splatfx::Footprint footprint(const Config& c) const {
         return splatfx::Footprint({.kernel = c.gaussian ? splatfx::Kernel::Gaussian : splatfx::Kernel::CrawfisMax,
-                                   .tableSize = c.tableSize, .gaussianRadius = c.gaussianRadius});
+                                   .tableSize = c.tableSize,
+                                   .gaussianRadius = c.gaussianRadius});
     }
 
     // A setting ready to time: its GL target, renderer and per-frame CPU work.
@@ -293,8 +294,8 @@ struct Bench {
     std::vector<std::unique_ptr<Setting>> settings;
 
     // Registers one setting of the fire; everything is timed later, round-robin.
-    void add(const std::string& knob, const std::string& setting, const Config& c, const splatfx::Grid& truthGrid,
-             const splatfx::Image& truth, bool mainTruth = true, bool remapTextures = true, double extraCpuMs = 0.0) {
+    void add(const std::string& knob, const std::string& setting, const Config& c, const splatfx::Grid& truthGrid, const splatfx::Image& truth,
+             bool mainTruth = true, bool remapTextures = true, double extraCpuMs = 0.0) {
         if (opt.fogOnly && knob.rfind("fog", 0) != 0) return; // --fog-only
         auto s = std::make_unique<Setting>();
         s->row = Row{knob, setting};
@@ -358,8 +359,8 @@ struct Bench {
             row.cpuMs = median(s->cpu) + s->extraCpuMs;
             row.totalMs = median(s->total) + s->extraCpuMs;
             row.rmse = e.rmse, row.maxErr = e.maxErr, row.psnr = e.psnr;
-            std::printf("  %-24s %-26s wall %8.3f ms  CPU %8.3f ms  RMSE %.5f  max %.4f  PSNR %6.2f dB\n", row.knob.c_str(),
-                        row.setting.c_str(), row.totalMs, row.cpuMs, row.rmse, row.maxErr, row.psnr);
+            std::printf("  %-24s %-26s wall %8.3f ms  CPU %8.3f ms  RMSE %.5f  max %.4f  PSNR %6.2f dB\n", row.knob.c_str(), row.setting.c_str(),
+                        row.totalMs, row.cpuMs, row.rmse, row.maxErr, row.psnr);
             rows.push_back(row);
         }
     }
@@ -465,9 +466,10 @@ void writePlots(const Bench& b, const std::string& dir) {
     gp << "# Written by splatfx-bench accuracy; run: gnuplot accuracy.gp\n"
        << "set terminal pngcairo size " << 420 * cols << "," << 330 * rowsN << " font 'sans,9'\n"
        << "set output 'accuracy_knobs.png'\n"
-       << "set multiplot layout " << rowsN << "," << cols << " title 'splatfx accuracy vs time per knob (GL vs exact reference, "
-       << b.opt.size.x << "x" << b.opt.size.y << ")'\n"
-       << "set logscale y\nset grid\nset xrange [0:*]\nset xlabel 'CPU time per frame (ms, median, all threads)'\nset ylabel 'RMSE vs reference'\nset key off\n"
+       << "set multiplot layout " << rowsN << "," << cols << " title 'splatfx accuracy vs time per knob (GL vs exact reference, " << b.opt.size.x
+       << "x" << b.opt.size.y << ")'\n"
+       << "set logscale y\nset grid\nset xrange [0:*]\nset xlabel 'CPU time per frame (ms, median, all threads)'\nset ylabel 'RMSE vs "
+          "reference'\nset key off\n"
        << "set offsets graph 0.12, graph 0.12, graph 0.1, graph 0.1\n";
     for (size_t k = 0; k < knobs.size(); ++k)
         gp << "set title '" << knobs[k] << "'\nplot 'accuracy.dat' index " << k << " using 1:2 with linespoints pt 7 lc rgb '#c0392b', "
@@ -500,8 +502,7 @@ int runAccuracy(int argc, char** argv) {
     if (b.opt.replotOnly) {
         const cli::SpawnResult gp = plotCommand(b.opt.out);
         if (!gp.started || gp.exitCode != 0) {
-            std::fprintf(stderr, "accuracy: gnuplot failed on %s/accuracy.gp%s%s\n", b.opt.out.c_str(), gp.started ? "" : ": ",
-                         gp.error.c_str());
+            std::fprintf(stderr, "accuracy: gnuplot failed on %s/accuracy.gp%s%s\n", b.opt.out.c_str(), gp.started ? "" : ": ", gp.error.c_str());
             return 1;
         }
         std::printf("accuracy: replotted %s/accuracy.gp\n", b.opt.out.c_str());
@@ -519,8 +520,8 @@ int runAccuracy(int argc, char** argv) {
         std::fprintf(stderr, "accuracy: %s\n", ctx.error().c_str());
         return 1;
     }
-    std::printf("splatfx-bench accuracy: %dx%d, %d timed frames per setting, GL renderer: %s\n", b.opt.size.x, b.opt.size.y,
-                b.opt.reps, ctx->renderer().c_str());
+    std::printf("splatfx-bench accuracy: %dx%d, %d timed frames per setting, GL renderer: %s\n", b.opt.size.x, b.opt.size.y, b.opt.reps,
+                ctx->renderer().c_str());
     std::printf("cores: %u, load average (1/5/15 min): %s\n", std::thread::hardware_concurrency(), loadAverage().c_str());
     // The clouds' knobs: a 65x65x17 field (the popping run's) at 256x192, 9 frames a setting.
     const auto cloudKnobs = [&] { return runCloudKnobs({65, 65, 17}, {256, 192}, 9); };
@@ -542,7 +543,7 @@ int runAccuracy(int argc, char** argv) {
     std::fflush(stdout);
     const Config def;
     const splatfx::Grid onTexture = fireGrid(kTruthCount / def.count); // every voxel exactly on one of the 8 textures
-    const splatfx::Grid between = fireGrid(1);                           // voxels anywhere along the loop
+    const splatfx::Grid between = fireGrid(1);                         // voxels anywhere along the loop
     const bool all = !b.opt.fogOnly;
     const splatfx::Image truth = all ? b.truthImage(onTexture, def) : splatfx::Image{};
     const splatfx::Image truthBetween = all ? b.truthImage(between, def) : splatfx::Image{};
@@ -610,8 +611,8 @@ int runAccuracy(int argc, char** argv) {
         Config c;
         c.octagons = octagons;
         const bool isDefault = octagons == splatfx::gl::RendererDesc{}.trimCorners;
-        b.add("footprint shape (RendererDesc)", std::string(octagons ? "octagon, 6 triangles" : "square, 2 triangles") + (isDefault ? " (default)" : ""),
-              c, onTexture, truth);
+        b.add("footprint shape (RendererDesc)",
+              std::string(octagons ? "octagon, 6 triangles" : "square, 2 triangles") + (isDefault ? " (default)" : ""), c, onTexture, truth);
     }
     {
         using splatfx::gl::TextureSampling;
@@ -682,8 +683,11 @@ int runAccuracy(int argc, char** argv) {
         for (int terms : {5, 4, 2, 1, 0}) {
             Config c;
             c.fogTerms = terms;
-            b.add("fog: terms kept", terms == 5 ? "all 5 (default: the fog as given)" : terms == 0 ? "0 (no fog)" : std::to_string(terms) + " of 5", c,
-                  onTexture, truthFog, false);
+            b.add("fog: terms kept",
+                  terms == 5   ? "all 5 (default: the fog as given)"
+                  : terms == 0 ? "0 (no fog)"
+                               : std::to_string(terms) + " of 5",
+                  c, onTexture, truthFog, false);
         }
     }
 
@@ -749,8 +753,8 @@ int runAccuracy(int argc, char** argv) {
         const auto t1 = Clock::now();
         auto spl = splatfx::renderSplatExact(builder.splats(), vcam, mat, {.host = {.background = kSky}});
         const double splMs = ms(t1, Clock::now());
-        std::printf("  volume-exact: %.0f ms, converged to %.1e (max estimate %.1e, %llu pixels unconverged)\n", volMs, 1e-4,
-                    vstats.maxErrorEstimate, static_cast<unsigned long long>(vstats.unconverged));
+        std::printf("  volume-exact: %.0f ms, converged to %.1e (max estimate %.1e, %llu pixels unconverged)\n", volMs, 1e-4, vstats.maxErrorEstimate,
+                    static_cast<unsigned long long>(vstats.unconverged));
         const Error se = compare(*spl, *vol);
         std::printf("  splat-exact vs volume-exact:          RMSE %.5f  max %.4f  PSNR %6.2f dB   (%.0f ms)\n", se.rmse, se.maxErr, se.psnr, splMs);
         for (Precision p : {Precision::U8, Precision::F32}) {
@@ -760,15 +764,17 @@ int runAccuracy(int argc, char** argv) {
             fb->clear(kSky);
             r->draw(builder.splats(), vcam, {.framebuffer = fb->handle(), .width = vs.x, .height = vs.y});
             const Error ge = compare(fb->read(), *vol);
-            std::printf("  GL (%s, defaults) vs volume-exact:    RMSE %.5f  max %.4f  PSNR %6.2f dB\n", precisionName(p), ge.rmse, ge.maxErr, ge.psnr);
+            std::printf("  GL (%s, defaults) vs volume-exact:    RMSE %.5f  max %.4f  PSNR %6.2f dB\n", precisionName(p), ge.rmse, ge.maxErr,
+                        ge.psnr);
         }
         (void)splatfx::writeImage(b.opt.out + "/volume_exact.png", *vol);
         (void)splatfx::writeImage(b.opt.out + "/splat_exact_untextured.png", *spl);
     }
 
     // The reference's own accuracy: step halving on the same field (colour varies along rays).
-    if (all) std::printf("\nvolume-exact self-check (fixed steps vs step h0/256, %dx%d, h0 = 0.2 = a quarter of the kernel radius):\n",
-                b.opt.size.x / 4, b.opt.size.y / 4);
+    if (all)
+        std::printf("\nvolume-exact self-check (fixed steps vs step h0/256, %dx%d, h0 = 0.2 = a quarter of the kernel radius):\n", b.opt.size.x / 4,
+                    b.opt.size.y / 4);
     if (all) {
         const glm::ivec2 vs = b.opt.size / 4;
         const splatfx::Camera vcam = camera(vs);
@@ -803,8 +809,8 @@ int runAccuracy(int argc, char** argv) {
         return 1.0;
     };
     for (const Row& r : b.rows) {
-        csv << '"' << r.knob << "\",\"" << r.setting << "\"," << r.cpuMs << ',' << r.totalMs << ',' << r.rmse << ',' << r.maxErr << ','
-            << r.psnr << ',' << (r.pareto ? 1 : 0) << ',' << (r.mainTruth ? 1 : 0) << '\n';
+        csv << '"' << r.knob << "\",\"" << r.setting << "\"," << r.cpuMs << ',' << r.totalMs << ',' << r.rmse << ',' << r.maxErr << ',' << r.psnr
+            << ',' << (r.pareto ? 1 : 0) << ',' << (r.mainTruth ? 1 : 0) << '\n';
         std::printf("| %s | %s | %.2f | %.2fx | %.2f | %.5f | %.4f | %.2f | %s |\n", r.knob.c_str(), r.setting.c_str(), r.cpuMs,
                     r.cpuMs / defaultMs(r.knob), r.totalMs, r.rmse, r.maxErr, r.psnr, r.pareto ? "yes" : "");
     }
@@ -816,8 +822,7 @@ int runAccuracy(int argc, char** argv) {
         // An argument vector, never a shell line: --out may hold quotes or ';'.
         const cli::SpawnResult gp = plotCommand(b.opt.out);
         if (!gp.started || gp.exitCode != 0) {
-            std::fprintf(stderr, "accuracy: gnuplot failed on %s/accuracy.gp%s%s\n", b.opt.out.c_str(), gp.started ? "" : ": ",
-                         gp.error.c_str());
+            std::fprintf(stderr, "accuracy: gnuplot failed on %s/accuracy.gp%s%s\n", b.opt.out.c_str(), gp.started ? "" : ": ", gp.error.c_str());
             return 1;
         }
         std::printf("wrote %s/accuracy_knobs.png and %s/accuracy_pareto.png (data: accuracy.dat, script: accuracy.gp)\n", b.opt.out.c_str(),

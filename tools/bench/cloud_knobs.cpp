@@ -50,7 +50,6 @@ struct View {
     splatfx::Image exact; // the finest level, no table, RGBA premultiplied over black
 };
 
-
 // The ray through a pixel centre (x right, y top row first, as Framebuffer::read orders rows).
 glm::dvec3 pixelRay(const splatfx::Camera& cam, int x, int y) {
     const glm::dmat4 inv = glm::inverse(glm::dmat4(cam.proj) * glm::dmat4(cam.view));
@@ -83,8 +82,8 @@ int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
         auto vol = splatfx::LodVolume::create(*field, {.minAccuracyC = k.minC, .delta = k.delta});
         if (!vol) return std::fprintf(stderr, "clouds knobs: %s\n", vol.error().c_str()), false;
         const float longest = std::sqrt(3.0f) * float(1 << vol->rootLevel()) * vol->spacingWorld();
-        auto table = splatfx::PreIntegrationTable::create(
-            *tf, {.scalarResolution = k.table.x, .lengthResolution = k.table.y, .maxLengthWorld = longest});
+        auto table =
+            splatfx::PreIntegrationTable::create(*tf, {.scalarResolution = k.table.x, .lengthResolution = k.table.y, .maxLengthWorld = longest});
         if (!table) return std::fprintf(stderr, "clouds knobs: %s\n", table.error().c_str()), false;
         scene.addVolume(std::move(*vol), *tf, std::move(*table), {.name = "clouds", .refine = {.detailC = k.detailC}});
         return true;
@@ -95,9 +94,13 @@ int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
     const glm::vec3 ext = glm::vec3(ref.pointDims() - 1) * ref.spacingWorld();
 
     std::vector<View> views;
-    views.push_back({"outside", splatfx::Camera::lookAt(glm::vec3(-0.6f, -0.35f, 1.8f) * ext, 0.5f * ext, {0, 0, 1}, glm::radians(60.0f), size, 0.1f, 5000.0f), {}});
-    views.push_back({"inside", splatfx::Camera::lookAt(glm::vec3(0.3f, 0.4f, 0.5f) * ext, glm::vec3(0.9f, 0.55f, 0.5f) * ext, {0, 0, 1},
-                                                       glm::radians(60.0f), size, 0.1f, 5000.0f), {}});
+    views.push_back({"outside",
+                     splatfx::Camera::lookAt(glm::vec3(-0.6f, -0.35f, 1.8f) * ext, 0.5f * ext, {0, 0, 1}, glm::radians(60.0f), size, 0.1f, 5000.0f),
+                     {}});
+    views.push_back({"inside",
+                     splatfx::Camera::lookAt(glm::vec3(0.3f, 0.4f, 0.5f) * ext, glm::vec3(0.9f, 0.55f, 0.5f) * ext, {0, 0, 1}, glm::radians(60.0f),
+                                             size, 0.1f, 5000.0f),
+                     {}});
     const auto e0 = Clock::now();
     for (View& v : views) {
         v.exact = {size.x, size.y, 4, std::vector<float>(std::size_t(size.x) * std::size_t(size.y) * 4, 0.0f)};
@@ -116,7 +119,8 @@ int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
     std::vector<Row> rows;
     rows.push_back({"defaults", "", {}});
     for (glm::ivec2 t : {glm::ivec2(16, 32), glm::ivec2(32, 64), glm::ivec2(128, 256)})
-        rows.push_back({"table (finest mesh)", std::to_string(t.x) + "x" + std::to_string(t.x) + "x" + std::to_string(t.y), {.table = t, .detailC = 1e9f}});
+        rows.push_back(
+            {"table (finest mesh)", std::to_string(t.x) + "x" + std::to_string(t.x) + "x" + std::to_string(t.y), {.table = t, .detailC = 1e9f}});
     rows.push_back({"table (finest mesh)", "64x64x128", {.detailC = 1e9f}});
     for (float c : {2.0f, 5.0f, 20.0f, 50.0f}) rows.push_back({"c", std::to_string(int(c)), {.detailC = c}});
     for (float C : {2.0f, 8.0f, 16.0f}) rows.push_back({"C", std::to_string(int(C)), {.minC = C}});

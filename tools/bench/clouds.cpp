@@ -100,7 +100,6 @@ bool inside(const glm::vec3& ext, const splatfx::Camera& c) {
     return e.x > 0 && e.y > 0 && e.z > 0 && e.x < ext.x && e.y < ext.y && e.z < ext.z;
 }
 
-
 int usage() {
     std::printf("usage: splatfx-bench clouds [--dims X Y Z] [--c DETAIL] [--frames N] [--size W H]\n"
                 "                            [--pop-dims X Y Z] [--pop-frames N] [--pop-size W H] [--pop-c DETAIL]\n"
@@ -115,8 +114,14 @@ int usage() {
 int runClouds(int argc, char** argv) {
     Options o;
     for (int i = 1; i < argc; ++i) {
-        auto next3 = [&](glm::ivec3& v) { v = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2]), std::atoi(argv[i + 3])}; i += 3; };
-        auto next2 = [&](glm::ivec2& v) { v = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2])}; i += 2; };
+        auto next3 = [&](glm::ivec3& v) {
+            v = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2]), std::atoi(argv[i + 3])};
+            i += 3;
+        };
+        auto next2 = [&](glm::ivec2& v) {
+            v = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2])};
+            i += 2;
+        };
         if (!std::strcmp(argv[i], "--dims") && i + 3 < argc) next3(o.dims);
         else if (!std::strcmp(argv[i], "--pop-dims") && i + 3 < argc) next3(o.popDims);
         else if (!std::strcmp(argv[i], "--size") && i + 2 < argc) next2(o.size);
@@ -146,8 +151,8 @@ int runClouds(int argc, char** argv) {
         CloudSet cs;
         const auto t0 = Clock::now();
         if (!makeClouds(o.dims, o.detailC, cs)) return 1;
-        std::printf("clouds %dx%dx%d, c = %.1f: field + octree + 64x64x128 table %.0f ms\n", o.dims.x, o.dims.y, o.dims.z,
-                    o.detailC, ms(Clock::now() - t0));
+        std::printf("clouds %dx%dx%d, c = %.1f: field + octree + 64x64x128 table %.0f ms\n", o.dims.x, o.dims.y, o.dims.z, o.detailC,
+                    ms(Clock::now() - t0));
         auto fb = splatfx::gl::Framebuffer::create({.width = o.size.x, .height = o.size.y});
         if (!fb) return std::fprintf(stderr, "%s\n", fb.error().c_str()), 1;
         // Each frame drawn at full resolution and, with --scale, again with the tetrahedra
@@ -222,8 +227,8 @@ int runClouds(int argc, char** argv) {
                             double(cs.full) / std::max(dm, 1.0), med, 1000.0 / med, mean(t), percentile(t, 0.9), percentile(p, 0.5));
                 const auto& e = in ? pass.errIn : pass.errOut;
                 if (pass.scale != 1 && !e.empty())
-                    std::printf("; vs full resolution: %.2fx the time, mean |d| per pixel %.4f (worst frame %.4f)", med / percentile(in ? passes[0].tIn : passes[0].tOut, 0.5),
-                                mean(e), *std::max_element(e.begin(), e.end()));
+                    std::printf("; vs full resolution: %.2fx the time, mean |d| per pixel %.4f (worst frame %.4f)",
+                                med / percentile(in ? passes[0].tIn : passes[0].tOut, 0.5), mean(e), *std::max_element(e.begin(), e.end()));
                 std::printf("\n");
             }
         std::printf("memory: LOD volume %zu bytes, table %zu bytes (CPU) + %zu (GPU, RGBA32F), per-frame tetrahedra up to %zu bytes "
@@ -237,9 +242,9 @@ int runClouds(int argc, char** argv) {
         if (!makeClouds(o.popDims, o.popDetailC, cs)) return 1;
         auto fb = splatfx::gl::Framebuffer::create({.width = o.popSize.x, .height = o.popSize.y, .color = splatfx::gl::Precision::F32});
         if (!fb) return std::fprintf(stderr, "%s\n", fb.error().c_str()), 1;
-        std::printf("popping: clouds %dx%dx%d (full %llu tetrahedra), %d frames at %dx%d, %.3f world units per frame, c = %.1f\n",
-                    o.popDims.x, o.popDims.y, o.popDims.z, static_cast<unsigned long long>(cs.full), o.popFrames, o.popSize.x,
-                    o.popSize.y, o.popStepWorld, o.popDetailC);
+        std::printf("popping: clouds %dx%dx%d (full %llu tetrahedra), %d frames at %dx%d, %.3f world units per frame, c = %.1f\n", o.popDims.x,
+                    o.popDims.y, o.popDims.z, static_cast<unsigned long long>(cs.full), o.popFrames, o.popSize.x, o.popSize.y, o.popStepWorld,
+                    o.popDetailC);
         struct Mode {
             const char* name;
             float c;
@@ -262,15 +267,16 @@ int runClouds(int argc, char** argv) {
                 if (f > 0)
                     for (std::size_t p = 0; p < img.pixels.size(); p += 4) {
                         double e = 0;
-                        for (int k = 0; k < 4; ++k) e = std::max(e, double(std::abs(img.pixels[p + std::size_t(k)] - prev.pixels[p + std::size_t(k)])));
+                        for (int k = 0; k < 4; ++k)
+                            e = std::max(e, double(std::abs(img.pixels[p + std::size_t(k)] - prev.pixels[p + std::size_t(k)])));
                         change.push_back(e);
                     }
                 prev = std::move(img);
             }
             const double mx = percentile(change, 1.0), p99 = percentile(change, 0.99);
             if (m.c >= 1e9f) finestMax = mx, finestP99 = p99;
-            std::printf("  %-17s drawn mean %9.0f  change max %.4f  p99 %.4f   (vs finest: max %.2fx, p99 %.2fx)\n", m.name,
-                        drawn / o.popFrames, mx, p99, mx / std::max(finestMax, 1e-12), p99 / std::max(finestP99, 1e-12));
+            std::printf("  %-17s drawn mean %9.0f  change max %.4f  p99 %.4f   (vs finest: max %.2fx, p99 %.2fx)\n", m.name, drawn / o.popFrames, mx,
+                        p99, mx / std::max(finestMax, 1e-12), p99 / std::max(finestP99, 1e-12));
         }
     }
 
@@ -289,8 +295,8 @@ int runClouds(int argc, char** argv) {
         auto fb = splatfx::gl::Framebuffer::create({.width = o.fogSize.x, .height = o.fogSize.y, .color = splatfx::gl::Precision::F32});
         if (!fog || !tf || !frNoFog || !frFog || !fb) return std::fprintf(stderr, "fog on tetrahedra: setup failed\n"), 1;
         // Outside, above a corner, the whole field in view (z up).
-        const splatfx::Camera cam = splatfx::Camera::lookAt(glm::vec3(-0.6f, -0.35f, 1.8f) * cs.ext, 0.5f * cs.ext, {0, 0, 1},
-                                                            glm::radians(60.0f), o.fogSize, 0.1f, 5000.0f);
+        const splatfx::Camera cam =
+            splatfx::Camera::lookAt(glm::vec3(-0.6f, -0.35f, 1.8f) * cs.ext, 0.5f * cs.ext, {0, 0, 1}, glm::radians(60.0f), o.fogSize, 0.1f, 5000.0f);
         splatfx::Frame frame;
         cs.scene.prepare(1.0, cam, materials, frame);
         auto shared = std::make_shared<const splatfx::Fog>(*fog);

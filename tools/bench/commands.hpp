@@ -6,15 +6,15 @@
 
 #include <glm/glm.hpp>
 
-int runAccuracy(int argc, char** argv); // accuracy.cpp: error vs time per quality knob (issue 5)
-int runTable1(int argc, char** argv);   // table1.cpp: the paper's Table I, fill limit, CPU scaling (issue 7)
-int runScheduling(int argc, char** argv); // scheduling.cpp: 1000 effects, 10 in view; catch-up error (issue 6)
-int runShadows(int argc, char** argv);    // shadows.cpp: Ebert & Parent 1990 Table 2, shadow tables vs tracing (issue 16)
-int runFog(int argc, char** argv);        // fog.cpp: Biri et al. 2002 Table 1, fog cost per pixel and per fog texture (issue 14)
-int runClouds(int argc, char** argv);     // clouds.cpp: LOD volumes as projected tetrahedra, flight, popping (issue 17)
-int runGroundFog(int argc, char** argv);  // groundfog.cpp: LOD ground fog over the Jacksboro DEM: count, time, error, popping (issue 17)
-int runCut(int argc, char** argv);        // cut.cpp: splats cut by the host depth and the near plane: cost, accuracy, popping (issue 15)
-int runSoak(int argc, char** argv);       // soak.cpp: every preset for an hour of scene time; finite, flat bounds and memory (issue 13)
+int runAccuracy(int argc, char** argv);     // accuracy.cpp: error vs time per quality knob (issue 5)
+int runTable1(int argc, char** argv);       // table1.cpp: the paper's Table I, fill limit, CPU scaling (issue 7)
+int runScheduling(int argc, char** argv);   // scheduling.cpp: 1000 effects, 10 in view; catch-up error (issue 6)
+int runShadows(int argc, char** argv);      // shadows.cpp: Ebert & Parent 1990 Table 2, shadow tables vs tracing (issue 16)
+int runFog(int argc, char** argv);          // fog.cpp: Biri et al. 2002 Table 1, fog cost per pixel and per fog texture (issue 14)
+int runClouds(int argc, char** argv);       // clouds.cpp: LOD volumes as projected tetrahedra, flight, popping (issue 17)
+int runGroundFog(int argc, char** argv);    // groundfog.cpp: LOD ground fog over the Jacksboro DEM: count, time, error, popping (issue 17)
+int runCut(int argc, char** argv);          // cut.cpp: splats cut by the host depth and the near plane: cost, accuracy, popping (issue 15)
+int runSoak(int argc, char** argv);         // soak.cpp: every preset for an hour of scene time; finite, flat bounds and memory (issue 13)
 int runTransparency(int argc, char** argv); // transparency.cpp: glass panes among the fire, fragment lists vs ordered blend (issue 15)
 
 // cloud_knobs.cpp, run by accuracy (--clouds-only alone): the LOD clouds' table size, c, C and

@@ -146,7 +146,8 @@ void costRows(int frames) {
                 frames);
     std::printf("%-9s %6s | %9s %9s %6s | %9s %9s %6s | %6s %6s %5s\n", "window", "voxels", "plain ms", "cut ms", "ratio", "plain ms", "cut ms",
                 "ratio", "cut", "hidden", "draws");
-    std::printf("%-9s %6s | %-26s | %-26s | %s\n", "", "", "  no host surface", "  wall through the fire", "(with the wall: splats drawn with the host cut, skipped)");
+    std::printf("%-9s %6s | %-26s | %-26s | %s\n", "", "", "  no host surface", "  wall through the fire",
+                "(with the wall: splats drawn with the host cut, skipped)");
     auto plain = splatfx::gl::Renderer::create({.depthCut = false});
     auto cut = splatfx::gl::Renderer::create({.depthCut = true});
     const splatfx::Materials m = fireMaterials(32, 64);
@@ -182,8 +183,8 @@ void costRows(int frames) {
     }
 }
 
-splatfx::Image glFrame(splatfx::gl::Renderer& r, const std::vector<splatfx::Splat>& splats, const splatfx::Camera& cam,
-                       splatfx::gl::Framebuffer& fb, float wallZ, int wallFromX) {
+splatfx::Image glFrame(splatfx::gl::Renderer& r, const std::vector<splatfx::Splat>& splats, const splatfx::Camera& cam, splatfx::gl::Framebuffer& fb,
+                       float wallZ, int wallFromX) {
     host(fb, cam, wallZ, wallFromX);
     r.draw(splats, cam, {.framebuffer = fb.handle(), .width = cam.viewport.x, .height = cam.viewport.y});
     return fb.read();
@@ -320,7 +321,8 @@ int cowPopping(const std::string& scenePath, int steps) {
             player->renderFrame(t, cam, fb->handle());
             splatfx::Image img = fb->read();
             for (size_t p = 0; p < img.pixels.size(); ++p) {
-                if (p % 4 == 0 && std::abs(img.pixels[p] - bare.pixels[p]) + std::abs(img.pixels[p + 1] - bare.pixels[p + 1]) > 1e-6f) mask[p / 4] = 1;
+                if (p % 4 == 0 && std::abs(img.pixels[p] - bare.pixels[p]) + std::abs(img.pixels[p + 1] - bare.pixels[p + 1]) > 1e-6f)
+                    mask[p / 4] = 1;
                 img.pixels[p] -= bare.pixels[p];
             }
             frames.push_back(std::move(img));

@@ -180,8 +180,8 @@ int runFog(int argc, char** argv) {
         else std::snprintf(texName, sizeof texName, "%dx%d", c.tex.x, c.tex.y);
         if (c.tex.x == 0) perPixelMs = c.ms;
         const char* pareto = c.tex.x == 0 ? "" : c.ms < perPixelMs ? "yes" : "NO: not Pareto-useful here";
-        std::printf("%-24s %-10s %9.2f %7.1f %8.2f %11s %10s %s\n", c.fog < 0 ? "none" : fogs[std::size_t(c.fog)].name, texName, c.ms,
-                    1000.0 / c.ms, c.ms / noneMs, c.rmse.c_str(), c.maxe.c_str(), pareto);
+        std::printf("%-24s %-10s %9.2f %7.1f %8.2f %11s %10s %s\n", c.fog < 0 ? "none" : fogs[std::size_t(c.fog)].name, texName, c.ms, 1000.0 / c.ms,
+                    c.ms / noneMs, c.rmse.c_str(), c.maxe.c_str(), pareto);
     }
     std::printf("\nRMSE / max: linear RGB in [0, 1] of the RGBA8 frame, against per-pixel fog at the same time (1/255 = 0.0039).\n");
     std::printf("Targets (issue 14): per-pixel fog adds <= 30 %% to the frame without fog (vs none <= 1.30) and runs >= 60 Hz.\n");

@@ -39,11 +39,10 @@ struct Options {
     float stepWorld = 1.0f; // world units per frame along the flight
     float detailC = 1.0f;
     float minAccuracyC = 4.0f;
-    std::string out; // --out DIR: the last frame of each mode as PNG
+    std::string out;           // --out DIR: the last frame of each mode as PNG
     float densityDepth = 0.0f; // --affine DEPTH: GroundFogDesc::densityDepthWorld (0: the paper's model)
     glm::ivec2 probe{-1};      // --probe X Y: print the exact ray integral (integrateRay) of that pixel per frame and mode
 };
-
 
 int usage() {
     std::printf("usage: splatfx-bench groundfog [--dem FILE.pgm] [--size W H] [--frames N] [--step WORLD_PER_FRAME]\n"
@@ -74,8 +73,7 @@ splatfx::GroundFogDesc jacksboro(const splatfx::Image& img, bool lod, float minA
 splatfx::Camera flight(int f, float step, glm::ivec2 size) {
     const glm::vec3 start(-110.0f, 30.0f, 80.0f), end(90.0f, 22.0f, -70.0f);
     const glm::vec3 dir = glm::normalize(end - start), eye = start + dir * (step * float(f));
-    return splatfx::Camera::lookAt(eye, eye + dir * 60.0f + glm::vec3(0.0f, -18.0f, 0.0f), {0, 1, 0}, glm::radians(55.0f), size, 0.5f,
-                                   1000.0f);
+    return splatfx::Camera::lookAt(eye, eye + dir * 60.0f + glm::vec3(0.0f, -18.0f, 0.0f), {0, 1, 0}, glm::radians(55.0f), size, 0.5f, 1000.0f);
 }
 
 } // namespace
@@ -210,11 +208,11 @@ int runGroundFog(int argc, char** argv) {
         const double mx = percentile(m.change, 1.0), p99 = percentile(m.change, 0.99);
         std::printf("  %-17s drawn mean %8.0f (%6.1fx fewer)  frame ms median %7.1f (prepare %6.2f)  RMSE vs full mean %.5f max %.5f  "
                     "change max %.4f p99 %.4f (vs full: max %.2fx, p99 %.2fx)\n",
-                    m.name, mean(m.drawn), double(full) / std::max(mean(m.drawn), 1.0), percentile(m.msFrame, 0.5),
-                    percentile(m.msPrepare, 0.5), mean(m.rmse), m.rmse.empty() ? 0.0 : *std::max_element(m.rmse.begin(), m.rmse.end()),
-                    mx, p99, mx / std::max(finestMax, 1e-12), p99 / std::max(finestP99, 1e-12));
-        std::printf("  %-17s largest change between frames %d and %d at pixel (%d, %d) from the top left\n", "", m.worstFrame - 1,
-                    m.worstFrame, m.worstX, m.worstY);
+                    m.name, mean(m.drawn), double(full) / std::max(mean(m.drawn), 1.0), percentile(m.msFrame, 0.5), percentile(m.msPrepare, 0.5),
+                    mean(m.rmse), m.rmse.empty() ? 0.0 : *std::max_element(m.rmse.begin(), m.rmse.end()), mx, p99, mx / std::max(finestMax, 1e-12),
+                    p99 / std::max(finestP99, 1e-12));
+        std::printf("  %-17s largest change between frames %d and %d at pixel (%d, %d) from the top left\n", "", m.worstFrame - 1, m.worstFrame,
+                    m.worstX, m.worstY);
     }
     return 0;
 }

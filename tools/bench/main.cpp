@@ -26,4 +26,6 @@ int benchMain(int argc, char** argv) {
 
 // Any exception a benchmark lets escape (std::bad_alloc from a size the
 // machine cannot hold) becomes a message and exit code 1, not an abort.
-int main(int argc, char** argv) { return cli::guardedMain("splatfx-bench", [&] { return benchMain(argc, argv); }); }
+int main(int argc, char** argv) {
+    return cli::guardedMain("splatfx-bench", [&] { return benchMain(argc, argv); });
+}

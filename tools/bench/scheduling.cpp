@@ -57,8 +57,8 @@ void drawFrame(splatfx::Scene& scene, const splatfx::Materials& m, FrameDraw& d,
 
 // Median seconds per frame over `frames` (drawn when `d` is given, else
 // CPU only: update + emit + sort).
-double frameCost(splatfx::Scene& scene, splatfx::Materials& m, int frames, double t0,
-                 const std::function<splatfx::Camera(int)>& camera, double* neededAvg, FrameDraw* d = nullptr) {
+double frameCost(splatfx::Scene& scene, splatfx::Materials& m, int frames, double t0, const std::function<splatfx::Camera(int)>& camera,
+                 double* neededAvg, FrameDraw* d = nullptr) {
     splatfx::SplatBuilder builder;
     std::vector<double> t;
     double needed = 0;
@@ -80,7 +80,6 @@ double frameCost(splatfx::Scene& scene, splatfx::Materials& m, int frames, doubl
     std::sort(t.begin(), t.end());
     return t[t.size() / 2];
 }
-
 
 } // namespace
 
@@ -157,9 +156,7 @@ int runScheduling(int argc, char** argv) {
     FrameDraw draw{*fb, *renderer, splatfx::Frame{}};
     std::printf("drawing at %dx%d on %s\n\n", size.x, size.y, ctx->renderer().c_str());
 
-    const auto fixed = [&](int) {
-        return splatfx::Camera::lookAt({0, 6, 40}, {0, 4, 0}, {0, 1, 0}, glm::radians(50.0f), size, 0.1f, 1000.0f);
-    };
+    const auto fixed = [&](int) { return splatfx::Camera::lookAt({0, 6, 40}, {0, 4, 0}, {0, 1, 0}, glm::radians(50.0f), size, 0.1f, 1000.0f); };
     // Warm both scenes up to the same time, then time them frame by frame
     // alternately, so machine load affects both alike: drawn full frames
     // first (what a player waits for), then the CPU part alone.
@@ -184,10 +181,11 @@ int runScheduling(int argc, char** argv) {
     const double frameLevel = median(drawnLevel), frameOnly = median(drawnOnly);
     const double costLevel = median(costsLevel), costOnly = median(costsOnly);
     std::printf("Fixed camera, %d frames drawn at %dx%d (full frame: update + emit + sort + draw + glFinish,\n"
-                "  median per frame, scenes timed alternately)\n", frames, size.x, size.y);
+                "  median per frame, scenes timed alternately)\n",
+                frames, size.x, size.y);
     std::printf("  %-28s %8s %10s %10s\n", "scene", "needed", "splats", "ms/frame");
-    std::printf("  %-28s %8.1f %10.0f %10.3f\n", (std::to_string(count) + " effects declared").c_str(), neededLevel,
-                double(splatsLevel) / frames, 1e3 * frameLevel);
+    std::printf("  %-28s %8.1f %10.0f %10.3f\n", (std::to_string(count) + " effects declared").c_str(), neededLevel, double(splatsLevel) / frames,
+                1e3 * frameLevel);
     std::printf("  %-28s %8.1f %10.0f %10.3f\n", "only the 10 in view", neededOnly, double(splatsOnly) / frames, 1e3 * frameOnly);
     std::printf("  ratio %.2fx (target: at most 1.5x)\n\n", frameLevel / frameOnly);
     std::printf("CPU part alone (update + emit + sort, median of %d frames, alternately)\n", frames);
@@ -200,8 +198,7 @@ int runScheduling(int argc, char** argv) {
     const auto sweep = [&](int f) {
         const float a = 6.2831853f * float(f) / float(sweepFrames);
         const glm::vec3 eye(0, 6, 20);
-        return splatfx::Camera::lookAt(eye, eye + glm::vec3(std::sin(a), -0.05f, -std::cos(a)), {0, 1, 0}, glm::radians(50.0f),
-                                       size, 0.1f, 1000.0f);
+        return splatfx::Camera::lookAt(eye, eye + glm::vec3(std::sin(a), -0.05f, -std::cos(a)), {0, 1, 0}, glm::radians(50.0f), size, 0.1f, 1000.0f);
     };
     double neededSweep = 0;
     const double costSweep = frameCost(level, m, sweepFrames, 1.0, sweep, &neededSweep, &draw);

@@ -290,9 +290,8 @@ int runShadows(int argc, char** argv) {
     const splatfx::Grid lattice = steamLattice();
     auto gasAt = [&](double t) { return *splatfx::sampleProceduralGas(gas, lattice, float(t)); };
 
-    std::printf("steam from a glass: %zu of %d lattice cells hold steam at t = 2 s; %s; on %s\n", gasAt(2.0).voxels.size(),
-                16 * 24 * 16, animated ? "the steam evolves (tables rebuilt every frame)" : "static steam (tables reused)",
-                ctx->renderer().c_str());
+    std::printf("steam from a glass: %zu of %d lattice cells hold steam at t = 2 s; %s; on %s\n", gasAt(2.0).voxels.size(), 16 * 24 * 16,
+                animated ? "the steam evolves (tables rebuilt every frame)" : "static steam (tables reused)", ctx->renderer().c_str());
 
     for (glm::ivec2 size : sizes) {
         auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});

@@ -64,7 +64,7 @@ struct Outcome {
     std::string name;
     long long steps = 0;
     double wallSec = 0.0;
-    std::string nonFinite;           // where the first NaN/Inf appeared ("" = none)
+    std::string nonFinite; // where the first NaN/Inf appeared ("" = none)
     double nonFiniteAtSec = 0.0;
     splatfx::Aabb firstBox, lastBox; // union of bounds over the first and the last tenth of the run
     double rssFirstMiB = 0.0, rssLastMiB = 0.0;
@@ -121,8 +121,7 @@ int runSoak(int argc, char** argv) {
     // Bounds are sampled once per scene second (and at the window edges);
     // the check itself runs every step.
     const long long boundsEvery = 60;
-    std::printf("splatfx-bench soak: %.1f min of scene time per preset at 60 Hz = %lld steps, NaN/Inf checked every step\n", minutes,
-                steps);
+    std::printf("splatfx-bench soak: %.1f min of scene time per preset at 60 Hz = %lld steps, NaN/Inf checked every step\n", minutes, steps);
     std::vector<Outcome> out;
     for (const Preset& p : presets) {
         if (!only.empty() && only != p.name) continue;
@@ -177,7 +176,8 @@ int runSoak(int argc, char** argv) {
         out.push_back(o);
     }
 
-    std::printf("\n| preset | steps | scene time | wall s | us/step | NaN/Inf | bounds extent, first 10%% -> last 10%% | RSS MiB, at 10%% -> end | max voxels, first -> last 10%% | max solver density sum | verdict |\n"
+    std::printf("\n| preset | steps | scene time | wall s | us/step | NaN/Inf | bounds extent, first 10%% -> last 10%% | RSS MiB, at 10%% -> end | "
+                "max voxels, first -> last 10%% | max solver density sum | verdict |\n"
                 "|---|---:|---:|---:|---:|---|---|---|---|---|---|\n");
     bool ok = true;
     for (const Outcome& o : out) {
@@ -187,10 +187,11 @@ int runSoak(int argc, char** argv) {
         const std::string nan = o.nonFinite.empty() ? "none" : o.nonFinite + " at " + std::to_string(o.nonFiniteAtSec) + " s";
         char mass[64] = "-";
         if (o.massFirst > 0.0 || o.massLast > 0.0) std::snprintf(mass, sizeof mass, "%.1f -> %.1f", o.massFirst, o.massLast);
-        std::printf("| %s | %lld | %.1f min | %.1f | %.1f | %s | %.2f x %.2f x %.2f -> %.2f x %.2f x %.2f%s | %.1f -> %.1f%s | %zu -> %zu | %s | %s |\n",
-                    o.name.c_str(), o.steps, o.steps * dt / 60.0, o.wallSec, 1e6 * o.wallSec / double(o.steps), nan.c_str(), a.x, a.y, a.z,
-                    b.x, b.y, b.z, o.boundsFlat ? "" : " (GROWS)", o.rssFirstMiB, o.rssLastMiB, o.memoryFlat ? "" : " (GROWS)",
-                    o.voxelsFirst, o.voxelsLast, mass, pass ? "pass" : "FAIL");
+        std::printf(
+            "| %s | %lld | %.1f min | %.1f | %.1f | %s | %.2f x %.2f x %.2f -> %.2f x %.2f x %.2f%s | %.1f -> %.1f%s | %zu -> %zu | %s | %s |\n",
+            o.name.c_str(), o.steps, o.steps * dt / 60.0, o.wallSec, 1e6 * o.wallSec / double(o.steps), nan.c_str(), a.x, a.y, a.z, b.x, b.y, b.z,
+            o.boundsFlat ? "" : " (GROWS)", o.rssFirstMiB, o.rssLastMiB, o.memoryFlat ? "" : " (GROWS)", o.voxelsFirst, o.voxelsLast, mass,
+            pass ? "pass" : "FAIL");
     }
     std::printf("\nsoak: %s\n", ok ? "every preset stayed finite with flat bounds and memory" : "FAILED (see the table)");
     return ok ? 0 : 1;

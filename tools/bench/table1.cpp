@@ -243,13 +243,12 @@ public:
         glDeleteVertexArrays(1, &vao);
         glDeleteBuffers(1, &buffer);
     }
-    void draw(const splatfx::Grid& grid, const splatfx::Materials& m, const splatfx::Camera& cam, GLuint fbo, glm::ivec2 size,
-              GLuint layers, GLuint colors) {
+    void draw(const splatfx::Grid& grid, const splatfx::Materials& m, const splatfx::Camera& cam, GLuint fbo, glm::ivec2 size, GLuint layers,
+              GLuint colors) {
         instances.clear();
         const float half = m.footprint().radius() * std::max({grid.spacing.x, grid.spacing.y, grid.spacing.z});
         for (const splatfx::Voxel& v : grid.voxels)
-            instances.push_back({glm::vec4(grid.worldPosition(v.cell), half),
-                                 glm::vec4(v.opacity, float(1 + v.texture % 8), v.colorCoord, 0.0f)});
+            instances.push_back({glm::vec4(grid.worldPosition(v.cell), half), glm::vec4(v.opacity, float(1 + v.texture % 8), v.colorCoord, 0.0f)});
         glNamedBufferData(buffer, GLsizeiptr(instances.size() * sizeof(Instance)), instances.data(), GL_STREAM_DRAW);
         beginOver(fbo, size, program);
         const glm::mat4 vp = cam.proj * cam.view;
@@ -291,7 +290,8 @@ struct GpuMaterials {
 };
 
 struct RowResult {
-    double scaledHz = 0; int scale = 1;  // reduced-resolution result where full resolution misses the Onyx2 rate
+    double scaledHz = 0;
+    int scale = 1; // reduced-resolution result where full resolution misses the Onyx2 rate
     double hz = 0, naiveHz = 0, fillFraction = 0, splatFragsPerSec = 0, fillRate = 0, covered = 0, overdraw = 0;
     double naiveFragsPerSec = 0;
     double sizedRate = 0, side = 0; // fill rate of screen-aligned squares of the splats' mean size, and that size
@@ -387,11 +387,11 @@ RowResult measureRow(const Row& row, const Settings& settings) {
 
     NaiveRenderer naive;
     out.naiveHz = 1.0 / medianFrame(5, frames, [&](int i) {
-        cycle(base, grid, i / 60.0);
-        fb->clear({0, 0, 0, 1});
-        naive.draw(grid, materials, cam, fb->handle(), row.window, gpu.layers, gpu.colors);
-        glFinish();
-    });
+                      cycle(base, grid, i / 60.0);
+                      fb->clear({0, 0, 0, 1});
+                      naive.draw(grid, materials, cam, fb->handle(), row.window, gpu.layers, gpu.colors);
+                      glFinish();
+                  });
     // The naive pass's own fragment rate (its draw alone, instance upload included).
     const GLuint64 naiveSamples = samplesPassed([&] { naive.draw(grid, materials, cam, fb->handle(), row.window, gpu.layers, gpu.colors); });
     const double naiveSec = medianFrame(3, frames, [&](int) {
@@ -431,12 +431,11 @@ void fragmentCosts(std::FILE* csv) {
         bool blend;
         GLuint layers;
     };
-    const std::string upsampled =
-        "splat fragment, " +
-        std::string(renderer->sampling() == splatfx::gl::TextureSampling::Upsampled
-                        ? "upsampled " + std::to_string(renderer->upsampleFactor()) + "x, nearest"
-                        : "bilinear") +
-        " (default)";
+    const std::string upsampled = "splat fragment, " +
+                                  std::string(renderer->sampling() == splatfx::gl::TextureSampling::Upsampled
+                                                  ? "upsampled " + std::to_string(renderer->upsampleFactor()) + "x, nearest"
+                                                  : "bilinear") +
+                                  " (default)";
     const Probe probes[] = {
         {"flat colour, no blend", flat, false, 0},
         {"flat colour, over blend", flat, true, 0},
@@ -461,9 +460,9 @@ void fragmentCosts(std::FILE* csv) {
 void cpuScaling(std::FILE* csv) {
     const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
     std::printf("\nCPU work per frame (texture cycling + splat build + radix sort + copy to the instance stream),\n"
-                "SplatBuilderDesc::threads = 1 (default) and = %u (this machine's hardware threads):\n", hw);
-    std::printf("%10s %12s %12s %12s %12s | %8s %8s %8s\n", "voxels", "ms/frame", "ns/voxel", "ms/frame", "ns/voxel", "build", "sort",
-                "other");
+                "SplatBuilderDesc::threads = 1 (default) and = %u (this machine's hardware threads):\n",
+                hw);
+    std::printf("%10s %12s %12s %12s %12s | %8s %8s %8s\n", "voxels", "ms/frame", "ns/voxel", "ms/frame", "ns/voxel", "build", "sort", "other");
     std::printf("%10s %25s %25s | %26s\n", "", "1 thread", (std::to_string(hw) + " threads").c_str(), "1 thread, ns/voxel (median)");
     csvPrintf(csv, "\nvoxels,threads,ms_per_frame,ns_per_voxel,build_ns,sort_ns,other_ns\n");
     splatfx::Materials materials{splatfx::Footprint{}};
@@ -512,8 +511,7 @@ void cpuScaling(std::FILE* csv) {
         for (int k = 0; k < 2; ++k) {
             const double ns = 1e9 * best[k] / double(grid.voxels.size());
             std::printf(" %12.3f %12.1f", 1e3 * best[k], ns);
-            csvPrintf(csv, "%zu,%u,%.4f,%.2f,%.2f,%.2f,%.2f\n", grid.voxels.size(), counts[k], 1e3 * best[k], ns, split[0], split[1],
-                         split[2]);
+            csvPrintf(csv, "%zu,%u,%.4f,%.2f,%.2f,%.2f,%.2f\n", grid.voxels.size(), counts[k], 1e3 * best[k], ns, split[0], split[1], split[2]);
         }
         std::printf(" | %8.1f %8.1f %8.1f\n", split[0], split[1], split[2]);
     }
@@ -533,8 +531,7 @@ int runTable1(int argc, char** argv) {
                 std::fprintf(stderr, "table1: %s\n", st.error().c_str());
                 return 2;
             }
-        }
-        else if (a == "--csv" && i + 1 < argc) csvPath = argv[++i];
+        } else if (a == "--csv" && i + 1 < argc) csvPath = argv[++i];
         else if (a == "--quick") quick = true;
         else if (a == "--footprint-cut" && i + 1 < argc) {
             // A fraction of the footprint's peak below which fragments are discarded.
@@ -542,8 +539,7 @@ int runTable1(int argc, char** argv) {
                 std::fprintf(stderr, "table1: %s\n", st.error().c_str());
                 return 2;
             }
-        }
-        else if (a == "--sampling" && i + 1 < argc) {
+        } else if (a == "--sampling" && i + 1 < argc) {
             using splatfx::gl::TextureSampling;
             const std::string v = argv[++i];
             if (v == "auto") settings.renderer.sampling = TextureSampling::Auto;
@@ -562,8 +558,7 @@ int runTable1(int argc, char** argv) {
                 std::fprintf(stderr, "table1: --sampling takes auto, bilinear, nearest, upsampled or upsampledN\n");
                 return 2;
             }
-        }
-        else if (a == "--crossfade") settings.crossfade = true;
+        } else if (a == "--crossfade") settings.crossfade = true;
         else if (a == "--squares") settings.renderer.trimCorners = false;
         else if (a == "--octagons") settings.renderer.trimCorners = true;
         else if (a == "--help" || a == "-h") {
@@ -592,12 +587,12 @@ int runTable1(int argc, char** argv) {
     }
     fragmentCosts(csv);
     std::printf("Table I on %s (median of %d frames per row; paper columns in Hz)\n\n", ctx->renderer().c_str(), frames);
-    std::printf("%-9s %6s | %6s %6s %7s %6s | %9s %9s %13s | %8s %8s %8s %6s | %6s %8s | %8s %8s %6s\n", "window", "voxels", "O2", "Indy",
-                "Octane", "Onyx2", "splatfx", "vs Onyx2", "reduced res", "covered", "overdraw", "Mfrag/s", "fill", "side", "vs sized",
-                "naive Hz", "Mfrag/s", "ratio");
+    std::printf("%-9s %6s | %6s %6s %7s %6s | %9s %9s %13s | %8s %8s %8s %6s | %6s %8s | %8s %8s %6s\n", "window", "voxels", "O2", "Indy", "Octane",
+                "Onyx2", "splatfx", "vs Onyx2", "reduced res", "covered", "overdraw", "Mfrag/s", "fill", "side", "vs sized", "naive Hz", "Mfrag/s",
+                "ratio");
     csvPrintf(csv, "window,voxels,o2_hz,indy_hz,octane_hz,onyx2_hz,splatfx_hz,pixels_covered,overdraw,splat_mfrag_s,fill_mfrag_s,"
-                      "fill_fraction,mean_splat_side_px,sized_fill_mfrag_s,fraction_of_sized_fill,naive_hz,naive_mfrag_s,speedup_vs_naive,reduced_scale,"
-                      "reduced_hz\n");
+                   "fill_fraction,mean_splat_side_px,sized_fill_mfrag_s,fraction_of_sized_fill,naive_hz,naive_mfrag_s,speedup_vs_naive,reduced_scale,"
+                   "reduced_hz\n");
     for (const Row& row : kRows) {
         const RowResult r = measureRow(row, settings);
         char win[16];
@@ -608,10 +603,9 @@ int runTable1(int argc, char** argv) {
                     row.voxels, row.o2, row.indy, row.octane, row.onyx2, r.hz, r.hz / row.onyx2, reduced, r.covered, r.overdraw,
                     r.splatFragsPerSec / 1e6, 100 * r.fillFraction, r.side, 100 * r.splatFragsPerSec / r.sizedRate, r.naiveHz,
                     r.naiveFragsPerSec / 1e6, r.hz / r.naiveHz);
-        csvPrintf(csv, "%s,%d,%g,%g,%g,%g,%.2f,%.0f,%.2f,%.1f,%.1f,%.3f,%.1f,%.1f,%.3f,%.2f,%.1f,%.3f,%d,%.2f\n", win, row.voxels, row.o2,
-                     row.indy, row.octane, row.onyx2, r.hz, r.covered, r.overdraw, r.splatFragsPerSec / 1e6, r.fillRate / 1e6, r.fillFraction,
-                     r.side, r.sizedRate / 1e6, r.splatFragsPerSec / r.sizedRate, r.naiveHz, r.naiveFragsPerSec / 1e6, r.hz / r.naiveHz, r.scale,
-                     r.scaledHz);
+        csvPrintf(csv, "%s,%d,%g,%g,%g,%g,%.2f,%.0f,%.2f,%.1f,%.1f,%.3f,%.1f,%.1f,%.3f,%.2f,%.1f,%.3f,%d,%.2f\n", win, row.voxels, row.o2, row.indy,
+                  row.octane, row.onyx2, r.hz, r.covered, r.overdraw, r.splatFragsPerSec / 1e6, r.fillRate / 1e6, r.fillFraction, r.side,
+                  r.sizedRate / 1e6, r.splatFragsPerSec / r.sizedRate, r.naiveHz, r.naiveFragsPerSec / 1e6, r.hz / r.naiveHz, r.scale, r.scaledHz);
         std::fflush(stdout);
     }
     std::printf("\nfill = splat-pass fragments/s as a fraction of full-screen quads doing the same per-fragment work\n"

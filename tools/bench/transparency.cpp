@@ -122,7 +122,7 @@ Error compare(const splatfx::Image& a, const splatfx::Image& b) {
 int runTransparency(int argc, char** argv) {
     glm::ivec2 size{640, 480};
     int frames = 15, rounds = 3;
-    bool cut = true; // RendererDesc::depthCut: sections weighted by the partial integral
+    bool cut = true;       // RendererDesc::depthCut: sections weighted by the partial integral
     std::string imagesDir; // --images: the GL-vs-reference still
     std::string only;      // --only TEXT: the opaque-only frame and the configurations whose name contains TEXT
     for (int i = 1; i < argc; ++i) {
@@ -135,7 +135,8 @@ int runTransparency(int argc, char** argv) {
         else if (a == "--only" && i + 1 < argc) only = argv[++i];
         else if (a == "--images" && i + 1 < argc) imagesDir = argv[++i];
         else if (a == "--help" || a == "-h") {
-            std::printf("usage: splatfx-bench transparency [--size W H (640 480)] [--frames N (15)] [--rounds R (3)] [--quick] [--no-cut] [--only TEXT] [--images DIR]\n"
+            std::printf("usage: splatfx-bench transparency [--size W H (640 480)] [--frames N (15)] [--rounds R (3)] [--quick] [--no-cut] [--only "
+                        "TEXT] [--images DIR]\n"
                         "Glass panes among the 1560-voxel Table I fire: opaque-only frame, ordered blend and fragment lists,\n"
                         "time and error against the exact reference; the fragment budget knob; list memory.\n"
                         "--only TEXT: the opaque-only frame and the configurations whose name contains TEXT.\n"
@@ -247,11 +248,10 @@ int runTransparency(int argc, char** argv) {
         std::vector<splatfx::ReferenceSurface> surfaces;
         if (panes)
             for (const Pane& p : *panes) surfaces.push_back(Glass::reference(p));
-        return *splatfx::renderSplatExact(frame.splats(), cam, materials,
-                                          {.host = {.background = kBackground}, .surfaces = surfaces});
+        return *splatfx::renderSplatExact(frame.splats(), cam, materials, {.host = {.background = kBackground}, .surfaces = surfaces});
     };
-    const splatfx::Image refOpaque = reference(nullptr), refFront = reference(&front), refMiddle = reference(&middle),
-                         refBehind = reference(&behind), refThree = reference(&three);
+    const splatfx::Image refOpaque = reference(nullptr), refFront = reference(&front), refMiddle = reference(&middle), refBehind = reference(&behind),
+                         refThree = reference(&three);
     std::vector<const splatfx::Image*> mosaicRefs;
     std::vector<splatfx::Image> mosaicGl;
     for (std::size_t i = 0; i < configs.size(); ++i) {

@@ -62,8 +62,8 @@ std::string show(T v) {
 template <std::integral T>
 splatfx::Status parseInt(std::string_view option, std::string_view text, std::type_identity_t<T> lo, std::type_identity_t<T> hi, T& out) {
     auto bad = [&](const char* why) {
-        return splatfx::makeError(std::string(option) + " expects a whole number in [" + detail::show(lo) + ", " + detail::show(hi) +
-                                  "], got " + detail::quoted(text) + why);
+        return splatfx::makeError(std::string(option) + " expects a whole number in [" + detail::show(lo) + ", " + detail::show(hi) + "], got " +
+                                  detail::quoted(text) + why);
     };
     std::string_view digits = text;
     if (!digits.empty() && digits.front() == '+') digits.remove_prefix(1); // from_chars accepts '-' only
@@ -84,11 +84,10 @@ splatfx::Status parseInt(std::string_view option, std::string_view text, std::ty
 // A finite floating-point number filling the whole text, within [lo, hi].
 // "nan", "inf", "1e999" and "0.5x" are errors.
 template <std::floating_point T>
-splatfx::Status parseReal(std::string_view option, std::string_view text, std::type_identity_t<T> lo, std::type_identity_t<T> hi,
-                          T& out) {
+splatfx::Status parseReal(std::string_view option, std::string_view text, std::type_identity_t<T> lo, std::type_identity_t<T> hi, T& out) {
     auto bad = [&]() {
-        return splatfx::makeError(std::string(option) + " expects a number in [" + detail::show(lo) + ", " + detail::show(hi) +
-                                  "], got " + detail::quoted(text));
+        return splatfx::makeError(std::string(option) + " expects a number in [" + detail::show(lo) + ", " + detail::show(hi) + "], got " +
+                                  detail::quoted(text));
     };
     std::string_view digits = text;
     if (!digits.empty() && digits.front() == '+') digits.remove_prefix(1);
@@ -105,8 +104,7 @@ splatfx::Status parseReal(std::string_view option, std::string_view text, std::t
 inline splatfx::Status parseSize(std::string_view option, std::string_view text, int lo, int hi, int& width, int& height) {
     const size_t x = text.find('x');
     int w = 0, h = 0;
-    if (x == std::string_view::npos || !parseInt(option, text.substr(0, x), lo, hi, w) ||
-        !parseInt(option, text.substr(x + 1), lo, hi, h))
+    if (x == std::string_view::npos || !parseInt(option, text.substr(0, x), lo, hi, w) || !parseInt(option, text.substr(x + 1), lo, hi, h))
         return splatfx::makeError(std::string(option) + " expects WxH with each side a whole number in [" + std::to_string(lo) + ", " +
                                   std::to_string(hi) + "], got " + detail::quoted(text));
     width = w;
@@ -131,8 +129,7 @@ struct FrameRange {
 inline splatfx::Status parseFrameRange(std::string_view option, std::string_view text, int maxIndex, FrameRange& out) {
     const std::string opt(option);
     auto bad = [&](const std::string& why) {
-        return splatfx::makeError(opt + " expects A-B or A-B:STEP (frame indices from 0, e.g. 0-23 or 0-95:4), got " +
-                                  detail::quoted(text) + why);
+        return splatfx::makeError(opt + " expects A-B or A-B:STEP (frame indices from 0, e.g. 0-23 or 0-95:4), got " + detail::quoted(text) + why);
     };
     const size_t dash = text.find('-');
     if (dash == std::string_view::npos) return bad("");
@@ -144,15 +141,12 @@ inline splatfx::Status parseFrameRange(std::string_view option, std::string_view
         st = rest.substr(colon + 1);
     }
     // Each part digits only: no signs ("--range -3-5" or "3-+5" is garbage, not a negative frame).
-    auto digitsOnly = [](std::string_view v) {
-        return !v.empty() && v.find_first_not_of("0123456789") == std::string_view::npos;
-    };
+    auto digitsOnly = [](std::string_view v) { return !v.empty() && v.find_first_not_of("0123456789") == std::string_view::npos; };
     if (!digitsOnly(a) || !digitsOnly(b) || (rest.find(':') != std::string_view::npos && !digitsOnly(st))) return bad("");
     FrameRange r;
     if (!parseInt(option, a, 0, maxIndex, r.first) || !parseInt(option, b, 0, maxIndex, r.last))
         return bad(" (frame indices go from 0 to " + std::to_string(maxIndex) + ")");
-    if (r.last < r.first)
-        return bad(" (the last frame " + std::to_string(r.last) + " comes before the first " + std::to_string(r.first) + ")");
+    if (r.last < r.first) return bad(" (the last frame " + std::to_string(r.last) + " comes before the first " + std::to_string(r.first) + ")");
     if (!st.empty()) {
         long long step = 0;
         if (!parseInt(option, st, 0ll, (long long)maxIndex + 1, step)) return bad(" (STEP must be a whole number from 1)");
@@ -180,11 +174,11 @@ int guardedMain(const char* tool, Body&& body) noexcept {
     try {
         return body();
     } catch (const std::bad_alloc&) {
-        std::fprintf(stderr, "%s: out of memory: this run needs more memory than the machine could allocate; "
-                             "lower the sizes or counts asked for\n", tool);
-    } catch (const std::exception& e) {
-        std::fprintf(stderr, "%s: internal error: %s\n", tool, e.what());
-    } catch (...) {
+        std::fprintf(stderr,
+                     "%s: out of memory: this run needs more memory than the machine could allocate; "
+                     "lower the sizes or counts asked for\n",
+                     tool);
+    } catch (const std::exception& e) { std::fprintf(stderr, "%s: internal error: %s\n", tool, e.what()); } catch (...) {
         std::fprintf(stderr, "%s: internal error (unknown exception)\n", tool);
     }
     return 1;

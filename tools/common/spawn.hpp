@@ -34,9 +34,9 @@ enum class ChildOutput {
 };
 
 struct SpawnDesc {
-    std::vector<std::string> argv{}; // argv[0] is looked up in PATH (execvp); required, non-empty
-    std::string workingDir{};       // default "": this process's working folder
-    std::vector<std::string> env{}; // default none: NAME=VALUE entries added to (or replacing in) this environment
+    std::vector<std::string> argv{};           // argv[0] is looked up in PATH (execvp); required, non-empty
+    std::string workingDir{};                  // default "": this process's working folder
+    std::vector<std::string> env{};            // default none: NAME=VALUE entries added to (or replacing in) this environment
     ChildOutput output = ChildOutput::Inherit; // default Inherit
 };
 
@@ -73,7 +73,7 @@ inline SpawnResult spawn(const SpawnDesc& d) {
     for (const std::string& e : envStore) envp.push_back(const_cast<char*>(e.c_str()));
     envp.push_back(nullptr);
 
-    int status[2];  // the child writes errno here if exec fails; closed on a successful exec
+    int status[2]; // the child writes errno here if exec fails; closed on a successful exec
     int capture[2] = {-1, -1};
     if (pipe2(status, O_CLOEXEC) != 0) {
         r.error = "spawn: " + d.argv[0] + ": pipe: " + std::strerror(errno);
@@ -129,8 +129,7 @@ inline SpawnResult spawn(const SpawnDesc& d) {
     while (got < 0 && errno == EINTR);
     close(status[0]);
     int ws = 0;
-    while (waitpid(pid, &ws, 0) < 0 && errno == EINTR) {
-    }
+    while (waitpid(pid, &ws, 0) < 0 && errno == EINTR) {}
     if (got == ssize_t(sizeof err)) {
         r.error = err[0] == 1 ? "cannot enter folder '" + d.workingDir + "' to run " + d.argv[0] + ": " + std::strerror(err[1])
                               : "cannot run '" + d.argv[0] + "': " + std::strerror(err[1]);

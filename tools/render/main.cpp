@@ -48,36 +48,35 @@ struct Args {
     bool traditional = false;
     bool quiet = false;
     splatfx::gl::FrameRendererDesc renderer{}; // --scale, --sampling, --fog-texture
-    int abortAfter = -1; // testing aid: fail after this many frames
-    std::optional<cli::FrameRange> range; // --range: only these frames, no GIF
-    bool assemble = false;                // --assemble: the GIF from the frames in --out
-    splatfx::Budgets budgets{};           // --budget NAME=N
+    int abortAfter = -1;                       // testing aid: fail after this many frames
+    std::optional<cli::FrameRange> range;      // --range: only these frames, no GIF
+    bool assemble = false;                     // --assemble: the GIF from the frames in --out
+    splatfx::Budgets budgets{};                // --budget NAME=N
 };
 
 void usage() {
-    std::printf(
-        "splatfx-render: render a splatfx scene file headless into PNG frames and an animated GIF\n\n"
-        "usage: splatfx-render SCENE.json [options]\n"
-        "  --out DIR        output folder (default: out); writes DIR/<name>_NNNN.png and DIR/<name>.gif\n"
-        "  --frames N       frames to render (default: the scene's output.frames)\n"
-        "  --size WxH       image size in pixels (default: the scene's output.size)\n"
-        "  --fps F          animation rate; frame i shows time i / F (default: the scene's output.fps)\n"
-        "  --seed S         scene seed (every effect's random choices derive from it; default: the file's)\n"
-        "  --traditional    draw every effect with plain footprints, no textures (the paper's Fig. 1a)\n"
-        "  --scale N        draw the effects and volumes (splats, clouds, ground fog) at 1/N resolution per axis\n"
-        "                   (1, 2 or 4; default 1) with depth-aware upsampling\n"
-        "  --sampling M     texture sampling: auto (default), bilinear, nearest, upsampled, upsampledN (N = 2..16)\n"
-        "  --fog-texture WxH  fog the host image through a reduced WxH fog texture (default: per pixel)\n"
-        "  --range A-B[:STEP]  render-farm task: write only frames A..B (every STEP-th; indices from 0), exactly\n"
-        "                   as a full run writes them; no GIF (see --assemble; docs/render-farm.md)\n"
-        "  --assemble       write DIR/<name>.gif from the frames DIR/<name>_NNNN.png the tasks wrote (renders nothing)\n"
-        "  --budget NAME=N  raise (or lower) one of the loader's budgets (splatfx/budget.hpp; repeatable): effectCells,\n"
-        "                   solverCells, sampledTexels, textureLayers, meshElements, meshFileBytes,\n"
-        "                   meshImportBytes, meshImportSeconds\n"
-        "  --no-depth-cut   the plain depth test at each splat's plane instead of the exact cut (RendererDesc::depthCut)\n"
-        "  --quiet          no per-frame progress\n"
-        "  --abort-after N  testing aid: fail on purpose after N frames (checks that nothing partial is left)\n"
-        "<name> is the scene's output.name (default: the scene file's folder name).\n");
+    std::printf("splatfx-render: render a splatfx scene file headless into PNG frames and an animated GIF\n\n"
+                "usage: splatfx-render SCENE.json [options]\n"
+                "  --out DIR        output folder (default: out); writes DIR/<name>_NNNN.png and DIR/<name>.gif\n"
+                "  --frames N       frames to render (default: the scene's output.frames)\n"
+                "  --size WxH       image size in pixels (default: the scene's output.size)\n"
+                "  --fps F          animation rate; frame i shows time i / F (default: the scene's output.fps)\n"
+                "  --seed S         scene seed (every effect's random choices derive from it; default: the file's)\n"
+                "  --traditional    draw every effect with plain footprints, no textures (the paper's Fig. 1a)\n"
+                "  --scale N        draw the effects and volumes (splats, clouds, ground fog) at 1/N resolution per axis\n"
+                "                   (1, 2 or 4; default 1) with depth-aware upsampling\n"
+                "  --sampling M     texture sampling: auto (default), bilinear, nearest, upsampled, upsampledN (N = 2..16)\n"
+                "  --fog-texture WxH  fog the host image through a reduced WxH fog texture (default: per pixel)\n"
+                "  --range A-B[:STEP]  render-farm task: write only frames A..B (every STEP-th; indices from 0), exactly\n"
+                "                   as a full run writes them; no GIF (see --assemble; docs/render-farm.md)\n"
+                "  --assemble       write DIR/<name>.gif from the frames DIR/<name>_NNNN.png the tasks wrote (renders nothing)\n"
+                "  --budget NAME=N  raise (or lower) one of the loader's budgets (splatfx/budget.hpp; repeatable): effectCells,\n"
+                "                   solverCells, sampledTexels, textureLayers, meshElements, meshFileBytes,\n"
+                "                   meshImportBytes, meshImportSeconds\n"
+                "  --no-depth-cut   the plain depth test at each splat's plane instead of the exact cut (RendererDesc::depthCut)\n"
+                "  --quiet          no per-frame progress\n"
+                "  --abort-after N  testing aid: fail on purpose after N frames (checks that nothing partial is left)\n"
+                "<name> is the scene's output.name (default: the scene file's folder name).\n");
 }
 
 bool parse(int argc, char** argv, Args& a) {
@@ -241,8 +240,8 @@ int assemble(const Args& a) {
         std::string list;
         for (std::size_t k = 0; k < missing.size() && k < 8; ++k) list += (k ? ", " : "") + std::to_string(missing[k]);
         if (missing.size() > 8) list += ", ...";
-        return fail("--assemble: " + std::to_string(missing.size()) + " of the " + std::to_string(frames) + " frames are missing from '" +
-                    a.out + "' (frame " + list + "); render them first (--range), with the same --frames");
+        return fail("--assemble: " + std::to_string(missing.size()) + " of the " + std::to_string(frames) + " frames are missing from '" + a.out +
+                    "' (frame " + list + "); render them first (--range), with the same --frames");
     }
     auto outputs = splatfx::OutputSet::begin(a.out, name + ".gif");
     if (!outputs) return fail(outputs.error());
@@ -301,16 +300,15 @@ static int renderMain(int argc, char** argv) {
 
     auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
     if (!fb) return fail(fb.error());
-    std::printf("splatfx-render: %s (%s) on %s\n", a.scene.c_str(), file.title.empty() ? name.c_str() : file.title.c_str(),
-                ctx->renderer().c_str());
+    std::printf("splatfx-render: %s (%s) on %s\n", a.scene.c_str(), file.title.empty() ? name.c_str() : file.title.c_str(), ctx->renderer().c_str());
     if (whole)
-        std::printf("splatfx-render: %d frames at %dx%d, %g fps, seed %u, %s splats -> %s/%s_NNNN.png + %s.gif\n", frames, size.x, size.y,
-                    fps, file.seed, a.traditional ? "traditional" : "textured", a.out.c_str(), name.c_str(), name.c_str());
+        std::printf("splatfx-render: %d frames at %dx%d, %g fps, seed %u, %s splats -> %s/%s_NNNN.png + %s.gif\n", frames, size.x, size.y, fps,
+                    file.seed, a.traditional ? "traditional" : "textured", a.out.c_str(), name.c_str(), name.c_str());
     else
         std::printf("splatfx-render: frames %d-%d%s (%d of the sequence's %d) at %dx%d, %g fps, seed %u, %s splats -> %s/%s_NNNN.png "
                     "(no GIF: --assemble writes it)\n",
-                    a.range->first, a.range->last, a.range->step > 1 ? (":" + std::to_string(a.range->step)).c_str() : "", toWrite, frames,
-                    size.x, size.y, fps, file.seed, a.traditional ? "traditional" : "textured", a.out.c_str(), name.c_str());
+                    a.range->first, a.range->last, a.range->step > 1 ? (":" + std::to_string(a.range->step)).c_str() : "", toWrite, frames, size.x,
+                    size.y, fps, file.seed, a.traditional ? "traditional" : "textured", a.out.c_str(), name.c_str());
 
     std::optional<splatfx::AnimationWriter> gif;
     if (whole) gif.emplace(outputs->path(name + ".gif"), fps);
@@ -335,8 +333,7 @@ static int renderMain(int argc, char** argv) {
             continue;
         }
         if (written == 0) reachMs = replayMs;
-        if (written == a.abortAfter)
-            return fail("aborted on purpose after " + std::to_string(written) + " frames (--abort-after); no output kept");
+        if (written == a.abortAfter) return fail("aborted on purpose after " + std::to_string(written) + " frames (--abort-after); no output kept");
         const auto f0 = Clock::now();
         player->renderFrame(t, player->cameraAt(t, size), fb->handle(), {.traditional = a.traditional});
         splatfx::Image img = fb->read();
@@ -356,8 +353,8 @@ static int renderMain(int argc, char** argv) {
         ++written;
         // A terminal gets a live line; a log gets about ten lines.
         if (!a.quiet && (tty || written % std::max(1, toWrite / 10) == 0 || written == toWrite)) {
-            std::printf("%ssplatfx-render: frame %d (%d/%d)  t=%.2fs  %llu splats  %zu/%zu effects visible", tty ? "\r" : "", i, written,
-                        toWrite, t, (unsigned long long)s.splats, s.needed, s.declared);
+            std::printf("%ssplatfx-render: frame %d (%d/%d)  t=%.2fs  %llu splats  %zu/%zu effects visible", tty ? "\r" : "", i, written, toWrite, t,
+                        (unsigned long long)s.splats, s.needed, s.declared);
             if (!tty) std::printf("\n");
             std::fflush(stdout);
         }
@@ -378,7 +375,8 @@ static int renderMain(int argc, char** argv) {
         std::printf("  replay            %d frame(s) before or between this task's stepped through undrawn, as a full run steps through them: "
                     "%.2f s (%.1f ms each), %.2f s of it to reach frame %d\n",
                     replayed, replayMs / 1000.0, replayMs / replayed, reachMs / 1000.0, a.range->first);
-    std::printf("  time              %.2f s in all, %.1f ms per frame written (frame + readback %.1f ms: prepare %.2f, GL submission %.2f; PNG/GIF the rest)\n",
+    std::printf("  time              %.2f s in all, %.1f ms per frame written (frame + readback %.1f ms: prepare %.2f, GL submission %.2f; PNG/GIF "
+                "the rest)\n",
                 sec, 1000.0 * sec / n, renderMs / n, prepareMs / n, submitMs / n);
     std::printf("  splats per frame  min %llu, mean %.0f, max %llu\n", (unsigned long long)splatsMin, double(splatsSum) / n,
                 (unsigned long long)splatsMax);
@@ -391,10 +389,11 @@ static int renderMain(int argc, char** argv) {
                     a.out.c_str(), name.c_str());
     else
         std::printf("  wrote             %s/%s_%04d.png .. %s_%04d.png (%d frames%s)\n", a.out.c_str(), name.c_str(), a.range->first, name.c_str(),
-                    lastIndex, n,
-                    a.range->step > 1 ? (", step " + std::to_string(a.range->step)).c_str() : "");
+                    lastIndex, n, a.range->step > 1 ? (", step " + std::to_string(a.range->step)).c_str() : "");
     return 0;
 }
 
 // Any exception that escapes (std::bad_alloc included) becomes a message and exit code 1.
-int main(int argc, char** argv) { return cli::guardedMain("splatfx-render", [&] { return renderMain(argc, argv); }); }
+int main(int argc, char** argv) {
+    return cli::guardedMain("splatfx-render", [&] { return renderMain(argc, argv); });
+}

@@ -139,7 +139,8 @@ splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<spl
     impl->program = *program;
     {
         const std::string include = splatfx::transparentGlsl();
-        auto tp = splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n", include.c_str(), kHostNormal, kTransparentBody}, "GeometryRenderer (transparent)");
+        auto tp = splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n", include.c_str(), kHostNormal, kTransparentBody},
+                                           "GeometryRenderer (transparent)");
         if (!tp) return splatfx::makeError(tp.error());
         impl->transparentProgram = *tp;
     }
@@ -209,7 +210,9 @@ void GeometryRenderer::setWorldTriangles(std::size_t i, const std::vector<glm::v
         bool operator==(const Key&) const = default;
     };
     struct KeyHash {
-        std::size_t operator()(const Key& k) const { return (std::size_t(k.x) * 73856093u) ^ (std::size_t(k.y) * 19349663u) ^ (std::size_t(k.z) * 83492791u); }
+        std::size_t operator()(const Key& k) const {
+            return (std::size_t(k.x) * 73856093u) ^ (std::size_t(k.y) * 19349663u) ^ (std::size_t(k.z) * 83492791u);
+        }
     };
     std::unordered_map<Key, std::uint32_t, KeyHash> corner;
     corner.reserve(triangles.size() / 2);

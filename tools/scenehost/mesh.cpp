@@ -114,8 +114,7 @@ splatfx::Status checkHeaderCounts(const std::string& path, std::uintmax_t fileBy
         for (int k = 0; k < found; ++k) claims.push_back({names[k], numbers[k], minBytes[k]});
     }
     for (const Claim& c : claims) {
-        if (auto s = splatfx::checkBudget(path + ": the mesh, by its header,", c.count, c.what, budgets.meshElements, "meshElements"); !s)
-            return s;
+        if (auto s = splatfx::checkBudget(path + ": the mesh, by its header,", c.count, c.what, budgets.meshElements, "meshElements"); !s) return s;
         if (c.count * c.minBytes > fileBytes)
             return splatfx::makeError(path + ": the header claims " + std::to_string(c.count) + " " + c.what + " but the file has only " +
                                       std::to_string(fileBytes) + " bytes (truncated or crafted)");
@@ -189,7 +188,8 @@ splatfx::Result<Mesh> importWithAssimp(const std::string& path, const splatfx::B
     for (unsigned m = 0; m < scene->mNumMeshes; ++m)
         for (unsigned f = 0; f < scene->mMeshes[m]->mNumFaces; ++f)
             if (scene->mMeshes[m]->mFaces[f].mNumIndices == 0 || !scene->mMeshes[m]->mFaces[f].mIndices)
-                return splatfx::makeError(path + ": face " + std::to_string(f) + " of mesh " + std::to_string(m) + " has no vertices (a malformed face)");
+                return splatfx::makeError(path + ": face " + std::to_string(f) + " of mesh " + std::to_string(m) +
+                                          " has no vertices (a malformed face)");
     scene = importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
     if (!scene || !scene->mRootNode) return splatfx::makeError(path + ": cannot load mesh: " + importer.GetErrorString());
     Mesh out;
@@ -230,8 +230,7 @@ extern "C" __attribute__((weak)) void __sanitizer_set_death_callback(void (*)(vo
     // the handlers it inherited (a fuzzer's would file the input as its own crash), writes no
     // core file and prints nothing.
     if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(nullptr);
-    for (int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGILL, SIGFPE, SIGXCPU, SIGALRM, SIGINT, SIGTERM, SIGUSR1, SIGUSR2})
-        std::signal(sig, SIG_DFL);
+    for (int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGILL, SIGFPE, SIGXCPU, SIGALRM, SIGINT, SIGTERM, SIGUSR1, SIGUSR2}) std::signal(sig, SIG_DFL);
     const rlimit noCore{0, 0};
     setrlimit(RLIMIT_CORE, &noCore);
     if (const int devNull = ::open("/dev/null", O_WRONLY); devNull >= 0) ::dup2(devNull, STDERR_FILENO), ::dup2(devNull, STDOUT_FILENO);
@@ -259,16 +258,13 @@ extern "C" __attribute__((weak)) void __sanitizer_set_death_callback(void (*)(vo
         if (r) mesh = std::move(*r), h.ok = 1, h.positions = mesh.positions.size(), h.indices = mesh.indices.size();
         // assimp catches the allocation failure itself and reports its name.
         else message = r.error().find("bad_alloc") != std::string::npos ? outOfMemory : r.error();
-    } catch (const std::bad_alloc&) {
-        message = outOfMemory;
-    } catch (const std::exception& e) {
+    } catch (const std::bad_alloc&) { message = outOfMemory; } catch (const std::exception& e) {
         message = path + ": cannot load mesh: " + e.what();
     }
     if (!h.ok) h.positions = message.size();
-    const bool sent = writeAll(fd, &h, sizeof h) &&
-                      (h.ok ? writeAll(fd, mesh.positions.data(), mesh.positions.size() * sizeof(glm::vec3)) &&
-                                  writeAll(fd, mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t))
-                            : writeAll(fd, message.data(), message.size()));
+    const bool sent = writeAll(fd, &h, sizeof h) && (h.ok ? writeAll(fd, mesh.positions.data(), mesh.positions.size() * sizeof(glm::vec3)) &&
+                                                                writeAll(fd, mesh.indices.data(), mesh.indices.size() * sizeof(std::uint32_t))
+                                                          : writeAll(fd, message.data(), message.size()));
     _exit(sent ? 0 : 1);
 }
 
@@ -316,8 +312,8 @@ splatfx::Result<Mesh> importIsolated(const std::string& path, const splatfx::Bud
         received = readAll(fds[0], message.data(), message.size(), deadline);
     } else if (received) {
         // The counts come from another process: checked before anything is allocated.
-        if (auto s = splatfx::checkBudget(path + ": the mesh", std::max(h.positions, h.indices / 3), "vertices or faces",
-                                          budgets.meshElements, "meshElements");
+        if (auto s = splatfx::checkBudget(path + ": the mesh", std::max(h.positions, h.indices / 3), "vertices or faces", budgets.meshElements,
+                                          "meshElements");
             !s) {
             ::kill(child, SIGKILL);
             message = s.error();
@@ -332,8 +328,7 @@ splatfx::Result<Mesh> importIsolated(const std::string& path, const splatfx::Bud
     if (!received) ::kill(child, SIGKILL);
     ::close(fds[0]);
     int status = 0;
-    while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
-    }
+    while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {}
     if (!message.empty()) return splatfx::makeError(message);
     if (received && h.ok) return mesh;
     if (timedOut)
@@ -352,7 +347,8 @@ splatfx::Result<Mesh> importIsolated(const std::string& path, const splatfx::Bud
 splatfx::Result<Mesh> loadMesh(const std::string& path, const splatfx::Budgets& budgets) {
     std::error_code ec;
     if (!std::filesystem::exists(path, ec)) return splatfx::makeError(path + ": mesh file not found");
-    if (!std::filesystem::is_regular_file(path, ec)) return splatfx::makeError(path + ": not a regular file (a folder, FIFO or device is never read as a mesh)");
+    if (!std::filesystem::is_regular_file(path, ec))
+        return splatfx::makeError(path + ": not a regular file (a folder, FIFO or device is never read as a mesh)");
     const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
     if (ec) return splatfx::makeError(path + ": cannot read its size: " + ec.message());
     if (auto s = splatfx::checkBudget(path + ": the mesh file", bytes, "bytes", budgets.meshFileBytes, "meshFileBytes"); !s)
@@ -378,7 +374,8 @@ splatfx::Result<Mesh> heightmapMesh(const std::string& path, float spacing, floa
     auto img = splatfx::readImage(path, splatfx::Alpha::Straight);
     if (!img) return splatfx::makeError(img.error());
     const int w = img->width, h = img->height;
-    if (w < 2 || h < 2) return splatfx::makeError(path + ": a heightmap needs at least 2x2 samples, got " + std::to_string(w) + "x" + std::to_string(h));
+    if (w < 2 || h < 2)
+        return splatfx::makeError(path + ": a heightmap needs at least 2x2 samples, got " + std::to_string(w) + "x" + std::to_string(h));
     Mesh m;
     m.positions.reserve(std::size_t(w) * std::size_t(h));
     for (int j = 0; j < h; ++j)

@@ -29,23 +29,23 @@
 namespace scenehost {
 
 struct PlayerOptions {
-    std::optional<std::uint32_t> seed;            // replaces the file's seed; default the file's
-    splatfx::gl::FrameRendererDesc renderer{};    // the frame renderer's settings; default the SDK's
-    splatfx::Budgets budgets{};                   // what the file and its meshes may ask for (budget.hpp); default the SDK's
+    std::optional<std::uint32_t> seed;         // replaces the file's seed; default the file's
+    splatfx::gl::FrameRendererDesc renderer{}; // the frame renderer's settings; default the SDK's
+    splatfx::Budgets budgets{};                // what the file and its meshes may ask for (budget.hpp); default the SDK's
 };
 
 struct FrameOptions {
-    bool traditional = false;   // every effect untextured (Fig. 1a); default false
-    float opacityScale = 1.0f;  // multiplies every splat's opacity; default 1
-    bool drawGeometry = true;   // default true
-    bool clear = true;          // clear colour (scene background) and depth first; default true
+    bool traditional = false;  // every effect untextured (Fig. 1a); default false
+    float opacityScale = 1.0f; // multiplies every splat's opacity; default 1
+    bool drawGeometry = true;  // default true
+    bool clear = true;         // clear colour (scene background) and depth first; default true
 };
 
 struct FrameStats {
-    splatfx::FrameCounters counters;             // declared / needed / simulated / drawn, voxels, splats
-    std::vector<std::uint64_t> splatsPerEffect;  // in SceneFile::effects order (0 when skipped)
-    double prepareMs = 0.0;                      // CPU: Scene::prepare (decide, simulate, build, sort)
-    double renderMs = 0.0;                       // CPU: FrameRenderer::render (GL submission, geometry included)
+    splatfx::FrameCounters counters;            // declared / needed / simulated / drawn, voxels, splats
+    std::vector<std::uint64_t> splatsPerEffect; // in SceneFile::effects order (0 when skipped)
+    double prepareMs = 0.0;                     // CPU: Scene::prepare (decide, simulate, build, sort)
+    double renderMs = 0.0;                      // CPU: FrameRenderer::render (GL submission, geometry included)
 };
 
 class ScenePlayer {

@@ -104,26 +104,36 @@ splatfx::Result<Options> parseOptions(int argc, const char* const* argv) {
             v = argv[++i];
             return true;
         };
-#define TEXPICK_NUM(field, type, lo, hi)                                                                                  \
-    {                                                                                                                     \
-        if (!need()) return makeError(a + " needs a value");                                                             \
-        auto r = number<type>(a, v, lo, hi);                                                                              \
-        if (!r) return makeError(r.error());                                                                              \
-        field = *r;                                                                                                       \
-        continue;                                                                                                         \
+#define TEXPICK_NUM(field, type, lo, hi)                                                                                                             \
+    {                                                                                                                                                \
+        if (!need()) return makeError(a + " needs a value");                                                                                         \
+        auto r = number<type>(a, v, lo, hi);                                                                                                         \
+        if (!r) return makeError(r.error());                                                                                                         \
+        field = *r;                                                                                                                                  \
+        continue;                                                                                                                                    \
     }
         if (a == "--help" || a == "-h") {
             std::fputs(kUsage, stdout);
             return makeError("");
         }
-        if (a == "--out") { if (!need()) return makeError("--out needs a folder"); o.out = v; continue; }
+        if (a == "--out") {
+            if (!need()) return makeError("--out needs a folder");
+            o.out = v;
+            continue;
+        }
         if (a == "--patch") TEXPICK_NUM(o.patch, int, 1, 16384)
-        if (a == "--count") { o.countGiven = true; TEXPICK_NUM(o.count, int, 1, kMaxTextures) }
+        if (a == "--count") {
+            o.countGiven = true;
+            TEXPICK_NUM(o.count, int, 1, kMaxTextures)
+        }
         if (a == "--seed") TEXPICK_NUM(o.seed, std::uint32_t, 0u, 4294967295u)
         if (a == "--min-std") TEXPICK_NUM(o.accept.minStd, float, 0.0f, 1.0f)
         if (a == "--min-mean") TEXPICK_NUM(o.accept.minMean, float, 0.0f, 1.0f)
         if (a == "--min-coverage") TEXPICK_NUM(o.accept.minCoverage, float, 0.0f, 1.0f)
-        if (a == "--absolute-thresholds") { o.accept.relative = false; continue; }
+        if (a == "--absolute-thresholds") {
+            o.accept.relative = false;
+            continue;
+        }
         if (a == "--alpha") {
             if (!need()) return makeError("--alpha needs auto, coverage or density");
             const std::string m = v;
@@ -160,10 +170,8 @@ splatfx::Result<Options> parseOptions(int argc, const char* const* argv) {
             if (!need()) return makeError("--band needs LO:HI");
             char colon = 0, extra = 0;
             std::istringstream in(v);
-            if (!(in >> o.bandLo >> colon >> o.bandHi) || colon != ':' || (in >> extra) || !(o.bandLo >= 0.0) ||
-                !(o.bandHi > o.bandLo))
-                return makeError("--band expects LO:HI cycles per pixel with 0 <= LO < HI (e.g. 0.125:0.75), got '" +
-                                 std::string(v) + "'");
+            if (!(in >> o.bandLo >> colon >> o.bandHi) || colon != ':' || (in >> extra) || !(o.bandLo >= 0.0) || !(o.bandHi > o.bandLo))
+                return makeError("--band expects LO:HI cycles per pixel with 0 <= LO < HI (e.g. 0.125:0.75), got '" + std::string(v) + "'");
             continue;
         }
         if (a == "--path") {
@@ -199,18 +207,59 @@ splatfx::Result<Options> parseOptions(int argc, const char* const* argv) {
             o.output.previewColors = c;
             continue;
         }
-        if (a == "--source-name") { if (!need()) return makeError("--source-name needs a value"); o.sourceName = v; continue; }
-        if (a == "--credit") { if (!need()) return makeError("--credit needs a value"); o.credit = v; continue; }
-        if (a == "--license") { if (!need()) return makeError("--license needs a value"); o.license = v; continue; }
-        if (a == "--events") { if (!need()) return makeError("--events needs a list"); o.events = v; continue; }
-        if (a == "--screenshot") { if (!need()) return makeError("--screenshot needs a file"); o.screenshot = v; continue; }
-        if (a == "--spread") { o.spread = true; continue; }
-        if (a == "--color") { o.process.color = true; continue; }
-        if (a == "--order") { o.process.order = true; continue; }
-        if (a == "--window") { o.process.window = true; continue; }
-        if (a == "--no-preview") { o.output.preview = false; continue; }
-        if (a == "--no-contact") { o.output.contactSheet = false; continue; }
-        if (a == "--quiet") { o.quiet = true; continue; }
+        if (a == "--source-name") {
+            if (!need()) return makeError("--source-name needs a value");
+            o.sourceName = v;
+            continue;
+        }
+        if (a == "--credit") {
+            if (!need()) return makeError("--credit needs a value");
+            o.credit = v;
+            continue;
+        }
+        if (a == "--license") {
+            if (!need()) return makeError("--license needs a value");
+            o.license = v;
+            continue;
+        }
+        if (a == "--events") {
+            if (!need()) return makeError("--events needs a list");
+            o.events = v;
+            continue;
+        }
+        if (a == "--screenshot") {
+            if (!need()) return makeError("--screenshot needs a file");
+            o.screenshot = v;
+            continue;
+        }
+        if (a == "--spread") {
+            o.spread = true;
+            continue;
+        }
+        if (a == "--color") {
+            o.process.color = true;
+            continue;
+        }
+        if (a == "--order") {
+            o.process.order = true;
+            continue;
+        }
+        if (a == "--window") {
+            o.process.window = true;
+            continue;
+        }
+        if (a == "--no-preview") {
+            o.output.preview = false;
+            continue;
+        }
+        if (a == "--no-contact") {
+            o.output.contactSheet = false;
+            continue;
+        }
+        if (a == "--quiet") {
+            o.quiet = true;
+            continue;
+        }
         if (a.size() > 1 && a[0] == '-') return makeError("unknown option '" + a + "' (try --help)");
         positional.push_back(a);
     }
@@ -238,15 +287,13 @@ splatfx::Result<Options> parseOptions(int argc, const char* const* argv) {
     const double texels = double(o.count) * o.process.textureSize * o.process.textureSize * (o.process.color ? 3 : 1);
     if (texels > kMaxSetTexels)
         return makeError("--count " + std::to_string(o.count) + " x --size " + std::to_string(o.process.textureSize) +
-                         (o.process.color ? " (colour)" : "") + " asks for " + std::to_string((long long)texels) +
-                         " texels, more than the " + std::to_string(kMaxSetTexels) +
-                         " a texture set may hold (about 256 MB as floats); lower --count or --size");
+                         (o.process.color ? " (colour)" : "") + " asks for " + std::to_string((long long)texels) + " texels, more than the " +
+                         std::to_string(kMaxSetTexels) + " a texture set may hold (about 256 MB as floats); lower --count or --size");
     o.output.footprint = o.process.footprint;
     return o;
 }
 
-splatfx::Status produce(const Options& o, const Source& src, const Selection& sel, const std::string& method,
-                        const std::string& parametersJson) {
+splatfx::Status produce(const Options& o, const Source& src, const Selection& sel, const std::string& method, const std::string& parametersJson) {
     auto made = makeSet(src, sel.patches, o.process);
     if (!made) return makeError(made.error());
     Provenance p;
@@ -262,8 +309,9 @@ splatfx::Status produce(const Options& o, const Source& src, const Selection& se
     p.order = made->order;
     std::vector<Patch> ordered;
     for (int k : made->order) ordered.push_back(sel.patches[size_t(k)]);
-    if (!o.quiet) std::printf("%s: writing %s/ (%d textures, %dx%d%s)\n", kToolName, o.out.c_str(), made->set.count(),
-                              made->set.size, made->set.size, o.output.preview ? ", rendering the preview" : "");
+    if (!o.quiet)
+        std::printf("%s: writing %s/ (%d textures, %dx%d%s)\n", kToolName, o.out.c_str(), made->set.count(), made->set.size, made->set.size,
+                    o.output.preview ? ", rendering the preview" : "");
     return writeOutput(o.out, made->set, provenanceJson(p), o.output, &src, &ordered);
 }
 
@@ -284,16 +332,20 @@ int runTurbulence(const Options& o) {
     d.seed = o.seed;
     splatfx::TextureSet set = splatfx::TextureSet::turbulence(d);
     if (o.process.window) set = set.windowed(splatfx::Footprint(o.process.footprint));
-    json params{{"count", d.count}, {"size", d.size}, {"seed", d.seed}, {"octaves", d.octaves},
-                {"baseFrequency", f6(d.baseFrequency)}, {"loopRadius", f6(d.loopRadius)}};
+    json params{{"count", d.count},
+                {"size", d.size},
+                {"seed", d.seed},
+                {"octaves", d.octaves},
+                {"baseFrequency", f6(d.baseFrequency)},
+                {"loopRadius", f6(d.loopRadius)}};
     Provenance p;
     p.sourceFile = "splatfx::TextureSet::turbulence (procedural, no photograph)";
     p.method = "turbulence";
     p.parametersJson = params.dump();
     if (!o.quiet) std::printf("%s: turbulence: %d textures, %dx%d, seed %u -> %s/\n", kToolName, d.count, d.size, d.size, d.seed, o.out.c_str());
     json prov = json::parse(provenanceJson(p));
-    prov["processing"] = {{"windowed", o.process.window}, {"ordered", false},
-                          {"note", "turbulence textures are already a closed loop (TurbulenceDesc::loopRadius)"}};
+    prov["processing"] = {
+        {"windowed", o.process.window}, {"ordered", false}, {"note", "turbulence textures are already a closed loop (TurbulenceDesc::loopRadius)"}};
     if (auto s = writeOutput(o.out, set, prov.dump(), o.output); !s) return fail(s.error());
     return 0;
 }
@@ -310,10 +362,9 @@ int runMerge(const Options& o) {
             merged.isWindowed = set->isWindowed;
         } else if (set->size != merged.size || set->color != merged.color || set->isWindowed != merged.isWindowed) {
             return fail("merge: '" + folder + "' is " + std::to_string(set->size) + "x" + std::to_string(set->size) +
-                        (set->color ? " colour" : " grayscale") + (set->isWindowed ? " windowed" : "") + " but '" + o.sets[0] +
-                        "' is " + std::to_string(merged.size) + "x" + std::to_string(merged.size) +
-                        (merged.color ? " colour" : " grayscale") + (merged.isWindowed ? " windowed" : "") +
-                        "; merge sets made alike (same --size, --color and --window)");
+                        (set->color ? " colour" : " grayscale") + (set->isWindowed ? " windowed" : "") + " but '" + o.sets[0] + "' is " +
+                        std::to_string(merged.size) + "x" + std::to_string(merged.size) + (merged.color ? " colour" : " grayscale") +
+                        (merged.isWindowed ? " windowed" : "") + "; merge sets made alike (same --size, --color and --window)");
         }
         for (auto& l : set->layers) merged.layers.push_back(std::move(l));
         json part{{"folder", baseName(folder)}, {"textures", set->count()}};
@@ -340,8 +391,8 @@ int run(const Options& o) {
     auto src = loadSource(o.input, o.source);
     if (!src) return fail(src.error());
     if (!o.quiet) {
-        std::printf("%s: %s: %s, %dx%d, luminance %.3g..%.3g", kToolName, o.mode.c_str(), o.input.c_str(), src->width, src->height,
-                    src->luminanceMin, src->luminanceMax);
+        std::printf("%s: %s: %s, %dx%d, luminance %.3g..%.3g", kToolName, o.mode.c_str(), o.input.c_str(), src->width, src->height, src->luminanceMin,
+                    src->luminanceMax);
         if (src->fileChannels == 4)
             std::printf(", alpha as %s (%s; %.0f%% of covered pixels semi-transparent)", alphaUseName(src->alpha),
                         o.source.alpha == AlphaUse::Auto ? "detected" : "--alpha", 100.0 * src->softAlphaFraction);
@@ -363,17 +414,32 @@ int run(const Options& o) {
     } else if (o.mode == "random") {
         const float minDistance = o.minDistance >= 0.0f ? o.minDistance : 0.0f;
         sel = pickRandom(*src, {.count = o.count, .patch = o.patch, .seed = o.seed, .accept = o.accept, .minDistance = minDistance});
-        params = {{"count", o.count}, {"patch", o.patch}, {"seed", o.seed}, {"minStd", f6(o.accept.minStd)},
-                  {"minMean", f6(o.accept.minMean)}, {"minCoverage", f6(o.accept.minCoverage)}, {"minDistance", f6(minDistance)},
+        params = {{"count", o.count},
+                  {"patch", o.patch},
+                  {"seed", o.seed},
+                  {"minStd", f6(o.accept.minStd)},
+                  {"minMean", f6(o.accept.minMean)},
+                  {"minCoverage", f6(o.accept.minCoverage)},
+                  {"minDistance", f6(minDistance)},
                   {"rng", "std::mt19937, raw words modulo the span"}};
         sourceParams(params);
     } else if (o.mode == "spectral") {
-        SpectralDesc d{.count = o.count, .patch = o.patch, .stride = o.stride, .bandLo = o.bandLo, .bandHi = o.bandHi,
-                       .spread = o.spread, .minDistance = o.minDistance, .accept = o.accept};
+        SpectralDesc d{.count = o.count,
+                       .patch = o.patch,
+                       .stride = o.stride,
+                       .bandLo = o.bandLo,
+                       .bandHi = o.bandHi,
+                       .spread = o.spread,
+                       .minDistance = o.minDistance,
+                       .accept = o.accept};
         sel = pickSpectral(*src, d);
-        params = {{"count", o.count}, {"patch", o.patch}, {"stride", o.stride > 0 ? o.stride : std::max(1, o.patch / 4)},
+        params = {{"count", o.count},
+                  {"patch", o.patch},
+                  {"stride", o.stride > 0 ? o.stride : std::max(1, o.patch / 4)},
                   {"minDistance", o.minDistance >= 0.0f ? f6(o.minDistance) : 0.5 * o.patch},
-                  {"minStd", f6(o.accept.minStd)}, {"minMean", f6(o.accept.minMean)}, {"minCoverage", f6(o.accept.minCoverage)}};
+                  {"minStd", f6(o.accept.minStd)},
+                  {"minMean", f6(o.accept.minMean)},
+                  {"minCoverage", f6(o.accept.minCoverage)}};
         sourceParams(params);
         if (o.spread) params["spread"] = true;
         else params["bandCyclesPerPixel"] = {o.bandLo, o.bandHi};
@@ -386,11 +452,11 @@ int run(const Options& o) {
     }
     if (!sel) return fail(sel.error());
     if (!o.quiet)
-        std::printf("%s: %s: picked %zu patches of %d px (%d candidates considered, %d rejected)\n", kToolName, o.mode.c_str(),
-                    sel->patches.size(), sel->patches.empty() ? 0 : sel->patches[0].size, sel->candidates, sel->rejected);
+        std::printf("%s: %s: picked %zu patches of %d px (%d candidates considered, %d rejected)\n", kToolName, o.mode.c_str(), sel->patches.size(),
+                    sel->patches.empty() ? 0 : sel->patches[0].size, sel->candidates, sel->rejected);
     if (auto s = produce(o, *src, *sel, o.mode, params.dump()); !s) return fail(s.error());
-    if (!o.quiet) std::printf("%s: done: %s/ (manifest.json, t000.png..., contact.png%s)\n", kToolName, o.out.c_str(),
-                              o.output.preview ? ", preview.gif" : "");
+    if (!o.quiet)
+        std::printf("%s: done: %s/ (manifest.json, t000.png..., contact.png%s)\n", kToolName, o.out.c_str(), o.output.preview ? ", preview.gif" : "");
     return 0;
 }
 

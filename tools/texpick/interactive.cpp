@@ -24,7 +24,8 @@ using json = nlohmann::json;
 namespace {
 
 const char* kWindow = "splatfx-texpick";
-const char* kHelp = "click: add  right-click: undo  p: positions/path  r: random  f: spectral spread  o: order  +/-: patch  c: clear  s: save  q: quit";
+const char* kHelp =
+    "click: add  right-click: undo  p: positions/path  r: random  f: spectral spread  o: order  +/-: patch  c: clear  s: save  q: quit";
 
 struct Event {
     std::string kind; // click | rclick | key
@@ -130,8 +131,9 @@ struct App {
     }
 
     void save() {
-        auto sel = pathMode ? pickPath(source, {.points = path, .patch = patch, .step = options.step, .count = options.countGiven ? options.count : 0})
-                            : pickPositions(source, {.centers = centers, .defaultSize = patch});
+        auto sel = pathMode
+                       ? pickPath(source, {.points = path, .patch = patch, .step = options.step, .count = options.countGiven ? options.count : 0})
+                       : pickPositions(source, {.centers = centers, .defaultSize = patch});
         if (!sel) {
             status = "not saved: " + sel.error();
             return;
@@ -163,17 +165,40 @@ struct App {
 
     void key(int k) {
         switch (k) {
-        case 'q': case 27: quit = true; break;
-        case 'p': pathMode = !pathMode; status = pathMode ? "path mode: click the path's points" : "positions mode: click patch centres"; dirty = true; break;
-        case 'o': options.process.order = !options.process.order; dirty = true; break;
-        case 'c': centers.clear(); path.clear(); dirty = true; break;
+        case 'q':
+        case 27: quit = true; break;
+        case 'p':
+            pathMode = !pathMode;
+            status = pathMode ? "path mode: click the path's points" : "positions mode: click patch centres";
+            dirty = true;
+            break;
+        case 'o':
+            options.process.order = !options.process.order;
+            dirty = true;
+            break;
+        case 'c':
+            centers.clear();
+            path.clear();
+            dirty = true;
+            break;
         case 'u': click({}, true); break;
-        case '+': case '=': patch = std::min({patch + 8, source.width, source.height}); resizeCenters(); break;
-        case '-': patch = std::max(kMinPatch, patch - 8); resizeCenters(); break;
-        case 'r': case 'f': {
+        case '+':
+        case '=':
+            patch = std::min({patch + 8, source.width, source.height});
+            resizeCenters();
+            break;
+        case '-':
+            patch = std::max(kMinPatch, patch - 8);
+            resizeCenters();
+            break;
+        case 'r':
+        case 'f': {
             auto sel = k == 'r' ? pickRandom(source, {.count = options.count, .patch = patch, .seed = seed++, .accept = options.accept})
                                 : pickSpectral(source, {.count = options.count, .patch = patch, .spread = true, .accept = options.accept});
-            if (!sel) { status = sel.error(); break; }
+            if (!sel) {
+                status = sel.error();
+                break;
+            }
             pathMode = false;
             centers.clear();
             for (const Patch& p : sel->patches) centers.emplace_back(p.x + p.size / 2, p.y + p.size / 2, p.size);
@@ -247,8 +272,8 @@ struct App {
             large.copyTo(canvas(cv::Rect(x0, by, big, big)));
         }
         std::ostringstream info;
-        info << (pathMode ? "path" : "positions") << "  patch " << patch << " px  ->  " << options.process.textureSize
-             << " texels  " << n << " textures" << (options.process.order ? "  ordered" : "");
+        info << (pathMode ? "path" : "positions") << "  patch " << patch << " px  ->  " << options.process.textureSize << " texels  " << n
+             << " textures" << (options.process.order ? "  ordered" : "");
         cv::putText(canvas, info.str(), cv::Point(x0, by + big + 20), cv::FONT_HERSHEY_PLAIN, 1.0, white);
         cv::putText(canvas, status.substr(0, 150), cv::Point(6, H - 8), cv::FONT_HERSHEY_PLAIN, 0.9, white);
         return canvas;
@@ -271,8 +296,10 @@ int runInteractive(const Options& o) {
     const char* display = std::getenv("DISPLAY");
     const char* wayland = std::getenv("WAYLAND_DISPLAY");
     if ((!display || !*display) && (!wayland || !*wayland)) {
-        std::fprintf(stderr, "%s: interactive mode needs a display and DISPLAY is not set; use the command-line modes, "
-                             "or try it headless with: xvfb-run -a splatfx-texpick interactive ...\n", kToolName);
+        std::fprintf(stderr,
+                     "%s: interactive mode needs a display and DISPLAY is not set; use the command-line modes, "
+                     "or try it headless with: xvfb-run -a splatfx-texpick interactive ...\n",
+                     kToolName);
         return 1;
     }
     Options opts = o;
@@ -280,13 +307,16 @@ int runInteractive(const Options& o) {
     App app(opts, *src);
     try {
         cv::namedWindow(kWindow, cv::WINDOW_AUTOSIZE);
-        cv::setMouseCallback(kWindow, [](int ev, int x, int y, int, void* user) {
-            App& a = *static_cast<App*>(user);
-            const cv::Point2d at(x / a.scale, y / a.scale);
-            if (at.x >= a.source.width || at.y >= a.source.height) return; // the side panel
-            if (ev == cv::EVENT_LBUTTONDOWN) a.click(at, false);
-            if (ev == cv::EVENT_RBUTTONDOWN) a.click(at, true);
-        }, &app);
+        cv::setMouseCallback(
+            kWindow,
+            [](int ev, int x, int y, int, void* user) {
+                App& a = *static_cast<App*>(user);
+                const cv::Point2d at(x / a.scale, y / a.scale);
+                if (at.x >= a.source.width || at.y >= a.source.height) return; // the side panel
+                if (ev == cv::EVENT_LBUTTONDOWN) a.click(at, false);
+                if (ev == cv::EVENT_RBUTTONDOWN) a.click(at, true);
+            },
+            &app);
         std::printf("%s: interactive: %s (%dx%d); %s\n", kToolName, o.input.c_str(), src->width, src->height, kHelp);
         size_t next = 0;
         cv::Mat shown;

@@ -157,8 +157,7 @@ splatfx::Image contactSheet(const splatfx::TextureSet& set, const splatfx::Footp
                 sheet.at<cv::Vec3f>(y0 + y, x0 + x) = texel(set, k, tx, ty);
                 sheet.at<cv::Vec3f>(y0 + cell + gap + y, x0 + x) = texel(windowed, k, tx, ty);
             }
-        cv::putText(sheet, std::to_string(k), cv::Point(x0 + 2, y0 + 2 * cell + gap + label - 3), cv::FONT_HERSHEY_PLAIN, 0.9,
-                    text, 1);
+        cv::putText(sheet, std::to_string(k), cv::Point(x0 + 2, y0 + 2 * cell + gap + label - 3), cv::FONT_HERSHEY_PLAIN, 0.9, text, 1);
     }
     splatfx::Image img;
     img.width = W;
@@ -275,10 +274,11 @@ splatfx::Status renderPreview(const splatfx::TextureSet& set, const OutputDesc& 
 
 splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::TextureSet& set, const OutputDesc& d) {
     std::vector<splatfx::Image> frames;
-    if (auto s = renderPreview(set, d, [&](const splatfx::Image& f) {
-            frames.push_back(f);
-            return splatfx::Status{};
-        });
+    if (auto s = renderPreview(set, d,
+                               [&](const splatfx::Image& f) {
+                                   frames.push_back(f);
+                                   return splatfx::Status{};
+                               });
         !s)
         return makeError(s.error());
     return frames;
@@ -318,8 +318,9 @@ splatfx::Status recoverKilledRuns(const fs::path& parent, const fs::path& target
         std::error_code e2;
         if (old && !fs::exists(target, e2)) {
             fs::rename(entry.path(), target, e2);
-            if (e2) return makeError("a killed run left the previous '" + target.string() + "' at '" + entry.path().string() +
-                                     "' and it cannot be put back: " + e2.message());
+            if (e2)
+                return makeError("a killed run left the previous '" + target.string() + "' at '" + entry.path().string() +
+                                 "' and it cannot be put back: " + e2.message());
         } else {
             fs::remove_all(entry.path(), e2);
         }
@@ -329,8 +330,8 @@ splatfx::Status recoverKilledRuns(const fs::path& parent, const fs::path& target
 
 } // namespace
 
-splatfx::Status writeOutput(const std::string& folder, const splatfx::TextureSet& set, const std::string& provenance,
-                            const OutputDesc& d, const Source* source, const std::vector<Patch>* patches) {
+splatfx::Status writeOutput(const std::string& folder, const splatfx::TextureSet& set, const std::string& provenance, const OutputDesc& d,
+                            const Source* source, const std::vector<Patch>* patches) {
     std::error_code ec;
     if (folder.empty()) return makeError("--out is required: the folder to write the texture set to");
     const fs::path target = fs::path(folder).lexically_normal();

@@ -13,8 +13,7 @@ using splatfx::makeError;
 
 splatfx::Result<MadeSet> makeSet(const Source& s, const std::vector<Patch>& patches, const ProcessDesc& d) {
     if (patches.empty()) return makeError("no patches to make a texture set from");
-    if (d.textureSize < 4 || d.textureSize > 1024)
-        return makeError("--size must be between 4 and 1024 texels, got " + std::to_string(d.textureSize));
+    if (d.textureSize < 4 || d.textureSize > 1024) return makeError("--size must be between 4 and 1024 texels, got " + std::to_string(d.textureSize));
     // TextureSet::save writes a windowed colour set as RGBA PNG; reading that
     // back premultiplies colour by alpha (OpenImageIO's default for PNG) and
     // TextureSet::load multiplies again, so such a set would not load as made.
@@ -29,13 +28,11 @@ splatfx::Result<MadeSet> makeSet(const Source& s, const std::vector<Patch>& patc
     for (size_t i = 0; i < patches.size(); ++i) {
         const Patch& p = patches[i];
         if (p.x < 0 || p.y < 0 || p.size < 1 || p.x + p.size > s.width || p.y + p.size > s.height)
-            return makeError("patch " + std::to_string(i + 1) + " (" + std::to_string(p.size) + " px at " + std::to_string(p.x) +
-                             ", " + std::to_string(p.y) + ") leaves the " + std::to_string(s.width) + "x" +
-                             std::to_string(s.height) + " image");
+            return makeError("patch " + std::to_string(i + 1) + " (" + std::to_string(p.size) + " px at " + std::to_string(p.x) + ", " +
+                             std::to_string(p.y) + ") leaves the " + std::to_string(s.width) + "x" + std::to_string(s.height) + " image");
         cv::Mat cut = s.rgb(cv::Rect(p.x, p.y, p.size, p.size)).clone();
         if (p.size != d.textureSize)
-            cv::resize(cut, cut, cv::Size(d.textureSize, d.textureSize), 0, 0,
-                       p.size > d.textureSize ? cv::INTER_AREA : cv::INTER_LINEAR);
+            cv::resize(cut, cut, cv::Size(d.textureSize, d.textureSize), 0, 0, p.size > d.textureSize ? cv::INTER_AREA : cv::INTER_LINEAR);
         rgb.push_back(cut);
     }
     auto lum = [](const cv::Vec3f& v) { return 0.2126f * v[0] + 0.7152f * v[1] + 0.0722f * v[2]; };
@@ -74,8 +71,7 @@ splatfx::Result<MadeSet> makeSet(const Source& s, const std::vector<Patch>& patc
         for (int y = 0; y < d.textureSize; ++y)
             for (int x = 0; x < d.textureSize; ++x) {
                 const cv::Vec3f v = rgb[i].at<cv::Vec3f>(y, x);
-                for (int c = 0; c < 3; ++c)
-                    im.at(x, y, c) = float(std::clamp(affine[i].first + affine[i].second * v[c], 0.0, 1.0));
+                for (int c = 0; c < 3; ++c) im.at(x, y, c) = float(std::clamp(affine[i].first + affine[i].second * v[c], 0.0, 1.0));
             }
         images.push_back(std::move(im));
     }

@@ -32,24 +32,19 @@ std::string str(double v) {
     return o.str();
 }
 
-std::string describe(const Patch& p) {
-    return std::to_string(p.size) + "-px patch at (" + std::to_string(p.x) + ", " + std::to_string(p.y) + ")";
-}
+std::string describe(const Patch& p) { return std::to_string(p.size) + "-px patch at (" + std::to_string(p.x) + ", " + std::to_string(p.y) + ")"; }
 
-bool inside(const Source& s, const Patch& p) {
-    return p.size >= 1 && p.x >= 0 && p.y >= 0 && p.x + p.size <= s.width && p.y + p.size <= s.height;
-}
+bool inside(const Source& s, const Patch& p) { return p.size >= 1 && p.x >= 0 && p.y >= 0 && p.x + p.size <= s.width && p.y + p.size <= s.height; }
 
 splatfx::Status checkPatchFits(const Source& s, int patch, const std::string& option) {
-    if (patch < kMinPatch)
-        return makeError(option + " must be at least " + std::to_string(kMinPatch) + " pixels, got " + std::to_string(patch));
+    if (patch < kMinPatch) return makeError(option + " must be at least " + std::to_string(kMinPatch) + " pixels, got " + std::to_string(patch));
     if (std::min(s.width, s.height) < kMinPatch)
         return makeError("image '" + s.path + "' is " + std::to_string(s.width) + "x" + std::to_string(s.height) +
                          " pixels, smaller than the smallest patch (" + std::to_string(kMinPatch) + " px); use a larger image");
     if (patch > s.width || patch > s.height)
-        return makeError("image '" + s.path + "' is " + std::to_string(s.width) + "x" + std::to_string(s.height) +
-                         " pixels, too small for one " + std::to_string(patch) + "-px patch; use " + option + " " +
-                         std::to_string(std::max(kMinPatch, std::min(s.width, s.height))) + " or less");
+        return makeError("image '" + s.path + "' is " + std::to_string(s.width) + "x" + std::to_string(s.height) + " pixels, too small for one " +
+                         std::to_string(patch) + "-px patch; use " + option + " " + std::to_string(std::max(kMinPatch, std::min(s.width, s.height))) +
+                         " or less");
     return {};
 }
 
@@ -296,8 +291,7 @@ std::string rejectionText(const Source& s, const Selection& sel, const Acceptanc
     std::string text = "of " + std::to_string(sel.candidates) + " candidates, " + std::to_string(sel.rejectedCoverage) +
                        " were rejected by --min-coverage " + str(a.minCoverage) + " (mean alpha; alpha read as " + alphaUseName(s.alpha) +
                        (s.alpha == AlphaUse::Density ? ", so never" : "") + "), " + std::to_string(sel.rejectedEmpty) + " by --min-mean " +
-                       str(a.minMean) + unit(t.minMean) + ", " + std::to_string(sel.rejectedFlat) + " by --min-std " + str(a.minStd) +
-                       unit(t.minStd);
+                       str(a.minMean) + unit(t.minMean) + ", " + std::to_string(sel.rejectedFlat) + " by --min-std " + str(a.minStd) + unit(t.minStd);
     if (minDistance > 0) text += ", " + std::to_string(sel.rejectedDistance) + " by --min-distance " + str(minDistance);
     // Advice for the threshold that did the most.
     const int most = std::max({sel.rejectedCoverage, sel.rejectedEmpty, sel.rejectedFlat, sel.rejectedDistance});
@@ -331,9 +325,7 @@ Thresholds effectiveThresholds(const Source& s, const Acceptance& a) {
     return t;
 }
 
-namespace {
-
-} // namespace
+namespace {} // namespace
 
 splatfx::Result<Selection> pickPositions(const Source& s, const PositionsDesc& d) {
     if (d.centers.empty()) return makeError("positions: give at least one position (--at X,Y[,SIZE])");
@@ -342,14 +334,13 @@ splatfx::Result<Selection> pickPositions(const Source& s, const PositionsDesc& d
         const cv::Point3i c = d.centers[i];
         const int size = c.z > 0 ? c.z : d.defaultSize;
         if (size < kMinPatch)
-            return makeError("position " + std::to_string(i + 1) + ": patch size must be at least " + std::to_string(kMinPatch) +
-                             " pixels, got " + std::to_string(size));
+            return makeError("position " + std::to_string(i + 1) + ": patch size must be at least " + std::to_string(kMinPatch) + " pixels, got " +
+                             std::to_string(size));
         // The centre of an even patch is a texel corner: top-left = centre - size / 2.
         const Patch p{c.x - size / 2, c.y - size / 2, size};
         if (!inside(s, p))
-            return makeError("position " + std::to_string(i + 1) + " (" + std::to_string(c.x) + ", " + std::to_string(c.y) +
-                             "): its " + describe(p) + " leaves the " + std::to_string(s.width) + "x" +
-                             std::to_string(s.height) + " image '" + s.path + "'");
+            return makeError("position " + std::to_string(i + 1) + " (" + std::to_string(c.x) + ", " + std::to_string(c.y) + "): its " + describe(p) +
+                             " leaves the " + std::to_string(s.width) + "x" + std::to_string(s.height) + " image '" + s.path + "'");
         sel.patches.push_back(p);
         sel.stats.push_back(analyze(s, p));
         ++sel.candidates;
@@ -385,9 +376,9 @@ splatfx::Result<Selection> pickRandom(const Source& s, const RandomDesc& d) {
         sel.stats.push_back(st);
     }
     if (int(sel.patches.size()) < d.count)
-        return makeError("random: only " + std::to_string(sel.patches.size()) + " of " + std::to_string(d.count) + " " +
-                         std::to_string(d.patch) + "-px patches of '" + s.path + "' passed after " +
-                         std::to_string(sel.candidates) + " tries: " + rejectionText(s, sel, d.accept, d.minDistance));
+        return makeError("random: only " + std::to_string(sel.patches.size()) + " of " + std::to_string(d.count) + " " + std::to_string(d.patch) +
+                         "-px patches of '" + s.path + "' passed after " + std::to_string(sel.candidates) +
+                         " tries: " + rejectionText(s, sel, d.accept, d.minDistance));
     return sel;
 }
 
@@ -395,8 +386,7 @@ splatfx::Result<Selection> pickSpectral(const Source& s, const SpectralDesc& d) 
     if (d.count < 1) return makeError("spectral: --count must be at least 1, got " + std::to_string(d.count));
     if (auto st = checkPatchFits(s, d.patch, "--patch"); !st) return makeError(st.error());
     if (!d.spread && !(d.bandLo >= 0.0 && d.bandHi > d.bandLo))
-        return makeError("spectral: --band must be LO:HI cycles per pixel with 0 <= LO < HI, got " + str(d.bandLo) + ":" +
-                         str(d.bandHi));
+        return makeError("spectral: --band must be LO:HI cycles per pixel with 0 <= LO < HI, got " + str(d.bandLo) + ":" + str(d.bandHi));
     const int stride = d.stride > 0 ? d.stride : std::max(1, d.patch / 4);
     const double minDistance = d.minDistance >= 0.0f ? d.minDistance : 0.5 * d.patch;
     struct Candidate {
@@ -467,9 +457,8 @@ splatfx::Result<Selection> pickSpectral(const Source& s, const SpectralDesc& d) 
         if (int(sel.patches.size()) < d.count) sel.rejected += blocked, sel.rejectedDistance += blocked;
     }
     if (int(sel.patches.size()) < d.count)
-        return makeError("spectral: only " + std::to_string(sel.patches.size()) + " of " + std::to_string(d.count) + " " +
-                         std::to_string(d.patch) + "-px patches of '" + s.path + "' are usable: " +
-                         rejectionText(s, sel, d.accept, minDistance));
+        return makeError("spectral: only " + std::to_string(sel.patches.size()) + " of " + std::to_string(d.count) + " " + std::to_string(d.patch) +
+                         "-px patches of '" + s.path + "' are usable: " + rejectionText(s, sel, d.accept, minDistance));
     return sel;
 }
 
@@ -484,10 +473,9 @@ splatfx::Result<Selection> pickPath(const Source& s, const PathDesc& d) {
     for (size_t i = 0; i < d.points.size(); ++i) {
         const cv::Point2d q = d.points[i];
         if (!(q.x >= lo && q.x <= hiX && q.y >= lo && q.y <= hiY))
-            return makeError("path: point " + std::to_string(i + 1) + " (" + str(q.x) + ", " + str(q.y) + ") leaves the " +
-                             std::to_string(s.width) + "x" + std::to_string(s.height) + " image '" + s.path + "': a " +
-                             std::to_string(d.patch) + "-px patch needs its centre within [" + str(lo) + ", " + str(hiX) +
-                             "] x [" + str(lo) + ", " + str(hiY) + "]");
+            return makeError("path: point " + std::to_string(i + 1) + " (" + str(q.x) + ", " + str(q.y) + ") leaves the " + std::to_string(s.width) +
+                             "x" + std::to_string(s.height) + " image '" + s.path + "': a " + std::to_string(d.patch) +
+                             "-px patch needs its centre within [" + str(lo) + ", " + str(hiX) + "] x [" + str(lo) + ", " + str(hiY) + "]");
     }
     std::vector<double> along{0.0};
     for (size_t i = 1; i < d.points.size(); ++i) along.push_back(along.back() + cv::norm(d.points[i] - d.points[i - 1]));
@@ -495,14 +483,12 @@ splatfx::Result<Selection> pickPath(const Source& s, const PathDesc& d) {
     const double fitReal = std::floor(length / d.step + 1e-9) + 1.0;
     if (d.count <= 0 && fitReal > kMaxTextures)
         return makeError("path: --step " + str(d.step) + " along a path " + str(length) + " px long gives " + str(fitReal) +
-                         " patches, more than the " + std::to_string(kMaxTextures) +
-                         " a texture set may hold; raise --step or give --count");
+                         " patches, more than the " + std::to_string(kMaxTextures) + " a texture set may hold; raise --step or give --count");
     const int fit = int(std::min(fitReal, double(std::numeric_limits<int>::max())));
     const int count = d.count > 0 ? d.count : fit;
     if (count > fit)
-        return makeError("path: " + std::to_string(count) + " patches " + str(d.step) + " px apart need a path " +
-                         str((count - 1) * d.step) + " px long, but the path is " + str(length) +
-                         " px; lower --count or --step, or lengthen --path");
+        return makeError("path: " + std::to_string(count) + " patches " + str(d.step) + " px apart need a path " + str((count - 1) * d.step) +
+                         " px long, but the path is " + str(length) + " px; lower --count or --step, or lengthen --path");
     Selection sel;
     size_t seg = 1;
     for (int k = 0; k < count; ++k) {

@@ -38,7 +38,7 @@ inline constexpr const char* kToolName = "splatfx-texpick";
 inline constexpr const char* kToolVersion = "1.0.0";
 // Version of the "provenance" object texpick writes into manifest.json.
 inline constexpr int kProvenanceVersion = 1;
-inline constexpr int kMinPatch = 4; // smallest patch side, source pixels
+inline constexpr int kMinPatch = 4;       // smallest patch side, source pixels
 inline constexpr int kMaxTextures = 4096; // most textures in one set (--count, and patches a path may give)
 // Most texels (per channel) in one set: 64 Mi, 256 MB as floats, kept a few
 // times over while the set, its windowed copy and the contact sheet are built.
@@ -74,16 +74,15 @@ struct SourceDesc {
 // when the alpha is a cut-out; 1 where the file has none or the alpha is
 // density, which the luminance then already carries).
 struct Source {
-    
-    std::string path{};   // as given
+    std::string path{}; // as given
     int width = 0, height = 0;
     int fileChannels = 0;
-    
-    cv::Mat rgb{};        // CV_32FC3, [0, 1], premultiplied by alpha (straight alpha read from the file, multiplied once)
-    
-    cv::Mat luminance{};  // CV_32FC1, Rec. 709 weights
-    
-    cv::Mat coverage{};   // CV_32FC1, [0, 1]
+
+    cv::Mat rgb{}; // CV_32FC3, [0, 1], premultiplied by alpha (straight alpha read from the file, multiplied once)
+
+    cv::Mat luminance{}; // CV_32FC1, Rec. 709 weights
+
+    cv::Mat coverage{}; // CV_32FC1, [0, 1]
     // The alpha's meaning as used (never Auto here) and the evidence for Auto.
     AlphaUse alpha = AlphaUse::Coverage;
     double softAlphaFraction = 0.0; // of the covered pixels, the semi-transparent ones (0 without alpha)
@@ -123,13 +122,12 @@ inline const std::vector<double>& bandEdges() {
 // removed and it is multiplied by a separable Hann window first, so the edges
 // of the square do not leak power into every band.
 struct SpectralStats {
-    
     std::vector<double> bandEnergy{}; // fraction of (non-DC) power per band of bandEdges(); sums to 1 (all 0 when flat)
-    double power = 0.0;             // total non-DC power per pixel (windowed luminance variance)
-    double centroid = 0.0;          // power-weighted mean radial frequency, cycles per pixel
-    double mean = 0.0;              // luminance mean over the patch
-    double stddev = 0.0;            // luminance standard deviation over the patch
-    double coverage = 1.0;          // mean alpha over the patch
+    double power = 0.0;               // total non-DC power per pixel (windowed luminance variance)
+    double centroid = 0.0;            // power-weighted mean radial frequency, cycles per pixel
+    double mean = 0.0;                // luminance mean over the patch
+    double stddev = 0.0;              // luminance standard deviation over the patch
+    double coverage = 1.0;            // mean alpha over the patch
 };
 
 // Expects the patch inside the source.
@@ -146,10 +144,10 @@ double bandFraction(const Source& source, const Patch& patch, double lo, double 
 // texel is 68/255 is judged by its own contrast; a source spanning 0..1
 // gets the absolute thresholds texpick always had.
 struct Acceptance {
-    float minStd = 0.03f;      // luminance std below this x the source's range is flat; default 0.03
-    float minMean = 0.03f;     // luminance mean below this x the source's brightest is near-empty (black or cut-out); default 0.03
-    float minCoverage = 0.9f;  // mean alpha below this is mostly outside a cut-out (coverage alpha only); default 0.9
-    bool relative = true;      // scale minStd, minMean by the source's range; default true
+    float minStd = 0.03f;     // luminance std below this x the source's range is flat; default 0.03
+    float minMean = 0.03f;    // luminance mean below this x the source's brightest is near-empty (black or cut-out); default 0.03
+    float minCoverage = 0.9f; // mean alpha below this is mostly outside a cut-out (coverage alpha only); default 0.9
+    bool relative = true;     // scale minStd, minMean by the source's range; default true
 };
 
 // The thresholds in the source's luminance units, as applied.
@@ -159,32 +157,30 @@ struct Thresholds {
 Thresholds effectiveThresholds(const Source& source, const Acceptance& accept);
 
 struct Selection {
-    
     std::vector<Patch> patches{};
-    
+
     std::vector<SpectralStats> stats{}; // one per patch
-    int candidates = 0;               // patches considered
-    int rejected = 0;                 // flat, near-empty, outside a cut-out or too close to a pick
+    int candidates = 0;                 // patches considered
+    int rejected = 0;                   // flat, near-empty, outside a cut-out or too close to a pick
     // ... by reason (each rejected candidate counted once, for the first test it fails in this order).
-    int rejectedCoverage = 0;         // mean alpha below --min-coverage
-    int rejectedEmpty = 0;            // mean luminance below --min-mean
-    int rejectedFlat = 0;             // luminance std below --min-std
-    int rejectedDistance = 0;         // closer than --min-distance to a pick
+    int rejectedCoverage = 0; // mean alpha below --min-coverage
+    int rejectedEmpty = 0;    // mean luminance below --min-mean
+    int rejectedFlat = 0;     // luminance std below --min-std
+    int rejectedDistance = 0; // closer than --min-distance to a pick
 };
 
 // Each position is a patch centre; size 0 takes `defaultSize`. Errors name
 // the position that leaves the image.
 struct PositionsDesc {
-    
     std::vector<cv::Point3i> centers{}; // (x, y, size) in source pixels
-    int defaultSize = 64;             // default 64
+    int defaultSize = 64;               // default 64
 };
 splatfx::Result<Selection> pickPositions(const Source& source, const PositionsDesc& desc);
 
 struct RandomDesc {
-    int count = 8;           // default 8
-    int patch = 64;          // source pixels; default 64
-    std::uint32_t seed = 1;  // default 1
+    int count = 8;          // default 8
+    int patch = 64;         // source pixels; default 64
+    std::uint32_t seed = 1; // default 1
     Acceptance accept{};
     float minDistance = 0.0f; // smallest distance between picked centres, pixels; default 0 (overlap allowed)
     int maxTries = 0;         // default 0 = 2000 per texture
@@ -193,14 +189,14 @@ struct RandomDesc {
 splatfx::Result<Selection> pickRandom(const Source& source, const RandomDesc& desc);
 
 struct SpectralDesc {
-    int count = 8;            // default 8
-    int patch = 64;           // default 64
-    int stride = 0;           // candidate grid step, pixels; default 0 = patch / 4
+    int count = 8;  // default 8
+    int patch = 64; // default 64
+    int stride = 0; // candidate grid step, pixels; default 0 = patch / 4
     // Band mode: keep the patches with the largest share of power in [bandLo, bandHi) cycles per pixel.
     double bandLo = 0.125, bandHi = 0.75; // default: the upper two octaves
     // Spread mode (true): greedily maximize the spectral variation across the
     // set instead (farthest-point selection on band energies).
-    bool spread = false;      // default false
+    bool spread = false;       // default false
     float minDistance = -1.0f; // smallest distance between picked centres; default -1 = patch / 2
     Acceptance accept{};
 };
@@ -210,11 +206,10 @@ splatfx::Result<Selection> pickSpectral(const Source& source, const SpectralDesc
 // pixels apart (so consecutive patches overlap by patch - step pixels along
 // the path), rounded to whole pixels so each is an exact cut of the photo.
 struct PathDesc {
-    
     std::vector<cv::Point2d> points{}; // at least 2 vertices, source pixels
-    int patch = 64;                  // default 64
-    double step = 4.0;               // pixels along the path between consecutive patches; default 4
-    int count = 0;                   // default 0 = as many as fit on the path
+    int patch = 64;                    // default 64
+    double step = 4.0;                 // pixels along the path between consecutive patches; default 4
+    int count = 0;                     // default 0 = as many as fit on the path
 };
 splatfx::Result<Selection> pickPath(const Source& source, const PathDesc& desc);
 
@@ -227,21 +222,20 @@ enum class Contrast {
 };
 
 struct ProcessDesc {
-    int textureSize = 32;        // texels on a side; default 32
-    bool color = false;          // keep RGB (default false: grayscale, sec. 2 step 1)
+    int textureSize = 32;                // texels on a side; default 32
+    bool color = false;                  // keep RGB (default false: grayscale, sec. 2 step 1)
     Contrast contrast = Contrast::Patch; // default Patch
-    float contrastStd = 0.25f;   // target standard deviation; default 0.25 (about 2 std either side of 0.5 fit in [0, 1])
-    bool order = false;          // reorder for smooth cycling; default false
-    bool window = false;         // bake the footprint into the saved set (else the renderer windows it); default false
-    splatfx::FootprintDesc footprint{}; // kernel for the window, the contact sheet and the preview
+    float contrastStd = 0.25f;           // target standard deviation; default 0.25 (about 2 std either side of 0.5 fit in [0, 1])
+    bool order = false;                  // reorder for smooth cycling; default false
+    bool window = false;                 // bake the footprint into the saved set (else the renderer windows it); default false
+    splatfx::FootprintDesc footprint{};  // kernel for the window, the contact sheet and the preview
 };
 
 // The textures, before windowing unless desc.window. `order[k]` is the index
 // (in the input patch list) of texture k.
 struct MadeSet {
-    
     splatfx::TextureSet set{};
-    
+
     std::vector<int> order{};
 };
 splatfx::Result<MadeSet> makeSet(const Source& source, const std::vector<Patch>& patches, const ProcessDesc& desc);
@@ -257,29 +251,28 @@ double cycleCost(const splatfx::TextureSet& set, const std::vector<int>& order);
 
 // What manifest.json's "provenance" records (versioned by kProvenanceVersion).
 struct Provenance {
-    
-    std::string sourceFile{};          // file name only (baseName) or an artist-given name
-    
-    std::string credit{};              // author / origin of the photograph; default empty
-    
-    std::string license{};             // licence of the photograph; default empty
+    std::string sourceFile{}; // file name only (baseName) or an artist-given name
+
+    std::string credit{}; // author / origin of the photograph; default empty
+
+    std::string license{}; // licence of the photograph; default empty
     int sourceWidth = 0, sourceHeight = 0;
-    
-    std::string method{};              // positions | random | spectral | path | turbulence | merge
-    std::string parametersJson = "{}"; // the method's parameters, as given
+
+    std::string method{};                 // positions | random | spectral | path | turbulence | merge
+    std::string parametersJson = "{}";    // the method's parameters, as given
     const Selection* selection = nullptr; // patches and their spectra (photo methods)
     const ProcessDesc* process = nullptr;
-    
-    std::vector<int> order{};          // texture k came from patch order[k]
+
+    std::vector<int> order{}; // texture k came from patch order[k]
 };
 std::string provenanceJson(const Provenance& p);
 
 struct OutputDesc {
-    bool contactSheet = true;    // write contact.png; default true
-    bool preview = true;         // write preview.gif (needs headless GL); default true
-    int previewFrames = 0;       // default 0 = 3 per texture (one full cycle)
-    int previewFps = 12;         // default 12
-    int previewSize = 192;       // height in pixels; the GIF is twice as wide; default 192
+    bool contactSheet = true;            // write contact.png; default true
+    bool preview = true;                 // write preview.gif (needs headless GL); default true
+    int previewFrames = 0;               // default 0 = 3 per texture (one full cycle)
+    int previewFps = 12;                 // default 12
+    int previewSize = 192;               // height in pixels; the GIF is twice as wide; default 192
     std::string previewColors = "smoke"; // fire | smoke | steam | dust | white; default smoke
     splatfx::FootprintDesc footprint{};
 };
@@ -290,14 +283,13 @@ struct OutputDesc {
 // texture-set folder is replaced; any other existing path is refused. On
 // failure nothing is left behind (staging and any parent folders it created
 // are removed) and the message says why.
-splatfx::Status writeOutput(const std::string& folder, const splatfx::TextureSet& set, const std::string& provenanceJson,
-                            const OutputDesc& desc, const Source* source = nullptr,
-                            const std::vector<Patch>* patches = nullptr);
+splatfx::Status writeOutput(const std::string& folder, const splatfx::TextureSet& set, const std::string& provenanceJson, const OutputDesc& desc,
+                            const Source* source = nullptr, const std::vector<Patch>* patches = nullptr);
 
 // The contact sheet: the source with numbered patch outlines (when given),
 // then each texture above its windowed splat (Fig. 2). RGB float, top row first.
-splatfx::Image contactSheet(const splatfx::TextureSet& set, const splatfx::FootprintDesc& footprint,
-                            const Source* source = nullptr, const std::vector<Patch>* patches = nullptr);
+splatfx::Image contactSheet(const splatfx::TextureSet& set, const splatfx::FootprintDesc& footprint, const Source* source = nullptr,
+                            const std::vector<Patch>* patches = nullptr);
 
 // Renders the cycling preview headless: one large textured splat (left) and
 // a puff of textured splats (right), cross-fading through the set in order.
@@ -312,39 +304,38 @@ splatfx::Result<std::vector<splatfx::Image>> renderPreview(const splatfx::Textur
 
 // Everything the command line can say; defaults match `splatfx-texpick --help`.
 struct Options {
-    
-    std::string mode{};             // positions | random | spectral | path | interactive | turbulence | merge
-    
-    std::string input{};            // the photograph (merge: unused)
-    
+    std::string mode{}; // positions | random | spectral | path | interactive | turbulence | merge
+
+    std::string input{}; // the photograph (merge: unused)
+
     std::vector<std::string> sets{}; // merge: the texture-set folders to concatenate
-    
-    std::string out{};              // --out
+
+    std::string out{}; // --out
     int patch = 64, count = 8;
     bool countGiven = false;
     std::uint32_t seed = 1;
-    
-    std::vector<cv::Point3i> at{};  // positions
-    SourceDesc source{};          // --alpha
+
+    std::vector<cv::Point3i> at{}; // positions
+    SourceDesc source{};           // --alpha
     Acceptance accept{};
-    float minDistance = -1.0f;    // -1: the mode's default
+    float minDistance = -1.0f; // -1: the mode's default
     double bandLo = 0.125, bandHi = 0.75;
     bool spread = false;
     int stride = 0;
-    
+
     std::vector<cv::Point2d> path{};
     double step = 4.0;
     splatfx::TurbulenceDesc turbulence{};
     ProcessDesc process{};
     OutputDesc output{};
-    
+
     std::string sourceName{}, credit{}, license{};
     bool quiet = false;
-    int autoQuitAfter = 0;        // interactive: close after this many frames (0 = wait for the user)
-    
-    std::string events{};           // interactive: scripted input, e.g. "click:120,80;key:s"
-    
-    std::string screenshot{};       // interactive: write the window's image here before quitting
+    int autoQuitAfter = 0; // interactive: close after this many frames (0 = wait for the user)
+
+    std::string events{}; // interactive: scripted input, e.g. "click:120,80;key:s"
+
+    std::string screenshot{}; // interactive: write the window's image here before quitting
 };
 
 // Parses argv into options; on --help prints usage and returns an empty error.
@@ -357,8 +348,8 @@ int run(const Options& options);
 int runInteractive(const Options& options);
 // Builds the set for a selection and writes it: what `run` and the interactive
 // mode's save both do, so their outputs match.
-splatfx::Status produce(const Options& options, const Source& source, const Selection& selection,
-                        const std::string& method, const std::string& parametersJson);
+splatfx::Status produce(const Options& options, const Source& source, const Selection& selection, const std::string& method,
+                        const std::string& parametersJson);
 
 // [SECTION] Helpers shared by the command line and the interactive mode
 

@@ -49,8 +49,8 @@ namespace {
 struct Args {
     std::string scene;
     glm::ivec2 size{1280, 720};
-    int autoQuitAfter = 0;     // > 0: quit after this many frames (fixed time step)
-    std::string screenshot;    // written after the last frame (with --auto-quit-after)
+    int autoQuitAfter = 0;  // > 0: quit after this many frames (fixed time step)
+    std::string screenshot; // written after the last frame (with --auto-quit-after)
     std::optional<std::uint32_t> seed;
     std::string camera = "path";
     bool hideUi = false;
@@ -116,10 +116,8 @@ struct SamplingChoice {
     int upsample;
 };
 constexpr SamplingChoice kSamplings[] = {
-    {"auto (SDK default)", splatfx::gl::TextureSampling::Auto, 0},
-    {"bilinear", splatfx::gl::TextureSampling::Bilinear, 0},
-    {"nearest", splatfx::gl::TextureSampling::Nearest, 0},
-    {"upsampled 2x", splatfx::gl::TextureSampling::Upsampled, 2},
+    {"auto (SDK default)", splatfx::gl::TextureSampling::Auto, 0}, {"bilinear", splatfx::gl::TextureSampling::Bilinear, 0},
+    {"nearest", splatfx::gl::TextureSampling::Nearest, 0},         {"upsampled 2x", splatfx::gl::TextureSampling::Upsampled, 2},
     {"upsampled 4x", splatfx::gl::TextureSampling::Upsampled, 4},
 };
 
@@ -136,7 +134,7 @@ struct Viewer {
     CameraMode mode = CameraMode::Path;
     splatfx::DynamicsToggles toggles;
     scenehost::FrameOptions frame;
-    int sampling = 0; // index into kSamplings
+    int sampling = 0;        // index into kSamplings
     int resolutionScale = 1; // 1, 2 or 4
     float fovDeg = 45.0f;
     // Orbit
@@ -204,7 +202,7 @@ struct Viewer {
         const splatfx::CameraPath& cp = player->file().camera;
         if (mode == CameraMode::Orbit) {
             const glm::vec3 eye = orbitTarget + orbitDistance * glm::vec3(std::cos(orbitPitch) * std::sin(orbitYaw), std::sin(orbitPitch),
-                                                                         std::cos(orbitPitch) * std::cos(orbitYaw));
+                                                                          std::cos(orbitPitch) * std::cos(orbitYaw));
             return splatfx::Camera::lookAt(eye, orbitTarget, {0, 1, 0}, fov, vp, cp.nearPlane, cp.farPlane);
         }
         if (mode == CameraMode::Fly) {
@@ -300,8 +298,8 @@ struct Viewer {
             mode = CameraMode(m);
             ImGui::SliderFloat("fov (deg)", &fovDeg, 10.0f, 120.0f);
             ImGui::TextDisabled(mode == CameraMode::Orbit ? "left drag: rotate, right drag: pan, wheel: zoom"
-                                : mode == CameraMode::Fly  ? "WASD move, Q/E down/up, shift fast, right drag look"
-                                                           : "the scene file's camera path");
+                                : mode == CameraMode::Fly ? "WASD move, Q/E down/up, shift fast, right drag look"
+                                                          : "the scene file's camera path");
         }
         if (ImGui::CollapsingHeader("Dynamics and drawing", ImGuiTreeNodeFlags_DefaultOpen)) {
             bool changed = ImGui::Checkbox("object (sec. 3.1)", &toggles.object);
@@ -331,7 +329,8 @@ struct Viewer {
             }
             if (player) {
                 const splatfx::gl::Renderer& r = player->renderer().splatRenderer();
-                if (r.sampling() == splatfx::gl::TextureSampling::Upsampled) ImGui::TextDisabled("in use: layers upsampled %dx, nearest", r.upsampleFactor());
+                if (r.sampling() == splatfx::gl::TextureSampling::Upsampled)
+                    ImGui::TextDisabled("in use: layers upsampled %dx, nearest", r.upsampleFactor());
                 else ImGui::TextDisabled("in use: %s", r.sampling() == splatfx::gl::TextureSampling::Bilinear ? "bilinear" : "nearest");
             }
         }
@@ -390,10 +389,13 @@ static int viewerMain(int argc, char** argv) {
     Viewer v;
     if (!parse(argc, argv, v.args)) return 2;
     v.mode = v.args.camera == "orbit" ? CameraMode::Orbit : v.args.camera == "fly" ? CameraMode::Fly : CameraMode::Path;
-    auto window = splatfx::Window::create({.width = v.args.size.x, .height = v.args.size.y, .title = "splatfx viewer", .vsync = v.args.autoQuitAfter == 0});
+    auto window =
+        splatfx::Window::create({.width = v.args.size.x, .height = v.args.size.y, .title = "splatfx viewer", .vsync = v.args.autoQuitAfter == 0});
     if (!window) {
-        std::fprintf(stderr, "splatfx-viewer: %s\nsplatfx-viewer: the viewer is interactive; without a display run it under xvfb-run, or render "
-                             "the scene headless with splatfx-render SCENE --out DIR\n", window.error().c_str());
+        std::fprintf(stderr,
+                     "splatfx-viewer: %s\nsplatfx-viewer: the viewer is interactive; without a display run it under xvfb-run, or render "
+                     "the scene headless with splatfx-render SCENE --out DIR\n",
+                     window.error().c_str());
         return 1;
     }
     IMGUI_CHECKVERSION();
@@ -447,8 +449,8 @@ static int viewerMain(int argc, char** argv) {
         window->swapBuffers();
         if (lastFrame) {
             const splatfx::FrameCounters s = v.player ? v.player->stats().counters : splatfx::FrameCounters{};
-            std::printf("splatfx-viewer: %d frames, t = %.2f s, %zu effects declared / %zu simulated / %zu visible, %llu splats\n",
-                        frameIndex + 1, v.time, s.declared, s.simulated, s.needed, (unsigned long long)s.splats);
+            std::printf("splatfx-viewer: %d frames, t = %.2f s, %zu effects declared / %zu simulated / %zu visible, %llu splats\n", frameIndex + 1,
+                        v.time, s.declared, s.simulated, s.needed, (unsigned long long)s.splats);
             break;
         }
     }
@@ -460,4 +462,6 @@ static int viewerMain(int argc, char** argv) {
 }
 
 // Any exception that escapes (std::bad_alloc included) becomes a message and exit code 1.
-int main(int argc, char** argv) { return cli::guardedMain("splatfx-viewer", [&] { return viewerMain(argc, argv); }); }
+int main(int argc, char** argv) {
+    return cli::guardedMain("splatfx-viewer", [&] { return viewerMain(argc, argv); });
+}

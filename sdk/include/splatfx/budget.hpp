@@ -59,8 +59,7 @@ std::vector<std::string> budgetNames();
 
 // OK when estimate <= budget; otherwise the error
 // "<what> needs <estimate> <unit>, over the budget of <budget> (raise Budgets::<field>)".
-Status checkBudget(std::string_view what, std::uint64_t estimate, std::string_view unit, std::uint64_t budget,
-                   std::string_view field);
+Status checkBudget(std::string_view what, std::uint64_t estimate, std::string_view unit, std::uint64_t budget, std::string_view field);
 
 // "NAME=N" (NAME a field of Budgets, N a whole number >= 1) into budgets.
 // Fails naming the unknown field or the bad number; budgets is unchanged then.

@@ -22,8 +22,8 @@ struct Camera {
     // From host matrices; near plane and projection kind are read off proj.
     static Camera fromMatrices(const glm::mat4& view, const glm::mat4& proj, glm::ivec2 viewport);
     // Perspective camera; fovY in radians; near/far in world units.
-    static Camera lookAt(glm::vec3 eye, glm::vec3 target, glm::vec3 up, float fovY, glm::ivec2 viewport,
-                         float nearPlane = 0.05f, float farPlane = 1000.0f);
+    static Camera lookAt(glm::vec3 eye, glm::vec3 target, glm::vec3 up, float fovY, glm::ivec2 viewport, float nearPlane = 0.05f,
+                         float farPlane = 1000.0f);
 
     glm::vec3 eye() const;
     glm::vec3 forward() const; // unit view direction in world space

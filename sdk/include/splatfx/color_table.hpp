@@ -30,10 +30,10 @@ public:
 
     // Piecewise-linear table through (t, colour) stops, t increasing.
     static ColorTable gradient(const std::vector<std::pair<float, glm::vec4>>& stops, int size = 256);
-    static ColorTable fire();   // white-yellow base, orange, red, dark fading tips
-    static ColorTable smoke();  // grey, thinning with height
-    static ColorTable steam();  // white, thinning with height
-    static ColorTable dust();   // sandy brown
+    static ColorTable fire();  // white-yellow base, orange, red, dark fading tips
+    static ColorTable smoke(); // grey, thinning with height
+    static ColorTable steam(); // white, thinning with height
+    static ColorTable dust();  // sandy brown
     static ColorTable constant(glm::vec4 rgba);
 };
 

@@ -44,10 +44,10 @@ private:
 };
 
 struct WindowDesc {
-    int width = 1280;                 // default 1280
-    int height = 720;                 // default 720
+    int width = 1280; // default 1280
+    int height = 720; // default 720
     std::string title = "splatfx";
-    bool vsync = true;                // default true
+    bool vsync = true; // default true
 };
 
 class Window {

@@ -69,9 +69,9 @@ enum class Propagation {
 // Global dynamics (sec. 3.2).
 struct PropagationDesc {
     Propagation mode = Propagation::Fixed; // default Fixed
-    glm::ivec3 direction{0, 1, 0};   // lattice step a texture travels per propagation step (Fixed); default up (+y)
-    float stepsPerSec = 8.0f;        // propagation steps per second (cells travelled per second, Fixed), > 0; default 8
-    std::uint32_t offset = 1;        // added to the index at every hop ("offset slightly"); default 1
+    glm::ivec3 direction{0, 1, 0};         // lattice step a texture travels per propagation step (Fixed); default up (+y)
+    float stepsPerSec = 8.0f;              // propagation steps per second (cells travelled per second, Fixed), > 0; default 8
+    std::uint32_t offset = 1;              // added to the index at every hop ("offset slightly"); default 1
 };
 
 enum class Cycling {
@@ -105,8 +105,7 @@ std::uint32_t initialIndex(glm::ivec3 cell, std::uint32_t seed);
 // Seed hash of a source cell (no upwind voxel) at step n >= 1.
 std::uint32_t sourceIndex(glm::ivec3 cell, std::int64_t step, std::uint32_t seed);
 // index_n(c) for a cell with chainLength upwind voxels (K above). Expects step >= 0.
-std::uint32_t propagatedIndex(glm::ivec3 cell, int chainLength, std::int64_t step, const PropagationDesc& desc,
-                              std::uint32_t seed);
+std::uint32_t propagatedIndex(glm::ivec3 cell, int chainLength, std::int64_t step, const PropagationDesc& desc, std::uint32_t seed);
 // Propagation step count at t: floor(t * stepsPerSec). Expects t >= 0.
 std::int64_t propagationStep(double timeSec, const PropagationDesc& desc);
 // Local dynamics of one cell at t: the tick count and phase. Expects t >= 0.
@@ -159,8 +158,8 @@ public:
     // takes the index of the neighbour upwind of the flow (the 26-neighbour
     // closest to -velocity) plus offset; with no occupied upwind neighbour it
     // is reseeded. Any dt >= 0 is fine (at most one hop per cell per call).
-    void advanceFlow(const std::vector<glm::vec3>& velocityCellsPerSec, const std::vector<std::uint8_t>& occupied,
-                     double dtSec, std::uint32_t offset);
+    void advanceFlow(const std::vector<glm::vec3>& velocityCellsPerSec, const std::vector<std::uint8_t>& occupied, double dtSec,
+                     std::uint32_t offset);
 
     std::uint32_t index(glm::ivec3 cell) const { return mIndex[linear(cell)]; }
     // Overrides one cell's index (e.g. to mark a texture and watch it travel).

@@ -63,11 +63,11 @@ namespace splatfx {
 // `style`; with blend > 0 the layer fades in/out over `blend` around an inner
 // edge, so two layers meeting at h overlap and their weights sum to 1.
 struct EffectLayer {
-    SplatStyle style{};         // texture set, colour table, textured, crossfade; default SplatStyle{}
-    float heightFrom = 0.0f;    // [0, 1]; default 0
-    float heightTo = 1.0f;      // [heightFrom, 1]; default 1
-    float blend = 0.0f;         // normalized height of the fade at inner edges, >= 0; default 0 (hard split)
-    bool remapColor = false;    // colour coordinate = position within [heightFrom, heightTo]; default false (keep the voxel's)
+    SplatStyle style{};      // texture set, colour table, textured, crossfade; default SplatStyle{}
+    float heightFrom = 0.0f; // [0, 1]; default 0
+    float heightTo = 1.0f;   // [heightFrom, 1]; default 1
+    float blend = 0.0f;      // normalized height of the fade at inner edges, >= 0; default 0 (hard split)
+    bool remapColor = false; // colour coordinate = position within [heightFrom, heightTo]; default false (keep the voxel's)
 };
 
 // Each scale of motion can be switched off (the viewer's toggles). Off means
@@ -79,22 +79,22 @@ struct DynamicsToggles {
 };
 
 struct EffectDesc {
-    std::string name = "effect";     // used in messages; default "effect"
-    Motion motion{};                 // object dynamics of the whole grid (grid effects only); default at rest
-    GrowthDesc growth{};             // how Pose::growth reveals material; default from the lattice centre
-    TextureDynamicsDesc textures{};  // global + local dynamics and their seed; default up, ordered cycling
+    std::string name = "effect";       // used in messages; default "effect"
+    Motion motion{};                   // object dynamics of the whole grid (grid effects only); default at rest
+    GrowthDesc growth{};               // how Pose::growth reveals material; default from the lattice centre
+    TextureDynamicsDesc textures{};    // global + local dynamics and their seed; default up, ordered cycling
     std::vector<EffectLayer> layers{}; // default (empty): one layer with SplatStyle{}
-    SparseOutputDesc sparse{};       // solver effects: dense fields to voxels; default SparseOutputDesc{}
-    DynamicsToggles enabled{};       // default all on
+    SparseOutputDesc sparse{};         // solver effects: dense fields to voxels; default SparseOutputDesc{}
+    DynamicsToggles enabled{};         // default all on
     // Support radius of the Materials footprint the effect is drawn with, in
     // voxel units (Footprint::radius()); bounds() depend on it. Presets set it.
-    float footprintRadius = 1.6f;    // default 1.6 (Kernel::CrawfisMax)
+    float footprintRadius = 1.6f; // default 1.6 (Kernel::CrawfisMax)
 };
 
 struct EffectCounters {
-    std::uint64_t updates = 0;         // update() / step() calls that did work
-    std::uint64_t stepsSimulated = 0;  // solver substeps
-    std::uint64_t voxelsUpdated = 0;   // voxels (grid) or cells (solver) evaluated
+    std::uint64_t updates = 0;          // update() / step() calls that did work
+    std::uint64_t stepsSimulated = 0;   // solver substeps
+    std::uint64_t voxelsUpdated = 0;    // voxels (grid) or cells (solver) evaluated
     std::uint64_t propagationSteps = 0; // step-by-step texture propagation steps (solver effects)
 };
 

@@ -45,8 +45,8 @@ namespace splatfx {
 
 // How one emit() is drawn; Scene combines the caller's with EffectOptions::draw.
 struct EmitOptions {
-    bool textured = true;        // false: traditional splats for every layer (Fig. 1a); default true
-    float opacityScale = 1.0f;   // multiplies each layer's style.opacityScale; default 1
+    bool textured = true;      // false: traditional splats for every layer (Fig. 1a); default true
+    float opacityScale = 1.0f; // multiplies each layer's style.opacityScale; default 1
 };
 
 // What alive() may use besides the time; filled by the Scene from EffectOptions.
@@ -65,12 +65,12 @@ struct AdvanceContext {
     int maxCatchUpSteps = 8;            // default 8
     // True when the kind was skipped since it last advanced (the Scene did not
     // need it at its previous update) and has been advanced before.
-    bool resumed = false;               // default false
+    bool resumed = false; // default false
 };
 
 struct AdvanceResult {
-    int steps = 0;          // steps (stateful) or evaluations (stateless) taken; 0 when already at t
-    bool caughtUp = false;  // a resumed stateful kind covered a skipped interval
+    int steps = 0;         // steps (stateful) or evaluations (stateless) taken; 0 when already at t
+    bool caughtUp = false; // a resumed stateful kind covered a skipped interval
 };
 
 class EffectKind {

@@ -54,17 +54,15 @@ struct FogCurve {
 // Direction and speed that change with time are a change of this vector:
 // velocity = speed(t) * direction(t) sampled at keys, interpolated as a vector.
 struct FogWindKey {
-    double timeSec = 0.0;        // default 0
-    glm::dvec3 velocity{0.0};    // world units per second; default 0 (calm)
+    double timeSec = 0.0;     // default 0
+    glm::dvec3 velocity{0.0}; // world units per second; default 0 (calm)
 };
 struct FogWind {
     std::vector<FogWindKey> keys; // sorted by timeSec; default empty (no wind)
 
     static FogWind constant(glm::dvec3 velocity) { return FogWind{{{0.0, velocity}}}; }
     // Velocity v0 at t0 changing linearly to v1 at t1 (held outside [t0, t1]).
-    static FogWind ramp(double t0Sec, glm::dvec3 v0, double t1Sec, glm::dvec3 v1) {
-        return FogWind{{{t0Sec, v0}, {t1Sec, v1}}};
-    }
+    static FogWind ramp(double t0Sec, glm::dvec3 v0, double t1Sec, glm::dvec3 v1) { return FogWind{{{t0Sec, v0}, {t1Sec, v1}}}; }
     glm::dvec3 velocity(double tSec) const;
     // Exact integral of velocity over [0, tSec].
     glm::dvec3 displacement(double tSec) const;
@@ -97,10 +95,10 @@ struct FogMonomial {
 // The factory functions below fill the fields of each kind.
 struct FogTerm {
     FogTermKind kind = FogTermKind::Constant; // default Constant
-    double weight = 1.0;          // c_i, extinction per world unit; default 1
-    FogCurve weightOverTime;      // replaces weight when not empty; default empty
-    double windFactor = 1.0;      // the term moves by windFactor * D(t) (0 = not sensitive to wind); default 1
-    FogWind motion;               // the term's own motion, added to the wind's (e.g. a drifting potential); default none
+    double weight = 1.0;                      // c_i, extinction per world unit; default 1
+    FogCurve weightOverTime;                  // replaces weight when not empty; default empty
+    double windFactor = 1.0;                  // the term moves by windFactor * D(t) (0 = not sensitive to wind); default 1
+    FogWind motion;                           // the term's own motion, added to the wind's (e.g. a drifting potential); default none
 
     // Cosine, CosineProduct
     glm::dvec3 wave{1.0, 0.0, 0.0};  // k * direction, rad per world unit; default (1, 0, 0)
@@ -111,11 +109,11 @@ struct FogTerm {
     double phase2 = 0.0;             // rad; default 0
 
     // Polynomial
-    std::vector<FogMonomial> monomials;  // shape A; total degree <= kFogMaxDegree; default empty
-    std::vector<FogMonomial> monomialsB; // shape B; when not empty the shape is (1 - s) A + s B; default empty
-    FogCurve blendOverTime;              // s(t) in [0, 1]; empty = 0 (shape A); default empty
-    glm::dvec3 cellCentre{0.0};          // world; default origin
-    glm::dvec3 cellHalfSize{1.0};        // C per axis, world units, > 0; default (1, 1, 1)
+    std::vector<FogMonomial> monomials;           // shape A; total degree <= kFogMaxDegree; default empty
+    std::vector<FogMonomial> monomialsB;          // shape B; when not empty the shape is (1 - s) A + s B; default empty
+    FogCurve blendOverTime;                       // s(t) in [0, 1]; empty = 0 (shape A); default empty
+    glm::dvec3 cellCentre{0.0};                   // world; default origin
+    glm::dvec3 cellHalfSize{1.0};                 // C per axis, world units, > 0; default (1, 1, 1)
     FogCellMode cellMode = FogCellMode::Periodic; // default Periodic
 
     // Point, Line, Sphere
@@ -130,11 +128,10 @@ struct FogTerm {
     static FogTerm constant(double weight);
     // weight * cos(k * dot(direction, x) + phase); direction is normalized.
     static FogTerm cosine(double weight, double k, glm::dvec3 direction, double phase = 0.0);
-    static FogTerm cosineProduct(double weight, double k1, glm::dvec3 dir1, double phase1, double k2,
-                                 glm::dvec3 dir2, double phase2);
+    static FogTerm cosineProduct(double weight, double k1, glm::dvec3 dir1, double phase1, double k2, glm::dvec3 dir2, double phase2);
     // weight * sum_n coeffs[n] * u^n along one axis (0 = x, 1 = y, 2 = z), u = (x_axis - centre) / halfSize.
-    static FogTerm polynomial1D(double weight, int axis, std::vector<double> coeffs, double halfSize,
-                                FogCellMode mode = FogCellMode::Periodic, double centre = 0.0);
+    static FogTerm polynomial1D(double weight, int axis, std::vector<double> coeffs, double halfSize, FogCellMode mode = FogCellMode::Periodic,
+                                double centre = 0.0);
     static FogTerm point(double weight, glm::dvec3 centre, double c, double d);
     static FogTerm line(double weight, glm::dvec3 point, glm::dvec3 axis, double c, double d);
     static FogTerm sphere(double weight, glm::dvec3 centre, double radius, double c, double d);
@@ -143,10 +140,10 @@ struct FogTerm {
 inline constexpr int kFogMaxDegree = 9; // total degree of a polynomial term: 5-point Gauss-Legendre is exact
 
 struct FogDesc {
-    std::vector<FogTerm> terms;         // default empty: no fog (transmittance 1 everywhere)
-    glm::dvec3 colour{0.8, 0.8, 0.85};  // C_fog of eq. 5, linear RGB; default (0.8, 0.8, 0.85)
-    double farDistanceWorld = 0.0;      // beyond it fully fogged (sec. 4.2); default 0 = no cut-off
-    FogWind wind;                       // default: calm
+    std::vector<FogTerm> terms;        // default empty: no fog (transmittance 1 everywhere)
+    glm::dvec3 colour{0.8, 0.8, 0.85}; // C_fog of eq. 5, linear RGB; default (0.8, 0.8, 0.85)
+    double farDistanceWorld = 0.0;     // beyond it fully fogged (sec. 4.2); default 0 = no cut-off
+    FogWind wind;                      // default: calm
 };
 
 // A quadrature result (integrateFogNumerically).
@@ -196,8 +193,8 @@ private:
 
 // Options of the GLSL generator.
 struct FogGlslOptions {
-    std::string prefix = "splatfx_fog";  // prefix of every emitted name; default "splatfx_fog"
-    int uniformLocation = -1;            // explicit layout(location) of the parameter array; default -1 (none)
+    std::string prefix = "splatfx_fog"; // prefix of every emitted name; default "splatfx_fog"
+    int uniformLocation = -1;           // explicit layout(location) of the parameter array; default -1 (none)
     // A multi-variable periodic polynomial on a general ray is a walk over the
     // cells it crosses; past this many cells the rest of the ray is taken at
     // the cell's mean density (an approximation, docs/fog.md). 1D polynomials
@@ -214,8 +211,8 @@ struct FogGlslOptions {
 // Fill <prefix>_params with Fog::glslParameters(t, reference) each frame.
 struct FogGlsl {
     std::string source;
-    std::string uniformName;  // "<prefix>_params"
-    int vec4Count = 0;        // N (at least 1)
+    std::string uniformName; // "<prefix>_params"
+    int vec4Count = 0;       // N (at least 1)
 };
 // Fails only for invalid options.
 Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& options = {});
@@ -225,8 +222,8 @@ Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& options = {});
 // renderer and the tests use it to check the closed forms. The segment is
 // first cut into pieces short against the highest cosine frequency and the
 // smallest polynomial cell so that no feature is stepped over.
-FogQuadrature integrateFogNumerically(const Fog& fog, glm::dvec3 o, glm::dvec3 p, double tSec,
-                                      double absTolerance = 1e-10, long maxEvaluations = 20'000'000);
+FogQuadrature integrateFogNumerically(const Fog& fog, glm::dvec3 o, glm::dvec3 p, double tSec, double absTolerance = 1e-10,
+                                      long maxEvaluations = 20'000'000);
 
 // The paper's example fogs (sec. 6), in the paper's units (x, y, z as in
 // its formulas; scale the scene or the desc to taste).

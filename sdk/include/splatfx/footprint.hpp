@@ -48,8 +48,8 @@ struct FootprintDesc {
     // [0, radius] by depth entries over the chord, sigma = s / sqrt(R^2 - r^2)
     // in [-1, 1]. Each clamped to [2, 1024]. Defaults 32 x 64 (8 KiB):
     // the bench's table-size sweep (docs/BENCHMARKS.md, "The depth cut").
-    int partialRadialSize = 32;         // default 32
-    int partialDepthSize = 64;          // default 64
+    int partialRadialSize = 32; // default 32
+    int partialDepthSize = 64;  // default 64
 };
 
 class Footprint {

@@ -45,9 +45,9 @@ struct FrameCounters {
     std::uint64_t voxels = 0;  // voxels offered to the splat builder
     std::uint64_t splats = 0;  // splats in the frame
     // ---- lighting (issue 16; Scene fills them)
-    std::size_t litEffects = 0;             // needed effects lit by the scene's lights
-    std::uint64_t shadowTableBuilds = 0;    // shadow tables (self-shadowing and the scene's) rebuilt for this frame
-    std::uint64_t shadowTableReuses = 0;    // ... and reused because density and light had not changed
+    std::size_t litEffects = 0;          // needed effects lit by the scene's lights
+    std::uint64_t shadowTableBuilds = 0; // shadow tables (self-shadowing and the scene's) rebuilt for this frame
+    std::uint64_t shadowTableReuses = 0; // ... and reused because density and light had not changed
 };
 
 // ---- lighting (issue 16): the shadow the frame's gas casts on the scene.
@@ -56,15 +56,14 @@ struct FrameCounters {
 // uploads as a 3D texture before the host's opaque pass, and what the GLSL
 // of shadowGlsl() samples. Empty (valid = false): nothing is shadowed.
 struct FrameShadow {
-    bool valid = false;                 // default false: no shadow this frame
-    std::vector<float> depth;           // dims.x * dims.y * dims.z optical depths (log2), x fastest
+    bool valid = false;       // default false: no shadow this frame
+    std::vector<float> depth; // dims.x * dims.y * dims.z optical depths (log2), x fastest
     glm::ivec3 dims{0};
-    glm::mat4 worldToTable{1.0f};       // world to the table's [0, 1]^3 (ShadowTable::worldToTable)
+    glm::mat4 worldToTable{1.0f};                    // world to the table's [0, 1]^3 (ShadowTable::worldToTable)
     glm::vec4 lightInTable{0.0f, -1.0f, 0.0f, 0.0f}; // ShadowTable::lightInTable
     // Changes whenever the contents do (a renderer re-uploads only then); 0 when never filled.
     std::uint64_t version = 0;
 };
-
 
 // ---- [clouds, issue 17] LOD volumes drawn as projected tetrahedra ----
 // One volume's tetrahedra for this frame (LodVolume::update's output) and the
@@ -72,15 +71,15 @@ struct FrameShadow {
 // hosts without a Scene push them between begin() and end().
 struct FrameVolume {
     const PreIntegrationTable* table = nullptr; // not owned; must outlive the render; null: not drawn
-    std::uint64_t tableVersion = 0;            // change it when the table at this address changes (the GL pass re-uploads); default 0
+    std::uint64_t tableVersion = 0;             // change it when the table at this address changes (the GL pass re-uploads); default 0
     LodFrame lod;                               // lod.tets back to front, world space
 };
 // One run of the interleaved back-to-front draw sequence (Frame::drawOrder).
 struct DrawBatch {
     enum class Kind : std::uint8_t { Splats, Tetrahedra };
     Kind kind = Kind::Splats;
-    std::uint32_t volume = 0;               // index into Frame::volumes() (Tetrahedra only)
-    std::uint32_t begin = 0, end = 0;       // [begin, end) into splats() or volumes()[volume].lod.tets
+    std::uint32_t volume = 0;         // index into Frame::volumes() (Tetrahedra only)
+    std::uint32_t begin = 0, end = 0; // [begin, end) into splats() or volumes()[volume].lod.tets
 };
 // Merges the splats (sorted back to front) and every volume's tetrahedra
 // (each list in its own exact visibility order) into one back-to-front
@@ -140,9 +139,9 @@ private:
     FrameCounters mCounters;
     FrameShadow mShadow; // lighting (issue 16)
     double mTime = 0.0;
-    std::shared_ptr<const Fog> mFog; // fog (issue 14); default none
-    std::vector<FrameVolume> mVolumes;   // [clouds]
-    std::vector<DrawBatch> mDrawOrder;   // [clouds]
+    std::shared_ptr<const Fog> mFog;   // fog (issue 14); default none
+    std::vector<FrameVolume> mVolumes; // [clouds]
+    std::vector<DrawBatch> mDrawOrder; // [clouds]
 };
 
 } // namespace splatfx

@@ -54,8 +54,7 @@ public:
     static Result<Grid> cone(float radiusCells, int heightCells, glm::vec3 spacing = glm::vec3(1.0f));
     // x fastest, then y, then z. Voxels with opacity 0 are left out (sparse).
     // Fails on a size mismatch or an opacity that is NaN, infinite, negative or above 1.
-    static Result<Grid> fromDense(glm::ivec3 dims, const std::vector<float>& opacity,
-                                  glm::vec3 spacing = glm::vec3(1.0f));
+    static Result<Grid> fromDense(glm::ivec3 dims, const std::vector<float>& opacity, glm::vec3 spacing = glm::vec3(1.0f));
 
     // Position of a lattice point in grid-local and world coordinates.
     glm::vec3 localPosition(glm::ivec3 cell) const;

@@ -60,15 +60,17 @@ struct SequencePosition {
 };
 
 struct GridSequence {
-    glm::ivec3 dims{0};        // lattice cells along x, y, z; default 0 (empty)
-    glm::vec3 spacing{1.0f};   // distance between lattice points, grid-local units; default 1
-    glm::mat4 transform{1.0f}; // grid-local to world (as Grid::transform; Grid::localPosition centres x and z); default identity
-    double framesPerSec = 24.0; // playback rate, frames per second, > 0; default 24 (Blender's default)
+    glm::ivec3 dims{0};                  // lattice cells along x, y, z; default 0 (empty)
+    glm::vec3 spacing{1.0f};             // distance between lattice points, grid-local units; default 1
+    glm::mat4 transform{1.0f};           // grid-local to world (as Grid::transform; Grid::localPosition centres x and z); default identity
+    double framesPerSec = 24.0;          // playback rate, frames per second, > 0; default 24 (Blender's default)
     SequenceEnd end = SequenceEnd::Loop; // default Loop
     std::vector<GridSequenceFrame> frames;
 
     std::size_t cellCount() const { return std::size_t(dims.x) * std::size_t(dims.y) * std::size_t(dims.z); }
-    std::size_t cellIndex(glm::ivec3 c) const { return (std::size_t(c.z) * std::size_t(dims.y) + std::size_t(c.y)) * std::size_t(dims.x) + std::size_t(c.x); }
+    std::size_t cellIndex(glm::ivec3 c) const {
+        return (std::size_t(c.z) * std::size_t(dims.y) + std::size_t(c.y)) * std::size_t(dims.x) + std::size_t(c.x);
+    }
 
     // Checks dims (positive, at most kMaxVoxels cells), spacing, framesPerSec,
     // at least one frame, every array's size and every value (finite,

@@ -43,8 +43,8 @@ enum class Alpha {
 };
 
 // Budgets checked before anything is decoded.
-inline constexpr int kMaxImageSide = 16384;                        // pixels on a side
-inline constexpr long long kMaxImagePixels = 1ll << 26;            // 8192x8192: 1 GiB as float RGBA
+inline constexpr int kMaxImageSide = 16384;                          // pixels on a side
+inline constexpr long long kMaxImagePixels = 1ll << 26;              // 8192x8192: 1 GiB as float RGBA
 inline constexpr unsigned long long kMaxImageFileBytes = 1ull << 30; // 1 GiB of file
 
 // Fails with the file name and the reason: missing, a symbolic-link loop, not

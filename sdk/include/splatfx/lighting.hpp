@@ -57,10 +57,10 @@ struct Light {
     // radiant intensity, i.e. irradiance at 1 world unit (inverse-square
     // falloff). >= 0; default 1.
     float intensity = 1.0f;
-    glm::vec3 direction{0.0f, -1.0f, 0.0f};  // where the light travels (directional; spot axis); non-zero, need not be unit; default down
-    glm::vec3 position{0.0f};                // world position (point, spot); default origin
-    float innerConeRad = 0.4f;               // spot: full intensity within this half-angle, [0, outer]; default 0.4
-    float outerConeRad = 0.6f;               // spot: no light beyond this half-angle, (0, pi); default 0.6
+    glm::vec3 direction{0.0f, -1.0f, 0.0f}; // where the light travels (directional; spot axis); non-zero, need not be unit; default down
+    glm::vec3 position{0.0f};               // world position (point, spot); default origin
+    float innerConeRad = 0.4f;              // spot: full intensity within this half-angle, [0, outer]; default 0.4
+    float outerConeRad = 0.6f;              // spot: no light beyond this half-angle, (0, pi); default 0.6
     // Point and spot: the irradiance of a voxel closer than this (or than half
     // its voxel's size, whichever is larger) is that at this distance, so a
     // light inside the gas stays finite. >= 0, world units; default 0.
@@ -68,8 +68,8 @@ struct Light {
 
     static Light directional(glm::vec3 direction, glm::vec3 color = glm::vec3(1.0f), float intensity = 1.0f);
     static Light point(glm::vec3 position, glm::vec3 color = glm::vec3(1.0f), float intensity = 1.0f);
-    static Light spot(glm::vec3 position, glm::vec3 direction, float innerConeRad, float outerConeRad,
-                      glm::vec3 color = glm::vec3(1.0f), float intensity = 1.0f);
+    static Light spot(glm::vec3 position, glm::vec3 direction, float innerConeRad, float outerConeRad, glm::vec3 color = glm::vec3(1.0f),
+                      float intensity = 1.0f);
 };
 
 // Checks every field that matters for the light's type; the message names
@@ -198,8 +198,8 @@ private:
 };
 
 struct ShadowTableDesc {
-    glm::ivec3 dims{64};                             // entries per axis, each in [1, 1024]; default 64^3
-    std::uint64_t memoryBudgetBytes = 64ull << 20;   // table plus build scratch (memoryBytes); default 64 MiB
+    glm::ivec3 dims{64};                           // entries per axis, each in [1, 1024]; default 64^3
+    std::uint64_t memoryBudgetBytes = 64ull << 20; // table plus build scratch (memoryBytes); default 64 MiB
 };
 
 // Ebert & Parent 1990's reduced-resolution shadow table: accumulated optical
@@ -307,8 +307,8 @@ std::string shadowGlsl();
 // ---------------------------------------------------------------- [SECTION] lighting
 
 struct GasLightingDesc {
-    PhaseFunction phase{};            // default isotropic
-    float albedo = 0.5f;              // scattered fraction of extinction, [0, 1]; default 0.5
+    PhaseFunction phase{}; // default isotropic
+    float albedo = 0.5f;   // scattered fraction of extinction, [0, 1]; default 0.5
     // Weight of the voxel's own colour as emitted light: fire 1, smoke and
     // steam 0. >= 0; default 0.
     float emission = 0.0f;
@@ -317,7 +317,7 @@ struct GasLightingDesc {
     // unshadowed and isotropically with this fraction of its irradiance.
     // >= 0; default 0 (pure low-albedo single scattering).
     float multipleScattering = 0.0f;
-    glm::vec3 ambient{0.0f};          // uniform environment light (linear RGB, >= 0) scattered by the albedo; default black
+    glm::vec3 ambient{0.0f}; // uniform environment light (linear RGB, >= 0) scattered by the albedo; default black
     // Base colours: the table at each voxel's colour coordinate (as the
     // splat builder). Null: white, so the output is a factor to multiply
     // the splat's colour by. Default null.
@@ -337,8 +337,8 @@ struct GasLightingDesc {
 // grid.voxels.size(); it allocates only when out's capacity is too small.
 // O(voxels x lights). Voxels with non-finite data get 0.
 // Fails (out untouched) on a bad light or desc; the message names the field.
-Status lightVoxels(const Grid& grid, glm::vec3 eyeWorld, std::span<const Light> lights, const ShadowProvider* shadows,
-                   const GasLightingDesc& desc, std::vector<glm::vec3>& out);
+Status lightVoxels(const Grid& grid, glm::vec3 eyeWorld, std::span<const Light> lights, const ShadowProvider* shadows, const GasLightingDesc& desc,
+                   std::vector<glm::vec3>& out);
 
 // The same model at arbitrary world points (a frame's splat centres): the
 // base colour is white (desc.colorTable is ignored), so out[i] is the factor

@@ -50,11 +50,11 @@ struct Aabb {
 
 // Where an object is at one moment, and how much of it there is.
 struct Pose {
-    glm::vec3 position{0.0f};          // world units; default origin
-    glm::quat rotation{1, 0, 0, 0};    // unit quaternion (w, x, y, z); default identity
-    glm::vec3 scale{1.0f};             // per axis, positive; default 1
-    float opacity = 1.0f;              // multiplies every voxel's opacity (fades), >= 0; default 1
-    float growth = 1.0f;               // fraction of the material present, [0, 1] (see GrowthDesc); default 1
+    glm::vec3 position{0.0f};       // world units; default origin
+    glm::quat rotation{1, 0, 0, 0}; // unit quaternion (w, x, y, z); default identity
+    glm::vec3 scale{1.0f};          // per axis, positive; default 1
+    float opacity = 1.0f;           // multiplies every voxel's opacity (fades), >= 0; default 1
+    float growth = 1.0f;            // fraction of the material present, [0, 1] (see GrowthDesc); default 1
 
     // Object to world: translate * rotate * scale.
     glm::mat4 matrix() const;
@@ -67,8 +67,8 @@ enum class Easing {
 };
 
 struct Keyframe {
-    double timeSec = 0.0;          // seconds; keys must be strictly increasing; default 0
-    Pose pose{};                   // default identity pose
+    double timeSec = 0.0;           // seconds; keys must be strictly increasing; default 0
+    Pose pose{};                    // default identity pose
     Easing easing = Easing::Linear; // of the segment from this key to the next; default Linear
 };
 
@@ -76,12 +76,12 @@ struct Keyframe {
 //   position += velocity * t + bobAmplitude * sin(2 pi bobHz t + bobPhaseRad)
 //   rotation  = angleAxis(spinRadPerSec * t, spinAxis) * keyed rotation
 struct ProceduralMotion {
-    glm::vec3 velocity{0.0f};       // world units / s; default 0
-    glm::vec3 spinAxis{0, 1, 0};    // world axis, need not be unit; default +y
-    float spinRadPerSec = 0.0f;     // radians / s; default 0
-    glm::vec3 bobAmplitude{0.0f};   // world units per axis; default 0
-    float bobHz = 0.0f;             // cycles / s; default 0
-    float bobPhaseRad = 0.0f;       // radians; default 0
+    glm::vec3 velocity{0.0f};     // world units / s; default 0
+    glm::vec3 spinAxis{0, 1, 0};  // world axis, need not be unit; default +y
+    float spinRadPerSec = 0.0f;   // radians / s; default 0
+    glm::vec3 bobAmplitude{0.0f}; // world units per axis; default 0
+    float bobHz = 0.0f;           // cycles / s; default 0
+    float bobPhaseRad = 0.0f;     // radians; default 0
 };
 
 class Motion {
@@ -122,9 +122,9 @@ private:
 // from the origin is below growth * (largest distance + softness), with a
 // soft edge. Fire spreading from its base: origin at the bottom centre.
 struct GrowthDesc {
-    glm::vec3 originCells{0.0f};     // lattice coordinates (cells) the material grows from; default cell (0, 0, 0)
-    bool originAtCentre = true;      // ignore originCells and use the lattice centre of the base (y at its bottom); default true
-    float softnessCells = 1.5f;      // width of the soft edge, cells, > 0; default 1.5
+    glm::vec3 originCells{0.0f}; // lattice coordinates (cells) the material grows from; default cell (0, 0, 0)
+    bool originAtCentre = true;  // ignore originCells and use the lattice centre of the base (y at its bottom); default true
+    float softnessCells = 1.5f;  // width of the soft edge, cells, > 0; default 1.5
 };
 
 // Opacity factor in [0, 1] for a voxel distanceCells from the growth origin.

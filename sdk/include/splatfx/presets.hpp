@@ -52,51 +52,51 @@
 namespace splatfx::presets {
 
 struct FireDesc {
-    glm::ivec3 dims{7, 20, 5};        // lattice cells; default the paper's Fig. 1 grid
-    glm::vec3 spacing{0.5f};          // world units between voxels; default 0.5
-    glm::vec3 position{0.0f};         // world position of the base centre; default origin
+    glm::ivec3 dims{7, 20, 5};              // lattice cells; default the paper's Fig. 1 grid
+    glm::vec3 spacing{0.5f};                // world units between voxels; default 0.5
+    glm::vec3 position{0.0f};               // world position of the base centre; default origin
     std::optional<TextureSet> textureSet{}; // detail textures (e.g. a loaded folder); default none (procedural turbulence)
-    int textureCount = 8;             // procedural textures; default 8
-    float opacity = 0.55f;            // opacity at the core of the base, (0, 1]; default 0.55
-    float propagationStepsPerSec = 8.0f; // global dynamics: cells per second the detail rises; default 8
-    float texturesPerSec = 6.0f;      // local dynamics rate; default 6
-    bool crossfade = true;            // cross-fade consecutive textures; default true
-    Motion motion{};                  // object dynamics (keyframes, procedure); default at rest
-    std::uint32_t seed = 1;           // texture dynamics (which texture each voxel shows when); default 1
-    std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
+    int textureCount = 8;                   // procedural textures; default 8
+    float opacity = 0.55f;                  // opacity at the core of the base, (0, 1]; default 0.55
+    float propagationStepsPerSec = 8.0f;    // global dynamics: cells per second the detail rises; default 8
+    float texturesPerSec = 6.0f;            // local dynamics rate; default 6
+    bool crossfade = true;                  // cross-fade consecutive textures; default true
+    Motion motion{};                        // object dynamics (keyframes, procedure); default at rest
+    std::uint32_t seed = 1;                 // texture dynamics (which texture each voxel shows when); default 1
+    std::uint32_t textureSeed = 1;          // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> fire(Materials& materials, const FireDesc& desc = {});
 
 struct SmokeDesc {
-    glm::ivec3 dims{10, 20, 10};      // solver cells; default 10x20x10
-    glm::vec3 spacing{0.5f};          // world units per cell; default 0.5
-    glm::vec3 position{0.0f};         // world position of the domain's base centre; default origin
+    glm::ivec3 dims{10, 20, 10};              // solver cells; default 10x20x10
+    glm::vec3 spacing{0.5f};                  // world units per cell; default 0.5
+    glm::vec3 position{0.0f};                 // world position of the domain's base centre; default origin
     glm::vec3 sourceOffset{0.0f, 0.5f, 0.0f}; // emitter centre in the source object's frame; default 0.5 up
-    float sourceRadius = 0.75f;       // emitter radius, world units; default 0.75
-    Motion sourceMotion{};            // the object the chimney sits on; default at rest at `position`
-    glm::vec3 windWorld{1.0f, 0.0f, 0.0f}; // world units/s; default 1 along +x
-    float dissipation = 0.15f;        // 1/s smoke thinning; default 0.15
-    std::optional<TextureSet> textureSet{}; // default none (procedural turbulence)
-    int textureCount = 8;             // default 8
-    float texturesPerSec = 3.0f;      // local dynamics rate; default 3
-    int substeps = 1;                 // solver substeps per step; default 1
-    std::uint32_t seed = 1;           // texture dynamics (which texture each voxel shows when); default 1
-    std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
+    float sourceRadius = 0.75f;               // emitter radius, world units; default 0.75
+    Motion sourceMotion{};                    // the object the chimney sits on; default at rest at `position`
+    glm::vec3 windWorld{1.0f, 0.0f, 0.0f};    // world units/s; default 1 along +x
+    float dissipation = 0.15f;                // 1/s smoke thinning; default 0.15
+    std::optional<TextureSet> textureSet{};   // default none (procedural turbulence)
+    int textureCount = 8;                     // default 8
+    float texturesPerSec = 3.0f;              // local dynamics rate; default 3
+    int substeps = 1;                         // solver substeps per step; default 1
+    std::uint32_t seed = 1;                   // texture dynamics (which texture each voxel shows when); default 1
+    std::uint32_t textureSeed = 1;            // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> smoke(Materials& materials, const SmokeDesc& desc = {});
 
 struct SteamDesc {
-    glm::ivec3 dims{2, 20, 2};        // lattice; default the paper's Fig. 5 grid
-    glm::vec3 spacing{0.25f};         // world units; default 0.25
-    glm::vec3 position{0.0f};         // world position of the base (the spout); default origin
+    glm::ivec3 dims{2, 20, 2};              // lattice; default the paper's Fig. 5 grid
+    glm::vec3 spacing{0.25f};               // world units; default 0.25
+    glm::vec3 position{0.0f};               // world position of the base (the spout); default origin
     std::optional<TextureSet> textureSet{}; // default none (procedural turbulence)
-    int textureCount = 16;            // default 16 (sec. 5.2)
-    float opacity = 0.35f;            // at the spout; default 0.35
-    float propagationStepsPerSec = 10.0f; // inter-voxel advection rate; default 10
-    float texturesPerSec = 4.0f;      // default 4
-    Motion motion{};                  // default at rest
-    std::uint32_t seed = 1;           // texture dynamics (which texture each voxel shows when); default 1
-    std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
+    int textureCount = 16;                  // default 16 (sec. 5.2)
+    float opacity = 0.35f;                  // at the spout; default 0.35
+    float propagationStepsPerSec = 10.0f;   // inter-voxel advection rate; default 10
+    float texturesPerSec = 4.0f;            // default 4
+    Motion motion{};                        // default at rest
+    std::uint32_t seed = 1;                 // texture dynamics (which texture each voxel shows when); default 1
+    std::uint32_t textureSeed = 1;          // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> steam(Materials& materials, const SteamDesc& desc = {});
 
@@ -105,65 +105,65 @@ Result<Effect> steam(Materials& materials, const SteamDesc& desc = {});
 // sampled into a lattice of `dims` cells placed with its base centre at
 // `position`; the gas's own coordinates are world coordinates.
 struct GasDesc {
-    ProceduralGasDesc gas{};          // which gas and its parameters; default rising steam
-    glm::ivec3 dims{16, 16, 16};      // lattice cells sampled per update; default 16^3
-    glm::vec3 spacing{0.125f};        // world units; default 0.125
-    glm::vec3 position{0.0f};         // world position of the lattice's base centre; default origin
+    ProceduralGasDesc gas{};                // which gas and its parameters; default rising steam
+    glm::ivec3 dims{16, 16, 16};            // lattice cells sampled per update; default 16^3
+    glm::vec3 spacing{0.125f};              // world units; default 0.125
+    glm::vec3 position{0.0f};               // world position of the lattice's base centre; default origin
     std::optional<TextureSet> textureSet{}; // default none (procedural turbulence)
-    int textureCount = 16;            // default 16
-    float opacity = 1.0f;             // scales the gas's density into splat opacity, (0, 1]; default 1
-    float texturesPerSec = 3.0f;      // local dynamics' cycling rate; default 3
-    Motion motion{};                  // moves the lattice; default at rest
-    std::uint32_t seed = 1;           // texture cycling; default 1
-    std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
+    int textureCount = 16;                  // default 16
+    float opacity = 1.0f;                   // scales the gas's density into splat opacity, (0, 1]; default 1
+    float texturesPerSec = 3.0f;            // local dynamics' cycling rate; default 3
+    Motion motion{};                        // moves the lattice; default at rest
+    std::uint32_t seed = 1;                 // texture cycling; default 1
+    std::uint32_t textureSeed = 1;          // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> gas(Materials& materials, const GasDesc& desc = {});
 
 struct DustDesc {
-    glm::ivec3 dims{24, 6, 12};       // solver cells; default 24x6x12
-    glm::vec3 spacing{0.5f};          // world units per cell; default 0.5
-    glm::vec3 position{0.0f};         // world position of the domain's base centre; default origin
-    Motion sourceMotion{};            // the animal kicking up dust; default at rest at `position`
+    glm::ivec3 dims{24, 6, 12};                // solver cells; default 24x6x12
+    glm::vec3 spacing{0.5f};                   // world units per cell; default 0.5
+    glm::vec3 position{0.0f};                  // world position of the domain's base centre; default origin
+    Motion sourceMotion{};                     // the animal kicking up dust; default at rest at `position`
     glm::vec3 sourceOffset{0.0f, 0.25f, 0.0f}; // hooves, in the animal's frame; default 0.25 up
-    float sourceRadius = 0.8f;        // world units; default 0.8
-    glm::vec3 windWorld{0.0f};        // default none
-    float settle = 0.6f;              // downward pull per unit density, world units/s^2; default 0.6
-    float dissipation = 0.3f;         // 1/s; default 0.3
-    std::optional<TextureSet> textureSet{}; // default none (procedural turbulence)
-    int textureCount = 8;             // default 8
-    std::uint32_t seed = 1;           // texture dynamics (which texture each voxel shows when); default 1
-    std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
+    float sourceRadius = 0.8f;                 // world units; default 0.8
+    glm::vec3 windWorld{0.0f};                 // default none
+    float settle = 0.6f;                       // downward pull per unit density, world units/s^2; default 0.6
+    float dissipation = 0.3f;                  // 1/s; default 0.3
+    std::optional<TextureSet> textureSet{};    // default none (procedural turbulence)
+    int textureCount = 8;                      // default 8
+    std::uint32_t seed = 1;                    // texture dynamics (which texture each voxel shows when); default 1
+    std::uint32_t textureSeed = 1;             // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> dust(Materials& materials, const DustDesc& desc = {});
 
 struct FireToSmokeDesc {
-    glm::ivec3 dims{7, 32, 5};        // lattice; default 7x32x5
-    glm::vec3 spacing{0.5f};          // default 0.5
-    glm::vec3 position{0.0f};         // default origin
-    float split = 0.45f;              // normalized height where smoke takes over, (0, 1); default 0.45
-    float blend = 0.15f;              // overlap of the two layers, normalized height; default 0.15
+    glm::ivec3 dims{7, 32, 5};                   // lattice; default 7x32x5
+    glm::vec3 spacing{0.5f};                     // default 0.5
+    glm::vec3 position{0.0f};                    // default origin
+    float split = 0.45f;                         // normalized height where smoke takes over, (0, 1); default 0.45
+    float blend = 0.15f;                         // overlap of the two layers, normalized height; default 0.15
     std::optional<TextureSet> fireTextureSet{};  // default none (procedural turbulence)
     std::optional<TextureSet> smokeTextureSet{}; // default none (procedural, softer turbulence)
-    float propagationStepsPerSec = 8.0f; // default 8
-    float texturesPerSec = 5.0f;      // default 5
-    Motion motion{};                  // default at rest
-    std::uint32_t seed = 1;           // texture dynamics (which texture each voxel shows when); default 1
-    std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
+    float propagationStepsPerSec = 8.0f;         // default 8
+    float texturesPerSec = 5.0f;                 // default 5
+    Motion motion{};                             // default at rest
+    std::uint32_t seed = 1;                      // texture dynamics (which texture each voxel shows when); default 1
+    std::uint32_t textureSeed = 1;               // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> fireToSmoke(Materials& materials, const FireToSmokeDesc& desc = {});
 
 struct GhostsDesc {
-    float headRadiusCells = 3.0f;     // the head's voxel sphere; default 3
-    int plumeCells = 8;               // cells of rising, dissipating faces above it; default 8
-    glm::vec3 spacing{0.3f};          // default 0.3
-    glm::vec3 position{0.0f};         // world position of the base; default origin
+    float headRadiusCells = 3.0f;           // the head's voxel sphere; default 3
+    int plumeCells = 8;                     // cells of rising, dissipating faces above it; default 8
+    glm::vec3 spacing{0.3f};                // default 0.3
+    glm::vec3 position{0.0f};               // world position of the base; default origin
     std::optional<TextureSet> textureSet{}; // face images; default none (procedural faces)
-    int textureCount = 12;            // procedural faces; default 12
-    float opacity = 0.4f;             // default 0.4
-    float texturesPerSec = 5.0f;      // random selection rate; default 5
-    float propagationStepsPerSec = 4.0f; // faces drifting upwards; default 4
-    std::uint32_t seed = 1;           // texture dynamics (which texture each voxel shows when); default 1
-    std::uint32_t textureSeed = 1;    // procedural texture set; equal values share one set in Materials; default 1
+    int textureCount = 12;                  // procedural faces; default 12
+    float opacity = 0.4f;                   // default 0.4
+    float texturesPerSec = 5.0f;            // random selection rate; default 5
+    float propagationStepsPerSec = 4.0f;    // faces drifting upwards; default 4
+    std::uint32_t seed = 1;                 // texture dynamics (which texture each voxel shows when); default 1
+    std::uint32_t textureSeed = 1;          // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> ghosts(Materials& materials, const GhostsDesc& desc = {});
 

@@ -35,21 +35,21 @@ enum class GasKind {
 };
 
 struct GasTurbulenceDesc {
-    std::uint32_t seed = 1;     // noise permutation; default 1
-    int octaves = 4;            // |noise| octaves summed, [1, 12]; default 4
-    float frequency = 1.0f;     // noise cycles per world unit at the first octave, > 0; default 1
+    std::uint32_t seed = 1; // noise permutation; default 1
+    int octaves = 4;        // |noise| octaves summed, [1, 12]; default 4
+    float frequency = 1.0f; // noise cycles per world unit at the first octave, > 0; default 1
 };
 
 struct GasSteamDesc {
-    glm::vec3 source{0.0f};     // world centre of the source disc (a glass's rim); default origin
-    float sourceRadius = 0.3f;  // world radius of the plume at the source, > 0; default 0.3
-    float spread = 1.5f;        // the plume's radius grows by this factor over `height`, >= 0; default 1.5
-    float height = 2.0f;        // world height at which the steam has dissipated, > 0; default 2
-    float riseSpeed = 0.4f;     // world units per second the steam rises through turbulent space; default 0.4
-    float swirlPeriodSec = 6.0f;// one turn of the helical drift, > 0; default 6
-    float swirlRadius = 0.3f;   // world radius of the helical drift through turbulent space, >= 0; default 0.3
-    float opaque = 1.6f;        // density scale (the paper's opaque), >= 0; default 1.6
-    float power = 1.5f;         // density exponent (the paper's power), > 0; default 1.5
+    glm::vec3 source{0.0f};      // world centre of the source disc (a glass's rim); default origin
+    float sourceRadius = 0.3f;   // world radius of the plume at the source, > 0; default 0.3
+    float spread = 1.5f;         // the plume's radius grows by this factor over `height`, >= 0; default 1.5
+    float height = 2.0f;         // world height at which the steam has dissipated, > 0; default 2
+    float riseSpeed = 0.4f;      // world units per second the steam rises through turbulent space; default 0.4
+    float swirlPeriodSec = 6.0f; // one turn of the helical drift, > 0; default 6
+    float swirlRadius = 0.3f;    // world radius of the helical drift through turbulent space, >= 0; default 0.3
+    float opaque = 1.6f;         // density scale (the paper's opaque), >= 0; default 1.6
+    float power = 1.5f;          // density exponent (the paper's power), > 0; default 1.5
 };
 
 // The paper's chess_fog, with frames turned into seconds: frame_num * DOWN
@@ -59,7 +59,7 @@ struct GasSteamDesc {
 // frontSpeed * t, deformed by turbulence; density is zero beyond it (x > f)
 // and grows to full over thickenDistance behind it.
 struct GasFogDesc {
-    float swirlPeriodSec = 8.0f;  // one turn of the ellipse in the y-z plane, > 0; default 8
+    float swirlPeriodSec = 8.0f; // one turn of the ellipse in the y-z plane, > 0; default 8
     // The ellipse's axes along y and z (ELLIPSE1, ELLIPSE2; the paper calls
     // them diameters, its code multiplies cos and sin by them), world units, >= 0.
     float ellipse1 = 0.6f;        // default 0.6
@@ -75,12 +75,12 @@ struct GasFogDesc {
 };
 
 struct GasCloudDesc {
-    glm::vec3 center{0.0f};       // world centre at t = 0; default origin
-    glm::vec3 radii{2.0f, 1.0f, 1.5f}; // world semi-axes, each > 0; default (2, 1, 1.5)
+    glm::vec3 center{0.0f};                 // world centre at t = 0; default origin
+    glm::vec3 radii{2.0f, 1.0f, 1.5f};      // world semi-axes, each > 0; default (2, 1, 1.5)
     glm::vec3 windPerSec{0.2f, 0.0f, 0.0f}; // the cloud drifts with the wind, through turbulent space; default (0.2, 0, 0)
-    float frequency = 3.0f;       // the paper's clouds(): sine frequency through turbulent space, > 0; default 3
-    float power = 1.0f;           // ... and its exponent, > 0; default 1
-    float opaque = 1.0f;          // density scale, >= 0; default 1
+    float frequency = 3.0f;                 // the paper's clouds(): sine frequency through turbulent space, > 0; default 3
+    float power = 1.0f;                     // ... and its exponent, > 0; default 1
+    float opaque = 1.0f;                    // density scale, >= 0; default 1
 };
 
 struct ProceduralGasDesc {

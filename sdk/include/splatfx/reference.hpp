@@ -76,10 +76,10 @@ enum class ReferenceWindow {
 
 // What the GL frame was drawn over: a constant colour, or the host's image.
 struct ReferenceHost {
-    glm::vec4 background{0.0f};         // premultiplied RGBA under the splats; default transparent black
+    glm::vec4 background{0.0f};             // premultiplied RGBA under the splats; default transparent black
     const Image* backgroundImage = nullptr; // optional RGBA, top row first, viewport size; replaces `background`
-    const Image* depth = nullptr;       // optional host depth, window units [0, 1], one channel, top row first
-                                        // (as gl::Framebuffer::readDepth returns); fragments behind it are dropped
+    const Image* depth = nullptr;           // optional host depth, window units [0, 1], one channel, top row first
+                                            // (as gl::Framebuffer::readDepth returns); fragments behind it are dropped
 };
 
 // ---- (issue 15) A transparent surface the reference composites exactly
@@ -88,8 +88,8 @@ struct ReferenceHost {
 // faces of a box count, like glass drawn without culling). Hidden behind the
 // host depth like the splats.
 struct ReferenceSurface {
-    std::vector<glm::dvec3> triangles;  // three world points per triangle
-    glm::dvec4 premultiplied{0.0};      // premultiplied RGBA of one crossing; default zero (invisible)
+    std::vector<glm::dvec3> triangles; // three world points per triangle
+    glm::dvec4 premultiplied{0.0};     // premultiplied RGBA of one crossing; default zero (invisible)
     // The quad a, b, c, d (in order around its edge) as two triangles.
     static ReferenceSurface quad(glm::dvec3 a, glm::dvec3 b, glm::dvec3 c, glm::dvec3 d, glm::dvec4 premultiplied);
     // An axis-aligned box's six faces (12 triangles).
@@ -98,10 +98,10 @@ struct ReferenceSurface {
 // ---- end (issue 15) ----
 
 struct SplatExactDesc {
-    ReferenceHost host{};                           // default: transparent black, no depth
+    ReferenceHost host{};                            // default: transparent black, no depth
     ReferenceWindow window = ReferenceWindow::Exact; // default Exact
-    bool trimCorners = false; // match RendererDesc::trimCorners (octagon vs square quad); default false, as the renderer's
-    int threads = 0;         // worker threads; 0 = std::thread::hardware_concurrency(); default 0
+    bool trimCorners = false;                        // match RendererDesc::trimCorners (octagon vs square quad); default false, as the renderer's
+    int threads = 0;                                 // worker threads; 0 = std::thread::hardware_concurrency(); default 0
     // Lighting (issue 16): false reads each splat's colour table exactly at its
     // colour coordinate (unlit splats); true uses the splat's RGBA8 colour,
     // which is what the GL pass draws and where a Scene puts lit colours
@@ -137,19 +137,19 @@ struct SplatExactDesc {
 };
 
 struct SplatExactStats {
-    std::uint64_t fragments = 0;    // (pixel, splat) pairs composited
-    std::uint64_t maxOverlap = 0;   // most fragments on one pixel
-    std::uint64_t skippedSplats = 0; // non-finite or degenerate splats, or layer/row out of range
-    double fogMaxOpticalDepth = 0.0;   // largest finite tau from the eye to a fragment or the host point
-    double fogMaxErrorEstimate = 0.0;  // largest quadrature error estimate of one pixel's optical depths (summed)
-    std::uint64_t fogUnconverged = 0;  // quadratures that missed fogTolerance
+    std::uint64_t fragments = 0;      // (pixel, splat) pairs composited
+    std::uint64_t maxOverlap = 0;     // most fragments on one pixel
+    std::uint64_t skippedSplats = 0;  // non-finite or degenerate splats, or layer/row out of range
+    double fogMaxOpticalDepth = 0.0;  // largest finite tau from the eye to a fragment or the host point
+    double fogMaxErrorEstimate = 0.0; // largest quadrature error estimate of one pixel's optical depths (summed)
+    std::uint64_t fogUnconverged = 0; // quadratures that missed fogTolerance
 };
 
 // Expects camera.viewport > 0 and materials holding every splat's layer and
 // colour row (others are skipped and counted). Fails with a message on a
 // host image whose size or channel count does not match the viewport.
-Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& camera, const Materials& materials,
-                               const SplatExactDesc& desc = {}, SplatExactStats* stats = nullptr);
+Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& camera, const Materials& materials, const SplatExactDesc& desc = {},
+                               SplatExactStats* stats = nullptr);
 
 // The continuous field that untextured splatting reconstructs.
 //
@@ -165,15 +165,15 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
 class VolumeField {
 public:
     struct Sample {
-        double extinction = 0.0;     // sum of sigma_j(x), per world unit
-        glm::dvec3 color{0.0};       // extinction-weighted mean colour (0 where extinction is 0)
+        double extinction = 0.0; // sum of sigma_j(x), per world unit
+        glm::dvec3 color{0.0};   // extinction-weighted mean colour (0 where extinction is 0)
     };
     struct VoxelKernel {
         glm::dvec3 center{0.0};
-        glm::dmat3 inverse{1.0};     // M^-1
-        double scale = 0.0;          // ln 2 * tau / (F(0) |det M|^(1/3))
-        double boundRadius = 0.0;    // world radius of a sphere holding the support
-        glm::dvec3 color{1.0};       // colour row at colorCoord (texel.rgb = 1 for the plain footprint)
+        glm::dmat3 inverse{1.0};  // M^-1
+        double scale = 0.0;       // ln 2 * tau / (F(0) |det M|^(1/3))
+        double boundRadius = 0.0; // world radius of a sphere holding the support
+        glm::dvec3 color{1.0};    // colour row at colorCoord (texel.rgb = 1 for the plain footprint)
     };
 
     explicit VolumeField(const Materials& materials);
@@ -202,20 +202,20 @@ private:
 };
 
 struct VolumeExactDesc {
-    ReferenceHost host{};        // default: transparent black, no depth
-    double tolerance = 1e-5;     // stop halving when two results differ by less (max over RGBA); default 1e-5
-    double initialStep = 0.0;    // world units; 0 = a quarter of the smallest kernel support radius; default 0
-    int maxHalvings = 10;        // at most this many halvings per pixel; default 10
-    int minHalvings = 1;         // at least this many (so every pixel has an error estimate); default 1
+    ReferenceHost host{};     // default: transparent black, no depth
+    double tolerance = 1e-5;  // stop halving when two results differ by less (max over RGBA); default 1e-5
+    double initialStep = 0.0; // world units; 0 = a quarter of the smallest kernel support radius; default 0
+    int maxHalvings = 10;     // at most this many halvings per pixel; default 10
+    int minHalvings = 1;      // at least this many (so every pixel has an error estimate); default 1
     // Fixed step (no refinement) when > 0: for convergence studies. Default 0.
     double fixedStep = 0.0;
-    int threads = 0;             // 0 = std::thread::hardware_concurrency(); default 0
+    int threads = 0; // 0 = std::thread::hardware_concurrency(); default 0
 };
 
 struct VolumeExactStats {
-    double maxErrorEstimate = 0.0;   // largest |C(h) - C(h/2)| over pixels at the final step
+    double maxErrorEstimate = 0.0; // largest |C(h) - C(h/2)| over pixels at the final step
     int maxHalvingsUsed = 0;
-    std::uint64_t unconverged = 0;   // pixels that hit maxHalvings above tolerance
+    std::uint64_t unconverged = 0; // pixels that hit maxHalvings above tolerance
     std::uint64_t kernelEvaluations = 0;
 };
 
@@ -225,21 +225,20 @@ struct VolumeExactStats {
 // inside each piece, steps of at most h each contribute
 // (1 - exp(-dtau)) * (extinction-weighted colour) with dtau by 4-point
 // Gauss-Legendre: exact for a constant colour, second order in h otherwise.
-Result<Image> renderVolumeExact(const VolumeField& field, const Camera& camera, const VolumeExactDesc& desc = {},
-                                VolumeExactStats* stats = nullptr);
+Result<Image> renderVolumeExact(const VolumeField& field, const Camera& camera, const VolumeExactDesc& desc = {}, VolumeExactStats* stats = nullptr);
 
 // ---- Tetrahedra (LOD volumes) and fog in one medium ----
 
 struct RayFogDesc {
-    const Fog* fog = nullptr;  // default none (then the cloud alone, like integrateRay)
-    double timeSec = 0.0;      // the fog's time; default 0
+    const Fog* fog = nullptr; // default none (then the cloud alone, like integrateRay)
+    double timeSec = 0.0;     // the fog's time; default 0
     // true: the fog is integrated to the ray's end (the host point) and counts
     // in alpha, as a frame with gl::FrameRenderer's host fog pass; false: as a
     // frame drawn without it (fog only in front of cloud matter, alpha the
     // cloud's). Default true.
     bool fogHost = true;
-    double tolerance = 1e-6;   // per tetrahedron piece: halve the step until two results differ by less; default 1e-6
-    int maxHalvings = 12;      // at most this many halvings per piece; default 12
+    double tolerance = 1e-6; // per tetrahedron piece: halve the step until two results differ by less; default 1e-6
+    int maxHalvings = 12;    // at most this many halvings per piece; default 12
 };
 struct RayFogStats {
     double errorEstimate = 0.0;      // sum of the pieces' last differences and the fog quadratures' estimates
@@ -257,22 +256,21 @@ struct RayFogStats {
 // inside them; never the closed forms) and starting at the eye. Beyond the
 // fog's farDistanceWorld the fog's transmittance is 0 (its colour at the cut-off),
 // as the GL passes do. Premultiplied RGBA. Brute force: for tests and benches.
-glm::dvec4 integrateRayWithFog(const std::vector<Tetrahedron>& tets, const TransferFunction& transfer, glm::dvec3 eye,
-                               glm::dvec3 dir, double tNear, double tFar, const RayFogDesc& desc = {},
-                               RayFogStats* stats = nullptr);
+glm::dvec4 integrateRayWithFog(const std::vector<Tetrahedron>& tets, const TransferFunction& transfer, glm::dvec3 eye, glm::dvec3 dir, double tNear,
+                               double tFar, const RayFogDesc& desc = {}, RayFogStats* stats = nullptr);
 
 struct TetraExactDesc {
-    ReferenceHost host{};      // default: transparent black, no depth (a depth that is NaN or < 0 is ignored)
-    const Fog* fog = nullptr;  // default none
-    double fogTimeSec = 0.0;   // default 0
-    bool fogHost = true;       // RayFogDesc::fogHost; default true
-    double tolerance = 1e-6;   // RayFogDesc::tolerance; default 1e-6
-    int maxHalvings = 12;      // in [1, 20]; default 12
-    int threads = 0;           // 0 = std::thread::hardware_concurrency(); default 0
+    ReferenceHost host{};     // default: transparent black, no depth (a depth that is NaN or < 0 is ignored)
+    const Fog* fog = nullptr; // default none
+    double fogTimeSec = 0.0;  // default 0
+    bool fogHost = true;      // RayFogDesc::fogHost; default true
+    double tolerance = 1e-6;  // RayFogDesc::tolerance; default 1e-6
+    int maxHalvings = 12;     // in [1, 20]; default 12
+    int threads = 0;          // 0 = std::thread::hardware_concurrency(); default 0
 };
 struct TetraExactStats {
-    double maxErrorEstimate = 0.0;  // largest RayFogStats::errorEstimate of a pixel
-    std::uint64_t unconverged = 0;  // pixels whose integral missed the tolerance somewhere
+    double maxErrorEstimate = 0.0; // largest RayFogStats::errorEstimate of a pixel
+    std::uint64_t unconverged = 0; // pixels whose integral missed the tolerance somewhere
 };
 
 // integrateRayWithFog through every pixel centre (GL's conventions, as the

@@ -30,16 +30,25 @@ inline Error makeError(std::string message) { return Error{std::move(message)}; 
 template <class T>
 class [[nodiscard]] Result {
 public:
-    Result(T value) : mValue(std::move(value)) {}           // NOLINT: implicit by design
+    Result(T value) : mValue(std::move(value)) {}             // NOLINT: implicit by design
     Result(Error error) : mError(std::move(error.message)) {} // NOLINT: implicit by design
 
     bool ok() const { return mValue.has_value(); }
     explicit operator bool() const { return ok(); }
 
     // Expects ok().
-    T& value() & { assert(ok() && "Result::value() called on an error"); return *mValue; }
-    const T& value() const& { assert(ok() && "Result::value() called on an error"); return *mValue; }
-    T&& value() && { assert(ok() && "Result::value() called on an error"); return std::move(*mValue); }
+    T& value() & {
+        assert(ok() && "Result::value() called on an error");
+        return *mValue;
+    }
+    const T& value() const& {
+        assert(ok() && "Result::value() called on an error");
+        return *mValue;
+    }
+    T&& value() && {
+        assert(ok() && "Result::value() called on an error");
+        return std::move(*mValue);
+    }
     T& operator*() & { return value(); }
     const T& operator*() const& { return value(); }
     T&& operator*() && { return std::move(*this).value(); }

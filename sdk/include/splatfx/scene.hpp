@@ -64,7 +64,7 @@ enum class SelfShadow {
 // at each splat's centre (per splat, on the CPU; the GL pass is unchanged).
 // Only effects added as an Effect are lit (other kinds stay unlit).
 struct EffectLighting {
-    bool enabled = false;                      // default false (unlit)
+    bool enabled = false; // default false (unlit)
     // Albedo, phase lobes, emission, ambient, multipleScattering; its
     // colorTable is ignored (each layer's own table is the base colour).
     GasLightingDesc gas{};                     // default GasLightingDesc{} (albedo 0.5, isotropic)
@@ -80,29 +80,29 @@ struct EffectLighting {
 // exactly one effect casts and its self-shadowing table for that light has
 // these dims, that table is used (no second build).
 struct SceneShadowDesc {
-    bool enabled = true;        // default true (when a light exists)
-    std::size_t light = 0;      // index into Scene::lights(); default 0 (the first)
-    glm::ivec3 dims{64};        // entries per axis, each in [1, 1024]; default 64^3
+    bool enabled = true;                           // default true (when a light exists)
+    std::size_t light = 0;                         // index into Scene::lights(); default 0 (the first)
+    glm::ivec3 dims{64};                           // entries per axis, each in [1, 1024]; default 64^3
     std::uint64_t memoryBudgetBytes = 64ull << 20; // as ShadowTableDesc; default 64 MiB
 };
 
 struct EffectOptions {
-    std::string name;                                        // for counters and messages; default empty
+    std::string name;                                          // for counters and messages; default empty
     float rangeWorld = std::numeric_limits<float>::infinity(); // skipped beyond this distance from its bounds; default no limit
-    bool enabled = true;                                     // default true
+    bool enabled = true;                                       // default true
     // Passed to the kind's advanceTo (AdvanceContext): solver effects
     // returning after dt unseen seconds catch up in
     // n = min(ceil(dt / catchUpStepSec), maxCatchUpSteps) steps of dt / n.
-    double catchUpStepSec = 1.0 / 30.0;                      // default 1/30 s
-    int maxCatchUpSteps = 8;                                 // default 8
+    double catchUpStepSec = 1.0 / 30.0; // default 1/30 s
+    int maxCatchUpSteps = 8;            // default 8
     // Passed to the kind's alive (AliveHints): a solver effect whose emitters
     // are all off and whose total density is below this is dead: not
     // simulated, not drawn.
-    double deadDensity = 1e-4;                               // default 1e-4
+    double deadDensity = 1e-4; // default 1e-4
     // How the effect is drawn (textured or traditional, opacity scale);
     // combined with the options given to prepare()/emit(). Default EmitOptions{}.
     EmitOptions draw{};
-    EffectLighting lighting{};                               // lighting (issue 16); default unlit
+    EffectLighting lighting{}; // lighting (issue 16); default unlit
 };
 
 // Why an effect was or was not needed at the last update, and what it cost.
@@ -124,23 +124,23 @@ struct EffectStatus {
 };
 
 struct SceneCounters {
-    std::size_t declared = 0;   // effects in the scene
-    std::size_t needed = 0;     // needed at the last update (= simulated and drawn)
-    std::size_t simulated = 0;  // effects that did dynamics work at the last update
-    std::uint64_t splats = 0;   // splats emitted at the last emit()
+    std::size_t declared = 0;  // effects in the scene
+    std::size_t needed = 0;    // needed at the last update (= simulated and drawn)
+    std::size_t simulated = 0; // effects that did dynamics work at the last update
+    std::uint64_t splats = 0;  // splats emitted at the last emit()
     // ---- lighting (issue 16)
-    std::size_t litEffects = 0;               // effects lit at the last emit()
-    std::uint64_t shadowTableBuilds = 0;      // self-shadowing and scene-shadow tables built at the last emit()
-    std::uint64_t shadowTableReuses = 0;      // ... reused unchanged at the last emit()
-    std::uint64_t sceneShadowBuilds = 0;      // scene-shadow table builds (cumulative)
+    std::size_t litEffects = 0;          // effects lit at the last emit()
+    std::uint64_t shadowTableBuilds = 0; // self-shadowing and scene-shadow tables built at the last emit()
+    std::uint64_t shadowTableReuses = 0; // ... reused unchanged at the last emit()
+    std::uint64_t sceneShadowBuilds = 0; // scene-shadow table builds (cumulative)
 };
 
 // ---- [clouds, issue 17] LOD volumes, drawn as projected tetrahedra ----
 using VolumeId = std::uint32_t;
 struct VolumeOptions {
-    std::string name;          // for messages; default empty
-    bool enabled = true;       // default true
-    LodRefineDesc refine{};    // per-frame refinement (c, morphing, culling); default LodRefineDesc{}
+    std::string name;       // for messages; default empty
+    bool enabled = true;    // default true
+    LodRefineDesc refine{}; // per-frame refinement (c, morphing, culling); default LodRefineDesc{}
     // Ground fog only: prepare() keeps the frame's terrain triangles
     // (groundFogTerrain), so a host draws its terrain from the same LOD mesh
     // without refining it twice. Default false.
@@ -238,10 +238,10 @@ public:
 private:
     // ---- lighting (issue 16): what a lit effect keeps between frames (scene_lighting.cpp).
     struct LitState {
-        Grid densityGrid;           // the layers' voxels, opacity as the splats draw it (scratch)
-        DensityField field;         // what the light sees; its fingerprint says when it changed
-        ShadowTables tables;        // self-shadowing, one per light
-        glm::ivec3 tableDims{0};    // what `tables` was made with
+        Grid densityGrid;                       // the layers' voxels, opacity as the splats draw it (scratch)
+        DensityField field;                     // what the light sees; its fingerprint says when it changed
+        ShadowTables tables;                    // self-shadowing, one per light
+        glm::ivec3 tableDims{0};                // what `tables` was made with
         std::vector<glm::vec3> points, factors; // scratch: splat centres and their light factors
     };
     struct Entry {
@@ -249,7 +249,7 @@ private:
         Effect* effect = nullptr;         // kind as an Effect, if it was added as one
         EffectOptions options;
         EffectStatus status;
-        std::unique_ptr<LitState> lit;    // lighting (issue 16): made when first lit
+        std::unique_ptr<LitState> lit; // lighting (issue 16): made when first lit
     };
     EffectId push(Entry entry);
     // lighting (issue 16): lights the splats [first, end) the entry just emitted.

@@ -49,13 +49,13 @@ inline constexpr const char* kSceneFileFormat = "splatfx-scene";
 inline constexpr int kSceneFileVersion = 1;
 
 enum class GeometryType {
-    Plane,    // square in the object's xz plane, size.x by size.z, facing +y
-    Box,      // axis-aligned in object space, size = full extents
-    Cylinder, // along object +y from y = 0 to size.y, radius size.x / 2
-    Sphere,   // radius size.x / 2, centred on the object origin
-    Mesh,     // triangles from meshPath (the host loads it)
+    Plane,     // square in the object's xz plane, size.x by size.z, facing +y
+    Box,       // axis-aligned in object space, size = full extents
+    Cylinder,  // along object +y from y = 0 to size.y, radius size.x / 2
+    Sphere,    // radius size.x / 2, centred on the object origin
+    Mesh,      // triangles from meshPath (the host loads it)
     Heightmap, // a terrain grid from heightmapPath (an image, channel 0), centred on the object origin
-    Empty,    // nothing drawn: an anchor whose motion other objects and effects share
+    Empty,     // nothing drawn: an anchor whose motion other objects and effects share
 };
 
 // One piece of scene geometry. Object to world at t:
@@ -64,14 +64,14 @@ enum class GeometryType {
 // `motion` is its own keyframed/procedural motion or the motion of the object
 // it is attached to (so a locomotive's parts and its smoke move together).
 struct GeometryDesc {
-    std::string name;               // default "geometry[i]"
+    std::string name; // default "geometry[i]"
     GeometryType type = GeometryType::Box;
-    std::string meshPath;           // Mesh: absolute or cwd-relative path, resolved against the scene file
-    glm::vec3 size{1.0f};           // world units (see GeometryType); default 1
-    glm::mat4 transform{1.0f};      // static placement; default identity
-    Motion motion;                  // default at rest
-    std::string attachedTo;         // name of the object whose motion it shares; default empty
-    glm::vec3 color{0.6f};          // linear RGB albedo; default grey
+    std::string meshPath;      // Mesh: absolute or cwd-relative path, resolved against the scene file
+    glm::vec3 size{1.0f};      // world units (see GeometryType); default 1
+    glm::mat4 transform{1.0f}; // static placement; default identity
+    Motion motion;             // default at rest
+    std::string attachedTo;    // name of the object whose motion it shares; default empty
+    glm::vec3 color{0.6f};     // linear RGB albedo; default grey
     // ---- (issue 15) below 1: a transparent surface (glass), premultiplied
     // (lit colour x opacity, opacity) per layer, which a host draws through
     // transparentGlsl() into the fragment lists (tools/scenehost does). [0, 1]; default 1 (opaque).
@@ -83,9 +83,9 @@ struct GeometryDesc {
     // Heightmap: sample (i, j) of the image (row 0 = -z edge) is the
     // point ((i - (w-1)/2) s, heightScale v, (j - (h-1)/2) s), s = heightmapSpacing,
     // v the image value in [0, 1] (a 16-bit PGM: code / 65535). heightmapPoint() below.
-    std::string heightmapPath;      // Heightmap: resolved against the scene file
-    float heightmapSpacing = 1.0f;  // world units between samples; default 1
-    float heightmapScale = 1.0f;    // world height of value 1; default 1
+    std::string heightmapPath;     // Heightmap: resolved against the scene file
+    float heightmapSpacing = 1.0f; // world units between samples; default 1
+    float heightmapScale = 1.0f;   // world height of value 1; default 1
 };
 
 // Object-space point of heightmap sample (i, j) of a w x h image with value v.
@@ -95,34 +95,34 @@ inline glm::vec3 heightmapPoint(int i, int j, int w, int h, float v, float spaci
 
 // One key of the camera path.
 struct CameraKey {
-    double timeSec = 0.0;             // strictly increasing; default 0
-    glm::vec3 position{0, 2, 10};     // world; default (0, 2, 10)
-    glm::vec3 target{0, 1, 0};        // world point looked at; default (0, 1, 0)
-    float fovYRad = 0.7853982f;       // vertical field of view, radians; default 45 degrees
+    double timeSec = 0.0;         // strictly increasing; default 0
+    glm::vec3 position{0, 2, 10}; // world; default (0, 2, 10)
+    glm::vec3 target{0, 1, 0};    // world point looked at; default (0, 1, 0)
+    float fovYRad = 0.7853982f;   // vertical field of view, radians; default 45 degrees
 };
 
 struct CameraPath {
-    std::vector<CameraKey> keys;      // at least one (a default key when the file has no camera)
-    bool smooth = true;               // smoothstep between keys (false: linear); default true
-    float nearPlane = 0.05f;          // world units; default 0.05
-    float farPlane = 500.0f;          // world units; default 500
+    std::vector<CameraKey> keys; // at least one (a default key when the file has no camera)
+    bool smooth = true;          // smoothstep between keys (false: linear); default true
+    float nearPlane = 0.05f;     // world units; default 0.05
+    float farPlane = 500.0f;     // world units; default 500
 };
 
 struct OutputSettings {
-    glm::ivec2 size{640, 480};        // pixels; default 640x480
-    int frames = 48;                  // default 48
-    float fps = 24.0f;                // animation time of frame i is i / fps; default 24
+    glm::ivec2 size{640, 480};                 // pixels; default 640x480
+    int frames = 48;                           // default 48
+    float fps = 24.0f;                         // animation time of frame i is i / fps; default 24
     glm::vec3 background{0.02f, 0.02f, 0.04f}; // clear colour, linear RGB; default near black
-    std::string name;                 // output file stem; default the scene file's folder name
+    std::string name;                          // output file stem; default the scene file's folder name
 };
 
 // What the file said about each effect, beside the Scene entry built for it.
 struct SceneEffectInfo {
-    EffectId id = 0;                  // in SceneFile::scene
-    std::string name;                 // default "<kind><i>"
-    std::string kind;                 // "fire", "smoke", ..., "grid"
-    std::string attachedTo;           // geometry name whose motion it rides; default empty
-    bool traditional = false;         // drawn with plain footprints (Fig. 1a); default false
+    EffectId id = 0;          // in SceneFile::scene
+    std::string name;         // default "<kind><i>"
+    std::string kind;         // "fire", "smoke", ..., "grid"
+    std::string attachedTo;   // geometry name whose motion it rides; default empty
+    bool traditional = false; // drawn with plain footprints (Fig. 1a); default false
 };
 
 // [issue 17] A LOD ground-fog layer whose terrain mesh the host draws in
@@ -134,10 +134,10 @@ struct GroundFogTerrain {
 };
 
 struct SceneFile {
-    std::string path;                 // the file as given
-    std::string title;                // default empty
-    std::uint32_t seed = 1;           // scene seed after SceneFileOptions::seed; default 1
-    Scene scene;                      // one entry per effect, in file order
+    std::string path;       // the file as given
+    std::string title;      // default empty
+    std::uint32_t seed = 1; // scene seed after SceneFileOptions::seed; default 1
+    Scene scene;            // one entry per effect, in file order
     std::vector<SceneEffectInfo> effects;
     std::vector<GeometryDesc> geometry;
     CameraPath camera;
@@ -147,11 +147,11 @@ struct SceneFile {
 
 struct SceneFileOptions {
     // Replaces the file's top-level "seed" (every effect's seed derives from it).
-    std::optional<std::uint32_t> seed;   // default: the file's seed
-    int maxErrors = 8;                   // problems reported before giving up, >= 1; default 8
+    std::optional<std::uint32_t> seed; // default: the file's seed
+    int maxErrors = 8;                 // problems reported before giving up, >= 1; default 8
     // What the file may ask to build: lattice and solver cells, sampled
     // texels, texture layers (budget.hpp); checked before each is built.
-    Budgets budgets{};                   // default: Budgets' defaults
+    Budgets budgets{}; // default: Budgets' defaults
 };
 
 // Reads and builds a scene file. Expects options.maxErrors >= 1.
@@ -162,7 +162,6 @@ Result<SceneFile> loadSceneFile(const std::string& path, Materials& materials, c
 
 // Same, from text already in memory. `path` names the file in messages and
 // its folder anchors relative paths (it need not exist).
-Result<SceneFile> parseSceneFile(const std::string& text, const std::string& path, Materials& materials,
-                                 const SceneFileOptions& options = {});
+Result<SceneFile> parseSceneFile(const std::string& text, const std::string& path, Materials& materials, const SceneFileOptions& options = {});
 
 } // namespace splatfx

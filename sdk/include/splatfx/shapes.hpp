@@ -59,11 +59,11 @@ struct Shape {
 };
 
 struct VoxelizeDesc {
-    glm::ivec3 dims{7, 20, 5};      // lattice cells, each >= 1, at most kMaxVoxels in all; default the paper's 7x20x5
-    glm::vec3 spacing{1.0f};        // grid-local units between cells, each > 0; default 1
-    float opacity = 0.5f;           // multiplies every shape's weight, [0, 1]; default 0.5
-    glm::vec3 fadeAxis{0, 1, 0};    // direction (any length > 0) of the fade and the colour coordinate; default +y
-    float fadeTo = 1.0f;            // opacity factor at the far end of fadeAxis (1 at the near end), [0, 1]; default 1 (no fade)
+    glm::ivec3 dims{7, 20, 5};   // lattice cells, each >= 1, at most kMaxVoxels in all; default the paper's 7x20x5
+    glm::vec3 spacing{1.0f};     // grid-local units between cells, each > 0; default 1
+    float opacity = 0.5f;        // multiplies every shape's weight, [0, 1]; default 0.5
+    glm::vec3 fadeAxis{0, 1, 0}; // direction (any length > 0) of the fade and the colour coordinate; default +y
+    float fadeTo = 1.0f;         // opacity factor at the far end of fadeAxis (1 at the near end), [0, 1]; default 1 (no fade)
 };
 
 // Each cell takes the strongest shape covering it (every cell weight 1 when

@@ -45,45 +45,45 @@ namespace splatfx {
 // A region in world space that injects material, attached to a moving object
 // (its Motion): its centre is motion.matrix(t) * offset.
 struct EmitterDesc {
-    glm::vec3 offset{0.0f};     // centre in the object's frame, object units; default origin
+    glm::vec3 offset{0.0f}; // centre in the object's frame, object units; default origin
     // World units, > 0; cells within it are fed with weight (1 - (r/radius)^2)^2.
     // Never smaller than half a cell's diagonal, so an emitter always reaches a cell.
-    float radius = 1.0f;        // default 1
-    float density = 1.0f;       // target density inside the region, >= 0; default 1
-    float temperature = 1.0f;   // target temperature (above ambient), >= 0; default 1
-    float rate = 4.0f;          // 1/s: how fast cells relax towards the targets, >= 0; default 4
-    glm::vec3 velocity{0.0f};   // world units/s the material leaves with (exhaust); default 0
+    float radius = 1.0f;         // default 1
+    float density = 1.0f;        // target density inside the region, >= 0; default 1
+    float temperature = 1.0f;    // target temperature (above ambient), >= 0; default 1
+    float rate = 4.0f;           // 1/s: how fast cells relax towards the targets, >= 0; default 4
+    glm::vec3 velocity{0.0f};    // world units/s the material leaves with (exhaust); default 0
     bool injectVelocity = false; // relax the velocity towards `velocity` too; default false
 };
 
 struct Emitter {
     EmitterDesc desc{};
-    Motion motion{};            // the object the emitter is attached to; default at rest at the origin
+    Motion motion{}; // the object the emitter is attached to; default at rest at the origin
     // World centre at t.
     glm::vec3 worldCenter(double timeSec) const { return glm::vec3(motion.matrix(timeSec) * glm::vec4(desc.offset, 1.0f)); }
 };
 
 struct FluidSolverDesc {
-    glm::ivec3 dims{8, 16, 8};      // cells per axis, each >= 1, at most kMaxVoxels in all; default 8x16x8
-    glm::vec3 spacing{1.0f};        // cell size, grid-local units, > 0; default 1
-    glm::mat4 transform{1.0f};      // grid-local to world (same lattice convention as Grid); default identity
-    float buoyancy = 4.0f;          // upward acceleration per unit temperature, local units/s^2; default 4
-    float weight = 0.0f;            // downward acceleration per unit density (dust settles), local units/s^2; default 0
-    float ambientTemperature = 0.0f; // temperature of the surroundings; default 0
-    glm::vec3 windWorld{0.0f};      // world units/s the air relaxes towards; default none
-    float windCoupling = 0.0f;      // 1/s: how fast velocity relaxes towards the wind, >= 0; default 0
-    float velocityDamping = 0.2f;   // 1/s, implicit drag, >= 0; default 0.2
-    float densityDissipation = 0.0f; // 1/s, implicit decay of density, >= 0; default 0
+    glm::ivec3 dims{8, 16, 8};           // cells per axis, each >= 1, at most kMaxVoxels in all; default 8x16x8
+    glm::vec3 spacing{1.0f};             // cell size, grid-local units, > 0; default 1
+    glm::mat4 transform{1.0f};           // grid-local to world (same lattice convention as Grid); default identity
+    float buoyancy = 4.0f;               // upward acceleration per unit temperature, local units/s^2; default 4
+    float weight = 0.0f;                 // downward acceleration per unit density (dust settles), local units/s^2; default 0
+    float ambientTemperature = 0.0f;     // temperature of the surroundings; default 0
+    glm::vec3 windWorld{0.0f};           // world units/s the air relaxes towards; default none
+    float windCoupling = 0.0f;           // 1/s: how fast velocity relaxes towards the wind, >= 0; default 0
+    float velocityDamping = 0.2f;        // 1/s, implicit drag, >= 0; default 0.2
+    float densityDissipation = 0.0f;     // 1/s, implicit decay of density, >= 0; default 0
     float temperatureDissipation = 0.5f; // 1/s, implicit cooling towards ambient, >= 0; default 0.5
-    int pressureIterations = 60;    // conjugate-gradient iterations, >= 0 (0: no projection); default 60
-    float pressureTolerance = 1e-5f; // relative residual at which CG stops early; default 1e-5
-    int substeps = 1;               // substeps per step(), >= 1; default 1
-    bool closedFloor = true;        // no flow through the -y face; default true
-    bool closedWalls = false;       // no flow through the x and z faces; default false (open)
-    bool closedCeiling = false;     // no flow through the +y face; default false (open)
+    int pressureIterations = 60;         // conjugate-gradient iterations, >= 0 (0: no projection); default 60
+    float pressureTolerance = 1e-5f;     // relative residual at which CG stops early; default 1e-5
+    int substeps = 1;                    // substeps per step(), >= 1; default 1
+    bool closedFloor = true;             // no flow through the -y face; default true
+    bool closedWalls = false;            // no flow through the x and z faces; default false (open)
+    bool closedCeiling = false;          // no flow through the +y face; default false (open)
     // Rescale density after advection so its total equals the total before
     // (semi-Lagrangian advection is not conservative). Needs every face closed.
-    bool conserveMass = false;      // default false
+    bool conserveMass = false; // default false
 };
 
 // How dense fields become a sparse grid.
@@ -94,22 +94,22 @@ enum class ColorSource {
 };
 
 struct SparseOutputDesc {
-    float opacityPerDensity = 0.6f; // voxel opacity = clamp(density * this, 0, 1); default 0.6
-    float minOpacity = 0.01f;       // cells below it are left out (sparse); default 0.01
+    float opacityPerDensity = 0.6f;          // voxel opacity = clamp(density * this, 0, 1); default 0.6
+    float minOpacity = 0.01f;                // cells below it are left out (sparse); default 0.01
     ColorSource color = ColorSource::Height; // default Height
     // Temperature colour: coord = 1 - clamp((T - ambient) / temperatureRange):
     // hottest at 0 (a fire table's white-yellow base), cold at 1.
-    float temperatureRange = 1.0f;  // > 0; default 1
-    float stretchPerSpeed = 0.0f;   // kernel stretch = velocity * this (seconds / local unit); default 0 (round kernels)
-    float maxStretch = 1.0f;        // cap on |stretch|; default 1
+    float temperatureRange = 1.0f; // > 0; default 1
+    float stretchPerSpeed = 0.0f;  // kernel stretch = velocity * this (seconds / local unit); default 0 (round kernels)
+    float maxStretch = 1.0f;       // cap on |stretch|; default 1
 };
 
 struct SolverStats {
-    std::uint64_t steps = 0;         // step() calls
-    std::uint64_t substeps = 0;      // substeps simulated
-    std::uint64_t cellsUpdated = 0;  // cells times substeps
-    int lastPressureIterations = 0;  // CG iterations of the last projection
-    float lastResidual = 0.0f;       // relative residual after it
+    std::uint64_t steps = 0;        // step() calls
+    std::uint64_t substeps = 0;     // substeps simulated
+    std::uint64_t cellsUpdated = 0; // cells times substeps
+    int lastPressureIterations = 0; // CG iterations of the last projection
+    float lastResidual = 0.0f;      // relative residual after it
 };
 
 class FluidSolver {
@@ -172,7 +172,7 @@ private:
     FluidSolverDesc mDesc;
     glm::ivec3 mDims{0};
     std::vector<float> mDensity, mTemp, mScratch;
-    std::vector<float> mU[3], mUScratch[3]; // face velocities, local units/s
+    std::vector<float> mU[3], mUScratch[3];   // face velocities, local units/s
     std::vector<double> mP, mR, mD, mQ, mRhs; // CG workspace
     std::vector<Emitter> mEmitters;
     glm::vec3 mUpLocal{0, 1, 0};

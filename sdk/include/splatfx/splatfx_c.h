@@ -59,15 +59,15 @@
 #include <stdint.h>
 
 #if defined(_WIN32)
-#  if defined(SPLATFX_C_BUILDING)
-#    define SPLATFX_C_API __declspec(dllexport)
-#  else
-#    define SPLATFX_C_API __declspec(dllimport)
-#  endif
-#elif defined(__GNUC__)
-#  define SPLATFX_C_API __attribute__((visibility("default")))
+#if defined(SPLATFX_C_BUILDING)
+#define SPLATFX_C_API __declspec(dllexport)
 #else
-#  define SPLATFX_C_API
+#define SPLATFX_C_API __declspec(dllimport)
+#endif
+#elif defined(__GNUC__)
+#define SPLATFX_C_API __attribute__((visibility("default")))
+#else
+#define SPLATFX_C_API
 #endif
 
 /* Enums are 32-bit signed integers on both sides. In C++ they get that as a
@@ -77,9 +77,9 @@
  * C each enum carries a 0x7fffffff enumerator, which keeps it int-sized under
  * -fshort-enums too. */
 #ifdef __cplusplus
-#  define SPLATFX_C_ENUM(name) enum name : int32_t
+#define SPLATFX_C_ENUM(name) enum name : int32_t
 #else
-#  define SPLATFX_C_ENUM(name) enum name
+#define SPLATFX_C_ENUM(name) enum name
 #endif
 
 #ifdef __cplusplus
@@ -93,17 +93,15 @@ SPLATFX_C_API uint32_t splatfx_c_api_version(void);
 
 /* ---- [errors] ------------------------------------------------------------ */
 
-typedef SPLATFX_C_ENUM(splatfx_status) {
-    SPLATFX_OK = 0,
-    SPLATFX_ERROR_INVALID_ARGUMENT = 1, /* a NULL handle, a field out of range, a NaN */
-    SPLATFX_ERROR_INVALID_STATE = 2,    /* e.g. rendering a frame that was never prepared */
-    SPLATFX_ERROR_NOT_FOUND = 3,        /* an effect id the scene does not have */
-    SPLATFX_ERROR_FILE = 4,             /* a scene file or texture-set folder could not be read or is invalid */
-    SPLATFX_ERROR_GL = 5,               /* no OpenGL 4.5 context, no EGL display, a GL name that is not what was asked */
-    SPLATFX_ERROR_OUT_OF_MEMORY = 6,
-    SPLATFX_ERROR_INTERNAL = 7,         /* an unexpected C++ exception, caught at the boundary */
-    SPLATFX_STATUS_MAX_ENUM = 0x7fffffff
-} splatfx_status;
+typedef SPLATFX_C_ENUM(splatfx_status){SPLATFX_OK = 0,
+                                       SPLATFX_ERROR_INVALID_ARGUMENT = 1, /* a NULL handle, a field out of range, a NaN */
+                                       SPLATFX_ERROR_INVALID_STATE = 2,    /* e.g. rendering a frame that was never prepared */
+                                       SPLATFX_ERROR_NOT_FOUND = 3,        /* an effect id the scene does not have */
+                                       SPLATFX_ERROR_FILE = 4,             /* a scene file or texture-set folder could not be read or is invalid */
+                                       SPLATFX_ERROR_GL = 5, /* no OpenGL 4.5 context, no EGL display, a GL name that is not what was asked */
+                                       SPLATFX_ERROR_OUT_OF_MEMORY = 6,
+                                       SPLATFX_ERROR_INTERNAL = 7, /* an unexpected C++ exception, caught at the boundary */
+                                       SPLATFX_STATUS_MAX_ENUM = 0x7fffffff} splatfx_status;
 
 /* A short constant name for a status ("SPLATFX_ERROR_FILE"); never NULL. */
 SPLATFX_C_API const char* splatfx_status_name(splatfx_status status);
@@ -141,8 +139,7 @@ typedef struct splatfx_materials_desc {
 SPLATFX_C_API void splatfx_materials_desc_init(splatfx_materials_desc* desc);
 
 typedef struct splatfx_materials splatfx_materials;
-SPLATFX_C_API splatfx_status splatfx_materials_create(const splatfx_materials_desc* desc, splatfx_materials** out,
-                                                      splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_materials_create(const splatfx_materials_desc* desc, splatfx_materials** out, splatfx_error* error);
 SPLATFX_C_API void splatfx_materials_destroy(splatfx_materials* materials);
 /* Texture layers held (layer 0 is the plain footprint). 0 for NULL. */
 SPLATFX_C_API uint32_t splatfx_materials_layer_count(const splatfx_materials* materials);
@@ -163,11 +160,11 @@ SPLATFX_C_API void splatfx_scene_destroy(splatfx_scene* scene);
 
 /* How the scene treats one effect (scene.hpp, EffectOptions). */
 typedef struct splatfx_effect_options {
-    const char* name;       /* for messages, copied; default NULL (no name) */
-    float range_world;      /* skipped beyond this distance of its bounds from the camera, > 0; default INFINITY */
-    int enabled;            /* default 1 */
-    int textured;           /* 0: traditional splats (the plain footprint); default 1 */
-    float opacity_scale;    /* multiplies the effect's opacity, [0, 1000]; default 1 */
+    const char* name;    /* for messages, copied; default NULL (no name) */
+    float range_world;   /* skipped beyond this distance of its bounds from the camera, > 0; default INFINITY */
+    int enabled;         /* default 1 */
+    int textured;        /* 0: traditional splats (the plain footprint); default 1 */
+    float opacity_scale; /* multiplies the effect's opacity, [0, 1000]; default 1 */
 } splatfx_effect_options;
 SPLATFX_C_API void splatfx_effect_options_init(splatfx_effect_options* options);
 
@@ -178,21 +175,19 @@ SPLATFX_C_API void splatfx_effect_options_init(splatfx_effect_options* options);
  * moves it from where it was built: object to world at t is
  * motion(t) * translate(desc.position). A solver preset's source motion is
  * where its emitter is, in world space (the smoke trails it). */
-typedef SPLATFX_C_ENUM(splatfx_easing) {
-    SPLATFX_EASING_LINEAR = 0, /* constant rate between keys */
-    SPLATFX_EASING_SMOOTH = 1, /* smoothstep: eases in and out of each key */
-    SPLATFX_EASING_STEP = 2,   /* holds the key until the next one */
-    SPLATFX_EASING_MAX_ENUM = 0x7fffffff
-} splatfx_easing;
+typedef SPLATFX_C_ENUM(splatfx_easing){SPLATFX_EASING_LINEAR = 0, /* constant rate between keys */
+                                       SPLATFX_EASING_SMOOTH = 1, /* smoothstep: eases in and out of each key */
+                                       SPLATFX_EASING_STEP = 2,   /* holds the key until the next one */
+                                       SPLATFX_EASING_MAX_ENUM = 0x7fffffff} splatfx_easing;
 
 typedef struct splatfx_keyframe {
-    double time_sec;        /* strictly increasing along the track; default 0 */
-    float position[3];      /* world units; default 0 */
-    float rotation[4];      /* unit quaternion w, x, y, z; default 1, 0, 0, 0 */
-    float scale[3];         /* per axis, > 0; default 1 */
-    float opacity;          /* multiplies the effect's opacity (fades), >= 0; default 1 */
-    float growth;           /* fraction of the material present, [0, 1]; default 1 */
-    splatfx_easing easing;  /* of the segment from this key to the next; default SPLATFX_EASING_LINEAR */
+    double time_sec;       /* strictly increasing along the track; default 0 */
+    float position[3];     /* world units; default 0 */
+    float rotation[4];     /* unit quaternion w, x, y, z; default 1, 0, 0, 0 */
+    float scale[3];        /* per axis, > 0; default 1 */
+    float opacity;         /* multiplies the effect's opacity (fades), >= 0; default 1 */
+    float growth;          /* fraction of the material present, [0, 1]; default 1 */
+    splatfx_easing easing; /* of the segment from this key to the next; default SPLATFX_EASING_LINEAR */
 } splatfx_keyframe;
 SPLATFX_C_API void splatfx_keyframe_init(splatfx_keyframe* key);
 
@@ -201,104 +196,104 @@ SPLATFX_C_API void splatfx_keyframe_init(splatfx_keyframe* key);
  * turbulence; otherwise copied at add time (the handle may be destroyed
  * after). The preset validates its fields; the message names the field. */
 typedef struct splatfx_fire_desc {
-    int32_t dims[3];                  /* lattice cells; default 7, 20, 5 (the paper's Fig. 1) */
-    float spacing[3];                 /* world units between voxels; default 0.5 */
-    float position[3];                /* world position of the base centre; default 0 */
+    int32_t dims[3];                        /* lattice cells; default 7, 20, 5 (the paper's Fig. 1) */
+    float spacing[3];                       /* world units between voxels; default 0.5 */
+    float position[3];                      /* world position of the base centre; default 0 */
     const splatfx_texture_set* texture_set; /* default NULL (procedural) */
-    int32_t texture_count;            /* procedural textures; default 8 */
-    float opacity;                    /* at the core of the base, (0, 1]; default 0.55 */
-    float propagation_steps_per_sec;  /* cells per second the detail rises; default 8 */
-    float textures_per_sec;           /* texture cycling rate; default 6 */
-    int crossfade;                    /* cross-fade consecutive textures; default 1 */
-    const splatfx_keyframe* motion_keys; /* object dynamics of the whole fire; default NULL (at rest) */
-    uint32_t motion_key_count;        /* keys at motion_keys; default 0 */
-    uint32_t seed;                    /* texture dynamics; default 1 */
-    uint32_t texture_seed;            /* procedural texture set; default 1 */
+    int32_t texture_count;                  /* procedural textures; default 8 */
+    float opacity;                          /* at the core of the base, (0, 1]; default 0.55 */
+    float propagation_steps_per_sec;        /* cells per second the detail rises; default 8 */
+    float textures_per_sec;                 /* texture cycling rate; default 6 */
+    int crossfade;                          /* cross-fade consecutive textures; default 1 */
+    const splatfx_keyframe* motion_keys;    /* object dynamics of the whole fire; default NULL (at rest) */
+    uint32_t motion_key_count;              /* keys at motion_keys; default 0 */
+    uint32_t seed;                          /* texture dynamics; default 1 */
+    uint32_t texture_seed;                  /* procedural texture set; default 1 */
 } splatfx_fire_desc;
 SPLATFX_C_API void splatfx_fire_desc_init(splatfx_fire_desc* desc);
 
 typedef struct splatfx_smoke_desc {
-    int32_t dims[3];                  /* solver cells; default 10, 20, 10 */
-    float spacing[3];                 /* world units per cell; default 0.5 */
-    float position[3];                /* world position of the domain's base centre; default 0 */
-    float source_offset[3];           /* emitter centre above the position; default 0, 0.5, 0 */
-    float source_radius;              /* emitter radius, world units; default 0.75 */
-    float wind_world[3];              /* world units per second; default 1, 0, 0 */
-    float dissipation;                /* 1/s; default 0.15 */
-    const splatfx_texture_set* texture_set; /* default NULL (procedural) */
-    int32_t texture_count;            /* default 8 */
-    float textures_per_sec;           /* default 3 */
-    int32_t substeps;                 /* solver substeps per step; default 1 */
+    int32_t dims[3];                            /* solver cells; default 10, 20, 10 */
+    float spacing[3];                           /* world units per cell; default 0.5 */
+    float position[3];                          /* world position of the domain's base centre; default 0 */
+    float source_offset[3];                     /* emitter centre above the position; default 0, 0.5, 0 */
+    float source_radius;                        /* emitter radius, world units; default 0.75 */
+    float wind_world[3];                        /* world units per second; default 1, 0, 0 */
+    float dissipation;                          /* 1/s; default 0.15 */
+    const splatfx_texture_set* texture_set;     /* default NULL (procedural) */
+    int32_t texture_count;                      /* default 8 */
+    float textures_per_sec;                     /* default 3 */
+    int32_t substeps;                           /* solver substeps per step; default 1 */
     const splatfx_keyframe* source_motion_keys; /* the object the chimney sits on; default NULL (at rest at position) */
-    uint32_t source_motion_key_count; /* default 0 */
-    uint32_t seed;                    /* default 1 */
-    uint32_t texture_seed;            /* default 1 */
+    uint32_t source_motion_key_count;           /* default 0 */
+    uint32_t seed;                              /* default 1 */
+    uint32_t texture_seed;                      /* default 1 */
 } splatfx_smoke_desc;
 SPLATFX_C_API void splatfx_smoke_desc_init(splatfx_smoke_desc* desc);
 
 typedef struct splatfx_steam_desc {
-    int32_t dims[3];                  /* lattice; default 2, 20, 2 (the paper's Fig. 5) */
-    float spacing[3];                 /* default 0.25 */
-    float position[3];                /* the spout; default 0 */
+    int32_t dims[3];                        /* lattice; default 2, 20, 2 (the paper's Fig. 5) */
+    float spacing[3];                       /* default 0.25 */
+    float position[3];                      /* the spout; default 0 */
     const splatfx_texture_set* texture_set; /* default NULL (procedural) */
-    int32_t texture_count;            /* default 16 */
-    float opacity;                    /* at the spout; default 0.35 */
-    float propagation_steps_per_sec;  /* default 10 */
-    float textures_per_sec;           /* default 4 */
-    const splatfx_keyframe* motion_keys; /* default NULL (at rest) */
-    uint32_t motion_key_count;        /* default 0 */
-    uint32_t seed;                    /* default 1 */
-    uint32_t texture_seed;            /* default 1 */
+    int32_t texture_count;                  /* default 16 */
+    float opacity;                          /* at the spout; default 0.35 */
+    float propagation_steps_per_sec;        /* default 10 */
+    float textures_per_sec;                 /* default 4 */
+    const splatfx_keyframe* motion_keys;    /* default NULL (at rest) */
+    uint32_t motion_key_count;              /* default 0 */
+    uint32_t seed;                          /* default 1 */
+    uint32_t texture_seed;                  /* default 1 */
 } splatfx_steam_desc;
 SPLATFX_C_API void splatfx_steam_desc_init(splatfx_steam_desc* desc);
 
 typedef struct splatfx_dust_desc {
-    int32_t dims[3];                  /* solver cells; default 24, 6, 12 */
-    float spacing[3];                 /* default 0.5 */
-    float position[3];                /* default 0 */
-    float source_offset[3];           /* default 0, 0.25, 0 */
-    float source_radius;              /* default 0.8 */
-    float wind_world[3];              /* default 0 */
-    float settle;                     /* downward pull per unit density, world units/s^2; default 0.6 */
-    float dissipation;                /* 1/s; default 0.3 */
-    const splatfx_texture_set* texture_set; /* default NULL (procedural) */
-    int32_t texture_count;            /* default 8 */
+    int32_t dims[3];                            /* solver cells; default 24, 6, 12 */
+    float spacing[3];                           /* default 0.5 */
+    float position[3];                          /* default 0 */
+    float source_offset[3];                     /* default 0, 0.25, 0 */
+    float source_radius;                        /* default 0.8 */
+    float wind_world[3];                        /* default 0 */
+    float settle;                               /* downward pull per unit density, world units/s^2; default 0.6 */
+    float dissipation;                          /* 1/s; default 0.3 */
+    const splatfx_texture_set* texture_set;     /* default NULL (procedural) */
+    int32_t texture_count;                      /* default 8 */
     const splatfx_keyframe* source_motion_keys; /* the animal kicking up dust; default NULL (at rest at position) */
-    uint32_t source_motion_key_count; /* default 0 */
-    uint32_t seed;                    /* default 1 */
-    uint32_t texture_seed;            /* default 1 */
+    uint32_t source_motion_key_count;           /* default 0 */
+    uint32_t seed;                              /* default 1 */
+    uint32_t texture_seed;                      /* default 1 */
 } splatfx_dust_desc;
 SPLATFX_C_API void splatfx_dust_desc_init(splatfx_dust_desc* desc);
 
 typedef struct splatfx_fire_to_smoke_desc {
-    int32_t dims[3];                  /* default 7, 32, 5 */
-    float spacing[3];                 /* default 0.5 */
-    float position[3];                /* default 0 */
-    float split;                      /* normalized height where smoke takes over, (0, 1); default 0.45 */
-    float blend;                      /* overlap of the two layers; default 0.15 */
+    int32_t dims[3];                              /* default 7, 32, 5 */
+    float spacing[3];                             /* default 0.5 */
+    float position[3];                            /* default 0 */
+    float split;                                  /* normalized height where smoke takes over, (0, 1); default 0.45 */
+    float blend;                                  /* overlap of the two layers; default 0.15 */
     const splatfx_texture_set* fire_texture_set;  /* default NULL (procedural) */
     const splatfx_texture_set* smoke_texture_set; /* default NULL (procedural) */
-    float propagation_steps_per_sec;  /* default 8 */
-    float textures_per_sec;           /* default 5 */
-    const splatfx_keyframe* motion_keys; /* default NULL (at rest) */
-    uint32_t motion_key_count;        /* default 0 */
-    uint32_t seed;                    /* default 1 */
-    uint32_t texture_seed;            /* default 1 */
+    float propagation_steps_per_sec;              /* default 8 */
+    float textures_per_sec;                       /* default 5 */
+    const splatfx_keyframe* motion_keys;          /* default NULL (at rest) */
+    uint32_t motion_key_count;                    /* default 0 */
+    uint32_t seed;                                /* default 1 */
+    uint32_t texture_seed;                        /* default 1 */
 } splatfx_fire_to_smoke_desc;
 SPLATFX_C_API void splatfx_fire_to_smoke_desc_init(splatfx_fire_to_smoke_desc* desc);
 
 typedef struct splatfx_ghosts_desc {
-    float head_radius_cells;          /* default 3 */
-    int32_t plume_cells;              /* default 8 */
-    float spacing[3];                 /* default 0.3 */
-    float position[3];                /* default 0 */
+    float head_radius_cells;                /* default 3 */
+    int32_t plume_cells;                    /* default 8 */
+    float spacing[3];                       /* default 0.3 */
+    float position[3];                      /* default 0 */
     const splatfx_texture_set* texture_set; /* face images; default NULL (procedural faces) */
-    int32_t texture_count;            /* default 12 */
-    float opacity;                    /* default 0.4 */
-    float textures_per_sec;           /* default 5 */
-    float propagation_steps_per_sec;  /* default 4 */
-    uint32_t seed;                    /* default 1 */
-    uint32_t texture_seed;            /* default 1 */
+    int32_t texture_count;                  /* default 12 */
+    float opacity;                          /* default 0.4 */
+    float textures_per_sec;                 /* default 5 */
+    float propagation_steps_per_sec;        /* default 4 */
+    uint32_t seed;                          /* default 1 */
+    uint32_t texture_seed;                  /* default 1 */
 } splatfx_ghosts_desc;
 SPLATFX_C_API void splatfx_ghosts_desc_init(splatfx_ghosts_desc* desc);
 
@@ -307,56 +302,48 @@ SPLATFX_C_API void splatfx_ghosts_desc_init(splatfx_ghosts_desc* desc);
  * id. desc and options may be NULL (defaults). On failure nothing is added.
  * A scene's effects are built with one materials handle: the first add (or
  * the load) fixes it, and adding or preparing with another is an error. */
-SPLATFX_C_API splatfx_status splatfx_scene_add_fire(splatfx_scene* scene, splatfx_materials* materials,
-                                                    const splatfx_fire_desc* desc, const splatfx_effect_options* options,
-                                                    uint32_t* out_id, splatfx_error* error);
-SPLATFX_C_API splatfx_status splatfx_scene_add_smoke(splatfx_scene* scene, splatfx_materials* materials,
-                                                     const splatfx_smoke_desc* desc, const splatfx_effect_options* options,
-                                                     uint32_t* out_id, splatfx_error* error);
-SPLATFX_C_API splatfx_status splatfx_scene_add_steam(splatfx_scene* scene, splatfx_materials* materials,
-                                                     const splatfx_steam_desc* desc, const splatfx_effect_options* options,
-                                                     uint32_t* out_id, splatfx_error* error);
-SPLATFX_C_API splatfx_status splatfx_scene_add_dust(splatfx_scene* scene, splatfx_materials* materials,
-                                                    const splatfx_dust_desc* desc, const splatfx_effect_options* options,
-                                                    uint32_t* out_id, splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_scene_add_fire(splatfx_scene* scene, splatfx_materials* materials, const splatfx_fire_desc* desc,
+                                                    const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_scene_add_smoke(splatfx_scene* scene, splatfx_materials* materials, const splatfx_smoke_desc* desc,
+                                                     const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_scene_add_steam(splatfx_scene* scene, splatfx_materials* materials, const splatfx_steam_desc* desc,
+                                                     const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_scene_add_dust(splatfx_scene* scene, splatfx_materials* materials, const splatfx_dust_desc* desc,
+                                                    const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error);
 SPLATFX_C_API splatfx_status splatfx_scene_add_fire_to_smoke(splatfx_scene* scene, splatfx_materials* materials,
-                                                             const splatfx_fire_to_smoke_desc* desc,
-                                                             const splatfx_effect_options* options, uint32_t* out_id,
-                                                             splatfx_error* error);
-SPLATFX_C_API splatfx_status splatfx_scene_add_ghosts(splatfx_scene* scene, splatfx_materials* materials,
-                                                      const splatfx_ghosts_desc* desc, const splatfx_effect_options* options,
-                                                      uint32_t* out_id, splatfx_error* error);
+                                                             const splatfx_fire_to_smoke_desc* desc, const splatfx_effect_options* options,
+                                                             uint32_t* out_id, splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_scene_add_ghosts(splatfx_scene* scene, splatfx_materials* materials, const splatfx_ghosts_desc* desc,
+                                                      const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error);
 
 /* Reads a scene file (docs/scene-format.md) into a new scene, registering its
  * texture sets and colour tables in `materials`. seed: NULL keeps the file's
  * seed. The file's geometry, camera path and output settings are not
  * exposed here (C++: loadSceneFile); its effects are. On failure the message
  * names the file, the field (as a JSON path) and what was expected. */
-SPLATFX_C_API splatfx_status splatfx_scene_load_file(const char* path, splatfx_materials* materials, const uint32_t* seed,
-                                                     splatfx_scene** out, splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_scene_load_file(const char* path, splatfx_materials* materials, const uint32_t* seed, splatfx_scene** out,
+                                                     splatfx_error* error);
 
 /* Effects in the scene. 0 for NULL. */
 SPLATFX_C_API uint32_t splatfx_scene_effect_count(const splatfx_scene* scene);
-SPLATFX_C_API splatfx_status splatfx_scene_set_effect_enabled(splatfx_scene* scene, uint32_t id, int enabled,
-                                                              splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_scene_set_effect_enabled(splatfx_scene* scene, uint32_t id, int enabled, splatfx_error* error);
 
 /* ---- [camera] ---------------------------------------------------------------- */
 
 /* The host's camera, a plain value (camera.hpp). */
 typedef struct splatfx_camera {
-    float view[16];         /* world to view, column-major */
-    float proj[16];         /* view to clip, column-major, OpenGL clip z in [-w, w] */
-    int32_t viewport[2];    /* width, height in pixels, each in [1, 16384] */
+    float view[16];      /* world to view, column-major */
+    float proj[16];      /* view to clip, column-major, OpenGL clip z in [-w, w] */
+    int32_t viewport[2]; /* width, height in pixels, each in [1, 16384] */
 } splatfx_camera;
 
 /* From the host's matrices (copied; checked finite and the viewport in range). */
-SPLATFX_C_API splatfx_status splatfx_camera_from_matrices(const float view[16], const float proj[16], int32_t width,
-                                                          int32_t height, splatfx_camera* out, splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_camera_from_matrices(const float view[16], const float proj[16], int32_t width, int32_t height,
+                                                          splatfx_camera* out, splatfx_error* error);
 /* A perspective camera at eye looking at target (Camera::lookAt); fov_y in
  * (0, pi) radians, 0 < near_plane < far_plane. */
-SPLATFX_C_API splatfx_status splatfx_camera_look_at(const float eye[3], const float target[3], const float up[3],
-                                                    float fov_y, int32_t width, int32_t height, float near_plane,
-                                                    float far_plane, splatfx_camera* out, splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_camera_look_at(const float eye[3], const float target[3], const float up[3], float fov_y, int32_t width,
+                                                    int32_t height, float near_plane, float far_plane, splatfx_camera* out, splatfx_error* error);
 
 /* ---- [frame] ------------------------------------------------------------------ */
 
@@ -373,8 +360,7 @@ typedef struct splatfx_frame_stats {
     uint64_t splats;    /* splats in the frame */
     double time_sec;    /* the time it was prepared at */
 } splatfx_frame_stats;
-SPLATFX_C_API splatfx_status splatfx_frame_get_stats(const splatfx_frame* frame, splatfx_frame_stats* out,
-                                                     splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_frame_get_stats(const splatfx_frame* frame, splatfx_frame_stats* out, splatfx_error* error);
 
 /* One frame at time_sec (finite, >= 0) for the camera: decides which effects
  * are needed, brings exactly those to time_sec, builds and sorts their
@@ -382,8 +368,7 @@ SPLATFX_C_API splatfx_status splatfx_frame_get_stats(const splatfx_frame* frame,
  * handles. Times should not decrease across calls (solver effects do not run
  * backwards; stateless effects may be scrubbed freely). */
 SPLATFX_C_API splatfx_status splatfx_scene_prepare(splatfx_scene* scene, double time_sec, const splatfx_camera* camera,
-                                                   const splatfx_materials* materials, splatfx_frame* frame,
-                                                   splatfx_error* error);
+                                                   const splatfx_materials* materials, splatfx_frame* frame, splatfx_error* error);
 
 /* ---- [renderer] --------------------------------------------------------------- */
 
@@ -418,8 +403,7 @@ typedef struct splatfx_render_stats {
 /* gl::FrameRenderer: owns the order of the frame's passes. Needs a current
  * OpenGL 4.5 context at create, render and destroy. */
 typedef struct splatfx_renderer splatfx_renderer;
-SPLATFX_C_API splatfx_status splatfx_renderer_create(const splatfx_renderer_desc* desc, splatfx_renderer** out,
-                                                     splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_renderer_create(const splatfx_renderer_desc* desc, splatfx_renderer** out, splatfx_error* error);
 /* Call with its context current. Without one its GL objects cannot be
  * deleted (GL would abort): they are left to the context's own destruction
  * (and its CPU-side memory is not freed) rather than crash. */
@@ -427,17 +411,14 @@ SPLATFX_C_API void splatfx_renderer_destroy(splatfx_renderer* renderer);
 /* Uploads the materials' texture layers (only when they changed since the
  * last upload of these materials). Optional: render uploads too; call it to
  * take the upload's cost at a time of your choosing. */
-SPLATFX_C_API splatfx_status splatfx_renderer_upload(splatfx_renderer* renderer, const splatfx_materials* materials,
-                                                     splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_renderer_upload(splatfx_renderer* renderer, const splatfx_materials* materials, splatfx_error* error);
 /* Draws the frame into the host target: the opaque hook, the volumes tested
  * against the host depth, the transparent hook (gl::FrameRenderer::render).
  * `materials` must be those the frame was prepared with. Never clears, never
  * writes depth; restores the GL state it touches. */
-SPLATFX_C_API splatfx_status splatfx_renderer_render(splatfx_renderer* renderer, const splatfx_materials* materials,
-                                                     const splatfx_frame* frame, const splatfx_host_target* target,
-                                                     splatfx_error* error);
-SPLATFX_C_API splatfx_status splatfx_renderer_get_stats(const splatfx_renderer* renderer, splatfx_render_stats* out,
-                                                        splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_renderer_render(splatfx_renderer* renderer, const splatfx_materials* materials, const splatfx_frame* frame,
+                                                     const splatfx_host_target* target, splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_renderer_get_stats(const splatfx_renderer* renderer, splatfx_render_stats* out, splatfx_error* error);
 
 #ifdef __cplusplus
 } /* extern "C" */

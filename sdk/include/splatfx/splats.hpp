@@ -39,8 +39,8 @@ namespace splatfx {
 // the reference renderer, which reads the table exactly.
 struct Splat {
     glm::vec3 center{0.0f};
-    float density = 0.0f;        // optical depth scale, log2 units (includes the near-plane fade when SplatBuilderDesc::nearFade)
-    glm::vec3 axisU{0.0f};       // ellipse half-axis reaching the footprint's support radius
+    float density = 0.0f;  // optical depth scale, log2 units (includes the near-plane fade when SplatBuilderDesc::nearFade)
+    glm::vec3 axisU{0.0f}; // ellipse half-axis reaching the footprint's support radius
     float colorCoord = 0.0f;
     glm::vec3 axisV{0.0f};
     float colorRow = 0.0f;
@@ -50,7 +50,7 @@ struct Splat {
     // RGB8 colour, R in the lowest byte; the top byte is the kernel's
     // along-ray scale code (rayScaleCode; 255, the default, is 1).
     std::uint32_t color = 0xffffffffu;
-    float depth = 0.0f;          // distance from the eye (perspective) or along forward (ortho); sort key
+    float depth = 0.0f; // distance from the eye (perspective) or along forward (ortho); sort key
 };
 static_assert(sizeof(Splat) == 64, "Splat must match the GPU layout");
 
@@ -71,11 +71,11 @@ float splatRayScale(const Splat& splat, float footprintRadius);
 
 // How a grid's voxels become splats.
 struct SplatStyle {
-    std::uint32_t textureSet = 0;  // id from Materials::addTextureSet; default 0
-    std::uint32_t colorTable = 0;  // id from Materials::addColorTable; default 0
-    bool textured = true;          // false: traditional splatting with the plain footprint (Fig. 1a); default true
-    bool crossfade = false;        // blend towards the next texture by the voxel's phase; default false
-    float opacityScale = 1.0f;     // multiplies every voxel's opacity; default 1
+    std::uint32_t textureSet = 0; // id from Materials::addTextureSet; default 0
+    std::uint32_t colorTable = 0; // id from Materials::addColorTable; default 0
+    bool textured = true;         // false: traditional splatting with the plain footprint (Fig. 1a); default true
+    bool crossfade = false;       // blend towards the next texture by the voxel's phase; default false
+    float opacityScale = 1.0f;    // multiplies every voxel's opacity; default 1
 };
 
 enum class SortMode {
@@ -102,9 +102,9 @@ struct SplatBuilderDesc {
 };
 
 struct SplatStats {
-    std::uint64_t voxelsIn = 0;   // voxels offered
-    std::uint64_t culled = 0;     // outside the frustum, behind the eye or fully faded
-    std::uint64_t rejected = 0;   // non-finite voxel data or a degenerate transform
+    std::uint64_t voxelsIn = 0; // voxels offered
+    std::uint64_t culled = 0;   // outside the frustum, behind the eye or fully faded
+    std::uint64_t rejected = 0; // non-finite voxel data or a degenerate transform
 };
 
 // Memory the back-to-front sort reuses between frames (keys, indices, a copy

@@ -31,14 +31,14 @@
 namespace splatfx {
 
 struct TurbulenceDesc {
-    int count = 8;          // textures in the set; default 8 (the paper's choice)
-    int size = 32;          // texels on a side; default 32 (sec. 5.4)
-    std::uint32_t seed = 1; // default 1
-    int octaves = 4;        // turbulence octaves; default 4
+    int count = 8;              // textures in the set; default 8 (the paper's choice)
+    int size = 32;              // texels on a side; default 32 (sec. 5.4)
+    std::uint32_t seed = 1;     // default 1
+    int octaves = 4;            // turbulence octaves; default 4
     float baseFrequency = 3.0f; // lowest octave, cycles per texture; default 3
     // Textures are slices along a closed loop through 4D noise, so cycling
     // them in order is smooth and periodic (sec. 3.3 "cyclical pattern").
-    float loopRadius = 0.25f;   // noise units; larger = faster change between textures; default 0.25
+    float loopRadius = 0.25f; // noise units; larger = faster change between textures; default 0.25
     // Exponent applied after normalization: above 1 the detail gets sparser
     // and sharper, which survives the averaging of many overlapping splats
     // (fire: 2.5). Default 1 (plain turbulence).
@@ -48,17 +48,17 @@ struct TurbulenceDesc {
 // Windows cut from one larger image (King et al. 1999, sec. 4 / Fig. 11:
 // textures taken at random positions from a photograph).
 struct ImageSampleDesc {
-    int count = 16;           // windows cut, >= 1; default 16
-    int size = 32;            // window side in pixels (the set's texture size), >= 1; default 32
-    std::uint32_t seed = 1;   // picks the window positions; default 1
-    bool keepColor = false;   // keep RGB detail (else grayscale); default false
+    int count = 16;                       // windows cut, >= 1; default 16
+    int size = 32;                        // window side in pixels (the set's texture size), >= 1; default 32
+    std::uint32_t seed = 1;               // picks the window positions; default 1
+    bool keepColor = false;               // keep RGB detail (else grayscale); default false
     std::string sourceName = "the image"; // names the image in messages (e.g. "image 'wood.jpg'"); default "the image"
 };
 
 class TextureSet {
 public:
-    int size = 0;        // texels on a side (square)
-    bool color = false;  // true: RGB detail kept; false: grayscale (R=G=B=1, detail in A)
+    int size = 0;       // texels on a side (square)
+    bool color = false; // true: RGB detail kept; false: grayscale (R=G=B=1, detail in A)
     bool isWindowed = false;
     // One RGBA float image per texture, size x size, row-major.
     std::vector<std::vector<float>> layers;

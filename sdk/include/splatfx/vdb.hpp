@@ -48,14 +48,15 @@ namespace splatfx {
 inline constexpr std::uint64_t kMaxVdbSequenceCells = std::uint64_t(1) << 27;
 
 struct VdbImportDesc {
-    std::string densityGrid = "density";         // float grid, required; default "density"
-    std::string temperatureGrid = "temperature"; // float grid; empty: colour by height; default "temperature" (Blender; "flame" and "heat" are common too)
-    std::string velocityGrid = "velocity";       // vec3s grid; empty: no flow; default "velocity"
+    std::string densityGrid = "density"; // float grid, required; default "density"
+    std::string temperatureGrid =
+        "temperature";                     // float grid; empty: colour by height; default "temperature" (Blender; "flame" and "heat" are common too)
+    std::string velocityGrid = "velocity"; // vec3s grid; empty: no flow; default "velocity"
     // File voxels per coarse cell along every axis, >= 1; 0: the smallest
     // that keeps the union of the frames' density boxes within
     // maxCellsPerAxis cells along its longest side. Default 0.
     int voxelsPerCell = 0;
-    int maxCellsPerAxis = 24;           // used when voxelsPerCell is 0, >= 1; default 24
+    int maxCellsPerAxis = 24; // used when voxelsPerCell is 0, >= 1; default 24
     // Extinction coefficient per unit density, per world unit of the file
     // (sigma = density * this). Default 1.
     float extinctionPerDensity = 1.0f;
@@ -70,9 +71,9 @@ struct VdbImportDesc {
     // matches the density centroid rising about 16 voxels/s).
     enum class VelocityUnit { WorldPerSec, VoxelsPerSec };
     VelocityUnit velocityUnit = VelocityUnit::WorldPerSec; // default WorldPerSec
-    float velocityScale = 1.0f;         // multiplies the file's velocity (after the unit); default 1
-    double framesPerSec = 24.0;          // playback rate of the sequence, > 0; default 24
-    SequenceEnd end = SequenceEnd::Loop; // default Loop
+    float velocityScale = 1.0f;                            // multiplies the file's velocity (after the unit); default 1
+    double framesPerSec = 24.0;                            // playback rate of the sequence, > 0; default 24
+    SequenceEnd end = SequenceEnd::Loop;                   // default Loop
     // A grid whose metadata reports more active voxels than this is refused
     // before its voxels are read. Default 2^28 (1 GiB of floats).
     std::uint64_t maxFileVoxels = std::uint64_t(1) << 28;

@@ -83,8 +83,8 @@ private:
 // sub-steps of optical depth <= 1/4, each integrated by 5-point Gauss-Legendre
 // (relative error ~1e-12); it stops once transmittance < 1e-18.
 // Non-finite or negative lengths count as 0; +inf as 1e30 (fully saturated).
-glm::dvec4 integrateSegment(const TransferFunction& transfer, double frontScalar, double backScalar,
-                            double lengthWorld, double frontLengthScale = 1.0, double backLengthScale = 1.0);
+glm::dvec4 integrateSegment(const TransferFunction& transfer, double frontScalar, double backScalar, double lengthWorld,
+                            double frontLengthScale = 1.0, double backLengthScale = 1.0);
 
 struct PreIntegrationDesc {
     int scalarResolution = 64;   // default 64 (the paper's 64x64x128): samples along front and back scalar
@@ -149,12 +149,12 @@ enum class DeltaMode {
 };
 
 struct LodVolumeDesc {
-    glm::vec3 originWorld{0.0f};  // default (0,0,0): world position of grid point (0,0,0)
-    float spacingWorld = 1.0f;    // default 1: world distance between grid points
-    int rootLevel = 0;            // default 0 = auto: roots are cubes of 2^rootLevel cells (see LodVolume)
-    float minAccuracyC = 4.0f;    // default 4: C of eq. 1 (> sqrt(3)/2); fixes K_max of eq. 4 at build time
-    DeltaMode delta = DeltaMode::Max; // default Max
-    float padValue = 0.0f;        // default 0: value of the points added by padding (both fields)
+    glm::vec3 originWorld{0.0f};                          // default (0,0,0): world position of grid point (0,0,0)
+    float spacingWorld = 1.0f;                            // default 1: world distance between grid points
+    int rootLevel = 0;                                    // default 0 = auto: roots are cubes of 2^rootLevel cells (see LodVolume)
+    float minAccuracyC = 4.0f;                            // default 4: C of eq. 1 (> sqrt(3)/2); fixes K_max of eq. 4 at build time
+    DeltaMode delta = DeltaMode::Max;                     // default Max
+    float padValue = 0.0f;                                // default 0: value of the points added by padding (both fields)
     std::size_t memoryBudgetBytes = std::size_t(1) << 30; // default 1 GiB: create() fails beyond it
 };
 
@@ -254,8 +254,7 @@ public:
     // is integrated by integrateSegment). Premultiplied RGBA, front to back.
     // `dir` need not be unit; lengths are world lengths. Non-finite origin or
     // direction give 0.
-    glm::dvec4 integrateRay(const TransferFunction& transfer, glm::dvec3 originWorld, glm::dvec3 dir, double tNear,
-                            double tFar) const;
+    glm::dvec4 integrateRay(const TransferFunction& transfer, glm::dvec3 originWorld, glm::dvec3 dir, double tNear, double tFar) const;
 
 private:
     struct Level {
@@ -280,7 +279,7 @@ private:
     double mKMax = 1.0;
     DeltaMode mDeltaMode = DeltaMode::Max;
     std::vector<std::uint8_t> mScalar, mLength;
-    std::vector<Level> mLevels; // index = level; level 0 (unit cells) has no node storage
+    std::vector<Level> mLevels;                             // index = level; level 0 (unit cells) has no node storage
     std::vector<std::pair<int, std::size_t>> mMorphWritten; // nodes whose e' was set last frame
 };
 
@@ -288,8 +287,8 @@ private:
 // LodFrame::tets: every tetrahedron the ray crosses gives one linear piece,
 // integrated by integrateSegment, composited front to back in ray order (not
 // list order). Brute force, O(tets) per ray: for references and tests.
-glm::dvec4 integrateRay(const std::vector<Tetrahedron>& tets, const TransferFunction& transfer, glm::dvec3 originWorld,
-                        glm::dvec3 dir, double tNear, double tFar);
+glm::dvec4 integrateRay(const std::vector<Tetrahedron>& tets, const TransferFunction& transfer, glm::dvec3 originWorld, glm::dvec3 dir, double tNear,
+                        double tFar);
 
 // Clip a tetrahedron to the visible side of a plane (dot(normal, x) >= offset)
 // as a volume (sec. 4.3): 0 (all outside), 1 (a tetrahedron: untouched, or the
@@ -309,16 +308,16 @@ enum class CloudModel {
 };
 
 struct CloudDesc {
-    glm::ivec3 dims{129, 129, 33};        // default 129x129x33 grid points
-    std::uint32_t seed = 1;               // default 1
-    float featureCells = 24.0f;           // default 24: cells per period of the lowest noise octave
-    int octaves = 4;                      // default 4: Perlin octaves (fBm, gain 1/2, lacunarity 2)
-    float coverage = 0.45f;               // default 0.45: fraction of the noise range turned into cloud
-    float sharpness = 3.0f;               // default 3: gain from noise above the coverage cut to density
-    glm::vec3 sunDirection{0.3f, 0.2f, 1.0f}; // default (0.3,0.2,1): toward the sun (need not be unit), +z up
-    float ambient = 0.35f;                // default 0.35: ambient light
-    float diffuse = 0.65f;                // default 0.65: direct sun light before attenuation
-    float lightExtinctionPerCell = 0.6f;  // default 0.6: extinction per cell of density 1 toward the sun
+    glm::ivec3 dims{129, 129, 33};                          // default 129x129x33 grid points
+    std::uint32_t seed = 1;                                 // default 1
+    float featureCells = 24.0f;                             // default 24: cells per period of the lowest noise octave
+    int octaves = 4;                                        // default 4: Perlin octaves (fBm, gain 1/2, lacunarity 2)
+    float coverage = 0.45f;                                 // default 0.45: fraction of the noise range turned into cloud
+    float sharpness = 3.0f;                                 // default 3: gain from noise above the coverage cut to density
+    glm::vec3 sunDirection{0.3f, 0.2f, 1.0f};               // default (0.3,0.2,1): toward the sun (need not be unit), +z up
+    float ambient = 0.35f;                                  // default 0.35: ambient light
+    float diffuse = 0.65f;                                  // default 0.65: direct sun light before attenuation
+    float lightExtinctionPerCell = 0.6f;                    // default 0.6: extinction per cell of density 1 toward the sun
     CloudModel model = CloudModel::DensityTableLightLength; // default sec. 5.2
 };
 
@@ -330,17 +329,16 @@ struct CloudDesc {
 Result<ScalarVolume> makeCloudVolume(const CloudDesc& desc = {});
 
 struct CloudTransferDesc {
-    float threshold = 0.08f;               // default 0.08: densities below it get zero extinction (ZOT discards them)
-    float maxExtinctionPerWorld = 2.0f;    // default 2: extinction at density 1
-    glm::vec3 bright{1.0f, 1.0f, 1.0f};    // default white: kappa at low density
-    glm::vec3 dark{0.35f, 0.38f, 0.45f};   // default blue-grey: kappa at density 1 (inverse colour ramp)
+    float threshold = 0.08f;             // default 0.08: densities below it get zero extinction (ZOT discards them)
+    float maxExtinctionPerWorld = 2.0f;  // default 2: extinction at density 1
+    glm::vec3 bright{1.0f, 1.0f, 1.0f};  // default white: kappa at low density
+    glm::vec3 dark{0.35f, 0.38f, 0.45f}; // default blue-grey: kappa at density 1 (inverse colour ramp)
 };
 // The non-physical transfer functions of sec. 5.2: an inverse colour ramp
 // (bright thin edges, dark cores) and a linear optical density set to zero
 // below a threshold. For CloudModel::LightTableDensityLength pass the light
 // field as scalar: then rho = Id * max extinction and kappa is a ramp in gamma.
-Result<TransferFunction> makeCloudTransfer(const CloudTransferDesc& desc = {},
-                                           CloudModel model = CloudModel::DensityTableLightLength);
+Result<TransferFunction> makeCloudTransfer(const CloudTransferDesc& desc = {}, CloudModel model = CloudModel::DensityTableLightLength);
 
 // -----------------------------------------------------------------------------
 // [SECTION] Ground fog (sec. 6)
@@ -439,8 +437,7 @@ public:
     // LOD mesh morphed exactly as the fog's bottom (draw the host's terrain
     // with it so the two agree); triangles wholly in the padding are left out.
     // Fails on a non-finite camera or a bad refine field.
-    Status update(const Camera& camera, const LodRefineDesc& refine, LodFrame& out,
-                  std::vector<glm::vec3>* terrainTriangles = nullptr) const;
+    Status update(const Camera& camera, const LodRefineDesc& refine, LodFrame& out, std::vector<glm::vec3>* terrainTriangles = nullptr) const;
     // Prisms with fog at full resolution (the LOD emits fewer).
     std::uint64_t prismCount() const { return mPrisms; }
     bool lod() const { return mDesc.lod; }

@@ -10,9 +10,9 @@ struct Field {
     std::uint64_t Budgets::*member;
 };
 constexpr Field kFields[] = {
-    {"effectCells", &Budgets::effectCells},     {"solverCells", &Budgets::solverCells},
-    {"sampledTexels", &Budgets::sampledTexels}, {"textureLayers", &Budgets::textureLayers},
-    {"meshElements", &Budgets::meshElements},   {"meshFileBytes", &Budgets::meshFileBytes},
+    {"effectCells", &Budgets::effectCells},         {"solverCells", &Budgets::solverCells},
+    {"sampledTexels", &Budgets::sampledTexels},     {"textureLayers", &Budgets::textureLayers},
+    {"meshElements", &Budgets::meshElements},       {"meshFileBytes", &Budgets::meshFileBytes},
     {"meshImportBytes", &Budgets::meshImportBytes}, {"meshImportSeconds", &Budgets::meshImportSeconds},
 };
 
@@ -24,8 +24,7 @@ std::vector<std::string> budgetNames() {
     return out;
 }
 
-Status checkBudget(std::string_view what, std::uint64_t estimate, std::string_view unit, std::uint64_t budget,
-                   std::string_view field) {
+Status checkBudget(std::string_view what, std::uint64_t estimate, std::string_view unit, std::uint64_t budget, std::string_view field) {
     if (estimate <= budget) return {};
     return makeError(std::string(what) + " needs " + std::to_string(estimate) + " " + std::string(unit) + ", over the budget of " +
                      std::to_string(budget) + " (raise Budgets::" + std::string(field) + ")");
@@ -36,8 +35,7 @@ Status setBudget(Budgets& budgets, std::string_view assignment) {
     const std::string_view name = assignment.substr(0, eq);
     std::string names;
     for (const Field& f : kFields) names += std::string(names.empty() ? "" : ", ") + f.name;
-    if (eq == std::string_view::npos)
-        return makeError("a budget is NAME=N, got '" + std::string(assignment) + "' (names: " + names + ")");
+    if (eq == std::string_view::npos) return makeError("a budget is NAME=N, got '" + std::string(assignment) + "' (names: " + names + ")");
     const std::string_view number = assignment.substr(eq + 1);
     for (const Field& f : kFields) {
         if (name != f.name) continue;

@@ -32,11 +32,18 @@ std::optional<Outcome> checkFinite3(const std::string& field, const float v[3]) 
 }
 glm::vec3 vec3Of(const float v[3]) { return {v[0], v[1], v[2]}; }
 glm::ivec3 ivec3Of(const std::int32_t v[3]) { return {v[0], v[1], v[2]}; }
-void store3(float out[3], glm::vec3 v) { out[0] = v.x; out[1] = v.y; out[2] = v.z; }
-void store3(std::int32_t out[3], glm::ivec3 v) { out[0] = v.x; out[1] = v.y; out[2] = v.z; }
+void store3(float out[3], glm::vec3 v) {
+    out[0] = v.x;
+    out[1] = v.y;
+    out[2] = v.z;
+}
+void store3(std::int32_t out[3], glm::ivec3 v) {
+    out[0] = v.x;
+    out[1] = v.y;
+    out[2] = v.z;
+}
 
-std::optional<Outcome> setTextureSet(const std::string& field, const splatfx_texture_set* given,
-                                     std::optional<TextureSet>& out) {
+std::optional<Outcome> setTextureSet(const std::string& field, const splatfx_texture_set* given, std::optional<TextureSet>& out) {
     if (!given) return std::nullopt;
     if (auto bad = checkHandle(given, Magic::TextureSet, field.c_str(), "splatfx_texture_set")) return bad;
     out = given->value;
@@ -48,8 +55,7 @@ std::optional<Outcome> toMotion(const std::string& field, const splatfx_keyframe
     if (count == 0) return std::nullopt;
     if (!keys) return invalid(field + "_keys is NULL but " + field + "_key_count is " + std::to_string(count));
     constexpr std::uint32_t kMaxKeys = 1u << 20; // a track, not a baked simulation: 10^6 keys is already hours at 240 Hz
-    if (count > kMaxKeys)
-        return invalid(field + "_key_count is " + std::to_string(count) + "; expected at most " + std::to_string(kMaxKeys));
+    if (count > kMaxKeys) return invalid(field + "_key_count is " + std::to_string(count) + "; expected at most " + std::to_string(kMaxKeys));
     std::vector<Keyframe> track;
     track.reserve(count);
     for (std::uint32_t i = 0; i < count; ++i) {
@@ -102,8 +108,7 @@ std::optional<Outcome> checkSceneMaterials(const splatfx_scene& scene, const spl
 
 // The shared tail of every splatfx_scene_add_<preset>: check the handles, build, add.
 template <class Build>
-Outcome addPreset(splatfx_scene* scene, splatfx_materials* materials, const splatfx_effect_options* options,
-                  std::uint32_t* outId, Build&& build) {
+Outcome addPreset(splatfx_scene* scene, splatfx_materials* materials, const splatfx_effect_options* options, std::uint32_t* outId, Build&& build) {
     if (auto bad = checkHandle(scene, Magic::Scene, "scene", "splatfx_scene")) return *bad;
     if (auto bad = checkHandle(materials, Magic::Materials, "materials", "splatfx_materials")) return *bad;
     if (auto bad = checkSceneMaterials(*scene, *materials)) return *bad;
@@ -134,8 +139,8 @@ std::optional<Outcome> checkCamera(const splatfx_camera& c, const std::string& p
     }
     for (int i = 0; i < 2; ++i)
         if (c.viewport[i] < 1 || c.viewport[i] > kMaxViewportSide)
-            return invalid(param + ".viewport[" + std::to_string(i) + "] is " + std::to_string(c.viewport[i]) +
-                           "; expected a size in [1, " + std::to_string(kMaxViewportSide) + "] pixels");
+            return invalid(param + ".viewport[" + std::to_string(i) + "] is " + std::to_string(c.viewport[i]) + "; expected a size in [1, " +
+                           std::to_string(kMaxViewportSide) + "] pixels");
     // The eye and the frustum come from the inverses: a singular matrix has neither.
     const double dv = glm::determinant(glm::dmat4(glm::make_mat4(c.view)));
     if (!(std::abs(dv) > 1e-12) || !std::isfinite(dv))
@@ -165,7 +170,9 @@ struct DefaultsOut {
     void operator()(const char*, float (&c)[3], glm::vec3 d) { store3(c, d); }
     void operator()(const char*, const splatfx_texture_set*& c, const std::optional<TextureSet>&) { c = nullptr; }
     template <class C, class D>
-    void operator()(const char*, C& c, const D& d) { c = C(d); }
+    void operator()(const char*, C& c, const D& d) {
+        c = C(d);
+    }
     void motion(const char*, const splatfx_keyframe*& keys, std::uint32_t& count, const Motion&) { keys = nullptr, count = 0; }
 };
 
@@ -195,7 +202,8 @@ struct FieldsIn {
 // <Preset>Fields{}(v, c, d) visits every C field of one preset with its C++
 // counterpart; C and D are the C and C++ descs, either of them const.
 struct FireFields {
-    template <class V, class C, class D> void operator()(V& v, C& c, D& d) const {
+    template <class V, class C, class D>
+    void operator()(V& v, C& c, D& d) const {
         v("dims", c.dims, d.dims), v("spacing", c.spacing, d.spacing), v("position", c.position, d.position);
         v("texture_set", c.texture_set, d.textureSet), v("texture_count", c.texture_count, d.textureCount);
         v("opacity", c.opacity, d.opacity), v("propagation_steps_per_sec", c.propagation_steps_per_sec, d.propagationStepsPerSec);
@@ -205,7 +213,8 @@ struct FireFields {
     }
 };
 struct SmokeFields {
-    template <class V, class C, class D> void operator()(V& v, C& c, D& d) const {
+    template <class V, class C, class D>
+    void operator()(V& v, C& c, D& d) const {
         v("dims", c.dims, d.dims), v("spacing", c.spacing, d.spacing), v("position", c.position, d.position);
         v("source_offset", c.source_offset, d.sourceOffset), v("source_radius", c.source_radius, d.sourceRadius);
         v("wind_world", c.wind_world, d.windWorld), v("dissipation", c.dissipation, d.dissipation);
@@ -216,7 +225,8 @@ struct SmokeFields {
     }
 };
 struct SteamFields {
-    template <class V, class C, class D> void operator()(V& v, C& c, D& d) const {
+    template <class V, class C, class D>
+    void operator()(V& v, C& c, D& d) const {
         v("dims", c.dims, d.dims), v("spacing", c.spacing, d.spacing), v("position", c.position, d.position);
         v("texture_set", c.texture_set, d.textureSet), v("texture_count", c.texture_count, d.textureCount);
         v("opacity", c.opacity, d.opacity), v("propagation_steps_per_sec", c.propagation_steps_per_sec, d.propagationStepsPerSec);
@@ -226,7 +236,8 @@ struct SteamFields {
     }
 };
 struct DustFields {
-    template <class V, class C, class D> void operator()(V& v, C& c, D& d) const {
+    template <class V, class C, class D>
+    void operator()(V& v, C& c, D& d) const {
         v("dims", c.dims, d.dims), v("spacing", c.spacing, d.spacing), v("position", c.position, d.position);
         v("source_offset", c.source_offset, d.sourceOffset), v("source_radius", c.source_radius, d.sourceRadius);
         v("wind_world", c.wind_world, d.windWorld), v("settle", c.settle, d.settle), v("dissipation", c.dissipation, d.dissipation);
@@ -236,7 +247,8 @@ struct DustFields {
     }
 };
 struct FireToSmokeFields {
-    template <class V, class C, class D> void operator()(V& v, C& c, D& d) const {
+    template <class V, class C, class D>
+    void operator()(V& v, C& c, D& d) const {
         v("dims", c.dims, d.dims), v("spacing", c.spacing, d.spacing), v("position", c.position, d.position);
         v("split", c.split, d.split), v("blend", c.blend, d.blend);
         v("fire_texture_set", c.fire_texture_set, d.fireTextureSet), v("smoke_texture_set", c.smoke_texture_set, d.smokeTextureSet);
@@ -247,7 +259,8 @@ struct FireToSmokeFields {
     }
 };
 struct GhostsFields {
-    template <class V, class C, class D> void operator()(V& v, C& c, D& d) const {
+    template <class V, class C, class D>
+    void operator()(V& v, C& c, D& d) const {
         v("head_radius_cells", c.head_radius_cells, d.headRadiusCells), v("plume_cells", c.plume_cells, d.plumeCells);
         v("spacing", c.spacing, d.spacing), v("position", c.position, d.position);
         v("texture_set", c.texture_set, d.textureSet), v("texture_count", c.texture_count, d.textureCount);
@@ -268,9 +281,8 @@ void initPresetDesc(CDesc* desc, Fields fields) {
 // The body of every splatfx_scene_add_<preset>: defaults, the caller's desc
 // in, `extra` checks (a std::optional<Outcome>(const Desc&)), build, add.
 template <class Desc, class CDesc, class Init, class Fields, class Build, class Extra>
-splatfx_status addPresetC(const char* function, splatfx_error* error, splatfx_scene* scene, splatfx_materials* materials,
-                          const CDesc* desc, const splatfx_effect_options* options, std::uint32_t* outId, Init init,
-                          Fields fields, Build build, Extra extra) {
+splatfx_status addPresetC(const char* function, splatfx_error* error, splatfx_scene* scene, splatfx_materials* materials, const CDesc* desc,
+                          const splatfx_effect_options* options, std::uint32_t* outId, Init init, Fields fields, Build build, Extra extra) {
     return guard(function, error, [&] {
         CDesc c;
         init(&c);
@@ -311,9 +323,7 @@ const char* splatfx_status_name(splatfx_status status) {
 
 splatfx_error* splatfx_error_create(void) { return new (std::nothrow) splatfx_error(); }
 void splatfx_error_destroy(splatfx_error* error) { delete error; }
-splatfx_status splatfx_error_status(const splatfx_error* error) {
-    return error ? error->status : SPLATFX_ERROR_INVALID_ARGUMENT;
-}
+splatfx_status splatfx_error_status(const splatfx_error* error) { return error ? error->status : SPLATFX_ERROR_INVALID_ARGUMENT; }
 const char* splatfx_error_message(const splatfx_error* error) {
     if (!error) return "splatfx_error_message: error is NULL";
     if (error->status != SPLATFX_OK && error->message.empty()) return "out of memory while writing the error message";
@@ -419,24 +429,14 @@ void splatfx_keyframe_init(splatfx_keyframe* key) {
     key->easing = SPLATFX_EASING_LINEAR;
 }
 
-void splatfx_fire_desc_init(splatfx_fire_desc* desc) {
-    initPresetDesc<splatfx_fire_desc, presets::FireDesc>(desc, FireFields{});
-}
-void splatfx_smoke_desc_init(splatfx_smoke_desc* desc) {
-    initPresetDesc<splatfx_smoke_desc, presets::SmokeDesc>(desc, SmokeFields{});
-}
-void splatfx_steam_desc_init(splatfx_steam_desc* desc) {
-    initPresetDesc<splatfx_steam_desc, presets::SteamDesc>(desc, SteamFields{});
-}
-void splatfx_dust_desc_init(splatfx_dust_desc* desc) {
-    initPresetDesc<splatfx_dust_desc, presets::DustDesc>(desc, DustFields{});
-}
+void splatfx_fire_desc_init(splatfx_fire_desc* desc) { initPresetDesc<splatfx_fire_desc, presets::FireDesc>(desc, FireFields{}); }
+void splatfx_smoke_desc_init(splatfx_smoke_desc* desc) { initPresetDesc<splatfx_smoke_desc, presets::SmokeDesc>(desc, SmokeFields{}); }
+void splatfx_steam_desc_init(splatfx_steam_desc* desc) { initPresetDesc<splatfx_steam_desc, presets::SteamDesc>(desc, SteamFields{}); }
+void splatfx_dust_desc_init(splatfx_dust_desc* desc) { initPresetDesc<splatfx_dust_desc, presets::DustDesc>(desc, DustFields{}); }
 void splatfx_fire_to_smoke_desc_init(splatfx_fire_to_smoke_desc* desc) {
     initPresetDesc<splatfx_fire_to_smoke_desc, presets::FireToSmokeDesc>(desc, FireToSmokeFields{});
 }
-void splatfx_ghosts_desc_init(splatfx_ghosts_desc* desc) {
-    initPresetDesc<splatfx_ghosts_desc, presets::GhostsDesc>(desc, GhostsFields{});
-}
+void splatfx_ghosts_desc_init(splatfx_ghosts_desc* desc) { initPresetDesc<splatfx_ghosts_desc, presets::GhostsDesc>(desc, GhostsFields{}); }
 
 splatfx_status splatfx_scene_add_fire(splatfx_scene* scene, splatfx_materials* materials, const splatfx_fire_desc* desc,
                                       const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
@@ -452,38 +452,36 @@ splatfx_status splatfx_scene_add_smoke(splatfx_scene* scene, splatfx_materials* 
             return invalid("desc.substeps is " + std::to_string(d.substeps) + "; expected solver substeps in [1, 64]");
         return std::nullopt;
     };
-    return addPresetC<presets::SmokeDesc>("splatfx_scene_add_smoke", error, scene, materials, desc, options, out_id,
-                                          splatfx_smoke_desc_init, SmokeFields{}, presets::smoke, substeps);
+    return addPresetC<presets::SmokeDesc>("splatfx_scene_add_smoke", error, scene, materials, desc, options, out_id, splatfx_smoke_desc_init,
+                                          SmokeFields{}, presets::smoke, substeps);
 }
 
 splatfx_status splatfx_scene_add_steam(splatfx_scene* scene, splatfx_materials* materials, const splatfx_steam_desc* desc,
                                        const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
-    return addPresetC<presets::SteamDesc>("splatfx_scene_add_steam", error, scene, materials, desc, options, out_id,
-                                          splatfx_steam_desc_init, SteamFields{}, presets::steam, kNoExtraCheck);
+    return addPresetC<presets::SteamDesc>("splatfx_scene_add_steam", error, scene, materials, desc, options, out_id, splatfx_steam_desc_init,
+                                          SteamFields{}, presets::steam, kNoExtraCheck);
 }
 
 splatfx_status splatfx_scene_add_dust(splatfx_scene* scene, splatfx_materials* materials, const splatfx_dust_desc* desc,
                                       const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
-    return addPresetC<presets::DustDesc>("splatfx_scene_add_dust", error, scene, materials, desc, options, out_id,
-                                         splatfx_dust_desc_init, DustFields{}, presets::dust, kNoExtraCheck);
+    return addPresetC<presets::DustDesc>("splatfx_scene_add_dust", error, scene, materials, desc, options, out_id, splatfx_dust_desc_init,
+                                         DustFields{}, presets::dust, kNoExtraCheck);
 }
 
-splatfx_status splatfx_scene_add_fire_to_smoke(splatfx_scene* scene, splatfx_materials* materials,
-                                               const splatfx_fire_to_smoke_desc* desc, const splatfx_effect_options* options,
-                                               uint32_t* out_id, splatfx_error* error) {
+splatfx_status splatfx_scene_add_fire_to_smoke(splatfx_scene* scene, splatfx_materials* materials, const splatfx_fire_to_smoke_desc* desc,
+                                               const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
     return addPresetC<presets::FireToSmokeDesc>("splatfx_scene_add_fire_to_smoke", error, scene, materials, desc, options, out_id,
-                                                splatfx_fire_to_smoke_desc_init, FireToSmokeFields{},
-                                                presets::fireToSmoke, kNoExtraCheck);
+                                                splatfx_fire_to_smoke_desc_init, FireToSmokeFields{}, presets::fireToSmoke, kNoExtraCheck);
 }
 
 splatfx_status splatfx_scene_add_ghosts(splatfx_scene* scene, splatfx_materials* materials, const splatfx_ghosts_desc* desc,
                                         const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
-    return addPresetC<presets::GhostsDesc>("splatfx_scene_add_ghosts", error, scene, materials, desc, options, out_id,
-                                           splatfx_ghosts_desc_init, GhostsFields{}, presets::ghosts, kNoExtraCheck);
+    return addPresetC<presets::GhostsDesc>("splatfx_scene_add_ghosts", error, scene, materials, desc, options, out_id, splatfx_ghosts_desc_init,
+                                           GhostsFields{}, presets::ghosts, kNoExtraCheck);
 }
 
-splatfx_status splatfx_scene_load_file(const char* path, splatfx_materials* materials, const uint32_t* seed,
-                                       splatfx_scene** out, splatfx_error* error) {
+splatfx_status splatfx_scene_load_file(const char* path, splatfx_materials* materials, const uint32_t* seed, splatfx_scene** out,
+                                       splatfx_error* error) {
     return guard("splatfx_scene_load_file", error, [&] {
         if (!out) return invalid("out is NULL");
         *out = nullptr;
@@ -510,8 +508,8 @@ splatfx_status splatfx_scene_set_effect_enabled(splatfx_scene* scene, uint32_t i
     return guard("splatfx_scene_set_effect_enabled", error, [&] {
         if (auto bad = checkHandle(scene, Magic::Scene, "scene", "splatfx_scene")) return *bad;
         if (id >= scene->value.size())
-            return failure(SPLATFX_ERROR_NOT_FOUND, "id " + std::to_string(id) + " is not an effect of this scene (it has " +
-                                                        std::to_string(scene->value.size()) + ")");
+            return failure(SPLATFX_ERROR_NOT_FOUND,
+                           "id " + std::to_string(id) + " is not an effect of this scene (it has " + std::to_string(scene->value.size()) + ")");
         scene->value.setEnabled(id, enabled != 0);
         return success();
     });
@@ -519,8 +517,8 @@ splatfx_status splatfx_scene_set_effect_enabled(splatfx_scene* scene, uint32_t i
 
 // ---- [camera]
 
-splatfx_status splatfx_camera_from_matrices(const float view[16], const float proj[16], int32_t width, int32_t height,
-                                            splatfx_camera* out, splatfx_error* error) {
+splatfx_status splatfx_camera_from_matrices(const float view[16], const float proj[16], int32_t width, int32_t height, splatfx_camera* out,
+                                            splatfx_error* error) {
     return guard("splatfx_camera_from_matrices", error, [&] {
         if (!out) return invalid("out is NULL");
         if (!view) return invalid("view is NULL");
@@ -538,9 +536,8 @@ splatfx_status splatfx_camera_from_matrices(const float view[16], const float pr
     });
 }
 
-splatfx_status splatfx_camera_look_at(const float eye[3], const float target[3], const float up[3], float fov_y,
-                                      int32_t width, int32_t height, float near_plane, float far_plane,
-                                      splatfx_camera* out, splatfx_error* error) {
+splatfx_status splatfx_camera_look_at(const float eye[3], const float target[3], const float up[3], float fov_y, int32_t width, int32_t height,
+                                      float near_plane, float far_plane, splatfx_camera* out, splatfx_error* error) {
     return guard("splatfx_camera_look_at", error, [&] {
         if (!out) return invalid("out is NULL");
         if (!eye) return invalid("eye is NULL");
@@ -548,19 +545,17 @@ splatfx_status splatfx_camera_look_at(const float eye[3], const float target[3],
         if (!up) return invalid("up is NULL");
         for (auto bad : {checkFinite3("eye", eye), checkFinite3("target", target), checkFinite3("up", up)})
             if (bad) return *bad;
-        if (!(fov_y > 0.0f && fov_y < 3.14159265f))
-            return invalid("fov_y is " + str(fov_y) + "; expected radians in (0, pi)");
+        if (!(fov_y > 0.0f && fov_y < 3.14159265f)) return invalid("fov_y is " + str(fov_y) + "; expected radians in (0, pi)");
         if (!(near_plane > 0.0f && far_plane > near_plane && std::isfinite(far_plane)))
-            return invalid("near_plane " + str(near_plane) + ", far_plane " + str(far_plane) +
-                           "; expected 0 < near_plane < far_plane, both finite");
+            return invalid("near_plane " + str(near_plane) + ", far_plane " + str(far_plane) + "; expected 0 < near_plane < far_plane, both finite");
         const glm::vec3 e = vec3Of(eye), t = vec3Of(target), u = vec3Of(up);
         const glm::vec3 forward = t - e;
         if (!(glm::length(forward) > 0.0f)) return invalid("eye and target are the same point; expected a direction to look in");
         if (!(glm::length(glm::cross(glm::normalize(forward), u)) > 1e-6f))
             return invalid("up is zero or parallel to target - eye; expected a direction across the view");
         if (width < 1 || width > kMaxViewportSide || height < 1 || height > kMaxViewportSide)
-            return invalid("width, height are " + std::to_string(width) + ", " + std::to_string(height) +
-                           "; expected sizes in [1, " + std::to_string(kMaxViewportSide) + "] pixels");
+            return invalid("width, height are " + std::to_string(width) + ", " + std::to_string(height) + "; expected sizes in [1, " +
+                           std::to_string(kMaxViewportSide) + "] pixels");
         const Camera cam = Camera::lookAt(e, t, u, fov_y, {width, height}, near_plane, far_plane);
         splatfx_camera c{};
         const float* v = glm::value_ptr(cam.view);
@@ -603,8 +598,8 @@ splatfx_status splatfx_frame_get_stats(const splatfx_frame* frame, splatfx_frame
     });
 }
 
-splatfx_status splatfx_scene_prepare(splatfx_scene* scene, double time_sec, const splatfx_camera* camera,
-                                     const splatfx_materials* materials, splatfx_frame* frame, splatfx_error* error) {
+splatfx_status splatfx_scene_prepare(splatfx_scene* scene, double time_sec, const splatfx_camera* camera, const splatfx_materials* materials,
+                                     splatfx_frame* frame, splatfx_error* error) {
     return guard("splatfx_scene_prepare", error, [&] {
         if (auto bad = checkHandle(scene, Magic::Scene, "scene", "splatfx_scene")) return *bad;
         if (auto bad = checkHandle(materials, Magic::Materials, "materials", "splatfx_materials")) return *bad;

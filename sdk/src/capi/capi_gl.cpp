@@ -119,11 +119,9 @@ void splatfx_renderer_destroy(splatfx_renderer* renderer) {
         // loader. Then they are left to die with their context: the renderer
         // is moved out and its owner deliberately never freed (a documented
         // leak, not a crash; splatfx_c.h, splatfx_renderer_destroy).
-        if (renderer->value && !gl::detail::contextIsCurrent())
-            (void)new gl::FrameRenderer(std::move(*renderer->value));
+        if (renderer->value && !gl::detail::contextIsCurrent()) (void)new gl::FrameRenderer(std::move(*renderer->value));
         delete renderer;
-    } catch (...) {
-    }
+    } catch (...) {}
 }
 
 splatfx_status splatfx_renderer_upload(splatfx_renderer* renderer, const splatfx_materials* materials, splatfx_error* error) {
@@ -135,15 +133,14 @@ splatfx_status splatfx_renderer_upload(splatfx_renderer* renderer, const splatfx
     });
 }
 
-splatfx_status splatfx_renderer_render(splatfx_renderer* renderer, const splatfx_materials* materials,
-                                       const splatfx_frame* frame, const splatfx_host_target* target, splatfx_error* error) {
+splatfx_status splatfx_renderer_render(splatfx_renderer* renderer, const splatfx_materials* materials, const splatfx_frame* frame,
+                                       const splatfx_host_target* target, splatfx_error* error) {
     return guard("splatfx_renderer_render", error, [&] {
         if (auto bad = checkHandle(renderer, Magic::Renderer, "renderer", "splatfx_renderer")) return *bad;
         if (auto bad = checkHandle(materials, Magic::Materials, "materials", "splatfx_materials")) return *bad;
         if (auto bad = checkHandle(frame, Magic::Frame, "frame", "splatfx_frame")) return *bad;
         if (!target) return invalid("target is NULL");
-        if (!frame->prepared)
-            return failure(SPLATFX_ERROR_INVALID_STATE, "frame has not been prepared (call splatfx_scene_prepare first)");
+        if (!frame->prepared) return failure(SPLATFX_ERROR_INVALID_STATE, "frame has not been prepared (call splatfx_scene_prepare first)");
         const std::shared_ptr<int> preparedWith = frame->materials.lock();
         if (preparedWith != materials->identity)
             return invalid(preparedWith ? "materials are not the ones the frame was prepared with (its splats index their layers)"
@@ -154,16 +151,16 @@ splatfx_status splatfx_renderer_render(splatfx_renderer* renderer, const splatfx
         const bool sizeGiven = target->width != 0 || target->height != 0;
         if (sizeGiven && (target->width != viewport.x || target->height != viewport.y))
             return invalid("target->width, height are " + std::to_string(target->width) + ", " + std::to_string(target->height) +
-                           " but the frame's camera viewport is " + std::to_string(viewport.x) + ", " +
-                           std::to_string(viewport.y) + "; prepare the frame with a camera of the target's size (or pass 0, 0)");
+                           " but the frame's camera viewport is " + std::to_string(viewport.x) + ", " + std::to_string(viewport.y) +
+                           "; prepare the frame with a camera of the target's size (or pass 0, 0)");
         if (auto bad = checkContext()) return *bad;
         if (target->framebuffer != 0 && !glIsFramebuffer(target->framebuffer))
-            return failure(SPLATFX_ERROR_GL, "target->framebuffer " + std::to_string(target->framebuffer) +
-                                                 " is not a framebuffer object of the current context");
+            return failure(SPLATFX_ERROR_GL,
+                           "target->framebuffer " + std::to_string(target->framebuffer) + " is not a framebuffer object of the current context");
         if (target->depth_texture != 0) {
             if (!glIsTexture(target->depth_texture))
-                return failure(SPLATFX_ERROR_GL, "target->depth_texture " + std::to_string(target->depth_texture) +
-                                                     " is not a texture of the current context");
+                return failure(SPLATFX_ERROR_GL,
+                               "target->depth_texture " + std::to_string(target->depth_texture) + " is not a texture of the current context");
             GLint depthBits = 0;
             glGetTextureLevelParameteriv(target->depth_texture, 0, GL_TEXTURE_DEPTH_SIZE, &depthBits);
             if (depthBits <= 0)

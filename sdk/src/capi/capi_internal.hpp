@@ -76,17 +76,14 @@ splatfx_status guard(const char* function, splatfx_error* error, Body&& body) no
         return report(error, function, SPLATFX_ERROR_OUT_OF_MEMORY, "out of memory");
     } catch (const std::exception& e) {
         return report(error, function, SPLATFX_ERROR_INTERNAL, std::string("unexpected C++ exception: ") + e.what());
-    } catch (...) {
-        return report(error, function, SPLATFX_ERROR_INTERNAL, "unexpected C++ exception of unknown type");
-    }
+    } catch (...) { return report(error, function, SPLATFX_ERROR_INTERNAL, "unexpected C++ exception of unknown type"); }
 }
 
 // "materials is NULL" / "materials is not a splatfx_materials (wrong handle type, or destroyed)".
 template <class Handle>
 std::optional<Outcome> checkHandle(const Handle* h, Magic magic, const char* param, const char* type) {
     if (!h) return invalid(std::string(param) + " is NULL");
-    if (h->magic != magic)
-        return invalid(std::string(param) + " is not a " + type + " (a handle of another type, or one already destroyed)");
+    if (h->magic != magic) return invalid(std::string(param) + " is not a " + type + " (a handle of another type, or one already destroyed)");
     return std::nullopt;
 }
 

@@ -58,9 +58,7 @@ ColorTable ColorTable::steam() {
     return gradient({{0.0f, {0.95f, 0.95f, 0.97f, 0.8f}}, {0.7f, {0.9f, 0.92f, 0.95f, 0.4f}}, {1.0f, {0.9f, 0.92f, 0.95f, 0.0f}}});
 }
 
-ColorTable ColorTable::dust() {
-    return gradient({{0.0f, {0.55f, 0.45f, 0.3f, 0.9f}}, {1.0f, {0.7f, 0.62f, 0.48f, 0.3f}}});
-}
+ColorTable ColorTable::dust() { return gradient({{0.0f, {0.55f, 0.45f, 0.3f, 0.9f}}, {1.0f, {0.7f, 0.62f, 0.48f, 0.3f}}}); }
 
 ColorTable ColorTable::constant(glm::vec4 rgba) { return gradient({{0.0f, rgba}, {1.0f, rgba}}, 2); }
 

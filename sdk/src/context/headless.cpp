@@ -95,9 +95,15 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessDesc& desc) {
             // Surfaceless contexts may need no config at all.
             config = EGL_NO_CONFIG_KHR;
         }
-        const EGLint ctxAttribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                                     EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                                     EGL_CONTEXT_OPENGL_DEBUG, desc.debug ? EGL_TRUE : EGL_FALSE, EGL_NONE};
+        const EGLint ctxAttribs[] = {EGL_CONTEXT_MAJOR_VERSION,
+                                     4,
+                                     EGL_CONTEXT_MINOR_VERSION,
+                                     5,
+                                     EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                                     EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                                     EGL_CONTEXT_OPENGL_DEBUG,
+                                     desc.debug ? EGL_TRUE : EGL_FALSE,
+                                     EGL_NONE};
         impl->context = eglCreateContext(display, config, EGL_NO_CONTEXT, ctxAttribs);
         if (impl->context == EGL_NO_CONTEXT) {
             why = "the display offers no OpenGL 4.5 core context";

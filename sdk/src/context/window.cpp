@@ -11,8 +11,9 @@ Result<Window> Window::create(const WindowDesc& desc) {
     if (!glfwInit()) {
         const char* why = nullptr;
         glfwGetError(&why);
-        return makeError(std::string("cannot open a window: GLFW failed to initialize (") + (why ? why : "no display?") +
-                         "). A window needs a display: set DISPLAY or start an X server (e.g. Xvfb); without one, render headless (HeadlessContext).");
+        return makeError(
+            std::string("cannot open a window: GLFW failed to initialize (") + (why ? why : "no display?") +
+            "). A window needs a display: set DISPLAY or start an X server (e.g. Xvfb); without one, render headless (HeadlessContext).");
     }
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);

@@ -40,8 +40,7 @@ glm::vec3 spinAxis(const ProceduralMotion& m) {
 
 bool sameRotation(const glm::quat& a, const glm::quat& b) {
     // q and -q are the same rotation.
-    return (a.w == b.w && a.x == b.x && a.y == b.y && a.z == b.z) ||
-           (a.w == -b.w && a.x == -b.x && a.y == -b.y && a.z == -b.z);
+    return (a.w == b.w && a.x == b.x && a.y == b.y && a.z == b.z) || (a.w == -b.w && a.x == -b.x && a.y == -b.y && a.z == -b.z);
 }
 
 } // namespace
@@ -52,8 +51,7 @@ glm::mat4 Pose::matrix() const {
     return glm::scale(m, scale);
 }
 
-Motion::Motion(std::vector<Keyframe> keys, const ProceduralMotion& procedural)
-    : mKeys(std::move(keys)), mProc(procedural) {
+Motion::Motion(std::vector<Keyframe> keys, const ProceduralMotion& procedural) : mKeys(std::move(keys)), mProc(procedural) {
 #ifndef NDEBUG
     Result<Motion> checked = create(mKeys, mProc);
     assert(checked.ok() && "Motion: invalid keyframes (call Motion::create for the message)");
@@ -79,8 +77,8 @@ Result<Motion> Motion::create(std::vector<Keyframe> keys, const ProceduralMotion
         if (!std::isfinite(k.pose.growth) || k.pose.growth < 0.0f || k.pose.growth > 1.0f)
             return makeError(at + "pose.growth must be in [0, 1], got " + std::to_string(k.pose.growth));
     }
-    if (!finite3(p.velocity) || !finite3(p.spinAxis) || !std::isfinite(p.spinRadPerSec) || !finite3(p.bobAmplitude) ||
-        !std::isfinite(p.bobHz) || !std::isfinite(p.bobPhaseRad))
+    if (!finite3(p.velocity) || !finite3(p.spinAxis) || !std::isfinite(p.spinRadPerSec) || !finite3(p.bobAmplitude) || !std::isfinite(p.bobHz) ||
+        !std::isfinite(p.bobPhaseRad))
         return makeError("procedural motion: every field must be finite");
     for (Keyframe& k : keys) k.pose.rotation = glm::normalize(k.pose.rotation);
     Motion m;
@@ -94,8 +92,7 @@ Pose Motion::keyed(double t) const {
     if (t <= mKeys.front().timeSec) return mKeys.front().pose;
     if (t >= mKeys.back().timeSec) return mKeys.back().pose;
     // First key strictly after t.
-    const auto it = std::upper_bound(mKeys.begin(), mKeys.end(), t,
-                                     [](double v, const Keyframe& k) { return v < k.timeSec; });
+    const auto it = std::upper_bound(mKeys.begin(), mKeys.end(), t, [](double v, const Keyframe& k) { return v < k.timeSec; });
     const Keyframe& b = *it;
     const Keyframe& a = *(it - 1);
     const float u = float((t - a.timeSec) / (b.timeSec - a.timeSec));
@@ -105,10 +102,8 @@ Pose Motion::keyed(double t) const {
 Pose Motion::sample(double t) const {
     Pose p = keyed(t);
     p.position += mProc.velocity * float(t);
-    if (mProc.bobHz != 0.0f)
-        p.position += mProc.bobAmplitude * float(std::sin(kTwoPi * mProc.bobHz * t + mProc.bobPhaseRad));
-    if (mProc.spinRadPerSec != 0.0f)
-        p.rotation = glm::angleAxis(float(std::fmod(mProc.spinRadPerSec * t, kTwoPi)), spinAxis(mProc)) * p.rotation;
+    if (mProc.bobHz != 0.0f) p.position += mProc.bobAmplitude * float(std::sin(kTwoPi * mProc.bobHz * t + mProc.bobPhaseRad));
+    if (mProc.spinRadPerSec != 0.0f) p.rotation = glm::angleAxis(float(std::fmod(mProc.spinRadPerSec * t, kTwoPi)), spinAxis(mProc)) * p.rotation;
     return p;
 }
 
@@ -117,8 +112,7 @@ bool Motion::isStatic() const {
     if (mProc.bobHz != 0.0f && mProc.bobAmplitude != glm::vec3(0.0f)) return false;
     for (size_t i = 1; i < mKeys.size(); ++i) {
         const Pose &a = mKeys[i - 1].pose, &b = mKeys[i].pose;
-        if (a.position != b.position || !sameRotation(a.rotation, b.rotation) || a.scale != b.scale ||
-            a.opacity != b.opacity || a.growth != b.growth)
+        if (a.position != b.position || !sameRotation(a.rotation, b.rotation) || a.scale != b.scale || a.opacity != b.opacity || a.growth != b.growth)
             return false;
     }
     return true;

@@ -17,9 +17,7 @@ namespace {
 
 bool finite3(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
-std::string fieldError(const char* field, const std::string& what) {
-    return std::string("FluidSolverDesc.") + field + " " + what;
-}
+std::string fieldError(const char* field, const std::string& what) { return std::string("FluidSolverDesc.") + field + " " + what; }
 
 } // namespace
 
@@ -69,8 +67,7 @@ glm::vec3 FluidSolver::localPosition(glm::ivec3 cell) const {
 float FluidSolver::sampleScalar(const std::vector<float>& f, glm::vec3 p, float outside) const {
     const bool closedLo[3] = {mDesc.closedWalls, mDesc.closedFloor, mDesc.closedWalls};
     const bool closedHi[3] = {mDesc.closedWalls, mDesc.closedCeiling, mDesc.closedWalls};
-    for (int a = 0; a < 3; ++a)
-        p[a] = std::clamp(p[a], closedLo[a] ? 0.0f : -1.0f, closedHi[a] ? float(mDims[a] - 1) : float(mDims[a]));
+    for (int a = 0; a < 3; ++a) p[a] = std::clamp(p[a], closedLo[a] ? 0.0f : -1.0f, closedHi[a] ? float(mDims[a] - 1) : float(mDims[a]));
     return trilinear(p, [&](glm::ivec3 i) {
         if (glm::any(glm::lessThan(i, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(i, mDims))) return outside;
         return f[lin(i, mDims)];
@@ -104,36 +101,31 @@ glm::vec3 FluidSolver::backtrace(glm::vec3 p, float dt) const {
 
 Result<FluidSolver> FluidSolver::create(const FluidSolverDesc& d) {
     for (int a = 0; a < 3; ++a) {
-        if (d.dims[a] < 1)
-            return makeError(fieldError("dims", std::string(1, "xyz"[a]) + " must be at least 1, got " + std::to_string(d.dims[a])));
+        if (d.dims[a] < 1) return makeError(fieldError("dims", std::string(1, "xyz"[a]) + " must be at least 1, got " + std::to_string(d.dims[a])));
         if (!std::isfinite(d.spacing[a]) || d.spacing[a] <= 0.0f)
-            return makeError(fieldError("spacing", std::string(1, "xyz"[a]) + " must be a positive finite number, got " +
-                                                       std::to_string(d.spacing[a])));
+            return makeError(
+                fieldError("spacing", std::string(1, "xyz"[a]) + " must be a positive finite number, got " + std::to_string(d.spacing[a])));
     }
     const std::uint64_t n = std::uint64_t(d.dims.x) * std::uint64_t(d.dims.y) * std::uint64_t(d.dims.z);
-    if (n > kMaxVoxels)
-        return makeError(fieldError("dims", "asks for " + std::to_string(n) + " cells; the limit is " + std::to_string(kMaxVoxels)));
+    if (n > kMaxVoxels) return makeError(fieldError("dims", "asks for " + std::to_string(n) + " cells; the limit is " + std::to_string(kMaxVoxels)));
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r)
             if (!std::isfinite(d.transform[c][r])) return makeError(fieldError("transform", "has a non-finite entry"));
-    if (std::abs(glm::determinant(glm::mat3(d.transform))) < 1e-12f)
-        return makeError(fieldError("transform", "is singular"));
+    if (std::abs(glm::determinant(glm::mat3(d.transform))) < 1e-12f) return makeError(fieldError("transform", "is singular"));
     struct Rate {
         const char* name;
         float v;
     };
     for (Rate r : {Rate{"buoyancy", d.buoyancy}, Rate{"weight", d.weight}, Rate{"ambientTemperature", d.ambientTemperature}})
         if (!std::isfinite(r.v)) return makeError(fieldError(r.name, "must be finite"));
-    for (Rate r : {Rate{"windCoupling", d.windCoupling}, Rate{"velocityDamping", d.velocityDamping},
-                   Rate{"densityDissipation", d.densityDissipation}, Rate{"temperatureDissipation", d.temperatureDissipation}})
-        if (!std::isfinite(r.v) || r.v < 0.0f)
-            return makeError(fieldError(r.name, "must be finite and >= 0, got " + std::to_string(r.v)));
+    for (Rate r : {Rate{"windCoupling", d.windCoupling}, Rate{"velocityDamping", d.velocityDamping}, Rate{"densityDissipation", d.densityDissipation},
+                   Rate{"temperatureDissipation", d.temperatureDissipation}})
+        if (!std::isfinite(r.v) || r.v < 0.0f) return makeError(fieldError(r.name, "must be finite and >= 0, got " + std::to_string(r.v)));
     if (!finite3(d.windWorld)) return makeError(fieldError("windWorld", "must be finite"));
     if (d.pressureIterations < 0 || d.pressureIterations > 10000)
         return makeError(fieldError("pressureIterations", "must be in [0, 10000], got " + std::to_string(d.pressureIterations)));
     if (!(d.pressureTolerance >= 0.0f)) return makeError(fieldError("pressureTolerance", "must be >= 0"));
-    if (d.substeps < 1 || d.substeps > 1000)
-        return makeError(fieldError("substeps", "must be in [1, 1000], got " + std::to_string(d.substeps)));
+    if (d.substeps < 1 || d.substeps > 1000) return makeError(fieldError("substeps", "must be in [1, 1000], got " + std::to_string(d.substeps)));
     if (d.conserveMass && !(d.closedFloor && d.closedWalls && d.closedCeiling))
         return makeError(fieldError("conserveMass", "needs a closed domain (closedFloor, closedWalls and closedCeiling all "
                                                     "true); with open faces material leaves and the total is not conserved"));
@@ -185,9 +177,8 @@ void FluidSolver::substep(float dt) {
 void FluidSolver::applyEmitters(float dt) {
     if (mEmitters.empty() || dt <= 0.0f) return;
     const glm::mat3 lin3(mDesc.transform);
-    const float cellDiag =
-        0.5f * glm::length(glm::vec3(glm::length(lin3[0] * mDesc.spacing.x), glm::length(lin3[1] * mDesc.spacing.y),
-                                     glm::length(lin3[2] * mDesc.spacing.z)));
+    const float cellDiag = 0.5f * glm::length(glm::vec3(glm::length(lin3[0] * mDesc.spacing.x), glm::length(lin3[1] * mDesc.spacing.y),
+                                                        glm::length(lin3[2] * mDesc.spacing.z)));
     const glm::mat3 toLocal = glm::inverse(lin3);
     for (const Emitter& e : mEmitters) {
         const EmitterDesc& ed = e.desc;

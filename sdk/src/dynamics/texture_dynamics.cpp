@@ -49,14 +49,12 @@ TextureSample cycleSample(glm::ivec3 cell, double t, const CyclingDesc& d, std::
     if (d.mode == Cycling::None) return {};
     // King et al. 1999, sec. 3.3: phase shifting through the set at a
     // controlled rate; per-voxel start and rate keep neighbours out of step.
-    const double rate =
-        double(d.texturesPerSec) * (1.0 + double(d.rateJitter) * (2.0 * hashUnit(hashCell(cell, seed, kSaltRate)) - 1.0));
+    const double rate = double(d.texturesPerSec) * (1.0 + double(d.rateJitter) * (2.0 * hashUnit(hashCell(cell, seed, kSaltRate)) - 1.0));
     const double start = d.randomStart ? double(hashUnit(hashCell(cell, seed, kSaltStart))) : 0.0;
     const double p = t * rate + start;
     const double whole = std::floor(p);
     const auto tick = std::int64_t(whole);
-    if (d.mode == Cycling::Random)
-        return {hashCell(cell, seed ^ kSaltRandom, std::uint32_t(tick) ^ std::uint32_t(std::uint64_t(tick) >> 32)), 0.0f};
+    if (d.mode == Cycling::Random) return {hashCell(cell, seed ^ kSaltRandom, std::uint32_t(tick) ^ std::uint32_t(std::uint64_t(tick) >> 32)), 0.0f};
     float phase = float(p - whole);
     if (phase >= 1.0f) phase = std::nextafter(1.0f, 0.0f); // rounding of p - floor(p) to float
     return {std::uint32_t(tick), phase};
@@ -173,8 +171,7 @@ void TexturePropagator::stepFixed(glm::ivec3 d, std::uint32_t offset, const std:
     mIndex.swap(mScratch);
 }
 
-void TexturePropagator::advanceFlow(const std::vector<glm::vec3>& vel, const std::vector<std::uint8_t>& occupied,
-                                    double dt, std::uint32_t offset) {
+void TexturePropagator::advanceFlow(const std::vector<glm::vec3>& vel, const std::vector<std::uint8_t>& occupied, double dt, std::uint32_t offset) {
     assert(vel.size() == mIndex.size() && occupied.size() == mIndex.size() &&
            "TexturePropagator::advanceFlow: one velocity and one occupied flag per cell");
     assert(dt >= 0.0 && "TexturePropagator::advanceFlow: dtSec must be >= 0");
@@ -199,8 +196,7 @@ void TexturePropagator::advanceFlow(const std::vector<glm::vec3>& vel, const std
                 }
                 mTravel[i] = float(travelled - std::floor(travelled));
                 // Upwind 26-neighbour: components of -v at least half the largest.
-                const glm::ivec3 step{std::abs(v.x) >= 0.5f * m ? (v.x > 0 ? 1 : -1) : 0,
-                                      std::abs(v.y) >= 0.5f * m ? (v.y > 0 ? 1 : -1) : 0,
+                const glm::ivec3 step{std::abs(v.x) >= 0.5f * m ? (v.x > 0 ? 1 : -1) : 0, std::abs(v.y) >= 0.5f * m ? (v.y > 0 ? 1 : -1) : 0,
                                       std::abs(v.z) >= 0.5f * m ? (v.z > 0 ? 1 : -1) : 0};
                 const glm::ivec3 u = c - step;
                 mScratch[i] = inside(u) && occupied[linear(u)] ? mIndex[linear(u)] + offset : sourceIndex(c, mSteps, mSeed);

@@ -61,8 +61,7 @@ Status EffectBody::checkDesc(const EffectDesc& d) {
     if (!(c.texturesPerSec >= 0.0f && std::isfinite(c.texturesPerSec)))
         return makeError(at + "textures.cycling.texturesPerSec must be finite and >= 0");
     if (!(c.rateJitter >= 0.0f && c.rateJitter < 1.0f)) return makeError(at + "textures.cycling.rateJitter must be in [0, 1)");
-    if (!(d.footprintRadius > 0.0f && std::isfinite(d.footprintRadius)))
-        return makeError(at + "footprintRadius must be positive and finite");
+    if (!(d.footprintRadius > 0.0f && std::isfinite(d.footprintRadius))) return makeError(at + "footprintRadius must be positive and finite");
     if (!(d.growth.softnessCells > 0.0f)) return makeError(at + "growth.softnessCells must be > 0");
     const SparseOutputDesc& s = d.sparse;
     if (!(s.opacityPerDensity >= 0.0f) || !(s.minOpacity >= 0.0f) || !(s.temperatureRange > 0.0f) || !(s.maxStretch >= 0.0f) ||
@@ -129,8 +128,7 @@ Aabb EffectBody::transformBox(const Aabb& box, const glm::mat4& m) {
     return out;
 }
 
-Aabb EffectBody::withSplatExtent(const Aabb& world, float motionScale, const glm::mat4& transform, glm::vec3 spacing,
-                                 float maxStretch) const {
+Aabb EffectBody::withSplatExtent(const Aabb& world, float motionScale, const glm::mat4& transform, glm::vec3 spacing, float maxStretch) const {
     // Splat extent: the builder's R times the kernel's largest axis.
     const float extent = desc.footprintRadius * motionScale * kernelNormBound(transform, spacing, maxStretch);
     // A little slack for float rounding in the builder's matrix products.
@@ -148,8 +146,8 @@ AdvanceResult StatelessBody::advanceTo(double timeSec, const AdvanceContext&) {
     return {.steps = 1, .caughtUp = false};
 }
 
-Aabb StatelessBody::sweptBounds(const Aabb& localBox, const glm::mat4& latticeTransform, glm::vec3 spacing, float maxStretch,
-                                double t0, double t1) const {
+Aabb StatelessBody::sweptBounds(const Aabb& localBox, const glm::mat4& latticeTransform, glm::vec3 spacing, float maxStretch, double t0,
+                                double t1) const {
     if (t1 < t0) std::swap(t0, t1);
     if (localBox.empty()) return {};
     // Object space: the lattice transform's image of the local box (its corners bound it).

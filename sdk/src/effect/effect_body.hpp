@@ -42,15 +42,14 @@ public:
     // The world box `world` (lattice points, motion included) grown by the
     // largest splat: footprint radius times the kernel's largest axis for a
     // lattice with this transform and spacing, scaled by `motionScale`.
-    Aabb withSplatExtent(const Aabb& world, float motionScale, const glm::mat4& transform, glm::vec3 spacing,
-                         float maxStretch) const;
+    Aabb withSplatExtent(const Aabb& world, float motionScale, const glm::mat4& transform, glm::vec3 spacing, float maxStretch) const;
     // The corners of `box` through `m`.
     static Aabb transformBox(const Aabb& box, const glm::mat4& m);
 
     EffectDesc desc;
     std::vector<EffectLayer> layers;
-    Grid grid;                     // the whole effect now
-    std::vector<Grid> layerGrids;  // grid split by layers
+    Grid grid;                    // the whole effect now
+    std::vector<Grid> layerGrids; // grid split by layers
     int latticeLoY = 0, latticeHiY = 0;
     double time = 0.0;
     EffectCounters counters;
@@ -68,8 +67,7 @@ protected:
     // Bounds over [t0, t1] of the lattice points in `localBox` (lattice-local),
     // placed by `latticeTransform` and swept by the desc's motion (frozen at
     // t = 0 when object dynamics are off), grown by the largest splat.
-    Aabb sweptBounds(const Aabb& localBox, const glm::mat4& latticeTransform, glm::vec3 spacing, float maxStretch, double t0,
-                     double t1) const;
+    Aabb sweptBounds(const Aabb& localBox, const glm::mat4& latticeTransform, glm::vec3 spacing, float maxStretch, double t0, double t1) const;
 };
 
 std::unique_ptr<EffectBody> makeGridBody(Grid base, EffectDesc desc);

@@ -77,16 +77,15 @@ public:
 
 private:
     ProceduralGasDesc mGas;
-    Grid mLattice;                         // dims, spacing and transform only
-    TextureDynamics mNoTextureDynamics{};  // no base voxels to precompute for
+    Grid mLattice;                        // dims, spacing and transform only
+    TextureDynamics mNoTextureDynamics{}; // no base voxels to precompute for
 };
 
 } // namespace
 
 Result<std::unique_ptr<EffectBody>> makeGasBody(ProceduralGasDesc gas, Grid lattice, EffectDesc desc) {
     if (Status s = validateProceduralGas(gas); !s) return makeError("effect '" + desc.name + "': gas." + s.error());
-    if (glm::any(glm::lessThanEqual(lattice.dims, glm::ivec3(0))))
-        return makeError("effect '" + desc.name + "': the gas lattice has no cells");
+    if (glm::any(glm::lessThanEqual(lattice.dims, glm::ivec3(0)))) return makeError("effect '" + desc.name + "': the gas lattice has no cells");
     const std::uint64_t cells = std::uint64_t(lattice.dims.x) * std::uint64_t(lattice.dims.y) * std::uint64_t(lattice.dims.z);
     if (cells > kMaxVoxels)
         return makeError("effect '" + desc.name + "': the gas lattice has " + std::to_string(cells) + " cells, over kMaxVoxels (" +

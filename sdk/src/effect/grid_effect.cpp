@@ -26,8 +26,7 @@ public:
         if (!mBase.voxels.empty()) {
             // Growth distances from the origin, in cells.
             const GrowthDesc& g = desc.growth;
-            const glm::vec3 origin = g.originAtCentre ? glm::vec3(0.5f * (lo.x + hi.x), float(lo.y), 0.5f * (lo.z + hi.z))
-                                                      : g.originCells;
+            const glm::vec3 origin = g.originAtCentre ? glm::vec3(0.5f * (lo.x + hi.x), float(lo.y), 0.5f * (lo.z + hi.z)) : g.originCells;
             // The lattice never changes after construction: bounds() reuses this box.
             for (const Voxel& v : mBase.voxels) {
                 mBaseBox.extend(mBase.localPosition(v.cell));
@@ -82,9 +81,7 @@ public:
         return pose.opacity > 0.0f && pose.growth > 0.0f;
     }
 
-    Aabb bounds(double t0, double t1) const override {
-        return sweptBounds(mBaseBox, mBase.transform, mBase.spacing, mBaseMaxStretch, t0, t1);
-    }
+    Aabb bounds(double t0, double t1) const override { return sweptBounds(mBaseBox, mBase.transform, mBase.spacing, mBaseMaxStretch, t0, t1); }
 
 private:
     void rebuildTextureDynamics() {
@@ -94,18 +91,16 @@ private:
         mTexDyn = TextureDynamics(mBase, td);
     }
 
-    Grid mBase;                          // the t = 0 material
-    Aabb mBaseBox;                       // local box of the lattice points
-    float mBaseMaxStretch = 0.0f;        // largest voxel stretch
-    std::vector<float> mGrowthDistance;  // per base voxel, cells
+    Grid mBase;                         // the t = 0 material
+    Aabb mBaseBox;                      // local box of the lattice points
+    float mBaseMaxStretch = 0.0f;       // largest voxel stretch
+    std::vector<float> mGrowthDistance; // per base voxel, cells
     float mGrowthMax = 0.0f;
     TextureDynamics mTexDyn;
 };
 
 } // namespace
 
-std::unique_ptr<EffectBody> makeGridBody(Grid base, EffectDesc desc) {
-    return std::make_unique<GridBody>(std::move(base), std::move(desc));
-}
+std::unique_ptr<EffectBody> makeGridBody(Grid base, EffectDesc desc) { return std::make_unique<GridBody>(std::move(base), std::move(desc)); }
 
 } // namespace splatfx::detail

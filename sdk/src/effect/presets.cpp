@@ -46,8 +46,7 @@ struct PendingSet {
 };
 
 // A given set is shared by content (no key); a procedural one by its parameters.
-Result<PendingSet> resolveSet(const Materials& m, const std::optional<TextureSet>& given, const TurbulenceDesc& fallback,
-                              bool keepColor = false) {
+Result<PendingSet> resolveSet(const Materials& m, const std::optional<TextureSet>& given, const TurbulenceDesc& fallback, bool keepColor = false) {
     PendingSet p;
     if (!given) p.key = turbulenceKey(fallback);
     if (!p.key.empty()) p.id = m.findTextureSet(p.key);
@@ -105,8 +104,7 @@ Result<Effect> fire(Materials& materials, const FireDesc& d) {
     if (!grid) return makeError("FireDesc.dims/spacing: " + grid.error());
     // Sparse, sharp detail (contrast 2.5) reads as licking flames through the
     // ~20 splats that overlap on each pixel; plain turbulence averages to a haze.
-    Result<PendingSet> set =
-        resolveSet(materials, d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .contrast = 2.5f});
+    Result<PendingSet> set = resolveSet(materials, d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .contrast = 2.5f});
     if (!set) return makeError("FireDesc.textureSet: " + set.error());
 
     for (Voxel& v : grid->voxels) v.opacity = d.opacity * flameOpacity(v.cell, grid->dims, 1.0f);
@@ -140,8 +138,7 @@ Result<Effect> smoke(Materials& materials, const SmokeDesc& d) {
                        .substeps = d.substeps};
     Result<FluidSolver> solver = FluidSolver::create(sd);
     if (!solver) return makeError("SmokeDesc: " + solver.error());
-    Result<PendingSet> set =
-        resolveSet(materials, d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .baseFrequency = 2.0f});
+    Result<PendingSet> set = resolveSet(materials, d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .baseFrequency = 2.0f});
     if (!set) return makeError("SmokeDesc.textureSet: " + set.error());
     solver->addEmitter({.desc = {.offset = d.sourceOffset, .radius = d.sourceRadius, .density = 1.0f, .temperature = 1.0f, .rate = 6.0f},
                         .motion = restingAt(d.sourceMotion, d.position)});
@@ -220,8 +217,7 @@ Result<Effect> dust(Materials& materials, const DustDesc& d) {
                        .temperatureDissipation = 1.5f};
     Result<FluidSolver> solver = FluidSolver::create(sd);
     if (!solver) return makeError("DustDesc: " + solver.error());
-    Result<PendingSet> set =
-        resolveSet(materials, d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .baseFrequency = 2.5f});
+    Result<PendingSet> set = resolveSet(materials, d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .baseFrequency = 2.5f});
     if (!set) return makeError("DustDesc.textureSet: " + set.error());
     solver->addEmitter({.desc = {.offset = d.sourceOffset, .radius = d.sourceRadius, .density = 1.0f, .temperature = 0.6f, .rate = 5.0f},
                         .motion = restingAt(d.sourceMotion, d.position)});
@@ -278,9 +274,15 @@ Result<Effect> fireToSmoke(Materials& materials, const FireToSmokeDesc& d) {
     const std::uint32_t smokeLut = materials.addColorTable(ColorTable::smoke());
     e.layers = {
         {.style = {.textureSet = *fireId, .colorTable = fireLut, .textured = true, .crossfade = true},
-         .heightFrom = 0.0f, .heightTo = d.split, .blend = d.blend, .remapColor = true},
+         .heightFrom = 0.0f,
+         .heightTo = d.split,
+         .blend = d.blend,
+         .remapColor = true},
         {.style = {.textureSet = *smokeId, .colorTable = smokeLut, .textured = true, .crossfade = true},
-         .heightFrom = d.split, .heightTo = 1.0f, .blend = d.blend, .remapColor = true},
+         .heightFrom = d.split,
+         .heightTo = 1.0f,
+         .blend = d.blend,
+         .remapColor = true},
     };
     return Effect::fromGrid(std::move(*grid), std::move(e));
 }
@@ -305,8 +307,8 @@ TextureSet proceduralFaces(int count, int size, std::uint32_t seed) {
                 auto ellipse = [](float a, float b) { return a * a + b * b; };
                 const float head = ellipse(u / headW, v / headH);
                 float a = std::clamp((1.0f - head) / 0.25f, 0.0f, 1.0f);
-                const float eye = std::min(ellipse((u - eyeX) / eyeR, (v - eyeY) / (1.3f * eyeR)),
-                                           ellipse((u + eyeX) / eyeR, (v - eyeY) / (1.3f * eyeR)));
+                const float eye =
+                    std::min(ellipse((u - eyeX) / eyeR, (v - eyeY) / (1.3f * eyeR)), ellipse((u + eyeX) / eyeR, (v - eyeY) / (1.3f * eyeR)));
                 const float mouth = ellipse(u / mouthW, (v - mouthY) / mouthH);
                 a *= std::clamp((std::min(eye, mouth) - 0.6f) / 0.4f, 0.08f, 1.0f);
                 float* p = &px[(std::size_t(y) * size + x) * 4];
@@ -364,8 +366,8 @@ Result<Effect> ghosts(Materials& materials, const GhostsDesc& d) {
     e.textures.cycling = {.mode = Cycling::Random, .texturesPerSec = d.texturesPerSec, .rateJitter = 0.4f};
     const Result<std::uint32_t> setId = registerSet(materials, set);
     if (!setId) return makeError("GhostsDesc.textureSet: " + setId.error());
-    const std::uint32_t tableId = materials.addColorTable(ColorTable::gradient(
-        {{0.0f, {0.75f, 0.85f, 1.0f, 1.0f}}, {0.6f, {0.7f, 0.8f, 1.0f, 0.8f}}, {1.0f, {0.6f, 0.7f, 0.9f, 0.0f}}}));
+    const std::uint32_t tableId = materials.addColorTable(
+        ColorTable::gradient({{0.0f, {0.75f, 0.85f, 1.0f, 1.0f}}, {0.6f, {0.7f, 0.8f, 1.0f, 0.8f}}, {1.0f, {0.6f, 0.7f, 0.9f, 0.0f}}}));
     e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = false}}};
     return Effect::fromGrid(std::move(*grid), std::move(e));
 }

@@ -109,10 +109,10 @@ private:
     float mPeakDepth = 0.0f;
     Aabb mLocalBox;
     TexturePropagator mPropagator;
-    std::int64_t mPropSteps = 0;           // propagation steps mPropagator has taken
-    std::vector<float> mDepth;             // scratch: depth at a step's time
-    std::vector<glm::vec3> mVelocity;      // scratch: velocity at a step's time
-    TextureDynamics mNoTextureDynamics{};  // textureDynamics() of a sequence effect: empty
+    std::int64_t mPropSteps = 0;          // propagation steps mPropagator has taken
+    std::vector<float> mDepth;            // scratch: depth at a step's time
+    std::vector<glm::vec3> mVelocity;     // scratch: velocity at a step's time
+    TextureDynamics mNoTextureDynamics{}; // textureDynamics() of a sequence effect: empty
 };
 
 } // namespace
@@ -121,7 +121,8 @@ Result<std::unique_ptr<EffectBody>> makeSequenceBody(GridSequence sequence, Effe
     if (Status s = sequence.validate(); !s) return makeError("effect '" + desc.name + "': " + s.error());
     const PropagationDesc& p = desc.textures.propagation;
     if (p.mode == Propagation::Velocity && !sequence.hasVelocity())
-        return makeError("effect '" + desc.name + "': textures.propagation.mode is Velocity but the sequence carries no velocity "
+        return makeError("effect '" + desc.name +
+                         "': textures.propagation.mode is Velocity but the sequence carries no velocity "
                          "(import a velocity grid, or choose Fixed or None)");
     if (p.mode == Propagation::Fixed && glm::any(glm::greaterThan(glm::abs(p.direction), sequence.dims)))
         return makeError("effect '" + desc.name + "': textures.propagation.direction is longer than the sequence's lattice");

@@ -111,15 +111,16 @@ public:
 private:
     FluidSolver mSolver;
     TexturePropagator mPropagator;
-    double mSimulatedTo = 0.0;             // time the last step() or advanceTo() brought the effect to
-    TextureDynamics mNoTextureDynamics{};  // textureDynamics() of a solver effect: empty
+    double mSimulatedTo = 0.0;            // time the last step() or advanceTo() brought the effect to
+    TextureDynamics mNoTextureDynamics{}; // textureDynamics() of a solver effect: empty
 };
 
 } // namespace
 
 Result<std::unique_ptr<EffectBody>> makeSolverBody(FluidSolver solver, EffectDesc desc) {
     if (!desc.motion.isStatic())
-        return makeError("effect '" + desc.name + "': desc.motion must be at rest for a solver effect; attach the motion to "
+        return makeError("effect '" + desc.name +
+                         "': desc.motion must be at rest for a solver effect; attach the motion to "
                          "its emitters (the material then trails behind the moving object)");
     if (desc.textures.propagation.mode == Propagation::Fixed) {
         const glm::ivec3 d = desc.textures.propagation.direction;

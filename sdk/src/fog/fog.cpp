@@ -43,11 +43,10 @@ bool finite(glm::dvec3 v) { return finite(v.x) && finite(v.y) && finite(v.z); }
 
 Status checkCurve(const FogCurve& c, const std::string& name) {
     for (size_t i = 0; i < c.keys.size(); ++i) {
-        if (!finite(c.keys[i].x) || !finite(c.keys[i].y))
-            return makeError(name + ".keys[" + std::to_string(i) + "] must be finite");
+        if (!finite(c.keys[i].x) || !finite(c.keys[i].y)) return makeError(name + ".keys[" + std::to_string(i) + "] must be finite");
         if (i > 0 && c.keys[i].x < c.keys[i - 1].x)
-            return makeError(name + ".keys must be sorted by time (keys[" + std::to_string(i) + "] at " +
-                             fmt(c.keys[i].x) + " s comes before " + fmt(c.keys[i - 1].x) + " s)");
+            return makeError(name + ".keys must be sorted by time (keys[" + std::to_string(i) + "] at " + fmt(c.keys[i].x) + " s comes before " +
+                             fmt(c.keys[i - 1].x) + " s)");
     }
     return {};
 }
@@ -59,8 +58,7 @@ Status checkMonomials(const std::vector<FogMonomial>& ms, const std::string& nam
         if (!finite(m.coeff)) return makeError(n + ".coeff must be finite");
         if (m.px < 0 || m.py < 0 || m.pz < 0) return makeError(n + " has a negative power");
         if (m.px + m.py + m.pz > kFogMaxDegree)
-            return makeError(n + " has total degree " + std::to_string(m.px + m.py + m.pz) + ", above the maximum " +
-                             std::to_string(kFogMaxDegree));
+            return makeError(n + " has total degree " + std::to_string(m.px + m.py + m.pz) + ", above the maximum " + std::to_string(kFogMaxDegree));
     }
     return {};
 }
@@ -72,8 +70,7 @@ Status checkTerm(FogTerm& t, const std::string& n) {
     for (size_t i = 0; i < t.motion.keys.size(); ++i) {
         if (!finite(t.motion.keys[i].timeSec) || !finite(t.motion.keys[i].velocity))
             return makeError(n + ".motion.keys[" + std::to_string(i) + "] must be finite");
-        if (i > 0 && t.motion.keys[i].timeSec < t.motion.keys[i - 1].timeSec)
-            return makeError(n + ".motion.keys must be sorted by timeSec");
+        if (i > 0 && t.motion.keys[i].timeSec < t.motion.keys[i - 1].timeSec) return makeError(n + ".motion.keys must be sorted by timeSec");
     }
     switch (t.kind) {
     case FogTermKind::Constant: break;
@@ -106,19 +103,16 @@ Status checkTerm(FogTerm& t, const std::string& n) {
     case FogTermKind::Sphere:
         if (!finite(t.centre)) return makeError(n + ".centre must be finite");
         if (!finite(t.c) || t.c <= 0.0)
-            return makeError(n + ".c must be > 0 (the density 1 / (c + d r^2) is infinite at r = 0 otherwise; got " +
-                             fmt(t.c) + ")");
+            return makeError(n + ".c must be > 0 (the density 1 / (c + d r^2) is infinite at r = 0 otherwise; got " + fmt(t.c) + ")");
         if (!finite(t.d) || t.d < 0.0) return makeError(n + ".d must be finite and >= 0 (got " + fmt(t.d) + ")");
         if (!finite(t.radius) || t.radius < 0.0) return makeError(n + ".radius must be finite and >= 0");
         if (Status s = checkCurve(t.cOverTime, n + ".cOverTime"); !s) return s;
         if (Status s = checkCurve(t.dOverTime, n + ".dOverTime"); !s) return s;
         // Piecewise linear: positive at every key is positive everywhere.
         for (size_t i = 0; i < t.cOverTime.keys.size(); ++i)
-            if (t.cOverTime.keys[i].y <= 0.0)
-                return makeError(n + ".cOverTime.keys[" + std::to_string(i) + "] value must be > 0");
+            if (t.cOverTime.keys[i].y <= 0.0) return makeError(n + ".cOverTime.keys[" + std::to_string(i) + "] value must be > 0");
         for (size_t i = 0; i < t.dOverTime.keys.size(); ++i)
-            if (t.dOverTime.keys[i].y < 0.0)
-                return makeError(n + ".dOverTime.keys[" + std::to_string(i) + "] value must be >= 0");
+            if (t.dOverTime.keys[i].y < 0.0) return makeError(n + ".dOverTime.keys[" + std::to_string(i) + "] value must be >= 0");
         break;
     }
     return {};
@@ -202,15 +196,15 @@ Status checkNonNegative(const FogDesc& d) {
             case FogTermKind::Cosine:
             case FogTermKind::CosineProduct:
                 low = -std::abs(w);
-                where = "where its cosine" + std::string(term.kind == FogTermKind::CosineProduct ? "s' product" : "") +
-                        " is " + (w > 0 ? "-1" : "+1");
+                where =
+                    "where its cosine" + std::string(term.kind == FogTermKind::CosineProduct ? "s' product" : "") + " is " + (w > 0 ? "-1" : "+1");
                 break;
             case FogTermKind::Polynomial: {
                 const fogdetail::Poly& p = fr.polys[polyIndex++];
                 glm::dvec3 u(0.0);
                 low = polyMinimum(p, u);
-                where = "at cell coordinates " + fmt(u) + " (world " +
-                        fmt(term.cellCentre + u * term.cellHalfSize) + " at t = 0 without wind), minimum " + fmt(low);
+                where = "at cell coordinates " + fmt(u) + " (world " + fmt(term.cellCentre + u * term.cellHalfSize) +
+                        " at t = 0 without wind), minimum " + fmt(low);
                 if (term.cellMode == FogCellMode::ZeroOutside) low = std::min(low, 0.0);
                 break;
             }
@@ -231,8 +225,8 @@ Status checkNonNegative(const FogDesc& d) {
         }
         const double scale = positive - worst;
         if (total < -1e-12 * std::max(scale, 1e-300))
-            return makeError("fog density can go negative at t = " + fmt(t) + " s: the positive parts sum to at least " +
-                             fmt(positive) + " but the terms can take away " + fmt(positive - total) +
+            return makeError("fog density can go negative at t = " + fmt(t) + " s: the positive parts sum to at least " + fmt(positive) +
+                             " but the terms can take away " + fmt(positive - total) +
                              " (Biri et al. sec. 3.2.1: c_0 >= sum |c_i|); the largest is " + worstWhat);
     }
     return {};
@@ -302,8 +296,7 @@ FogTerm FogTerm::cosine(double weight, double k, glm::dvec3 direction, double ph
     return t;
 }
 
-FogTerm FogTerm::cosineProduct(double weight, double k1, glm::dvec3 dir1, double phase1, double k2, glm::dvec3 dir2,
-                               double phase2) {
+FogTerm FogTerm::cosineProduct(double weight, double k1, glm::dvec3 dir1, double phase1, double k2, glm::dvec3 dir2, double phase2) {
     FogTerm t = cosine(weight, k1, dir1, phase1);
     t.kind = FogTermKind::CosineProduct;
     const double len = glm::length(dir2);
@@ -312,8 +305,7 @@ FogTerm FogTerm::cosineProduct(double weight, double k1, glm::dvec3 dir1, double
     return t;
 }
 
-FogTerm FogTerm::polynomial1D(double weight, int axis, std::vector<double> coeffs, double halfSize, FogCellMode mode,
-                              double centre) {
+FogTerm FogTerm::polynomial1D(double weight, int axis, std::vector<double> coeffs, double halfSize, FogCellMode mode, double centre) {
     FogTerm t;
     t.kind = FogTermKind::Polynomial;
     t.weight = weight;
@@ -356,12 +348,10 @@ FogTerm FogTerm::sphere(double weight, glm::dvec3 centre, double radius, double 
 Result<Fog> Fog::create(FogDesc desc) {
     if (!finite(desc.colour)) return makeError("FogDesc.colour must be finite");
     if (!finite(desc.farDistanceWorld) || desc.farDistanceWorld < 0.0)
-        return makeError("FogDesc.farDistanceWorld must be finite and >= 0 (0 = no cut-off; got " +
-                         fmt(desc.farDistanceWorld) + ")");
+        return makeError("FogDesc.farDistanceWorld must be finite and >= 0 (0 = no cut-off; got " + fmt(desc.farDistanceWorld) + ")");
     for (size_t i = 0; i < desc.wind.keys.size(); ++i) {
         const std::string n = "FogDesc.wind.keys[" + std::to_string(i) + "]";
-        if (!finite(desc.wind.keys[i].timeSec) || !finite(desc.wind.keys[i].velocity))
-            return makeError(n + " must be finite");
+        if (!finite(desc.wind.keys[i].timeSec) || !finite(desc.wind.keys[i].velocity)) return makeError(n + " must be finite");
         if (i > 0 && desc.wind.keys[i].timeSec < desc.wind.keys[i - 1].timeSec)
             return makeError("FogDesc.wind.keys must be sorted by timeSec (" + n + " comes before its predecessor)");
     }

@@ -25,13 +25,13 @@ struct Poly {
     glm::dvec3 halfSize{1.0};
     bool used[3] = {false, false, false}; // axes with a non-zero power in A or B
     int usedCount = 0;
-    int usedAxis = -1;              // the axis when usedCount == 1
+    int usedAxis = -1; // the axis when usedCount == 1
     FogCellMode mode = FogCellMode::Periodic;
 };
 
 struct Potential {
     FogTermKind kind = FogTermKind::Point;
-    glm::dvec3 qRel{0.0};  // centre relative to the reference
+    glm::dvec3 qRel{0.0}; // centre relative to the reference
     glm::dvec3 axis{0.0, 1.0, 0.0};
     double radius2 = 0.0;
     double c = 1.0, d = 1.0, weight = 0.0;

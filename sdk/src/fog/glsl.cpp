@@ -26,14 +26,13 @@ int polyDegree(const Poly& p) {
 bool multi(const Poly& p) { return p.usedCount > 1; }
 int polyVec4s(const Poly& p) {
     if (multi(p)) return 2 + (int(p.mono.size()) + 3) / 4; // uRef + mean, 1/halfSize, coefficients
-    return 1 + (polyDegree(p) + 1 + 3) / 4;               // uRef, 1/h, cell integral; dense coefficients
+    return 1 + (polyDegree(p) + 1 + 3) / 4;                // uRef, 1/h, cell integral; dense coefficients
 }
 
 // Mean of a polynomial over its reference cell (used axes), by tensor Gauss (exact).
 double cellMean(const Poly& p) {
     static constexpr double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
-    static constexpr double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
-                                    0.2369268850561891};
+    static constexpr double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665, 0.2369268850561891};
     const int nu = p.used[0] ? 5 : 1, nv = p.used[1] ? 5 : 1, nw = p.used[2] ? 5 : 1;
     double mean = 0.0;
     for (int i = 0; i < nu; ++i)
@@ -54,8 +53,8 @@ namespace {
 std::string multiPolySource(const Poly& p, const std::string& P, const std::string& id, int base, int maxCells) {
     const std::string fn = P + "_poly" + id;
     auto prm = [&](int i) { return P + "_params[" + std::to_string(i) + "]"; };
-    const std::string used = std::string("vec3(") + (p.used[0] ? "1.0" : "0.0") + ", " + (p.used[1] ? "1.0" : "0.0") +
-                             ", " + (p.used[2] ? "1.0" : "0.0") + ")";
+    const std::string used =
+        std::string("vec3(") + (p.used[0] ? "1.0" : "0.0") + ", " + (p.used[1] ? "1.0" : "0.0") + ", " + (p.used[2] ? "1.0" : "0.0") + ")";
     int maxPow[3] = {0, 0, 0};
     for (const FogMonomial& m : p.mono) {
         maxPow[0] = std::max(maxPow[0], m.px);
@@ -73,22 +72,29 @@ std::string multiPolySource(const Poly& p, const std::string& P, const std::stri
     s += "    float r = 0.0;\n";
     for (size_t n = 0; n < p.mono.size(); ++n) {
         const FogMonomial& m = p.mono[n];
-        s += "    r += " + prm(base + 2 + int(n / 4)) + "[" + std::to_string(n % 4) + "] * X[" + std::to_string(m.px) +
-             "] * Y[" + std::to_string(m.py) + "] * Z[" + std::to_string(m.pz) + "];\n";
+        s += "    r += " + prm(base + 2 + int(n / 4)) + "[" + std::to_string(n % 4) + "] * X[" + std::to_string(m.px) + "] * Y[" +
+             std::to_string(m.py) + "] * Z[" + std::to_string(m.pz) + "];\n";
     }
     s += "    return r;\n}\n";
     const bool periodic = p.mode == FogCellMode::Periodic;
-    s += "float " + fn + "_piece(float la, float lb, vec3 U0, vec3 dU, float L) {\n"
+    s += "float " + fn +
+         "_piece(float la, float lb, vec3 U0, vec3 dU, float L) {\n"
          "    if (lb <= la) return 0.0;\n"
          "    float mid = 0.5 * (la + lb), hw = 0.5 * (lb - la), sum = 0.0;\n";
     s += periodic ? "    vec3 shift = 2.0 * floor((U0 + mid * dU + 1.0) * 0.5);\n" : "    vec3 shift = vec3(0.0);\n";
     s += "    for (int j = 0; j < 5; ++j) sum += " + P + "_GW[j] * " + fn + "(U0 + (mid + hw * " + P +
          "_GX[j]) * dU - shift);\n"
          "    return sum * hw * L;\n}\n";
-    s += "float " + fn + "_integral(vec3 oRel, vec3 pRel, float L) {\n"
-         "    const vec3 used = " + used + ";\n"
-         "    vec3 U0 = (" + prm(base) + ".xyz + oRel * " + prm(base + 1) + ".xyz) * used;\n"
-         "    vec3 dU = (pRel - oRel) * " + prm(base + 1) + ".xyz * used;\n";
+    s += "float " + fn +
+         "_integral(vec3 oRel, vec3 pRel, float L) {\n"
+         "    const vec3 used = " +
+         used +
+         ";\n"
+         "    vec3 U0 = (" +
+         prm(base) + ".xyz + oRel * " + prm(base + 1) +
+         ".xyz) * used;\n"
+         "    vec3 dU = (pRel - oRel) * " +
+         prm(base + 1) + ".xyz * used;\n";
     if (!periodic) {
         s += "    float la = 0.0, lb = 1.0;\n"
              "    for (int a = 0; a < 3; ++a) {\n"
@@ -98,13 +104,16 @@ std::string multiPolySource(const Poly& p, const std::string& P, const std::stri
              "        la = max(la, min(l0, l1));\n"
              "        lb = min(lb, max(l0, l1));\n"
              "    }\n"
-             "    return " + fn + "_piece(la, lb, U0, dU, L);\n}\n";
+             "    return " +
+             fn + "_piece(la, lb, U0, dU, L);\n}\n";
         return s;
     }
     s += "    vec3 n0 = floor((U0 + 1.0) * 0.5), n1 = floor((U0 + dU + 1.0) * 0.5);\n"
          "    bvec3 moving = notEqual(n0, n1);\n"
          "    int nMoving = int(moving.x) + int(moving.y) + int(moving.z);\n"
-         "    if (nMoving == 0) return " + fn + "_piece(0.0, 1.0, U0, dU, L);\n"
+         "    if (nMoving == 0) return " +
+         fn +
+         "_piece(0.0, 1.0, U0, dU, L);\n"
          "    bvec3 varies = notEqual(dU, vec3(0.0));\n"
          "    if (nMoving == 1 && int(varies.x) + int(varies.y) + int(varies.z) == 1) {\n"
          "        int a = moving.x ? 0 : (moving.y ? 1 : 2);\n"
@@ -115,8 +124,12 @@ std::string multiPolySource(const Poly& p, const std::string& P, const std::stri
          "        float whole = abs(n1[a] - n0[a]) - 1.0;\n"
          "        vec3 u = U0 - 2.0 * n0;\n"
          "        float cell = 0.0;\n"
-         "        for (int j = 0; j < 5; ++j) { u[a] = " + P + "_GX[j]; cell += " + P + "_GW[j] * " + fn + "(u); }\n"
-         "        return " + fn + "_piece(0.0, l1, U0, dU, L) + " + fn + "_piece(lk, 1.0, U0, dU, L)\n"
+         "        for (int j = 0; j < 5; ++j) { u[a] = " +
+         P + "_GX[j]; cell += " + P + "_GW[j] * " + fn +
+         "(u); }\n"
+         "        return " +
+         fn + "_piece(0.0, l1, U0, dU, L) + " + fn +
+         "_piece(lk, 1.0, U0, dU, L)\n"
          "             + whole * cell * (L / abs(dU[a]));\n"
          "    }\n"
          "    vec3 dir = sign(dU);\n"
@@ -124,15 +137,20 @@ std::string multiPolySource(const Poly& p, const std::string& P, const std::stri
          "    vec3 nx = vec3(2.0);\n"
          "    for (int a = 0; a < 3; ++a) if (dU[a] != 0.0) nx[a] = (nb[a] - U0[a]) / dU[a];\n"
          "    float lam = 0.0, total = 0.0;\n"
-         "    for (int i = 0; i < " + std::to_string(maxCells) + "; ++i) {\n"
+         "    for (int i = 0; i < " +
+         std::to_string(maxCells) +
+         "; ++i) {\n"
          "        float ln = min(min(min(nx.x, nx.y), nx.z), 1.0);\n"
-         "        total += " + fn + "_piece(lam, ln, U0, dU, L);\n"
+         "        total += " +
+         fn +
+         "_piece(lam, ln, U0, dU, L);\n"
          "        lam = ln;\n"
          "        if (lam >= 1.0) return total;\n"
          "        for (int a = 0; a < 3; ++a)\n"
          "            if (dU[a] != 0.0 && nx[a] <= lam) { nb[a] += 2.0 * dir[a]; nx[a] = (nb[a] - U0[a]) / dU[a]; }\n"
          "    }\n"
-         "    return total + (1.0 - lam) * L * " + prm(base) + ".w;\n}\n";
+         "    return total + (1.0 - lam) * L * " +
+         prm(base) + ".w;\n}\n";
     return s;
 }
 
@@ -152,21 +170,19 @@ std::vector<glm::vec4> Fog::glslParameters(double tSec, glm::dvec3 reference) co
             out.push_back({glm::vec3(1.0 / p.halfSize), 0.0f});
             for (size_t n = 0; n < p.mono.size(); n += 4)
                 out.push_back({float(p.mono[n].coeff), n + 1 < p.mono.size() ? float(p.mono[n + 1].coeff) : 0.0f,
-                               n + 2 < p.mono.size() ? float(p.mono[n + 2].coeff) : 0.0f,
-                               n + 3 < p.mono.size() ? float(p.mono[n + 3].coeff) : 0.0f});
+                               n + 2 < p.mono.size() ? float(p.mono[n + 2].coeff) : 0.0f, n + 3 < p.mono.size() ? float(p.mono[n + 3].coeff) : 0.0f});
             continue;
         }
         const int a = std::max(p.usedAxis, 0);
         const int deg = polyDegree(p);
         std::vector<double> dense(size_t(deg + 1), 0.0);
         for (const FogMonomial& m : p.mono) dense[size_t(m.px + m.py + m.pz)] += m.coeff; // one axis only
-        double cell = 0.0; // integral of P over [-1, 1]: odd powers vanish
+        double cell = 0.0;                                                                // integral of P over [-1, 1]: odd powers vanish
         for (int n = 0; n <= deg; n += 2) cell += 2.0 * dense[size_t(n)] / (n + 1);
         out.push_back({float(p.uRef[a]), float(1.0 / p.halfSize[a]), float(cell), 0.0f});
         for (int n = 0; n <= deg; n += 4)
             out.push_back({float(dense[size_t(n)]), n + 1 <= deg ? float(dense[size_t(n + 1)]) : 0.0f,
-                           n + 2 <= deg ? float(dense[size_t(n + 2)]) : 0.0f,
-                           n + 3 <= deg ? float(dense[size_t(n + 3)]) : 0.0f});
+                           n + 2 <= deg ? float(dense[size_t(n + 2)]) : 0.0f, n + 3 <= deg ? float(dense[size_t(n + 3)]) : 0.0f});
     }
     for (const auto& p : fr.pots) {
         out.push_back({glm::vec3(p.qRel), float(p.c)});
@@ -182,8 +198,8 @@ Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& opt) {
     bool identifier = !opt.prefix.empty() && !std::isdigit((unsigned char)opt.prefix[0]) && opt.prefix.rfind("gl_", 0) != 0;
     for (char ch : opt.prefix) identifier = identifier && (std::isalnum((unsigned char)ch) || ch == '_');
     if (!identifier)
-        return makeError("FogGlslOptions.prefix must be a GLSL identifier ([A-Za-z_][A-Za-z0-9_]*, not starting with gl_); got \"" +
-                         opt.prefix + "\"");
+        return makeError("FogGlslOptions.prefix must be a GLSL identifier ([A-Za-z_][A-Za-z0-9_]*, not starting with gl_); got \"" + opt.prefix +
+                         "\"");
     const std::string P = opt.prefix;
     int count = 1 + int(fr.waves.size()) * 2 + int(fr.pots.size()) * 3;
     for (const Poly& p : fr.polys) count += polyVec4s(p);
@@ -201,7 +217,8 @@ Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& opt) {
     s += "const float " + P + "_GW[5] = float[5](0.2369268851, 0.4786286705, 0.5688888889, 0.4786286705, 0.2369268851);\n";
     s += "float " + P + "_sinc(float z) { return abs(z) < 1e-2 ? 1.0 - z * z / 6.0 : sin(z) / z; }\n";
     // integrals.cpp: inverseQuadratic
-    s += "float " + P + "_inv_quadratic(vec3 v, vec3 e, float L, float c, float d) {\n"
+    s += "float " + P +
+         "_inv_quadratic(vec3 v, vec3 e, float L, float c, float d) {\n"
          "    if (d == 0.0) return L / c;\n"
          "    float m = length(e);\n"
          "    if (m == 0.0) return L / (c + d * dot(v, v));\n"
@@ -214,7 +231,8 @@ Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& opt) {
          "    float x0 = -sigma0 / A, x1 = (Lp - sigma0) / A;\n"
          "    return atan(Lp / A, 1.0 + x0 * x1) * (A / den) / m;\n"
          "}\n";
-    s += "float " + P + "_inv_shifted(float ua, float ub, float kappa, float d) {\n"
+    s += "float " + P +
+         "_inv_shifted(float ua, float ub, float kappa, float d) {\n"
          "    if (ub <= ua) return 0.0;\n"
          "    if (kappa > 0.0) {\n"
          "        float a = sqrt(kappa);\n"
@@ -226,19 +244,26 @@ Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& opt) {
          "    float Fb = yb < 1e-4 ? zb * (1.0 + yb / 3.0) : zb * atanh(sqrt(yb)) / sqrt(yb);\n"
          "    return (Fa - Fb) / d;\n"
          "}\n";
-    s += "float " + P + "_sphere(vec3 v, vec3 e, float L, float c, float d, float R2) {\n"
+    s += "float " + P +
+         "_sphere(vec3 v, vec3 e, float L, float c, float d, float R2) {\n"
          "    if (d == 0.0) return L / c;\n"
          "    float s0 = -dot(v, e);\n"
          "    vec3 hv = v + s0 * e;\n"
          "    float h2 = dot(hv, hv);\n"
-         "    if (R2 <= h2) return " + P + "_inv_shifted(-s0, L - s0, c / d + (h2 - R2), d);\n"
+         "    if (R2 <= h2) return " +
+         P +
+         "_inv_shifted(-s0, L - s0, c / d + (h2 - R2), d);\n"
          "    float w = sqrt(R2 - h2);\n"
          "    float kappa = c / d - w * w;\n"
          "    float total = max(min(L, s0 + w) - max(0.0, s0 - w), 0.0) / c;\n"
          "    float beforeEnd = min(L, s0 - w);\n"
-         "    if (beforeEnd > 0.0) total += " + P + "_inv_shifted(-s0, beforeEnd - s0, kappa, d);\n"
+         "    if (beforeEnd > 0.0) total += " +
+         P +
+         "_inv_shifted(-s0, beforeEnd - s0, kappa, d);\n"
          "    float afterStart = max(0.0, s0 + w);\n"
-         "    if (afterStart < L) total += " + P + "_inv_shifted(afterStart - s0, L - s0, kappa, d);\n"
+         "    if (afterStart < L) total += " +
+         P +
+         "_inv_shifted(afterStart - s0, L - s0, kappa, d);\n"
          "    return total;\n"
          "}\n";
 
@@ -264,11 +289,13 @@ Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& opt) {
         // Gauss piece over lambda in [la, lb]; local coordinate = uAnchor + (lambda - lAnchor) dU,
         // anchored at the piece's own end of the segment so that a piece far along a long ray
         // does not subtract two large cell coordinates in float.
-        s += "float " + P + "_poly" + id + "_piece(float la, float lb, float uAnchor, float lAnchor, float dU, float L) {\n"
+        s += "float " + P + "_poly" + id +
+             "_piece(float la, float lb, float uAnchor, float lAnchor, float dU, float L) {\n"
              "    if (lb <= la) return 0.0;\n"
              "    float mid = 0.5 * (la + lb), hw = 0.5 * (lb - la), sum = 0.0;\n"
-             "    for (int j = 0; j < 5; ++j) sum += " + P + "_GW[j] * " + P + "_poly" + id +
-             "(uAnchor + (mid + hw * " + P + "_GX[j] - lAnchor) * dU);\n"
+             "    for (int j = 0; j < 5; ++j) sum += " +
+             P + "_GW[j] * " + P + "_poly" + id + "(uAnchor + (mid + hw * " + P +
+             "_GX[j] - lAnchor) * dU);\n"
              "    return sum * hw * L;\n"
              "}\n";
         const std::string pv = P + "_params[" + std::to_string(base) + "]";
@@ -277,68 +304,81 @@ Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& opt) {
         if (p.usedCount == 0) {
             s += "    return L * " + P + "_poly" + id + "(0.0);\n}\n";
         } else {
-            s += std::string("    float U0 = ") + pv + ".x + oRel." + axisChar + " * " + pv + ".y;\n" +
-                 "    float U1 = " + pv + ".x + pRel." + axisChar + " * " + pv + ".y;\n" +
-                 "    float dU = (pRel." + axisChar + " - oRel." + axisChar + ") * " + pv + ".y;\n";
+            s += std::string("    float U0 = ") + pv + ".x + oRel." + axisChar + " * " + pv + ".y;\n" + "    float U1 = " + pv + ".x + pRel." +
+                 axisChar + " * " + pv + ".y;\n" + "    float dU = (pRel." + axisChar + " - oRel." + axisChar + ") * " + pv + ".y;\n";
             if (p.mode == FogCellMode::ZeroOutside) {
-                s += "    if (dU == 0.0) return abs(U0) > 1.0 ? 0.0 : " + P + "_poly" + id + "_piece(0.0, 1.0, U0, 0.0, 0.0, L);\n"
+                s += "    if (dU == 0.0) return abs(U0) > 1.0 ? 0.0 : " + P + "_poly" + id +
+                     "_piece(0.0, 1.0, U0, 0.0, 0.0, L);\n"
                      "    float l0 = (-1.0 - U0) / dU, l1 = (1.0 - U0) / dU;\n"
                      "    float la = max(min(l0, l1), 0.0), lb = min(max(l0, l1), 1.0);\n"
-                     "    return " + P + "_poly" + id + "_piece(la, lb, U0, 0.0, dU, L);\n}\n";
+                     "    return " +
+                     P + "_poly" + id + "_piece(la, lb, U0, 0.0, dU, L);\n}\n";
             } else {
                 s += "    float n0 = floor((U0 + 1.0) * 0.5), n1 = floor((U1 + 1.0) * 0.5);\n"
                      "    float a0 = U0 - 2.0 * n0, a1 = U1 - 2.0 * n1;\n"
-                     "    if (n0 == n1) return " + P + "_poly" + id + "_piece(0.0, 1.0, a0, 0.0, dU, L);\n"
+                     "    if (n0 == n1) return " +
+                     P + "_poly" + id +
+                     "_piece(0.0, 1.0, a0, 0.0, dU, L);\n"
                      "    float dir = dU > 0.0 ? 1.0 : -1.0;\n"
                      "    float l1 = clamp((dir - a0) / dU, 0.0, 1.0);\n"       // first boundary, from the start's cell
                      "    float lk = clamp(1.0 - (a1 + dir) / dU, 0.0, 1.0);\n" // last boundary, from the end's cell
                      "    float whole = abs(n1 - n0) - 1.0;\n"
-                     "    return " + P + "_poly" + id + "_piece(0.0, l1, a0, 0.0, dU, L) + " + P + "_poly" + id +
+                     "    return " +
+                     P + "_poly" + id + "_piece(0.0, l1, a0, 0.0, dU, L) + " + P + "_poly" + id +
                      "_piece(lk, 1.0, a1, 1.0, dU, L)\n"
-                     "         + whole * " + pv + ".z * (L / abs(dU));\n}\n";
+                     "         + whole * " +
+                     pv + ".z * (L / abs(dU));\n}\n";
             }
         }
         base += polyVec4s(p);
     }
 
-    s += "float " + P + "_optical_depth(vec3 oRel, vec3 pRel) {\n"
+    s += "float " + P +
+         "_optical_depth(vec3 oRel, vec3 pRel) {\n"
          "    vec3 seg = pRel - oRel;\n"
          "    float L = length(seg);\n"
          "    if (L == 0.0) return 0.0;\n"
          "    vec3 e = seg / L;\n"
-         "    float total = " + P + "_params[0].x * L;\n";
+         "    float total = " +
+         P + "_params[0].x * L;\n";
     for (size_t j = 0; j < fr.waves.size(); ++j) {
         const std::string w = P + "_params[" + std::to_string(1 + 2 * j) + "]";
         const std::string a = P + "_params[" + std::to_string(2 + 2 * j) + "].x";
-        s += "    total += " + a + " * L * cos(dot(" + w + ".xyz, 0.5 * (oRel + pRel)) + " + w + ".w) * " + P +
-             "_sinc(0.5 * dot(" + w + ".xyz, seg));\n";
+        s += "    total += " + a + " * L * cos(dot(" + w + ".xyz, 0.5 * (oRel + pRel)) + " + w + ".w) * " + P + "_sinc(0.5 * dot(" + w +
+             ".xyz, seg));\n";
     }
-    for (size_t j = 0; j < fr.polys.size(); ++j)
-        s += "    total += " + P + "_poly" + std::to_string(j) + "_integral(oRel, pRel, L);\n";
+    for (size_t j = 0; j < fr.polys.size(); ++j) s += "    total += " + P + "_poly" + std::to_string(j) + "_integral(oRel, pRel, L);\n";
     for (size_t j = 0; j < fr.pots.size(); ++j) {
         const auto& p = fr.pots[j];
         const std::string q = P + "_params[" + std::to_string(base) + "]";
         const std::string ax = P + "_params[" + std::to_string(base + 1) + "]";
         const std::string wr = P + "_params[" + std::to_string(base + 2) + "]";
         s += "    { vec3 v = oRel - " + q + ".xyz;\n";
-        if (p.kind == FogTermKind::Point)
-            s += "      total += " + wr + ".x * " + P + "_inv_quadratic(v, e, L, " + q + ".w, " + ax + ".w); }\n";
+        if (p.kind == FogTermKind::Point) s += "      total += " + wr + ".x * " + P + "_inv_quadratic(v, e, L, " + q + ".w, " + ax + ".w); }\n";
         else if (p.kind == FogTermKind::Line)
-            s += "      vec3 a = " + ax + ".xyz;\n"
-                 "      total += " + wr + ".x * " + P + "_inv_quadratic(v - dot(v, a) * a, e - dot(e, a) * a, L, " + q +
-                 ".w, " + ax + ".w); }\n";
-        else
-            s += "      total += " + wr + ".x * " + P + "_sphere(v, e, L, " + q + ".w, " + ax + ".w, " + wr + ".y); }\n";
+            s += "      vec3 a = " + ax +
+                 ".xyz;\n"
+                 "      total += " +
+                 wr + ".x * " + P + "_inv_quadratic(v - dot(v, a) * a, e - dot(e, a) * a, L, " + q + ".w, " + ax + ".w); }\n";
+        else s += "      total += " + wr + ".x * " + P + "_sphere(v, e, L, " + q + ".w, " + ax + ".w, " + wr + ".y); }\n";
         base += 3;
     }
     s += "    return max(total, 0.0);\n}\n";
-    s += "float " + P + "_transmittance(vec3 oRel, vec3 pRel) {\n"
+    s += "float " + P +
+         "_transmittance(vec3 oRel, vec3 pRel) {\n"
          "    if (any(isnan(oRel)) || any(isnan(pRel)) || any(isinf(oRel)) || any(isinf(pRel))) return 0.0;\n"
-         "    if (" + P + "_far > 0.0 && length(pRel - oRel) > " + P + "_far) return 0.0;\n"
-         "    return exp(-" + P + "_optical_depth(oRel, pRel));\n"
+         "    if (" +
+         P + "_far > 0.0 && length(pRel - oRel) > " + P +
+         "_far) return 0.0;\n"
+         "    return exp(-" +
+         P +
+         "_optical_depth(oRel, pRel));\n"
          "}\n";
-    s += "vec3 " + P + "_apply(vec3 oRel, vec3 pRel, vec3 colourIn) {\n"
-         "    return mix(" + P + "_colour, colourIn, " + P + "_transmittance(oRel, pRel));\n"
+    s += "vec3 " + P +
+         "_apply(vec3 oRel, vec3 pRel, vec3 colourIn) {\n"
+         "    return mix(" +
+         P + "_colour, colourIn, " + P +
+         "_transmittance(oRel, pRel));\n"
          "}\n";
     g.source = std::move(s);
     return g;

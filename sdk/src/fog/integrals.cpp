@@ -15,10 +15,8 @@ constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 // 5-point Gauss-Legendre on [-1, 1]: exact for polynomials of degree <= 9,
 // hence for any polynomial term restricted to a line inside one cell.
-constexpr double kGaussX[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
-                               0.9061798459386640};
-constexpr double kGaussW[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
-                               0.2369268850561891};
+constexpr double kGaussX[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
+constexpr double kGaussW[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665, 0.2369268850561891};
 
 double reduceAngle(double a) { return a - kTwoPi * std::nearbyint(a / kTwoPi); }
 
@@ -208,10 +206,8 @@ double integratePoly(const Poly& p, glm::dvec3 oRel, glm::dvec3 pRel, double L) 
             for (int i = 0; i < nu; ++i)
                 for (int j = 0; j < nv; ++j)
                     for (int k = 0; k < nw; ++k) {
-                        const double wgt = (nu > 1 ? kGaussW[i] / 2 : 1.0) * (nv > 1 ? kGaussW[j] / 2 : 1.0) *
-                                           (nw > 1 ? kGaussW[k] / 2 : 1.0);
-                        mean += wgt * evalPoly(p, {nu > 1 ? kGaussX[i] : 0.0, nv > 1 ? kGaussX[j] : 0.0,
-                                                   nw > 1 ? kGaussX[k] : 0.0});
+                        const double wgt = (nu > 1 ? kGaussW[i] / 2 : 1.0) * (nv > 1 ? kGaussW[j] / 2 : 1.0) * (nw > 1 ? kGaussW[k] / 2 : 1.0);
+                        mean += wgt * evalPoly(p, {nu > 1 ? kGaussX[i] : 0.0, nv > 1 ? kGaussX[j] : 0.0, nw > 1 ? kGaussX[k] : 0.0});
                     }
             total += (1.0 - lam) * L * mean;
             break;
@@ -306,8 +302,8 @@ Frozen freeze(const FogDesc& desc, double tSec, glm::dvec3 ref) {
         case FogTermKind::Point:
         case FogTermKind::Line:
         case FogTermKind::Sphere:
-            fr.pots.push_back({term.kind, term.centre + Dt - ref, term.axis, term.radius * term.radius,
-                               term.cOverTime.at(tSec, term.c), term.dOverTime.at(tSec, term.d), w});
+            fr.pots.push_back({term.kind, term.centre + Dt - ref, term.axis, term.radius * term.radius, term.cOverTime.at(tSec, term.c),
+                               term.dOverTime.at(tSec, term.d), w});
             break;
         }
     }
@@ -348,8 +344,7 @@ double integrate(const Frozen& f, glm::dvec3 oRel, glm::dvec3 pRel) {
         const glm::dvec3 v = oRel - p.qRel;
         double I = 0.0;
         if (p.kind == FogTermKind::Point) I = inverseQuadratic(v, e, L, p.c, p.d);
-        else if (p.kind == FogTermKind::Line)
-            I = inverseQuadratic(v - glm::dot(v, p.axis) * p.axis, e - glm::dot(e, p.axis) * p.axis, L, p.c, p.d);
+        else if (p.kind == FogTermKind::Line) I = inverseQuadratic(v - glm::dot(v, p.axis) * p.axis, e - glm::dot(e, p.axis) * p.axis, L, p.c, p.d);
         else I = integrateSphere(p, v, e, L);
         total += p.weight * I;
     }

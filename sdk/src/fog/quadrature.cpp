@@ -14,16 +14,14 @@ namespace {
 
 // Kronrod 15-point nodes (positive half) and weights, with the embedded
 // 7-point Gauss weights at the odd nodes (Kronrod 1965; the QUADPACK values).
-constexpr double kXgk[8] = {0.991455371120812639206854697526329, 0.949107912342758524526189684047851,
-                            0.864864423359769072789712788640926, 0.741531185599394439863864773280788,
-                            0.586087235467691130294144845693013, 0.405845151377397166906606412076961,
+constexpr double kXgk[8] = {0.991455371120812639206854697526329, 0.949107912342758524526189684047851, 0.864864423359769072789712788640926,
+                            0.741531185599394439863864773280788, 0.586087235467691130294144845693013, 0.405845151377397166906606412076961,
                             0.207784955007898467600689403773245, 0.000000000000000000000000000000000};
-constexpr double kWgk[8] = {0.022935322010529224963732008058970, 0.063092092629978553290700663189204,
-                            0.104790010322250183839876322541518, 0.140653259715525918745189590510238,
-                            0.169004726639267902826583426598550, 0.190350578064785409913256402421014,
+constexpr double kWgk[8] = {0.022935322010529224963732008058970, 0.063092092629978553290700663189204, 0.104790010322250183839876322541518,
+                            0.140653259715525918745189590510238, 0.169004726639267902826583426598550, 0.190350578064785409913256402421014,
                             0.204432940075298892414161999234649, 0.209482141084727828012999174891714};
-constexpr double kWg[4] = {0.129484966168869693270611432679082, 0.279705391489276667901467771423780,
-                           0.381830050505118944950369775488975, 0.417959183673469387755102040816327};
+constexpr double kWg[4] = {0.129484966168869693270611432679082, 0.279705391489276667901467771423780, 0.381830050505118944950369775488975,
+                           0.417959183673469387755102040816327};
 
 struct Segment {
     double a, b;
@@ -32,8 +30,7 @@ struct Segment {
 
 } // namespace
 
-FogQuadrature integrateFogNumerically(const Fog& fog, glm::dvec3 o, glm::dvec3 p, double tSec, double absTolerance,
-                                      long maxEvaluations) {
+FogQuadrature integrateFogNumerically(const Fog& fog, glm::dvec3 o, glm::dvec3 p, double tSec, double absTolerance, long maxEvaluations) {
     FogQuadrature q;
     const double L = glm::length(p - o);
     if (!(L > 0.0) || fog.empty()) {
@@ -65,8 +62,7 @@ FogQuadrature integrateFogNumerically(const Fog& fog, glm::dvec3 o, glm::dvec3 p
             const double u0 = poly.uRef[a], u1 = poly.uRef[a] + L * e[a] / poly.halfSize[a];
             const double lo = std::min(u0, u1), hi = std::max(u0, u1);
             const double first = 2.0 * std::ceil((lo - 1.0) * 0.5) + 1.0;
-            for (double b = first; b <= hi && bp.size() < 4'000'000; b += 2.0)
-                bp.push_back((b - u0) * poly.halfSize[a] / e[a]);
+            for (double b = first; b <= hi && bp.size() < 4'000'000; b += 2.0) bp.push_back((b - u0) * poly.halfSize[a] / e[a]);
         }
     }
     for (const auto& pot : fr.pots) {

@@ -32,8 +32,7 @@ double rawKernel(const FootprintDesc& d, double r) {
 template <class F>
 double integrate(F f, double a, double b, int panels) {
     static const double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
-    static const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
-                                0.2369268850561891};
+    static const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665, 0.2369268850561891};
     double sum = 0.0;
     const double h = (b - a) / panels;
     for (int p = 0; p < panels; ++p) {

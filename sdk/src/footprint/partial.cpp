@@ -16,8 +16,7 @@ namespace {
 template <class F>
 double gauss(F f, double a, double b, int panels) {
     static const double x[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
-    static const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
-                                0.2369268850561891};
+    static const double w[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665, 0.2369268850561891};
     double sum = 0.0;
     const double h = (b - a) / panels;
     for (int p = 0; p < panels; ++p) {
@@ -125,8 +124,7 @@ void buildPartialTable(const Footprint& fp, double R, int rows, int cols, std::v
             cum[size_t(j)] = cum[size_t(j - 1)] + gauss(f, a, b, 2);
         }
         const double total = cum.back();
-        for (int j = 0; j < cols; ++j)
-            out[size_t(i) * cols + j] = total > 0.0 ? float(cum[size_t(j)] / total) : (j * 2 >= cols - 1 ? 1.0f : 0.0f);
+        for (int j = 0; j < cols; ++j) out[size_t(i) * cols + j] = total > 0.0 ? float(cum[size_t(j)] / total) : (j * 2 >= cols - 1 ? 1.0f : 0.0f);
         out[size_t(i) * cols + cols - 1] = 1.0f;
     }
 }
@@ -145,8 +143,8 @@ std::string partialGlsl(const Footprint& fp, int binding) {
     s += "    float x = clamp(s / max(chord, 1e-6), -1.0, 1.0) * 0.5 + 0.5;\n";
     s += "    float y = min(abs(r) / R, 1.0);\n";
     // Texel centres: entry j at (j + 0.5) / cols, so GL_LINEAR reproduces the CPU's bilinear lookup.
-    s += "    vec2 tc = vec2(x * " + num(double(cols - 1) / cols) + " + " + num(0.5 / cols) + ", y * " +
-         num(double(rows - 1) / rows) + " + " + num(0.5 / rows) + ");\n";
+    s += "    vec2 tc = vec2(x * " + num(double(cols - 1) / cols) + " + " + num(0.5 / cols) + ", y * " + num(double(rows - 1) / rows) + " + " +
+         num(0.5 / rows) + ");\n";
     s += "    return texture(splatfx_partial_table, tc).r;\n";
     s += "}\n";
     s += "// World length of one kernel unit along a splat's centre ray (splats.hpp, splatRayScale):\n";

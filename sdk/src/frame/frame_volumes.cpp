@@ -58,10 +58,8 @@ void interleaveBackToFront(const std::vector<Splat>& splats, const std::vector<F
         if (best == lists) break;
         const DrawBatch::Kind kind = best == 0 ? DrawBatch::Kind::Splats : DrawBatch::Kind::Tetrahedra;
         const std::uint32_t volume = best == 0 ? 0u : std::uint32_t(best - 1);
-        if (!out.empty() && out.back().kind == kind && out.back().volume == volume && out.back().end == head[best])
-            ++out.back().end;
-        else
-            out.push_back({kind, volume, std::uint32_t(head[best]), std::uint32_t(head[best] + 1)});
+        if (!out.empty() && out.back().kind == kind && out.back().volume == volume && out.back().end == head[best]) ++out.back().end;
+        else out.push_back({kind, volume, std::uint32_t(head[best]), std::uint32_t(head[best] + 1)});
         ++head[best];
     }
     if (out.empty() && !splats.empty()) out.push_back({DrawBatch::Kind::Splats, 0, 0, std::uint32_t(splats.size())});

@@ -13,19 +13,17 @@ using grid_detail::str;
 Status checkSpacing(glm::vec3 spacing) {
     for (int a = 0; a < 3; ++a)
         if (!std::isfinite(spacing[a]) || spacing[a] <= 0.0f)
-            return makeError("grid spacing." + std::string(1, "xyz"[a]) + " must be a positive finite number, got " +
-                             str(spacing[a]));
+            return makeError("grid spacing." + std::string(1, "xyz"[a]) + " must be a positive finite number, got " + str(spacing[a]));
     return {};
 }
 
 Status checkCount(const char* what, glm::ivec3 dims) {
     for (int a = 0; a < 3; ++a)
-        if (dims[a] <= 0)
-            return makeError(std::string(what) + "." + "xyz"[a] + " must be at least 1, got " + std::to_string(dims[a]));
+        if (dims[a] <= 0) return makeError(std::string(what) + "." + "xyz"[a] + " must be at least 1, got " + std::to_string(dims[a]));
     const std::uint64_t n = std::uint64_t(dims.x) * std::uint64_t(dims.y) * std::uint64_t(dims.z);
     if (n > kMaxVoxels)
-        return makeError(std::string(what) + " asks for " + std::to_string(n) + " voxels; the limit is " +
-                         std::to_string(kMaxVoxels) + " (splatfx grids are meant to be coarse)");
+        return makeError(std::string(what) + " asks for " + std::to_string(n) + " voxels; the limit is " + std::to_string(kMaxVoxels) +
+                         " (splatfx grids are meant to be coarse)");
     return {};
 }
 
@@ -99,9 +97,8 @@ Result<Grid> Grid::fromDense(glm::ivec3 dims, const std::vector<float>& opacity,
     if (Status s = checkCount("fromDense dims", dims); !s) return makeError(s.error());
     const size_t n = size_t(dims.x) * dims.y * dims.z;
     if (opacity.size() != n)
-        return makeError("fromDense: opacity has " + std::to_string(opacity.size()) + " values but dims " +
-                         std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" + std::to_string(dims.z) +
-                         " need " + std::to_string(n));
+        return makeError("fromDense: opacity has " + std::to_string(opacity.size()) + " values but dims " + std::to_string(dims.x) + "x" +
+                         std::to_string(dims.y) + "x" + std::to_string(dims.z) + " need " + std::to_string(n));
     Grid g;
     g.dims = dims;
     g.spacing = spacing;
@@ -111,17 +108,15 @@ Result<Grid> Grid::fromDense(glm::ivec3 dims, const std::vector<float>& opacity,
             for (int x = 0; x < dims.x; ++x, ++i) {
                 const float o = opacity[i];
                 if (!std::isfinite(o) || o < 0.0f || o > 1.0f)
-                    return makeError("fromDense: opacity[" + std::to_string(i) + "] (cell " + std::to_string(x) + "," +
-                                     std::to_string(y) + "," + std::to_string(z) + ") is " + str(o) +
-                                     "; opacities must be finite and in [0, 1]");
+                    return makeError("fromDense: opacity[" + std::to_string(i) + "] (cell " + std::to_string(x) + "," + std::to_string(y) + "," +
+                                     std::to_string(z) + ") is " + str(o) + "; opacities must be finite and in [0, 1]");
                 if (o == 0.0f) continue;
                 Voxel v;
                 v.cell = {x, y, z};
                 v.opacity = o;
                 g.voxels.push_back(v);
             }
-    if (g.voxels.empty())
-        return makeError("fromDense: every opacity is 0; the grid would be empty (nothing to draw)");
+    if (g.voxels.empty()) return makeError("fromDense: every opacity is 0; the grid would be empty (nothing to draw)");
     g.colorByHeight();
     return g;
 }
@@ -141,8 +136,7 @@ Status Grid::validate() const {
         if (!std::isfinite(v.colorCoord) || v.colorCoord < 0.0f || v.colorCoord > 1.0f)
             return makeError(at + "colorCoord is " + str(v.colorCoord) + "; expected a finite value in [0, 1]");
         if (!std::isfinite(v.phase)) return makeError(at + "phase is not finite");
-        if (!std::isfinite(v.stretch.x) || !std::isfinite(v.stretch.y) || !std::isfinite(v.stretch.z))
-            return makeError(at + "stretch is not finite");
+        if (!std::isfinite(v.stretch.x) || !std::isfinite(v.stretch.y) || !std::isfinite(v.stretch.z)) return makeError(at + "stretch is not finite");
     }
     return {};
 }

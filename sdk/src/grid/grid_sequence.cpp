@@ -27,11 +27,10 @@ std::string cellName(const GridSequence& s, std::size_t i) {
 
 Status GridSequence::validate() const {
     if (dims.x <= 0 || dims.y <= 0 || dims.z <= 0)
-        return makeError("grid sequence: dims are (" + std::to_string(dims.x) + ", " + std::to_string(dims.y) + ", " +
-                         std::to_string(dims.z) + "); expected positive cell counts");
+        return makeError("grid sequence: dims are (" + std::to_string(dims.x) + ", " + std::to_string(dims.y) + ", " + std::to_string(dims.z) +
+                         "); expected positive cell counts");
     const std::uint64_t cells = std::uint64_t(dims.x) * std::uint64_t(dims.y) * std::uint64_t(dims.z);
-    if (cells > kMaxVoxels)
-        return makeError("grid sequence: " + std::to_string(cells) + " cells; the limit is " + std::to_string(kMaxVoxels));
+    if (cells > kMaxVoxels) return makeError("grid sequence: " + std::to_string(cells) + " cells; the limit is " + std::to_string(kMaxVoxels));
     for (int a = 0; a < 3; ++a)
         if (!std::isfinite(spacing[a]) || spacing[a] <= 0.0f)
             return makeError("grid sequence: spacing[" + std::to_string(a) + "] is " + str(spacing[a]) + "; expected a positive finite value");

@@ -37,9 +37,7 @@ Shape Shape::sphere(glm::vec3 centreCell, float radiusCells) {
     return {.type = ShapeType::Sphere, .from = centreCell, .radiusFrom = radiusCells, .radiusTo = radiusCells};
 }
 
-Shape Shape::cylinder(glm::vec3 fromCell, glm::vec3 toCell, float radiusCells) {
-    return cone(fromCell, toCell, radiusCells, radiusCells);
-}
+Shape Shape::cylinder(glm::vec3 fromCell, glm::vec3 toCell, float radiusCells) { return cone(fromCell, toCell, radiusCells, radiusCells); }
 
 Shape Shape::cone(glm::vec3 fromCell, glm::vec3 toCell, float radiusFromCells, float radiusToCells) {
     return {.type = ShapeType::Cone, .from = fromCell, .to = toCell, .radiusFrom = radiusFromCells, .radiusTo = radiusToCells};
@@ -72,8 +70,7 @@ Result<Grid> voxelizeShapes(const std::vector<Shape>& shapes, const VoxelizeDesc
     for (int a = 0; a < 3; ++a)
         if (dims[a] < 1) return makeError(std::string("VoxelizeDesc.dims.") + "xyz"[a] + " must be at least 1, got " + std::to_string(dims[a]));
     const std::uint64_t n = std::uint64_t(dims.x) * std::uint64_t(dims.y) * std::uint64_t(dims.z);
-    if (n > kMaxVoxels)
-        return makeError("VoxelizeDesc.dims asks for " + std::to_string(n) + " cells; the limit is " + std::to_string(kMaxVoxels));
+    if (n > kMaxVoxels) return makeError("VoxelizeDesc.dims asks for " + std::to_string(n) + " cells; the limit is " + std::to_string(kMaxVoxels));
     if (Status s = checkUnit("VoxelizeDesc.opacity", desc.opacity); !s) return makeError(s.error());
     if (Status s = checkUnit("VoxelizeDesc.fadeTo", desc.fadeTo); !s) return makeError(s.error());
     if (!finite(desc.fadeAxis) || glm::length(desc.fadeAxis) < 1e-6f) return makeError("VoxelizeDesc.fadeAxis must be finite and non-zero");

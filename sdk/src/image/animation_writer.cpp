@@ -49,8 +49,7 @@ int AnimationWriter::frames() const { return mImpl->frames; }
 Status AnimationWriter::add(const Image& frame) {
     Impl& w = *mImpl;
     if (w.failed) return makeError("animation '" + w.path + "': an earlier frame failed");
-    if (frame.width <= 0 || frame.height <= 0 || frame.channels < 3 ||
-        frame.pixels.size() != size_t(frame.width) * frame.height * frame.channels)
+    if (frame.width <= 0 || frame.height <= 0 || frame.channels < 3 || frame.pixels.size() != size_t(frame.width) * frame.height * frame.channels)
         return w.fail("frames must be RGB or RGBA, non-empty, with as many pixels as their size says");
     if (w.frames > 0 && (frame.width != w.width || frame.height != w.height))
         return w.fail("frame " + std::to_string(w.frames) + " is " + std::to_string(frame.width) + "x" + std::to_string(frame.height) +

@@ -26,17 +26,21 @@ struct Part {
     std::int64_t width = 0, height = 0;
     std::int64_t tileX = 0, tileY = 0; // 0: scanlines
     int levelMode = 0;                 // 0 one level, 1 mipmap, 2 ripmap
-    std::int64_t chunkCount = -1; // multi-part files state it; OpenEXR trusts it
+    std::int64_t chunkCount = -1;      // multi-part files state it; OpenEXR trusts it
 };
 
 // Scanlines per chunk, by compression (OpenEXR's file layout); an unknown
 // code counts as one line per chunk, the most chunks.
 std::int64_t linesPerChunk(unsigned char compression) {
     switch (compression) {
-    case 3: case 5: return 16;                 // ZIP, PXR24
-    case 4: case 6: case 7: case 8: return 32; // PIZ, B44, B44A, DWAA
-    case 9: return 256;                        // DWAB
-    default: return 1;                         // none, RLE, ZIPS
+    case 3:
+    case 5: return 16; // ZIP, PXR24
+    case 4:
+    case 6:
+    case 7:
+    case 8: return 32;  // PIZ, B44, B44A, DWAA
+    case 9: return 256; // DWAB
+    default: return 1;  // none, RLE, ZIPS
     }
 }
 
@@ -105,8 +109,8 @@ Status checkExrHeader(const std::string& path) {
         if (part.width <= 0 || part.height <= 0) return makeError(what + partName + "has an empty data window");
         if (part.width > kMaxImageSide || part.height > kMaxImageSide || part.width * part.height > kMaxImagePixels)
             return makeError(what + partName + "claims " + std::to_string(part.width) + "x" + std::to_string(part.height) +
-                             " pixels, over the image budget (" + std::to_string(kMaxImageSide) + " on a side, " +
-                             std::to_string(kMaxImagePixels) + " in all)");
+                             " pixels, over the image budget (" + std::to_string(kMaxImageSide) + " on a side, " + std::to_string(kMaxImagePixels) +
+                             " in all)");
         std::int64_t chunks;
         if (part.tileX > 0 || part.tileY > 0 || singleTiled) {
             if (part.tileX <= 0 || part.tileY <= 0) return makeError(what + partName + "has tiles of zero size");
@@ -118,8 +122,7 @@ Status checkExrHeader(const std::string& path) {
         }
         chunks = std::max(chunks, part.chunkCount);
         if (std::uint64_t(chunks) > kMaxExrChunks)
-            return makeError(what + partName + "claims " + std::to_string(chunks) + " chunks, over the budget of " +
-                             std::to_string(kMaxExrChunks));
+            return makeError(what + partName + "claims " + std::to_string(chunks) + " chunks, over the budget of " + std::to_string(kMaxExrChunks));
         if (!multipart) break;
         if (partIndex > 64) return makeError(what + "has more than 64 parts");
     }
@@ -162,7 +165,7 @@ Status checkGifHeader(const std::string& path) {
             const unsigned char flags = buf[at + 9];
             at += 10;
             if (flags & 0x80) at += 3u << ((flags & 7) + 1); // local colour table
-            ++at;                                           // LZW minimum code size
+            ++at;                                            // LZW minimum code size
             skipSubBlocks();
         } else {
             break; // not a block: the decoder reports the corrupt file

@@ -58,11 +58,10 @@ Result<Image> readImage(const std::string& path, Alpha alpha) {
         return makeError("cannot read image '" + path + "': " + why);
     }
     const OIIO::ImageSpec& spec = in->spec();
-    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0)
-        return makeError("cannot read image '" + path + "': it has no pixels");
+    if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) return makeError("cannot read image '" + path + "': it has no pixels");
     if (spec.width > kMaxImageSide || spec.height > kMaxImageSide)
-        return makeError("cannot read image '" + path + "': " + std::to_string(spec.width) + "x" +
-                         std::to_string(spec.height) + " is larger than " + std::to_string(kMaxImageSide) + " on a side");
+        return makeError("cannot read image '" + path + "': " + std::to_string(spec.width) + "x" + std::to_string(spec.height) + " is larger than " +
+                         std::to_string(kMaxImageSide) + " on a side");
     if (static_cast<long long>(spec.width) * spec.height > kMaxImagePixels)
         return makeError("cannot read image '" + path + "': " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
                          " is over the budget of " + std::to_string(kMaxImagePixels) + " pixels");
@@ -80,8 +79,7 @@ Result<Image> readImage(const std::string& path, Alpha alpha) {
 }
 
 Status writeImage(const std::string& path, const Image& image, Alpha alpha) {
-    if (image.width <= 0 || image.height <= 0 || image.channels <= 0 ||
-        image.pixels.size() != size_t(image.width) * image.height * image.channels)
+    if (image.width <= 0 || image.height <= 0 || image.channels <= 0 || image.pixels.size() != size_t(image.width) * image.height * image.channels)
         return makeError("cannot write image '" + path + "': the image is empty or its size does not match its pixels");
     const fs::path target(path);
     auto out = OIIO::ImageOutput::create(target.string());

@@ -38,7 +38,9 @@ std::vector<std::string> readRecord(const fs::path& path) {
     return files;
 }
 
-bool plainName(const std::string& n) { return !n.empty() && n.find('/') == std::string::npos && n != "." && n != ".." && n.find('\n') == std::string::npos; }
+bool plainName(const std::string& n) {
+    return !n.empty() && n.find('/') == std::string::npos && n != "." && n != ".." && n.find('\n') == std::string::npos;
+}
 
 // Moves a complete staged set into the folder and records it. Idempotent:
 // files already moved are skipped, so a publish cut short is finished by

@@ -27,8 +27,7 @@ Result<TextureSet> TextureSet::load(const std::string& folder) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) return makeError("texture set '" + folder + "': no such folder");
     // The manifest is small text: a FIFO, a device or a huge file is refused before reading.
-    if (fs::exists(manifestPath, ec) && !fs::is_regular_file(manifestPath, ec))
-        return makeError(manifestPath.string() + ": not a regular file");
+    if (fs::exists(manifestPath, ec) && !fs::is_regular_file(manifestPath, ec)) return makeError(manifestPath.string() + ": not a regular file");
     if (fs::is_regular_file(manifestPath, ec) && fs::file_size(manifestPath, ec) > kMaxManifestBytes)
         return makeError(manifestPath.string() + ": larger than " + std::to_string(kMaxManifestBytes) + " bytes; not a texture-set manifest");
     std::ifstream in(manifestPath);
@@ -36,13 +35,10 @@ Result<TextureSet> TextureSet::load(const std::string& folder) {
     json m;
     try {
         m = json::parse(in);
-    } catch (const json::exception& e) {
-        return makeError(manifestPath.string() + ": not valid JSON (" + e.what() + ")");
-    }
+    } catch (const json::exception& e) { return makeError(manifestPath.string() + ": not valid JSON (" + e.what() + ")"); }
     const std::string where = manifestPath.string() + ": ";
     if (!m.is_object()) return makeError(where + "expected a JSON object at the top level");
-    if (m.value("format", std::string()) != "splatfx-texture-set")
-        return makeError(where + "field 'format' must be \"splatfx-texture-set\"");
+    if (m.value("format", std::string()) != "splatfx-texture-set") return makeError(where + "field 'format' must be \"splatfx-texture-set\"");
     if (!m.contains("version") || !m["version"].is_number_integer() || m["version"].get<int>() != 1)
         return makeError(where + "field 'version' must be 1 (this build reads texture-set version 1)");
     if (!m.contains("textures") || !m["textures"].is_array() || m["textures"].empty())
@@ -76,8 +72,8 @@ Result<TextureSet> TextureSet::load(const std::string& folder) {
         auto img = readImage(file.string(), windowed ? Alpha::Straight : Alpha::Premultiplied);
         if (!img) return makeError("texture set '" + folder + "': " + img.error());
         if (statedSize > 0 && (img->width != statedSize || img->height != statedSize))
-            return makeError(at + " '" + name + "' is " + std::to_string(img->width) + "x" + std::to_string(img->height) + ", but field 'size' says " +
-                             std::to_string(statedSize));
+            return makeError(at + " '" + name + "' is " + std::to_string(img->width) + "x" + std::to_string(img->height) +
+                             ", but field 'size' says " + std::to_string(statedSize));
         if (windowed && img->channels != 4 && img->channels != 2)
             return makeError(at + " '" + name + "' has no alpha channel, but field 'windowed' says the detail is stored in alpha");
         images.push_back(std::move(*img));

@@ -49,13 +49,11 @@ Result<DensityField> DensityField::fromGrid(const Grid& grid, const DensityField
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r)
             if (!std::isfinite(grid.transform[c][r])) return makeError("grid.transform must be finite");
-    const glm::mat3 shape = glm::mat3(grid.transform) * glm::mat3(glm::vec3(grid.spacing.x, 0, 0), glm::vec3(0, grid.spacing.y, 0),
-                                                                 glm::vec3(0, 0, grid.spacing.z));
+    const glm::mat3 shape =
+        glm::mat3(grid.transform) * glm::mat3(glm::vec3(grid.spacing.x, 0, 0), glm::vec3(0, grid.spacing.y, 0), glm::vec3(0, 0, grid.spacing.z));
     const double det = std::abs(double(glm::determinant(shape)));
-    if (!(det > 1e-30) || !std::isfinite(det))
-        return makeError("grid.transform with grid.spacing gives voxels of zero or non-finite volume");
-    if (!std::isfinite(desc.opacityScale) || desc.opacityScale < 0.0f)
-        return makeError("DensityFieldDesc.opacityScale must be a finite number >= 0");
+    if (!(det > 1e-30) || !std::isfinite(det)) return makeError("grid.transform with grid.spacing gives voxels of zero or non-finite volume");
+    if (!std::isfinite(desc.opacityScale) || desc.opacityScale < 0.0f) return makeError("DensityFieldDesc.opacityScale must be a finite number >= 0");
 
     DensityField f;
     f.mVoxelSize = float(std::cbrt(det));
@@ -77,16 +75,14 @@ Result<DensityField> DensityField::fromGrid(const Grid& grid, const DensityField
         const std::uint64_t count = std::uint64_t(n.x) * std::uint64_t(n.y) * std::uint64_t(n.z);
         if (count > kMaxVoxels)
             return makeError("grid: the voxels' cells span " + std::to_string(n.x - 2) + "x" + std::to_string(n.y - 2) + "x" +
-                             std::to_string(n.z - 2) + " cells, more than the " + std::to_string(kMaxVoxels) +
-                             "-cell limit of a density field");
+                             std::to_string(n.z - 2) + " cells, more than the " + std::to_string(kMaxVoxels) + "-cell limit of a density field");
         f.mDims = glm::ivec3(n);
         f.mOrigin = glm::vec3(lo - 1);
         f.mValues.assign(std::size_t(count), 0.0f);
         for (const Voxel& v : grid.voxels) {
             if (!usable(v)) continue;
             float alpha = std::clamp(v.opacity * desc.opacityScale, 0.0f, 1.0f);
-            if (desc.colorTable && desc.colorTable->entries.size() >= 2)
-                alpha *= std::clamp(desc.colorTable->sample(v.colorCoord).a, 0.0f, 1.0f);
+            if (desc.colorTable && desc.colorTable->entries.size() >= 2) alpha *= std::clamp(desc.colorTable->sample(v.colorCoord).a, 0.0f, 1.0f);
             const float tau = alpha >= 1.0f ? kMaxTau : std::min(float(-std::log1p(-double(alpha)) / std::log(2.0)), kMaxTau);
             const glm::ivec3 c = v.cell - lo + 1;
             f.mValues[std::size_t(c.x) + std::size_t(n.x) * (std::size_t(c.y) + std::size_t(n.y) * std::size_t(c.z))] += tau;
@@ -94,8 +90,8 @@ Result<DensityField> DensityField::fromGrid(const Grid& grid, const DensityField
         // Lattice coordinate c of a world point: c = (T^-1 world) / spacing + halfXZ (Grid::localPosition inverted).
         const glm::vec3 half = glm::vec3(glm::max(grid.dims - 1, glm::ivec3(0))) * 0.5f;
         const glm::vec3 halfXZ(half.x, 0.0f, half.z);
-        f.mWorldToLattice = glm::translate(glm::mat4(1.0f), halfXZ - f.mOrigin) * glm::scale(glm::mat4(1.0f), 1.0f / grid.spacing) *
-                            glm::inverse(grid.transform);
+        f.mWorldToLattice =
+            glm::translate(glm::mat4(1.0f), halfXZ - f.mOrigin) * glm::scale(glm::mat4(1.0f), 1.0f / grid.spacing) * glm::inverse(grid.transform);
         const glm::mat4 toWorld = glm::inverse(f.mWorldToLattice);
         f.mBoundsMin = glm::vec3(std::numeric_limits<float>::max());
         f.mBoundsMax = glm::vec3(-std::numeric_limits<float>::max());

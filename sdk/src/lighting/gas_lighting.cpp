@@ -28,18 +28,17 @@ Status checkNonNegative(float v, const char* field) {
 // What one light contributes, prepared once per call.
 struct PreparedLight {
     LightType type;
-    glm::vec3 color;      // colour times intensity
-    glm::vec3 travel;     // unit direction the light travels (directional; spot axis)
+    glm::vec3 color;  // colour times intensity
+    glm::vec3 travel; // unit direction the light travels (directional; spot axis)
     glm::vec3 position;
     float cosOuter, cosInner;
-    float minDist2;       // irradiance is capped at intensity / minDist2
+    float minDist2; // irradiance is capped at intensity / minDist2
     float minDist;
 };
 
 Status checkInputs(glm::vec3 eyeWorld, std::span<const Light> lights, const GasLightingDesc& desc) {
     if (!finite3(eyeWorld)) return makeError("eyeWorld must be finite");
-    if (!std::isfinite(desc.albedo) || desc.albedo < 0.0f || desc.albedo > 1.0f)
-        return makeError("GasLightingDesc.albedo must be in [0, 1]");
+    if (!std::isfinite(desc.albedo) || desc.albedo < 0.0f || desc.albedo > 1.0f) return makeError("GasLightingDesc.albedo must be in [0, 1]");
     if (Status s = checkNonNegative(desc.emission, "emission"); !s) return s;
     if (Status s = checkNonNegative(desc.multipleScattering, "multipleScattering"); !s) return s;
     for (int a = 0; a < 3; ++a)
@@ -55,7 +54,6 @@ Status checkInputs(glm::vec3 eyeWorld, std::span<const Light> lights, const GasL
 template <class PointFn, class BaseFn>
 void lightImpl(std::size_t count, PointFn point, BaseFn base, float voxelSize, glm::vec3 eyeWorld, std::span<const Light> lights,
                const ShadowProvider* shadows, const GasLightingDesc& desc, std::vector<glm::vec3>& out) {
-
     // Up to this many lights are prepared on the stack; more are prepared per voxel (still no allocation).
     constexpr std::size_t kStackLights = 16;
     PreparedLight stackLights[kStackLights];
@@ -114,11 +112,11 @@ void lightImpl(std::size_t count, PointFn point, BaseFn base, float voxelSize, g
 
 } // namespace
 
-Status lightVoxels(const Grid& grid, glm::vec3 eyeWorld, std::span<const Light> lights, const ShadowProvider* shadows,
-                   const GasLightingDesc& desc, std::vector<glm::vec3>& out) {
+Status lightVoxels(const Grid& grid, glm::vec3 eyeWorld, std::span<const Light> lights, const ShadowProvider* shadows, const GasLightingDesc& desc,
+                   std::vector<glm::vec3>& out) {
     if (Status s = checkInputs(eyeWorld, lights, desc); !s) return s;
-    const glm::mat3 shape = glm::mat3(grid.transform) * glm::mat3(glm::vec3(grid.spacing.x, 0, 0), glm::vec3(0, grid.spacing.y, 0),
-                                                                 glm::vec3(0, 0, grid.spacing.z));
+    const glm::mat3 shape =
+        glm::mat3(grid.transform) * glm::mat3(glm::vec3(grid.spacing.x, 0, 0), glm::vec3(0, grid.spacing.y, 0), glm::vec3(0, 0, grid.spacing.z));
     const float det = std::abs(glm::determinant(shape));
     const float voxelSize = std::isfinite(det) ? std::cbrt(det) : 0.0f;
     const bool hasTable = desc.colorTable && desc.colorTable->entries.size() >= 2;

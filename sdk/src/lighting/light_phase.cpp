@@ -17,8 +17,7 @@ bool finite3(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && s
 
 Status checkColor(const glm::vec3& c, const std::string& field) {
     for (int a = 0; a < 3; ++a)
-        if (!std::isfinite(c[a]) || c[a] < 0.0f)
-            return makeError(field + "." + "rgb"[a] + " must be a finite number >= 0, got " + str(c[a]));
+        if (!std::isfinite(c[a]) || c[a] < 0.0f) return makeError(field + "." + "rgb"[a] + " must be a finite number >= 0, got " + str(c[a]));
     return {};
 }
 
@@ -42,8 +41,7 @@ Light Light::point(glm::vec3 position, glm::vec3 color, float intensity) {
     return l;
 }
 
-Light Light::spot(glm::vec3 position, glm::vec3 direction, float innerConeRad, float outerConeRad, glm::vec3 color,
-                  float intensity) {
+Light Light::spot(glm::vec3 position, glm::vec3 direction, float innerConeRad, float outerConeRad, glm::vec3 color, float intensity) {
     Light l;
     l.type = LightType::Spot;
     l.position = position;
@@ -75,8 +73,7 @@ Status validateLight(const Light& light, const std::string& name) {
         if (!std::isfinite(light.outerConeRad) || light.outerConeRad <= 0.0f || light.outerConeRad >= float(kPi))
             return makeError(name + ".outerConeRad must be in (0, pi), got " + str(light.outerConeRad));
         if (!std::isfinite(light.innerConeRad) || light.innerConeRad < 0.0f || light.innerConeRad > light.outerConeRad)
-            return makeError(name + ".innerConeRad must be in [0, outerConeRad = " + str(light.outerConeRad) + "], got " +
-                             str(light.innerConeRad));
+            return makeError(name + ".innerConeRad must be in [0, outerConeRad = " + str(light.outerConeRad) + "], got " + str(light.innerConeRad));
     }
     return {};
 }
@@ -84,15 +81,13 @@ Status validateLight(const Light& light, const std::string& name) {
 Result<PhaseFunction> PhaseFunction::create(std::span<const HgLobe> lobes) {
     if (lobes.empty()) return makeError("lobes must hold at least one Henyey-Greenstein lobe");
     if (lobes.size() > std::size_t(kMaxLobes))
-        return makeError("lobes holds " + std::to_string(lobes.size()) + " lobes; at most " + std::to_string(kMaxLobes) +
-                         " are supported");
+        return makeError("lobes holds " + std::to_string(lobes.size()) + " lobes; at most " + std::to_string(kMaxLobes) + " are supported");
     double sum = 0.0;
     for (std::size_t i = 0; i < lobes.size(); ++i) {
         const std::string at = "lobes[" + std::to_string(i) + "]";
         // |g| = 1 is a delta function, not a density; beyond 1 - 1e-6 the
         // peak (about 1 / (2 pi (1 - g)^2)) no longer fits a float.
-        if (!std::isfinite(lobes[i].g) || !(std::abs(lobes[i].g) < 1.0f))
-            return makeError(at + ".g must be in (-1, 1), got " + str(lobes[i].g));
+        if (!std::isfinite(lobes[i].g) || !(std::abs(lobes[i].g) < 1.0f)) return makeError(at + ".g must be in (-1, 1), got " + str(lobes[i].g));
         if (std::abs(lobes[i].g) > 1.0f - 1e-6f)
             return makeError(at + ".g must be within 1e-6 of +-1 at most (its peak would overflow), got " + str(lobes[i].g));
         if (!std::isfinite(lobes[i].weight) || lobes[i].weight < 0.0f)

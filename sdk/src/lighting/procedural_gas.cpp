@@ -119,7 +119,8 @@ Status validateProceduralGas(const ProceduralGasDesc& g) {
     if (Status s = positive(g.turbulence.frequency, "turbulence.frequency"); !s) return s;
     if (!(g.threshold >= 0.0f && g.threshold < 1.0f)) return makeError("threshold must be in [0, 1)");
     const GasSteamDesc& st = g.steam;
-    for (int a = 0; a < 3; ++a) if (Status s = finite(st.source[a], "steam.source"); !s) return s;
+    for (int a = 0; a < 3; ++a)
+        if (Status s = finite(st.source[a], "steam.source"); !s) return s;
     if (Status s = positive(st.sourceRadius, "steam.sourceRadius"); !s) return s;
     if (Status s = nonNegative(st.spread, "steam.spread"); !s) return s;
     if (Status s = positive(st.height, "steam.height"); !s) return s;
@@ -166,8 +167,7 @@ Result<Grid> sampleProceduralGas(const ProceduralGasDesc& desc, const Grid& latt
     if (Status s = validateProceduralGas(desc); !s) return makeError(s.error());
     if (!std::isfinite(timeSec)) return makeError("timeSec must be finite");
     for (int a = 0; a < 3; ++a)
-        if (lattice.dims[a] < 1)
-            return makeError(std::string("lattice.dims.") + "xyz"[a] + " must be at least 1 (build the lattice with Grid::box)");
+        if (lattice.dims[a] < 1) return makeError(std::string("lattice.dims.") + "xyz"[a] + " must be at least 1 (build the lattice with Grid::box)");
     const std::uint64_t n = std::uint64_t(lattice.dims.x) * std::uint64_t(lattice.dims.y) * std::uint64_t(lattice.dims.z);
     if (n > kMaxVoxels) return makeError("lattice.dims hold " + std::to_string(n) + " cells, more than kMaxVoxels");
     const detail::Noise4 noise(desc.turbulence.seed);

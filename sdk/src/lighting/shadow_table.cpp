@@ -14,9 +14,8 @@ namespace splatfx {
 namespace {
 
 bool sameLight(const Light& a, const Light& b) {
-    return a.type == b.type && a.color == b.color && a.intensity == b.intensity && a.direction == b.direction &&
-           a.position == b.position && a.innerConeRad == b.innerConeRad && a.outerConeRad == b.outerConeRad &&
-           a.radiusWorld == b.radiusWorld;
+    return a.type == b.type && a.color == b.color && a.intensity == b.intensity && a.direction == b.direction && a.position == b.position &&
+           a.innerConeRad == b.innerConeRad && a.outerConeRad == b.outerConeRad && a.radiusWorld == b.radiusWorld;
 }
 
 // Sort key of a float that orders like the float (negative values too).
@@ -106,8 +105,8 @@ Status ShadowTable::update(std::span<const DensityField* const> fields, const Li
         mDepth.clear();
         mDims = glm::ivec3(0);
         auto mib = [](std::uint64_t b) { return std::to_string((b + (1u << 20) - 1) >> 20) + " MiB"; };
-        return makeError("ShadowTableDesc.dims " + std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" + std::to_string(dims.z) +
-                         " needs " + mib(bytes) + " (table plus build scratch, 17 bytes per entry), over ShadowTableDesc.memoryBudgetBytes = " +
+        return makeError("ShadowTableDesc.dims " + std::to_string(dims.x) + "x" + std::to_string(dims.y) + "x" + std::to_string(dims.z) + " needs " +
+                         mib(bytes) + " (table plus build scratch, 17 bytes per entry), over ShadowTableDesc.memoryBudgetBytes = " +
                          mib(mDesc.memoryBudgetBytes) + "; lower the dims or raise the budget");
     }
     if (Status s = validateLight(light); !s) {
@@ -154,7 +153,7 @@ Status ShadowTable::update(std::span<const DensityField* const> fields, const Li
     const glm::vec3 orderKey = directional ? dir : L;
     const glm::vec3 w0 = -dir; // towards a directional light
     if (!directional && (mOrder.size() != n || mOrderType != int(light.type == LightType::Directional) || mOrderKey != orderKey ||
-        mOrderBoxMin != lo || mOrderBoxMax != hi || dims != mBuiltDims)) {
+                         mOrderBoxMin != lo || mOrderBoxMax != hi || dims != mBuiltDims)) {
         mOrder.resize(n);
         for (int k = 0; k < dims.z; ++k)
             for (int j = 0; j < dims.y; ++j)

@@ -69,12 +69,10 @@ inline Status checkHost(const ReferenceHost& host, const Camera& camera, const c
                          " must be between 1 and 16384 on each side");
     auto check = [&](const Image* img, int channels, const char* field) -> Status {
         if (!img) return {};
-        if (img->width != w || img->height != h || img->channels < channels ||
-            img->pixels.size() != size_t(img->width) * img->height * img->channels)
-            return makeError(std::string(who) + ": " + field + " is " + std::to_string(img->width) + "x" +
-                             std::to_string(img->height) + "x" + std::to_string(img->channels) + "; expected " +
-                             std::to_string(w) + "x" + std::to_string(h) + " with at least " + std::to_string(channels) +
-                             " channel(s)");
+        if (img->width != w || img->height != h || img->channels < channels || img->pixels.size() != size_t(img->width) * img->height * img->channels)
+            return makeError(std::string(who) + ": " + field + " is " + std::to_string(img->width) + "x" + std::to_string(img->height) + "x" +
+                             std::to_string(img->channels) + "; expected " + std::to_string(w) + "x" + std::to_string(h) + " with at least " +
+                             std::to_string(channels) + " channel(s)");
         return {};
     };
     if (Status s = check(host.backgroundImage, 4, "host.backgroundImage"); !s) return s;

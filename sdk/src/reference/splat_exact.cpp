@@ -117,8 +117,8 @@ ReferenceSurface ReferenceSurface::box(glm::dvec3 lo, glm::dvec3 hi, glm::dvec4 
     return s;
 }
 
-Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& camera, const Materials& materials,
-                               const SplatExactDesc& desc, SplatExactStats* statsOut) {
+Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& camera, const Materials& materials, const SplatExactDesc& desc,
+                               SplatExactStats* statsOut) {
     if (Status s = reference::checkHost(desc.host, camera, "renderSplatExact"); !s) return makeError(s.error());
     const int W = camera.viewport.x, H = camera.viewport.y;
     const Footprint& fp = materials.footprint();
@@ -145,8 +145,8 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
         const Splat& s = splats[i];
         const std::uint32_t layer = std::uint32_t(std::lround(s.layer)), next = std::uint32_t(std::lround(s.nextLayer));
         const std::uint32_t row = std::uint32_t(std::lround(s.colorRow));
-        if (!finite(s.center) || !finite(s.axisU) || !finite(s.axisV) || !std::isfinite(s.density) || !std::isfinite(s.blend) ||
-            !(s.layer >= 0.0f) || layer >= materials.layerCount() || (s.blend > 0.0f && (!(s.nextLayer >= 0.0f) || next >= materials.layerCount())) ||
+        if (!finite(s.center) || !finite(s.axisU) || !finite(s.axisV) || !std::isfinite(s.density) || !std::isfinite(s.blend) || !(s.layer >= 0.0f) ||
+            layer >= materials.layerCount() || (s.blend > 0.0f && (!(s.nextLayer >= 0.0f) || next >= materials.layerCount())) ||
             !(s.colorRow >= 0.0f) || row >= std::max(materials.colorTableCount(), 1u)) {
             ++stats.skippedSplats;
             continue;
@@ -196,7 +196,7 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
 
     reference::parallelRows(H, desc.threads, [&](int y) {
         std::vector<Fragment> frags;
-        std::vector<double> cuts;         
+        std::vector<double> cuts;
         std::vector<glm::dvec4> cutColour;
         std::uint64_t fragCount = 0, maxOverlap = 0;
         double fogTauMax = 0.0, fogErrMax = 0.0;
@@ -250,10 +250,10 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                     detail *= rr < R ? fp.exact(rr) / F0 : 0.0;
                 }
                 const std::uint32_t row = std::uint32_t(std::lround(s.colorRow));
-                const glm::dvec3 base = desc.packedColor
-                                            ? glm::dvec3(double(s.color & 255u), double((s.color >> 8) & 255u), double((s.color >> 16) & 255u)) / 255.0
-                                        : row < materials.colorTableCount() ? reference::rowColor(materials.colorRow(row), s.colorCoord)
-                                                                            : glm::dvec3(1.0);
+                const glm::dvec3 base =
+                    desc.packedColor ? glm::dvec3(double(s.color & 255u), double((s.color >> 8) & 255u), double((s.color >> 16) & 255u)) / 255.0
+                    : row < materials.colorTableCount() ? reference::rowColor(materials.colorRow(row), s.colorCoord)
+                                                        : glm::dvec3(1.0);
                 const glm::dvec3 col = base * glm::dvec3(tex);
                 if (!cuts.empty()) {
                     // (issue 15) Sections at the surface crossings: each
@@ -308,9 +308,11 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                 frags.push_back({t, alpha, col * alpha});
             }
             // The surfaces' layers at their crossings.
-            for (std::size_t k = 0; k < cuts.size(); ++k) frags.push_back({cuts[k], std::clamp(cutColour[k].a, 0.0, 1.0), glm::dvec3(cutColour[k]), 1});
+            for (std::size_t k = 0; k < cuts.size(); ++k)
+                frags.push_back({cuts[k], std::clamp(cutColour[k].a, 0.0, 1.0), glm::dvec3(cutColour[k]), 1});
             // Per-pixel exact order: farthest first (at equal depth, the far side of a surface first).
-            std::stable_sort(frags.begin(), frags.end(), [](const Fragment& a, const Fragment& b) { return a.t != b.t ? a.t > b.t : a.side > b.side; });
+            std::stable_sort(frags.begin(), frags.end(),
+                             [](const Fragment& a, const Fragment& b) { return a.t != b.t ? a.t > b.t : a.side > b.side; });
             glm::dvec4 acc = reference::background(desc.host, x, y);
             if (!fog) {
                 for (const Fragment& f : frags) acc = glm::dvec4(f.color, f.alpha) + (1.0 - f.alpha) * acc;

@@ -158,12 +158,12 @@ struct Integrator {
 
 } // namespace
 
-glm::dvec4 integrateRayWithFog(const std::vector<Tetrahedron>& tets, const TransferFunction& transfer, glm::dvec3 eye, glm::dvec3 dir,
-                               double tNear, double tFar, const RayFogDesc& desc, RayFogStats* statsOut) {
+glm::dvec4 integrateRayWithFog(const std::vector<Tetrahedron>& tets, const TransferFunction& transfer, glm::dvec3 eye, glm::dvec3 dir, double tNear,
+                               double tFar, const RayFogDesc& desc, RayFogStats* statsOut) {
     RayFogStats stats;
     const double speed = glm::length(dir);
-    if (!(speed > 0.0) || !std::isfinite(speed) || std::isnan(tNear) || std::isnan(tFar) || !std::isfinite(eye.x) ||
-        !std::isfinite(eye.y) || !std::isfinite(eye.z)) {
+    if (!(speed > 0.0) || !std::isfinite(speed) || std::isnan(tNear) || std::isnan(tFar) || !std::isfinite(eye.x) || !std::isfinite(eye.y) ||
+        !std::isfinite(eye.z)) {
         if (statsOut) *statsOut = stats;
         return glm::dvec4(0.0);
     }
@@ -171,7 +171,13 @@ glm::dvec4 integrateRayWithFog(const std::vector<Tetrahedron>& tets, const Trans
     tNear *= speed; // from here on t is world distance from the eye
     tFar = std::min(tFar * speed, 1e30);
     const Fog* fog = desc.fog && !desc.fog->empty() ? desc.fog : nullptr;
-    Integrator in{transfer, fog, desc.timeSec, desc.tolerance, desc.maxHalvings, eye, d,
+    Integrator in{transfer,
+                  fog,
+                  desc.timeSec,
+                  desc.tolerance,
+                  desc.maxHalvings,
+                  eye,
+                  d,
                   fog && fog->desc().farDistanceWorld > 0.0 ? fog->desc().farDistanceWorld : INFINITY};
     RayState s;
     in.fogOnly(s, 0.0, tNear); // the fog between the eye and the near plane
@@ -182,8 +188,8 @@ glm::dvec4 integrateRayWithFog(const std::vector<Tetrahedron>& tets, const Trans
         in.split(s, reached, t0, [&](RayState& st, double a, double b) { in.fogOnly(st, a, b); });
         const Tetrahedron& t = tets[p.tet];
         const glm::dvec3 p0(t.position[0]);
-        const glm::dmat3 inv = glm::inverse(
-            glm::dmat3(glm::dvec3(t.position[1]) - p0, glm::dvec3(t.position[2]) - p0, glm::dvec3(t.position[3]) - p0));
+        const glm::dmat3 inv =
+            glm::inverse(glm::dmat3(glm::dvec3(t.position[1]) - p0, glm::dvec3(t.position[2]) - p0, glm::dvec3(t.position[3]) - p0));
         auto at = [&](double tt, const std::array<float, 4>& v) {
             const glm::dvec3 l = inv * (eye + d * tt - p0);
             return (1.0 - l.x - l.y - l.z) * v[0] + l.x * v[1] + l.y * v[2] + l.z * v[3];
@@ -229,7 +235,8 @@ Result<Image> renderTetraExact(const std::vector<Tetrahedron>& tets, const Trans
     if (Status s = reference::checkHost(desc.host, camera, "renderTetraExact"); !s) return makeError(s.error());
     if (!(desc.tolerance > 0.0)) return makeError("renderTetraExact: desc.tolerance must be positive");
     if (desc.maxHalvings < 1 || desc.maxHalvings > 20) return makeError("renderTetraExact: desc.maxHalvings must be in [1, 20]");
-    if (!camera.perspective()) return makeError("renderTetraExact: needs a perspective camera (the fog is integrated from the eye along each pixel ray)");
+    if (!camera.perspective())
+        return makeError("renderTetraExact: needs a perspective camera (the fog is integrated from the eye along each pixel ray)");
     const int W = camera.viewport.x, H = camera.viewport.y;
     Image out;
     out.width = W;
@@ -245,12 +252,12 @@ Result<Image> renderTetraExact(const std::vector<Tetrahedron>& tets, const Trans
         for (int x = 0; x < W; ++x) {
             const double hd = reference::hostDepth(desc.host, x, y);
             const reference::PixelRay ray = mapper.ray(x, y, std::isnan(hd) || hd < 0.0 ? 2.0 : hd); // bad depth: none
-            const double tNear = glm::length(ray.origin - eye); // the ray passes through the eye
+            const double tNear = glm::length(ray.origin - eye);                                      // the ray passes through the eye
             RayFogStats rs;
-            const glm::dvec4 c = integrateRayWithFog(tets, transfer, eye, ray.dir, tNear, tNear + ray.tLimit,
-                                                     {.fog = desc.fog, .timeSec = desc.fogTimeSec, .fogHost = desc.fogHost,
-                                                      .tolerance = desc.tolerance, .maxHalvings = desc.maxHalvings},
-                                                     &rs);
+            const glm::dvec4 c = integrateRayWithFog(
+                tets, transfer, eye, ray.dir, tNear, tNear + ray.tLimit,
+                {.fog = desc.fog, .timeSec = desc.fogTimeSec, .fogHost = desc.fogHost, .tolerance = desc.tolerance, .maxHalvings = desc.maxHalvings},
+                &rs);
             local.maxErrorEstimate = std::max(local.maxErrorEstimate, rs.errorEstimate);
             local.unconverged += rs.converged ? 0 : 1;
             const double T = 1.0 - c.a;

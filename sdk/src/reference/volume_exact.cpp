@@ -28,8 +28,8 @@ struct RayResult {
     double transmittance = 1.0;
 };
 
-RayResult integrate(const std::vector<Crossing>& cs, const std::vector<double>& breaks, const Footprint& fp, double h,
-                    double cutoff, std::uint64_t& evals) {
+RayResult integrate(const std::vector<Crossing>& cs, const std::vector<double>& breaks, const Footprint& fp, double h, double cutoff,
+                    std::uint64_t& evals) {
     RayResult r;
     std::vector<const Crossing*> active;
     for (size_t i = 0; i + 1 < breaks.size(); ++i) {
@@ -76,8 +76,7 @@ RayResult integrate(const std::vector<Crossing>& cs, const std::vector<double>& 
 
 } // namespace
 
-Result<Image> renderVolumeExact(const VolumeField& field, const Camera& camera, const VolumeExactDesc& desc,
-                                VolumeExactStats* statsOut) {
+Result<Image> renderVolumeExact(const VolumeField& field, const Camera& camera, const VolumeExactDesc& desc, VolumeExactStats* statsOut) {
     if (Status s = reference::checkHost(desc.host, camera, "renderVolumeExact"); !s) return makeError(s.error());
     if (!(desc.tolerance > 0.0)) return makeError("renderVolumeExact: desc.tolerance must be positive");
     const int W = camera.viewport.x, H = camera.viewport.y;

@@ -34,8 +34,8 @@ void VolumeField::add(const Grid& grid, const SplatStyle& style) {
         }
         const double det = glm::determinant(m);
         const glm::dvec3 c = glm::dvec3(glm::dmat4(grid.transform) * glm::dvec4(glm::dvec3(grid.localPosition(v.cell)), 1.0));
-        if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord) || !std::isfinite(v.phase) || !finite(c) ||
-            !std::isfinite(det) || std::abs(det) < 1e-12) {
+        if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord) || !std::isfinite(v.phase) || !finite(c) || !std::isfinite(det) ||
+            std::abs(det) < 1e-12) {
             ++mRejected;
             continue;
         }
@@ -50,8 +50,7 @@ void VolumeField::add(const Grid& grid, const SplatStyle& style) {
         k.scale = kLn2 * tau / (mCentreFootprint * std::cbrt(std::abs(det)));
         k.boundRadius = R * std::sqrt(glm::dot(m[0], m[0]) + glm::dot(m[1], m[1]) + glm::dot(m[2], m[2]));
         const std::uint32_t row = hasTable ? style.colorTable : 0u;
-        k.color = row < mat.colorTableCount() ? reference::rowColor(mat.colorRow(row), std::clamp(double(v.colorCoord), 0.0, 1.0))
-                                              : glm::dvec3(1.0);
+        k.color = row < mat.colorTableCount() ? reference::rowColor(mat.colorRow(row), std::clamp(double(v.colorCoord), 0.0, 1.0)) : glm::dvec3(1.0);
         mKernels.push_back(k);
     }
 }

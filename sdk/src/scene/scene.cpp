@@ -43,11 +43,10 @@ bool Scene::inFrustum(const Aabb& box, const Camera& camera) {
     const glm::mat4 vp = camera.proj * camera.view;
     for (int i = 0; i < 3; ++i)
         for (int sign = -1; sign <= 1; sign += 2) {
-            const glm::vec4 plane = glm::vec4(vp[0][3], vp[1][3], vp[2][3], vp[3][3]) +
-                                    float(sign) * glm::vec4(vp[0][i], vp[1][i], vp[2][i], vp[3][i]);
+            const glm::vec4 plane =
+                glm::vec4(vp[0][3], vp[1][3], vp[2][3], vp[3][3]) + float(sign) * glm::vec4(vp[0][i], vp[1][i], vp[2][i], vp[3][i]);
             // The corner farthest along the plane normal decides.
-            const glm::vec3 p(plane.x >= 0 ? box.hi.x : box.lo.x, plane.y >= 0 ? box.hi.y : box.lo.y,
-                              plane.z >= 0 ? box.hi.z : box.lo.z);
+            const glm::vec3 p(plane.x >= 0 ? box.hi.x : box.lo.x, plane.y >= 0 ? box.hi.y : box.lo.y, plane.z >= 0 ? box.hi.z : box.lo.z);
             if (glm::dot(glm::vec3(plane), p) + plane.w < 0.0f) return false;
         }
     return true;
@@ -80,9 +79,8 @@ void Scene::update(double timeSec, const Camera& camera) {
             continue;
         }
         // Resumed: advanced before, skipped since; the kind decides what catching up costs.
-        const AdvanceContext context{.catchUpStepSec = e.options.catchUpStepSec,
-                                     .maxCatchUpSteps = e.options.maxCatchUpSteps,
-                                     .resumed = !wasNeeded && s.framesNeeded > 0};
+        const AdvanceContext context{
+            .catchUpStepSec = e.options.catchUpStepSec, .maxCatchUpSteps = e.options.maxCatchUpSteps, .resumed = !wasNeeded && s.framesNeeded > 0};
         if (e.kind->advanceTo(timeSec, context).caughtUp) ++s.catchUps;
         s.needed = true;
         ++s.framesNeeded;
@@ -115,7 +113,7 @@ void Scene::prepare(double timeSec, const Camera& camera, const Materials& mater
     update(timeSec, camera);
     frame.begin(timeSec, camera);
     emit(frame.builder(), materials, options);
-    shadeScene(frame); // lighting (issue 16): the shadow on the scene, into frame.shadow()
+    shadeScene(frame);             // lighting (issue 16): the shadow on the scene, into frame.shadow()
     prepareVolumes(camera, frame); // [clouds]
     frame.end();
     frame.setFog(mFog); // fog (issue 14)
@@ -133,8 +131,7 @@ void Scene::prepare(double timeSec, const Camera& camera, const Materials& mater
 
 // ---- [clouds, issue 17] LOD volumes ----
 VolumeId Scene::addVolume(LodVolume volume, TransferFunction transfer, PreIntegrationTable table, VolumeOptions options) {
-    mVolumes.push_back(std::make_unique<VolumeEntry>(
-        VolumeEntry{std::move(volume), std::move(transfer), std::move(table), 1, std::move(options)}));
+    mVolumes.push_back(std::make_unique<VolumeEntry>(VolumeEntry{std::move(volume), std::move(transfer), std::move(table), 1, std::move(options)}));
     return VolumeId(mVolumes.size() - 1);
 }
 
@@ -175,7 +172,8 @@ void Scene::prepareVolumes(const Camera& camera, Frame& frame) {
 
 //
 VolumeId Scene::addGroundFog(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, VolumeOptions options) {
-    mGroundFogs.push_back(std::make_unique<GroundFogEntry>(GroundFogEntry{std::move(fog), std::move(transfer), std::move(table), std::move(options), {}}));
+    mGroundFogs.push_back(
+        std::make_unique<GroundFogEntry>(GroundFogEntry{std::move(fog), std::move(transfer), std::move(table), std::move(options), {}}));
     return VolumeId(mGroundFogs.size() - 1);
 }
 

@@ -31,8 +31,7 @@ std::uint32_t packLit(glm::vec3 c) {
     for (int a = 0; a < 3; ++a) c[a] = std::isfinite(c[a]) ? std::max(c[a], 0.0f) : 0.0f;
     const float m = std::max({c.r, c.g, c.b});
     if (m > 1.0f) c /= m;
-    return std::uint32_t(c.r * 255.0f + 0.5f) | std::uint32_t(c.g * 255.0f + 0.5f) << 8 | std::uint32_t(c.b * 255.0f + 0.5f) << 16 |
-           0xff000000u;
+    return std::uint32_t(c.r * 255.0f + 0.5f) | std::uint32_t(c.g * 255.0f + 0.5f) << 8 | std::uint32_t(c.b * 255.0f + 0.5f) << 16 | 0xff000000u;
 }
 
 } // namespace
@@ -44,7 +43,8 @@ Result<std::size_t> Scene::addLight(const Light& light) {
 }
 
 Status Scene::setLight(std::size_t i, const Light& light) {
-    if (i >= mLights.size()) return makeError("setLight: index " + std::to_string(i) + " is not a light (" + std::to_string(mLights.size()) + " lights)");
+    if (i >= mLights.size())
+        return makeError("setLight: index " + std::to_string(i) + " is not a light (" + std::to_string(mLights.size()) + " lights)");
     if (Status s = validateLight(light, "lights[" + std::to_string(i) + "]"); !s) return s;
     mLights[i] = light;
     return {};
@@ -113,8 +113,8 @@ void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& mater
     const std::size_t n = splats.size() - first;
     lit.points.resize(n);
     for (std::size_t i = 0; i < n; ++i) lit.points[i] = splats[first + i].center;
-    const glm::mat3 shape = glm::mat3(whole.transform) * glm::mat3(glm::vec3(whole.spacing.x, 0, 0), glm::vec3(0, whole.spacing.y, 0),
-                                                                  glm::vec3(0, 0, whole.spacing.z));
+    const glm::mat3 shape =
+        glm::mat3(whole.transform) * glm::mat3(glm::vec3(whole.spacing.x, 0, 0), glm::vec3(0, whole.spacing.y, 0), glm::vec3(0, 0, whole.spacing.z));
     const float det = std::abs(glm::determinant(shape));
     const float voxelSize = std::isfinite(det) ? std::cbrt(det) : 0.0f;
     if (Status s = lightPoints(lit.points, voxelSize, builder.camera().eye(), mLights, shadows, L.gas, lit.factors); !s) {

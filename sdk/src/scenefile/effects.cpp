@@ -67,15 +67,15 @@ void readEffects(Context& c, const std::string& path, const Json& v, const std::
         // The default layer budget is what every GL 4.5 guarantees (GL_MAX_ARRAY_TEXTURE_LAYERS
         // >= 2048); checked as effects are read, so a level of too many distinct sets stops at
         // the effect that crosses it.
-        if (Status s = checkBudget("the scene, with this effect,", c.materials.layerCount(), "layers",
-                                   c.budgets.textureLayers, "textureLayers");
+        if (Status s = checkBudget("the scene, with this effect,", c.materials.layerCount(), "layers", c.budgets.textureLayers, "textureLayers");
             !s) {
-            c.d.error(e.path, s.error() + " in its distinct texture sets; share texture sets between effects (equal parameters and seeds) or use fewer textures");
+            c.d.error(e.path,
+                      s.error() +
+                          " in its distinct texture sets; share texture sets between effects (equal parameters and seeds) or use fewer textures");
             return;
         }
         totalCells += effect->costCells(); // EffectKind: cells or voxels one advance evaluates
-        if (Status s = checkBudget("the scene, with this effect,", totalCells, "cells", c.budgets.effectCells, "effectCells");
-            !s) {
+        if (Status s = checkBudget("the scene, with this effect,", totalCells, "cells", c.budgets.effectCells, "effectCells"); !s) {
             c.d.error(e.path, s.error());
             return;
         }

@@ -36,8 +36,7 @@ void readWind(Context& c, const std::string& path, const Json& v, FogWind& wind)
             k.velocity = dv(vel);
         });
         if (!key) continue;
-        if (!wind.keys.empty() && key->timeSec < wind.keys.back().timeSec)
-            c.d.error(join(kp, "timeSec"), "wind keys must be sorted by time");
+        if (!wind.keys.empty() && key->timeSec < wind.keys.back().timeSec) c.d.error(join(kp, "timeSec"), "wind keys must be sorted by time");
         wind.keys.push_back(*key);
     }
 }
@@ -50,8 +49,7 @@ int axisIndex(Context& c, const std::string& path, const Json& v) {
 void readTerm(Context& c, ObjectReader& o, FogTerm& t) {
     std::string kind;
     if (const Json* k = o.get("kind")) {
-        if (auto s = readChoice(c.d, o.at("kind"), *k, {"constant", "cosine", "cosineProduct", "polynomial", "point", "line", "sphere"}))
-            kind = *s;
+        if (auto s = readChoice(c.d, o.at("kind"), *k, {"constant", "cosine", "cosineProduct", "polynomial", "point", "line", "sphere"})) kind = *s;
     } else {
         c.d.error(o.at("kind"), "required: constant, cosine, cosineProduct, polynomial, point, line or sphere");
     }
@@ -88,8 +86,8 @@ void readTerm(Context& c, ObjectReader& o, FogTerm& t) {
         std::vector<double> coeffs;
         if (const Json* cv = o.get("coeffs")) {
             if (!cv->is_array() || cv->empty() || cv->size() > std::size_t(kFogMaxDegree + 1))
-                c.d.error(o.at("coeffs"), "expected 1 to " + std::to_string(kFogMaxDegree + 1) + " numbers (degree <= " +
-                                              std::to_string(kFogMaxDegree) + "), got " + brief(*cv));
+                c.d.error(o.at("coeffs"), "expected 1 to " + std::to_string(kFogMaxDegree + 1) +
+                                              " numbers (degree <= " + std::to_string(kFogMaxDegree) + "), got " + brief(*cv));
             else
                 for (std::size_t i = 0; i < cv->size(); ++i)
                     if (auto x = readNumber(c.d, o.at("coeffs") + "[" + std::to_string(i) + "]", (*cv)[i], -1e6, 1e6)) coeffs.push_back(*x);
@@ -101,7 +99,8 @@ void readTerm(Context& c, ObjectReader& o, FogTerm& t) {
         o.number("centre", centre, -kMaxCoord, kMaxCoord);
         FogCellMode mode = FogCellMode::Periodic;
         if (const Json* m = o.get("mode"))
-            if (auto s = readChoice(c.d, o.at("mode"), *m, {"periodic", "zeroOutside"})) mode = *s == "periodic" ? FogCellMode::Periodic : FogCellMode::ZeroOutside;
+            if (auto s = readChoice(c.d, o.at("mode"), *m, {"periodic", "zeroOutside"}))
+                mode = *s == "periodic" ? FogCellMode::Periodic : FogCellMode::ZeroOutside;
         const double w = t.weight, wf = t.windFactor;
         t = FogTerm::polynomial1D(w, axis, coeffs, halfSize, mode, centre);
         t.windFactor = wf;

@@ -43,8 +43,7 @@ std::vector<RawGeometry> readGeometryList(Context& c, const std::string& path, c
     }
     const std::vector<std::string> types = geometryKindNames();
     std::string typeList; // "\"plane\", \"box\", ... or \"empty\""
-    for (std::size_t i = 0; i < types.size(); ++i)
-        typeList += (i == 0 ? "" : i + 1 == types.size() ? " or " : ", ") + ("\"" + types[i] + "\"");
+    for (std::size_t i = 0; i < types.size(); ++i) typeList += (i == 0 ? "" : i + 1 == types.size() ? " or " : ", ") + ("\"" + types[i] + "\"");
     for (std::size_t i = 0; i < v.size() && !c.d.full(); ++i) {
         RawGeometry g;
         g.path = index(path, i);

@@ -147,8 +147,8 @@ std::optional<glm::vec3> readVec3(Diagnostics& d, const std::string& path, const
         return glm::vec3(float(*s));
     }
     if (!v.is_array() || v.size() != 3) {
-        d.error(path, std::string("expected ") + (allowScalar ? "a number or " : "") + "an array of 3 numbers in " + range(lo, hi) +
-                          ", got " + typeName(v) + " " + brief(v));
+        d.error(path, std::string("expected ") + (allowScalar ? "a number or " : "") + "an array of 3 numbers in " + range(lo, hi) + ", got " +
+                          typeName(v) + " " + brief(v));
         return std::nullopt;
     }
     glm::vec3 out;
@@ -162,8 +162,8 @@ std::optional<glm::vec3> readVec3(Diagnostics& d, const std::string& path, const
 
 std::optional<glm::ivec3> readIvec3(Diagnostics& d, const std::string& path, const Json& v, int lo, int hi) {
     if (!v.is_array() || v.size() != 3) {
-        d.error(path, "expected an array of 3 integers in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
-                          typeName(v) + " " + brief(v));
+        d.error(path,
+                "expected an array of 3 integers in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + typeName(v) + " " + brief(v));
         return std::nullopt;
     }
     glm::ivec3 out;
@@ -177,8 +177,8 @@ std::optional<glm::ivec3> readIvec3(Diagnostics& d, const std::string& path, con
 
 std::optional<glm::vec4> readColor(Diagnostics& d, const std::string& path, const Json& v, bool allowAlpha) {
     if (!v.is_array() || !(v.size() == 3 || (allowAlpha && v.size() == 4))) {
-        d.error(path, std::string("expected a colour [r, g, b") + (allowAlpha ? "(, a)" : "") + "] with values in [0, 1], got " +
-                          typeName(v) + " " + brief(v));
+        d.error(path, std::string("expected a colour [r, g, b") + (allowAlpha ? "(, a)" : "") + "] with values in [0, 1], got " + typeName(v) + " " +
+                          brief(v));
         return std::nullopt;
     }
     glm::vec4 out(1.0f);
@@ -263,8 +263,7 @@ void ObjectReader::finish() {
         const std::string near = closest(it.key(), known);
         std::string list;
         for (std::size_t i = 0; i < known.size(); ++i) list += (i ? ", " : "") + known[i];
-        mD.error(at(it.key()), "unknown key" + (near.empty() ? std::string() : " (did you mean \"" + near + "\"?)") +
-                                   "; keys allowed here: " + list);
+        mD.error(at(it.key()), "unknown key" + (near.empty() ? std::string() : " (did you mean \"" + near + "\"?)") + "; keys allowed here: " + list);
     }
 }
 

@@ -65,14 +65,12 @@ std::optional<std::int64_t> readInt(Diagnostics& d, const std::string& path, con
 std::optional<bool> readBool(Diagnostics& d, const std::string& path, const Json& v);
 std::optional<std::string> readString(Diagnostics& d, const std::string& path, const Json& v);
 // [x, y, z]; with allowScalar a single number s means [s, s, s].
-std::optional<glm::vec3> readVec3(Diagnostics& d, const std::string& path, const Json& v, double lo, double hi,
-                                  bool allowScalar = false);
+std::optional<glm::vec3> readVec3(Diagnostics& d, const std::string& path, const Json& v, double lo, double hi, bool allowScalar = false);
 std::optional<glm::ivec3> readIvec3(Diagnostics& d, const std::string& path, const Json& v, int lo, int hi);
 // [r, g, b] or [r, g, b, a] (alpha 1 when absent), each in [0, 1].
 std::optional<glm::vec4> readColor(Diagnostics& d, const std::string& path, const Json& v, bool allowAlpha);
 // One of `choices`; the message lists them.
-std::optional<std::string> readChoice(Diagnostics& d, const std::string& path, const Json& v,
-                                      const std::vector<std::string>& choices);
+std::optional<std::string> readChoice(Diagnostics& d, const std::string& path, const Json& v, const std::vector<std::string>& choices);
 
 // [SECTION] ObjectReader
 

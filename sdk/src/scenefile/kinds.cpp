@@ -26,7 +26,7 @@ constexpr EffectKind kEffectKinds[] = {
     {"grid", &readGridKind},           // kinds/grid.cpp
     {"gas", &readGasKind},             // kinds/gas.cpp
 #if SPLATFX_WITH_VDB
-    {"vdb", &readVdbKind},             // kinds/vdb.cpp
+    {"vdb", &readVdbKind}, // kinds/vdb.cpp
 #endif
 };
 
@@ -35,7 +35,7 @@ constexpr GeometryKind kGeometryKinds[] = {
     {"box", GeometryType::Box, nullptr},
     {"cylinder", GeometryType::Cylinder, nullptr},
     {"sphere", GeometryType::Sphere, nullptr},
-    {"mesh", GeometryType::Mesh, &readMeshGeometry}, // kinds/mesh.cpp
+    {"mesh", GeometryType::Mesh, &readMeshGeometry},                // kinds/mesh.cpp
     {"heightmap", GeometryType::Heightmap, &readHeightmapGeometry}, // kinds/heightmap.cpp
     {"empty", GeometryType::Empty, nullptr},
 };

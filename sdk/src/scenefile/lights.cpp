@@ -47,8 +47,10 @@ std::optional<Light> readLight(Context& c, const std::string& path, const Json& 
             if (what.rfind(prefix, 0) == 0) {
                 const std::size_t space = what.find(' ');
                 const std::string field = what.substr(prefix.size(), space - prefix.size());
-                const std::string key = field == "innerConeRad" ? "innerConeDeg" : field == "outerConeRad" ? "outerConeDeg"
-                                        : field == "radiusWorld" ? "radius" : field;
+                const std::string key = field == "innerConeRad"   ? "innerConeDeg"
+                                        : field == "outerConeRad" ? "outerConeDeg"
+                                        : field == "radiusWorld"  ? "radius"
+                                                                  : field;
                 cc.d.error(o.at(key), what.substr(space + 1));
             } else {
                 cc.d.error(path, what);
@@ -80,8 +82,8 @@ void readSceneShadow(Context& c, const std::string& path, const Json& v, SceneFi
         readAxisCounts(cc, o, "dims", s.dims, 1, 1024);
         const std::uint64_t bytes = ShadowTable::memoryBytes(s.dims);
         if (bytes > s.memoryBudgetBytes)
-            cc.d.error(o.at("dims"), std::to_string(s.dims.x) + "x" + std::to_string(s.dims.y) + "x" + std::to_string(s.dims.z) +
-                                         " needs " + std::to_string(bytes >> 20) + " MiB to build, over the 64 MiB budget");
+            cc.d.error(o.at("dims"), std::to_string(s.dims.x) + "x" + std::to_string(s.dims.y) + "x" + std::to_string(s.dims.z) + " needs " +
+                                         std::to_string(bytes >> 20) + " MiB to build, over the 64 MiB budget");
     });
     if (d) out.scene.setSceneShadow(*d);
 }

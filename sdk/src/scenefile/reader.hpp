@@ -30,9 +30,9 @@ namespace splatfx::scenefile {
 
 // Larger than any sensible scene, small enough that a typo (an extra zero,
 // a unit mistake) is caught before it allocates gigabytes.
-inline constexpr double kMaxCoord = 1.0e6;                   // world units for positions and offsets
-inline constexpr double kMaxSeconds = 1.0e6;                 // key times
-inline constexpr int kMaxAxis = 4096;                        // cells per lattice axis
+inline constexpr double kMaxCoord = 1.0e6;   // world units for positions and offsets
+inline constexpr double kMaxSeconds = 1.0e6; // key times
+inline constexpr int kMaxAxis = 4096;        // cells per lattice axis
 inline constexpr std::size_t kMaxEffects = 4096;
 inline constexpr std::size_t kMaxGeometry = 4096;
 inline constexpr std::size_t kMaxKeys = 100000;
@@ -50,7 +50,7 @@ struct Context {
     std::filesystem::path baseDir;
     Materials& materials;
     std::uint32_t sceneSeed = 1;
-    Budgets budgets{};          // SceneFileOptions::budgets
+    Budgets budgets{}; // SceneFileOptions::budgets
     // Texture-set folders already read for this file, by canonical path: a
     // level naming one folder for a thousand effects reads it once.
     std::map<std::string, TextureSet> folders{};
@@ -84,8 +84,8 @@ std::optional<Motion> readMotion(Context& c, const std::string& path, const Json
 // A texture set as written in a file.
 struct TextureSpec {
     enum class Kind { Procedural, Folder, Faces, SampleImage } kind = Kind::Procedural;
-    std::string folder;        // Folder: resolved path
-    std::string image;         // SampleImage: resolved path
+    std::string folder; // Folder: resolved path
+    std::string image;  // SampleImage: resolved path
     int count = 8;
     int size = 32;
     std::uint32_t seed = 1;
@@ -96,8 +96,7 @@ struct TextureSpec {
 };
 
 // presetOnly restricts the forms (presets take only a folder or a procedural count).
-std::optional<TextureSpec> readTextureSpec(Context& c, const std::string& path, const Json& v, int defaultCount,
-                                           std::uint32_t seed, bool presetOnly);
+std::optional<TextureSpec> readTextureSpec(Context& c, const std::string& path, const Json& v, int defaultCount, std::uint32_t seed, bool presetOnly);
 // Loads, generates or samples the set (the file read happens here).
 Result<TextureSet> buildTextureSet(const TextureSpec& t);
 // A preset's texture-set path: the folder, or empty for procedural.

@@ -130,19 +130,17 @@ Result<SceneFile> parse(const std::string& text, const std::string& path, Materi
                          (format ? brief(*format) : std::string("nothing")) + " (is this a splatfx scene file?)");
     const Json* version = o.get("version");
     if (!version || !version->is_number_integer() || version->get<std::int64_t>() != kSceneFileVersion)
-        return makeError(path + ": version: expected " + std::to_string(kSceneFileVersion) + ", got " +
-                         (version ? brief(*version) : std::string("nothing")) +
-                         (version && version->is_number_integer() && version->get<std::int64_t>() > kSceneFileVersion
-                              ? " (written by a newer splatfx)" : ""));
+        return makeError(
+            path + ": version: expected " + std::to_string(kSceneFileVersion) + ", got " + (version ? brief(*version) : std::string("nothing")) +
+            (version && version->is_number_integer() && version->get<std::int64_t>() > kSceneFileVersion ? " (written by a newer splatfx)" : ""));
     o.string("title", out.title);
     o.seed("seed", out.seed);
     if (options.seed) out.seed = *options.seed;
     c.sceneSeed = out.seed;
     out.output.name = fs::path(path).parent_path().filename().string();
     if (const Json* v = o.get("output")) readOutput(c, "output", *v, out.output);
-    if (out.output.name.empty() || !std::all_of(out.output.name.begin(), out.output.name.end(), [](char ch) {
-            return std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_';
-        }))
+    if (out.output.name.empty() || !std::all_of(out.output.name.begin(), out.output.name.end(),
+                                                [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '-' || ch == '_'; }))
         out.output.name = "scene";
     if (const Json* v = o.get("camera")) readCamera(c, "camera", *v, out.camera);
     if (out.camera.keys.empty()) out.camera.keys = {CameraKey{}};
@@ -168,9 +166,9 @@ Result<SceneFile> parse(const std::string& text, const std::string& path, Materi
         }
     }
     if (const Json* v = o.get("effects")) readEffects(c, "effects", *v, geo, geoByName, out);
-    if (const Json* v = o.get("lights")) readLights(c, "lights", *v, out);           // issue 16
+    if (const Json* v = o.get("lights")) readLights(c, "lights", *v, out); // issue 16
     if (const Json* v = o.get("sceneShadow")) readSceneShadow(c, "sceneShadow", *v, out);
-    if (const Json* v = o.get("fog")) readFog(c, "fog", *v, out.scene); // fog_block.cpp (issue 14)
+    if (const Json* v = o.get("fog")) readFog(c, "fog", *v, out.scene);       // fog_block.cpp (issue 14)
     if (const Json* v = o.get("volumes")) readVolumes(c, "volumes", *v, out); // [clouds]
     o.finish();
     if (!d.ok()) return makeError(d.message());
@@ -185,9 +183,7 @@ Result<SceneFile> parseSceneFile(const std::string& text, const std::string& pat
     // The JSON library reports through exceptions; none may cross the API.
     try {
         return scenefile::parse(text, path, materials, options);
-    } catch (const std::bad_alloc&) {
-        return makeError(path + ": out of memory while reading the scene");
-    } catch (const std::exception& e) {
+    } catch (const std::bad_alloc&) { return makeError(path + ": out of memory while reading the scene"); } catch (const std::exception& e) {
         return makeError(path + ": cannot read the scene: " + e.what());
     }
 }

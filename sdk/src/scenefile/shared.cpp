@@ -38,8 +38,8 @@ bool textureFolderExists(const std::string& folder) {
 Result<TextureSet> sampleImageFile(const TextureSpec& t) {
     Result<Image> img = readImage(t.image);
     if (!img) return makeError(img.error());
-    return TextureSet::sampleImage(*img, {.count = t.count, .size = t.size, .seed = t.seed, .keepColor = t.keepColor,
-                                          .sourceName = "image '" + t.image + "'"});
+    return TextureSet::sampleImage(
+        *img, {.count = t.count, .size = t.size, .seed = t.seed, .keepColor = t.keepColor, .sourceName = "image '" + t.image + "'"});
 }
 
 bool checkDims(Context& c, const std::string& path, glm::ivec3 dims, std::uint64_t limit, const char* field, const char* why) {
@@ -75,8 +75,7 @@ std::optional<Motion> readMotion(Context& c, const std::string& path, const Json
     std::vector<Keyframe> keys;
     if (const Json* k = o.get("keys")) {
         if (!k->is_array() || k->size() > kMaxKeys) {
-            c.d.error(o.at("keys"), "expected an array of at most " + std::to_string(kMaxKeys) + " keyframes, got " + typeName(*k) +
-                                        " " + brief(*k));
+            c.d.error(o.at("keys"), "expected an array of at most " + std::to_string(kMaxKeys) + " keyframes, got " + typeName(*k) + " " + brief(*k));
         } else {
             for (std::size_t i = 0; i < k->size() && !c.d.full(); ++i) {
                 ObjectReader ko(c.d, index(o.at("keys"), i), (*k)[i]);
@@ -122,8 +121,8 @@ std::optional<Motion> readMotion(Context& c, const std::string& path, const Json
     return std::move(*m);
 }
 
-std::optional<TextureSpec> readTextureSpec(Context& c, const std::string& path, const Json& v, int defaultCount,
-                                           std::uint32_t seed, bool presetOnly) {
+std::optional<TextureSpec> readTextureSpec(Context& c, const std::string& path, const Json& v, int defaultCount, std::uint32_t seed,
+                                           bool presetOnly) {
     TextureSpec t;
     t.count = defaultCount;
     t.seed = seed;
@@ -206,15 +205,16 @@ std::optional<TextureSpec> readTextureSpec(Context& c, const std::string& path, 
             // Each window becomes size^2 float RGBA texels: 256 windows of 1024^2 would be 4 GiB
             // per effect, so the set's texels are budgeted before anything is read.
             if (Status s = checkBudget("count " + std::to_string(t.count) + " x size " + std::to_string(t.size) + "^2",
-                                       std::uint64_t(t.count) * std::uint64_t(t.size) * std::uint64_t(t.size), "texels",
-                                       c.budgets.sampledTexels, "sampledTexels");
+                                       std::uint64_t(t.count) * std::uint64_t(t.size) * std::uint64_t(t.size), "texels", c.budgets.sampledTexels,
+                                       "sampledTexels");
                 !s)
                 c.d.error(po.path(), s.error() + "; or use fewer or smaller windows");
             po.finish();
             if (!image.empty()) {
                 t.image = resolvePath(c, image);
                 std::error_code ec;
-                if (!fs::is_regular_file(t.image, ec)) c.d.error(join(po.path(), "image"), "image file '" + image + "' not found (looked for '" + t.image + "')");
+                if (!fs::is_regular_file(t.image, ec))
+                    c.d.error(join(po.path(), "image"), "image file '" + image + "' not found (looked for '" + t.image + "')");
             }
         }
     }
@@ -230,8 +230,8 @@ Result<TextureSet> buildTextureSet(const TextureSpec& t) {
     case TextureSpec::Kind::SampleImage: return sampleImageFile(t);
     case TextureSpec::Kind::Procedural: break;
     }
-    return TextureSet::turbulence({.count = t.count, .size = t.size, .seed = t.seed, .octaves = t.octaves,
-                                   .baseFrequency = t.baseFrequency, .loopRadius = t.loopRadius});
+    return TextureSet::turbulence(
+        {.count = t.count, .size = t.size, .seed = t.seed, .octaves = t.octaves, .baseFrequency = t.baseFrequency, .loopRadius = t.loopRadius});
 }
 
 std::optional<TextureSet> presetSet(Context& c, const std::string& effectPath, const std::optional<TextureSpec>& t) {
@@ -293,7 +293,8 @@ std::optional<ColorTable> readColorTable(Context& c, const std::string& path, co
             if (ok) out = ColorTable::gradient(stops);
         }
     } else {
-        c.d.error(path, "expected \"fire\", \"smoke\", \"steam\", \"dust\", {\"constant\": [r, g, b, a]} or {\"gradient\": [[t, [r, g, b, a]], ...]}");
+        c.d.error(path,
+                  "expected \"fire\", \"smoke\", \"steam\", \"dust\", {\"constant\": [r, g, b, a]} or {\"gradient\": [[t, [r, g, b, a]], ...]}");
     }
     o.finish();
     return out;
@@ -313,7 +314,8 @@ glm::vec3 applyPoint(const glm::mat4& m, glm::vec3 p) { return glm::vec3(m * glm
 // "propagation" and "cycling" objects (kinds grid and vdb).
 void readPropagation(Context& c, ObjectReader& o, PropagationDesc& p, bool allowVelocity) {
     if (const Json* m = o.get("mode")) {
-        const std::vector<std::string> modes = allowVelocity ? std::vector<std::string>{"none", "fixed", "velocity"} : std::vector<std::string>{"none", "fixed"};
+        const std::vector<std::string> modes =
+            allowVelocity ? std::vector<std::string>{"none", "fixed", "velocity"} : std::vector<std::string>{"none", "fixed"};
         if (auto s = readChoice(c.d, o.at("mode"), *m, modes))
             p.mode = *s == "none" ? Propagation::None : *s == "fixed" ? Propagation::Fixed : Propagation::Velocity;
     }

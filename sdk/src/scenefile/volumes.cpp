@@ -117,8 +117,8 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     }
     // The grid is uniform only if the last sample lands on a multiple of step.
     if ((w - 1) % step != 0 || (h - 1) % step != 0) {
-        c.d.error(o.at("step"), "must divide the heightmap's " + std::to_string(w - 1) + "x" + std::to_string(h - 1) +
-                                    " cells so the layer's grid stays uniform");
+        c.d.error(o.at("step"),
+                  "must divide the heightmap's " + std::to_string(w - 1) + "x" + std::to_string(h - 1) + " cells so the layer's grid stays uniform");
         return;
     }
     const glm::vec3 corner = position + heightmapPoint(0, 0, w, h, 0.0f, spacing, 0.0f);
@@ -161,7 +161,8 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     LodRefineDesc refine;
     refine.detailC = detailC;
     refine.morph = morph;
-    const VolumeId id = out.scene.addGroundFog(std::move(*layer), std::move(*tf), std::move(*table), {.name = name, .enabled = enabled, .refine = refine, .keepTerrain = !terrainGeometry.empty()});
+    const VolumeId id = out.scene.addGroundFog(std::move(*layer), std::move(*tf), std::move(*table),
+                                               {.name = name, .enabled = enabled, .refine = refine, .keepTerrain = !terrainGeometry.empty()});
     if (!terrainGeometry.empty()) out.groundFogTerrain.push_back({terrainGeometry, id});
 }
 
@@ -185,7 +186,8 @@ void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& 
             continue;
         }
         if (kind != "clouds")
-            c.d.error(o.at("kind"), kind.empty() ? "required: \"clouds\" or \"groundFog\"" : "unknown kind '" + kind + "' (known: clouds, groundFog)");
+            c.d.error(o.at("kind"),
+                      kind.empty() ? "required: \"clouds\" or \"groundFog\"" : "unknown kind '" + kind + "' (known: clouds, groundFog)");
         bool enabled = true, morph = true;
         glm::ivec3 dims{129, 17, 129};
         glm::vec3 origin{0.0f}, sun{0.3f, 1.0f, 0.2f};
@@ -226,7 +228,7 @@ void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& 
             c.d.error(o.at("sunDirection"), "must not be zero");
             continue;
         }
-        cd.dims = {dims.x, dims.z, dims.y};                 // generator: z up
+        cd.dims = {dims.x, dims.z, dims.y}; // generator: z up
         cd.sunDirection = {sun.x, sun.z, sun.y};
         cd.seed = c.sceneSeed * 1000003u + 7919u + localSeed; // like effects: --seed changes them all
         auto field = makeCloudVolume(cd);

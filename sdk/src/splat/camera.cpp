@@ -4,12 +4,9 @@
 
 namespace splatfx {
 
-Camera Camera::fromMatrices(const glm::mat4& view, const glm::mat4& proj, glm::ivec2 viewport) {
-    return Camera{view, proj, viewport};
-}
+Camera Camera::fromMatrices(const glm::mat4& view, const glm::mat4& proj, glm::ivec2 viewport) { return Camera{view, proj, viewport}; }
 
-Camera Camera::lookAt(glm::vec3 eye, glm::vec3 target, glm::vec3 up, float fovY, glm::ivec2 viewport, float nearPlane,
-                      float farPlane) {
+Camera Camera::lookAt(glm::vec3 eye, glm::vec3 target, glm::vec3 up, float fovY, glm::ivec2 viewport, float nearPlane, float farPlane) {
     const float aspect = float(viewport.x) / float(glm::max(viewport.y, 1));
     return Camera{glm::lookAt(eye, target, up), glm::perspective(fovY, aspect, nearPlane, farPlane), viewport};
 }

@@ -116,8 +116,7 @@ std::optional<std::uint32_t> Materials::findTableContent(const ColorTable& t, st
     auto [b, e] = mTablesByContent.equal_range(hash);
     for (auto it = b; it != e; ++it) {
         const ColorTable& o = mTables[it->second];
-        if (o.entries.size() == t.entries.size() &&
-            std::memcmp(o.entries.data(), t.entries.data(), t.entries.size() * sizeof(glm::vec4)) == 0)
+        if (o.entries.size() == t.entries.size() && std::memcmp(o.entries.data(), t.entries.data(), t.entries.size() * sizeof(glm::vec4)) == 0)
             return it->second;
     }
     return std::nullopt;
@@ -169,9 +168,8 @@ Status Materials::checkLayerLimit(std::uint32_t maxLayers) const {
     std::iota(order.begin(), order.end(), 0u);
     std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return mSets[a].count > mSets[b].count; });
     constexpr std::size_t kNamed = 8; // enough to see the pattern; the rest are summed
-    std::string msg = "materials hold " + std::to_string(layerCount()) + " texture layers (the footprint and " +
-                      std::to_string(mSets.size()) + " distinct texture sets); this renderer allows " + std::to_string(maxLayers) +
-                      ". Largest sets:";
+    std::string msg = "materials hold " + std::to_string(layerCount()) + " texture layers (the footprint and " + std::to_string(mSets.size()) +
+                      " distinct texture sets); this renderer allows " + std::to_string(maxLayers) + ". Largest sets:";
     std::uint64_t rest = 0;
     for (std::size_t i = 0; i < order.size(); ++i) {
         const SetRange& r = mSets[order[i]];
@@ -183,10 +181,10 @@ Status Materials::checkLayerLimit(std::uint32_t maxLayers) const {
             rest += r.count;
         }
     }
-    if (order.size() > kNamed)
-        msg += " and " + std::to_string(order.size() - kNamed) + " more sets with " + std::to_string(rest) + " layers.";
+    if (order.size() > kNamed) msg += " and " + std::to_string(order.size() - kNamed) + " more sets with " + std::to_string(rest) + " layers.";
     msg += " Equal sets are registered once, so share them: give presets the same textureSeed and texture parameters, "
-           "reuse one set id across effects, use fewer textures per set (textureCount), or split the level across several Materials (one renderer each).";
+           "reuse one set id across effects, use fewer textures per set (textureCount), or split the level across several Materials (one renderer "
+           "each).";
     return makeError(msg);
 }
 

@@ -96,9 +96,7 @@ constexpr int kBatch = 64;
 struct GeometryBatch {
     float cx[kBatch], cy[kBatch], cz[kBatch], viewZ[kBatch], dist[kBatch];
     float ux[kBatch], uy[kBatch], uz[kBatch], vx[kBatch], vy[kBatch], vz[kBatch], chord[kBatch];
-    Geometry at(int i) const {
-        return {{cx[i], cy[i], cz[i]}, viewZ[i], dist[i], {ux[i], uy[i], uz[i]}, {vx[i], vy[i], vz[i]}, chord[i]};
-    }
+    Geometry at(int i) const { return {{cx[i], cy[i], cz[i]}, viewZ[i], dist[i], {ux[i], uy[i], uz[i]}, {vx[i], vy[i], vz[i]}, chord[i]}; }
 };
 
 // The projected ellipse and centre chord of `count` voxels sharing one shape.
@@ -140,8 +138,7 @@ void computeGeometry(const Frame& f, const Shape& shape, const Voxel* voxels, in
     for (int i = 0; i < count; ++i) {
         const float lx = (cellX[i] - hx) * sx, ly = (cellY[i] - hy) * sy, lz = (cellZ[i] - hz) * sz;
         // Eye-relative centre.
-        const float cx = t00 * lx + t10 * ly + t20 * lz + ox, cy = t01 * lx + t11 * ly + t21 * lz + oy,
-                    cz = t02 * lx + t12 * ly + t22 * lz + oz;
+        const float cx = t00 * lx + t10 * ly + t20 * lz + ox, cy = t01 * lx + t11 * ly + t21 * lz + oy, cz = t02 * lx + t12 * ly + t22 * lz + oz;
         const float dist = std::sqrt(cx * cx + cy * cy + cz * cz);
         // Selections as arithmetic on 0/1 weights: vector selects, no branches.
         const float ray = dist > 1e-20f ? perspW : 0.0f;
@@ -167,8 +164,8 @@ void computeGeometry(const Frame& f, const Shape& shape, const Voxel* voxels, in
             const float root = std::sqrt(std::max(a * c - b * b, 0.0f));
             const float inv = R / std::sqrt(std::max(a + c + 2.0f * root, 1e-30f));
             q0 = (a + root) * inv, q1 = b * inv, q2 = (c + root) * inv;
-            const float id = (i00 * dx + i01 * dy + i02 * dz) * dx + (i01 * dx + i11 * dy + i12 * dz) * dy +
-                             (i02 * dx + i12 * dy + i22 * dz) * dz; // |M^-1 d|^2
+            const float id =
+                (i00 * dx + i01 * dy + i02 * dz) * dx + (i01 * dx + i11 * dy + i12 * dz) * dy + (i02 * dx + i12 * dy + i22 * dz) * dz; // |M^-1 d|^2
             chord = invCbrtDet / std::sqrt(id);
         }
         out.cx[i] = cx + ex, out.cy[i] = cy + ey, out.cz[i] = cz + ez;
@@ -312,8 +309,8 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
                 } else if (shapeOk) {
                     g = batch.at(i);
                 }
-                if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord) || !std::isfinite(v.phase) || !shapeOk ||
-                    !std::isfinite(stretch2) || !finite3(g.center)) {
+                if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord) || !std::isfinite(v.phase) || !shapeOk || !std::isfinite(stretch2) ||
+                    !finite3(g.center)) {
                     ++stats.rejected;
                     continue;
                 }
@@ -350,8 +347,8 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
                 // log2(1 - alpha) loses small alphas (1 - alpha rounds to 1 below 6e-8):
                 // log1p below 2^-10, the cheaper log2 above, where it is exact to 1e-4 relative.
                 if (alpha != lastAlpha) {
-                    lastTau = alpha >= 1.0f ? kMaxTau
-                                            : std::min(alpha < 0x1p-10f ? -std::log1p(-alpha) * 1.44269504f : -std::log2(1.0f - alpha), kMaxTau);
+                    lastTau =
+                        alpha >= 1.0f ? kMaxTau : std::min(alpha < 0x1p-10f ? -std::log1p(-alpha) * 1.44269504f : -std::log2(1.0f - alpha), kMaxTau);
                     lastAlpha = alpha;
                 }
                 sp.density = lastTau * std::min(g.chord, 64.0f) * fade * gain;
@@ -390,8 +387,8 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
     auto chunk = [&](unsigned t) { return first + n * t / threads; };
     for (unsigned t = 1; t < threads; ++t)
         pool.emplace_back([&, t] {
-            ends[t] = build(grid.voxels.data() + (chunk(t) - first), grid.voxels.data() + (chunk(t + 1) - first),
-                            mSplats.data() + chunk(t), stats[t]);
+            ends[t] =
+                build(grid.voxels.data() + (chunk(t) - first), grid.voxels.data() + (chunk(t + 1) - first), mSplats.data() + chunk(t), stats[t]);
         });
     ends[0] = build(grid.voxels.data(), grid.voxels.data() + (chunk(1) - first), mSplats.data() + first, stats[0]);
     for (std::thread& th : pool) th.join();
@@ -431,8 +428,7 @@ void sortBackToFront(std::vector<Splat>& splats, SortScratch& scratch, SortMode 
         for (const Splat& s : splats) lo = std::min(lo, s.depth), hi = std::max(hi, s.depth);
         const float scale = hi > lo ? float(std::max(buckets, 1u)) / (hi - lo) : 0.0f;
         const std::uint32_t last = std::max(buckets, 1u) - 1;
-        for (size_t i = 0; i < n; ++i)
-            keys[i] = last - std::min(last, std::uint32_t((splats[i].depth - lo) * scale));
+        for (size_t i = 0; i < n; ++i) keys[i] = last - std::min(last, std::uint32_t((splats[i].depth - lo) * scale));
     }
     // LSD radix sort on indices, 8 bits per pass. The four digit histograms
     // come from one read of the keys; a pass whose digit is the same for every

@@ -15,8 +15,8 @@ Result<TextureSet> TextureSet::sampleImage(const Image& source, const ImageSampl
     if (source.width < 0 || source.height < 0 || source.channels < 1 || source.channels > 4 ||
         source.pixels.size() != std::size_t(source.width) * std::size_t(source.height) * std::size_t(source.channels))
         return makeError(desc.sourceName + " holds " + std::to_string(source.pixels.size()) + " values, which does not match " +
-                         std::to_string(source.width) + "x" + std::to_string(source.height) + " pixels of " +
-                         std::to_string(source.channels) + " channels (1 to 4)");
+                         std::to_string(source.width) + "x" + std::to_string(source.height) + " pixels of " + std::to_string(source.channels) +
+                         " channels (1 to 4)");
     if (source.width < desc.size || source.height < desc.size)
         return makeError(desc.sourceName + " is " + std::to_string(source.width) + "x" + std::to_string(source.height) +
                          ", smaller than the sample size " + std::to_string(desc.size));

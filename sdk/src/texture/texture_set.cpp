@@ -71,14 +71,14 @@ Result<TextureSet> TextureSet::fromImages(const std::vector<Image>& images, bool
     for (size_t i = 0; i < images.size(); ++i) {
         const Image& img = images[i];
         if (img.width != img.height)
-            return makeError("texture " + std::to_string(i) + " is " + std::to_string(img.width) + "x" +
-                             std::to_string(img.height) + "; textures must be square");
+            return makeError("texture " + std::to_string(i) + " is " + std::to_string(img.width) + "x" + std::to_string(img.height) +
+                             "; textures must be square");
         if (img.width != set.size)
-            return makeError("texture " + std::to_string(i) + " is " + std::to_string(img.width) +
-                             " texels wide but texture 0 is " + std::to_string(set.size) + "; all must match");
+            return makeError("texture " + std::to_string(i) + " is " + std::to_string(img.width) + " texels wide but texture 0 is " +
+                             std::to_string(set.size) + "; all must match");
         if (img.width < kMinSize || img.width > kMaxSize)
-            return makeError("texture " + std::to_string(i) + " size " + std::to_string(img.width) + " is outside [" +
-                             std::to_string(kMinSize) + ", " + std::to_string(kMaxSize) + "]");
+            return makeError("texture " + std::to_string(i) + " size " + std::to_string(img.width) + " is outside [" + std::to_string(kMinSize) +
+                             ", " + std::to_string(kMaxSize) + "]");
         std::vector<float> layer = blankLayer(set.size);
         for (int p = 0; p < set.size * set.size; ++p) {
             float rgb[3];
@@ -94,7 +94,6 @@ Result<TextureSet> TextureSet::fromImages(const std::vector<Image>& images, bool
     }
     return set;
 }
-
 
 TextureSet TextureSet::windowed(const Footprint& footprint) const {
     TextureSet out = *this;

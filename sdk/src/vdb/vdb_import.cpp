@@ -55,10 +55,8 @@ Status checkGrid(const openvdb::GridPtrVec& grids, const std::string& path, int 
         names += (names.empty() ? "" : ", ") + ("'" + g->getName() + "'");
     }
     if (!found) return makeError(at + "no such grid in the file (it has " + (names.empty() ? std::string("no grids") : names) + ")");
-    if (!found->isType<GridT>())
-        return makeError(at + "holds " + found->valueType() + " values; expected a " + typeWanted + " grid");
-    if (found->getGridClass() == openvdb::GRID_LEVEL_SET)
-        return makeError(at + "is a level set (signed distances), not a density/fog volume");
+    if (!found->isType<GridT>()) return makeError(at + "holds " + found->valueType() + " values; expected a " + typeWanted + " grid");
+    if (found->getGridClass() == openvdb::GRID_LEVEL_SET) return makeError(at + "is a level set (signed distances), not a density/fog volume");
     const auto countMeta = found->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT);
     const auto lo = found->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
     const auto hi = found->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
@@ -86,8 +84,7 @@ Status checkTransform(const openvdb::math::Transform& xf, const std::string& at,
             const double want = r == c ? s : 0.0;
             if (std::abs(m(r, c) - want) > tol)
                 return makeError(at + "has a rotated, sheared or non-uniform transform (voxel size " + num(xf.voxelSize()[0]) + ", " +
-                                 num(xf.voxelSize()[1]) + ", " + num(xf.voxelSize()[2]) +
-                                 "); only a uniform scale plus translation is supported");
+                                 num(xf.voxelSize()[1]) + ", " + num(xf.voxelSize()[2]) + "); only a uniform scale plus translation is supported");
         }
     if (!(s > 0.0) || !std::isfinite(s)) return makeError(at + "has voxel size " + num(s) + "; expected a positive finite value");
     voxelSize = s;
@@ -156,19 +153,23 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
             file.open(false);
             grids = file.readAllGridMetadata();
             file.close();
-        } catch (const std::exception& e) {
-            return makeError(fileAt + "cannot be read as OpenVDB: " + e.what());
-        }
+        } catch (const std::exception& e) { return makeError(fileAt + "cannot be read as OpenVDB: " + e.what()); }
         openvdb::GridBase::ConstPtr density, temperature, velocity;
         openvdb::CoordBBox unusedBox;
         bool unusedHas = false;
-        if (Status s = checkGrid<openvdb::FloatGrid>(*grids, fi.path, fi.frame, desc.densityGrid, "float", desc, density, fi.densityBox, fi.hasMetaBox); !s)
+        if (Status s =
+                checkGrid<openvdb::FloatGrid>(*grids, fi.path, fi.frame, desc.densityGrid, "float", desc, density, fi.densityBox, fi.hasMetaBox);
+            !s)
             return makeError(s.error());
         if (!desc.temperatureGrid.empty())
-            if (Status s = checkGrid<openvdb::FloatGrid>(*grids, fi.path, fi.frame, desc.temperatureGrid, "float", desc, temperature, unusedBox, unusedHas); !s)
+            if (Status s =
+                    checkGrid<openvdb::FloatGrid>(*grids, fi.path, fi.frame, desc.temperatureGrid, "float", desc, temperature, unusedBox, unusedHas);
+                !s)
                 return makeError(s.error());
         if (!desc.velocityGrid.empty())
-            if (Status s = checkGrid<openvdb::Vec3SGrid>(*grids, fi.path, fi.frame, desc.velocityGrid, "vec3s (float vector)", desc, velocity, unusedBox, unusedHas); !s)
+            if (Status s = checkGrid<openvdb::Vec3SGrid>(*grids, fi.path, fi.frame, desc.velocityGrid, "vec3s (float vector)", desc, velocity,
+                                                         unusedBox, unusedHas);
+                !s)
                 return makeError(s.error());
         fi.transform = density->transform().copy();
         double vs = 0.0;
@@ -181,11 +182,10 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
                                  "); every imported grid must share one transform");
         if (!infos.empty() && !(*fi.transform == *infos[0].transform)) {
             const openvdb::Vec3d o0 = infos[0].transform->indexToWorld(openvdb::Vec3d(0.0)), o1 = fi.transform->indexToWorld(openvdb::Vec3d(0.0));
-            return makeError(where(fi.path, fi.frame, desc.densityGrid) + "has a transform different from frame " +
-                             std::to_string(infos[0].frame) + "'s ('" + infos[0].path + "'): voxel size " + num(vs) + " vs " +
-                             num(infos[0].transform->voxelSize()[0]) + ", index origin at (" + num(o1[0]) + ", " + num(o1[1]) + ", " +
-                             num(o1[2]) + ") vs (" + num(o0[0]) + ", " + num(o0[1]) + ", " + num(o0[2]) +
-                             "); every frame of a sequence must share one transform");
+            return makeError(where(fi.path, fi.frame, desc.densityGrid) + "has a transform different from frame " + std::to_string(infos[0].frame) +
+                             "'s ('" + infos[0].path + "'): voxel size " + num(vs) + " vs " + num(infos[0].transform->voxelSize()[0]) +
+                             ", index origin at (" + num(o1[0]) + ", " + num(o1[1]) + ", " + num(o1[2]) + ") vs (" + num(o0[0]) + ", " + num(o0[1]) +
+                             ", " + num(o0[2]) + "); every frame of a sequence must share one transform");
         }
         infos.push_back(std::move(fi));
     }
@@ -201,8 +201,7 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
             openvdb::io::File file(fi.path);
             file.open(false);
             out.density = openvdb::gridConstPtrCast<openvdb::FloatGrid>(file.readGrid(desc.densityGrid));
-            if (!desc.temperatureGrid.empty())
-                out.temperature = openvdb::gridConstPtrCast<openvdb::FloatGrid>(file.readGrid(desc.temperatureGrid));
+            if (!desc.temperatureGrid.empty()) out.temperature = openvdb::gridConstPtrCast<openvdb::FloatGrid>(file.readGrid(desc.temperatureGrid));
             if (!desc.velocityGrid.empty()) out.velocity = openvdb::gridConstPtrCast<openvdb::Vec3SGrid>(file.readGrid(desc.velocityGrid));
             file.close();
         } catch (const std::exception& e) {
@@ -242,9 +241,12 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
     const openvdb::Coord extent = unionBox.dim();
     const int longest = std::max({extent.x(), extent.y(), extent.z()});
     lat.factor = desc.voxelsPerCell > 0 ? desc.voxelsPerCell : std::max(1, (longest + desc.maxCellsPerAxis - 1) / desc.maxCellsPerAxis);
-    lat.lo = openvdb::Coord(floorDiv(unionBox.min().x(), lat.factor), floorDiv(unionBox.min().y(), lat.factor), floorDiv(unionBox.min().z(), lat.factor));
-    const openvdb::Coord hi(floorDiv(unionBox.max().x(), lat.factor), floorDiv(unionBox.max().y(), lat.factor), floorDiv(unionBox.max().z(), lat.factor));
-    const std::uint64_t cells = std::uint64_t(hi.x() - lat.lo.x() + 1) * std::uint64_t(hi.y() - lat.lo.y() + 1) * std::uint64_t(hi.z() - lat.lo.z() + 1);
+    lat.lo =
+        openvdb::Coord(floorDiv(unionBox.min().x(), lat.factor), floorDiv(unionBox.min().y(), lat.factor), floorDiv(unionBox.min().z(), lat.factor));
+    const openvdb::Coord hi(floorDiv(unionBox.max().x(), lat.factor), floorDiv(unionBox.max().y(), lat.factor),
+                            floorDiv(unionBox.max().z(), lat.factor));
+    const std::uint64_t cells =
+        std::uint64_t(hi.x() - lat.lo.x() + 1) * std::uint64_t(hi.y() - lat.lo.y() + 1) * std::uint64_t(hi.z() - lat.lo.z() + 1);
     if (cells > kMaxVoxels)
         return makeError(where(infos[0].path, infos[0].frame, desc.densityGrid) + "the frames' density spans " + std::to_string(extent.x()) + " x " +
                          std::to_string(extent.y()) + " x " + std::to_string(extent.z()) + " voxels; at " + std::to_string(lat.factor) +
@@ -310,7 +312,8 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
                 if (sum[k] > 0.0 && frame.opticalDepth[k] > 0.0f) {
                     t[k] = sumT[k] / sum[k];
                     if (!std::isfinite(t[k]))
-                        return makeError(where(fi.path, fi.frame, desc.temperatureGrid) + "holds NaN or infinite temperatures where there is density");
+                        return makeError(where(fi.path, fi.frame, desc.temperatureGrid) +
+                                         "holds NaN or infinite temperatures where there is density");
                     tMin = std::min(tMin, float(t[k]));
                     tMax = std::max(tMax, float(t[k]));
                 }

@@ -15,13 +15,10 @@ Result<ScalarVolume> makeCloudVolume(const CloudDesc& desc) {
     const glm::ivec3 n = desc.dims;
     if (n.x < 2 || n.y < 2 || n.z < 2 || n.x > 4097 || n.y > 4097 || n.z > 4097)
         return makeError("CloudDesc.dims must be in [2, 4097] along every axis");
-    if (!std::isfinite(desc.featureCells) || !(desc.featureCells > 0.0f))
-        return makeError("CloudDesc.featureCells must be finite and > 0");
+    if (!std::isfinite(desc.featureCells) || !(desc.featureCells > 0.0f)) return makeError("CloudDesc.featureCells must be finite and > 0");
     if (desc.octaves < 1 || desc.octaves > 12) return makeError("CloudDesc.octaves must be in [1, 12]");
-    if (!std::isfinite(desc.coverage) || desc.coverage <= 0.0f || desc.coverage > 1.0f)
-        return makeError("CloudDesc.coverage must be in (0, 1]");
-    if (!std::isfinite(desc.sharpness) || !(desc.sharpness > 0.0f))
-        return makeError("CloudDesc.sharpness must be finite and > 0");
+    if (!std::isfinite(desc.coverage) || desc.coverage <= 0.0f || desc.coverage > 1.0f) return makeError("CloudDesc.coverage must be in (0, 1]");
+    if (!std::isfinite(desc.sharpness) || !(desc.sharpness > 0.0f)) return makeError("CloudDesc.sharpness must be finite and > 0");
     const glm::dvec3 sun(desc.sunDirection);
     if (!std::isfinite(sun.x) || !std::isfinite(sun.y) || !std::isfinite(sun.z) || glm::length(sun) == 0.0)
         return makeError("CloudDesc.sunDirection must be finite and non-zero");
@@ -61,8 +58,8 @@ Result<ScalarVolume> makeCloudVolume(const CloudDesc& desc) {
     // point attenuated from the point one step toward the sun (bilinear in the
     // previous plane). Light entering from outside the grid is unattenuated.
     std::vector<float> light(count, 1.0f);
-    const int axis = (std::fabs(sun.x) >= std::fabs(sun.y) && std::fabs(sun.x) >= std::fabs(sun.z)) ? 0
-                     : (std::fabs(sun.y) >= std::fabs(sun.z) ? 1 : 2);
+    const int axis =
+        (std::fabs(sun.x) >= std::fabs(sun.y) && std::fabs(sun.x) >= std::fabs(sun.z)) ? 0 : (std::fabs(sun.y) >= std::fabs(sun.z) ? 1 : 2);
     const int u = (axis + 1) % 3, v = (axis + 2) % 3;
     const glm::dvec3 stepToSun = sun / std::fabs(sun[axis]); // one plane toward the sun
     const double stepLen = glm::length(stepToSun);
@@ -80,8 +77,7 @@ Result<ScalarVolume> makeCloudVolume(const CloudDesc& desc) {
             p[v] = b;
             return double(f[at(p.x, p.y, p.z)]);
         };
-        return (1 - fu) * (1 - fv) * g(iu, iv) + fu * (1 - fv) * g(iu + 1, iv) + (1 - fu) * fv * g(iu, iv + 1) +
-               fu * fv * g(iu + 1, iv + 1);
+        return (1 - fu) * (1 - fv) * g(iu, iv) + fu * (1 - fv) * g(iu + 1, iv) + (1 - fu) * fv * g(iu, iv + 1) + fu * fv * g(iu + 1, iv + 1);
     };
     for (int k = 1; k < planes; ++k) {
         const int plane = towardSun > 0 ? planes - 1 - k : k;
@@ -126,8 +122,7 @@ Result<TransferFunction> makeCloudTransfer(const CloudTransferDesc& desc, CloudM
     auto mixc = [](glm::vec3 a, glm::vec3 b, float t) { return a + (b - a) * t; };
     if (model == CloudModel::LightTableDensityLength) {
         // kappa ramps with the light, rho = Id: the density enters through the length (eq. 9).
-        return TransferFunction::create({{0.0f, desc.dark, desc.maxExtinctionPerWorld},
-                                         {1.0f, desc.bright, desc.maxExtinctionPerWorld}});
+        return TransferFunction::create({{0.0f, desc.dark, desc.maxExtinctionPerWorld}, {1.0f, desc.bright, desc.maxExtinctionPerWorld}});
     }
     // Inverse colour ramp in density; rho linear in density, zero below the threshold (a step there).
     const float t = desc.threshold;

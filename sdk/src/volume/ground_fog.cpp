@@ -30,8 +30,8 @@ struct Emitter {
     glm::vec3 nearNormal{0.0f};
     float nearOffset = 0.0f;
     std::vector<Tetrahedron> pieces;
-    bool clip = true;                             // LodRefineDesc::clipNear
-    std::vector<glm::vec3>* terrain = nullptr;    // the host's terrain triangles, or null
+    bool clip = true;                          // LodRefineDesc::clipNear
+    std::vector<glm::vec3>* terrain = nullptr; // the host's terrain triangles, or null
 
     // A terrain triangle, counter-clockwise seen from above (+y).
     void terrainTri(glm::vec3 a, glm::vec3 b, glm::vec3 c) {
@@ -73,14 +73,15 @@ struct Emitter {
                 int ns = 0, apexI = -1;
                 for (int a = 0; a < 4; ++a) {
                     bool found = false;
-                    for (int b = 0; b < 4; ++b) found |= pieces[std::size_t(i)].position[std::size_t(a)] == pieces[std::size_t(j)].position[std::size_t(b)];
+                    for (int b = 0; b < 4; ++b)
+                        found |= pieces[std::size_t(i)].position[std::size_t(a)] == pieces[std::size_t(j)].position[std::size_t(b)];
                     if (found) shared[ns++] = pieces[std::size_t(i)].position[std::size_t(a)];
                     else apexI = a;
                 }
                 if (ns != 3 || apexI < 0) continue;
                 const glm::dvec3 p0(shared[0]), nrm = glm::cross(glm::dvec3(shared[1]) - p0, glm::dvec3(shared[2]) - p0);
-                const bool iNearer = (eyeSide(cam, p0, nrm) > 0.0) ==
-                                     (glm::dot(nrm, glm::dvec3(pieces[std::size_t(i)].position[std::size_t(apexI)]) - p0) > 0.0);
+                const bool iNearer =
+                    (eyeSide(cam, p0, nrm) > 0.0) == (glm::dot(nrm, glm::dvec3(pieces[std::size_t(i)].position[std::size_t(apexI)]) - p0) > 0.0);
                 if (iNearer) before[j][i] = true;
                 else before[i][j] = true;
             }
@@ -141,8 +142,8 @@ struct Emitter {
         t[2].scalar = {sb[2], 0.0f, 0.0f, 0.0f};
         bool keep[3];
         // The prism's horizontal extent for the degenerate test (the grid spacing at full resolution).
-        const double ext = std::max({std::abs(double(B[1].x) - B[0].x), std::abs(double(B[1].z) - B[0].z),
-                                     std::abs(double(B[2].x) - B[0].x), std::abs(double(B[2].z) - B[0].z)});
+        const double ext = std::max({std::abs(double(B[1].x) - B[0].x), std::abs(double(B[1].z) - B[0].z), std::abs(double(B[2].x) - B[0].x),
+                                     std::abs(double(B[2].z) - B[0].z)});
         for (int k = 0; k < 3; ++k) {
             t[k].lengthScale = {1.0f, 1.0f, 1.0f, 1.0f};
             const double o = orient(t[k]);
@@ -163,11 +164,11 @@ struct Emitter {
         const bool zeroNearer = nearerFirstSide(B[1], B[2], T[0], B[0]); // t0 vs t1
         const bool twoNearer = nearerFirstSide(B[2], T[0], T[1], T[2]);  // t2 vs t1
         int order[3];
-        if (d.sortFree) order[0] = 0, order[1] = 1, order[2] = 2; // eq. 10: any order
-        else if (!zeroNearer && twoNearer) order[0] = 0, order[1] = 1, order[2] = 2;      // t0 < t1 < t2
+        if (d.sortFree) order[0] = 0, order[1] = 1, order[2] = 2;                    // eq. 10: any order
+        else if (!zeroNearer && twoNearer) order[0] = 0, order[1] = 1, order[2] = 2; // t0 < t1 < t2
         else if (zeroNearer && !twoNearer) order[0] = 2, order[1] = 1, order[2] = 0; // t2 < t1 < t0
         else if (zeroNearer && twoNearer) order[0] = 1, order[1] = 0, order[2] = 2;  // t1 first; t0, t2 share an edge only
-        else order[0] = 0, order[1] = 2, order[2] = 1;                              // t1 last
+        else order[0] = 0, order[1] = 2, order[2] = 1;                               // t1 last
         for (int k : order)
             if (keep[k]) push(t[k]);
         return true;
@@ -248,13 +249,12 @@ struct LodGrid {
     float worldZ(int j) const { return origin.z + float(j) * spacing; }
     glm::dvec3 point(glm::ivec2 p) const { return {double(worldX(p.x)), double(height[at(p)]), double(worldZ(p.y))}; }
     // No area inside the grid (wholly in the padding, or in the cells just beyond its last row/column).
-    bool outside(const Tri& t) const {
-        return std::min({t.a.x, t.l.x, t.r.x}) >= dims.x - 1 || std::min({t.a.y, t.l.y, t.r.y}) >= dims.y - 1;
-    }
+    bool outside(const Tri& t) const { return std::min({t.a.x, t.l.x, t.r.x}) >= dims.x - 1 || std::min({t.a.y, t.l.y, t.r.y}) >= dims.y - 1; }
 };
 
 // Every triangle of depth `target` (roots are depth 0), in any order.
-template <class F> void visitDepth(const Tri& t, int depth, int target, F&& f) {
+template <class F>
+void visitDepth(const Tri& t, int depth, int target, F&& f) {
     if (depth == target) return f(t);
     const glm::ivec2 m = (t.l + t.r) / 2;
     visitDepth(Tri{m, t.l, t.a}, depth + 1, target, f);
@@ -272,10 +272,10 @@ struct LodRefiner {
     glm::dvec3 eye;
     double C, c;
     bool morph;
-    bool cull = false;            // LodRefineDesc::frustumCull
-    glm::dvec4 planes[6]{};       // the view frustum, normalized (Gribb & Hartmann), inside >= 0
-    double maxThickness = 0.0;    // the layer's thickest fog
-    bool prisms = true;           // false below a culled triangle: terrain only
+    bool cull = false;         // LodRefineDesc::frustumCull
+    glm::dvec4 planes[6]{};    // the view frustum, normalized (Gribb & Hartmann), inside >= 0
+    double maxThickness = 0.0; // the layer's thickest fog
+    bool prisms = true;        // false below a culled triangle: terrain only
 
     // Is a sphere around triangle t holding everything drawn below it outside
     // the frustum? Its descendants lie within r(m) of m (true heights); the
@@ -315,7 +315,8 @@ struct LodRefiner {
     // its apex. Cut points are computed from the original edge, from its
     // lower-keyed end, and keyed by the edge, so the triangle across that
     // edge makes the same point with the same key (conforming prisms).
-    template <class Key> void clippedLeaf(const Tri& t, Shown sa, Shown sl, Shown sr, Key&& key) {
+    template <class Key>
+    void clippedLeaf(const Tri& t, Shown sa, Shown sl, Shown sr, Key&& key) {
         struct CV {
             glm::dvec2 p;
             float h, th;
@@ -415,8 +416,7 @@ struct LodRefiner {
             const std::size_t k = g.at(m);
             const double len = glm::length(glm::dvec2(t.r - t.l)) * double(g.spacing);
             const double dist = glm::length(eye - g.point(m)) - double(g.radius[k]);
-            const double e = dist > 0.0 ? len * C * std::max(c * double(g.delta[k]), 1.0) / dist
-                                        : std::numeric_limits<double>::infinity();
+            const double e = dist > 0.0 ? len * C * std::max(c * double(g.delta[k]), 1.0) / dist : std::numeric_limits<double>::infinity();
             if (e > 1.0) {
                 ++em.out.stats.nodesRefined;
                 // Geomorph (sec. 3): from the coarse edge (w = 0, e = 1) to the true value (w = 1, e >= 2).
@@ -560,8 +560,7 @@ std::size_t GroundFog::bytesFor(glm::ivec2 dims, bool lod) {
 }
 
 std::size_t GroundFog::memoryBytes() const {
-    return sizeof(float) * (mDesc.terrainHeight.size() + mDesc.fogTop.size() + mHeight.size() + mThickness.size() +
-                            mDelta.size() + mRadius.size());
+    return sizeof(float) * (mDesc.terrainHeight.size() + mDesc.fogTop.size() + mHeight.size() + mThickness.size() + mDelta.size() + mRadius.size());
 }
 
 Status GroundFog::update(const Camera& camera, LodFrame& out) const { return update(camera, LodRefineDesc{}, out, nullptr); }
@@ -571,11 +570,9 @@ Status GroundFog::update(const Camera& camera, const LodRefineDesc& refine, LodF
     out.stats = {};
     if (terrainTriangles) terrainTriangles->clear();
     const glm::vec3 e = camera.eye(), f = camera.forward();
-    if (!std::isfinite(e.x) || !std::isfinite(e.y) || !std::isfinite(e.z) || !std::isfinite(f.x) || !std::isfinite(f.y) ||
-        !std::isfinite(f.z))
+    if (!std::isfinite(e.x) || !std::isfinite(e.y) || !std::isfinite(e.z) || !std::isfinite(f.x) || !std::isfinite(f.y) || !std::isfinite(f.z))
         return makeError("GroundFog::update: the camera is not finite");
-    if (!std::isfinite(refine.detailC) || refine.detailC < 0.0f)
-        return makeError("GroundFog::update: LodRefineDesc.detailC must be finite and >= 0");
+    if (!std::isfinite(refine.detailC) || refine.detailC < 0.0f) return makeError("GroundFog::update: LodRefineDesc.detailC must be finite and >= 0");
     Emitter em{mDesc, camera, out, {}, 0.0f, {}, refine.clipNear, terrainTriangles};
     em.nearNormal = f;
     em.nearOffset = glm::dot(f, e) + camera.nearPlane();
@@ -589,8 +586,8 @@ Status GroundFog::update(const Camera& camera, const LodRefineDesc& refine, LodF
         const glm::dmat4 vp = glm::dmat4(camera.proj) * glm::dmat4(camera.view);
         for (int i = 0; i < 3; ++i)
             for (int sign = 0; sign < 2; ++sign) {
-                glm::dvec4 pl = glm::dvec4(vp[0][3], vp[1][3], vp[2][3], vp[3][3]) +
-                                (sign ? -1.0 : 1.0) * glm::dvec4(vp[0][i], vp[1][i], vp[2][i], vp[3][i]);
+                glm::dvec4 pl =
+                    glm::dvec4(vp[0][3], vp[1][3], vp[2][3], vp[3][3]) + (sign ? -1.0 : 1.0) * glm::dvec4(vp[0][i], vp[1][i], vp[2][i], vp[3][i]);
                 const double len = glm::length(glm::dvec3(pl));
                 r.planes[2 * i + sign] = len > 0.0 ? pl / len : glm::dvec4(0.0, 0.0, 0.0, 1.0); // degenerate: never culls
             }

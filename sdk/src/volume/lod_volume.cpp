@@ -24,8 +24,7 @@ int autoRootLevel(glm::ivec3 dims) {
 
 glm::ivec3 rootsFor(glm::ivec3 dims, int n) {
     const int s = 1 << n;
-    return {std::max(1, (dims.x - 1 + s - 1) / s), std::max(1, (dims.y - 1 + s - 1) / s),
-            std::max(1, (dims.z - 1 + s - 1) / s)};
+    return {std::max(1, (dims.x - 1 + s - 1) / s), std::max(1, (dims.y - 1 + s - 1) / s), std::max(1, (dims.z - 1 + s - 1) / s)};
 }
 
 bool finiteVec(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
@@ -59,9 +58,7 @@ struct Viewer {
     glm::vec3 towardEye{0.0f}; // orthographic: -forward
     bool perspective = true;
     // > 0: the eye is on the side of the plane (through p0, normal n) that n points to.
-    float side(glm::vec3 n, glm::vec3 p0) const {
-        return perspective ? glm::dot(n, eye - p0) : glm::dot(n, towardEye);
-    }
+    float side(glm::vec3 n, glm::vec3 p0) const { return perspective ? glm::dot(n, eye - p0) : glm::dot(n, towardEye); }
 };
 
 // Back-to-front order of a few convex pieces meeting face to face (MPVO,
@@ -112,8 +109,7 @@ Tetrahedron lerpVertex(const Tetrahedron& t, int i, int o, float di, float dOut,
     const float f = di / (di - dOut); // in [0, 1): di >= 0 > dOut
     dst.position[std::size_t(slot)] = t.position[std::size_t(i)] + f * (t.position[std::size_t(o)] - t.position[std::size_t(i)]);
     dst.scalar[std::size_t(slot)] = t.scalar[std::size_t(i)] + f * (t.scalar[std::size_t(o)] - t.scalar[std::size_t(i)]);
-    dst.lengthScale[std::size_t(slot)] =
-        t.lengthScale[std::size_t(i)] + f * (t.lengthScale[std::size_t(o)] - t.lengthScale[std::size_t(i)]);
+    dst.lengthScale[std::size_t(slot)] = t.lengthScale[std::size_t(i)] + f * (t.lengthScale[std::size_t(o)] - t.lengthScale[std::size_t(i)]);
     return dst;
 }
 
@@ -159,9 +155,7 @@ int clipTetrahedron(const Tetrahedron& tet, glm::vec3 normal, float offset, std:
         if (no == 1) {
             for (int k = 0; k < 3; ++k) {
                 setSlot(k, [&](Tetrahedron& dst, int s) { copyVertex(tet, inside[k], dst, s); });
-                setSlot(k + 3, [&](Tetrahedron& dst, int s) {
-                    lerpVertex(tet, inside[k], outside[0], d[inside[k]], d[outside[0]], dst, s);
-                });
+                setSlot(k + 3, [&](Tetrahedron& dst, int s) { lerpVertex(tet, inside[k], outside[0], d[inside[k]], d[outside[0]], dst, s); });
             }
         } else {
             // a = (i0, cut(i0,o0), cut(i0,o1)), b = (i1, cut(i1,o0), cut(i1,o1)).
@@ -169,9 +163,7 @@ int clipTetrahedron(const Tetrahedron& tet, glm::vec3 normal, float offset, std:
                 const int base = 3 * k, iv = inside[k];
                 setSlot(base, [&](Tetrahedron& dst, int s) { copyVertex(tet, iv, dst, s); });
                 for (int l = 0; l < 2; ++l)
-                    setSlot(base + 1 + l, [&](Tetrahedron& dst, int s) {
-                        lerpVertex(tet, iv, outside[l], d[iv], d[outside[l]], dst, s);
-                    });
+                    setSlot(base + 1 + l, [&](Tetrahedron& dst, int s) { lerpVertex(tet, iv, outside[l], d[iv], d[outside[l]], dst, s); });
             }
         }
         auto getSlot = [&](int slot, Tetrahedron& dst, int s) { copyVertex(slot < 4 ? prism : prism2, slot < 4 ? slot : slot - 4, dst, s); };
@@ -199,8 +191,7 @@ int clipTetrahedron(const Tetrahedron& tet, glm::vec3 normal, float offset, std:
 std::size_t LodVolume::bytesFor(glm::ivec3 dims, bool hasLengthScale, int rootLevel) {
     const int n = rootLevel > 0 ? rootLevel : autoRootLevel(dims);
     const glm::ivec3 r = rootsFor(dims, n);
-    const double px = double(r.x) * double(1 << n) + 1, py = double(r.y) * double(1 << n) + 1,
-                 pz = double(r.z) * double(1 << n) + 1;
+    const double px = double(r.x) * double(1 << n) + 1, py = double(r.y) * double(1 << n) + 1, pz = double(r.z) * double(1 << n) + 1;
     double bytes = px * py * pz * (hasLengthScale ? 2.0 : 1.0);
     for (int l = 1; l <= n; ++l) {
         const double s = double(1 << (n - l));
@@ -212,8 +203,8 @@ std::size_t LodVolume::bytesFor(glm::ivec3 dims, bool hasLengthScale, int rootLe
 Result<LodVolume> LodVolume::create(const ScalarVolume& field, const LodVolumeDesc& desc) {
     const glm::ivec3 d = field.dims;
     if (d.x < 2 || d.y < 2 || d.z < 2)
-        return makeError("ScalarVolume.dims must be at least 2 along every axis (got " + std::to_string(d.x) + "x" +
-                         std::to_string(d.y) + "x" + std::to_string(d.z) + ")");
+        return makeError("ScalarVolume.dims must be at least 2 along every axis (got " + std::to_string(d.x) + "x" + std::to_string(d.y) + "x" +
+                         std::to_string(d.z) + ")");
     const double count = double(d.x) * double(d.y) * double(d.z);
     if (double(field.scalar.size()) != count)
         return makeError("ScalarVolume.scalar has " + std::to_string(field.scalar.size()) + " values; dims ask for " +
@@ -221,20 +212,17 @@ Result<LodVolume> LodVolume::create(const ScalarVolume& field, const LodVolumeDe
     if (!field.lengthScale.empty() && field.lengthScale.size() != field.scalar.size())
         return makeError("ScalarVolume.lengthScale must be empty or the size of ScalarVolume.scalar");
     if (!finiteVec(desc.originWorld)) return makeError("LodVolumeDesc.originWorld must be finite");
-    if (!std::isfinite(desc.spacingWorld) || !(desc.spacingWorld > 0.0f))
-        return makeError("LodVolumeDesc.spacingWorld must be finite and > 0");
+    if (!std::isfinite(desc.spacingWorld) || !(desc.spacingWorld > 0.0f)) return makeError("LodVolumeDesc.spacingWorld must be finite and > 0");
     // Eq. 4 holds for C > sqrt(3) (the paper's condition).
     if (!std::isfinite(desc.minAccuracyC) || !(double(desc.minAccuracyC) > std::sqrt(3.0)))
         return makeError("LodVolumeDesc.minAccuracyC must be finite and > sqrt(3) (eq. 4)");
     if (desc.rootLevel < 0 || desc.rootLevel > kMaxRootLevel)
         return makeError("LodVolumeDesc.rootLevel must be 0 (auto) or in [1, " + std::to_string(kMaxRootLevel) + "]");
-    if (!std::isfinite(desc.padValue) || desc.padValue < 0.0f || desc.padValue > 1.0f)
-        return makeError("LodVolumeDesc.padValue must be in [0, 1]");
+    if (!std::isfinite(desc.padValue) || desc.padValue < 0.0f || desc.padValue > 1.0f) return makeError("LodVolumeDesc.padValue must be in [0, 1]");
     const std::size_t need = bytesFor(d, !field.lengthScale.empty(), desc.rootLevel);
     if (need > desc.memoryBudgetBytes)
-        return makeError("LodVolume: a " + std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z) +
-                         " field needs " + std::to_string(need) + " bytes, above LodVolumeDesc.memoryBudgetBytes = " +
-                         std::to_string(desc.memoryBudgetBytes));
+        return makeError("LodVolume: a " + std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z) + " field needs " +
+                         std::to_string(need) + " bytes, above LodVolumeDesc.memoryBudgetBytes = " + std::to_string(desc.memoryBudgetBytes));
 
     for (std::size_t i = 0; i < field.scalar.size(); ++i) {
         const float v = field.scalar[i];
@@ -281,9 +269,7 @@ unsigned LodVolume::centreTetCorners(glm::ivec3 node) {
 }
 
 float LodVolume::scalarAt(glm::ivec3 p) const { return float(mScalar[pointIndex(p)]) / 255.0f; }
-float LodVolume::lengthScaleAt(glm::ivec3 p) const {
-    return mLength.empty() ? 1.0f : float(mLength[pointIndex(p)]) / 255.0f;
-}
+float LodVolume::lengthScaleAt(glm::ivec3 p) const { return mLength.empty() ? 1.0f : float(mLength[pointIndex(p)]) / 255.0f; }
 
 namespace {
 
@@ -294,8 +280,8 @@ namespace {
 // centre the four corners of the centre tetrahedron.
 struct LatticeRule {
     int index = 0;
-    int kind = 0;    // 1 edge, 2 face, 3 centre
-    int axis = 0;    // edge: its direction; face: its normal
+    int kind = 0;                 // 1 edge, 2 face, 3 centre
+    int axis = 0;                 // edge: its direction; face: its normal
     int coarse[4] = {0, 0, 0, 0}; // lattice indices of the coarse ends (2 or 4 used)
     int coarseCount = 0;
 };
@@ -412,9 +398,7 @@ double LodVolume::localDeltaAt(int level, glm::ivec3 node) const {
     return best;
 }
 
-double LodVolume::deltaAt(int level, glm::ivec3 node) const {
-    return double(mLevels[std::size_t(level)].delta[nodeIndex(level, node)]) / 65535.0;
-}
+double LodVolume::deltaAt(int level, glm::ivec3 node) const { return double(mLevels[std::size_t(level)].delta[nodeIndex(level, node)]) / 65535.0; }
 
 double LodVolume::errorMetric(int level, glm::ivec3 node, glm::vec3 eye, float detailC) const {
     const double size = double(1 << level) * double(mSpacing);
@@ -529,7 +513,7 @@ struct LodTraversal {
         }
         // Lattice values of the refined node: corners as given, the 19 others by eq. 8
         // (with the weights the right way round: w = 0 is the coarse value, so a new vertex does not pop).
-        const LatticeRule (&rl)[19] = rules[(n.x + n.y + n.z) & 1];
+        const LatticeRule(&rl)[19] = rules[(n.x + n.y + n.z) & 1];
         float vs[27], vm[27];
         for (unsigned c = 0; c < 8; ++c) {
             vs[cornerLat(c)] = cs[c];
@@ -554,8 +538,7 @@ struct LodTraversal {
         // order over the three mid-planes, so it is a visibility order, sec. 4).
         int nearBit[3];
         const glm::vec3 mid = worldOf(base + h);
-        for (int a = 0; a < 3; ++a)
-            nearBit[a] = viewer.perspective ? (viewer.eye[a] >= mid[a] ? 1 : 0) : (viewer.towardEye[a] > 0.0f ? 1 : 0);
+        for (int a = 0; a < 3; ++a) nearBit[a] = viewer.perspective ? (viewer.eye[a] >= mid[a] ? 1 : 0) : (viewer.towardEye[a] > 0.0f ? 1 : 0);
         for (int i = 0; i < 8; ++i) {
             const int bx = (i & 4) ? nearBit[0] : 1 - nearBit[0];
             const int by = (i & 2) ? nearBit[1] : 1 - nearBit[1];
@@ -576,7 +559,7 @@ struct LodTraversal {
         glm::vec3 p[8];
         for (unsigned c = 0; c < 8; ++c) p[c] = worldOf(base + size * glm::ivec3(int(c & 1), int((c >> 1) & 1), int((c >> 2) & 1)));
         const unsigned even = LodVolume::centreTetCorners(n);
-        auto make = [&](const unsigned (&idx)[4]) {
+        auto make = [&](const unsigned(&idx)[4]) {
             Tetrahedron t;
             for (int v = 0; v < 4; ++v) {
                 t.position[std::size_t(v)] = p[idx[v]];
@@ -636,16 +619,14 @@ struct LodTraversal {
     }
 };
 
-Status LodVolume::update(const Camera& camera, const LodRefineDesc& refine, const TransferFunction* transfer,
-                         LodFrame& out) {
+Status LodVolume::update(const Camera& camera, const LodRefineDesc& refine, const TransferFunction* transfer, LodFrame& out) {
     out.tets.clear();
     out.stats = LodFrameStats{};
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r)
             if (!std::isfinite(camera.view[c][r]) || !std::isfinite(camera.proj[c][r]))
                 return makeError("LodVolume::update: camera.view and camera.proj must be finite");
-    if (!std::isfinite(refine.detailC) || refine.detailC < 0.0f)
-        return makeError("LodRefineDesc.detailC must be finite and >= 0");
+    if (!std::isfinite(refine.detailC) || refine.detailC < 0.0f) return makeError("LodRefineDesc.detailC must be finite and >= 0");
     if (refine.zeroOpacityTest && transfer == nullptr)
         return makeError("LodVolume::update: LodRefineDesc.zeroOpacityTest needs a transfer function (got null)");
     const glm::vec3 eye = camera.eye();

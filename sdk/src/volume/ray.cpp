@@ -53,8 +53,7 @@ glm::dvec2 LodVolume::sampleFinest(glm::dvec3 pw) const {
     return {cellValue(s, odd, u, u), cellValue(m, odd, u, u)};
 }
 
-glm::dvec4 LodVolume::integrateRay(const TransferFunction& transfer, glm::dvec3 origin, glm::dvec3 dir, double tNear,
-                                   double tFar) const {
+glm::dvec4 LodVolume::integrateRay(const TransferFunction& transfer, glm::dvec3 origin, glm::dvec3 dir, double tNear, double tFar) const {
     const double speed = glm::length(dir); // world length per unit t
     if (!(speed > 0.0) || !std::isfinite(speed) || std::isnan(tNear) || std::isnan(tFar)) return glm::dvec4(0.0);
     if (!std::isfinite(origin.x) || !std::isfinite(origin.y) || !std::isfinite(origin.z)) return glm::dvec4(0.0);
@@ -139,8 +138,8 @@ glm::dvec4 LodVolume::integrateRay(const TransferFunction& transfer, glm::dvec3 
                     if (!(tb > ta)) continue;
                     const glm::dvec3 ua = o + d * ta - base, ub = o + d * tb - base, um = o + d * (0.5 * (ta + tb)) - base;
                     const glm::dvec3 ca = glm::clamp(ua, 0.0, 1.0), cb = glm::clamp(ub, 0.0, 1.0), cm = glm::clamp(um, 0.0, 1.0);
-                    const glm::dvec4 seg = integrateSegment(transfer, cellValue(s, odd, cm, ca), cellValue(s, odd, cm, cb),
-                                                            (tb - ta) * speed, cellValue(m, odd, cm, ca), cellValue(m, odd, cm, cb));
+                    const glm::dvec4 seg = integrateSegment(transfer, cellValue(s, odd, cm, ca), cellValue(s, odd, cm, cb), (tb - ta) * speed,
+                                                            cellValue(m, odd, cm, ca), cellValue(m, odd, cm, cb));
                     color += T * glm::dvec3(seg);
                     T *= 1.0 - seg.a;
                 }
@@ -159,8 +158,8 @@ glm::dvec4 LodVolume::integrateRay(const TransferFunction& transfer, glm::dvec3 
 
 namespace splatfx {
 
-glm::dvec4 integrateRay(const std::vector<Tetrahedron>& tets, const TransferFunction& transfer, glm::dvec3 o,
-                        glm::dvec3 d, double tNear, double tFar) {
+glm::dvec4 integrateRay(const std::vector<Tetrahedron>& tets, const TransferFunction& transfer, glm::dvec3 o, glm::dvec3 d, double tNear,
+                        double tFar) {
     const double speed = glm::length(d);
     if (!(speed > 0.0) || !std::isfinite(speed) || std::isnan(tNear) || std::isnan(tFar)) return glm::dvec4(0.0);
     if (!std::isfinite(o.x) || !std::isfinite(o.y) || !std::isfinite(o.z)) return glm::dvec4(0.0);
@@ -174,8 +173,8 @@ glm::dvec4 integrateRay(const std::vector<Tetrahedron>& tets, const TransferFunc
         const Tetrahedron& t = tets[i];
         double lo = tNear, hi = tFar;
         for (const auto& f : kFaces) {
-            const glm::dvec3 a(t.position[std::size_t(f[0])]), b(t.position[std::size_t(f[1])]),
-                c(t.position[std::size_t(f[2])]), q(t.position[std::size_t(f[3])]);
+            const glm::dvec3 a(t.position[std::size_t(f[0])]), b(t.position[std::size_t(f[1])]), c(t.position[std::size_t(f[2])]),
+                q(t.position[std::size_t(f[3])]);
             glm::dvec3 n = glm::cross(b - a, c - a);
             if (glm::dot(n, q - a) < 0.0) n = -n; // inward
             const double num = glm::dot(n, o - a), den = glm::dot(n, d);
@@ -204,8 +203,8 @@ glm::dvec4 integrateRay(const std::vector<Tetrahedron>& tets, const TransferFunc
             const glm::dvec3 l = inv * (o + d * tt - p0);
             return (1.0 - l.x - l.y - l.z) * v[0] + l.x * v[1] + l.y * v[2] + l.z * v[3];
         };
-        const glm::dvec4 seg = integrateSegment(transfer, at(t0, t.scalar), at(p.t1, t.scalar), (p.t1 - t0) * speed,
-                                                at(t0, t.lengthScale), at(p.t1, t.lengthScale));
+        const glm::dvec4 seg =
+            integrateSegment(transfer, at(t0, t.scalar), at(p.t1, t.scalar), (p.t1 - t0) * speed, at(t0, t.lengthScale), at(p.t1, t.lengthScale));
         color += T * glm::dvec3(seg);
         T *= 1.0 - seg.a;
         reached = p.t1;

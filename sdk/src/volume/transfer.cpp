@@ -32,8 +32,7 @@ TfPiece pieceAt(const std::vector<TransferPoint>& p, double s) {
         return out;
     }
     // First point strictly above s: right-continuous at steps (duplicate scalars).
-    const auto it = std::upper_bound(p.begin(), p.end(), s,
-                                     [](double v, const TransferPoint& q) { return v < double(q.scalar); });
+    const auto it = std::upper_bound(p.begin(), p.end(), s, [](double v, const TransferPoint& q) { return v < double(q.scalar); });
     const TransferPoint& hi = *it;
     const TransferPoint& lo = *(it - 1);
     const double span = double(hi.scalar) - double(lo.scalar); // > 0: lo.scalar <= s < hi.scalar
@@ -51,8 +50,7 @@ double clampUnit(double v) { return std::min(1.0, std::max(0.0, v)); }
 
 // 5-point Gauss-Legendre on [-1, 1].
 constexpr double kGlX[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831, 0.9061798459386640};
-constexpr double kGlW[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665,
-                            0.2369268850561891};
+constexpr double kGlW[5] = {0.2369268850561891, 0.4786286704993665, 0.5688888888888889, 0.4786286704993665, 0.2369268850561891};
 
 // Optical depth per unit step kept below this so exp() varies little inside a
 // Gauss-Legendre step: the 5-point rule then errs ~ (1/4)^10 / 10! relative.
@@ -67,13 +65,11 @@ Result<TransferFunction> TransferFunction::create(std::vector<TransferPoint> poi
     for (std::size_t i = 0; i < points.size(); ++i) {
         const TransferPoint& q = points[i];
         const std::string at = "TransferFunction: points[" + std::to_string(i) + "]";
-        if (!std::isfinite(q.scalar) || q.scalar < 0.0f || q.scalar > 1.0f)
-            return makeError(at + ".scalar must be finite and in [0, 1]");
-        if (!std::isfinite(q.color.x) || !std::isfinite(q.color.y) || !std::isfinite(q.color.z) || q.color.x < 0.0f ||
-            q.color.y < 0.0f || q.color.z < 0.0f)
+        if (!std::isfinite(q.scalar) || q.scalar < 0.0f || q.scalar > 1.0f) return makeError(at + ".scalar must be finite and in [0, 1]");
+        if (!std::isfinite(q.color.x) || !std::isfinite(q.color.y) || !std::isfinite(q.color.z) || q.color.x < 0.0f || q.color.y < 0.0f ||
+            q.color.z < 0.0f)
             return makeError(at + ".color must be finite and >= 0");
-        if (!std::isfinite(q.extinctionPerWorld) || q.extinctionPerWorld < 0.0f)
-            return makeError(at + ".extinctionPerWorld must be finite and >= 0");
+        if (!std::isfinite(q.extinctionPerWorld) || q.extinctionPerWorld < 0.0f) return makeError(at + ".extinctionPerWorld must be finite and >= 0");
         if (i > 0 && q.scalar < points[i - 1].scalar) return makeError(at + ".scalar must not be below the previous point's");
     }
     TransferFunction tf;
@@ -107,10 +103,9 @@ namespace {
 
 // The integral with its two accuracy knobs: the optical depth per Gauss-Legendre
 // step and the transmittance at which the rest is dropped.
-glm::dvec4 integrateSegmentWith(const TransferFunction& transfer, double sf, double sb, double length, double mf,
-                                double mb, double maxStepDepth, double minTransmittance) {
-    if (std::isnan(sf) || std::isnan(sb) || std::isnan(mf) || std::isnan(mb) || std::isnan(length) || !(length > 0.0))
-        return glm::dvec4(0.0);
+glm::dvec4 integrateSegmentWith(const TransferFunction& transfer, double sf, double sb, double length, double mf, double mb, double maxStepDepth,
+                                double minTransmittance) {
+    if (std::isnan(sf) || std::isnan(sb) || std::isnan(mf) || std::isnan(mb) || std::isnan(length) || !(length > 0.0)) return glm::dvec4(0.0);
     length = std::min(length, 1e30); // beyond this the transmittance is 0 in double for any extinction > 1e-28
     sf = clampUnit(sf);
     sb = clampUnit(sb);
@@ -155,11 +150,9 @@ glm::dvec4 integrateSegmentWith(const TransferFunction& transfer, double sf, dou
         };
         auto cAt = [&](double x) { return tp.c0 + tp.c1 * sAt(x); };
         // Exact optical depth of a quadratic over [x0, x1] (Simpson is exact for it).
-        auto depth = [&](double x0, double x1) {
-            return (x1 - x0) / 6.0 * (kAt(x0) + 4.0 * kAt(0.5 * (x0 + x1)) + kAt(x1));
-        };
+        auto depth = [&](double x0, double x1) { return (x1 - x0) / 6.0 * (kAt(x0) + 4.0 * kAt(0.5 * (x0 + x1)) + kAt(x1)); };
         // Bound of k on [x0, x1]: ends and the vertex of the quadratic.
-        const double qa = length * (tp.t1 * (sb - sf)) * (mb - mf);                                    // x^2
+        const double qa = length * (tp.t1 * (sb - sf)) * (mb - mf);                             // x^2
         const double qb = length * ((tp.t0 + tp.t1 * sf) * (mb - mf) + tp.t1 * (sb - sf) * mf); // x
         auto kMax = [&](double x0, double x1) {
             double m = std::max(kAt(x0), kAt(x1));
@@ -201,17 +194,13 @@ constexpr double kTableMinTransmittance = 1e-9;
 
 } // namespace
 
-glm::dvec4 integrateSegment(const TransferFunction& transfer, double sf, double sb, double length, double mf,
-                            double mb) {
+glm::dvec4 integrateSegment(const TransferFunction& transfer, double sf, double sb, double length, double mf, double mb) {
     return integrateSegmentWith(transfer, sf, sb, length, mf, mb, kMaxStepDepth, kMinTransmittance);
 }
 
-Result<PreIntegrationTable> PreIntegrationTable::create(const TransferFunction& transfer,
-                                                        const PreIntegrationDesc& desc) {
-    if (desc.scalarResolution < 2 || desc.scalarResolution > 1024)
-        return makeError("PreIntegrationDesc.scalarResolution must be in [2, 1024]");
-    if (desc.lengthResolution < 2 || desc.lengthResolution > 1024)
-        return makeError("PreIntegrationDesc.lengthResolution must be in [2, 1024]");
+Result<PreIntegrationTable> PreIntegrationTable::create(const TransferFunction& transfer, const PreIntegrationDesc& desc) {
+    if (desc.scalarResolution < 2 || desc.scalarResolution > 1024) return makeError("PreIntegrationDesc.scalarResolution must be in [2, 1024]");
+    if (desc.lengthResolution < 2 || desc.lengthResolution > 1024) return makeError("PreIntegrationDesc.lengthResolution must be in [2, 1024]");
     if (!std::isfinite(desc.maxLengthWorld) || !(desc.maxLengthWorld > 0.0f))
         return makeError("PreIntegrationDesc.maxLengthWorld must be finite and > 0");
     PreIntegrationTable t;
@@ -223,8 +212,8 @@ Result<PreIntegrationTable> PreIntegrationTable::create(const TransferFunction& 
         const double l = double(k) / double(m - 1) * double(desc.maxLengthWorld);
         for (int j = 0; j < n; ++j)
             for (int i = 0; i < n; ++i) {
-                const glm::dvec4 v = integrateSegmentWith(transfer, double(i) / (n - 1), double(j) / (n - 1), l, 1.0, 1.0,
-                                                          kTableStepDepth, kTableMinTransmittance);
+                const glm::dvec4 v =
+                    integrateSegmentWith(transfer, double(i) / (n - 1), double(j) / (n - 1), l, 1.0, 1.0, kTableStepDepth, kTableMinTransmittance);
                 float* o = &t.mData[4 * (std::size_t(i) + std::size_t(n) * (std::size_t(j) + std::size_t(n) * std::size_t(k)))];
                 o[0] = float(v.r);
                 o[1] = float(v.g);

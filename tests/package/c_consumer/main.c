@@ -13,8 +13,8 @@ int main(void) {
     splatfx_camera look, camera;
     splatfx_frame_stats stats;
     const float eye[3] = {0.0f, 5.0f, 20.0f}, target[3] = {0.0f, 5.0f, 0.0f}, up[3] = {0.0f, 1.0f, 0.0f};
-    if (splatfx_materials_create(NULL, &materials, err) || splatfx_scene_create(&scene, err) ||
-        splatfx_frame_create(&frame, err) || splatfx_scene_add_fire(scene, materials, NULL, NULL, NULL, err) ||
+    if (splatfx_materials_create(NULL, &materials, err) || splatfx_scene_create(&scene, err) || splatfx_frame_create(&frame, err) ||
+        splatfx_scene_add_fire(scene, materials, NULL, NULL, NULL, err) ||
         splatfx_camera_look_at(eye, target, up, 0.8f, 64, 64, 0.1f, 100.0f, &look, err) ||
         splatfx_camera_from_matrices(look.view, look.proj, 64, 64, &camera, err) ||
         splatfx_scene_prepare(scene, 0.5, &camera, materials, frame, err) || splatfx_frame_get_stats(frame, &stats, err)) {

@@ -29,8 +29,7 @@ int main() {
         const splatfx::Splat& s = splats[i];
         if (!std::isfinite(s.depth) || !std::isfinite(s.center.x) || !(s.density > 0.0f))
             return std::fprintf(stderr, "core consumer: splat %zu is not finite and positive\n", i), 1;
-        if (i > 0 && splats[i - 1].depth < s.depth)
-            return std::fprintf(stderr, "core consumer: splat %zu is out of back-to-front order\n", i), 1;
+        if (i > 0 && splats[i - 1].depth < s.depth) return std::fprintf(stderr, "core consumer: splat %zu is out of back-to-front order\n", i), 1;
     }
     std::printf("consumer: ok (%zu splats, core only)\n", splats.size());
     return 0;

@@ -68,7 +68,7 @@
 namespace splatfx::gl {
 
 struct FrameRendererDesc {
-    RendererDesc splats{};                // the splat pass's settings; default RendererDesc{}
+    RendererDesc splats{}; // the splat pass's settings; default RendererDesc{}
     // 1: splats at full resolution; 2 or 4: at 1/scale per axis, composited
     // with depth-aware upsampling (gl::ScaledRenderer). Default 1.
     int resolutionScale = 1;
@@ -78,18 +78,18 @@ struct FrameRendererDesc {
     // them at full resolution, all drawn before the splats. Default false.
     bool reduceTetrahedra = false;
     Precision reducedPrecision = Precision::F16; // reduced-resolution colour format; default F16
-    float depthThreshold = 0.1f;          // reduced resolution: relative view depth still one surface; default 0.1
+    float depthThreshold = 0.1f;                 // reduced resolution: relative view depth still one surface; default 0.1
     // ---- lighting (issue 16): the texture unit the frame's shadow table is
     // bound to while the host's hooks run (splatfx_shadowTable of shadowGlsl()).
-    int shadowTextureUnit = 15;           // [0, 15] (GL 4.5 guarantees 16 per stage); default 15
+    int shadowTextureUnit = 15; // [0, 15] (GL 4.5 guarantees 16 per stage); default 15
     // --- Fog (issue 14, docs/fog.md) ---
     // (0, 0): the host image's fog evaluated per pixel; otherwise the size of
     // the reduced fog texture it is evaluated into (the paper's Table 1:
     // 512x512 ... 128x128 for 800x600) and upsampled with depth-aware
     // weights. Default (0, 0).
     glm::ivec2 fogTextureSize{0, 0};
-    float fogDepthThreshold = 0.05f;      // fog texture: relative distance still one surface; default 0.05
-    bool fogHost = true;                  // fog the host's opaque image (false: only the splats); default true
+    float fogDepthThreshold = 0.05f; // fog texture: relative distance still one surface; default 0.05
+    bool fogHost = true;             // fog the host's opaque image (false: only the splats); default true
     // --- end fog ---
     // ---- (issue 15) order-exact transparency (HostTarget::transparentToLists) ----
     // The fragment budget for the host's transparent surfaces: the node pool
@@ -108,10 +108,10 @@ struct FrameRendererDesc {
 // shadow in the frame the unit holds a 1^3 table of zero depth, so
 // splatfx_shadow() returns 1 and the host shader needs no variant.
 struct ShadowBinding {
-    bool valid = false;               // the frame had a shadow
-    int textureUnit = 15;             // uniform sampler3D splatfx_shadowTable
-    unsigned texture = 0;             // GL name of the 3D texture (GL_R32F)
-    glm::mat4 worldToTable{1.0f};     // uniform mat4 splatfx_worldToTable
+    bool valid = false;                              // the frame had a shadow
+    int textureUnit = 15;                            // uniform sampler3D splatfx_shadowTable
+    unsigned texture = 0;                            // GL name of the 3D texture (GL_R32F)
+    glm::mat4 worldToTable{1.0f};                    // uniform mat4 splatfx_worldToTable
     glm::vec4 lightInTable{0.0f, -1.0f, 0.0f, 0.0f}; // uniform vec4 splatfx_shadowLight
 };
 // Sets shadowGlsl()'s three uniforms on `program` (glProgramUniform: the
@@ -120,8 +120,8 @@ void setShadowUniforms(unsigned program, const ShadowBinding& binding);
 
 // What the host owns, handed over for one frame.
 struct HostTarget {
-    unsigned framebuffer = 0;  // the host's framebuffer object (0: the default framebuffer); default 0
-    int x = 0, y = 0;          // viewport origin; its size is the frame camera's viewport; default 0, 0
+    unsigned framebuffer = 0; // the host's framebuffer object (0: the default framebuffer); default 0
+    int x = 0, y = 0;         // viewport origin; its size is the frame camera's viewport; default 0, 0
     // The host's depth as a texture (GL name). Reduced resolution reads it
     // (0: the framebuffer's depth attachment when it is a texture); at full
     // resolution the framebuffer's own depth buffer tests the splats. The
@@ -149,15 +149,15 @@ struct HostTarget {
 };
 
 struct FrameRenderStats {
-    std::uint64_t splats = 0;    // splats drawn
-    std::uint64_t drawCalls = 0; // draw calls of the volume passes
-    int resolutionScale = 1;     // the scale the splats were drawn at
+    std::uint64_t splats = 0;        // splats drawn
+    std::uint64_t drawCalls = 0;     // draw calls of the volume passes
+    int resolutionScale = 1;         // the scale the splats were drawn at
     std::uint64_t shadowUploads = 0; // lighting (issue 16): shadow-table uploads (cumulative; only when the frame's changed)
     // --- Fog (issue 14) ---
-    bool fogHost = false;        // the host image was fogged (a fog, fogHost and a host depth texture)
-    bool fogSplats = false;      // the splats were drawn with per-fragment fog
-    bool fogTetrahedra = false;  // the tetrahedra were drawn with per-segment fog
-    std::string fogError;        // empty, or why the fog could not be drawn (it was then skipped)
+    bool fogHost = false;       // the host image was fogged (a fog, fogHost and a host depth texture)
+    bool fogSplats = false;     // the splats were drawn with per-fragment fog
+    bool fogTetrahedra = false; // the tetrahedra were drawn with per-segment fog
+    std::string fogError;       // empty, or why the fog could not be drawn (it was then skipped)
     // --- end fog ---
     // ---- [clouds, issue 17] projected tetrahedra ----
     std::uint64_t tetrahedra = 0;            // tetrahedra drawn
@@ -165,25 +165,28 @@ struct FrameRenderStats {
     std::uint64_t batches = 0;               // runs of the interleaved splat/tetrahedron sequence
     std::size_t tableBytes = 0;              // GPU bytes of the uploaded pre-integration tables
     // ---- (issue 15) order-exact transparency (last frame) ----
-    bool transparentLists = false;        // the host's surfaces went through the fragment lists
-    bool splatsInLists = false;           // ... and the splats too (false: drawn before them, ordered blend; see transparentNote; with a fog, the splats that meet a surface take the ordered blend, also noted)
-    std::string transparentNote;          // empty, or why the splats took the ordered blend in a list frame
-    std::uint64_t transparentNodes = 0;   // surface fragments stored in the lists
-    std::uint64_t transparentFallback = 0;     // surface fragments that found the pool full: blended directly by the include, unsorted
+    bool transparentLists = false; // the host's surfaces went through the fragment lists
+    bool splatsInLists =
+        false; // ... and the splats too (false: drawn before them, ordered blend; see transparentNote; with a fog, the splats that meet a surface take the ordered blend, also noted)
+    std::string transparentNote;                 // empty, or why the splats took the ordered blend in a list frame
+    std::uint64_t transparentNodes = 0;          // surface fragments stored in the lists
+    std::uint64_t transparentFallback = 0;       // surface fragments that found the pool full: blended directly by the include, unsorted
     std::uint64_t transparentOverflowPixels = 0; // pixels with more surfaces than fragmentsPerPixel (their farthest merged)
     std::uint64_t transparentMergedNodes = 0;    // surface nodes merged so
     std::uint64_t transparentMaxSurfaces = 0;    // most surfaces stored on one pixel
     int transparentSections = 0;                 // section targets the splats were composited into (2, 4 or 8; 0: none)
-    std::uint64_t transparentSectionOverflow = 0; // pixels with more surfaces than sections - 1 (7 at most): the gas behind the extra ones merged into the last section
-    bool transparentCut = false;          // sections weighted by the kernel's partial line integral (RendererDesc::depthCut)
-    std::uint64_t transparentGeneral = 0; // sectioned splats whose polygon crosses the eye plane (camera inside a kernel): drawn screen-covering, exact
+    std::uint64_t transparentSectionOverflow =
+        0; // pixels with more surfaces than sections - 1 (7 at most): the gas behind the extra ones merged into the last section
+    bool transparentCut = false; // sections weighted by the kernel's partial line integral (RendererDesc::depthCut)
+    std::uint64_t transparentGeneral =
+        0; // sectioned splats whose polygon crosses the eye plane (camera inside a kernel): drawn screen-covering, exact
     // How the splats of a list frame were drawn: behind every surface they
     // cover (the ordinary splat pass, before the resolve), in front of every
     // one (the ordinary pass, after it), or cut into sections (the rest).
     std::uint64_t transparentSplatsBehind = 0;
     std::uint64_t transparentSplatsFront = 0;
     std::uint64_t transparentSplatsSectioned = 0;
-    std::size_t transparentBytes = 0;     // GPU bytes of the lists (pool, heads, counts, counters, section targets)
+    std::size_t transparentBytes = 0; // GPU bytes of the lists (pool, heads, counts, counters, section targets)
     // ---- end (issue 15) ----
 };
 

@@ -21,9 +21,9 @@ namespace splatfx::gl {
 enum class Precision { U8, F16, F32 };
 
 struct FramebufferDesc {
-    int width = 640;                  // default 640
-    int height = 480;                 // default 480
-    Precision color = Precision::U8;  // colour attachment format; default RGBA8
+    int width = 640;                 // default 640
+    int height = 480;                // default 480
+    Precision color = Precision::U8; // colour attachment format; default RGBA8
 };
 
 class Framebuffer {

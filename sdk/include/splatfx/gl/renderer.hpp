@@ -59,10 +59,10 @@ enum class TextureSampling {
 inline constexpr std::size_t kUpsampleBudgetBytes = 512 * 1024;
 
 struct RendererDesc {
-    bool restoreState = true;  // save and restore host GL state around draw(); default true
-    bool depthTest = true;     // test against the host's depth buffer; default true
+    bool restoreState = true;                         // save and restore host GL state around draw(); default true
+    bool depthTest = true;                            // test against the host's depth buffer; default true
     TextureSampling sampling = TextureSampling::Auto; // default Auto
-    int upsample = 0;          // Upsampled's factor, 2 to 16 (1: Bilinear); 0 (default): automatic (see Upsampled)
+    int upsample = 0;                                 // Upsampled's factor, 2 to 16 (1: Bilinear); 0 (default): automatic (see Upsampled)
     // Draw octagons (6 triangles) that skip the square's empty corners, or
     // squares (2 triangles). Octagons save ~17 % of the fragments but cost 3x
     // the triangles; on Mesa's llvmpipe squares are 1.3-2x faster per frame

@@ -10,8 +10,8 @@ namespace splatfx::gl::detail {
 
 bool contextIsCurrent() {
     using GetCurrent = void* (*)();
-    const char* libs[][2] = {{"libEGL.so.1", "eglGetCurrentContext"}, {"libGLX.so.0", "glXGetCurrentContext"},
-                             {"libGL.so.1", "glXGetCurrentContext"}};
+    const char* libs[][2] = {
+        {"libEGL.so.1", "eglGetCurrentContext"}, {"libGLX.so.0", "glXGetCurrentContext"}, {"libGL.so.1", "glXGetCurrentContext"}};
     for (const auto& lib : libs) {
         void* handle = dlopen(lib[0], RTLD_LAZY | RTLD_NOLOAD);
         if (!handle) continue;

@@ -43,8 +43,7 @@ public:
 
     // textureSize (0, 0): per pixel; else the reduced fog texture's size.
     // depthThreshold: relative distance difference still one surface when upsampling.
-    Status draw(const Fog& fog, double timeSec, const Camera& camera, const FogPassTarget& target, glm::ivec2 textureSize,
-                float depthThreshold);
+    Status draw(const Fog& fog, double timeSec, const Camera& camera, const FogPassTarget& target, glm::ivec2 textureSize, float depthThreshold);
 
 private:
     Status build(const Fog& fog);

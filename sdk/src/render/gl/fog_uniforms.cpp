@@ -16,8 +16,8 @@ Status setFogUniforms(unsigned program, const Fog& fog, double timeSec, glm::dve
     const GLint colour = glGetUniformLocation(program, (options.prefix + "_colour").c_str());
     const GLint far = glGetUniformLocation(program, (options.prefix + "_far").c_str());
     if (params < 0 && colour < 0 && far < 0)
-        return makeError("setFogUniforms: program " + std::to_string(program) + " uses none of " + glsl->uniformName + ", " +
-                         options.prefix + "_colour, " + options.prefix + "_far (not the fog include, or another prefix)");
+        return makeError("setFogUniforms: program " + std::to_string(program) + " uses none of " + glsl->uniformName + ", " + options.prefix +
+                         "_colour, " + options.prefix + "_far (not the fog include, or another prefix)");
     const std::vector<glm::vec4> p = fog.glslParameters(timeSec, eye);
     if (int(p.size()) != glsl->vec4Count)
         return makeError("setFogUniforms: the include expects " + std::to_string(glsl->vec4Count) + " parameters, this fog has " +

@@ -413,8 +413,8 @@ struct FragmentListPass::Impl {
     static constexpr int kKinds = 6;
     SectionProgram sectionPrograms[kKinds][3];
     static int cutKind(unsigned needs) { return needs == 3 ? 1 : needs == 0 ? 3 : needs == 1 ? 4 : 5; }
-    PartialTexture partial;               // the footprint's partial-integral table (cut programs)
-    std::string partialSource;            // partialGlsl() the cut programs were built from
+    PartialTexture partial;    // the footprint's partial-integral table (cut programs)
+    std::string partialSource; // partialGlsl() the cut programs were built from
     float kernelRadius = 1.0f;
     std::string programError;
 
@@ -425,8 +425,9 @@ struct FragmentListPass::Impl {
         const std::string include = transparentGlsl();
         const int counts[3] = {2, 4, kTransparentMaxSections};
         const bool nearCut = kind == 1 || kind == 2 || kind == 4, hostCut = kind == 1 || kind == 2 || kind == 5;
-        const std::string head = std::string("#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n") + (cut ? "#define CUT 1\n" : "#define CUT 0\n") +
-                                 (hostCut ? "#define HOST_DEPTH 1\n" : "#define HOST_DEPTH 0\n") + (nearCut ? "#define NEAR_CUT 1\n" : "#define NEAR_CUT 0\n") +
+        const std::string head = std::string("#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n") +
+                                 (cut ? "#define CUT 1\n" : "#define CUT 0\n") + (hostCut ? "#define HOST_DEPTH 1\n" : "#define HOST_DEPTH 0\n") +
+                                 (nearCut ? "#define NEAR_CUT 1\n" : "#define NEAR_CUT 0\n") +
                                  (kind == 2 ? "#define GENERAL 1\n" : "#define GENERAL 0\n") + "#define CROSSFADE 1\n";
         const char* partialSrc = cut ? partialSource.c_str() : "";
         for (int v = 0; v < 3; ++v) {
@@ -480,12 +481,12 @@ struct FragmentListPass::Impl {
     GLuint tileRange = 0;
     glm::ivec2 tileSize{0};
     std::vector<GLuint> tileBits;
-    std::vector<float> tileView; // tileBits' surface depth range as view depth
-    std::vector<float> tileHost; // tileBits' nearest host depth as view depth
+    std::vector<float> tileView;       // tileBits' surface depth range as view depth
+    std::vector<float> tileHost;       // tileBits' nearest host depth as view depth
     std::vector<std::uint8_t> classes; // insertSplats(): per splat, its variant
-    std::vector<std::uint8_t> needs; // split(): per splat of the middle run, the cuts its section variant needs (1 near, 2 host)
-    std::array<float, 256> rho{}; // rayScaleRho by code (the kernel's reach along the rays)
-    GLuint depths = 0; // R32F array: each pixel's nearest surface depths
+    std::vector<std::uint8_t> needs;   // split(): per splat of the middle run, the cuts its section variant needs (1 near, 2 host)
+    std::array<float, 256> rho{};      // rayScaleRho by code (the kernel's reach along the rays)
+    GLuint depths = 0;                 // R32F array: each pixel's nearest surface depths
     int depthLayers = 0;
     glm::ivec2 depthSize{0};
     GLuint resolved = 0; // RGBA16F, the lists' viewport
@@ -602,7 +603,8 @@ Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
     // them (the per-pixel arrays cost in proportion to K on a CPU rasterizer).
     for (int k = 1;; k = std::min(2 * k, impl->perPixel)) {
         const std::string def = "#define K " + std::to_string(k) + "\n";
-        auto resolve = linkComputeProgram({"#version 450 core\n#define FRAG 0\n", def.c_str(), computeInclude.c_str(), kResolveCompute}, "fragment lists (resolve)");
+        auto resolve = linkComputeProgram({"#version 450 core\n#define FRAG 0\n", def.c_str(), computeInclude.c_str(), kResolveCompute},
+                                          "fragment lists (resolve)");
         if (!resolve) return makeError(resolve.error());
         impl->resolvePrograms.push_back({k, *resolve});
         if (k == impl->perPixel) break;
@@ -755,8 +757,10 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
         const float hx = persp ? ext * focalX / minZ : ext * focalX, hy = persp ? ext * focalY / minZ : ext * focalY;
         int x0 = 0, x1 = tilesX - 1, y0 = 0, y1 = tilesY - 1; // near or across the eye plane, or not finite: every tile
         if ((!persp || minZ >= 0.5f * nearZ) && std::isfinite(px) && std::isfinite(py) && std::isfinite(hx) && std::isfinite(hy)) {
-            x0 = std::clamp(int(std::floor((px - hx) / float(tile))), 0, tilesX - 1), x1 = std::clamp(int(std::floor((px + hx) / float(tile))), 0, tilesX - 1);
-            y0 = std::clamp(int(std::floor((py - hy) / float(tile))), 0, tilesY - 1), y1 = std::clamp(int(std::floor((py + hy) / float(tile))), 0, tilesY - 1);
+            x0 = std::clamp(int(std::floor((px - hx) / float(tile))), 0, tilesX - 1),
+            x1 = std::clamp(int(std::floor((px + hx) / float(tile))), 0, tilesX - 1);
+            y0 = std::clamp(int(std::floor((py - hy) / float(tile))), 0, tilesY - 1),
+            y1 = std::clamp(int(std::floor((py + hy) / float(tile))), 0, tilesY - 1);
         }
         float host = 3.4e38f;
         for (int ty = y0; ty <= y1; ++ty)
@@ -999,29 +1003,29 @@ void FragmentListPass::resolve(const FragmentListTarget& target) {
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glBindTextureUnit(4, 0);
     } else {
-    glUseProgram(program);
-    glUniform1i(glGetUniformLocation(program, "uSectionCount"), r.sectionsThisFrame);
-    glUniform2i(glGetUniformLocation(program, "uOrigin"), target.x, target.y);
-    glUniform2i(glGetUniformLocation(program, "uSize"), target.width, target.height);
-    if (r.sectionsThisFrame > 0) glBindTextureUnit(1, r.sections);
-    glBindTextureUnit(2, r.heads);
-    glBindImageTexture(5, r.resolved, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
-    glDispatchCompute(GLuint((target.width + 7) / 8), GLuint((target.height + 7) / 8), 1);
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-    glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+        glUseProgram(program);
+        glUniform1i(glGetUniformLocation(program, "uSectionCount"), r.sectionsThisFrame);
+        glUniform2i(glGetUniformLocation(program, "uOrigin"), target.x, target.y);
+        glUniform2i(glGetUniformLocation(program, "uSize"), target.width, target.height);
+        if (r.sectionsThisFrame > 0) glBindTextureUnit(1, r.sections);
+        glBindTextureUnit(2, r.heads);
+        glBindImageTexture(5, r.resolved, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
+        glDispatchCompute(GLuint((target.width + 7) / 8), GLuint((target.height + 7) / 8), 1);
+        glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+        glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
 
-    glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
-    glViewport(target.x, target.y, target.width, target.height);
-    glEnable(GL_BLEND);
-    glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-    glBlendEquation(GL_FUNC_ADD);
-    glDisable(GL_DEPTH_TEST);
-    glDepthMask(GL_FALSE);
-    glUseProgram(r.compositeProgram);
-    glUniform2i(glGetUniformLocation(r.compositeProgram, "uOrigin"), target.x, target.y);
-    glBindTextureUnit(1, r.resolved);
-    glBindVertexArray(r.emptyVao);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
+        glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
+        glViewport(target.x, target.y, target.width, target.height);
+        glEnable(GL_BLEND);
+        glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
+        glBlendEquation(GL_FUNC_ADD);
+        glDisable(GL_DEPTH_TEST);
+        glDepthMask(GL_FALSE);
+        glUseProgram(r.compositeProgram);
+        glUniform2i(glGetUniformLocation(r.compositeProgram, "uOrigin"), target.x, target.y);
+        glBindTextureUnit(1, r.resolved);
+        glBindVertexArray(r.emptyVao);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
     }
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     GLuint c[kCounterWords] = {};
@@ -1033,7 +1037,8 @@ void FragmentListPass::resolve(const FragmentListTarget& target) {
     r.stats.overflowPixels = c[8];
     r.stats.mergedNodes = c[9];
     r.stats.sections = r.sectionsThisFrame;
-    r.stats.bytes = std::size_t(r.depthSize.x) * r.depthSize.y * 4 * std::size_t(r.depthLayers) /* sorted depths */ + r.poolNodes * kTransparentNodeBytes + std::size_t(r.width) * r.height * kTransparentHeadBytesPerPixel +
+    r.stats.bytes = std::size_t(r.depthSize.x) * r.depthSize.y * 4 * std::size_t(r.depthLayers) /* sorted depths */ +
+                    r.poolNodes * kTransparentNodeBytes + std::size_t(r.width) * r.height * kTransparentHeadBytesPerPixel +
                     std::size_t(kCounterBytes) + std::size_t(r.width) * r.height * 8 /* resolved RGBA16F */ +
                     std::size_t(r.sectionSize.x) * r.sectionSize.y * kTransparentSectionBytesPerPixel * std::size_t(r.sectionLayers) +
                     std::size_t(r.tileSize.x) * std::size_t(r.tileSize.y) * 16 /* the survey's tiles (RGBA32UI) */ +

@@ -63,20 +63,20 @@ struct FragmentListTarget {
 };
 
 struct FragmentListStats {
-    std::uint64_t nodes = 0;            // surface nodes stored
-    std::uint64_t fallback = 0;         // surface fragments that found the pool full (blended directly instead)
-    std::uint64_t maxSurfaces = 0;      // most surfaces stored on one pixel
-    int sections = 0;                   // section targets the splats were drawn into (0: no splats in the lists)
-    std::uint64_t sectionOverflow = 0;  // pixels with more surfaces than sections - 1 (the gas behind the extra ones merged into the last section)
-    std::uint64_t overflowPixels = 0;   // pixels with more nodes than fragmentsPerPixel
-    std::uint64_t mergedNodes = 0;      // nodes merged into a pixel's farthest slot
-    bool cut = false;                   // the sections were weighted by the kernel's partial line integral
-    std::uint64_t generalSplats = 0;    // sectioned splats whose polygon crosses the eye plane: drawn with the general (screen-covering) variant
-    std::uint64_t splatsBehind = 0;     // split(): splats behind every surface they cover (ordinary pass, before the resolve)
-    std::uint64_t splatsFront = 0;      // split(): splats in front of every surface they cover (ordinary pass, after it)
-    std::uint64_t splatsSectioned = 0;  // splats drawn into the section targets
-    std::size_t bytes = 0;              // GPU bytes of the pool, heads, counts, counters and the section targets in use
-    std::size_t poolNodes = 0;          // capacity of the pool
+    std::uint64_t nodes = 0;           // surface nodes stored
+    std::uint64_t fallback = 0;        // surface fragments that found the pool full (blended directly instead)
+    std::uint64_t maxSurfaces = 0;     // most surfaces stored on one pixel
+    int sections = 0;                  // section targets the splats were drawn into (0: no splats in the lists)
+    std::uint64_t sectionOverflow = 0; // pixels with more surfaces than sections - 1 (the gas behind the extra ones merged into the last section)
+    std::uint64_t overflowPixels = 0;  // pixels with more nodes than fragmentsPerPixel
+    std::uint64_t mergedNodes = 0;     // nodes merged into a pixel's farthest slot
+    bool cut = false;                  // the sections were weighted by the kernel's partial line integral
+    std::uint64_t generalSplats = 0;   // sectioned splats whose polygon crosses the eye plane: drawn with the general (screen-covering) variant
+    std::uint64_t splatsBehind = 0;    // split(): splats behind every surface they cover (ordinary pass, before the resolve)
+    std::uint64_t splatsFront = 0;     // split(): splats in front of every surface they cover (ordinary pass, after it)
+    std::uint64_t splatsSectioned = 0; // splats drawn into the section targets
+    std::size_t bytes = 0;             // GPU bytes of the pool, heads, counts, counters and the section targets in use
+    std::size_t poolNodes = 0;         // capacity of the pool
 };
 
 class FragmentListPass {
@@ -117,8 +117,8 @@ public:
     // depthCut (RendererDesc::depthCut): sections weighted by the kernel's
     // partial line integral and cut at the near plane and the host depth;
     // false: the kernel as a step at its plane.
-    void insertSplats(const std::vector<Splat>& splats, std::size_t begin, std::size_t end, const Camera& camera, unsigned layerTexture, float cut, bool trimCorners, bool depthCut,
-                      const FragmentListTarget& target);
+    void insertSplats(const std::vector<Splat>& splats, std::size_t begin, std::size_t end, const Camera& camera, unsigned layerTexture, float cut,
+                      bool trimCorners, bool depthCut, const FragmentListTarget& target);
     // Sorts every pixel's surfaces, interleaves the sections, composites
     // over the framebuffer, unbinds the lists, reads the counters back.
     void resolve(const FragmentListTarget& target);

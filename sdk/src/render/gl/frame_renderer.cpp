@@ -13,7 +13,7 @@
 #include "splatfx/gl/scaled_renderer.hpp"
 #include "tetra_pass.hpp"
 #include "fragment_list_pass.hpp"
-#include "saved_state.hpp"       
+#include "saved_state.hpp"
 
 namespace splatfx::gl {
 
@@ -24,7 +24,7 @@ struct FrameRenderer::Impl {
     std::optional<ScaledRenderer> reduced;
     FrameRenderStats stats;
     std::optional<ShadowPass> shadow; // lighting (issue 16): pass 0, the frame's shadow table
-    detail::FogPass fog; // fog of the host image (issue 14)
+    detail::FogPass fog;              // fog of the host image (issue 14)
     // [clouds] Projected tetrahedra, and the splats of one interleaved batch.
     std::optional<detail::TetraPass> tetra;
     std::vector<Splat> batch;
@@ -49,10 +49,8 @@ Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
         if (!r) return makeError(r.error());
         impl->full.emplace(std::move(*r));
     } else {
-        auto r = ScaledRenderer::create({.scale = desc.resolutionScale,
-                                         .renderer = desc.splats,
-                                         .precision = desc.reducedPrecision,
-                                         .depthThreshold = desc.depthThreshold});
+        auto r = ScaledRenderer::create(
+            {.scale = desc.resolutionScale, .renderer = desc.splats, .precision = desc.reducedPrecision, .depthThreshold = desc.depthThreshold});
         if (!r) return makeError(r.error());
         impl->reduced.emplace(std::move(*r));
     }
@@ -64,8 +62,7 @@ Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
     { // (issue 15)
         if (desc.fragmentsPerPixel < 1 || desc.fragmentsPerPixel > detail::FragmentListPass::kMaxFragmentsPerPixel)
             return makeError("FrameRendererDesc::fragmentsPerPixel must be in [1, " +
-                             std::to_string(detail::FragmentListPass::kMaxFragmentsPerPixel) + "], got " +
-                             std::to_string(desc.fragmentsPerPixel));
+                             std::to_string(detail::FragmentListPass::kMaxFragmentsPerPixel) + "], got " + std::to_string(desc.fragmentsPerPixel));
         auto l = detail::FragmentListPass::create(desc.fragmentsPerPixel);
         if (!l) return makeError(l.error());
         impl->lists.emplace(std::move(*l));
@@ -99,8 +96,8 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
     if (r.shadow->upload(frame.shadow())) ++r.stats.shadowUploads;
     r.shadow->bind();
     // 0. [clouds] Upload the pre-integration tables that changed; per-tetrahedron data.
-    const bool anyTets = std::any_of(frame.volumes().begin(), frame.volumes().end(),
-                                     [](const FrameVolume& v) { return v.table && !v.lod.tets.empty(); });
+    const bool anyTets =
+        std::any_of(frame.volumes().begin(), frame.volumes().end(), [](const FrameVolume& v) { return v.table && !v.lod.tets.empty(); });
     if (anyTets) r.tetra->prepare(frame);
 
     // 1. The host's opaque pass: its depth is what the volumes are tested against.
@@ -124,9 +121,10 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
             depth = unsigned(name);
         }
         if (depth) {
-            const Status s = r.fog.draw(*fog, frame.time(), camera,
-                                        {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h, .depthTexture = depth},
-                                        r.desc.fogTextureSize, r.desc.fogDepthThreshold);
+            const Status s =
+                r.fog.draw(*fog, frame.time(), camera,
+                           {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h, .depthTexture = depth},
+                           r.desc.fogTextureSize, r.desc.fogDepthThreshold);
             if (s) r.stats.fogHost = true;
             else r.stats.fogError = s.error();
         }
@@ -166,10 +164,10 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
     r.stats.transparentLists = lists;
     r.stats.splatsInLists = splatsInLists;
     r.stats.transparentNote = !lists || splatsInLists ? std::string()
-                              : !r.full              ? "reduced resolution: the splats take the ordered blend under the surfaces"
-                              : anyTets              ? "tetrahedra in the frame: the volumes take the ordered blend under the surfaces"
-                                                     : "no host depth texture (HostTarget::depthTexture or a texture depth attachment): "
-                                                       "the splats take the ordered blend under the surfaces";
+                              : !r.full               ? "reduced resolution: the splats take the ordered blend under the surfaces"
+                              : anyTets               ? "tetrahedra in the frame: the volumes take the ordered blend under the surfaces"
+                                                      : "no host depth texture (HostTarget::depthTexture or a texture depth attachment): "
+                                                        "the splats take the ordered blend under the surfaces";
     // ---- end (issue 15) ----
 
     // 2. The volumes, back to front.
@@ -179,13 +177,18 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         // [clouds] Splats and tetrahedra interleaved by Frame::drawOrder (frame.hpp).
         drawInterleaved(frame, target);
     } else if (r.full) {
-        r.full->draw(frame.splats(), camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
-                                              .depthTexture = target.depthTexture}); // the host depth the splats are cut by (issue 15)
+        r.full->draw(frame.splats(), camera,
+                     {.framebuffer = target.framebuffer,
+                      .x = target.x,
+                      .y = target.y,
+                      .width = w,
+                      .height = h,
+                      .depthTexture = target.depthTexture}); // the host depth the splats are cut by (issue 15)
         r.stats.drawCalls = r.full->stats().drawCalls;
     } else {
-        r.reduced->draw(frame.splats(), camera,
-                        {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
-                         .depthTexture = target.depthTexture});
+        r.reduced->draw(
+            frame.splats(), camera,
+            {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h, .depthTexture = target.depthTexture});
         r.stats.drawCalls = r.reduced->renderer().stats().drawCalls;
     }
     r.stats.splats = frame.splats().size();
@@ -197,8 +200,8 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         // sections at them, every pixel sorted and composited.
         detail::SavedState saved;
         if (r.desc.splats.restoreState) saved.save({.texture2DUnits = 0, .scissor = false});
-        const detail::FragmentListTarget lt{.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
-                                            .depthTexture = listDepth};
+        const detail::FragmentListTarget lt{
+            .framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h, .depthTexture = listDepth};
         const Status s = r.lists->collectSurfaces(lt, target.drawTransparent);
         if (s) {
             detail::FragmentListPass::Split split{};
@@ -209,8 +212,9 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
             auto ordinary = [&](std::size_t begin, std::size_t end) {
                 if (begin >= end) return;
                 r.batch.assign(all.begin() + std::ptrdiff_t(begin), all.begin() + std::ptrdiff_t(end));
-                r.full->draw(r.batch, camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
-                                               .depthTexture = target.depthTexture});
+                r.full->draw(
+                    r.batch, camera,
+                    {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h, .depthTexture = target.depthTexture});
                 r.stats.drawCalls += r.full->stats().drawCalls;
             };
             if (splatsInLists) {
@@ -218,8 +222,9 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
                 split = r.lists->split(all, camera, r.desc.splats.footprintCut, r.desc.splats.trimCorners, r.desc.splats.depthCut, lt);
                 if (fog && split.frontBegin > split.behindEnd) {
                     ordinary(0, split.frontBegin);
-                    r.stats.transparentNote = "fog: " + std::to_string(split.frontBegin - split.behindEnd) +
-                                              " splats that meet a surface take the ordered blend under the surfaces (fogged sections not implemented)";
+                    r.stats.transparentNote =
+                        "fog: " + std::to_string(split.frontBegin - split.behindEnd) +
+                        " splats that meet a surface take the ordered blend under the surfaces (fogged sections not implemented)";
                 } else {
                     ordinary(0, split.behindEnd);
                     r.lists->insertSplats(all, split.behindEnd, split.frontBegin, camera, r.full->layerTexture(), r.desc.splats.footprintCut,
@@ -260,17 +265,17 @@ void FrameRenderer::drawInterleaved(const Frame& frame, const HostTarget& target
     Impl& r = *mImpl;
     const Camera& camera = frame.camera();
     const int w = camera.viewport.x, h = camera.viewport.y;
-    const detail::TetraTarget tt{.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
-                                 .depthTexture = target.depthTexture};
+    const detail::TetraTarget tt{
+        .framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h, .depthTexture = target.depthTexture};
     std::uint64_t calls = 0, batches = 0;
     if (r.reduced && !r.desc.reduceTetrahedra) {
         // Reduced-resolution splats are composited in one pass, so the order
         // is per pass: every tetrahedron (full resolution), then the splats.
         for (const DrawBatch& b : frame.drawOrder())
             if (b.kind == DrawBatch::Kind::Tetrahedra) r.tetra->draw(frame, b.volume, b.begin, b.end, tt), ++batches;
-        r.reduced->draw(frame.splats(), camera,
-                        {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
-                         .depthTexture = target.depthTexture});
+        r.reduced->draw(
+            frame.splats(), camera,
+            {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h, .depthTexture = target.depthTexture});
         calls += r.reduced->renderer().stats().drawCalls;
         ++batches;
     } else {
@@ -297,8 +302,9 @@ void FrameRenderer::drawInterleaved(const Frame& frame, const HostTarget& target
                 r.reduced->drawSplats(r.batch, camera);
                 calls += r.reduced->renderer().stats().drawCalls;
             } else {
-                r.full->draw(r.batch, camera, {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h,
-                                               .depthTexture = target.depthTexture});
+                r.full->draw(
+                    r.batch, camera,
+                    {.framebuffer = target.framebuffer, .x = target.x, .y = target.y, .width = w, .height = h, .depthTexture = target.depthTexture});
                 calls += r.full->stats().drawCalls;
             }
         }

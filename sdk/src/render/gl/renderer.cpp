@@ -44,8 +44,7 @@ const float* upsampleBilinear(const float* src, int n, int factor, std::vector<f
             const float* c = src + (std::size_t(y1) * n + x0) * 4;
             const float* d = src + (std::size_t(y1) * n + x1) * 4;
             float* o = out.data() + (std::size_t(y) * m + x) * 4;
-            for (int k = 0; k < 4; ++k)
-                o[k] = (1.0f - ay) * ((1.0f - ax) * a[k] + ax * b[k]) + ay * ((1.0f - ax) * c[k] + ax * d[k]);
+            for (int k = 0; k < 4; ++k) o[k] = (1.0f - ay) * ((1.0f - ax) * a[k] + ax * b[k]) + ay * ((1.0f - ax) * c[k] + ax * d[k]);
         }
     }
     return out.data();
@@ -65,12 +64,11 @@ struct Renderer::Impl {
         // Fog (issue 14)
         GLint uFogEye = -1, uParams = -1, uColour = -1, uFar = -1;
         // Depth cut (issue 15)
-        GLint uEye = -1, uForward = -1, uNearZ = -1, uPersp = -1, uKernelRadius = -1, uDepthToView = -1, uInvViewProj = -1,
-              uViewport = -1;
+        GLint uEye = -1, uForward = -1, uNearZ = -1, uPersp = -1, uKernelRadius = -1, uDepthToView = -1, uInvViewProj = -1, uViewport = -1;
     };
     std::map<unsigned, Program> programs;
     std::string programError; // the last variant that failed to build (never expected: a shader bug)
-    std::string fogSource; // generated GLSL the fog programs were built from
+    std::string fogSource;    // generated GLSL the fog programs were built from
     std::string fogUniform;
     int fogVec4s = 0;
     const Fog* fog = nullptr;
@@ -82,7 +80,7 @@ struct Renderer::Impl {
     float kernelRadius = 1.6f;
     std::array<float, 256> rho{}; // rayScaleRho by code
     std::vector<std::uint8_t> classes;
-    GLuint depthQueried = 0;  // the host depth texture last checked, and whether it can be sampled
+    GLuint depthQueried = 0; // the host depth texture last checked, and whether it can be sampled
     bool depthUsable = false;
     // The host depth as view depth (R32F, the target's size), its framebuffer and program.
     // The host view-depth range per kCutTile tile (RG32F), read back per draw.
@@ -205,8 +203,8 @@ int Renderer::upsampleFactor() const { return mImpl->upsample; }
 Result<Renderer> Renderer::create(const RendererDesc& desc) {
     if (!detail::contextIsCurrent()) return makeError("splatfx::gl::Renderer::create: no OpenGL context is current on this thread");
     if (epoxy_gl_version() < 45)
-        return makeError("splatfx::gl::Renderer::create: OpenGL 4.5 is required, the current context has " +
-                         std::to_string(epoxy_gl_version() / 10) + "." + std::to_string(epoxy_gl_version() % 10));
+        return makeError("splatfx::gl::Renderer::create: OpenGL 4.5 is required, the current context has " + std::to_string(epoxy_gl_version() / 10) +
+                         "." + std::to_string(epoxy_gl_version() % 10));
     auto impl = std::make_unique<Impl>();
     impl->desc = desc;
     for (int c = 0; c < 256; ++c) impl->rho[size_t(c)] = rayScaleRho(std::uint8_t(c));
@@ -445,8 +443,10 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
                     const float ext = cutExtent * (glm::length(sp.axisU) + glm::length(sp.axisV)) * 1.01f;
                     const float px = (cc.x / cc.w * 0.5f + 0.5f) * float(target.width), py = (cc.y / cc.w * 0.5f + 0.5f) * float(target.height);
                     const float hx = persp ? ext * focalX / minZ : ext * focalX, hy = persp ? ext * focalY / minZ : ext * focalY;
-                    const int x0 = std::clamp(int(std::floor((px - hx) / float(tile))), 0, tilesX - 1), x1 = std::clamp(int(std::floor((px + hx) / float(tile))), 0, tilesX - 1);
-                    const int y0 = std::clamp(int(std::floor((py - hy) / float(tile))), 0, tilesY - 1), y1 = std::clamp(int(std::floor((py + hy) / float(tile))), 0, tilesY - 1);
+                    const int x0 = std::clamp(int(std::floor((px - hx) / float(tile))), 0, tilesX - 1),
+                              x1 = std::clamp(int(std::floor((px + hx) / float(tile))), 0, tilesX - 1);
+                    const int y0 = std::clamp(int(std::floor((py - hy) / float(tile))), 0, tilesY - 1),
+                              y1 = std::clamp(int(std::floor((py + hy) / float(tile))), 0, tilesY - 1);
                     if (std::isfinite(px) && std::isfinite(py) && std::isfinite(hx) && std::isfinite(hy)) {
                         lo = 3.4e38f, hi = 0.0f;
                         for (int ty = y0; ty <= y1; ++ty)

@@ -176,8 +176,7 @@ ReducedLayer ScaledRenderer::begin(const ScaledTarget& target, glm::ivec4 box) {
             glTextureStorage2D(r.hostCopy, 1, GLenum(format), target.width, target.height);
             r.copyW = target.width, r.copyH = target.height, r.copyFormat = GLenum(format);
         }
-        glCopyImageSubData(hostDepth, GL_TEXTURE_2D, 0, target.x, target.y, 0, r.hostCopy, GL_TEXTURE_2D, 0, 0, 0, 0, target.width,
-                           target.height, 1);
+        glCopyImageSubData(hostDepth, GL_TEXTURE_2D, 0, target.x, target.y, 0, r.hostCopy, GL_TEXTURE_2D, 0, 0, 0, 0, target.width, target.height, 1);
     }
     // The copy starts at the viewport's corner, so the shaders read it at offset 0.
     const GLint hostRect[4] = {0, 0, target.width, target.height};

@@ -182,8 +182,8 @@ struct TetraPass::Impl {
         bool used = false;
     };
     std::vector<Table> tables;
-    std::vector<int> tableOfVolume;               // per frame volume: index into tables (-1: not drawn)
-    std::vector<std::size_t> recordBase;          // per frame volume: first record
+    std::vector<int> tableOfVolume;                      // per frame volume: index into tables (-1: not drawn)
+    std::vector<std::size_t> recordBase;                 // per frame volume: first record
     std::vector<std::vector<std::uint32_t>> firstRecord; // per volume: records before tet i (size tets + 1)
     std::vector<glm::vec4> records;
     glm::vec3 eye{0.0f};
@@ -235,8 +235,7 @@ Result<GLuint> buildTetraProgram(int v, const std::string& fogSource) {
     const char* persp = (v & 2) ? "#define PERSPECTIVE 1\n" : "#define PERSPECTIVE 0\n";
     const char* depth = (v & 1) ? "#define HAS_DEPTH 1\n" : "#define HAS_DEPTH 0\n";
     const char* fog = fogSource.empty() ? "#define FOG 0\n" : "#define FOG 1\n";
-    return linkProgram({"#version 450 core\n", kTetraVertex},
-                       {"#version 450 core\n", persp, depth, fog, fogSource.c_str(), kTetraFragment},
+    return linkProgram({"#version 450 core\n", kTetraVertex}, {"#version 450 core\n", persp, depth, fog, fogSource.c_str(), kTetraFragment},
                        fogSource.empty() ? "tetrahedra" : "tetrahedra (fog)");
 }
 } // namespace
@@ -449,7 +448,7 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     if (hostDepth) {
         glDisable(GL_DEPTH_TEST); // the shader cuts each segment at the host depth
     } else {
-        glEnable(GL_DEPTH_TEST);  // no depth texture: whole fragments behind the host are dropped
+        glEnable(GL_DEPTH_TEST); // no depth texture: whole fragments behind the host are dropped
         glDepthFunc(GL_LEQUAL);
     }
     glEnable(GL_DEPTH_CLAMP); // the CPU clipped at the near plane; GL must not clip again by rounding

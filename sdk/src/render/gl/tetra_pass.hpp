@@ -41,13 +41,13 @@ struct TetraTarget {
 };
 
 struct TetraStats {
-    std::uint64_t tetrahedra = 0;      // drawn this frame
-    std::uint64_t transparent = 0;     // skipped by the table's zero-opacity test
-    std::uint64_t degenerate = 0;      // skipped: zero or non-finite volume
+    std::uint64_t tetrahedra = 0;  // drawn this frame
+    std::uint64_t transparent = 0; // skipped by the table's zero-opacity test
+    std::uint64_t degenerate = 0;  // skipped: zero or non-finite volume
     std::uint64_t drawCalls = 0;
-    std::uint64_t tableUploads = 0;    // since creation
-    std::size_t tableBytes = 0;        // GPU bytes held by uploaded tables
-    std::uint64_t foggedDraws = 0;     // draws with the fog variant this frame
+    std::uint64_t tableUploads = 0; // since creation
+    std::size_t tableBytes = 0;     // GPU bytes held by uploaded tables
+    std::uint64_t foggedDraws = 0;  // draws with the fog variant this frame
 };
 
 class TetraPass {

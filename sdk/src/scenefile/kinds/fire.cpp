@@ -4,8 +4,8 @@
 namespace splatfx::scenefile {
 
 std::optional<Effect> readFire(Context& c, ObjectReader& o, const EffectCommon& e, const Placement& pl) {
-    return readLatticePreset<presets::FireDesc>(c, o, e, pl, [&](presets::FireDesc& d) { o.boolean("crossfade", d.crossfade); },
-                                                &presets::fire);
+    return readLatticePreset<presets::FireDesc>(
+        c, o, e, pl, [&](presets::FireDesc& d) { o.boolean("crossfade", d.crossfade); }, &presets::fire);
 }
 
 } // namespace splatfx::scenefile

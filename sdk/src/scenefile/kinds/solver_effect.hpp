@@ -14,8 +14,8 @@ template <class Desc>
 std::optional<Effect> readSolverEffect(Context& c, ObjectReader& o, const EffectCommon& e, const Placement& pl,
                                        Result<Effect> (*make)(Materials&, const Desc&)) {
     if (e.motion)
-        c.d.error(join(e.path, "motion"), "solver effects (\"" + e.kind +
-                                              "\") stay put; move their source with \"sourceMotion\" or \"attachTo\" so the material trails");
+        c.d.error(join(e.path, "motion"),
+                  "solver effects (\"" + e.kind + "\") stay put; move their source with \"sourceMotion\" or \"attachTo\" so the material trails");
     std::optional<Motion> sourceMotion;
     if (const Json* m = o.get("sourceMotion")) {
         sourceMotion = readMotion(c, o.at("sourceMotion"), *m);

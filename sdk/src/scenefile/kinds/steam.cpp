@@ -4,7 +4,8 @@
 namespace splatfx::scenefile {
 
 std::optional<Effect> readSteam(Context& c, ObjectReader& o, const EffectCommon& e, const Placement& pl) {
-    return readLatticePreset<presets::SteamDesc>(c, o, e, pl, [](presets::SteamDesc&) {}, &presets::steam);
+    return readLatticePreset<presets::SteamDesc>(
+        c, o, e, pl, [](presets::SteamDesc&) {}, &presets::steam);
 }
 
 } // namespace splatfx::scenefile
