@@ -14,6 +14,7 @@ PACKAGES=(
   libgl1-mesa-dri libegl-mesa0 libegl1
   libopenimageio-dev openimageio-tools python3-imath libopencv-dev nlohmann-json3-dev libgtest-dev
   libassimp-dev libimgui-dev
+  glslang-tools libcli11-dev  # every shader variant compiled at build time; the tools' command lines
   gnuplot-nox xvfb xauth
   # OpenVDB import (splatfx::vdb, optional at configure: SPLATFX_VDB). Debian's
   # FindOpenVDB.cmake also needs Boost iostreams; python3-openvdb reads and
