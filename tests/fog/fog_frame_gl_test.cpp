@@ -106,10 +106,10 @@ TEST_F(FogFrameGL, SplatsAndHostInFogAgreeWithTheReferenceWithinSplatErrorPlusFo
         return fb->read();
     };
     const Image glPlain = drawGL(nullptr);
-    EXPECT_FALSE(fr->stats().fogHost || fr->stats().fogSplats);
+    EXPECT_FALSE(fr->stats().fog.host || fr->stats().fog.splats);
     const Image depth = fb->readDepth();
     const Image glFog = drawGL(&fog);
-    EXPECT_TRUE(fr->stats().fogHost && fr->stats().fogSplats) << fr->stats().fogError;
+    EXPECT_TRUE(fr->stats().fog.host && fr->stats().fog.splats) << fr->stats().fog.error;
 
     SplatExactDesc rd;
     rd.host.background = kBackground;
@@ -190,7 +190,7 @@ TEST_F(FogFrameGL, HostFogHandlesSkyNaNAndOutOfRangeDepth) {
     const float clear[4] = {kBackground.r, kBackground.g, kBackground.b, kBackground.a};
     glClearNamedFramebufferfv(fbo, GL_COLOR, 0, clear);
     fr->render(frame, {.framebuffer = fbo, .depthTexture = depthTex});
-    EXPECT_TRUE(fr->stats().fogHost) << fr->stats().fogError;
+    EXPECT_TRUE(fr->stats().fog.host) << fr->stats().fog.error;
     Image got;
     got.width = kSize.x, got.height = kSize.y, got.channels = 4;
     std::vector<float> raw(size_t(kSize.x) * kSize.y * 4);
@@ -257,7 +257,7 @@ TEST_F(FogFrameGL, ReducedFogTextureStaysWithinTheSameSurfacesPerPixelRange) {
         EXPECT_TRUE(fr->upload(mat));
         auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
         fr->render(frame, {.framebuffer = fb->handle(), .drawOpaque = host});
-        EXPECT_TRUE(fr->stats().fogHost) << fr->stats().fogError;
+        EXPECT_TRUE(fr->stats().fog.host) << fr->stats().fog.error;
         return std::make_pair(fb->read(), fb->readDepth());
     };
     const auto [perPixel, depth] = render({0, 0});

@@ -129,7 +129,7 @@ TEST_F(FrameShadowGL, HostGroundShaderDarkensUnderTheGasAsTheTableSays) {
     const Drawn d = draw(*fr, s.frame, prog);
     EXPECT_TRUE(d.binding.valid);
     EXPECT_EQ(d.binding.textureUnit, 15);
-    EXPECT_EQ(fr->stats().shadowUploads, 1u);
+    EXPECT_EQ(fr->stats().shadow.uploads, 1u);
     // Tolerance as tests/lighting/shadow_gl_test.cpp: GL may filter with 8-bit weights, an error of
     // 3/256 of the largest node step in depth, i.e. ln 2 times that in transmittance (T <= 1);
     // times 0.8 (the shader's sun share) in colour, plus float rounding.
@@ -153,7 +153,7 @@ TEST_F(FrameShadowGL, HostGroundShaderDarkensUnderTheGasAsTheTableSays) {
     EXPECT_LT(darkest, 0.6f) << "the blob should cast a visible shadow on the ground";
     // The same frame again: nothing uploaded.
     draw(*fr, s.frame, prog);
-    EXPECT_EQ(fr->stats().shadowUploads, 1u);
+    EXPECT_EQ(fr->stats().shadow.uploads, 1u);
     glDeleteProgram(prog);
 }
 

@@ -168,7 +168,7 @@ TEST_F(FragmentListsGL, WithoutTransparentSurfacesTheFrameTakesTheOrderedPath) {
     ASSERT_TRUE(a && b);
     fr->render(f.frame, {.framebuffer = a->handle(), .drawOpaque = clearTo(kBackground)});
     fr->render(f.frame, {.framebuffer = b->handle(), .drawOpaque = clearTo(kBackground), .transparentToLists = true});
-    EXPECT_FALSE(fr->stats().transparentLists);
+    EXPECT_FALSE(fr->stats().lists.used);
     const test::ImageDiff d = test::compareImages(b->read(), a->read(), 0.0);
     EXPECT_EQ(d.maxAbs, 0.0) << test::writeFailureImages(b->read(), d);
 }
@@ -202,17 +202,17 @@ TEST_F(FragmentListsGL, PanesInFrontOfAndBehindTheFireSortLikeTheUnambiguousOrde
                              .drawOpaque = clearTo(kBackground),
                              .drawTransparent = [&] { glass.draw(pane, cam); },
                              .transparentToLists = true});
-        EXPECT_TRUE(fr->stats().transparentLists && fr->stats().splatsInLists);
-        EXPECT_EQ(fr->stats().transparentFallback, 0u);
-        EXPECT_EQ(fr->stats().transparentOverflowPixels, 0u);
-        EXPECT_GE(fr->stats().transparentNodes, std::uint64_t(kSize.x) * kSize.y); // the pane covers every pixel
+        EXPECT_TRUE(fr->stats().lists.used && fr->stats().lists.splats);
+        EXPECT_EQ(fr->stats().lists.fallback, 0u);
+        EXPECT_EQ(fr->stats().lists.overflowPixels, 0u);
+        EXPECT_GE(fr->stats().lists.nodes, std::uint64_t(kSize.x) * kSize.y); // the pane covers every pixel
         const Image got = lists->read();
         // Every splat lies wholly behind (or in front of) the pane: none
         // needs a section; all take the ordinary splat pass, before (after)
         // the resolve (FragmentListPass::split).
-        EXPECT_EQ(fr->stats().transparentSections, 0);
-        EXPECT_EQ(fr->stats().transparentSplatsSectioned, 0u);
-        EXPECT_EQ(inFront ? fr->stats().transparentSplatsBehind : fr->stats().transparentSplatsFront, f.frame.splats().size());
+        EXPECT_EQ(fr->stats().lists.sections, 0);
+        EXPECT_EQ(fr->stats().lists.splatsSectioned, 0u);
+        EXPECT_EQ(inFront ? fr->stats().lists.splatsBehind : fr->stats().lists.splatsFront, f.frame.splats().size());
         if (inFront) {
             fr->render(f.frame, {.framebuffer = ordered->handle(), .drawOpaque = clearTo(kBackground)});
             fr->render(empty, {.framebuffer = ordered->handle(), .drawTransparent = [&] { glass.draw(pane, cam); }, .transparentToLists = true});
@@ -251,8 +251,8 @@ TEST_F(FragmentListsGL, ThreePanesAroundTheFireSortPerSplat) {
                          .drawOpaque = clearTo(kBackground),
                          .drawTransparent = [&] { glass.draw(panes, cam); },
                          .transparentToLists = true});
-    EXPECT_TRUE(fr->stats().splatsInLists);
-    EXPECT_EQ(fr->stats().transparentSections, 4);
+    EXPECT_TRUE(fr->stats().lists.splats);
+    EXPECT_EQ(fr->stats().lists.sections, 4);
     const Image got = lists->read();
     Frame empty;
     empty.begin(0.0, cam);
@@ -324,17 +324,17 @@ TEST_F(FragmentListsGL, SixtyFourLayersOnOnePixel) {
         // plus one 8-bit step of the readback.
         const double tol = kEightBit + 64 * 0.11 * std::ldexp(1.0, -11);
         EXPECT_LE(maxAlphaErr, tol) << budget;
-        EXPECT_EQ(s.transparentNodes + s.transparentFallback, 64 * pixels) << budget; // every fragment stored or blended
+        EXPECT_EQ(s.lists.nodes + s.lists.fallback, 64 * pixels) << budget; // every fragment stored or blended
         if (budget >= 64) {
             EXPECT_LE(maxErr, tol) << test::writeFailureImages(img, test::compareImages(img, img, 0.0));
-            EXPECT_EQ(s.transparentFallback, 0u);
-            EXPECT_EQ(s.transparentOverflowPixels, 0u);
-            EXPECT_EQ(s.transparentMaxSurfaces, 64u);
+            EXPECT_EQ(s.lists.fallback, 0u);
+            EXPECT_EQ(s.lists.overflowPixels, 0u);
+            EXPECT_EQ(s.lists.maxSurfaces, 64u);
         } else {
             // The pool is shared: it fills after 8 per pixel on average, some
             // pixels holding more than 8 (those merge their farthest).
-            EXPECT_EQ(s.transparentNodes, pixels * std::uint64_t(budget));
-            EXPECT_EQ(s.transparentFallback, pixels * std::uint64_t(64 - budget));
+            EXPECT_EQ(s.lists.nodes, pixels * std::uint64_t(budget));
+            EXPECT_EQ(s.lists.fallback, pixels * std::uint64_t(64 - budget));
         }
     }
 }
@@ -373,9 +373,9 @@ TEST_F(FragmentListsGL, MorePixelNodesThanTheBudgetMergeTheFarthest) {
                        .drawTransparent = [&] { glass.draw(panes, cam); },
                        .transparentToLists = true});
     const gl::FrameRenderStats& s = fr->stats();
-    EXPECT_EQ(s.transparentFallback, 0u);
-    EXPECT_GT(s.transparentOverflowPixels, 0u);
-    EXPECT_GE(s.transparentMergedNodes, 12u * s.transparentOverflowPixels / 2); // most overflowing pixels hold all 16
+    EXPECT_EQ(s.lists.fallback, 0u);
+    EXPECT_GT(s.lists.overflowPixels, 0u);
+    EXPECT_GE(s.lists.mergedNodes, 12u * s.lists.overflowPixels / 2); // most overflowing pixels hold all 16
     const Image img = fb->read();
     const int cx = kSize.x / 2, cy = kSize.y / 2;
     EXPECT_NEAR(img.at(cx, cy, 3), 1.0 - transmit, kEightBit + 16 * std::ldexp(1.0, -11));
@@ -405,7 +405,7 @@ TEST_F(FragmentListsGL, ZeroAlphaAndFullyOpaqueSurfaces) {
                          .drawOpaque = clearTo(kBackground),
                          .drawTransparent = [&] { glass.draw(zero, cam); },
                          .transparentToLists = true});
-    EXPECT_EQ(fr->stats().transparentNodes, 0u); // nothing stored
+    EXPECT_EQ(fr->stats().lists.nodes, 0u); // nothing stored
     test::ImageDiff d = test::compareImages(fb->read(), fire, tol);
     EXPECT_LE(d.maxAbs, tol) << "zero pane changed the image: " << test::writeFailureImages(fb->read(), d);
 
@@ -459,15 +459,15 @@ TEST_F(FragmentListsGL, BudgetOfOneFragmentPerPixel) {
         {.framebuffer = fb->handle(), .drawOpaque = clearTo(clear), .drawTransparent = [&] { glass.draw(panes, cam); }, .transparentToLists = true});
     const gl::FrameRenderStats s = fr->stats();
     const std::uint64_t pixels = std::uint64_t(kSize.x) * kSize.y;
-    EXPECT_EQ(s.transparentNodes, pixels);
-    EXPECT_EQ(s.transparentFallback, pixels);
-    EXPECT_GE(s.transparentSections, 2);
+    EXPECT_EQ(s.lists.nodes, pixels);
+    EXPECT_EQ(s.lists.fallback, pixels);
+    EXPECT_GE(s.lists.sections, 2);
     // Pool, heads and counts, the resolved RGBA16F image, the section targets,
     // the sorted depths (R32F, one layer fewer than sections), the counters.
-    EXPECT_EQ(s.transparentBytes,
+    EXPECT_EQ(s.lists.bytes,
               std::size_t(pixels) *
                       (kTransparentNodeBytes + kTransparentHeadBytesPerPixel + 8 +
-                       std::size_t(s.transparentSections) * kTransparentSectionBytesPerPixel + 4 * std::size_t(s.transparentSections - 1)) +
+                       std::size_t(s.lists.sections) * kTransparentSectionBytesPerPixel + 4 * std::size_t(s.lists.sections - 1)) +
                   48 +
                   (16 + 4) * std::size_t((kSize.x + 15) / 16) *
                       std::size_t((kSize.y + 15) / 16)); // + per 16 x 16 tile the survey (RGBA32UI) and, with sections, the host depth (R32F)
@@ -553,9 +553,9 @@ TEST_F(FragmentListsGL, SplatStraddlingAPaneIsCutIntoSections) {
     const double base = errorAgainstReference({{.z = 40.0f, .premultiplied = glm::vec4(0.0f)}}); // no visible pane
     for (const float dz : {0.3f, -0.3f}) {
         const double err = errorAgainstReference({{.z = centre.z + dz, .premultiplied = tint}});
-        EXPECT_TRUE(fr->stats().transparentCut);
-        EXPECT_EQ(fr->stats().transparentSplatsSectioned, 1u); // the pane meets its kernel: sections, not the ordinary pass
-        EXPECT_EQ(fr->stats().transparentSections, 2);
+        EXPECT_TRUE(fr->stats().lists.cut);
+        EXPECT_EQ(fr->stats().lists.splatsSectioned, 1u); // the pane meets its kernel: sections, not the ordinary pass
+        EXPECT_EQ(fr->stats().lists.sections, 2);
         EXPECT_LE(err, base + 2.0 * std::log(2.0) * tau * delta + 4.0 * std::ldexp(1.0, -12)) << "pane at z = centre + " << dz;
     }
 }
@@ -589,10 +589,10 @@ TEST_F(FragmentListsGL, WithAFogSplatsClearOfTheSurfacesAreExactAndTheRestSaySo)
                          .drawTransparent = [&] { glass.draw(front, cam); },
                          .transparentToLists = true});
     gl::FrameRenderStats s = fr->stats();
-    EXPECT_TRUE(s.transparentLists && s.splatsInLists && s.fogSplats);
-    EXPECT_TRUE(s.transparentNote.empty()) << s.transparentNote;
-    EXPECT_EQ(s.transparentSplatsBehind, f.frame.splats().size());
-    EXPECT_EQ(s.transparentNodes, std::uint64_t(kSize.x) * kSize.y);
+    EXPECT_TRUE(s.lists.used && s.lists.splats && s.fog.splats);
+    EXPECT_TRUE(s.lists.note.empty()) << s.lists.note;
+    EXPECT_EQ(s.lists.splatsBehind, f.frame.splats().size());
+    EXPECT_EQ(s.lists.nodes, std::uint64_t(kSize.x) * kSize.y);
     const Image got = fb->read();
     Frame empty;
     empty.begin(0.0, cam);
@@ -610,10 +610,10 @@ TEST_F(FragmentListsGL, WithAFogSplatsClearOfTheSurfacesAreExactAndTheRestSaySo)
                          .drawTransparent = [&] { glass.draw(through, cam); },
                          .transparentToLists = true});
     s = fr->stats();
-    EXPECT_NE(s.transparentNote.find("fog"), std::string::npos) << s.transparentNote;
-    EXPECT_EQ(s.transparentSplatsSectioned, 0u);
-    EXPECT_LT(s.transparentSplatsBehind + s.transparentSplatsFront, f.frame.splats().size()); // some meet the pane
-    EXPECT_EQ(s.transparentNodes, std::uint64_t(kSize.x) * kSize.y);
+    EXPECT_NE(s.lists.note.find("fog"), std::string::npos) << s.lists.note;
+    EXPECT_EQ(s.lists.splatsSectioned, 0u);
+    EXPECT_LT(s.lists.splatsBehind + s.lists.splatsFront, f.frame.splats().size()); // some meet the pane
+    EXPECT_EQ(s.lists.nodes, std::uint64_t(kSize.x) * kSize.y);
     EXPECT_GT(s.splats, 0u);
 }
 
@@ -694,10 +694,10 @@ gl::FrameRenderStats blockAgainstReference(const Camera& cam, const std::vector<
     for (const float depth : depths) {
         const double err = errorAgainstReference({{.z = eye.z - depth, .premultiplied = tint, .half = 1.0f, .centre = {eye.x, eye.y}}});
         s = fr->stats();
-        EXPECT_TRUE(s.splatsInLists);
-        EXPECT_GT(s.transparentSplatsSectioned, 0u) << what << depth;
+        EXPECT_TRUE(s.lists.splats);
+        EXPECT_GT(s.lists.splatsSectioned, 0u) << what << depth;
         std::printf("  %s, pane at view depth %.2f: error %.3e (bound %.3e; no pane %.3e), general %llu, sectioned %llu\n", what, depth, err, bound,
-                    base, (unsigned long long)s.transparentGeneral, (unsigned long long)s.transparentSplatsSectioned);
+                    base, (unsigned long long)s.lists.general, (unsigned long long)s.lists.splatsSectioned);
         EXPECT_LE(err, bound) << what << ", pane at view depth " << depth;
     }
     return s;
@@ -711,7 +711,7 @@ TEST_F(FragmentListsGL, CameraInsideTheGasInFrontOfAPaneIsExact) {
     const Camera cam = Camera::lookAt(eye, eye + glm::vec3(0.0f, 0.0f, -1.0f), {0, 1, 0}, 1.2f, {40, 32}, 0.02f, 50.0f);
     // Through the eye's kernel; beyond it, among the others.
     const gl::FrameRenderStats s = blockAgainstReference(cam, {0.6f, 0.2f}, "camera inside");
-    EXPECT_GT(s.transparentGeneral, 0u) << "the eye's kernel is cut by the pane: sections, general variant";
+    EXPECT_GT(s.lists.general, 0u) << "the eye's kernel is cut by the pane: sections, general variant";
 }
 
 // The camera just outside the gas with the near plane through the front

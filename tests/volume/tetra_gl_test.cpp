@@ -226,7 +226,7 @@ TEST_F(TetraPassGL, MatchesTheReferenceOnTheSameMeshWithinADerivedBound) {
     ASSERT_TRUE(fr && fb);
     renderFrame(*fr, *fb, frame, 1.0);
     const Image img = fb->read();
-    EXPECT_GT(fr->stats().tetrahedra, 0u);
+    EXPECT_GT(fr->stats().tetrahedra.drawn, 0u);
     Result3 r;
     int covered = 0;
     for (int y = 0; y < kSize.y; ++y)
@@ -440,10 +440,10 @@ TEST_F(TetraPassGL, DegenerateNonFiniteAndTransparentTetrahedraAreSkipped) {
         return fb->read();
     };
     const Image alone = draw({visible});
-    EXPECT_EQ(fr->stats().tetrahedra, 1u);
+    EXPECT_EQ(fr->stats().tetrahedra.drawn, 1u);
     const Image mixed = draw({flat, nan, visible, clear});
-    EXPECT_EQ(fr->stats().tetrahedra, 1u);
-    EXPECT_EQ(fr->stats().tetrahedraTransparent, 1u);
+    EXPECT_EQ(fr->stats().tetrahedra.drawn, 1u);
+    EXPECT_EQ(fr->stats().tetrahedra.transparent, 1u);
     double maxAbs = 0.0, alpha = 0.0;
     for (std::size_t i = 0; i < alone.pixels.size(); ++i) {
         ASSERT_TRUE(std::isfinite(mixed.pixels[i]));
@@ -557,7 +557,7 @@ TEST_F(TetraPassGL, ReducedResolutionSplatsLeaveTheTetrahedraAtFullResolution) {
     }
     EXPECT_GT(alpha, 0.1);
     EXPECT_EQ(maxAbs, 0.0);
-    EXPECT_EQ(half->stats().tetrahedra, full->stats().tetrahedra);
+    EXPECT_EQ(half->stats().tetrahedra.drawn, full->stats().tetrahedra.drawn);
 }
 
 // FrameRendererDesc::reduceTetrahedra: the tetrahedra go into the splats'
@@ -689,7 +689,7 @@ TEST_F(TetraPassGL, SliverTetrahedraStayFiniteAndWithinTheBound) {
         auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
         ASSERT_TRUE(fr && fb);
         renderFrame(*fr, *fb, frame, 1.0);
-        EXPECT_EQ(fr->stats().tetrahedra, 1u) << "a sliver is not degenerate";
+        EXPECT_EQ(fr->stats().tetrahedra.drawn, 1u) << "a sliver is not degenerate";
         const Image img = fb->read();
         int over = 0;
         double worst = 0.0, alpha = 0.0;
@@ -837,7 +837,7 @@ TEST_F(TetraPassGL, FogAttenuatesEveryTetrahedronAsOneMedium) {
     auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
     ASSERT_TRUE(fr && fb);
     renderFrame(*fr, *fb, frame, 1.0);
-    EXPECT_TRUE(fr->stats().fogTetrahedra) << fr->stats().fogError;
+    EXPECT_TRUE(fr->stats().fog.tetrahedra) << fr->stats().fog.error;
     const Image img = fb->read();
     int over = 0, overExact = 0, overRule = 0, covered = 0, changed = 0;
     double worst = 0.0, worstExact = 0.0, worstRule = 0.0, maxRule = 0.0, maxPlacement = 0.0;

@@ -160,7 +160,7 @@ int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
                 }
             std::sort(err.begin(), err.end());
             std::printf("%-20s %-12s %-8s %10llu %9.1f %9.4f %9.4f %9.4f\n", r.knob.c_str(), r.value.c_str(), v.name,
-                        static_cast<unsigned long long>(fr->stats().tetrahedra), median(t), sum / double(err.size()),
+                        static_cast<unsigned long long>(fr->stats().tetrahedra.drawn), median(t), sum / double(err.size()),
                         err[std::min(err.size() - 1, std::size_t(0.99 * double(err.size())))], err.back());
         }
     }

@@ -203,7 +203,7 @@ int runClouds(int argc, char** argv) {
                 }
             }
             if (f < 0) continue;
-            (in ? drawnIn : drawnOut).push_back(double(fr->stats().tetrahedra));
+            (in ? drawnIn : drawnOut).push_back(double(fr->stats().tetrahedra.drawn));
             std::size_t bytes = 0;
             for (const auto& v : frame.volumes()) bytes += v.lod.tets.size() * (sizeof(splatfx::Tetrahedron) + 160);
             maxFrameBytes = std::max(maxFrameBytes, bytes);
@@ -233,7 +233,7 @@ int runClouds(int argc, char** argv) {
             }
         std::printf("memory: LOD volume %zu bytes, table %zu bytes (CPU) + %zu (GPU, RGBA32F), per-frame tetrahedra up to %zu bytes "
                     "(CPU list + GPU records)\n",
-                    cs.volumeBytes, cs.tableBytes, fr->stats().tableBytes, maxFrameBytes);
+                    cs.volumeBytes, cs.tableBytes, fr->stats().tetrahedra.tableBytes, maxFrameBytes);
     }
 
     // ---- 2. Popping: per-pixel change between consecutive frames ----
@@ -262,7 +262,7 @@ int runClouds(int argc, char** argv) {
                 const splatfx::Camera cam = slowFlight(cs.ext, f, o.popStepWorld, o.popSize);
                 cs.scene.prepare(f / 60.0 + 1.0, cam, materials, frame);
                 fr->render(frame, bench::clearedTarget(*fb, {0.0f, 0.0f, 0.0f, 0.0f}));
-                drawn += double(fr->stats().tetrahedra);
+                drawn += double(fr->stats().tetrahedra.drawn);
                 splatfx::Image img = fb->read();
                 if (f > 0)
                     for (std::size_t p = 0; p < img.pixels.size(); p += 4) {

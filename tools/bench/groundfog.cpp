@@ -153,7 +153,7 @@ int runGroundFog(int argc, char** argv) {
             if (!frame.volumes().empty()) full = frame.volumes()[0].lod.stats.fullResolution;
             m.msFrame.push_back(ms(c - a));
             m.msPrepare.push_back(ms(b - a));
-            m.drawn.push_back(double(l.renderer->stats().tetrahedra));
+            m.drawn.push_back(double(l.renderer->stats().tetrahedra.drawn));
             splatfx::Image im = fb->read();
             if (o.probe.x >= 0 && !frame.volumes().empty()) {
                 // The pixel's centre ray (55° vertical field of view, as flight()).

@@ -291,18 +291,18 @@ int runTransparency(int argc, char** argv) {
     std::printf("\n%-44s %9s %9s %9s %8s %10s %10s %12s %9s\n", "configuration", "ms/frame", "vs opaque", "RMSE", "max", "fallback", "merged px",
                 "list MB", "B/pixel");
     for (const Config& c : configs) {
-        const double mb = double(c.stats.transparentBytes) / 1e6;
+        const double mb = double(c.stats.lists.bytes) / 1e6;
         std::printf("%-44s %9.2f %9.2f %9.4f %8.3f %10llu %10llu %12.2f %9.1f\n", c.name.c_str(), c.ms, c.ms / opaqueMs, c.error.rmse, c.error.max,
-                    (unsigned long long)c.stats.transparentFallback, (unsigned long long)c.stats.transparentOverflowPixels, c.lists ? mb : 0.0,
-                    c.lists ? double(c.stats.transparentBytes) / double(size.x * size.y) : 0.0);
+                    (unsigned long long)c.stats.lists.fallback, (unsigned long long)c.stats.lists.overflowPixels, c.lists ? mb : 0.0,
+                    c.lists ? double(c.stats.lists.bytes) / double(size.x * size.y) : 0.0);
     }
     std::printf("\nHow the splats of the list frames were drawn (FrameRenderStats): behind every surface they cover / in front of\n"
                 "every one (both: the ordinary splat pass) / cut into sections / of those, by the general (eye-plane) variant\n");
     for (const Config& c : configs)
         if (c.lists)
-            std::printf("%-44s %6llu %6llu %6llu %6llu\n", c.name.c_str(), (unsigned long long)c.stats.transparentSplatsBehind,
-                        (unsigned long long)c.stats.transparentSplatsFront, (unsigned long long)c.stats.transparentSplatsSectioned,
-                        (unsigned long long)c.stats.transparentGeneral);
+            std::printf("%-44s %6llu %6llu %6llu %6llu\n", c.name.c_str(), (unsigned long long)c.stats.lists.splatsBehind,
+                        (unsigned long long)c.stats.lists.splatsFront, (unsigned long long)c.stats.lists.splatsSectioned,
+                        (unsigned long long)c.stats.lists.general);
     std::printf("\nRMSE / max: linear RGB of the RGBA8 frame against renderSplatExact with the same panes (ReferenceSurface),\n"
                 "each splat cut into exact sections at the panes; 1/255 = 0.0039.\n"
                 "Targets (issue 15): one pane in front, lists <= 2x the opaque-only frame, error within the opaque-only error.\n");

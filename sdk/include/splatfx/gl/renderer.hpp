@@ -26,6 +26,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "splatfx/camera.hpp"
@@ -106,6 +107,19 @@ struct Target {
     unsigned depthTexture = 0;
 };
 
+// A Target whose host depth is resolved: what every pass of gl::FrameRenderer
+// draws into (frame_plan.hpp). depthTexture is the single-sampled texture the
+// passes read, or 0 when the host has none they can read (no lookup follows).
+struct PassTarget {
+    unsigned framebuffer = 0;
+    int x = 0, y = 0, width = 0, height = 0;
+    unsigned depthTexture = 0;
+};
+
+namespace detail {
+class SplatPass;
+}
+
 struct DrawStats {
     std::uint64_t splats = 0;
     std::uint64_t drawCalls = 0;
@@ -130,7 +144,7 @@ public:
     Status upload(const Materials& materials);
     // Draws splats (already sorted back to front) with camera's matrices.
     // Expects upload() to have been called.
-    void draw(const std::vector<Splat>& splats, const Camera& camera, const Target& target);
+    void draw(std::span<const Splat> splats, const Camera& camera, const Target& target);
 
     // Per-fragment fog (issue 14, docs/fog.md): from the next draw() on,
     // every splat fragment becomes f c + (1 - f) alpha C_fog (premultiplied,
@@ -154,6 +168,10 @@ public:
     int upsampleFactor() const;
 
 private:
+    friend class detail::SplatPass;
+    friend class ScaledRenderer;
+    // draw() with the host depth already resolved (no framebuffer query).
+    void drawResolved(std::span<const Splat> splats, const Camera& camera, const PassTarget& target);
     struct Impl;
     explicit Renderer(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> mImpl;

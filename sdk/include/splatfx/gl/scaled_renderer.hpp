@@ -33,6 +33,7 @@
 #pragma once
 
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "splatfx/camera.hpp"
@@ -51,26 +52,6 @@ struct ScaledRendererDesc {
     float depthThreshold = 0.1f;          // relative view-depth difference that still counts as one surface; default 0.1
 };
 
-// Where to draw: the host's framebuffer and viewport, and its depth as a texture.
-struct ScaledTarget {
-    unsigned framebuffer = 0;
-    int x = 0, y = 0;
-    int width = 0, height = 0;
-    // Host depth texture (GL name). 0: use the framebuffer's depth attachment
-    // when it is a texture; with none, no depth test and plain bilinear upsampling.
-    unsigned depthTexture = 0;
-};
-
-// The reduced-resolution image between ScaledRenderer::begin and composite:
-// a framebuffer of width x height pixels, premultiplied RGBA cleared to 0,
-// whose depth attachment (depthTexture) holds the host depth downsampled
-// (farthest of each block; 1.0 without a host depth).
-struct ReducedLayer {
-    unsigned framebuffer = 0;
-    int width = 0, height = 0;
-    unsigned depthTexture = 0;
-};
-
 class ScaledRenderer {
 public:
     // Fails when no GL 4.5 context is current or scale is not 1, 2 or 4 (the message names desc.scale).
@@ -81,7 +62,10 @@ public:
 
     Status upload(const Materials& materials);
     // Expects upload() first and a target of positive size.
-    void draw(const std::vector<Splat>& splats, const Camera& camera, const ScaledTarget& target);
+    // The target's depthTexture (0: the framebuffer's depth attachment when it
+    // is a texture) is downsampled for the test and the upsampling; with none,
+    // no depth test and plain bilinear upsampling.
+    void draw(std::span<const Splat> splats, const Camera& camera, const Target& target);
 
     // draw() in steps, for more than one pass into the reduced image (gl::FrameRenderer
     // draws a frame's tetrahedra and splats into it in one back-to-front order):
@@ -91,15 +75,23 @@ public:
     // full-resolution rectangle (x0, y0, x1, y1, viewport-relative) the passes can
     // touch: the composite is scissored to it. Expects scale 2 or 4, begin and
     // composite paired; GL state as draw() (saved at begin, restored at composite).
-    ReducedLayer begin(const ScaledTarget& target, glm::ivec4 box);
-    void drawSplats(const std::vector<Splat>& splats, const Camera& camera);
+    // The layer is a framebuffer of ceil(width / scale) x ceil(height / scale)
+    // pixels, premultiplied RGBA cleared to 0, whose depth attachment
+    // (depthTexture) holds the host depth downsampled (farthest of each
+    // block; 1.0 without a host depth).
+    PassTarget begin(const Target& target, glm::ivec4 box);
+    void drawSplats(std::span<const Splat> splats, const Camera& camera);
     void composite(const Camera& camera);
 
     const ScaledRendererDesc& desc() const;
     const Renderer& renderer() const;
-    Renderer& renderer(); // e.g. Renderer::setFog (issue 14)
+    Renderer& renderer(); // e.g. Renderer::setFog
 
 private:
+    friend class detail::SplatPass;
+    // draw() and begin() with the host depth already resolved.
+    void drawResolved(std::span<const Splat> splats, const Camera& camera, const PassTarget& target);
+    PassTarget beginResolved(const PassTarget& target, glm::ivec4 box);
     struct Impl;
     explicit ScaledRenderer(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> mImpl;

@@ -2,6 +2,7 @@
 #include "fog_pass.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <string>
 
 #include <epoxy/gl.h>
@@ -155,14 +156,10 @@ Status FogPass::build(const Fog& fog) {
     return {};
 }
 
-Status FogPass::draw(const Fog& fog, double timeSec, const Camera& camera, const FogPassTarget& target, glm::ivec2 textureSize,
-                     float depthThreshold) {
+Status FogPass::draw(const Fog& fog, double timeSec, const Camera& camera, const PassTarget& target) {
     if (fog.empty()) return {};
-    GLint samples = 0;
-    glGetTextureLevelParameteriv(target.depthTexture, 0, GL_TEXTURE_SAMPLES, &samples);
-    if (samples > 1)
-        return makeError("fog pass: HostTarget::depthTexture is multisampled (" + std::to_string(samples) +
-                         " samples); resolve it into a single-sample depth texture first");
+    const glm::ivec2 textureSize = mAskedSize;
+    const float depthThreshold = mDepthThreshold;
     if (Status s = build(fog); !s) return s;
     const bool reduced = textureSize.x > 0 && textureSize.y > 0;
     if (reduced && textureSize != mTextureSize) {
@@ -236,6 +233,26 @@ Status FogPass::draw(const Fog& fog, double timeSec, const Camera& camera, const
     for (int u = 0; u < 2; ++u) glBindSampler(GLuint(u), GLuint(hostSampler[u]));
     saved.restore();
     return {};
+}
+
+// ---- As a pass of the frame (passes/pass.hpp) ----
+
+void FogPass::prepare(const FramePlan&, const Frame&) {
+    mDrawn = false;
+    mError.clear();
+}
+
+void FogPass::execute(const PlanStep& step, StepContext& context) {
+    assert(step.kind == StepKind::HostFog && context.plan.fog);
+    (void)step;
+    const Status s = draw(*context.plan.fog, context.plan.timeSec, context.frame.camera(), context.plan.target);
+    mDrawn = bool(s);
+    if (!s) mError = s.error();
+}
+
+void FogPass::report(FrameRenderStats& stats) const {
+    stats.fog.host = mDrawn;
+    if (!mError.empty()) stats.fog.error = mError;
 }
 
 } // namespace splatfx::gl::detail

@@ -25,25 +25,25 @@
 #include "splatfx/camera.hpp"
 #include "splatfx/fog.hpp"
 #include "splatfx/result.hpp"
+#include "passes/pass.hpp"
 
 namespace splatfx::gl::detail {
 
-struct FogPassTarget {
-    unsigned framebuffer = 0;
-    int x = 0, y = 0, width = 0, height = 0;
-    unsigned depthTexture = 0; // the host depth, framebuffer-sized, window units
-};
-
-class FogPass {
+class FogPass final : public Pass {
 public:
-    FogPass() = default;
+    // textureSize (0, 0): per pixel; else the reduced fog texture's size.
+    // depthThreshold: relative distance difference still one surface when upsampling.
+    FogPass(glm::ivec2 textureSize, float depthThreshold) : mAskedSize(textureSize), mDepthThreshold(depthThreshold) {}
     FogPass(const FogPass&) = delete;
     FogPass& operator=(const FogPass&) = delete;
     ~FogPass();
 
-    // textureSize (0, 0): per pixel; else the reduced fog texture's size.
-    // depthThreshold: relative distance difference still one surface when upsampling.
-    Status draw(const Fog& fog, double timeSec, const Camera& camera, const FogPassTarget& target, glm::ivec2 textureSize, float depthThreshold);
+    // Expects a single-sampled host depth in the target.
+    Status draw(const Fog& fog, double timeSec, const Camera& camera, const PassTarget& target);
+
+    void prepare(const FramePlan& plan, const Frame& frame) override;
+    void execute(const PlanStep& step, StepContext& context) override; // HostFog
+    void report(FrameRenderStats& stats) const override;
 
 private:
     Status build(const Fog& fog);
@@ -56,6 +56,10 @@ private:
     unsigned mVao = 0, mFbo = 0, mTexture = 0, mSampler = 0;
     glm::ivec2 mTextureSize{0};
     std::vector<glm::vec4> mParams;
+    glm::ivec2 mAskedSize{0};
+    float mDepthThreshold = 0.05f;
+    bool mDrawn = false;
+    std::string mError;
 };
 
 } // namespace splatfx::gl::detail

@@ -3,6 +3,7 @@
 #include "fragment_list_pass.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -587,7 +588,7 @@ FragmentListPass& FragmentListPass::operator=(FragmentListPass&&) noexcept = def
 FragmentListPass::~FragmentListPass() = default;
 const FragmentListStats& FragmentListPass::stats() const { return mImpl->stats; }
 
-Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
+Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel, const RendererDesc& splats) {
     auto impl = std::make_unique<Impl>();
     impl->perPixel = std::clamp(fragmentsPerPixel, 1, kMaxFragmentsPerPixel);
     if (!impl->buildSections(0)) return makeError(impl->programError);
@@ -637,7 +638,9 @@ Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel) {
     }
     glCreateBuffers(1, &impl->counters);
     glNamedBufferStorage(impl->counters, kCounterBytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
-    return FragmentListPass(std::move(impl));
+    FragmentListPass pass(std::move(impl));
+    pass.mSplatDesc = splats;
+    return pass;
 }
 
 Status FragmentListPass::upload(const Materials& materials) {
@@ -657,7 +660,7 @@ Status FragmentListPass::upload(const Materials& materials) {
     return {};
 }
 
-Status FragmentListPass::collectSurfaces(const FragmentListTarget& target, const std::function<void()>& drawSurfaces) {
+Status FragmentListPass::collectSurfaces(const PassTarget& target, const std::function<void()>& drawSurfaces) {
     Impl& r = *mImpl;
     if (target.width <= 0 || target.height <= 0) return makeError("fragment lists: the viewport must be positive");
     r.resize(target.width, target.height);
@@ -700,7 +703,7 @@ Status FragmentListPass::collectSurfaces(const FragmentListTarget& target, const
 }
 
 FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats, const Camera& camera, float cut, bool trimCorners, bool depthCut,
-                                                const FragmentListTarget& target) {
+                                                const PassTarget& target) {
     Impl& r = *mImpl;
     r.stats.splatsBehind = r.stats.splatsFront = r.stats.splatsSectioned = 0;
     r.needs.clear();
@@ -820,7 +823,7 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
 }
 
 void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t begin, std::size_t end, const Camera& camera, unsigned layerTexture,
-                                    float cut, bool trimCorners, bool depthCut, const FragmentListTarget& target) {
+                                    float cut, bool trimCorners, bool depthCut, const PassTarget& target) {
     Impl& r = *mImpl;
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     end = std::min(end, all.size());
@@ -966,7 +969,7 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t b
     r.stats.generalSplats = crossing;
 }
 
-void FragmentListPass::resolve(const FragmentListTarget& target) {
+void FragmentListPass::resolve(const PassTarget& target) {
     Impl& r = *mImpl;
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     GLuint maxSurfaces = 0;
@@ -1050,6 +1053,67 @@ void FragmentListPass::resolve(const FragmentListTarget& target) {
     glBindTextureUnit(1, 0);
     glBindTextureUnit(2, 0);
     glBindTextureUnit(3, 0);
+}
+
+// ---- As a pass of the frame (passes/pass.hpp) ----
+
+void FragmentListPass::prepare(const FramePlan& plan, const Frame&) {
+    mUsed = plan.lists;
+    mSectioned = 0;
+}
+
+void FragmentListPass::execute(const PlanStep& step, StepContext& context) {
+    const PassTarget& target = context.plan.target;
+    const RendererDesc& d = mSplatDesc;
+    switch (step.kind) {
+    case StepKind::ListsCollect: {
+        if (d.restoreState) mSaved.save({.texture2DUnits = 0, .scissor = false});
+        const Status s = collectSurfaces(target, context.host.drawTransparent);
+        context.listsReady = bool(s);
+        if (!s) context.listsNote = s.error();
+        if (!s && d.restoreState) mSaved.restore();
+        break;
+    }
+    case StepKind::ListsSplit: {
+        if (!context.listsReady) break;
+        const Split split = this->split(context.frame.splats(), context.frame.camera(), d.footprintCut, d.trimCorners, d.depthCut, target);
+        context.behindEnd = split.behindEnd;
+        context.frontBegin = split.frontBegin;
+        break;
+    }
+    case StepKind::ListsSections:
+        if (!context.listsReady) break;
+        insertSplats(context.frame.splats(), context.behindEnd, context.frontBegin, context.frame.camera(), context.splatLayers, d.footprintCut,
+                     d.trimCorners, d.depthCut, target);
+        if (context.frontBegin > context.behindEnd) ++mSectioned;
+        break;
+    case StepKind::ListsResolve:
+        if (!context.listsReady) break;
+        resolve(target);
+        if (d.restoreState) mSaved.restore();
+        break;
+    default: assert(false && "FragmentListPass: not a list step");
+    }
+}
+
+void FragmentListPass::report(FrameRenderStats& stats) const {
+    if (!mUsed) return;
+    const FragmentListStats& ls = mImpl->stats;
+    FrameRenderStats::Lists& l = stats.lists;
+    l.nodes = ls.nodes;
+    l.fallback = ls.fallback;
+    l.overflowPixels = ls.overflowPixels;
+    l.mergedNodes = ls.mergedNodes;
+    l.sectionOverflow = ls.sectionOverflow;
+    l.maxSurfaces = ls.maxSurfaces;
+    l.sections = ls.sections;
+    l.cut = ls.cut;
+    l.general = ls.generalSplats;
+    l.splatsBehind = ls.splatsBehind;
+    l.splatsFront = ls.splatsFront;
+    l.splatsSectioned = ls.splatsSectioned;
+    l.bytes = ls.bytes;
+    stats.drawCalls += mSectioned;
 }
 
 } // namespace splatfx::gl::detail

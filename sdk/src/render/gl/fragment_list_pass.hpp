@@ -1,5 +1,5 @@
-// (issue 15) The order-exact transparency pass (private to the GL
-// backend, owned by gl::FrameRenderer): per-pixel linked fragment lists.
+// The order-exact transparency pass (private to the GL backend, a pass of
+// gl::FrameRenderer): per-pixel linked fragment lists.
 //
 // Method (Ebert & Parent 1990, "Combining A-buffer and Volume Rendering",
 // Fig. 1: "the volume to be rendered must be broken into sections that lie
@@ -53,14 +53,11 @@
 #include "splatfx/materials.hpp"
 #include "splatfx/result.hpp"
 #include "splatfx/splats.hpp"
+#include "passes/pass.hpp"
+#include "saved_state.hpp"
+#include "splatfx/gl/renderer.hpp"
 
 namespace splatfx::gl::detail {
-
-struct FragmentListTarget {
-    unsigned framebuffer = 0;
-    int x = 0, y = 0, width = 0, height = 0;
-    unsigned depthTexture = 0; // the host's depth texture (splat sections are depth-tested against it); 0: none
-};
 
 struct FragmentListStats {
     std::uint64_t nodes = 0;           // surface nodes stored
@@ -79,11 +76,12 @@ struct FragmentListStats {
     std::size_t poolNodes = 0;         // capacity of the pool
 };
 
-class FragmentListPass {
+class FragmentListPass final : public Pass {
 public:
     // fragmentsPerPixel in [1, kMaxFragmentsPerPixel] (checked by the caller).
     static constexpr int kMaxFragmentsPerPixel = 128;
-    static Result<FragmentListPass> create(int fragmentsPerPixel);
+    // splats: the splat pass's settings (the sections cut and trim as it does).
+    static Result<FragmentListPass> create(int fragmentsPerPixel, const RendererDesc& splats);
     FragmentListPass(FragmentListPass&&) noexcept;
     FragmentListPass& operator=(FragmentListPass&&) noexcept;
     ~FragmentListPass();
@@ -94,7 +92,7 @@ public:
     // transparentGlsl() expects them; then runs drawSurfaces with the
     // target's framebuffer bound, premultiplied "over" blending, depth test
     // LEQUAL without writes.
-    Status collectSurfaces(const FragmentListTarget& target, const std::function<void()>& drawSurfaces);
+    Status collectSurfaces(const PassTarget& target, const std::function<void()>& drawSurfaces);
     // After collectSurfaces: the sorted splats (back to front) as three runs.
     // [0, behindEnd) lie behind every surface stored on every pixel they may
     // cover, [frontBegin, size) in front of every one, the rest between.
@@ -109,7 +107,7 @@ public:
     struct Split {
         std::size_t behindEnd = 0, frontBegin = 0;
     };
-    Split split(const std::vector<Splat>& splats, const Camera& camera, float cut, bool trimCorners, bool depthCut, const FragmentListTarget& target);
+    Split split(const std::vector<Splat>& splats, const Camera& camera, float cut, bool trimCorners, bool depthCut, const PassTarget& target);
     // Composites the splats [begin, end) (sorted back to front) into their sections.
     // layerTexture: the splat pass's GL_TEXTURE_2D_ARRAY; cut, trimCorners:
     // RendererDesc's. Reads the surface counters back first (one GPU sync)
@@ -118,17 +116,25 @@ public:
     // partial line integral and cut at the near plane and the host depth;
     // false: the kernel as a step at its plane.
     void insertSplats(const std::vector<Splat>& splats, std::size_t begin, std::size_t end, const Camera& camera, unsigned layerTexture, float cut,
-                      bool trimCorners, bool depthCut, const FragmentListTarget& target);
+                      bool trimCorners, bool depthCut, const PassTarget& target);
     // Sorts every pixel's surfaces, interleaves the sections, composites
     // over the framebuffer, unbinds the lists, reads the counters back.
-    void resolve(const FragmentListTarget& target);
+    void resolve(const PassTarget& target);
 
     const FragmentListStats& stats() const;
+
+    void prepare(const FramePlan& plan, const Frame& frame) override;
+    void execute(const PlanStep& step, StepContext& context) override; // ListsCollect, ListsSplit, ListsSections, ListsResolve
+    void report(FrameRenderStats& stats) const override;
 
 private:
     struct Impl;
     explicit FragmentListPass(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> mImpl;
+    RendererDesc mSplatDesc;
+    SavedState mSaved; // the host's state, from ListsCollect to ListsResolve
+    bool mUsed = false;
+    std::uint64_t mSectioned = 0; // section draws this frame
 };
 
 } // namespace splatfx::gl::detail

@@ -16,6 +16,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "context_check.hpp"
+#include "host_depth.hpp"
 #include "partial_texture.hpp"
 #include "saved_state.hpp"
 #include "splatfx/gl/program.hpp"
@@ -80,8 +81,6 @@ struct Renderer::Impl {
     float kernelRadius = 1.6f;
     std::array<float, 256> rho{}; // rayScaleRho by code
     std::vector<std::uint8_t> classes;
-    GLuint depthQueried = 0; // the host depth texture last checked, and whether it can be sampled
-    bool depthUsable = false;
     // The host depth as view depth (R32F, the target's size), its framebuffer and program.
     // The host view-depth range per kCutTile tile (RG32F), read back per draw.
     GLuint tiles = 0, tilesFbo = 0, tilesProgram = 0, tilesVao = 0;
@@ -320,23 +319,13 @@ Status Renderer::setFog(const Fog* fog, double timeSec) {
     return {};
 }
 
-namespace {
+namespace {} // namespace
 
-// The host depth the cut reads: the target's texture, else the framebuffer's
-// depth attachment when it is a texture (the default framebuffer's never is).
-GLuint hostDepthTexture(const Target& target) {
-    if (target.depthTexture) return target.depthTexture;
-    if (target.framebuffer == 0) return 0;
-    GLint type = GL_NONE, name = 0;
-    glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
-    if (type != GL_TEXTURE) return 0;
-    glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &name);
-    return GLuint(name);
+void Renderer::draw(std::span<const Splat> splats, const Camera& camera, const Target& target) {
+    drawResolved(splats, camera, detail::resolveTarget(target));
 }
 
-} // namespace
-
-void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, const Target& target) {
+void Renderer::drawResolved(std::span<const Splat> splats, const Camera& camera, const PassTarget& target) {
     Impl& r = *mImpl;
     assert(r.layers && "splatfx::gl::Renderer::draw: call upload(materials) first");
     r.stats.splats = splats.size();
@@ -366,17 +355,8 @@ void Renderer::draw(const std::vector<Splat>& splats, const Camera& camera, cons
 
     // The cut reads the host depth where it can sample it (single-sampled):
     // first as view depth per pixel and its range per tile (read back).
-    GLuint depthTex = 0;
-    if (cut && r.desc.depthTest && r.tilesProgram) {
-        depthTex = hostDepthTexture(target);
-        if (depthTex && depthTex != r.depthQueried) {
-            GLint samples = 0;
-            glGetTextureLevelParameteriv(depthTex, 0, GL_TEXTURE_SAMPLES, &samples);
-            r.depthQueried = depthTex;
-            r.depthUsable = samples <= 1;
-        }
-        if (depthTex && !r.depthUsable) depthTex = 0; // multisampled: the plain test at the splat plane
-    }
+    // (A multisampled host depth was resolved to none: the plain test at the splat plane.)
+    const GLuint depthTex = cut && r.desc.depthTest && r.tilesProgram ? target.depthTexture : 0;
     r.stats.cutHostDepth = depthTex != 0;
     const glm::mat4 invProj = glm::inverse(camera.proj);
     const int tile = detail::kCutTile;

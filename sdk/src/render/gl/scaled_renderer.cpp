@@ -9,6 +9,7 @@
 #include <epoxy/gl.h>
 
 #include "context_check.hpp"
+#include "host_depth.hpp"
 #include "formats.hpp"
 #include "saved_state.hpp"
 #include "splatfx/gl/program.hpp"
@@ -19,7 +20,7 @@ namespace {
 
 // Window-space rectangle (x0, y0, x1, y1), relative to the viewport, that the
 // splats' quads can touch; the whole viewport when one crosses the eye plane.
-glm::ivec4 splatBounds(const std::vector<Splat>& splats, const Camera& camera, int w, int h) {
+glm::ivec4 splatBounds(std::span<const Splat> splats, const Camera& camera, int w, int h) {
     const glm::mat4 vp = camera.proj * camera.view;
     float x0 = 1e30f, y0 = 1e30f, x1 = -1e30f, y1 = -1e30f;
     for (const Splat& s : splats)
@@ -49,7 +50,7 @@ struct ScaledRenderer::Impl {
     GLenum copyFormat = 0;
     // Between begin() and composite().
     bool open = false, useDepth = false;
-    ScaledTarget target;
+    PassTarget target;
     glm::ivec4 lowBox{0}, fullBox{0};
     detail::SavedState saved;
 
@@ -120,13 +121,19 @@ Result<ScaledRenderer> ScaledRenderer::create(const ScaledRendererDesc& desc) {
 
 Status ScaledRenderer::upload(const Materials& materials) { return mImpl->inner->upload(materials); }
 
-void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera, const ScaledTarget& target) {
+void ScaledRenderer::draw(std::span<const Splat> splats, const Camera& camera, const Target& target) {
+    drawResolved(splats, camera, detail::resolveTarget(target));
+}
+
+PassTarget ScaledRenderer::begin(const Target& target, glm::ivec4 box) { return beginResolved(detail::resolveTarget(target), box); }
+
+void ScaledRenderer::drawResolved(std::span<const Splat> splats, const Camera& camera, const PassTarget& target) {
     Impl& r = *mImpl;
-    assert(target.width > 0 && target.height > 0 && "ScaledTarget::width and height must be positive");
+    assert(target.width > 0 && target.height > 0 && "Target::width and height must be positive");
     if (r.desc.scale == 1) {
         detail::SavedState saved;
         if (r.desc.renderer.restoreState) saved.save({.texture2DUnits = 3, .scissor = true});
-        r.inner->draw(splats, camera, {target.framebuffer, target.x, target.y, target.width, target.height});
+        r.inner->drawResolved(splats, camera, target);
         if (r.desc.renderer.restoreState) saved.restore();
         return;
     }
@@ -135,14 +142,14 @@ void ScaledRenderer::draw(const std::vector<Splat>& splats, const Camera& camera
     // rasterizer a full-screen pass costs as much as the effect itself.
     const glm::ivec4 box = splatBounds(splats, camera, target.width, target.height);
     if (box.z <= box.x || box.w <= box.y) return;
-    begin(target, box);
+    beginResolved(target, box);
     drawSplats(splats, camera);
     composite(camera);
 }
 
-ReducedLayer ScaledRenderer::begin(const ScaledTarget& target, glm::ivec4 box) {
+PassTarget ScaledRenderer::beginResolved(const PassTarget& target, glm::ivec4 box) {
     Impl& r = *mImpl;
-    assert(target.width > 0 && target.height > 0 && "ScaledTarget::width and height must be positive");
+    assert(target.width > 0 && target.height > 0 && "Target::width and height must be positive");
     assert(!r.open && "ScaledRenderer::begin: composite() the previous layer first");
     // The passes bind GL_TEXTURE_2D on units 0-2 (colour, depth, host depth
     // copy), the texture array on unit 0, and scissor to the box.
@@ -157,15 +164,7 @@ ReducedLayer ScaledRenderer::begin(const ScaledTarget& target, glm::ivec4 box) {
     r.fullBox = {std::max(r.lowBox.x * s, 0), std::max(r.lowBox.y * s, 0), std::min(r.lowBox.z * s, target.width),
                  std::min(r.lowBox.w * s, target.height)};
 
-    GLuint hostDepth = target.depthTexture;
-    if (hostDepth == 0 && target.framebuffer != 0) {
-        GLint type = GL_NONE, name = 0;
-        glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
-        if (type == GL_TEXTURE) {
-            glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &name);
-            hostDepth = GLuint(name);
-        }
-    }
+    const GLuint hostDepth = target.depthTexture;
     r.useDepth = hostDepth != 0;
     if (r.useDepth) {
         GLint format = 0;
@@ -209,17 +208,17 @@ ReducedLayer ScaledRenderer::begin(const ScaledTarget& target, glm::ivec4 box) {
     return {.framebuffer = r.fbo, .width = r.lowW, .height = r.lowH, .depthTexture = r.depth};
 }
 
-void ScaledRenderer::drawSplats(const std::vector<Splat>& splats, const Camera& camera) {
+void ScaledRenderer::drawSplats(std::span<const Splat> splats, const Camera& camera) {
     Impl& r = *mImpl;
     assert(r.open && "ScaledRenderer::drawSplats: begin() first");
     // Into the low-resolution target (transparent black, premultiplied).
-    r.inner->draw(splats, camera, {r.fbo, 0, 0, r.lowW, r.lowH});
+    r.inner->drawResolved(splats, camera, {.framebuffer = r.fbo, .width = r.lowW, .height = r.lowH, .depthTexture = r.depth});
 }
 
 void ScaledRenderer::composite(const Camera& camera) {
     Impl& r = *mImpl;
     assert(r.open && "ScaledRenderer::composite: begin() first");
-    const ScaledTarget& target = r.target;
+    const PassTarget& target = r.target;
     const GLint hostRect[4] = {0, 0, target.width, target.height};
     glEnable(GL_SCISSOR_TEST);
     glScissor(target.x + r.fullBox.x, target.y + r.fullBox.y, r.fullBox.z - r.fullBox.x, r.fullBox.w - r.fullBox.y);

@@ -3,7 +3,7 @@
 #include <epoxy/gl.h>
 #include <glm/gtc/type_ptr.hpp>
 
-namespace splatfx::gl {
+namespace splatfx::gl::detail {
 
 ShadowPass::~ShadowPass() {
     if (mTexture) glDeleteTextures(1, &mTexture);
@@ -59,6 +59,21 @@ void ShadowPass::unbind() {
 ShadowBinding ShadowPass::binding() const {
     return {.valid = mValid, .textureUnit = mUnit, .texture = mTexture, .worldToTable = mWorldToTable, .lightInTable = mLight};
 }
+
+void ShadowPass::execute(const PlanStep& step, StepContext& context) {
+    if (step.kind == StepKind::UploadShadow) {
+        if (upload(context.frame.shadow())) ++mUploads;
+        bind();
+    } else {
+        unbind();
+    }
+}
+
+void ShadowPass::report(FrameRenderStats& stats) const { stats.shadow.uploads = mUploads; }
+
+} // namespace splatfx::gl::detail
+
+namespace splatfx::gl {
 
 void setShadowUniforms(unsigned program, const ShadowBinding& b) {
     glProgramUniform1i(program, glGetUniformLocation(program, "splatfx_shadowTable"), b.textureUnit);

@@ -1,17 +1,18 @@
-// The frame's shadow on the scene (issue 16): uploads Frame::shadow() as a 3D
+// The frame's shadow on the scene: uploads Frame::shadow() as a 3D
 // texture when its version changed, and binds it for the host's hooks, so a
 // host surface shader with shadowGlsl() samples the gas's shadow.
-// Private to gl; owned by FrameRenderer::Impl (pass 0 in frame_renderer.hpp).
+// Private to gl; a pass of FrameRenderer (steps UploadShadow and UnbindShadow).
 #pragma once
 
 #include <cstdint>
 
 #include "splatfx/frame.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
+#include "passes/pass.hpp"
 
-namespace splatfx::gl {
+namespace splatfx::gl::detail {
 
-class ShadowPass {
+class ShadowPass final : public Pass {
 public:
     explicit ShadowPass(int textureUnit) : mUnit(textureUnit) {}
     ShadowPass(const ShadowPass&) = delete;
@@ -27,6 +28,9 @@ public:
     void unbind();
     ShadowBinding binding() const;
 
+    void execute(const PlanStep& step, StepContext& context) override; // UploadShadow, UnbindShadow
+    void report(FrameRenderStats& stats) const override;
+
 private:
     int mUnit;
     unsigned mTexture = 0;
@@ -36,6 +40,7 @@ private:
     glm::mat4 mWorldToTable{1.0f};
     glm::vec4 mLight{0.0f, -1.0f, 0.0f, 0.0f};
     int mSavedBinding = 0;
+    std::uint64_t mUploads = 0;
 };
 
-} // namespace splatfx::gl
+} // namespace splatfx::gl::detail

@@ -2,6 +2,7 @@
 #include "tetra_pass.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -284,7 +285,7 @@ Status TetraPass::setFog(const Fog* fog, double timeSec) {
     return {};
 }
 
-void TetraPass::prepare(const Frame& frame) {
+void TetraPass::uploadTables(const Frame& frame) {
     Impl& r = *mImpl;
     const std::uint64_t uploads = r.stats.tableUploads;
     r.stats = {};
@@ -393,7 +394,7 @@ void TetraPass::prepare(const Frame& frame) {
     }
 }
 
-void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const TetraTarget& target) {
+void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const PassTarget& target) {
     Impl& r = *mImpl;
     if (volume >= r.firstRecord.size() || r.tableOfVolume[volume] < 0) return;
     const auto& first = r.firstRecord[volume];
@@ -405,18 +406,7 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     const Impl::Table& tex = r.tables[std::size_t(r.tableOfVolume[volume])];
     const Camera& camera = frame.camera();
 
-    GLuint hostDepth = target.depthTexture;
-    if (!hostDepth) { // the framebuffer's depth attachment, when it is a texture
-        GLint type = GL_NONE;
-        if (target.framebuffer) {
-            glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
-            if (type == GL_TEXTURE) {
-                GLint name = 0;
-                glGetNamedFramebufferAttachmentParameteriv(target.framebuffer, GL_DEPTH_ATTACHMENT, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_NAME, &name);
-                hostDepth = GLuint(name);
-            }
-        }
-    }
+    const GLuint hostDepth = target.depthTexture;
 
     // Which winding is front-facing on screen for this camera (hosts may mirror
     // their projection): a triangle facing the eye, projected.
@@ -508,6 +498,39 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     glFrontFace(GLenum(prevFrontFace));
     if (!prevClamp) glDisable(GL_DEPTH_CLAMP);
     saved.restore();
+}
+
+// ---- As a pass of the frame (passes/pass.hpp) ----
+
+void TetraPass::prepare(const FramePlan& plan, const Frame&) {
+    mFogError.clear();
+    mFogged = false;
+    mActive = plan.tetrahedra;
+    if (!plan.tetrahedra) return;
+    const Status s = setFog(plan.fog, plan.timeSec);
+    if (!s) mFogError = s.error();
+    mFogged = plan.fog && s;
+}
+
+void TetraPass::execute(const PlanStep& step, StepContext& context) {
+    if (step.kind == StepKind::PrepareTetrahedra) {
+        uploadTables(context.frame);
+        return;
+    }
+    assert(step.kind == StepKind::Tetrahedra);
+    draw(context.frame, step.volume, std::uint32_t(step.begin), std::uint32_t(step.end),
+         step.target == StepTarget::Reduced ? context.reduced : context.plan.target);
+}
+
+void TetraPass::report(FrameRenderStats& stats) const {
+    const TetraStats& ts = mImpl->stats;
+    stats.tetrahedra.tableBytes = ts.tableBytes;
+    if (!mActive) return; // the pass's counters are last frame's
+    stats.drawCalls += ts.drawCalls;
+    stats.tetrahedra.drawn = ts.tetrahedra;
+    stats.tetrahedra.transparent = ts.transparent;
+    stats.fog.tetrahedra = mFogged;
+    if (!mFogError.empty()) stats.fog.error = mFogError;
 }
 
 } // namespace splatfx::gl::detail

@@ -23,22 +23,16 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "splatfx/camera.hpp"
 #include "splatfx/fog.hpp"
 #include "splatfx/frame.hpp"
 #include "splatfx/result.hpp"
+#include "passes/pass.hpp"
 
 namespace splatfx::gl::detail {
-
-struct TetraTarget {
-    unsigned framebuffer = 0;
-    int x = 0, y = 0, width = 0, height = 0;
-    // The host's depth texture; 0: none (then the framebuffer's depth test
-    // culls whole fragments at the front face, which is not exact).
-    unsigned depthTexture = 0;
-};
 
 struct TetraStats {
     std::uint64_t tetrahedra = 0;  // drawn this frame
@@ -50,7 +44,7 @@ struct TetraStats {
     std::uint64_t foggedDraws = 0;  // draws with the fog variant this frame
 };
 
-class TetraPass {
+class TetraPass final : public Pass {
 public:
     static Result<TetraPass> create();
     TetraPass(TetraPass&&) noexcept;
@@ -60,9 +54,9 @@ public:
     // Step 0 of the frame: uploads the tables the frame's volumes use that
     // changed (new address or version), drops tables no longer used, and
     // builds the per-tetrahedron data of every volume. Resets the frame stats.
-    void prepare(const Frame& frame);
-    // Draws tetrahedra [begin, end) of frame.volumes()[volume] (after prepare).
-    void draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const TetraTarget& target);
+    void uploadTables(const Frame& frame);
+    // Draws tetrahedra [begin, end) of frame.volumes()[volume] (after uploadTables).
+    void draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const PassTarget& target);
     // (issue 14) The fog every following draw is seen through (null
     // or empty: none): each segment's colour becomes f c + (1 - f) alpha C_fog
     // with f from the eye to the segment's opacity centroid. Builds the fog
@@ -71,11 +65,18 @@ public:
 
     const TetraStats& stats() const;
 
+    void prepare(const FramePlan& plan, const Frame& frame) override;  // the fog variant
+    void execute(const PlanStep& step, StepContext& context) override; // PrepareTetrahedra, Tetrahedra
+    void report(FrameRenderStats& stats) const override;
+
     struct Impl; // public so the .cpp's helpers can name Impl::Program; defined there only
 
 private:
     explicit TetraPass(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> mImpl;
+    std::string mFogError;
+    bool mFogged = false;
+    bool mActive = false; // the frame has tetrahedra
 };
 
 } // namespace splatfx::gl::detail

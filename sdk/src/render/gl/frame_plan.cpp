@@ -1,0 +1,185 @@
+// Every ordering and fallback decision of a frame (frame_plan.hpp). GL-free:
+// the frame renderer queries the host's depth once and executes the steps.
+#include "splatfx/gl/frame_plan.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <string>
+
+namespace splatfx::gl {
+
+namespace {
+
+PlanStep step(StepKind kind, StepTarget target = StepTarget::Host) { return {.kind = kind, .target = target}; }
+
+PlanStep splatRange(std::size_t begin, std::size_t end, StepTarget target = StepTarget::Host) {
+    return {.kind = StepKind::Splats, .target = target, .begin = begin, .end = end};
+}
+
+PlanStep listRun(StepKind kind, StepRange range) { return {.kind = kind, .range = range}; }
+
+// The volumes when the frame has tetrahedra: splats and tetrahedra interleaved
+// by Frame::drawOrder (frame.hpp).
+void planInterleaved(const Frame& frame, const FrameRendererDesc& desc, bool reduced, FramePlan& plan) {
+    if (reduced && !desc.reduceTetrahedra) {
+        // Reduced-resolution splats are composited in one pass, so the order
+        // is per pass: every tetrahedron (full resolution), then the splats.
+        for (const DrawBatch& b : frame.drawOrder())
+            if (b.kind == DrawBatch::Kind::Tetrahedra)
+                plan.steps.push_back({.kind = StepKind::Tetrahedra, .volume = b.volume, .begin = b.begin, .end = b.end});
+        plan.steps.push_back(step(StepKind::ReducedSplats));
+        return;
+    }
+    // Every batch in draw order: into the host target, or (reduceTetrahedra)
+    // all into one reduced image composited once (an "over" sequence drawn
+    // into a cleared layer and then over the host is the same sequence).
+    const StepTarget into = reduced ? StepTarget::Reduced : StepTarget::Host;
+    if (reduced) plan.steps.push_back(step(StepKind::ReducedBegin));
+    for (const DrawBatch& b : frame.drawOrder()) {
+        if (b.kind == DrawBatch::Kind::Tetrahedra)
+            plan.steps.push_back({.kind = StepKind::Tetrahedra, .target = into, .volume = b.volume, .begin = b.begin, .end = b.end});
+        else plan.steps.push_back(splatRange(b.begin, b.end, into));
+    }
+    if (reduced) plan.steps.push_back(step(StepKind::ReducedComposite));
+}
+
+std::string multisampledNote(const char* what, int samples) {
+    return std::string(what) + ": the host depth is multisampled (" + std::to_string(samples) +
+           " samples); resolve it into a single-sample depth texture (HostTarget::depthTexture) first";
+}
+
+} // namespace
+
+FramePlan planFrame(const Frame& frame, const HostTarget& host, const FrameRendererDesc& desc, const HostDepth& depth) {
+    const Camera& camera = frame.camera();
+    assert(camera.viewport.x > 0 && camera.viewport.y > 0 && "planFrame: the frame camera's viewport must be positive");
+    FramePlan plan;
+    const bool multisampled = depth.texture != 0 && depth.samples > 1;
+    plan.target = {.framebuffer = host.framebuffer,
+                   .x = host.x,
+                   .y = host.y,
+                   .width = camera.viewport.x,
+                   .height = camera.viewport.y,
+                   .depthTexture = multisampled ? 0u : depth.texture};
+    plan.fog = frame.fog() && !frame.fog()->empty() ? frame.fog() : nullptr;
+    plan.timeSec = frame.time();
+    plan.tetrahedra =
+        std::any_of(frame.volumes().begin(), frame.volumes().end(), [](const FrameVolume& v) { return v.table && !v.lod.tets.empty(); });
+    plan.reduced = desc.resolutionScale != 1;
+    const bool hasDepth = plan.target.depthTexture != 0;
+
+    // 0. Uploads: the frame's shadow table (bound while the hooks run), the tetrahedra's tables.
+    plan.steps.push_back(step(StepKind::UploadShadow));
+    if (plan.tetrahedra) plan.steps.push_back(step(StepKind::PrepareTetrahedra));
+
+    // 1. The host's opaque pass: its depth is what the volumes are tested against.
+    if (host.drawOpaque) plan.steps.push_back(step(StepKind::HostOpaque));
+
+    // 1b. The fog of the host's opaque image, read from its depth.
+    if (plan.fog && desc.fogHost) {
+        if (hasDepth) {
+            plan.steps.push_back(step(StepKind::HostFog));
+            plan.fogHost = true;
+        } else if (multisampled) {
+            plan.fogNote = multisampledNote("fog of the host image skipped", depth.samples);
+        } else {
+            plan.fogNote = "fog of the host image skipped: no host depth texture (HostTarget::depthTexture, or a texture depth attachment; "
+                           "the default framebuffer's depth is never one)";
+        }
+    }
+
+    // The order-exact path: the splats go into the fragment lists with the
+    // host's transparent surfaces (step 3) when nothing the lists cannot draw
+    // is in the frame; otherwise they are drawn in step 2 as usual and only
+    // the surfaces are sorted (among themselves) in step 3.
+    plan.lists = host.transparentToLists && bool(host.drawTransparent);
+    plan.splatsInLists = plan.lists && !plan.reduced && !plan.tetrahedra && hasDepth;
+    if (plan.lists && !plan.splatsInLists)
+        plan.listsNote = plan.reduced      ? "reduced resolution: the splats take the ordered blend under the surfaces"
+                         : plan.tetrahedra ? "tetrahedra in the frame: the volumes take the ordered blend under the surfaces"
+                         : multisampled    ? multisampledNote("the splats take the ordered blend under the surfaces", depth.samples)
+                                           : "no host depth texture (HostTarget::depthTexture or a texture depth attachment): "
+                                             "the splats take the ordered blend under the surfaces";
+
+    // 2. The volumes, back to front.
+    const std::size_t splats = frame.splats().size();
+    if (plan.splatsInLists) {
+        // drawn in step 3
+    } else if (plan.tetrahedra) {
+        planInterleaved(frame, desc, plan.reduced, plan);
+    } else if (!plan.reduced) {
+        plan.steps.push_back(splatRange(0, splats));
+    } else {
+        plan.steps.push_back(step(StepKind::ReducedSplats));
+    }
+    if (multisampled && desc.splats.depthCut && splats > 0 && !plan.splatsInLists)
+        plan.steps.back().note = multisampledNote("depth cut off (the plain depth test at each splat's plane)", depth.samples);
+
+    // 3. The host's transparent surfaces, over the volumes: into the lists,
+    // the splats cut into sections at them, every pixel sorted and
+    // composited; or blended in the host's own order.
+    if (plan.lists) {
+        plan.steps.push_back(step(StepKind::ListsCollect));
+        if (plan.splatsInLists) {
+            // The splats behind every surface they cover, and those in front
+            // of every one, take the ordinary splat pass before and after the
+            // resolve; the rest are sectioned, except with a fog (fogged
+            // sections are not implemented): then they take the ordered blend.
+            plan.steps.push_back(step(StepKind::ListsSplit));
+            if (plan.fog) {
+                plan.steps.push_back(listRun(StepKind::Splats, StepRange::ListsBehindAndBetween));
+                plan.steps.back().note = "fog: the splats that meet a surface take the ordered blend under the surfaces "
+                                         "(fogged sections not implemented)";
+            } else {
+                plan.steps.push_back(listRun(StepKind::Splats, StepRange::ListsBehind));
+                plan.steps.push_back(listRun(StepKind::ListsSections, StepRange::ListsBetween));
+            }
+        }
+        plan.steps.push_back(step(StepKind::ListsResolve));
+        if (plan.splatsInLists) plan.steps.push_back(listRun(StepKind::Splats, StepRange::ListsFront));
+    } else if (host.drawTransparent) {
+        plan.steps.push_back(step(StepKind::HostTransparent));
+    }
+    plan.steps.push_back(step(StepKind::UnbindShadow));
+    return plan;
+}
+
+const char* toString(StepKind kind) {
+    switch (kind) {
+    case StepKind::UploadShadow: return "UploadShadow";
+    case StepKind::PrepareTetrahedra: return "PrepareTetrahedra";
+    case StepKind::HostOpaque: return "HostOpaque";
+    case StepKind::HostFog: return "HostFog";
+    case StepKind::Splats: return "Splats";
+    case StepKind::ReducedSplats: return "ReducedSplats";
+    case StepKind::ReducedBegin: return "ReducedBegin";
+    case StepKind::ReducedComposite: return "ReducedComposite";
+    case StepKind::Tetrahedra: return "Tetrahedra";
+    case StepKind::ListsCollect: return "ListsCollect";
+    case StepKind::ListsSplit: return "ListsSplit";
+    case StepKind::ListsSections: return "ListsSections";
+    case StepKind::ListsResolve: return "ListsResolve";
+    case StepKind::HostTransparent: return "HostTransparent";
+    case StepKind::UnbindShadow: return "UnbindShadow";
+    }
+    return "?";
+}
+
+std::string describe(const PlanStep& s) {
+    std::string line = toString(s.kind);
+    if (s.kind == StepKind::Tetrahedra) line += " volume " + std::to_string(s.volume);
+    switch (s.range) {
+    case StepRange::Explicit:
+        if (s.kind == StepKind::Splats || s.kind == StepKind::Tetrahedra) line += " [" + std::to_string(s.begin) + ", " + std::to_string(s.end) + ")";
+        break;
+    case StepRange::ListsBehind: line += " (behind every surface)"; break;
+    case StepRange::ListsBetween: line += " (meeting a surface)"; break;
+    case StepRange::ListsFront: line += " (in front of every surface)"; break;
+    case StepRange::ListsBehindAndBetween: line += " (behind or meeting a surface)"; break;
+    }
+    if (s.target == StepTarget::Reduced) line += " into the reduced image";
+    if (!s.note.empty()) line += ": " + s.note;
+    return line;
+}
+
+} // namespace splatfx::gl
