@@ -316,6 +316,7 @@ static int renderMain(int argc, char** argv) {
     const auto start = Clock::now();
     double renderMs = 0.0, prepareMs = 0.0, submitMs = 0.0;
     std::uint64_t splatsMin = ~0ull, splatsMax = 0, splatsSum = 0, voxelsMax = 0;
+    std::vector<std::string> notes; // the frame renderer's fallbacks, each once
     std::size_t visibleMax = 0, simulatedMax = 0, drawnMax = 0, visibleSum = 0, simulatedSum = 0, drawnSum = 0;
     const bool tty = isatty(fileno(stdout)) != 0;
     int written = 0, replayed = 0;
@@ -337,6 +338,12 @@ static int renderMain(int argc, char** argv) {
         const auto f0 = Clock::now();
         player->renderFrame(t, player->cameraAt(t, size), fb->handle(), {.traditional = a.traditional});
         splatfx::Image img = fb->read();
+        // Every fallback of the frame renderer, said once, as it happens (FrameRenderStats::notes).
+        for (const std::string& note : player->renderer().stats().notes)
+            if (std::find(notes.begin(), notes.end(), note) == notes.end()) {
+                notes.push_back(note);
+                if (!a.quiet) std::printf("%ssplatfx-render: note: %s\n", tty ? "\n" : "", note.c_str());
+            }
         renderMs += std::chrono::duration<double, std::milli>(Clock::now() - f0).count();
         const splatfx::FrameCounters& s = player->stats().counters;
         prepareMs += player->stats().prepareMs, submitMs += player->stats().renderMs;
@@ -384,6 +391,7 @@ static int renderMain(int argc, char** argv) {
     std::printf("  effects           %zu declared; per frame mean/max: %.1f/%zu simulated, %.1f/%zu visible, %.1f/%zu drawn\n", last.declared,
                 double(simulatedSum) / n, simulatedMax, double(visibleSum) / n, visibleMax, double(drawnSum) / n, drawnMax);
     std::printf("  geometry          %zu objects, %zu triangles\n", player->geometry().stats().objects, player->geometry().stats().triangles);
+    for (const std::string& note : notes) std::printf("  note              %s\n", note.c_str());
     if (whole)
         std::printf("  wrote             %s/%s_0000.png .. %s_%04d.png and %s/%s.gif\n", a.out.c_str(), name.c_str(), name.c_str(), frames - 1,
                     a.out.c_str(), name.c_str());

@@ -271,6 +271,9 @@ struct Viewer {
         ImGui::Text("voxels: %llu   splats: %llu", (unsigned long long)s.voxels, (unsigned long long)s.splats);
         ImGui::Text("prepare %.2f ms  render %.2f ms", fs.prepareMs, fs.renderMs);
         if (!error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", error.c_str());
+        // What the frame renderer could not do as asked (FrameRenderStats::notes): said where the user looks.
+        if (player)
+            for (const std::string& note : player->renderer().stats().notes) ImGui::TextColored(ImVec4(1, 0.8f, 0.3f, 1), "note: %s", note.c_str());
         ImGui::Separator();
 
         if (ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) {
