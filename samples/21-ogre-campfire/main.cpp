@@ -10,7 +10,7 @@
 
 #include "cli.hpp"
 #include "ogre_campfire.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 
 namespace {
 

@@ -21,7 +21,7 @@
 #include "splatfx/context.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/gl/framebuffer.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 #include "splatfx/scene.hpp"
 #include "splatfx/scene_file.hpp"
 #include "splatfx/volume.hpp"

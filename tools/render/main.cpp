@@ -31,7 +31,7 @@
 #include "scene_player.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/framebuffer.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 #include "splatfx/output_set.hpp"
 
 namespace fs = std::filesystem;

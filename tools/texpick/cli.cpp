@@ -354,7 +354,7 @@ int runMerge(const Options& o) {
     splatfx::TextureSet merged;
     json parts = json::array();
     for (const std::string& folder : o.sets) {
-        auto set = splatfx::TextureSet::load(folder);
+        auto set = splatfx::loadTextureSet(folder);
         if (!set) return fail("merge: " + set.error());
         if (merged.layers.empty()) {
             merged.size = set->size;

@@ -38,7 +38,7 @@
 
 #include "scene_player.hpp"
 #include "splatfx/context.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 
 namespace fs = std::filesystem;
 
