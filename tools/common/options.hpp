@@ -1,0 +1,104 @@
+// tools/common/options.hpp: the tools' command lines through CLI11, with the
+// strict checks of cli.hpp.
+//
+// What it is: options whose values go through cli::parseInt, parseReal,
+// parseSize or any check returning a splatfx::Status, so every number is
+// parsed whole and range-checked and a bad one is refused with the message
+// docs/ERRORS.md promises ("--frames expects a whole number in [5, 100000],
+// got '12abc'"); CLI11's own conversions (which accept "0x10", "010" as
+// octal and "true" as 1) never see them. parse() runs the parser and turns
+// --help and errors into an exit code.
+// What it does not do: option tables beyond CLI11's (each tool builds its
+// own CLI::App), locale handling (numbers are C-locale).
+//
+//   CLI::App app{"A level of N effects ...", "splatfx-bench scheduling"};
+//   cli::addInt(app, "--effects", count, 20, 100000, "effects in the level");
+//   if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+//
+// Threading: build and parse on one thread; the options write into the
+// caller's variables, which must outlive parse().
+#pragma once
+
+#include <concepts>
+#include <cstdio>
+#include <functional>
+#include <string>
+#include <type_traits>
+
+#include <CLI/CLI.hpp>
+
+#include "cli.hpp"
+
+namespace cli {
+
+// "--frames" from CLI11's name list ("-f,--frames"): the spelling messages use.
+inline std::string longName(const std::string& names) {
+    const size_t comma = names.rfind(',');
+    return comma == std::string::npos ? names : names.substr(comma + 1);
+}
+
+// An option taking one value that check(option, text) accepts (stores) or
+// refuses with a message, which is printed as it is.
+inline CLI::Option* addChecked(CLI::App& app, const std::string& names, std::function<splatfx::Status(const std::string&, const std::string&)> check,
+                               const std::string& help, const std::string& typeName = "VALUE") {
+    const std::string option = longName(names);
+    CLI::Option* o = app.add_option_function<std::string>(
+        names,
+        [option, check = std::move(check)](const std::string& text) {
+            if (splatfx::Status s = check(option, text); !s) throw CLI::ValidationError(s.error());
+        },
+        help);
+    o->type_name(typeName);
+    return o;
+}
+
+// A whole number in [lo, hi] (cli::parseInt); the help shows the range and the default.
+template <std::integral T>
+CLI::Option* addInt(CLI::App& app, const std::string& names, T& out, std::type_identity_t<T> lo, std::type_identity_t<T> hi,
+                    const std::string& help) {
+    const std::string range = " [" + detail::show(lo) + ", " + detail::show(hi) + "], default " + detail::show(out);
+    return addChecked(
+        app, names, [&out, lo, hi](const std::string& option, const std::string& text) { return parseInt(option, text, lo, hi, out); }, help + range,
+        "N");
+}
+
+// A finite number in [lo, hi] (cli::parseReal).
+template <std::floating_point T>
+CLI::Option* addReal(CLI::App& app, const std::string& names, T& out, std::type_identity_t<T> lo, std::type_identity_t<T> hi,
+                     const std::string& help) {
+    const std::string range = " [" + detail::show(lo) + ", " + detail::show(hi) + "], default " + detail::show(out);
+    return addChecked(
+        app, names, [&out, lo, hi](const std::string& option, const std::string& text) { return parseReal(option, text, lo, hi, out); }, help + range,
+        "X");
+}
+
+// "WxH", each side a whole number in [lo, hi] (cli::parseSize).
+inline CLI::Option* addSize(CLI::App& app, const std::string& names, int& width, int& height, int lo, int hi, const std::string& help) {
+    const std::string range =
+        " (each side in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]), default " + std::to_string(width) + "x" + std::to_string(height);
+    return addChecked(
+        app, names,
+        [&width, &height, lo, hi](const std::string& option, const std::string& text) { return parseSize(option, text, lo, hi, width, height); },
+        help + range, "WxH");
+}
+
+// Parses argv (argv[0] is the program or subcommand name). Returns -1 when the
+// caller goes on; 0 after printing the help (--help, -h); 2 after printing
+// "<name>: <why> (try --help)" on stderr, name being the app's.
+inline int parse(CLI::App& app, int argc, const char* const* argv) {
+    try {
+        app.parse(argc, argv);
+        return -1;
+    } catch (const CLI::CallForHelp&) {
+        std::fputs(app.help().c_str(), stdout);
+        return 0;
+    } catch (const CLI::CallForAllHelp&) {
+        std::fputs(app.help("", CLI::AppFormatMode::All).c_str(), stdout);
+        return 0;
+    } catch (const CLI::ParseError& e) {
+        std::fprintf(stderr, "%s: %s (try --help)\n", app.get_name().c_str(), e.what());
+        return 2;
+    }
+}
+
+} // namespace cli
