@@ -23,15 +23,7 @@ int runLodRefine(int argc, char** argv) {
     CLI::App app{"LOD cloud volume refinement on the CPU: a cloud field, a flight through it; tetrahedra emitted per frame against the\n"
                  "full-resolution count, LodVolume::update time, memory, near-plane clipping, error against the finest level.",
                  "splatfx-bench lodrefine"};
-    app.add_option_function<std::vector<std::string>>(
-           "--dims",
-           [&dims](const std::vector<std::string>& xyz) {
-               for (int a = 0; a < 3; ++a)
-                   if (splatfx::Status s = cli::parseInt("--dims", xyz[size_t(a)], 2, 4097, dims[a]); !s) throw CLI::ValidationError(s.error());
-           },
-           "grid points of the cloud field per axis, each in [2, 4097], default 257 257 33")
-        ->expected(3)
-        ->type_name("X Y Z");
+    cli::addInts(app, "--dims", &dims.x, 3, 2, 4097, "grid points of the cloud field per axis", "X Y Z");
     cli::addReal(app, "--c", detailC, 0.0f, 1.0e6f, "detail knob c of the refinement");
     cli::addReal(app, "--C", minC, 0.0f, 1.0e6f, "minimum accuracy C of the octree");
     cli::addInt(app, "--frames", frames, 1, 100000, "frames of the flight");

@@ -19,11 +19,13 @@
 // caller's variables, which must outlive parse().
 #pragma once
 
+#include <algorithm>
 #include <concepts>
 #include <cstdio>
 #include <functional>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -80,6 +82,26 @@ inline CLI::Option* addSize(CLI::App& app, const std::string& names, int& width,
         app, names,
         [&width, &height, lo, hi](const std::string& option, const std::string& text) { return parseSize(option, text, lo, hi, width, height); },
         help + range, "WxH");
+}
+
+// `count` (1 to 4) whole numbers in [lo, hi] after one option ("--dims X Y Z",
+// "--size W H"), each checked as cli::parseInt checks one.
+inline CLI::Option* addInts(CLI::App& app, const std::string& names, int* values, int count, int lo, int hi, const std::string& help,
+                            const std::string& typeName) {
+    const std::string option = longName(names);
+    std::string defaults;
+    for (int k = 0; k < count; ++k) defaults += (k ? " " : "") + std::to_string(values[k]);
+    CLI::Option* o = app.add_option_function<std::vector<std::string>>(
+        names,
+        [option, values, count, lo, hi](const std::vector<std::string>& texts) {
+            int parsed[4] = {};
+            for (int k = 0; k < count; ++k)
+                if (splatfx::Status s = parseInt(option, texts[size_t(k)], lo, hi, parsed[k]); !s) throw CLI::ValidationError(s.error());
+            std::copy(parsed, parsed + count, values);
+        },
+        help + " (each in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]), default " + defaults);
+    o->expected(count)->type_name(typeName);
+    return o;
 }
 
 // Parses argv (argv[0] is the program or subcommand name). Returns -1 when the
