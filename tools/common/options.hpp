@@ -50,7 +50,7 @@ inline CLI::Option* addChecked(CLI::App& app, const std::string& names, std::fun
             if (splatfx::Status s = check(option, text); !s) throw CLI::ValidationError(s.error());
         },
         help);
-    o->type_name(typeName);
+    o->type_name(typeName)->multi_option_policy(CLI::MultiOptionPolicy::TakeLast); // given twice: the last wins
     return o;
 }
 
@@ -100,7 +100,7 @@ inline CLI::Option* addInts(CLI::App& app, const std::string& names, int* values
             std::copy(parsed, parsed + count, values);
         },
         help + " (each in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]), default " + defaults);
-    o->expected(count)->type_name(typeName);
+    o->expected(count)->type_name(typeName)->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
     return o;
 }
 
