@@ -31,13 +31,10 @@ namespace samples {
 namespace option_text {
 template <class T>
 std::string show(T value) {
-    if constexpr (std::is_floating_point_v<T>) {
-        char buf[32];
-        std::snprintf(buf, sizeof buf, "%g", double(value));
-        return buf;
-    } else {
-        return std::to_string(value);
-    }
+    if constexpr (std::is_integral_v<T>) return std::to_string(value);
+    char digits[32];
+    std::snprintf(digits, sizeof digits, "%g", double(value));
+    return digits;
 }
 
 // The whole text as one T (an optional '+'; a finite value for floating point).
@@ -69,7 +66,7 @@ CLI::Option* addNumber(CLI::App& app, const std::string& name, T& out, std::type
             out = value;
         },
         help + " (" + option_text::show(lo) + " to " + option_text::show(hi) + ", default " + option_text::show(out) + ")");
-    option->type_name(std::is_integral_v<T> ? "N" : "X");
+    option->type_name(std::is_integral_v<T> ? "N" : "X")->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
     return option;
 }
 
@@ -89,23 +86,18 @@ inline CLI::Option* addSize(CLI::App& app, const std::string& name, int& width, 
             height = h;
         },
         help + " (default " + std::to_string(width) + "x" + std::to_string(height) + ")");
-    option->type_name("WxH");
+    option->type_name("WxH")->multi_option_policy(CLI::MultiOptionPolicy::TakeLast);
     return option;
 }
 
 // Parses argv: -1 when the sample goes on; 0 after printing the help; 2
-// after printing "<sample>: <why> (try --help)".
+// after printing "<sample>: <why> (try --help)" (CLI11's App::exit prints both).
 inline int parseCommandLine(CLI::App& app, int argc, const char* const* argv) {
+    app.failure_message([](const CLI::App* failed, const CLI::Error& e) { return failed->get_name() + ": " + e.what() + " (try --help)\n"; });
     try {
         app.parse(argc, argv);
-        return -1;
-    } catch (const CLI::CallForHelp&) {
-        std::fputs(app.help().c_str(), stdout);
-        return 0;
-    } catch (const CLI::ParseError& e) {
-        std::fprintf(stderr, "%s: %s (try --help)\n", app.get_name().c_str(), e.what());
-        return 2;
-    }
+    } catch (const CLI::ParseError& e) { return app.exit(e) == 0 ? 0 : 2; }
+    return -1;
 }
 
 // Runs body() (the exit code); an exception escaping it becomes "<sample>: ..."

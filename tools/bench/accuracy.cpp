@@ -405,7 +405,7 @@ int parse(int argc, char** argv, Options& o) {
     // 2048 a side: the run keeps a dozen float images of this size
     // (references in double), about 1 GB at the cap.
     cli::addSize(app, "--size", o.size.x, o.size.y, 16, 2048, "frame size");
-    cli::addInt(app, "--reps", o.reps, 1, 10000, "timed frames per setting, median reported");
+    cli::addNumber(app, "--reps", o.reps, 1, 10000, "timed frames per setting, median reported");
     bool noPlots = false;
     app.add_flag("--no-plots", noPlots, "print the tables only");
     app.add_flag("--replot", o.replotOnly, "only run gnuplot again on DIR/accuracy.gp (after editing it)");

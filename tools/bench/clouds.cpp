@@ -109,17 +109,17 @@ int runClouds(int argc, char** argv) {
                  "and inside, the flight also with the tetrahedra at 1/scale resolution, popping, fog on the tetrahedra.",
                  "splatfx-bench clouds"};
     cli::addInts(app, "--dims", &o.dims.x, 3, 2, 4097, "grid points of the flight's cloud field", "X Y Z");
-    cli::addReal(app, "--c", o.detailC, 0.0f, 1.0e6f, "detail knob c of the flight");
-    cli::addInt(app, "--frames", o.frames, 2, 100000, "frames of the flight");
+    cli::addNumber(app, "--c", o.detailC, 0.0f, 1.0e6f, "detail knob c of the flight");
+    cli::addNumber(app, "--frames", o.frames, 2, 100000, "frames of the flight");
     cli::addInts(app, "--size", &o.size.x, 2, 16, 8192, "frame size of the flight", "W H");
     cli::addInts(app, "--pop-dims", &o.popDims.x, 3, 2, 4097, "grid points of the popping run's field", "X Y Z");
-    cli::addInt(app, "--pop-frames", o.popFrames, 2, 100000, "frames of the popping run");
+    cli::addNumber(app, "--pop-frames", o.popFrames, 2, 100000, "frames of the popping run");
     cli::addInts(app, "--pop-size", &o.popSize.x, 2, 16, 8192, "frame size of the popping run", "W H");
-    cli::addReal(app, "--pop-c", o.popDetailC, 0.0f, 1.0e6f, "detail knob c of the popping run");
-    cli::addReal(app, "--pop-step", o.popStepWorld, 1.0e-6f, 1.0e6f, "world units per frame of the popping run");
+    cli::addNumber(app, "--pop-c", o.popDetailC, 0.0f, 1.0e6f, "detail knob c of the popping run");
+    cli::addNumber(app, "--pop-step", o.popStepWorld, 1.0e-6f, 1.0e6f, "world units per frame of the popping run");
     cli::addInts(app, "--fog-dims", &o.fogDims.x, 3, 2, 4097, "grid points of the fogged cloud", "X Y Z");
     cli::addInts(app, "--fog-size", &o.fogSize.x, 2, 16, 8192, "frame size of the fog runs", "W H");
-    cli::addInt(app, "--fog-frames", o.fogFrames, 1, 100000, "frames timed per fog mode");
+    cli::addNumber(app, "--fog-frames", o.fogFrames, 1, 100000, "frames timed per fog mode");
     app.add_flag("--fog-only", o.fogOnly, "skip the flight and the popping runs");
     cli::addChecked(
         app, "--scale",

@@ -345,8 +345,8 @@ int runCut(int argc, char** argv) {
                  "reference per partial-table size and for the plain test, the popping metric while a wall moves slowly through a fire\n"
                  "(GL cut, GL plain, the reference), and on the cow sample (run from the repository root, or pass --cow).",
                  "splatfx-bench cut"};
-    cli::addInt(app, "--frames", frames, 1, 1000, "timed frames per row");
-    cli::addInt(app, "--steps", steps, 2, 1000, "positions of the moving wall");
+    cli::addNumber(app, "--frames", frames, 1, 1000, "timed frames per row");
+    cli::addNumber(app, "--steps", steps, 2, 1000, "positions of the moving wall");
     app.add_option("--cow", cowPath, "the cow sample's scene file")->type_name("SCENE")->capture_default_str();
     cli::addChecked(
         app, "--only",

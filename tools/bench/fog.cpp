@@ -59,8 +59,8 @@ int runFog(int argc, char** argv) {
                  "textures of Biri et al.'s Table 1, for three fogs; error of each against per-pixel.",
                  "splatfx-bench fog"};
     app.add_option("--scene", scenePath, "the scene file")->type_name("FILE")->capture_default_str();
-    CLI::Option* framesOption = cli::addInt(app, "--frames", frames, 3, 100000, "timed frames per mode");
-    CLI::Option* roundsOption = cli::addInt(app, "--rounds", rounds, 1, 1000, "rounds over the modes");
+    CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 3, 100000, "timed frames per mode");
+    CLI::Option* roundsOption = cli::addNumber(app, "--rounds", rounds, 1, 1000, "rounds over the modes");
     app.add_flag("--quick", quick, "5 frames x 1 round (unless given)");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     if (quick && framesOption->count() == 0) frames = 5;

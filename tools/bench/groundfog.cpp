@@ -80,12 +80,12 @@ int runGroundFog(int argc, char** argv) {
                  "splatfx-bench groundfog"};
     app.add_option("--dem", o.dem, "the terrain, a PGM heightmap")->type_name("FILE.pgm")->capture_default_str();
     cli::addInts(app, "--size", &o.size.x, 2, 16, 8192, "frame size", "W H");
-    cli::addInt(app, "--frames", o.frames, 2, 100000, "frames of the flight");
-    cli::addReal(app, "--step", o.stepWorld, 1.0e-6f, 1.0e6f, "world units per frame along the flight");
-    cli::addReal(app, "--c", o.detailC, 0.0f, 1.0e6f, "detail knob c");
-    cli::addReal(app, "--C", o.minAccuracyC, 0.0f, 1.0e6f, "minimum accuracy C");
+    cli::addNumber(app, "--frames", o.frames, 2, 100000, "frames of the flight");
+    cli::addNumber(app, "--step", o.stepWorld, 1.0e-6f, 1.0e6f, "world units per frame along the flight");
+    cli::addNumber(app, "--c", o.detailC, 0.0f, 1.0e6f, "detail knob c");
+    cli::addNumber(app, "--C", o.minAccuracyC, 0.0f, 1.0e6f, "minimum accuracy C");
     app.add_option("--out", o.out, "write the last frame of each mode as PNG here")->type_name("DIR");
-    cli::addReal(app, "--affine", o.densityDepth, 0.0f, 1.0e6f, "GroundFogDesc::densityDepthWorld (0: the paper's model)");
+    cli::addNumber(app, "--affine", o.densityDepth, 0.0f, 1.0e6f, "GroundFogDesc::densityDepthWorld (0: the paper's model)");
     cli::addInts(app, "--probe", &o.probe.x, 2, 0, 8191, "print the exact ray integral of this pixel per frame and mode", "X Y");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     auto img = splatfx::readImage(o.dem, splatfx::Alpha::Straight);

@@ -24,9 +24,9 @@ int runLodRefine(int argc, char** argv) {
                  "full-resolution count, LodVolume::update time, memory, near-plane clipping, error against the finest level.",
                  "splatfx-bench lodrefine"};
     cli::addInts(app, "--dims", &dims.x, 3, 2, 4097, "grid points of the cloud field per axis", "X Y Z");
-    cli::addReal(app, "--c", detailC, 0.0f, 1.0e6f, "detail knob c of the refinement");
-    cli::addReal(app, "--C", minC, 0.0f, 1.0e6f, "minimum accuracy C of the octree");
-    cli::addInt(app, "--frames", frames, 1, 100000, "frames of the flight");
+    cli::addNumber(app, "--c", detailC, 0.0f, 1.0e6f, "detail knob c of the refinement");
+    cli::addNumber(app, "--C", minC, 0.0f, 1.0e6f, "minimum accuracy C of the octree");
+    cli::addNumber(app, "--frames", frames, 1, 100000, "frames of the flight");
     app.add_flag("--average", average, "Delta from the average, not the maximum, error");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     using Clock = std::chrono::steady_clock;

@@ -91,8 +91,8 @@ int runScheduling(int argc, char** argv) {
                  "only those 10, drawn headless; a camera sweep; solver catch-up error.",
                  "splatfx-bench scheduling"};
     // Strict and bounded: 100000 effects is about 100x the level this bench models.
-    cli::addInt(app, "--effects", count, 20, 100000, "effects in the level");
-    CLI::Option* framesOption = cli::addInt(app, "--frames", frames, 5, 100000, "timed frames per run");
+    cli::addNumber(app, "--effects", count, 20, 100000, "effects in the level");
+    CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 5, 100000, "timed frames per run");
     cli::addSize(app, "--size", size.x, size.y, 16, 8192, "frame size");
     app.add_flag("--quick", quick, "15 frames (unless --frames is given)");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;

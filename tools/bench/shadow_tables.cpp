@@ -60,7 +60,7 @@ int runShadowTables(int argc, char** argv) {
     CLI::App app{"Shadow tables (16^3 .. 128^3) against tracing every voxel, for a 1560-voxel effect lit by a sun and by a point light\n"
                  "inside it: median build and lookup time (wall and CPU) and transmittance error, on the CPU.",
                  "splatfx-bench shadowtables"};
-    cli::addInt(app, "--repeats", repeats, 1, 1000, "runs per timing (the median is printed)");
+    cli::addNumber(app, "--repeats", repeats, 1, 1000, "runs per timing (the median is printed)");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     const Grid grid = column1560();
     auto field = DensityField::fromGrid(grid);

@@ -266,7 +266,7 @@ int runShadows(int argc, char** argv) {
                  "FrameRenderer::render + glFinish) as a ratio to no shadowing, and each table's transmittance error against tracing.\n"
                  "Then the phase-lobe knob: 1..4 HG lobes fitted to Cornette-Shanks, lit error and lightPoints time.",
                  "splatfx-bench shadows"};
-    CLI::Option* framesOption = cli::addInt(app, "--frames", frames, 3, 100000, "timed frames per configuration");
+    CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 3, 100000, "timed frames per configuration");
     app.add_flag("--static", still, "the steam does not evolve (tables reused)");
     app.add_flag("--quick", quick, "one size, 5 frames (unless --frames is given), 1 warm-up");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;

@@ -86,7 +86,7 @@ int runSoak(int argc, char** argv) {
                  "216000 steps each), checking every step for NaN/Inf in the grids and solver fields, and that Effect::bounds and the\n"
                  "resident memory (/proc/self/statm) stay flat. Exit 1 on any failure.",
                  "splatfx-bench soak"};
-    cli::addReal(app, "--minutes", minutes, 0.1, 24.0 * 60.0, "minutes of scene time per preset");
+    cli::addNumber(app, "--minutes", minutes, 0.1, 24.0 * 60.0, "minutes of scene time per preset");
     app.add_option("--preset", only, "only this preset")->type_name("NAME");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     namespace P = splatfx::presets;

@@ -528,12 +528,12 @@ int runTable1(int argc, char** argv) {
                  "overdraw, the splat pass as a fraction of this GL's fill rate and of its rate for squares of the splats' size, a naive\n"
                  "baseline, and CPU scaling. Renderer options default to the SDK's.",
                  "splatfx-bench table1"};
-    CLI::Option* framesOption = cli::addInt(app, "--frames", frames, 3, 100000, "timed frames per row");
+    CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 3, 100000, "timed frames per row");
     app.add_option("--csv", csvPath, "also write the figures as CSV to FILE (nothing is written without it)")->type_name("FILE");
     app.add_flag("--quick", quick, "5 frames per row (unless --frames is given)");
     // A fraction of the footprint's peak below which fragments are discarded.
-    cli::addReal(app, "--footprint-cut", settings.renderer.footprintCut, 0.0f, 1.0f,
-                 "fragments below this fraction of the footprint's peak are discarded");
+    cli::addNumber(app, "--footprint-cut", settings.renderer.footprintCut, 0.0f, 1.0f,
+                   "fragments below this fraction of the footprint's peak are discarded");
     cli::addChecked(
         app, "--sampling",
         [&settings](const std::string&, const std::string& v) -> splatfx::Status {

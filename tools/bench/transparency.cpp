@@ -131,8 +131,8 @@ int runTransparency(int argc, char** argv) {
                  "against the exact reference; the fragment budget knob; list memory.",
                  "splatfx-bench transparency"};
     CLI::Option* sizeOption = cli::addInts(app, "--size", &size.x, 2, 16, 8192, "frame size", "W H");
-    CLI::Option* framesOption = cli::addInt(app, "--frames", frames, 3, 100000, "timed frames per configuration");
-    CLI::Option* roundsOption = cli::addInt(app, "--rounds", rounds, 1, 1000, "rounds over the configurations");
+    CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 3, 100000, "timed frames per configuration");
+    CLI::Option* roundsOption = cli::addNumber(app, "--rounds", rounds, 1, 1000, "rounds over the configurations");
     app.add_flag("--quick", quick, "5 frames x 1 round at 320x240 (unless given)");
     app.add_flag("--no-cut", noCut, "sections without the partial integral (RendererDesc::depthCut = false)");
     app.add_option("--only", only, "the opaque-only frame and the configurations whose name contains TEXT")->type_name("TEXT");

@@ -2,7 +2,7 @@
 // strict checks of cli.hpp.
 //
 // What it is: options whose values go through cli::parseInt, parseReal,
-// parseSize or any check returning a splatfx::Status, so every number is
+// parseSize, a table of names or any check returning a splatfx::Status, so every number is
 // parsed whole and range-checked and a bad one is refused with the message
 // docs/ERRORS.md promises ("--frames expects a whole number in [5, 100000],
 // got '12abc'"); CLI11's own conversions (which accept "0x10", "010" as
@@ -12,7 +12,7 @@
 // own CLI::App), locale handling (numbers are C-locale).
 //
 //   CLI::App app{"A level of N effects ...", "splatfx-bench scheduling"};
-//   cli::addInt(app, "--effects", count, 20, 100000, "effects in the level");
+//   cli::addNumber(app, "--effects", count, 20, 100000, "effects in the level");
 //   if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
 //
 // Threading: build and parse on one thread; the options write into the
@@ -25,6 +25,7 @@
 #include <functional>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -54,24 +55,35 @@ inline CLI::Option* addChecked(CLI::App& app, const std::string& names, std::fun
     return o;
 }
 
-// A whole number in [lo, hi] (cli::parseInt); the help shows the range and the default.
-template <std::integral T>
-CLI::Option* addInt(CLI::App& app, const std::string& names, T& out, std::type_identity_t<T> lo, std::type_identity_t<T> hi,
-                    const std::string& help) {
+// A whole number (integral T: cli::parseInt) or a finite number
+// (floating-point T: cli::parseReal) in [lo, hi]; the help shows the range
+// and the default.
+template <class T>
+requires std::integral<T> || std::floating_point<T> CLI::Option*
+addNumber(CLI::App& app, const std::string& names, T& out, std::type_identity_t<T> lo, std::type_identity_t<T> hi, const std::string& help) {
     const std::string range = " [" + detail::show(lo) + ", " + detail::show(hi) + "], default " + detail::show(out);
-    return addChecked(
-        app, names, [&out, lo, hi](const std::string& option, const std::string& text) { return parseInt(option, text, lo, hi, out); }, help + range,
-        "N");
+    auto check = [&out, lo, hi](const std::string& option, const std::string& text) {
+        if constexpr (std::is_integral_v<T>) return parseInt(option, text, lo, hi, out);
+        else return parseReal(option, text, lo, hi, out);
+    };
+    return addChecked(app, names, check, help + range, std::is_integral_v<T> ? "N" : "X");
 }
 
-// A finite number in [lo, hi] (cli::parseReal).
-template <std::floating_point T>
-CLI::Option* addReal(CLI::App& app, const std::string& names, T& out, std::type_identity_t<T> lo, std::type_identity_t<T> hi,
-                     const std::string& help) {
-    const std::string range = " [" + detail::show(lo) + ", " + detail::show(hi) + "], default " + detail::show(out);
-    return addChecked(
-        app, names, [&out, lo, hi](const std::string& option, const std::string& text) { return parseReal(option, text, lo, hi, out); }, help + range,
-        "X");
+// One of a few names, each standing for a value of `out`; any other text is
+// refused as "<refusal>, got '<text>'" (refusal e.g. "--alpha expects auto,
+// coverage or density").
+template <class T>
+CLI::Option* addOneOf(CLI::App& app, const std::string& names, T& out, std::vector<std::pair<std::string, T>> table, const std::string& refusal,
+                      const std::string& help) {
+    auto check = [&out, table = std::move(table), refusal](const std::string&, const std::string& text) -> splatfx::Status {
+        for (const auto& [name, value] : table)
+            if (name == text) {
+                out = value;
+                return {};
+            }
+        return splatfx::makeError(refusal + ", got " + detail::quoted(text));
+    };
+    return addChecked(app, names, check, help, "NAME");
 }
 
 // "WxH", each side a whole number in [lo, hi] (cli::parseSize).

@@ -63,7 +63,7 @@ int parse(int argc, char** argv, Args& a) {
     app.add_option("--out", a.out, "output folder")->type_name("DIR")->capture_default_str();
     int frames = 0, width = 0, height = 0;
     std::uint32_t seed = 0;
-    CLI::Option* framesOption = cli::addInt(app, "--frames", frames, 1, 100000, "frames to render (default: the scene's output.frames)");
+    CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 1, 100000, "frames to render (default: the scene's output.frames)");
     CLI::Option* sizeOption = cli::addChecked(
         app, "--size",
         [&](const std::string& option, const std::string& text) -> splatfx::Status {
@@ -82,7 +82,7 @@ int parse(int argc, char** argv, Args& a) {
         },
         "animation rate; frame i shows time i / F (default: the scene's output.fps)", "F");
     CLI::Option* seedOption =
-        cli::addInt(app, "--seed", seed, 0u, 4294967295u, "scene seed (every effect's random choices derive from it; default: the file's)");
+        cli::addNumber(app, "--seed", seed, 0u, 4294967295u, "scene seed (every effect's random choices derive from it; default: the file's)");
     app.add_flag("--traditional", a.traditional, "draw every effect with plain footprints, no textures (the paper's Fig. 1a)");
     cli::addChecked(
         app, "--scale",
@@ -152,7 +152,8 @@ int parse(int argc, char** argv, Args& a) {
         "--no-depth-cut", [&a] { a.renderer.splats.depthCut = false; },
         "the plain depth test at each splat's plane instead of the exact cut (RendererDesc::depthCut)");
     app.add_flag("--quiet", a.quiet, "no per-frame progress");
-    cli::addInt(app, "--abort-after", a.abortAfter, 0, 100000, "testing aid: fail on purpose after N frames (checks that nothing partial is left)");
+    cli::addNumber(app, "--abort-after", a.abortAfter, 0, 100000,
+                   "testing aid: fail on purpose after N frames (checks that nothing partial is left)");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     if (framesOption->count()) a.frames = frames;
     if (sizeOption->count()) a.size = glm::ivec2(width, height);

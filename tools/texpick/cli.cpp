@@ -98,32 +98,28 @@ splatfx::Result<Options> parseOptions(int argc, const char* const* argv) {
             app, name, [set = std::move(set)](const std::string&, const std::string& v) { return set(v); }, "");
     };
     text("--out", o.out);
-    cli::addInt(app, "--patch", o.patch, 1, 16384, "");
-    CLI::Option* count = cli::addInt(app, "--count", o.count, 1, kMaxTextures, "");
-    cli::addInt(app, "--seed", o.seed, 0u, 4294967295u, "");
-    cli::addReal(app, "--min-std", o.accept.minStd, 0.0f, 1.0f, "");
-    cli::addReal(app, "--min-mean", o.accept.minMean, 0.0f, 1.0f, "");
-    cli::addReal(app, "--min-coverage", o.accept.minCoverage, 0.0f, 1.0f, "");
+    cli::addNumber(app, "--patch", o.patch, 1, 16384, "");
+    CLI::Option* count = cli::addNumber(app, "--count", o.count, 1, kMaxTextures, "");
+    cli::addNumber(app, "--seed", o.seed, 0u, 4294967295u, "");
+    cli::addNumber(app, "--min-std", o.accept.minStd, 0.0f, 1.0f, "");
+    cli::addNumber(app, "--min-mean", o.accept.minMean, 0.0f, 1.0f, "");
+    cli::addNumber(app, "--min-coverage", o.accept.minCoverage, 0.0f, 1.0f, "");
     app.add_flag_callback("--absolute-thresholds", [&o] { o.accept.relative = false; });
-    choice("--alpha", [&o](const std::string& m) -> splatfx::Status {
-        if (m == "auto") o.source.alpha = AlphaUse::Auto;
-        else if (m == "coverage") o.source.alpha = AlphaUse::Coverage;
-        else if (m == "density") o.source.alpha = AlphaUse::Density;
-        else return makeError("--alpha expects auto, coverage or density, got '" + m + "'");
-        return {};
-    });
-    cli::addReal(app, "--min-distance", o.minDistance, 0.0f, 1e6f, "");
-    cli::addInt(app, "--stride", o.stride, 1, 16384, "");
-    cli::addReal(app, "--step", o.step, 1e-3, 1e6, "");
-    cli::addInt(app, "--size", o.process.textureSize, 4, 1024, "");
-    cli::addReal(app, "--contrast-std", o.process.contrastStd, 1e-3f, 0.5f, "");
-    cli::addInt(app, "--octaves", o.turbulence.octaves, 1, 12, "");
-    cli::addReal(app, "--base-frequency", o.turbulence.baseFrequency, 0.01f, 1000.0f, "");
-    cli::addReal(app, "--loop-radius", o.turbulence.loopRadius, 0.0f, 100.0f, "");
-    cli::addInt(app, "--preview-frames", o.output.previewFrames, 1, 1000, "");
-    cli::addInt(app, "--preview-fps", o.output.previewFps, 1, 100, "");
-    cli::addInt(app, "--preview-size", o.output.previewSize, 32, 2048, "");
-    cli::addInt(app, "--auto-quit-after", o.autoQuitAfter, 1, 1000000, "");
+    cli::addOneOf<AlphaUse>(app, "--alpha", o.source.alpha,
+                            {{"auto", AlphaUse::Auto}, {"coverage", AlphaUse::Coverage}, {"density", AlphaUse::Density}},
+                            "--alpha expects auto, coverage or density", "");
+    cli::addNumber(app, "--min-distance", o.minDistance, 0.0f, 1e6f, "");
+    cli::addNumber(app, "--stride", o.stride, 1, 16384, "");
+    cli::addNumber(app, "--step", o.step, 1e-3, 1e6, "");
+    cli::addNumber(app, "--size", o.process.textureSize, 4, 1024, "");
+    cli::addNumber(app, "--contrast-std", o.process.contrastStd, 1e-3f, 0.5f, "");
+    cli::addNumber(app, "--octaves", o.turbulence.octaves, 1, 12, "");
+    cli::addNumber(app, "--base-frequency", o.turbulence.baseFrequency, 0.01f, 1000.0f, "");
+    cli::addNumber(app, "--loop-radius", o.turbulence.loopRadius, 0.0f, 100.0f, "");
+    cli::addNumber(app, "--preview-frames", o.output.previewFrames, 1, 1000, "");
+    cli::addNumber(app, "--preview-fps", o.output.previewFps, 1, 100, "");
+    cli::addNumber(app, "--preview-size", o.output.previewSize, 32, 2048, "");
+    cli::addNumber(app, "--auto-quit-after", o.autoQuitAfter, 1, 1000000, "");
     // Repeatable: one patch centre (and side) each.
     app.add_option_function<std::vector<std::string>>(
            "--at",
@@ -152,25 +148,14 @@ splatfx::Result<Options> parseOptions(int argc, const char* const* argv) {
         o.path = *p;
         return {};
     });
-    choice("--contrast", [&o](const std::string& m) -> splatfx::Status {
-        if (m == "patch") o.process.contrast = Contrast::Patch;
-        else if (m == "set") o.process.contrast = Contrast::Set;
-        else if (m == "none") o.process.contrast = Contrast::None;
-        else return makeError("--contrast must be patch, set or none, got '" + m + "'");
-        return {};
-    });
-    choice("--kernel", [&o](const std::string& k) -> splatfx::Status {
-        if (k == "crawfis-max") o.process.footprint.kernel = splatfx::Kernel::CrawfisMax;
-        else if (k == "gaussian") o.process.footprint.kernel = splatfx::Kernel::Gaussian;
-        else return makeError("--kernel must be crawfis-max or gaussian, got '" + k + "'");
-        return {};
-    });
-    choice("--preview-colors", [&o](const std::string& c) -> splatfx::Status {
-        if (c != "fire" && c != "smoke" && c != "steam" && c != "dust" && c != "white")
-            return makeError("--preview-colors must be fire, smoke, steam, dust or white, got '" + c + "'");
-        o.output.previewColors = c;
-        return {};
-    });
+    cli::addOneOf<Contrast>(app, "--contrast", o.process.contrast, {{"patch", Contrast::Patch}, {"set", Contrast::Set}, {"none", Contrast::None}},
+                            "--contrast must be patch, set or none", "");
+    cli::addOneOf<splatfx::Kernel>(app, "--kernel", o.process.footprint.kernel,
+                                   {{"crawfis-max", splatfx::Kernel::CrawfisMax}, {"gaussian", splatfx::Kernel::Gaussian}},
+                                   "--kernel must be crawfis-max or gaussian", "");
+    std::vector<std::pair<std::string, std::string>> colors;
+    for (const char* c : {"fire", "smoke", "steam", "dust", "white"}) colors.emplace_back(c, c);
+    cli::addOneOf(app, "--preview-colors", o.output.previewColors, colors, "--preview-colors must be fire, smoke, steam, dust or white", "");
     text("--source-name", o.sourceName);
     text("--credit", o.credit);
     text("--license", o.license);

@@ -62,17 +62,10 @@ int parse(int argc, char** argv, Args& a) {
     app.add_option("scene", a.scene, "the scene file (default: none; open one from the UI)")->type_name("SCENE.json");
     cli::addSize(app, "--size", a.size.x, a.size.y, 64, 8192, "window size");
     std::uint32_t seed = 0;
-    CLI::Option* seedOption = cli::addInt(app, "--seed", seed, 0u, 4294967295u, "scene seed (default: the file's)");
-    cli::addChecked(
-        app, "--camera",
-        [&a](const std::string& option, const std::string& text) -> splatfx::Status {
-            if (text != "path" && text != "orbit" && text != "fly")
-                return splatfx::makeError(option + " expects path, orbit or fly, got '" + text + "'");
-            a.camera = text;
-            return {};
-        },
-        "path (the scene's camera path, default), orbit or fly", "MODE");
-    cli::addInt(app, "--auto-quit-after", a.autoQuitAfter, 1, 1000000, "render N frames at the scene's fps (fixed steps), then quit");
+    CLI::Option* seedOption = cli::addNumber(app, "--seed", seed, 0u, 4294967295u, "scene seed (default: the file's)");
+    cli::addOneOf<std::string>(app, "--camera", a.camera, {{"path", "path"}, {"orbit", "orbit"}, {"fly", "fly"}},
+                               "--camera expects path, orbit or fly", "path (the scene's camera path, default), orbit or fly");
+    cli::addNumber(app, "--auto-quit-after", a.autoQuitAfter, 1, 1000000, "render N frames at the scene's fps (fixed steps), then quit");
     app.add_option("--screenshot", a.screenshot, "write the last frame (with the UI) to FILE (PNG)")->type_name("FILE");
     app.add_flag("--hide-ui", a.hideUi, "no UI panel");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
