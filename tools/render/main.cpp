@@ -154,6 +154,9 @@ int parse(int argc, char** argv, Args& a) {
     app.add_flag("--quiet", a.quiet, "no per-frame progress");
     cli::addNumber(app, "--abort-after", a.abortAfter, 0, 100000,
                    "testing aid: fail on purpose after N frames (checks that nothing partial is left)");
+    // Unset, these come from the scene file: the help says so instead of showing the placeholder 0.
+    framesOption->description("frames to render, in [1, 100000] (default: the scene's output.frames)");
+    seedOption->description("scene seed, in [0, 4294967295] (every effect's random choices derive from it; default: the file's)");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     if (framesOption->count()) a.frames = frames;
     if (sizeOption->count()) a.size = glm::ivec2(width, height);

@@ -63,6 +63,7 @@ int parse(int argc, char** argv, Args& a) {
     cli::addSize(app, "--size", a.size.x, a.size.y, 64, 8192, "window size");
     std::uint32_t seed = 0;
     CLI::Option* seedOption = cli::addNumber(app, "--seed", seed, 0u, 4294967295u, "scene seed (default: the file's)");
+    seedOption->description("scene seed, in [0, 4294967295] (default: the file's)");
     cli::addOneOf<std::string>(app, "--camera", a.camera, {{"path", "path"}, {"orbit", "orbit"}, {"fly", "fly"}},
                                "--camera expects path, orbit or fly", "path (the scene's camera path, default), orbit or fly");
     cli::addNumber(app, "--auto-quit-after", a.autoQuitAfter, 1, 1000000, "render N frames at the scene's fps (fixed steps), then quit");
