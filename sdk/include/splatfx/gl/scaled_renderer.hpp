@@ -97,7 +97,7 @@ public:
 
     const ScaledRendererDesc& desc() const;
     const Renderer& renderer() const;
-    Renderer& renderer(); // e.g. for Renderer::setFog
+    Renderer& renderer(); // e.g. Renderer::setFog
 
 private:
     struct Impl;
