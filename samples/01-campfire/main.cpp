@@ -98,7 +98,9 @@ struct Campfire {
 
 int main(int argc, char** argv) {
     Campfire app;
-    if (!samples::parseOptions(argc, argv, "campfire", "the paper's 7x20x5 fire as textured splats (Figure 1)", app.options)) return 2;
+    if (const int code = samples::parseOptions(argc, argv, "campfire", "the paper's 7x20x5 fire as textured splats (Figure 1)", app.options);
+        code >= 0)
+        return code;
     return samples::run(
         app.options, "campfire", [&] { return app.setup(); }, [&](const samples::FrameContext& fc) { return app.frame(fc); });
 }

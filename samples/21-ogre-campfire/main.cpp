@@ -6,11 +6,10 @@
 // Needs an X display: headless, run it under xvfb-run -a.
 #include <cstdio>
 #include <string>
-#include <string_view>
 
-#include "cli.hpp"
 #include "ogre_campfire.hpp"
-#include "splatfx/image.hpp"
+#include "sample_options.hpp"
+#include "splatfx/image_io.hpp"
 
 namespace {
 
@@ -24,21 +23,14 @@ int run(int argc, char** argv) {
     int frames = 24;
     double timeSec = 1.0;
     std::string screenshot;
-    for (int i = 1; i < argc; ++i) {
-        const std::string_view a = argv[i];
-        const bool hasValue = i + 1 < argc;
-        splatfx::Status s;
-        if (a == "--frames" && hasValue) s = cli::parseInt("--frames", argv[++i], 1, 100000, frames);
-        else if (a == "--size" && hasValue) s = cli::parseSize("--size", argv[++i], 16, 8192, desc.width, desc.height);
-        else if (a == "--scale" && hasValue) s = cli::parseInt("--scale", argv[++i], 1, 4, desc.resolutionScale);
-        else if (a == "--seed" && hasValue) s = cli::parseInt("--seed", argv[++i], 0u, 0xffffffffu, desc.seed);
-        else if (a == "--time" && hasValue) s = cli::parseReal("--time", argv[++i], 0.0, 1.0e6, timeSec);
-        else if (a == "--screenshot" && hasValue) screenshot = argv[++i];
-        else
-            return fail("unknown or incomplete option '" + std::string(a) +
-                        "'; usage: ogre-campfire [--frames N] [--size WxH] [--scale 1|2|4] [--seed S] [--time SECONDS] [--screenshot out.png]");
-        if (!s) return fail(s.error());
-    }
+    CLI::App cli{"splatfx's campfire drawn inside OGRE 1.12 (GL3Plus); needs an X display (headless: xvfb-run -a)", "ogre-campfire"};
+    samples::addNumber(cli, "--frames", frames, 1, 100000, "frames rendered, 24 per second, ending at --time");
+    samples::addSize(cli, "--size", desc.width, desc.height, 16, 8192, "window size");
+    samples::addNumber(cli, "--scale", desc.resolutionScale, 1, 4, "splat resolution divisor (1, 2 or 4)");
+    samples::addNumber(cli, "--seed", desc.seed, 0u, 0xffffffffu, "seed of every random choice");
+    samples::addNumber(cli, "--time", timeSec, 0.0, 1.0e6, "scene time of the last frame, seconds");
+    cli.add_option("--screenshot", screenshot, "write the last frame here (PNG)")->type_name("FILE");
+    if (const int code = samples::parseCommandLine(cli, argc, argv); code >= 0) return code;
     auto app = ogrefx::OgreCampfire::create(desc);
     if (!app) return fail(app.error());
     // Frames at 24 per second ending at --time; the screenshot is the last.
@@ -65,5 +57,5 @@ int run(int argc, char** argv) {
 } // namespace
 
 int main(int argc, char** argv) {
-    return cli::guardedMain("ogre-campfire", [&] { return run(argc, argv); });
+    return samples::runGuarded("ogre-campfire", [&] { return run(argc, argv); });
 }

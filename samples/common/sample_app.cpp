@@ -1,4 +1,5 @@
 #include "sample_app.hpp"
+#include "sample_options.hpp"
 
 #include "splatfx/output_set.hpp"
 
@@ -11,62 +12,29 @@
 #include <epoxy/gl.h>
 #include <GLFW/glfw3.h>
 
-#include "cli.hpp"
 #include "splatfx/context.hpp"
 
 namespace samples {
 
-bool parseOptions(int argc, char** argv, const char* name, const char* about, Options& o) {
-    auto usage = [&] {
-        std::printf("%s: %s\n\nusage: %s [--frames N --out DIR] [--size WxH] [--seed S] [--fps F] [--traditional]\n"
-                    "  (no --frames: open a window; Esc quits)\n",
-                    name, about, name);
-    };
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        auto next = [&]() -> const char* {
-            if (i + 1 >= argc) {
-                std::fprintf(stderr, "%s: %s needs a value\n", name, a.c_str());
-                return nullptr;
-            }
-            return argv[++i];
-        };
-        const char* v = nullptr;
-        if (a == "--help" || a == "-h") {
-            usage();
-            return false;
-        } else if (a == "--traditional") {
-            o.traditional = true;
-        } else if (a == "--frames" && (v = next())) {
-            if (auto st = cli::parseInt("--frames", v, 1, 100000, o.frames); !st) {
-                std::fprintf(stderr, "%s: %s\n", name, st.error().c_str());
-                return false;
-            }
-        } else if (a == "--out" && (v = next())) {
-            o.out = v;
-        } else if (a == "--size" && (v = next())) {
-            if (auto st = cli::parseSize("--size", v, 16, 8192, o.size.x, o.size.y); !st) {
-                std::fprintf(stderr, "%s: %s (e.g. 640x480)\n", name, st.error().c_str());
-                return false;
-            }
-        } else if (a == "--seed" && (v = next())) {
-            if (auto st = cli::parseInt("--seed", v, 0u, 4294967295u, o.seed); !st) {
-                std::fprintf(stderr, "%s: %s\n", name, st.error().c_str());
-                return false;
-            }
-        } else if (a == "--fps" && (v = next())) {
-            if (!cli::parseReal("--fps", v, 0.0f, 240.0f, o.fps) || !(o.fps > 0.0f)) {
-                std::fprintf(stderr, "%s: --fps must be in (0, 240], got '%s'\n", name, v);
-                return false;
-            }
-        } else if (a == "--extra" && (v = next())) {
-            o.extra = v;
-        } else {
-            if (!v) std::fprintf(stderr, "%s: unknown or incomplete option '%s' (try --help)\n", name, a.c_str());
-            return false;
-        }
-    }
-    return true;
+int parseOptions(int argc, char** argv, const char* name, const char* about, Options& o) {
+    CLI::App app{std::string(about) + "\n(no --frames: open a window; Esc quits)", name};
+    addNumber(app, "--frames", o.frames, 1, 100000, "render this many frames headless, then exit");
+    app.add_option("--out", o.out, "output folder (headless)")->type_name("DIR")->capture_default_str();
+    addSize(app, "--size", o.size.x, o.size.y, 16, 8192, "frame size");
+    addNumber(app, "--seed", o.seed, 0u, 4294967295u, "seed of every random choice");
+    app.add_option_function<std::string>(
+           "--fps",
+           [&o, name](const std::string& text) {
+               float fps = 0.0f;
+               if (!option_text::readAll(text, fps) || !(fps > 0.0f && fps <= 240.0f))
+                   throw CLI::ValidationError(std::string("--fps must be in (0, 240], got '") + text + "'");
+               o.fps = fps;
+           },
+           "frames per second of the animation (default 24)")
+        ->type_name("F");
+    app.add_flag("--traditional", o.traditional, "untextured splats (Fig. 1a)");
+    app.add_option("--extra", o.extra, "a sample-specific value (see the sample)")->type_name("VALUE");
+    return parseCommandLine(app, argc, argv);
 }
 
 namespace {
@@ -159,7 +127,7 @@ int runWindowed(const Options& o, const char* name, const std::function<bool()>&
 
 int run(const Options& o, const char* name, const std::function<bool()>& setup, const std::function<bool(const FrameContext&)>& frame) {
     // Any exception from a sample's setup or frame (std::bad_alloc at a huge --size) becomes a message and exit code 1.
-    return cli::guardedMain(name, [&] { return o.frames > 0 ? runHeadless(o, name, setup, frame) : runWindowed(o, name, setup, frame); });
+    return runGuarded(name, [&] { return o.frames > 0 ? runHeadless(o, name, setup, frame) : runWindowed(o, name, setup, frame); });
 }
 
 } // namespace samples

@@ -27,8 +27,9 @@ struct Options {
     std::string extra;        // sample-specific flag value (see each sample's --help)
 };
 
-// Parses argv; prints usage and returns false on --help or a bad flag.
-bool parseOptions(int argc, char** argv, const char* name, const char* about, Options& options);
+// Parses argv (samples/common/sample_options.hpp). Returns -1 when the sample
+// goes on, else the exit code: 0 after printing the help, 2 after a bad option.
+int parseOptions(int argc, char** argv, const char* name, const char* about, Options& options);
 
 struct FrameContext {
     int index = 0;        // frame number

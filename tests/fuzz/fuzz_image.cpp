@@ -6,7 +6,7 @@
 #include <cstdint>
 
 #include "fuzz_common.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     using fuzz::startsWith;

@@ -1,14 +1,14 @@
 // libFuzzer target for texture-set manifests: the input is written as
 // manifest.json into a folder beside 16 real 32x32 textures (t000.png ...
 // t015.png, copied once from textures/turbulence-16x32), then
-// TextureSet::load reads the folder. Any manifest must give a set or a
+// loadTextureSet reads the folder. Any manifest must give a set or a
 // message, never a crash, hang or sanitizer report.
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 
 #include "fuzz_common.hpp"
-#include "splatfx/texture_set.hpp"
+#include "splatfx/texture_set_io.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     namespace fs = std::filesystem;
@@ -20,7 +20,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         return f;
     }();
     fuzz::writeFile("set/manifest.json", data, size);
-    auto set = splatfx::TextureSet::load(folder.string());
+    auto set = splatfx::loadTextureSet(folder.string());
     if (!set && set.error().empty()) __builtin_trap();
     return 0;
 }

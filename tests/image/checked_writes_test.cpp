@@ -12,7 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "gl_fixture.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 
 using namespace splatfx;
 namespace fs = std::filesystem;

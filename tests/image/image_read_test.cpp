@@ -9,8 +9,8 @@
 #include <gtest/gtest.h>
 
 #include "gl_fixture.hpp"
-#include "splatfx/image.hpp"
-#include "splatfx/texture_set.hpp"
+#include "splatfx/image_io.hpp"
+#include "splatfx/texture_set_io.hpp"
 
 using namespace splatfx;
 namespace fs = std::filesystem;
@@ -123,10 +123,10 @@ TEST(ImageRead, AHeaderClaimingHugeSidesIsRefusedBeforeDecoding) {
 TEST(ImageRead, ATextureSetWhoseFirstTextureIsAFifoFailsInsteadOfHanging) {
     const fs::path set = dir() / "fifo_set";
     fs::remove_all(set);
-    ASSERT_TRUE(TextureSet::turbulence({.count = 2, .size = 8}).save(set.string(), "{}"));
+    ASSERT_TRUE(saveTextureSet(TextureSet::turbulence({.count = 2, .size = 8}), set.string(), "{}"));
     fs::remove(set / "t000.png");
     ASSERT_EQ(mkfifo((set / "t000.png").c_str(), 0600), 0);
-    auto loaded = TextureSet::load(set.string());
+    auto loaded = loadTextureSet(set.string());
     ASSERT_FALSE(loaded);
     EXPECT_NE(loaded.error().find("t000.png"), std::string::npos) << loaded.error();
 }

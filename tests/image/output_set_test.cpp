@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "gl_fixture.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 #include "splatfx/output_set.hpp"
 
 using namespace splatfx;

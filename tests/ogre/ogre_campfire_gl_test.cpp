@@ -17,7 +17,7 @@
 
 #include "gl_fixture.hpp"
 #include "ogre_campfire.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 
 namespace {
 

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "splatfx/scene_file.hpp"
+#include "splatfx/texture_set_io.hpp"
 
 namespace {
 
@@ -143,7 +144,7 @@ TEST(SceneFile, PresetTextureFoldersAreLoadedByTheReader) {
     auto r =
         splatfx::parseSceneFile("{" + kHead + R"(, "effects": [{"kind": "fire", "textureSet": {"folder": ")" + set + R"("}}]})", "dir/scene.json", m);
     ASSERT_TRUE(r.ok()) << r.error();
-    auto direct = splatfx::TextureSet::load(set);
+    auto direct = splatfx::loadTextureSet(set);
     ASSERT_TRUE(direct) << direct.error();
     ASSERT_EQ(m.setCount(), sets + 1);
     ASSERT_EQ(m.layerCount() - layers, std::uint32_t(direct->count()));

@@ -6,6 +6,7 @@
 
 #include "splatfx/materials.hpp"
 #include "splatfx/presets.hpp"
+#include "splatfx/texture_set_io.hpp"
 
 using namespace splatfx;
 
@@ -137,9 +138,9 @@ TEST(Presets, EffectsWithDifferentSeedsShareTheirTextureSets) {
 }
 
 TEST(Presets, AGivenSetIsSharedByContent) {
-    auto folder = TextureSet::load(std::string(SPLATFX_SOURCE_DIR) + "/textures/turbulence-8x32");
+    auto folder = loadTextureSet(std::string(SPLATFX_SOURCE_DIR) + "/textures/turbulence-8x32");
     ASSERT_TRUE(folder) << folder.error();
-    auto again = TextureSet::load(std::string(SPLATFX_SOURCE_DIR) + "/textures/turbulence-8x32/"); // spelled differently
+    auto again = loadTextureSet(std::string(SPLATFX_SOURCE_DIR) + "/textures/turbulence-8x32/"); // spelled differently
     ASSERT_TRUE(again) << again.error();
     Materials m{Footprint{}};
     auto a = presets::steam(m, {.textureSet = *folder});

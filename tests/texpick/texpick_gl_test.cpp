@@ -51,7 +51,7 @@ TEST_F(TexpickGLTest, CommandLineWritesThePreview) {
     auto o = texpick::parseOptions(9, argv);
     ASSERT_TRUE(o) << o.error();
     ASSERT_EQ(texpick::run(*o), 0);
-    ASSERT_TRUE(splatfx::TextureSet::load(set));
+    ASSERT_TRUE(splatfx::loadTextureSet(set));
     auto in = OIIO::ImageInput::open(set + "/preview.gif");
     ASSERT_TRUE(in) << OIIO::geterror();
     EXPECT_EQ(in->spec().width, 128);

@@ -276,7 +276,7 @@ TEST(TexpickPositions, ReproducesTheGivenPatchesExactly) {
     const fs::path out = scratch() / "positions";
     texpick::Provenance prov{.sourceFile = "rgb", .method = "positions", .selection = &*sel, .process = &proc, .order = made->order};
     ASSERT_TRUE(texpick::writeOutput(out.string(), made->set, texpick::provenanceJson(prov), {.preview = false}, &src, &sel->patches));
-    auto back = splatfx::TextureSet::load(out.string());
+    auto back = splatfx::loadTextureSet(out.string());
     ASSERT_TRUE(back) << back.error();
     ASSERT_EQ(back->count(), 3);
     EXPECT_TRUE(back->color);
@@ -531,8 +531,8 @@ TEST(TexpickSets, TurbulenceAndMergeLoad) {
     ASSERT_EQ(rc2, 0) << err2;
     auto [rc3, err3] = runCli({"merge", (dir / "turb").string(), (dir / "turb2").string(), "--out", (dir / "both").string(), "--no-preview"});
     ASSERT_EQ(rc3, 0) << err3;
-    auto turb = splatfx::TextureSet::load((dir / "turb").string());
-    auto both = splatfx::TextureSet::load((dir / "both").string());
+    auto turb = splatfx::loadTextureSet((dir / "turb").string());
+    auto both = splatfx::loadTextureSet((dir / "both").string());
     ASSERT_TRUE(turb) << turb.error();
     ASSERT_TRUE(both) << both.error();
     EXPECT_EQ(turb->count(), 4);
@@ -552,7 +552,7 @@ TEST(TexpickSets, WindowedSetRoundTrips) {
     ASSERT_TRUE(made->set.isWindowed);
     const fs::path out = scratch() / "windowed";
     ASSERT_TRUE(texpick::writeOutput(out.string(), made->set, "{}", {.preview = false}));
-    auto back = splatfx::TextureSet::load(out.string());
+    auto back = splatfx::loadTextureSet(out.string());
     ASSERT_TRUE(back) << back.error();
     EXPECT_TRUE(back->isWindowed);
     for (int k = 0; k < 2; ++k)
@@ -578,7 +578,7 @@ TEST(TexpickSets, EveryShippedSetLoads) {
     for (const auto& e : fs::directory_iterator(root)) {
         if (!fs::exists(e.path() / "manifest.json")) continue;
         ++sets;
-        auto set = splatfx::TextureSet::load(e.path().string());
+        auto set = splatfx::loadTextureSet(e.path().string());
         ASSERT_TRUE(set) << set.error();
         std::smatch m;
         const std::string name = e.path().filename().string();
@@ -604,7 +604,7 @@ TEST(TexpickSets, ShippedTurbulenceRegenerates) {
                                                       .octaves = p["octaves"],
                                                       .baseFrequency = p["baseFrequency"],
                                                       .loopRadius = p["loopRadius"]});
-    auto set = splatfx::TextureSet::load(dir.string());
+    auto set = splatfx::loadTextureSet(dir.string());
     ASSERT_TRUE(set) << set.error();
     ASSERT_EQ(set->count(), ref.count());
     for (int k = 0; k < ref.count(); ++k)
@@ -620,13 +620,13 @@ TEST(TexpickOutput, KilledRunsAreRecoveredByTheNextRun) {
     fs::remove_all(dir);
     fs::create_directories(dir);
     const auto set = splatfx::TextureSet::turbulence({.count = 2, .size = 16, .seed = 4});
-    ASSERT_TRUE(set.save((dir / ".fire.texpick-old-4194305").string(), "{}"));
+    ASSERT_TRUE(saveTextureSet(set, (dir / ".fire.texpick-old-4194305").string(), "{}"));
     fs::create_directories(dir / ".fire.texpick-4194306");
     std::ofstream(dir / ".fire.texpick-4194306" / "t000.png") << "half written";
     const splatfx::Status s = texpick::writeOutput((dir / "fire").string(), splatfx::TextureSet{}, "{}", {.contactSheet = false, .preview = false});
     ASSERT_FALSE(s) << "an empty set must fail to save";
     EXPECT_TRUE(fs::exists(dir / "fire" / "manifest.json")) << "the previous set must be back under its name";
-    EXPECT_TRUE(splatfx::TextureSet::load((dir / "fire").string()));
+    EXPECT_TRUE(splatfx::loadTextureSet((dir / "fire").string()));
     EXPECT_FALSE(fs::exists(dir / ".fire.texpick-4194306")) << "the killed run's staging folder must be gone";
     EXPECT_FALSE(fs::exists(dir / ".fire.texpick-old-4194305"));
 }

@@ -6,9 +6,10 @@
 
 #include "gl_fixture.hpp"
 #include "splatfx/materials.hpp"
-#include "splatfx/texture_set.hpp"
+#include "splatfx/texture_set_io.hpp"
 
 using splatfx::Footprint;
+using splatfx::loadTextureSet;
 using splatfx::TextureSet;
 namespace fs = std::filesystem;
 
@@ -63,8 +64,8 @@ TEST(TextureSet, WindowingKeepsDetailInsideTheFootprint) {
 TEST(TextureSet, SaveAndLoadRoundTrip) {
     const std::string dir = splatfx::test::outputDir() + "/set";
     const auto set = TextureSet::turbulence({.count = 3, .size = 16, .seed = 5});
-    ASSERT_TRUE(set.save(dir, R"({"method": "test"})"));
-    auto back = TextureSet::load(dir);
+    ASSERT_TRUE(saveTextureSet(set, dir, R"({"method": "test"})"));
+    auto back = loadTextureSet(dir);
     ASSERT_TRUE(back) << back.error();
     ASSERT_EQ(back->count(), 3);
     ASSERT_EQ(back->size, 16);
@@ -74,7 +75,7 @@ TEST(TextureSet, SaveAndLoadRoundTrip) {
 }
 
 TEST(TextureSetBadInput, MissingFolderIsNamed) {
-    auto set = TextureSet::load("/nonexistent/fire-set");
+    auto set = loadTextureSet("/nonexistent/fire-set");
     ASSERT_FALSE(set);
     EXPECT_EQ(set.error(), "texture set '/nonexistent/fire-set': no such folder");
 }
@@ -82,9 +83,9 @@ TEST(TextureSetBadInput, MissingFolderIsNamed) {
 TEST(TextureSetBadInput, MissingTextureFileIsNamed) {
     const std::string dir = splatfx::test::outputDir() + "/missing";
     fs::remove_all(dir);
-    ASSERT_TRUE(TextureSet::turbulence({.count = 2, .size = 8}).save(dir));
+    ASSERT_TRUE(saveTextureSet(TextureSet::turbulence({.count = 2, .size = 8}), dir));
     fs::remove(dir + "/t001.png");
-    auto set = TextureSet::load(dir);
+    auto set = loadTextureSet(dir);
     ASSERT_FALSE(set);
     EXPECT_NE(set.error().find("t001.png': no such file"), std::string::npos) << set.error();
 }
@@ -92,14 +93,14 @@ TEST(TextureSetBadInput, MissingTextureFileIsNamed) {
 TEST(TextureSetBadInput, CorruptAndZeroSizeImagesAreNamed) {
     const std::string dir = splatfx::test::outputDir() + "/corrupt";
     fs::remove_all(dir);
-    ASSERT_TRUE(TextureSet::turbulence({.count = 2, .size = 8}).save(dir));
+    ASSERT_TRUE(saveTextureSet(TextureSet::turbulence({.count = 2, .size = 8}), dir));
     { std::ofstream(dir + "/t000.png", std::ios::trunc); } // zero bytes
-    auto empty = TextureSet::load(dir);
+    auto empty = loadTextureSet(dir);
     ASSERT_FALSE(empty);
     EXPECT_NE(empty.error().find("t000.png': the file is empty"), std::string::npos) << empty.error();
 
     { std::ofstream(dir + "/t000.png", std::ios::trunc) << "\x89PNG\r\n\x1a\n this is not really a png"; }
-    auto corrupt = TextureSet::load(dir);
+    auto corrupt = loadTextureSet(dir);
     ASSERT_FALSE(corrupt);
     EXPECT_NE(corrupt.error().find("cannot read image '" + dir + "/t000.png'"), std::string::npos) << corrupt.error();
 }
@@ -108,11 +109,11 @@ TEST(TextureSetBadInput, MalformedManifestNamesTheField) {
     const std::string dir = splatfx::test::outputDir() + "/manifest";
     fs::create_directories(dir);
     { std::ofstream(dir + "/manifest.json") << R"({"format": "splatfx-texture-set", "version": 2, "textures": []})"; }
-    auto v = TextureSet::load(dir);
+    auto v = loadTextureSet(dir);
     ASSERT_FALSE(v);
     EXPECT_NE(v.error().find("field 'version' must be 1"), std::string::npos) << v.error();
     { std::ofstream(dir + "/manifest.json") << "{ not json"; }
-    auto j = TextureSet::load(dir);
+    auto j = loadTextureSet(dir);
     ASSERT_FALSE(j);
     EXPECT_NE(j.error().find("not valid JSON"), std::string::npos) << j.error();
 }
@@ -137,8 +138,8 @@ TEST(TextureSet, WindowedColourSetsRoundTrip) {
     for (auto& layer : set.layers)
         for (size_t i = 0; i < layer.size(); i += 4) layer[i + 1] *= 0.5f, layer[i + 2] *= 0.25f; // warm tint
     const TextureSet win = set.windowed(Footprint{});
-    ASSERT_TRUE(win.save(dir));
-    auto back = TextureSet::load(dir);
+    ASSERT_TRUE(saveTextureSet(win, dir));
+    auto back = loadTextureSet(dir);
     ASSERT_TRUE(back) << back.error();
     ASSERT_TRUE(back->color && back->isWindowed);
     for (int k = 0; k < 2; ++k)
@@ -157,15 +158,15 @@ TEST(TextureSet, WindowedColourSetsRoundTrip) {
 TEST(TextureSetBadInput, LyingOrEscapingManifestsAreRefused) {
     const std::string dir = splatfx::test::outputDir() + "/lying";
     fs::remove_all(dir);
-    ASSERT_TRUE(TextureSet::turbulence({.count = 2, .size = 8}).save(dir, "{}"));
+    ASSERT_TRUE(saveTextureSet(TextureSet::turbulence({.count = 2, .size = 8}), dir, "{}"));
     const std::string good = [&] {
         std::ifstream in(dir + "/manifest.json");
         return std::string(std::istreambuf_iterator<char>(in), {});
     }();
-    ASSERT_TRUE(TextureSet::load(dir));
+    ASSERT_TRUE(loadTextureSet(dir));
     auto withManifest = [&](const std::string& text) {
         std::ofstream(dir + "/manifest.json") << text;
-        return TextureSet::load(dir);
+        return loadTextureSet(dir);
     };
     auto replaced = [&](const std::string& from, const std::string& to) {
         std::string s = good;

@@ -36,7 +36,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "bench_stats.hpp"
-#include "cli.hpp"
+#include "options.hpp"
 #include "spawn.hpp"
 #include "commands.hpp"
 #include "splatfx/context.hpp"
@@ -398,44 +398,22 @@ std::string loadAverage() {
 
 const char* precisionName(Precision p) { return p == Precision::U8 ? "U8" : p == Precision::F16 ? "F16" : "F32"; }
 
-bool parse(int argc, char** argv, Options& o) {
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        auto next = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
-        if (a == "--out") {
-            const char* v = next();
-            if (!v) return false;
-            o.out = v;
-        } else if (a == "--size") {
-            // 2048 a side: the run keeps a dozen float images of this size
-            // (references in double), about 1 GB at the cap.
-            const char* v = next();
-            if (!v) return false;
-            if (auto s = cli::parseSize("--size", v, 16, 2048, o.size.x, o.size.y); !s) {
-                std::fprintf(stderr, "accuracy: %s\n", s.error().c_str());
-                return false;
-            }
-        } else if (a == "--reps") {
-            const char* v = next();
-            if (!v) return false;
-            if (auto s = cli::parseInt("--reps", v, 1, 10000, o.reps); !s) {
-                std::fprintf(stderr, "accuracy: %s\n", s.error().c_str());
-                return false;
-            }
-        } else if (a == "--no-plots") {
-            o.plots = false;
-        } else if (a == "--replot") {
-            o.replotOnly = true;
-        } else if (a == "--fog-only") {
-            o.fogOnly = true;
-        } else if (a == "--clouds-only") {
-            o.cloudsOnly = true;
-            o.plots = false; // the clouds' table is printed, not plotted
-        } else {
-            return false;
-        }
-    }
-    return true;
+// Returns -1 to go on, else the exit code (cli::parse).
+int parse(int argc, char** argv, Options& o) {
+    CLI::App app{"Error against the exact reference vs time per frame, for every quality knob.", "splatfx-bench accuracy"};
+    app.add_option("--out", o.out, "where accuracy.csv, accuracy.dat, accuracy.gp and the PNG plots go")->type_name("DIR")->capture_default_str();
+    // 2048 a side: the run keeps a dozen float images of this size
+    // (references in double), about 1 GB at the cap.
+    cli::addSize(app, "--size", o.size.x, o.size.y, 16, 2048, "frame size");
+    cli::addNumber(app, "--reps", o.reps, 1, 10000, "timed frames per setting, median reported");
+    bool noPlots = false;
+    app.add_flag("--no-plots", noPlots, "print the tables only");
+    app.add_flag("--replot", o.replotOnly, "only run gnuplot again on DIR/accuracy.gp (after editing it)");
+    app.add_flag("--fog-only", o.fogOnly, "only the fog knobs (host fog texture, per-splat fog, fog terms) and their reference");
+    app.add_flag("--clouds-only", o.cloudsOnly, "only the LOD clouds' knobs (table size, c, C, max vs average Delta) against the finest level");
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+    if (noPlots || o.cloudsOnly) o.plots = false; // the clouds' table is printed, not plotted
+    return -1;
 }
 
 void writePlots(const Bench& b, const std::string& dir) {
@@ -489,16 +467,7 @@ cli::SpawnResult plotCommand(const std::string& outDir) { return cli::spawn({.ar
 
 int runAccuracy(int argc, char** argv) {
     Bench b;
-    if (!parse(argc, argv, b.opt)) {
-        std::fprintf(stderr, "usage: splatfx-bench accuracy [--out DIR] [--size WxH] [--reps N] [--no-plots] [--replot]\n"
-                             "  --out DIR    where accuracy.csv, accuracy.dat, accuracy.gp and the PNG plots go (default bench-accuracy)\n"
-                             "  --size WxH   frame size (default 320x240)\n"
-                             "  --reps N     timed frames per setting, median reported (default 11)\n"
-                             "  --replot     only run gnuplot again on DIR/accuracy.gp (after editing it)\n"
-                             "  --fog-only   only the fog knobs (host fog texture, per-splat fog, fog terms) and their reference\n"
-                             "  --clouds-only  only the LOD clouds' knobs (table size, c, C, max vs average Delta) against the finest level\n");
-        return 2;
-    }
+    if (const int code = parse(argc, argv, b.opt); code >= 0) return code;
     if (b.opt.replotOnly) {
         const cli::SpawnResult gp = plotCommand(b.opt.out);
         if (!gp.started || gp.exitCode != 0) {

@@ -18,6 +18,7 @@
 #include <epoxy/gl.h>
 
 #include "bench_gl.hpp"
+#include "options.hpp"
 #include "bench_stats.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
@@ -100,46 +101,35 @@ bool inside(const glm::vec3& ext, const splatfx::Camera& c) {
     return e.x > 0 && e.y > 0 && e.z > 0 && e.x < ext.x && e.y < ext.y && e.z < ext.z;
 }
 
-int usage() {
-    std::printf("usage: splatfx-bench clouds [--dims X Y Z] [--c DETAIL] [--frames N] [--size W H]\n"
-                "                            [--pop-dims X Y Z] [--pop-frames N] [--pop-size W H] [--pop-c DETAIL]\n"
-                "                            [--pop-step WORLD_PER_FRAME]\n"
-                "                            [--fog-dims X Y Z] [--fog-size W H] [--fog-frames N] [--fog-only]\n"
-                "                            [--scale 1|2|4]   (the flight also with the tetrahedra at 1/scale resolution; default 2)\n");
-    return 2;
-}
-
 } // namespace
 
 int runClouds(int argc, char** argv) {
     Options o;
-    for (int i = 1; i < argc; ++i) {
-        auto next3 = [&](glm::ivec3& v) {
-            v = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2]), std::atoi(argv[i + 3])};
-            i += 3;
-        };
-        auto next2 = [&](glm::ivec2& v) {
-            v = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2])};
-            i += 2;
-        };
-        if (!std::strcmp(argv[i], "--dims") && i + 3 < argc) next3(o.dims);
-        else if (!std::strcmp(argv[i], "--pop-dims") && i + 3 < argc) next3(o.popDims);
-        else if (!std::strcmp(argv[i], "--size") && i + 2 < argc) next2(o.size);
-        else if (!std::strcmp(argv[i], "--pop-size") && i + 2 < argc) next2(o.popSize);
-        else if (!std::strcmp(argv[i], "--c") && i + 1 < argc) o.detailC = float(std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--pop-c") && i + 1 < argc) o.popDetailC = float(std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--pop-step") && i + 1 < argc) o.popStepWorld = float(std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) o.frames = std::atoi(argv[++i]);
-        else if (!std::strcmp(argv[i], "--fog-dims") && i + 3 < argc) next3(o.fogDims);
-        else if (!std::strcmp(argv[i], "--fog-size") && i + 2 < argc) next2(o.fogSize);
-        else if (!std::strcmp(argv[i], "--fog-frames") && i + 1 < argc) o.fogFrames = std::atoi(argv[++i]);
-        else if (!std::strcmp(argv[i], "--fog-only")) o.fogOnly = true;
-        else if (!std::strcmp(argv[i], "--scale") && i + 1 < argc) o.scale = std::atoi(argv[++i]);
-        else if (!std::strcmp(argv[i], "--pop-frames") && i + 1 < argc) o.popFrames = std::atoi(argv[++i]);
-        else return usage();
-    }
-    if (o.scale != 1 && o.scale != 2 && o.scale != 4) return usage();
-    if (o.frames < 2 || o.popFrames < 2 || o.size.x < 1 || o.size.y < 1 || o.popSize.x < 1 || o.popSize.y < 1) return usage();
+    CLI::App app{"LOD cloud volumes as pre-integrated projected tetrahedra: count vs full resolution, frame rate and memory outside\n"
+                 "and inside, the flight also with the tetrahedra at 1/scale resolution, popping, fog on the tetrahedra.",
+                 "splatfx-bench clouds"};
+    cli::addInts(app, "--dims", &o.dims.x, 3, 2, 4097, "grid points of the flight's cloud field", "X Y Z");
+    cli::addNumber(app, "--c", o.detailC, 0.0f, 1.0e6f, "detail knob c of the flight");
+    cli::addNumber(app, "--frames", o.frames, 2, 100000, "frames of the flight");
+    cli::addInts(app, "--size", &o.size.x, 2, 16, 8192, "frame size of the flight", "W H");
+    cli::addInts(app, "--pop-dims", &o.popDims.x, 3, 2, 4097, "grid points of the popping run's field", "X Y Z");
+    cli::addNumber(app, "--pop-frames", o.popFrames, 2, 100000, "frames of the popping run");
+    cli::addInts(app, "--pop-size", &o.popSize.x, 2, 16, 8192, "frame size of the popping run", "W H");
+    cli::addNumber(app, "--pop-c", o.popDetailC, 0.0f, 1.0e6f, "detail knob c of the popping run");
+    cli::addNumber(app, "--pop-step", o.popStepWorld, 1.0e-6f, 1.0e6f, "world units per frame of the popping run");
+    cli::addInts(app, "--fog-dims", &o.fogDims.x, 3, 2, 4097, "grid points of the fogged cloud", "X Y Z");
+    cli::addInts(app, "--fog-size", &o.fogSize.x, 2, 16, 8192, "frame size of the fog runs", "W H");
+    cli::addNumber(app, "--fog-frames", o.fogFrames, 1, 100000, "frames timed per fog mode");
+    app.add_flag("--fog-only", o.fogOnly, "skip the flight and the popping runs");
+    cli::addChecked(
+        app, "--scale",
+        [&o](const std::string& option, const std::string& text) -> splatfx::Status {
+            if (auto s = cli::parseInt(option, text, 1, 4, o.scale); !s || o.scale == 3)
+                return splatfx::makeError(option + " expects 1, 2 or 4, got '" + text + "'");
+            return {};
+        },
+        "the flight also with the tetrahedra at 1/scale resolution: 1, 2 or 4 (default 2; 1: full resolution only)", "N");
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) return std::fprintf(stderr, "%s\n", ctx.error().c_str()), 1;
     auto fr = splatfx::gl::FrameRenderer::create();

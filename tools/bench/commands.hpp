@@ -16,6 +16,8 @@ int runGroundFog(int argc, char** argv);    // groundfog.cpp: LOD ground fog ove
 int runCut(int argc, char** argv);          // cut.cpp: splats cut by the host depth and the near plane: cost, accuracy, popping (issue 15)
 int runSoak(int argc, char** argv);         // soak.cpp: every preset for an hour of scene time; finite, flat bounds and memory (issue 13)
 int runTransparency(int argc, char** argv); // transparency.cpp: glass panes among the fire, fragment lists vs ordered blend (issue 15)
+int runShadowTables(int argc, char** argv); // shadow_tables.cpp: shadow-table build time and error against tracing, CPU only
+int runLodRefine(int argc, char** argv);    // lod_refine.cpp: LOD cloud refinement on the CPU: tetrahedra, update time, memory
 
 // cloud_knobs.cpp, run by accuracy (--clouds-only alone): the LOD clouds' table size, c, C and
 // max vs average Delta against the finest level integrated exactly (issue 17). Needs a current GL context.
@@ -31,9 +33,11 @@ inline constexpr BenchCommand kCommands[] = {
     {"accuracy", "error against the exact reference vs time per frame, for every quality knob", runAccuracy},
     {"table1", "King et al. 1999 Table I on this machine, fill limit, naive baseline, CPU scaling", runTable1},
     {"clouds", "LOD cloud volumes as tetrahedra: count vs full, frame rate and memory outside/inside, popping", runClouds},
+    {"lodrefine", "LOD cloud refinement on the CPU: tetrahedra per frame vs full, update() time, memory, error vs finest", runLodRefine},
     {"groundfog", "LOD ground fog over the Jacksboro DEM: count vs full, ms/frame, error vs full, popping with/without morphing", runGroundFog},
     {"scheduling", "a level of 1000 effects with 10 in view vs those 10 alone; camera sweep; catch-up error", runScheduling},
     {"shadows", "Ebert & Parent 1990 Table 2: steam from a glass, no/geometry/traced/table shadowing, table error", runShadows},
+    {"shadowtables", "shadow tables 16^3..128^3 vs tracing for a 1560-voxel effect: build and lookup time, error (CPU only)", runShadowTables},
     {"fog", "Biri et al. 2002 Table 1: no fog, per-pixel fog, reduced fog textures at 800x600; error vs per pixel", runFog},
     {"cut", "splats cut exactly by depth: cost vs plain on Table I rows, error per table size, popping of a moving wall and the cow", runCut},
     {"transparency", "glass panes among the 1560-voxel fire: fragment lists vs ordered blend vs opaque only, budget, memory", runTransparency},

@@ -14,7 +14,7 @@
 
 #include <epoxy/gl.h>
 
-#include "cli.hpp"
+#include "options.hpp"
 #include "scene_player.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/splatfx.hpp"
@@ -341,39 +341,23 @@ int runCut(int argc, char** argv) {
     int frames = 15, steps = 32;
     bool doCost = true, doAccuracy = true, doPlane = true, doCow = true;
     std::string cowPath = "samples/03-cow-through-fire/scene.json";
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        if (a == "--frames" && i + 1 < argc) {
-            if (auto s = cli::parseInt("--frames", argv[++i], 1, 1000, frames); !s) {
-                std::fprintf(stderr, "cut: %s\n", s.error().c_str());
-                return 2;
-            }
-        } else if (a == "--steps" && i + 1 < argc) {
-            if (auto s = cli::parseInt("--steps", argv[++i], 2, 1000, steps); !s) {
-                std::fprintf(stderr, "cut: %s\n", s.error().c_str());
-                return 2;
-            }
-        } else if (a == "--cow" && i + 1 < argc) {
-            cowPath = argv[++i];
-        } else if (a == "--only" && i + 1 < argc) {
-            const std::string w = argv[++i];
+    CLI::App app{"The depth cut: cut vs plain depth-tested splats on the Table I rows (cost ratio in one run), error against the exact\n"
+                 "reference per partial-table size and for the plain test, the popping metric while a wall moves slowly through a fire\n"
+                 "(GL cut, GL plain, the reference), and on the cow sample (run from the repository root, or pass --cow).",
+                 "splatfx-bench cut"};
+    cli::addNumber(app, "--frames", frames, 1, 1000, "timed frames per row");
+    cli::addNumber(app, "--steps", steps, 2, 1000, "positions of the moving wall");
+    app.add_option("--cow", cowPath, "the cow sample's scene file")->type_name("SCENE")->capture_default_str();
+    cli::addChecked(
+        app, "--only",
+        [&](const std::string&, const std::string& w) -> splatfx::Status {
             doCost = w == "cost", doAccuracy = w == "accuracy", doPlane = w == "popping", doCow = w == "cow";
-            if (!(doCost || doAccuracy || doPlane || doCow)) {
-                std::fprintf(stderr, "cut: --only expects cost, accuracy, popping or cow, got '%s'\n", w.c_str());
-                return 2;
-            }
-        } else if (a == "--help" || a == "-h") {
-            std::printf("splatfx-bench cut [--frames N] [--steps N] [--only cost|accuracy|popping|cow] [--cow SCENE]\n"
-                        "  The depth cut (issue 15): cut vs plain depth-tested splats on the Table I rows (cost ratio in one run),\n"
-                        "  error against the exact reference per partial-table size and for the plain test, the popping metric\n"
-                        "  while a wall moves slowly through a fire (GL cut, GL plain, the reference), and on the cow sample\n"
-                        "  (run from the repository root, or pass --cow).\n");
-            return 0;
-        } else {
-            std::fprintf(stderr, "cut: unknown option '%s'\n", a.c_str());
-            return 2;
-        }
-    }
+            if (!(doCost || doAccuracy || doPlane || doCow))
+                return splatfx::makeError("--only expects cost, accuracy, popping or cow, got '" + w + "'");
+            return {};
+        },
+        "run one part only: cost, accuracy, popping or cow", "PART");
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) {
         std::fprintf(stderr, "cut: %s\n", ctx.error().c_str());

@@ -15,6 +15,7 @@
 
 #include <epoxy/gl.h>
 
+#include "options.hpp"
 #include "scene_player.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/fog.hpp"
@@ -53,22 +54,17 @@ int runFog(int argc, char** argv) {
     std::string scenePath = "samples/09-fog-countryside/scene.json";
     int frames = 30, rounds = 3;
     glm::ivec2 size{800, 600};
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        if (a == "--scene" && i + 1 < argc) scenePath = argv[++i];
-        else if (a == "--frames" && i + 1 < argc) frames = std::max(3, std::atoi(argv[++i]));
-        else if (a == "--rounds" && i + 1 < argc) rounds = std::max(1, std::atoi(argv[++i]));
-        else if (a == "--quick") frames = 5, rounds = 1;
-        else if (a == "--help" || a == "-h") {
-            std::printf("usage: splatfx-bench fog [--scene samples/09-fog-countryside/scene.json] [--frames N (30)] [--rounds R (3)] [--quick]\n"
-                        "Frame time at 800x600 of the scene's geometry (its effects disabled) with no fog, per-pixel fog and\n"
-                        "the reduced fog textures of Biri et al.'s Table 1, for three fogs; error of each against per-pixel.\n");
-            return 0;
-        } else {
-            std::fprintf(stderr, "fog: unknown option '%s'\n", a.c_str());
-            return 2;
-        }
-    }
+    bool quick = false;
+    CLI::App app{"Frame time at 800x600 of the scene's geometry (its effects disabled) with no fog, per-pixel fog and the reduced fog\n"
+                 "textures of Biri et al.'s Table 1, for three fogs; error of each against per-pixel.",
+                 "splatfx-bench fog"};
+    app.add_option("--scene", scenePath, "the scene file")->type_name("FILE")->capture_default_str();
+    CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 3, 100000, "timed frames per mode");
+    CLI::Option* roundsOption = cli::addNumber(app, "--rounds", rounds, 1, 1000, "rounds over the modes");
+    app.add_flag("--quick", quick, "5 frames x 1 round (unless given)");
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+    if (quick && framesOption->count() == 0) frames = 5;
+    if (quick && roundsOption->count() == 0) rounds = 1;
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) {
         std::fprintf(stderr, "fog: %s\n", ctx.error().c_str());

@@ -17,11 +17,12 @@
 #include <epoxy/gl.h>
 
 #include "bench_gl.hpp"
+#include "options.hpp"
 #include "bench_stats.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/gl/framebuffer.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 #include "splatfx/scene.hpp"
 #include "splatfx/scene_file.hpp"
 #include "splatfx/volume.hpp"
@@ -43,12 +44,6 @@ struct Options {
     float densityDepth = 0.0f; // --affine DEPTH: GroundFogDesc::densityDepthWorld (0: the paper's model)
     glm::ivec2 probe{-1};      // --probe X Y: print the exact ray integral (integrateRay) of that pixel per frame and mode
 };
-
-int usage() {
-    std::printf("usage: splatfx-bench groundfog [--dem FILE.pgm] [--size W H] [--frames N] [--step WORLD_PER_FRAME]\n"
-                "                               [--c DETAIL] [--C MIN_ACCURACY] [--out DIR] [--affine DEPTH]\n");
-    return 2;
-}
 
 // Sample 22's layer: spacing 1, heightScale 1228.78, position y -4.69, fog top 5.
 splatfx::GroundFogDesc jacksboro(const splatfx::Image& img, bool lod, float minAccuracyC, float densityDepth) {
@@ -80,19 +75,19 @@ splatfx::Camera flight(int f, float step, glm::ivec2 size) {
 
 int runGroundFog(int argc, char** argv) {
     Options o;
-    for (int i = 1; i < argc; ++i) {
-        if (!std::strcmp(argv[i], "--dem") && i + 1 < argc) o.dem = argv[++i];
-        else if (!std::strcmp(argv[i], "--size") && i + 2 < argc) o.size = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2])}, i += 2;
-        else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) o.frames = std::atoi(argv[++i]);
-        else if (!std::strcmp(argv[i], "--step") && i + 1 < argc) o.stepWorld = float(std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--c") && i + 1 < argc) o.detailC = float(std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--C") && i + 1 < argc) o.minAccuracyC = float(std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) o.out = argv[++i];
-        else if (!std::strcmp(argv[i], "--affine") && i + 1 < argc) o.densityDepth = float(std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--probe") && i + 2 < argc) o.probe = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2])}, i += 2;
-        else return usage();
-    }
-    if (o.frames < 2 || o.size.x < 1 || o.size.y < 1 || !(o.stepWorld > 0.0f)) return usage();
+    CLI::App app{"LOD ground fog over the Jacksboro DEM (samples 22 and 23): tetrahedra vs full resolution, ms per frame, error vs\n"
+                 "full resolution, popping with and without morphing, along a flight.",
+                 "splatfx-bench groundfog"};
+    app.add_option("--dem", o.dem, "the terrain, a PGM heightmap")->type_name("FILE.pgm")->capture_default_str();
+    cli::addInts(app, "--size", &o.size.x, 2, 16, 8192, "frame size", "W H");
+    cli::addNumber(app, "--frames", o.frames, 2, 100000, "frames of the flight");
+    cli::addNumber(app, "--step", o.stepWorld, 1.0e-6f, 1.0e6f, "world units per frame along the flight");
+    cli::addNumber(app, "--c", o.detailC, 0.0f, 1.0e6f, "detail knob c");
+    cli::addNumber(app, "--C", o.minAccuracyC, 0.0f, 1.0e6f, "minimum accuracy C");
+    app.add_option("--out", o.out, "write the last frame of each mode as PNG here")->type_name("DIR");
+    cli::addNumber(app, "--affine", o.densityDepth, 0.0f, 1.0e6f, "GroundFogDesc::densityDepthWorld (0: the paper's model)");
+    cli::addInts(app, "--probe", &o.probe.x, 2, 0, 8191, "print the exact ray integral of this pixel per frame and mode", "X Y");
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     auto img = splatfx::readImage(o.dem, splatfx::Alpha::Straight);
     if (!img) return std::fprintf(stderr, "%s\n", img.error().c_str()), 1;
     auto ctx = splatfx::HeadlessContext::create();

@@ -14,7 +14,7 @@
 #include <epoxy/gl.h>
 
 #include "bench_stats.hpp"
-#include "cli.hpp"
+#include "options.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/gl/framebuffer.hpp"
@@ -86,26 +86,17 @@ double frameCost(splatfx::Scene& scene, splatfx::Materials& m, int frames, doubl
 int runScheduling(int argc, char** argv) {
     int count = 1000, frames = 60;
     glm::ivec2 size{640, 480};
-    for (int i = 1; i < argc; ++i) { // argv[0] is the subcommand
-        const std::string a = argv[i];
-        // Strict and bounded (tools/common/cli.hpp): 100000 effects is about 100x the level this bench models.
-        splatfx::Status st;
-        if (a == "--effects" && i + 1 < argc) st = cli::parseInt("--effects", argv[++i], 20, 100000, count);
-        else if (a == "--frames" && i + 1 < argc) st = cli::parseInt("--frames", argv[++i], 5, 100000, frames);
-        else if (a == "--quick") frames = 15;
-        else if (a == "--size" && i + 1 < argc && std::sscanf(argv[i + 1], "%dx%d", &size.x, &size.y) == 2 && size.x > 0 && size.y > 0) ++i;
-        else {
-            std::printf("splatfx-bench scheduling [--effects N] [--frames N] [--size WxH] [--quick]\n"
-                        "  A level of N effects (fire, steam, smoke solver, fire-to-smoke) of which 10 are in view,\n"
-                        "  against a scene holding only those 10, drawn headless at WxH (default 640x480);\n"
-                        "  a camera sweep; solver catch-up error.\n");
-            return a == "--help" || a == "-h" ? 0 : 2;
-        }
-        if (!st) {
-            std::fprintf(stderr, "scheduling: %s\n", st.error().c_str());
-            return 2;
-        }
-    }
+    bool quick = false;
+    CLI::App app{"A level of N effects (fire, steam, smoke solver, fire-to-smoke) of which 10 are in view, against a scene holding\n"
+                 "only those 10, drawn headless; a camera sweep; solver catch-up error.",
+                 "splatfx-bench scheduling"};
+    // Strict and bounded: 100000 effects is about 100x the level this bench models.
+    cli::addNumber(app, "--effects", count, 20, 100000, "effects in the level");
+    CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 5, 100000, "timed frames per run");
+    cli::addSize(app, "--size", size.x, size.y, 16, 8192, "frame size");
+    app.add_flag("--quick", quick, "15 frames (unless --frames is given)");
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+    if (quick && framesOption->count() == 0) frames = 15;
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) {
         std::fprintf(stderr, "scheduling: %s\n", ctx.error().c_str());

@@ -23,6 +23,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "bench_gl.hpp"
+#include "options.hpp"
 #include "geometry_renderer.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
@@ -259,20 +260,20 @@ int runShadows(int argc, char** argv) {
     int frames = 15, warm = 3;
     bool animated = true;
     std::vector<glm::ivec2> sizes = {{360, 250}, {640, 480}};
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        if (a == "--frames" && i + 1 < argc) frames = std::max(3, std::atoi(argv[++i]));
-        else if (a == "--static") animated = false;
-        else if (a == "--quick") frames = 5, warm = 1, sizes = {{360, 250}};
-        else {
-            std::printf("splatfx-bench shadows [--frames N] [--static] [--quick]\n"
-                        "  Ebert & Parent 1990 Table 2: steam from a glass at 360x250 and 640x480, no shadowing, shadows\n"
-                        "  on the geometry only, traced self-shadowing, table self-shadowing at 16^3..128^3: median frame\n"
-                        "  time (Scene::prepare + FrameRenderer::render + glFinish) as a ratio to no shadowing, and each\n"
-                        "  table's transmittance error against tracing. --static: the steam does not evolve (tables reused).\n"
-                        "  Then the phase-lobe knob: 1..4 HG lobes fitted to Cornette-Shanks, lit error and lightPoints time.\n");
-            return a == "--help" || a == "-h" ? 0 : 2;
-        }
+    bool still = false, quick = false;
+    CLI::App app{"Ebert & Parent 1990 Table 2: steam from a glass at 360x250 and 640x480, no shadowing, shadows on the geometry only,\n"
+                 "traced self-shadowing, table self-shadowing at 16^3..128^3: median frame time (Scene::prepare +\n"
+                 "FrameRenderer::render + glFinish) as a ratio to no shadowing, and each table's transmittance error against tracing.\n"
+                 "Then the phase-lobe knob: 1..4 HG lobes fitted to Cornette-Shanks, lit error and lightPoints time.",
+                 "splatfx-bench shadows"};
+    CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 3, 100000, "timed frames per configuration");
+    app.add_flag("--static", still, "the steam does not evolve (tables reused)");
+    app.add_flag("--quick", quick, "one size, 5 frames (unless --frames is given), 1 warm-up");
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+    animated = !still;
+    if (quick) {
+        if (framesOption->count() == 0) frames = 5;
+        warm = 1, sizes = {{360, 250}};
     }
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) {

@@ -14,7 +14,7 @@
 #include <unistd.h>
 #include <vector>
 
-#include "cli.hpp"
+#include "options.hpp"
 #include "commands.hpp"
 #include "splatfx/splatfx.hpp"
 
@@ -82,23 +82,13 @@ glm::vec3 extent(const splatfx::Aabb& b) { return b.empty() ? glm::vec3(0.0f) : 
 int runSoak(int argc, char** argv) {
     double minutes = 60.0;
     std::string only;
-    for (int i = 1; i < argc; ++i) { // argv[0] is the subcommand
-        const std::string a = argv[i];
-        splatfx::Status st;
-        if (a == "--minutes" && i + 1 < argc) st = cli::parseReal("--minutes", argv[++i], 0.1, 24.0 * 60.0, minutes);
-        else if (a == "--preset" && i + 1 < argc) only = argv[++i];
-        else {
-            std::printf("splatfx-bench soak [--minutes M] [--preset NAME]\n"
-                        "  Steps every preset (fire, smoke, steam, dust, fireToSmoke, ghosts) at 60 Hz for M minutes of scene\n"
-                        "  time (default 60: 216000 steps each), checking every step for NaN/Inf in the grids and solver fields,\n"
-                        "  and that Effect::bounds and the resident memory (/proc/self/statm) stay flat. Exit 1 on any failure.\n");
-            return a == "--help" || a == "-h" ? 0 : 2;
-        }
-        if (!st) {
-            std::fprintf(stderr, "soak: %s\n", st.error().c_str());
-            return 2;
-        }
-    }
+    CLI::App app{"Steps every preset (fire, smoke, steam, dust, fireToSmoke, ghosts) at 60 Hz for M minutes of scene time (default 60:\n"
+                 "216000 steps each), checking every step for NaN/Inf in the grids and solver fields, and that Effect::bounds and the\n"
+                 "resident memory (/proc/self/statm) stay flat. Exit 1 on any failure.",
+                 "splatfx-bench soak"};
+    cli::addNumber(app, "--minutes", minutes, 0.1, 24.0 * 60.0, "minutes of scene time per preset");
+    app.add_option("--preset", only, "only this preset")->type_name("NAME");
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     namespace P = splatfx::presets;
     const std::vector<Preset> presets = {
         {"fire", [](splatfx::Materials& m) { return P::fire(m); }},

@@ -18,7 +18,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
-#include "cli.hpp"
+#include "options.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/program.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
@@ -524,57 +524,41 @@ int runTable1(int argc, char** argv) {
     int& frames = settings.frames;
     std::string csvPath; // no CSV unless --csv names one
     bool quick = false;
-    for (int i = 1; i < argc; ++i) { // argv[0] is the subcommand
-        const std::string a = argv[i];
-        if (a == "--frames" && i + 1 < argc) {
-            if (auto st = cli::parseInt("--frames", argv[++i], 3, 100000, frames); !st) {
-                std::fprintf(stderr, "table1: %s\n", st.error().c_str());
-                return 2;
-            }
-        } else if (a == "--csv" && i + 1 < argc) csvPath = argv[++i];
-        else if (a == "--quick") quick = true;
-        else if (a == "--footprint-cut" && i + 1 < argc) {
-            // A fraction of the footprint's peak below which fragments are discarded.
-            if (auto st = cli::parseReal("--footprint-cut", argv[++i], 0.0f, 1.0f, settings.renderer.footprintCut); !st) {
-                std::fprintf(stderr, "table1: %s\n", st.error().c_str());
-                return 2;
-            }
-        } else if (a == "--sampling" && i + 1 < argc) {
+    CLI::App app{"What a fragment costs on this GL, then the paper's Table I rows on this machine (headless), with pixels covered,\n"
+                 "overdraw, the splat pass as a fraction of this GL's fill rate and of its rate for squares of the splats' size, a naive\n"
+                 "baseline, and CPU scaling. Renderer options default to the SDK's.",
+                 "splatfx-bench table1"};
+    CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 3, 100000, "timed frames per row");
+    app.add_option("--csv", csvPath, "also write the figures as CSV to FILE (nothing is written without it)")->type_name("FILE");
+    app.add_flag("--quick", quick, "5 frames per row (unless --frames is given)");
+    // A fraction of the footprint's peak below which fragments are discarded.
+    cli::addNumber(app, "--footprint-cut", settings.renderer.footprintCut, 0.0f, 1.0f,
+                   "fragments below this fraction of the footprint's peak are discarded");
+    cli::addChecked(
+        app, "--sampling",
+        [&settings](const std::string&, const std::string& v) -> splatfx::Status {
             using splatfx::gl::TextureSampling;
-            const std::string v = argv[++i];
             if (v == "auto") settings.renderer.sampling = TextureSampling::Auto;
             else if (v == "bilinear") settings.renderer.sampling = TextureSampling::Bilinear;
             else if (v == "nearest") settings.renderer.sampling = TextureSampling::Nearest;
             else if (v.rfind("upsampled", 0) == 0) {
                 settings.renderer.sampling = TextureSampling::Upsampled;
                 settings.renderer.upsample = 0; // "upsampled": the renderer's default factor; "upsampled4" -> 4
-                if (v.size() > 9) {
-                    if (auto st = cli::parseInt("--sampling upsampledN", v.substr(9), 2, 16, settings.renderer.upsample); !st) {
-                        std::fprintf(stderr, "table1: %s\n", st.error().c_str());
-                        return 2;
-                    }
-                }
+                if (v.size() > 9) return cli::parseInt("--sampling upsampledN", v.substr(9), 2, 16, settings.renderer.upsample);
             } else {
-                std::fprintf(stderr, "table1: --sampling takes auto, bilinear, nearest, upsampled or upsampledN\n");
-                return 2;
+                return splatfx::makeError("--sampling takes auto, bilinear, nearest, upsampled or upsampledN");
             }
-        } else if (a == "--crossfade") settings.crossfade = true;
-        else if (a == "--squares") settings.renderer.trimCorners = false;
-        else if (a == "--octagons") settings.renderer.trimCorners = true;
-        else if (a == "--help" || a == "-h") {
-            std::printf("splatfx-bench table1 [--frames N] [--csv FILE] [--quick] [--footprint-cut F] [--crossfade] [--squares | --octagons]\n"
-                        "                     [--sampling auto|bilinear|nearest|upsampled|upsampledN]\n"
-                        "  What a fragment costs on this GL, then the paper's Table I rows on this machine (headless), with\n"
-                        "  pixels covered, overdraw, the splat pass as a fraction of this GL's fill rate and of its rate for\n"
-                        "  squares of the splats' size, a naive baseline, and CPU scaling. Renderer options default to the SDK's.\n"
-                        "  --csv FILE writes the same figures as CSV (nothing is written without it).\n");
-            return 0;
-        } else {
-            std::fprintf(stderr, "table1: unknown option '%s'\n", a.c_str());
-            return 2;
-        }
-    }
-    if (quick) frames = 5;
+            return {};
+        },
+        "texture sampling: auto, bilinear, nearest, upsampled or upsampledN (N in [2, 16])", "MODE");
+    app.add_flag("--crossfade", settings.crossfade, "blend towards the next texture by the voxel's phase");
+    CLI::Option* squares = app.add_flag_callback(
+        "--squares", [&settings] { settings.renderer.trimCorners = false; }, "draw square splats");
+    app.add_flag_callback(
+           "--octagons", [&settings] { settings.renderer.trimCorners = true; }, "draw octagons (trimmed corners)")
+        ->excludes(squares);
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+    if (quick && framesOption->count() == 0) frames = 5;
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) {
         std::fprintf(stderr, "table1: %s\n", ctx.error().c_str());

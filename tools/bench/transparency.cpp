@@ -18,6 +18,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "bench_gl.hpp"
+#include "options.hpp"
 #include "splatfx/splatfx.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/transparency.hpp"
@@ -125,28 +126,25 @@ int runTransparency(int argc, char** argv) {
     bool cut = true;       // RendererDesc::depthCut: sections weighted by the partial integral
     std::string imagesDir; // --images: the GL-vs-reference still
     std::string only;      // --only TEXT: the opaque-only frame and the configurations whose name contains TEXT
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        if (a == "--size" && i + 2 < argc) size = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2])}, i += 2;
-        else if (a == "--frames" && i + 1 < argc) frames = std::max(3, std::atoi(argv[++i]));
-        else if (a == "--rounds" && i + 1 < argc) rounds = std::max(1, std::atoi(argv[++i]));
-        else if (a == "--quick") frames = 5, rounds = 1, size = {320, 240};
-        else if (a == "--no-cut") cut = false;
-        else if (a == "--only" && i + 1 < argc) only = argv[++i];
-        else if (a == "--images" && i + 1 < argc) imagesDir = argv[++i];
-        else if (a == "--help" || a == "-h") {
-            std::printf("usage: splatfx-bench transparency [--size W H (640 480)] [--frames N (15)] [--rounds R (3)] [--quick] [--no-cut] [--only "
-                        "TEXT] [--images DIR]\n"
-                        "Glass panes among the 1560-voxel Table I fire: opaque-only frame, ordered blend and fragment lists,\n"
-                        "time and error against the exact reference; the fragment budget knob; list memory.\n"
-                        "--only TEXT: the opaque-only frame and the configurations whose name contains TEXT.\n"
-                        "--images DIR: DIR/transparency_gl_vs_reference.png, a pane in front of, through and behind the fire,\n"
-                        "GL (fragment lists) above the exact reference.\n");
-            return 0;
-        } else {
-            std::fprintf(stderr, "transparency: unknown option '%s'\n", a.c_str());
-            return 2;
-        }
+    bool quick = false, noCut = false;
+    CLI::App app{"Glass panes among the 1560-voxel Table I fire: opaque-only frame, ordered blend and fragment lists, time and error\n"
+                 "against the exact reference; the fragment budget knob; list memory.",
+                 "splatfx-bench transparency"};
+    CLI::Option* sizeOption = cli::addInts(app, "--size", &size.x, 2, 16, 8192, "frame size", "W H");
+    CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 3, 100000, "timed frames per configuration");
+    CLI::Option* roundsOption = cli::addNumber(app, "--rounds", rounds, 1, 1000, "rounds over the configurations");
+    app.add_flag("--quick", quick, "5 frames x 1 round at 320x240 (unless given)");
+    app.add_flag("--no-cut", noCut, "sections without the partial integral (RendererDesc::depthCut = false)");
+    app.add_option("--only", only, "the opaque-only frame and the configurations whose name contains TEXT")->type_name("TEXT");
+    app.add_option("--images", imagesDir,
+                   "write DIR/transparency_gl_vs_reference.png: panes in front of, through and behind the fire, GL above the reference")
+        ->type_name("DIR");
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+    cut = !noCut;
+    if (quick) {
+        if (framesOption->count() == 0) frames = 5;
+        if (roundsOption->count() == 0) rounds = 1;
+        if (sizeOption->count() == 0) size = {320, 240};
     }
     if (size.x < 16 || size.y < 16 || size.x > 4096 || size.y > 4096) {
         std::fprintf(stderr, "transparency: --size must be between 16 and 4096 on each side\n");

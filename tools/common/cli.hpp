@@ -1,15 +1,16 @@
-// tools/common/cli.hpp: the command-line boundary shared by every tool and sample.
+// tools/common/cli.hpp: the command-line boundary shared by every tool.
 //
 // What it is: strict number parsing (the whole string, range-checked, no
 // silent wrap-around), a "WxH" size parser, an "A-B[:STEP]" frame-range
 // parser (render-farm tasks), and a guard for main() that turns any escaping
 // std::exception (std::bad_alloc included) into a message and a non-zero
 // exit instead of std::terminate's abort.
-// What it does not do: option tables or usage text (each tool keeps its own),
+// What it does not do: option tables, usage text or argv walking (CLI11 does,
+// through tools/common/options.hpp, whose options call these parsers),
 // locale handling (numbers are C-locale: '.' is the decimal point).
 //
 //   long n = 0;
-//   if (auto s = cli::parseInt("--frames", argv[i], 1, 100000, n); !s) return fail(s.error());
+//   if (auto s = cli::parseInt("--frames", text, 1, 100000, n); !s) return fail(s.error());
 //   int main(int argc, char** argv) { return cli::guardedMain("splatfx-bench", [&] { return run(argc, argv); }); }
 //
 // Threading: pure functions; no shared state.

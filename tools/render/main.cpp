@@ -27,11 +27,11 @@
 
 #include <unistd.h>
 
-#include "cli.hpp"
+#include "options.hpp"
 #include "scene_player.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/framebuffer.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 #include "splatfx/output_set.hpp"
 
 namespace fs = std::filesystem;
@@ -54,155 +54,122 @@ struct Args {
     splatfx::Budgets budgets{};                // --budget NAME=N
 };
 
-void usage() {
-    std::printf("splatfx-render: render a splatfx scene file headless into PNG frames and an animated GIF\n\n"
-                "usage: splatfx-render SCENE.json [options]\n"
-                "  --out DIR        output folder (default: out); writes DIR/<name>_NNNN.png and DIR/<name>.gif\n"
-                "  --frames N       frames to render (default: the scene's output.frames)\n"
-                "  --size WxH       image size in pixels (default: the scene's output.size)\n"
-                "  --fps F          animation rate; frame i shows time i / F (default: the scene's output.fps)\n"
-                "  --seed S         scene seed (every effect's random choices derive from it; default: the file's)\n"
-                "  --traditional    draw every effect with plain footprints, no textures (the paper's Fig. 1a)\n"
-                "  --scale N        draw the effects and volumes (splats, clouds, ground fog) at 1/N resolution per axis\n"
-                "                   (1, 2 or 4; default 1) with depth-aware upsampling\n"
-                "  --sampling M     texture sampling: auto (default), bilinear, nearest, upsampled, upsampledN (N = 2..16)\n"
-                "  --fog-texture WxH  fog the host image through a reduced WxH fog texture (default: per pixel)\n"
-                "  --range A-B[:STEP]  render-farm task: write only frames A..B (every STEP-th; indices from 0), exactly\n"
-                "                   as a full run writes them; no GIF (see --assemble; docs/render-farm.md)\n"
-                "  --assemble       write DIR/<name>.gif from the frames DIR/<name>_NNNN.png the tasks wrote (renders nothing)\n"
-                "  --budget NAME=N  raise (or lower) one of the loader's budgets (splatfx/budget.hpp; repeatable): effectCells,\n"
-                "                   solverCells, sampledTexels, textureLayers, meshElements, meshFileBytes,\n"
-                "                   meshImportBytes, meshImportSeconds\n"
-                "  --no-depth-cut   the plain depth test at each splat's plane instead of the exact cut (RendererDesc::depthCut)\n"
-                "  --quiet          no per-frame progress\n"
-                "  --abort-after N  testing aid: fail on purpose after N frames (checks that nothing partial is left)\n"
-                "<name> is the scene's output.name (default: the scene file's folder name).\n");
-}
-
-bool parse(int argc, char** argv, Args& a) {
-    for (int i = 1; i < argc; ++i) {
-        const std::string s = argv[i];
-        auto value = [&]() -> const char* {
-            if (i + 1 >= argc) {
-                std::fprintf(stderr, "splatfx-render: %s needs a value (try --help)\n", s.c_str());
-                return nullptr;
-            }
-            return argv[++i];
-        };
-        auto integer = [&](const char* v, long lo, long hi, long& out) {
-            if (auto st = cli::parseInt(s, v, lo, hi, out); !st) {
-                std::fprintf(stderr, "splatfx-render: %s\n", st.error().c_str());
-                return false;
-            }
-            return true;
-        };
-        const char* v = nullptr;
-        long n = 0;
-        if (s == "--help" || s == "-h") {
-            usage();
-            std::exit(0);
-        } else if (s == "--traditional") {
-            a.traditional = true;
-        } else if (s == "--quiet") {
-            a.quiet = true;
-        } else if (s == "--out") {
-            if (!(v = value())) return false;
-            a.out = v;
-        } else if (s == "--frames") {
-            if (!(v = value()) || !integer(v, 1, 100000, n)) return false;
-            a.frames = int(n);
-        } else if (s == "--scale") {
-            if (!(v = value()) || !integer(v, 1, 4, n)) return false;
-            if (n == 3) {
-                std::fprintf(stderr, "splatfx-render: --scale expects 1, 2 or 4, got '%s'\n", v);
-                return false;
-            }
-            a.renderer.resolutionScale = int(n);
+// Returns -1 to go on, else the exit code (0 after --help, 2 after a bad command line).
+int parse(int argc, char** argv, Args& a) {
+    CLI::App app{"splatfx-render: render a splatfx scene file headless into PNG frames and an animated GIF.\n"
+                 "Writes DIR/<name>_NNNN.png and DIR/<name>.gif; <name> is the scene's output.name (default: the scene file's folder name).",
+                 "splatfx-render"};
+    app.add_option("scene", a.scene, "the scene file")->type_name("SCENE.json");
+    app.add_option("--out", a.out, "output folder")->type_name("DIR")->capture_default_str();
+    int frames = 0, width = 0, height = 0;
+    std::uint32_t seed = 0;
+    CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 1, 100000, "frames to render (default: the scene's output.frames)");
+    CLI::Option* sizeOption = cli::addChecked(
+        app, "--size",
+        [&](const std::string& option, const std::string& text) -> splatfx::Status {
+            if (auto st = cli::parseSize(option, text, 16, 8192, width, height); !st) return splatfx::makeError(st.error() + " (e.g. 640x480)");
+            return {};
+        },
+        "image size in pixels, each side in [16, 8192] (default: the scene's output.size)", "WxH");
+    cli::addChecked(
+        app, "--fps",
+        [&a](const std::string& option, const std::string& text) -> splatfx::Status {
+            float f = 0.0f;
+            if (!cli::parseReal(option, text, 0.0f, 240.0f, f) || !(f > 0.0f))
+                return splatfx::makeError(option + " expects a number in (0, 240], got '" + text + "'");
+            a.fps = f;
+            return {};
+        },
+        "animation rate; frame i shows time i / F (default: the scene's output.fps)", "F");
+    CLI::Option* seedOption =
+        cli::addNumber(app, "--seed", seed, 0u, 4294967295u, "scene seed (every effect's random choices derive from it; default: the file's)");
+    app.add_flag("--traditional", a.traditional, "draw every effect with plain footprints, no textures (the paper's Fig. 1a)");
+    cli::addChecked(
+        app, "--scale",
+        [&a](const std::string& option, const std::string& text) -> splatfx::Status {
+            int n = 0;
+            if (auto st = cli::parseInt(option, text, 1, 4, n); !st) return st;
+            if (n == 3) return splatfx::makeError(option + " expects 1, 2 or 4, got '" + text + "'");
+            a.renderer.resolutionScale = n;
             a.renderer.reduceTetrahedra = true; // every volume at the reduced resolution, in one order
-        } else if (s == "--sampling") {
-            if (!(v = value())) return false;
+            return {};
+        },
+        "draw the effects and volumes (splats, clouds, ground fog) at 1/N resolution per axis (1, 2 or 4; default 1) with "
+        "depth-aware upsampling",
+        "N");
+    cli::addChecked(
+        app, "--sampling",
+        [&a](const std::string& option, const std::string& m) -> splatfx::Status {
             using splatfx::gl::TextureSampling;
-            const std::string m = v;
             if (m == "auto") a.renderer.splats.sampling = TextureSampling::Auto;
             else if (m == "bilinear") a.renderer.splats.sampling = TextureSampling::Bilinear;
             else if (m == "nearest") a.renderer.splats.sampling = TextureSampling::Nearest;
             else if (m.rfind("upsampled", 0) == 0) {
                 a.renderer.splats.sampling = TextureSampling::Upsampled;
-                if (m.size() > 9 && !integer(m.c_str() + 9, 2, 16, n)) return false;
-                a.renderer.splats.upsample = m.size() > 9 ? int(n) : 0;
+                a.renderer.splats.upsample = 0;
+                if (m.size() > 9) return cli::parseInt(option, m.substr(9), 2, 16, a.renderer.splats.upsample);
             } else {
-                std::fprintf(stderr, "splatfx-render: --sampling expects auto, bilinear, nearest, upsampled or upsampledN, got '%s'\n", v);
-                return false;
+                return splatfx::makeError(option + " expects auto, bilinear, nearest, upsampled or upsampledN, got '" + m + "'");
             }
-        } else if (s == "--fog-texture") {
-            // The host image's fog through a reduced fog texture (Biri et al. Table 1, Fig. 9).
-            if (!(v = value())) return false;
+            return {};
+        },
+        "texture sampling: auto (default), bilinear, nearest, upsampled, upsampledN (N = 2..16)", "M");
+    // The host image's fog through a reduced fog texture (Biri et al. Table 1, Fig. 9).
+    cli::addChecked(
+        app, "--fog-texture",
+        [&a](const std::string& option, const std::string& text) -> splatfx::Status {
             int fw = 0, fh = 0;
-            char tail = 0;
-            if (std::sscanf(v, "%dx%d%c", &fw, &fh, &tail) != 2 || fw < 1 || fh < 1 || fw > 8192 || fh > 8192) {
-                std::fprintf(stderr, "splatfx-render: --fog-texture expects WxH (1 to 8192 each), got '%s'\n", v);
-                return false;
-            }
+            if (!cli::parseSize(option, text, 1, 8192, fw, fh))
+                return splatfx::makeError(option + " expects WxH (1 to 8192 each), got '" + text + "'");
             a.renderer.fogTextureSize = {fw, fh};
-        } else if (s == "--range") {
-            if (!(v = value())) return false;
+            return {};
+        },
+        "fog the host image through a reduced WxH fog texture (default: per pixel)", "WxH");
+    cli::addChecked(
+        app, "--range",
+        [&a](const std::string& option, const std::string& text) -> splatfx::Status {
             cli::FrameRange r;
-            if (auto st = cli::parseFrameRange("--range", v, 99999, r); !st) {
-                std::fprintf(stderr, "splatfx-render: %s\n", st.error().c_str());
-                return false;
-            }
+            if (auto st = cli::parseFrameRange(option, text, 99999, r); !st) return st;
             a.range = r;
-        } else if (s == "--budget") {
-            if (!(v = value())) return false;
-            if (auto st = splatfx::setBudget(a.budgets, v); !st) {
-                std::fprintf(stderr, "splatfx-render: --budget: %s\n", st.error().c_str());
-                return false;
-            }
-        } else if (s == "--assemble") {
-            a.assemble = true;
-        } else if (s == "--no-depth-cut") {
-            a.renderer.splats.depthCut = false; // issue 15: for before/after comparisons
-        } else if (s == "--abort-after") {
-            if (!(v = value()) || !integer(v, 0, 100000, n)) return false;
-            a.abortAfter = int(n);
-        } else if (s == "--seed") {
-            if (!(v = value()) || !integer(v, 0, 4294967295L, n)) return false;
-            a.seed = std::uint32_t(n);
-        } else if (s == "--size") {
-            if (!(v = value())) return false;
-            int w = 0, h = 0;
-            if (auto st = cli::parseSize("--size", v, 16, 8192, w, h); !st) {
-                std::fprintf(stderr, "splatfx-render: %s (e.g. 640x480)\n", st.error().c_str());
-                return false;
-            }
-            a.size = glm::ivec2(w, h);
-        } else if (s == "--fps") {
-            if (!(v = value())) return false;
-            float f = 0.0f;
-            if (!cli::parseReal("--fps", v, 0.0f, 240.0f, f) || !(f > 0.0f)) {
-                std::fprintf(stderr, "splatfx-render: --fps expects a number in (0, 240], got '%s'\n", v);
-                return false;
-            }
-            a.fps = f;
-        } else if (!s.empty() && s[0] == '-') {
-            std::fprintf(stderr, "splatfx-render: unknown option '%s' (try --help)\n", s.c_str());
-            return false;
-        } else if (a.scene.empty()) {
-            a.scene = s;
-        } else {
-            std::fprintf(stderr, "splatfx-render: one scene file at a time (got '%s' and '%s')\n", a.scene.c_str(), s.c_str());
-            return false;
-        }
-    }
+            return {};
+        },
+        "render-farm task: write only frames A..B (every STEP-th; indices from 0), exactly as a full run writes them; no GIF "
+        "(see --assemble; docs/render-farm.md)",
+        "A-B[:STEP]");
+    app.add_flag("--assemble", a.assemble, "write DIR/<name>.gif from the frames DIR/<name>_NNNN.png the tasks wrote (renders nothing)");
+    app.add_option_function<std::vector<std::string>>(
+           "--budget",
+           [&a](const std::vector<std::string>& settings) {
+               for (const std::string& text : settings)
+                   if (auto st = splatfx::setBudget(a.budgets, text); !st) throw CLI::ValidationError("--budget: " + st.error());
+           },
+           "raise (or lower) one of the loader's budgets (splatfx/budget.hpp; repeatable): effectCells, solverCells, sampledTexels, "
+           "textureLayers, meshElements, meshFileBytes, meshImportBytes, meshImportSeconds")
+        ->type_name("NAME=N")
+        ->expected(1)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    app.add_flag_callback(
+        "--no-depth-cut", [&a] { a.renderer.splats.depthCut = false; },
+        "the plain depth test at each splat's plane instead of the exact cut (RendererDesc::depthCut)");
+    app.add_flag("--quiet", a.quiet, "no per-frame progress");
+    cli::addNumber(app, "--abort-after", a.abortAfter, 0, 100000,
+                   "testing aid: fail on purpose after N frames (checks that nothing partial is left)");
+    // Unset, these come from the scene file: the help says so instead of showing the placeholder 0.
+    framesOption->description("frames to render, in [1, 100000] (default: the scene's output.frames)");
+    seedOption->description("scene seed, in [0, 4294967295] (every effect's random choices derive from it; default: the file's)");
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+    if (framesOption->count()) a.frames = frames;
+    if (sizeOption->count()) a.size = glm::ivec2(width, height);
+    if (seedOption->count()) a.seed = seed;
     if (a.scene.empty()) {
         std::fprintf(stderr, "splatfx-render: no scene file given (try --help)\n");
-        return false;
+        return 2;
     }
     if (a.assemble && a.range) {
         std::fprintf(stderr, "splatfx-render: --assemble writes the GIF of the whole sequence; it takes no --range\n");
-        return false;
+        return 2;
     }
-    return true;
+    return -1;
 }
 
 int fail(const std::string& why) {
@@ -266,7 +233,7 @@ int assemble(const Args& a) {
 
 static int renderMain(int argc, char** argv) {
     Args a;
-    if (!parse(argc, argv, a)) return 2;
+    if (const int code = parse(argc, argv, a); code >= 0) return code;
     if (a.assemble) return assemble(a);
 
     auto ctx = splatfx::HeadlessContext::create();

@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 #include "splatfx/scene_file.hpp"
 
 #include <fcntl.h>

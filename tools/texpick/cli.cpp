@@ -7,7 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cli.hpp"
+#include "options.hpp"
 #include "texpick.hpp"
 
 namespace texpick {
@@ -78,191 +78,108 @@ interactive:
   --screenshot FILE    write the window's picture to FILE before closing
 )";
 
-// Every number on the command line goes through tools/common/cli.hpp (whole
-// string, range-checked, finite).
-template <class T>
-splatfx::Result<T> number(const std::string& opt, const char* text, T lo, T hi) {
-    T v{};
-    splatfx::Status s;
-    if constexpr (std::is_floating_point_v<T>) s = cli::parseReal<T>(opt, text, lo, hi, v);
-    else s = cli::parseInt<T>(opt, text, lo, hi, v);
-    if (!s) return makeError(s.error());
-    return v;
-}
-
 } // namespace
 
+// The command line through CLI11 (tools/common/options.hpp): every number
+// whole and range-checked, every message naming the option. --help prints
+// kUsage, the modes and options laid out by topic.
 splatfx::Result<Options> parseOptions(int argc, const char* const* argv) {
     Options o;
     if (argc < 2) return makeError(std::string("no mode given\n\n") + kUsage);
     std::vector<std::string> positional;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        const char* v = nullptr;
-        auto need = [&]() -> bool {
-            if (i + 1 >= argc) return false;
-            v = argv[++i];
-            return true;
-        };
-#define TEXPICK_NUM(field, type, lo, hi)                                                                                                             \
-    {                                                                                                                                                \
-        if (!need()) return makeError(a + " needs a value");                                                                                         \
-        auto r = number<type>(a, v, lo, hi);                                                                                                         \
-        if (!r) return makeError(r.error());                                                                                                         \
-        field = *r;                                                                                                                                  \
-        continue;                                                                                                                                    \
+    CLI::App app{"cut a texture set for splatfx out of a photograph", kToolName};
+    app.set_help_flag();
+    bool help = false;
+    app.add_flag("-h,--help", help);
+    app.add_option("mode", positional)->expected(0, -1);
+    auto text = [&](const char* name, std::string& field) { app.add_option(name, field)->multi_option_policy(CLI::MultiOptionPolicy::TakeLast); };
+    auto choice = [&](const char* name, std::function<splatfx::Status(const std::string&)> set) {
+        cli::addChecked(
+            app, name, [set = std::move(set)](const std::string&, const std::string& v) { return set(v); }, "");
+    };
+    text("--out", o.out);
+    cli::addNumber(app, "--patch", o.patch, 1, 16384, "");
+    CLI::Option* count = cli::addNumber(app, "--count", o.count, 1, kMaxTextures, "");
+    cli::addNumber(app, "--seed", o.seed, 0u, 4294967295u, "");
+    cli::addNumber(app, "--min-std", o.accept.minStd, 0.0f, 1.0f, "");
+    cli::addNumber(app, "--min-mean", o.accept.minMean, 0.0f, 1.0f, "");
+    cli::addNumber(app, "--min-coverage", o.accept.minCoverage, 0.0f, 1.0f, "");
+    app.add_flag_callback("--absolute-thresholds", [&o] { o.accept.relative = false; });
+    cli::addOneOf<AlphaUse>(app, "--alpha", o.source.alpha,
+                            {{"auto", AlphaUse::Auto}, {"coverage", AlphaUse::Coverage}, {"density", AlphaUse::Density}},
+                            "--alpha expects auto, coverage or density", "");
+    cli::addNumber(app, "--min-distance", o.minDistance, 0.0f, 1e6f, "");
+    cli::addNumber(app, "--stride", o.stride, 1, 16384, "");
+    cli::addNumber(app, "--step", o.step, 1e-3, 1e6, "");
+    cli::addNumber(app, "--size", o.process.textureSize, 4, 1024, "");
+    cli::addNumber(app, "--contrast-std", o.process.contrastStd, 1e-3f, 0.5f, "");
+    cli::addNumber(app, "--octaves", o.turbulence.octaves, 1, 12, "");
+    cli::addNumber(app, "--base-frequency", o.turbulence.baseFrequency, 0.01f, 1000.0f, "");
+    cli::addNumber(app, "--loop-radius", o.turbulence.loopRadius, 0.0f, 100.0f, "");
+    cli::addNumber(app, "--preview-frames", o.output.previewFrames, 1, 1000, "");
+    cli::addNumber(app, "--preview-fps", o.output.previewFps, 1, 100, "");
+    cli::addNumber(app, "--preview-size", o.output.previewSize, 32, 2048, "");
+    cli::addNumber(app, "--auto-quit-after", o.autoQuitAfter, 1, 1000000, "");
+    // Repeatable: one patch centre (and side) each.
+    app.add_option_function<std::vector<std::string>>(
+           "--at",
+           [&o](const std::vector<std::string>& values) {
+               for (const std::string& v : values) {
+                   int x = 0, y = 0, s = 0;
+                   char c1 = 0, c2 = 0, extra = 0;
+                   std::istringstream in(v);
+                   if (!(in >> x >> c1 >> y) || c1 != ',' || ((in >> c2) && (c2 != ',' || !(in >> s) || s < 1)) || (in >> extra))
+                       throw CLI::ValidationError("--at expects X,Y or X,Y,SIZE in whole pixels, got '" + v + "'");
+                   o.at.emplace_back(x, y, s);
+               }
+           })
+        ->expected(1)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+    choice("--band", [&o](const std::string& v) -> splatfx::Status {
+        char colon = 0, extra = 0;
+        std::istringstream in(v);
+        if (!(in >> o.bandLo >> colon >> o.bandHi) || colon != ':' || (in >> extra) || !(o.bandLo >= 0.0) || !(o.bandHi > o.bandLo))
+            return makeError("--band expects LO:HI cycles per pixel with 0 <= LO < HI (e.g. 0.125:0.75), got '" + v + "'");
+        return {};
+    });
+    choice("--path", [&o](const std::string& v) -> splatfx::Status {
+        auto p = parsePath(v, "--path");
+        if (!p) return makeError(p.error());
+        o.path = *p;
+        return {};
+    });
+    cli::addOneOf<Contrast>(app, "--contrast", o.process.contrast, {{"patch", Contrast::Patch}, {"set", Contrast::Set}, {"none", Contrast::None}},
+                            "--contrast must be patch, set or none", "");
+    cli::addOneOf<splatfx::Kernel>(app, "--kernel", o.process.footprint.kernel,
+                                   {{"crawfis-max", splatfx::Kernel::CrawfisMax}, {"gaussian", splatfx::Kernel::Gaussian}},
+                                   "--kernel must be crawfis-max or gaussian", "");
+    std::vector<std::pair<std::string, std::string>> colors;
+    for (const char* c : {"fire", "smoke", "steam", "dust", "white"}) colors.emplace_back(c, c);
+    cli::addOneOf(app, "--preview-colors", o.output.previewColors, colors, "--preview-colors must be fire, smoke, steam, dust or white", "");
+    text("--source-name", o.sourceName);
+    text("--credit", o.credit);
+    text("--license", o.license);
+    text("--events", o.events);
+    text("--screenshot", o.screenshot);
+    app.add_flag("--spread", o.spread);
+    app.add_flag("--color", o.process.color);
+    app.add_flag("--order", o.process.order);
+    app.add_flag("--window", o.process.window);
+    app.add_flag_callback("--no-preview", [&o] { o.output.preview = false; });
+    app.add_flag_callback("--no-contact", [&o] { o.output.contactSheet = false; });
+    app.add_flag("--quiet", o.quiet);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        std::string why = e.what();
+        if (dynamic_cast<const CLI::ExtrasError*>(&e)) why += " (try --help)";
+        return makeError(why);
     }
-        if (a == "--help" || a == "-h") {
-            std::fputs(kUsage, stdout);
-            return makeError("");
-        }
-        if (a == "--out") {
-            if (!need()) return makeError("--out needs a folder");
-            o.out = v;
-            continue;
-        }
-        if (a == "--patch") TEXPICK_NUM(o.patch, int, 1, 16384)
-        if (a == "--count") {
-            o.countGiven = true;
-            TEXPICK_NUM(o.count, int, 1, kMaxTextures)
-        }
-        if (a == "--seed") TEXPICK_NUM(o.seed, std::uint32_t, 0u, 4294967295u)
-        if (a == "--min-std") TEXPICK_NUM(o.accept.minStd, float, 0.0f, 1.0f)
-        if (a == "--min-mean") TEXPICK_NUM(o.accept.minMean, float, 0.0f, 1.0f)
-        if (a == "--min-coverage") TEXPICK_NUM(o.accept.minCoverage, float, 0.0f, 1.0f)
-        if (a == "--absolute-thresholds") {
-            o.accept.relative = false;
-            continue;
-        }
-        if (a == "--alpha") {
-            if (!need()) return makeError("--alpha needs auto, coverage or density");
-            const std::string m = v;
-            if (m == "auto") o.source.alpha = AlphaUse::Auto;
-            else if (m == "coverage") o.source.alpha = AlphaUse::Coverage;
-            else if (m == "density") o.source.alpha = AlphaUse::Density;
-            else return makeError("--alpha expects auto, coverage or density, got '" + m + "'");
-            continue;
-        }
-        if (a == "--min-distance") TEXPICK_NUM(o.minDistance, float, 0.0f, 1e6f)
-        if (a == "--stride") TEXPICK_NUM(o.stride, int, 1, 16384)
-        if (a == "--step") TEXPICK_NUM(o.step, double, 1e-3, 1e6)
-        if (a == "--size") TEXPICK_NUM(o.process.textureSize, int, 4, 1024)
-        if (a == "--contrast-std") TEXPICK_NUM(o.process.contrastStd, float, 1e-3f, 0.5f)
-        if (a == "--octaves") TEXPICK_NUM(o.turbulence.octaves, int, 1, 12)
-        if (a == "--base-frequency") TEXPICK_NUM(o.turbulence.baseFrequency, float, 0.01f, 1000.0f)
-        if (a == "--loop-radius") TEXPICK_NUM(o.turbulence.loopRadius, float, 0.0f, 100.0f)
-        if (a == "--preview-frames") TEXPICK_NUM(o.output.previewFrames, int, 1, 1000)
-        if (a == "--preview-fps") TEXPICK_NUM(o.output.previewFps, int, 1, 100)
-        if (a == "--preview-size") TEXPICK_NUM(o.output.previewSize, int, 32, 2048)
-        if (a == "--auto-quit-after") TEXPICK_NUM(o.autoQuitAfter, int, 1, 1000000)
-#undef TEXPICK_NUM
-        if (a == "--at") {
-            if (!need()) return makeError("--at needs X,Y[,SIZE]");
-            int x = 0, y = 0, s = 0;
-            char c1 = 0, c2 = 0, extra = 0;
-            std::istringstream in(v);
-            if (!(in >> x >> c1 >> y) || c1 != ',' || ((in >> c2) && (c2 != ',' || !(in >> s) || s < 1)) || (in >> extra))
-                return makeError("--at expects X,Y or X,Y,SIZE in whole pixels, got '" + std::string(v) + "'");
-            o.at.emplace_back(x, y, s);
-            continue;
-        }
-        if (a == "--band") {
-            if (!need()) return makeError("--band needs LO:HI");
-            char colon = 0, extra = 0;
-            std::istringstream in(v);
-            if (!(in >> o.bandLo >> colon >> o.bandHi) || colon != ':' || (in >> extra) || !(o.bandLo >= 0.0) || !(o.bandHi > o.bandLo))
-                return makeError("--band expects LO:HI cycles per pixel with 0 <= LO < HI (e.g. 0.125:0.75), got '" + std::string(v) + "'");
-            continue;
-        }
-        if (a == "--path") {
-            if (!need()) return makeError("--path needs X,Y:X,Y[:X,Y...]");
-            auto p = parsePath(v, "--path");
-            if (!p) return makeError(p.error());
-            o.path = *p;
-            continue;
-        }
-        if (a == "--contrast") {
-            if (!need()) return makeError("--contrast needs patch, set or none");
-            const std::string m = v;
-            if (m == "patch") o.process.contrast = Contrast::Patch;
-            else if (m == "set") o.process.contrast = Contrast::Set;
-            else if (m == "none") o.process.contrast = Contrast::None;
-            else return makeError("--contrast must be patch, set or none, got '" + m + "'");
-            continue;
-        }
-        if (a == "--kernel") {
-            if (!need()) return makeError("--kernel needs crawfis-max or gaussian");
-            const std::string k = v;
-            if (k == "crawfis-max") o.process.footprint.kernel = splatfx::Kernel::CrawfisMax;
-            else if (k == "gaussian") o.process.footprint.kernel = splatfx::Kernel::Gaussian;
-            else return makeError("--kernel must be crawfis-max or gaussian, got '" + k + "'");
-            o.output.footprint = o.process.footprint;
-            continue;
-        }
-        if (a == "--preview-colors") {
-            if (!need()) return makeError("--preview-colors needs a name");
-            const std::string c = v;
-            if (c != "fire" && c != "smoke" && c != "steam" && c != "dust" && c != "white")
-                return makeError("--preview-colors must be fire, smoke, steam, dust or white, got '" + c + "'");
-            o.output.previewColors = c;
-            continue;
-        }
-        if (a == "--source-name") {
-            if (!need()) return makeError("--source-name needs a value");
-            o.sourceName = v;
-            continue;
-        }
-        if (a == "--credit") {
-            if (!need()) return makeError("--credit needs a value");
-            o.credit = v;
-            continue;
-        }
-        if (a == "--license") {
-            if (!need()) return makeError("--license needs a value");
-            o.license = v;
-            continue;
-        }
-        if (a == "--events") {
-            if (!need()) return makeError("--events needs a list");
-            o.events = v;
-            continue;
-        }
-        if (a == "--screenshot") {
-            if (!need()) return makeError("--screenshot needs a file");
-            o.screenshot = v;
-            continue;
-        }
-        if (a == "--spread") {
-            o.spread = true;
-            continue;
-        }
-        if (a == "--color") {
-            o.process.color = true;
-            continue;
-        }
-        if (a == "--order") {
-            o.process.order = true;
-            continue;
-        }
-        if (a == "--window") {
-            o.process.window = true;
-            continue;
-        }
-        if (a == "--no-preview") {
-            o.output.preview = false;
-            continue;
-        }
-        if (a == "--no-contact") {
-            o.output.contactSheet = false;
-            continue;
-        }
-        if (a == "--quiet") {
-            o.quiet = true;
-            continue;
-        }
-        if (a.size() > 1 && a[0] == '-') return makeError("unknown option '" + a + "' (try --help)");
-        positional.push_back(a);
+    if (help) {
+        std::fputs(kUsage, stdout);
+        return makeError("");
     }
+    o.countGiven = count->count() > 0;
     if (positional.empty()) return makeError("no mode given (try --help)");
     o.mode = positional[0];
     static const char* modes[] = {"positions", "random", "spectral", "path", "interactive", "turbulence", "merge"};
@@ -354,7 +271,7 @@ int runMerge(const Options& o) {
     splatfx::TextureSet merged;
     json parts = json::array();
     for (const std::string& folder : o.sets) {
-        auto set = splatfx::TextureSet::load(folder);
+        auto set = splatfx::loadTextureSet(folder);
         if (!set) return fail("merge: " + set.error());
         if (merged.layers.empty()) {
             merged.size = set->size;

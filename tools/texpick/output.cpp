@@ -361,7 +361,7 @@ splatfx::Status writeOutput(const std::string& folder, const splatfx::TextureSet
         return splatfx::Status(makeError("nothing written to '" + folder + "': " + why));
     };
     // The set itself, atomically, into the staging folder...
-    if (auto s = set.save(staging.string(), provenance); !s) return fail(s.error());
+    if (auto s = saveTextureSet(set, staging.string(), provenance); !s) return fail(s.error());
     // ...then the pictures beside it...
     if (d.contactSheet)
         if (auto s = splatfx::writeImage((staging / "contact.png").string(), contactSheet(set, d.footprint, source, patches)); !s)
@@ -372,7 +372,7 @@ splatfx::Status writeOutput(const std::string& folder, const splatfx::TextureSet
         if (auto s = gif.finish(); !s) return fail(s.error());
     }
     // ...and a check that the SDK reads back what was written, before anything is replaced.
-    if (auto back = splatfx::TextureSet::load(staging.string()); !back) return fail("the written set does not load: " + back.error());
+    if (auto back = splatfx::loadTextureSet(staging.string()); !back) return fail("the written set does not load: " + back.error());
     // Finally the swap: the old folder steps aside, the new one takes its name.
     const fs::path old = parent / hiddenName(target, ".texpick-old-");
     fs::remove_all(old, ec);

@@ -14,9 +14,9 @@ using splatfx::makeError;
 splatfx::Result<MadeSet> makeSet(const Source& s, const std::vector<Patch>& patches, const ProcessDesc& d) {
     if (patches.empty()) return makeError("no patches to make a texture set from");
     if (d.textureSize < 4 || d.textureSize > 1024) return makeError("--size must be between 4 and 1024 texels, got " + std::to_string(d.textureSize));
-    // TextureSet::save writes a windowed colour set as RGBA PNG; reading that
+    // saveTextureSet writes a windowed colour set as RGBA PNG; reading that
     // back premultiplies colour by alpha (OpenImageIO's default for PNG) and
-    // TextureSet::load multiplies again, so such a set would not load as made.
+    // loadTextureSet multiplies again, so such a set would not load as made.
     if (d.window && d.color)
         return makeError("--window with --color is not supported: texture-set version 1 cannot store a windowed colour "
                          "set faithfully; leave out --window (the renderer windows the set with the same footprint)");

@@ -6,7 +6,7 @@
 // in frequency), or along a linear or piecewise-linear path whose overlapping
 // patches give coherent motion when cycled. The patches are converted to
 // grayscale (sec. 2 step 1), contrast-normalized, optionally ordered for
-// smooth cycling, and written as a texture-set folder splatfx::TextureSet::load
+// smooth cycling, and written as a texture-set folder splatfx::loadTextureSet
 // reads, with a contact sheet and a preview animation of textured splats.
 // It does not track motion in video, and it does not synthesize texture: every
 // texel comes from the photograph (or from splatfx::TextureSet::turbulence).
@@ -28,9 +28,9 @@
 #include <opencv2/core.hpp>
 
 #include "splatfx/footprint.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 #include "splatfx/result.hpp"
-#include "splatfx/texture_set.hpp"
+#include "splatfx/texture_set_io.hpp"
 
 namespace texpick {
 

@@ -31,14 +31,14 @@
 #include <GLFW/glfw3.h>
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "cli.hpp"
+#include "options.hpp"
 #include "backends/imgui_impl_glfw.h"
 #include "backends/imgui_impl_opengl3.h"
 #include "imgui.h"
 
 #include "scene_player.hpp"
 #include "splatfx/context.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 
 namespace fs = std::filesystem;
 
@@ -56,53 +56,22 @@ struct Args {
     bool hideUi = false;
 };
 
-bool parse(int argc, char** argv, Args& a) {
-    for (int i = 1; i < argc; ++i) {
-        const std::string s = argv[i];
-        auto value = [&]() -> const char* { return i + 1 < argc ? argv[++i] : nullptr; };
-        const char* v = nullptr;
-        if (s == "--help" || s == "-h") {
-            std::printf("splatfx-viewer: interactive splatfx scene viewer\n\n"
-                        "usage: splatfx-viewer [SCENE.json] [--size WxH] [--seed S] [--camera path|orbit|fly]\n"
-                        "                      [--auto-quit-after N] [--screenshot FILE] [--hide-ui]\n"
-                        "  --auto-quit-after N  render N frames at the scene's fps (fixed steps), then quit\n"
-                        "  --screenshot FILE    write the last frame (with the UI) to FILE (PNG)\n");
-            std::exit(0);
-        } else if (s == "--size" && (v = value())) {
-            if (auto st = cli::parseSize("--size", v, 64, 8192, a.size.x, a.size.y); !st) {
-                std::fprintf(stderr, "splatfx-viewer: %s\n", st.error().c_str());
-                return false;
-            }
-        } else if (s == "--auto-quit-after" && (v = value())) {
-            if (auto st = cli::parseInt("--auto-quit-after", v, 1, 1000000, a.autoQuitAfter); !st) {
-                std::fprintf(stderr, "splatfx-viewer: %s\n", st.error().c_str());
-                return false;
-            }
-        } else if (s == "--screenshot" && (v = value())) {
-            a.screenshot = v;
-        } else if (s == "--seed" && (v = value())) {
-            std::uint32_t seed = 0;
-            if (auto st = cli::parseInt("--seed", v, 0u, 4294967295u, seed); !st) {
-                std::fprintf(stderr, "splatfx-viewer: %s\n", st.error().c_str());
-                return false;
-            }
-            a.seed = seed;
-        } else if (s == "--camera" && (v = value())) {
-            a.camera = v;
-            if (a.camera != "path" && a.camera != "orbit" && a.camera != "fly") {
-                std::fprintf(stderr, "splatfx-viewer: --camera expects path, orbit or fly, got '%s'\n", v);
-                return false;
-            }
-        } else if (s == "--hide-ui") {
-            a.hideUi = true;
-        } else if (!s.empty() && s[0] != '-' && a.scene.empty()) {
-            a.scene = s;
-        } else {
-            std::fprintf(stderr, "splatfx-viewer: unknown or incomplete option '%s' (try --help)\n", s.c_str());
-            return false;
-        }
-    }
-    return true;
+// Returns -1 to go on, else the exit code (0 after --help, 2 after a bad command line).
+int parse(int argc, char** argv, Args& a) {
+    CLI::App app{"splatfx-viewer: interactive splatfx scene viewer", "splatfx-viewer"};
+    app.add_option("scene", a.scene, "the scene file (default: none; open one from the UI)")->type_name("SCENE.json");
+    cli::addSize(app, "--size", a.size.x, a.size.y, 64, 8192, "window size");
+    std::uint32_t seed = 0;
+    CLI::Option* seedOption = cli::addNumber(app, "--seed", seed, 0u, 4294967295u, "scene seed (default: the file's)");
+    seedOption->description("scene seed, in [0, 4294967295] (default: the file's)");
+    cli::addOneOf<std::string>(app, "--camera", a.camera, {{"path", "path"}, {"orbit", "orbit"}, {"fly", "fly"}},
+                               "--camera expects path, orbit or fly", "path (the scene's camera path, default), orbit or fly");
+    cli::addNumber(app, "--auto-quit-after", a.autoQuitAfter, 1, 1000000, "render N frames at the scene's fps (fixed steps), then quit");
+    app.add_option("--screenshot", a.screenshot, "write the last frame (with the UI) to FILE (PNG)")->type_name("FILE");
+    app.add_flag("--hide-ui", a.hideUi, "no UI panel");
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+    if (seedOption->count()) a.seed = seed;
+    return -1;
 }
 
 // [SECTION] Viewer state and cameras
@@ -390,7 +359,7 @@ bool writeScreenshot(const std::string& file, glm::ivec2 size) {
 
 static int viewerMain(int argc, char** argv) {
     Viewer v;
-    if (!parse(argc, argv, v.args)) return 2;
+    if (const int code = parse(argc, argv, v.args); code >= 0) return code;
     v.mode = v.args.camera == "orbit" ? CameraMode::Orbit : v.args.camera == "fly" ? CameraMode::Fly : CameraMode::Path;
     auto window =
         splatfx::Window::create({.width = v.args.size.x, .height = v.args.size.y, .title = "splatfx viewer", .vsync = v.args.autoQuitAfter == 0});

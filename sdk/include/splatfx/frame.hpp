@@ -7,10 +7,10 @@
 // same Frame can be drawn by the GL backend and integrated by the CPU
 // reference, which is how the backend is measured.
 // It does not simulate (Scene does), render (gl::FrameRenderer does) or own
-// GPU resources. Each system adds plain-data members: the gas's shadow on the
-// scene (shadow(), FrameShadow: issue 16), the fog (fog(): issue 14), LOD
-// volumes (volumes(): their tetrahedra and tables, and drawOrder(): splats and
-// tetrahedra interleaved back to front, made by end(): issue 17).
+// GPU resources. Besides the splats it holds the gas's shadow on the scene
+// (shadow(), FrameShadow), the fog (fog()), LOD volumes (volumes(): their
+// tetrahedra and tables) and drawOrder(): splats and tetrahedra interleaved
+// back to front, made by end().
 //
 //   splatfx::Frame frame;                          // keep it: it reuses its memory
 //   scene.prepare(timeSec, camera, materials, frame);
@@ -44,13 +44,13 @@ struct FrameCounters {
     std::size_t drawn = 0;     // effects that emitted at least one splat
     std::uint64_t voxels = 0;  // voxels offered to the splat builder
     std::uint64_t splats = 0;  // splats in the frame
-    // ---- lighting (issue 16; Scene fills them)
+    // Lighting (Scene fills them).
     std::size_t litEffects = 0;          // needed effects lit by the scene's lights
     std::uint64_t shadowTableBuilds = 0; // shadow tables (self-shadowing and the scene's) rebuilt for this frame
     std::uint64_t shadowTableReuses = 0; // ... and reused because density and light had not changed
 };
 
-// ---- lighting (issue 16): the shadow the frame's gas casts on the scene.
+// The shadow the frame's gas casts on the scene.
 // One shadow table (lighting.hpp, ShadowTable) for one light, covering every
 // needed effect that casts shadows, as plain data: what gl::FrameRenderer
 // uploads as a 3D texture before the host's opaque pass, and what the GLSL
@@ -65,8 +65,7 @@ struct FrameShadow {
     std::uint64_t version = 0;
 };
 
-// ---- [clouds, issue 17] LOD volumes drawn as projected tetrahedra ----
-// One volume's tetrahedra for this frame (LodVolume::update's output) and the
+// LOD volumes drawn as projected tetrahedra: one volume's tetrahedra for this frame (LodVolume::update's output) and the
 // pre-integration table they are drawn with. Scene::prepare fills these;
 // hosts without a Scene push them between begin() and end().
 struct FrameVolume {
@@ -90,7 +89,6 @@ struct DrawBatch {
 // splat inside a tetrahedron is drawn wholly before or after it (docs/volume.md).
 void interleaveBackToFront(const std::vector<Splat>& splats, const std::vector<FrameVolume>& volumes, const Camera& camera,
                            std::vector<DrawBatch>& out);
-// ---- end [clouds] ----
 
 class Frame {
 public:
@@ -111,37 +109,34 @@ public:
     const SplatStats& splatStats() const { return mBuilder.stats(); }
     const FrameCounters& counters() const { return mCounters; }
     FrameCounters& counters() { return mCounters; }
-    // ---- lighting (issue 16): kept across begin() (its version says when it changed).
+    // The gas's shadow on the scene: kept across begin() (its version says when it changed).
     const FrameShadow& shadow() const { return mShadow; }
     FrameShadow& shadow() { return mShadow; }
 
-    // --- Fog (issue 14, docs/fog.md) -------------------------------------
     // The one medium the frame is seen through: gl::FrameRenderer fogs the
     // host's opaque image with it and applies it per fragment to every
     // splat, at time(). Not cleared by begin() (a setting, not content);
     // Scene::prepare sets it from Scene::setFog. nullptr: clear air (default).
+    // docs/fog.md.
     void setFog(std::shared_ptr<const Fog> fog) { mFog = std::move(fog); }
     const Fog* fog() const { return mFog.get(); }
     const std::shared_ptr<const Fog>& sharedFog() const { return mFog; }
-    // --- end fog ---------------------------------------------------------
 
-    // ---- [clouds, issue 17] ----
     // Volumes to draw as tetrahedra (cleared by begin()).
     std::vector<FrameVolume>& volumes() { return mVolumes; }
     const std::vector<FrameVolume>& volumes() const { return mVolumes; }
     // The interleaved draw sequence of splats and tetrahedra, made by end()
     // (interleaveBackToFront); one Splats batch when there are no volumes.
     const std::vector<DrawBatch>& drawOrder() const { return mDrawOrder; }
-    // ---- end [clouds] ----
 
 private:
     SplatBuilder mBuilder;
     FrameCounters mCounters;
-    FrameShadow mShadow; // lighting (issue 16)
+    FrameShadow mShadow;
     double mTime = 0.0;
-    std::shared_ptr<const Fog> mFog;   // fog (issue 14); default none
-    std::vector<FrameVolume> mVolumes; // [clouds]
-    std::vector<DrawBatch> mDrawOrder; // [clouds]
+    std::shared_ptr<const Fog> mFog; // default none
+    std::vector<FrameVolume> mVolumes;
+    std::vector<DrawBatch> mDrawOrder;
 };
 
 } // namespace splatfx

@@ -20,8 +20,8 @@
 // A preset fails only when a given texture set is empty or a field is out of
 // range; the message names the field. Presets are GL-free and file-free
 // (splatfx::core): to use a texture-set folder, load it first with
-// TextureSet::load (splatfx::io) and pass the set, e.g.
-// `.textureSet = *TextureSet::load("textures/fire8")`.
+// loadTextureSet (splatfx::io) and pass the set, e.g.
+// `.textureSet = *loadTextureSet("textures/fire8")`.
 // Sharing: a preset registers its sets and tables by content (see
 // materials.hpp); a procedural set is keyed by what makes it (the turbulence
 // parameters and textureSeed), so presets with equal texture parameters share

@@ -82,7 +82,7 @@ struct ReferenceHost {
                                             // (as gl::Framebuffer::readDepth returns); fragments behind it are dropped
 };
 
-// ---- (issue 15) A transparent surface the reference composites exactly
+// A transparent surface the reference composites exactly
 // among the splats (what a host sends through transparentGlsl()): triangles,
 // each crossing of a pixel ray one layer of the premultiplied colour (both
 // faces of a box count, like glass drawn without culling). Hidden behind the
@@ -95,19 +95,18 @@ struct ReferenceSurface {
     // An axis-aligned box's six faces (12 triangles).
     static ReferenceSurface box(glm::dvec3 lo, glm::dvec3 hi, glm::dvec4 premultiplied);
 };
-// ---- end (issue 15) ----
 
 struct SplatExactDesc {
     ReferenceHost host{};                            // default: transparent black, no depth
     ReferenceWindow window = ReferenceWindow::Exact; // default Exact
     bool trimCorners = false;                        // match RendererDesc::trimCorners (octagon vs square quad); default false, as the renderer's
     int threads = 0;                                 // worker threads; 0 = std::thread::hardware_concurrency(); default 0
-    // Lighting (issue 16): false reads each splat's colour table exactly at its
+    // Lighting: false reads each splat's colour table exactly at its
     // colour coordinate (unlit splats); true uses the splat's RGBA8 colour,
     // which is what the GL pass draws and where a Scene puts lit colours
     // (docs/lighting.md, "In a Scene"). Default false.
     bool packedColor = false;
-    // Fog (issue 14): the medium the splats and the host are seen through,
+    // Fog: the medium the splats and the host are seen through,
     // integrated numerically (integrateFogNumerically, never the closed
     // forms) along each pixel ray from the eye: every fragment at world
     // point X becomes f c + (1 - f) alpha C_fog (premultiplied), f = exp(-tau(eye, X))
@@ -118,7 +117,7 @@ struct SplatExactDesc {
     double fogTimeSec = 0.0;    // the fog's time; default 0
     double fogTolerance = 1e-9; // absolute tolerance on each optical depth; default 1e-9
     bool fogHost = true;        // fog the background too (false: as a frame drawn without the host fog pass); default true
-    // The depth cut (issue 15, as gl::RendererDesc::depthCut): each fragment
+    // The depth cut (as gl::RendererDesc::depthCut): each fragment
     // keeps the share of its kernel's line integral between the near plane
     // and the host depth (or the far plane) on its pixel ray, exactly
     // (Footprint::exactFractionBefore), r = R |(u, v)|, s = (t - t_plane) / l
@@ -127,7 +126,7 @@ struct SplatExactDesc {
     // tail in front. false: the plain test at the splat plane (fragments
     // outside [near, min(far, host depth)] are dropped whole). Default true.
     bool depthCut = true;
-    // ---- (issue 15) transparent surfaces, composited per pixel in exact
+    // Transparent surfaces, composited per pixel in exact
     // depth order with the splats; each splat fragment is cut at the surface
     // crossings of its pixel ray into sections (Ebert & Parent 1990, Fig. 1),
     // each with its exact share of the kernel's line integral (depthCut; false:

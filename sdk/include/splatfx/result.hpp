@@ -5,7 +5,7 @@
 // public API, so engines built with -fno-exceptions can use the SDK.
 // Misuse of the API (a broken precondition) is an assertion, not a Result.
 //
-//   splatfx::Result<splatfx::TextureSet> set = splatfx::TextureSet::load("textures/fire8");
+//   splatfx::Result<splatfx::TextureSet> set = splatfx::loadTextureSet("textures/fire8");
 //   if (!set) { std::fprintf(stderr, "%s\n", set.error().c_str()); return 1; }
 //   use(*set);
 //

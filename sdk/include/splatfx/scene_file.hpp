@@ -72,7 +72,7 @@ struct GeometryDesc {
     Motion motion;             // default at rest
     std::string attachedTo;    // name of the object whose motion it shares; default empty
     glm::vec3 color{0.6f};     // linear RGB albedo; default grey
-    // ---- (issue 15) below 1: a transparent surface (glass), premultiplied
+    // Below 1: a transparent surface (glass), premultiplied
     // (lit colour x opacity, opacity) per layer, which a host draws through
     // transparentGlsl() into the fragment lists (tools/scenehost does). [0, 1]; default 1 (opaque).
     float opacity = 1.0f;
@@ -125,7 +125,7 @@ struct SceneEffectInfo {
     bool traditional = false; // drawn with plain footprints (Fig. 1a); default false
 };
 
-// [issue 17] A LOD ground-fog layer whose terrain mesh the host draws in
+// A LOD ground-fog layer whose terrain mesh the host draws in
 // place of a heightmap geometry (groundFog key "terrainGeometry"), so the
 // terrain and the fog's bottom are one mesh.
 struct GroundFogTerrain {
@@ -142,7 +142,7 @@ struct SceneFile {
     std::vector<GeometryDesc> geometry;
     CameraPath camera;
     OutputSettings output;
-    std::vector<GroundFogTerrain> groundFogTerrain; // [issue 17] default none
+    std::vector<GroundFogTerrain> groundFogTerrain; // default none
 };
 
 struct SceneFileOptions {

@@ -54,7 +54,7 @@ struct Splat {
 };
 static_assert(sizeof(Splat) == 64, "Splat must match the GPU layout");
 
-// The depth cut (issue 15, docs/architecture.md "The depth cut") needs the
+// The depth cut (docs/architecture.md "The depth cut") needs the
 // kernel's extent along the ray, which the ellipse alone does not give for an
 // anisotropic kernel: the world length of one kernel unit along the ray d
 // through the centre is l = 1 / |M^-1 d|. With the ellipse's half-axes
@@ -85,11 +85,11 @@ enum class SortMode {
 };
 
 struct SplatBuilderDesc {
-    // The near-plane fade of the splats' density (before issue 15). Off by
-    // default: the GL renderer and the reference cut every splat exactly at
-    // the near plane (RendererDesc::depthCut, docs/architecture.md "The depth
-    // cut"). Turn it on with RendererDesc::depthCut = false to get the old,
-    // all-or-nothing test at the splat plane without popping at the near plane.
+    // The near-plane fade of the splats' density. Off by default: the GL
+    // renderer and the reference cut every splat exactly at the near plane
+    // (RendererDesc::depthCut, docs/architecture.md "The depth cut"). Turn it
+    // on with RendererDesc::depthCut = false: the all-or-nothing test at the
+    // splat plane then shows no popping at the near plane.
     bool nearFade = false;       // default false
     float nearFadeStart = 0.25f; // with nearFade: fade begins at near + nearFadeStart * splat extent; default 0.25
     float nearFadeEnd = 1.5f;    // ... and is complete (full opacity) at near + nearFadeEnd * extent; default 1.5

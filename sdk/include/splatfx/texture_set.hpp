@@ -6,9 +6,8 @@
 // footprint. Sets come from Perlin turbulence (deterministic per seed, no
 // files needed) or from a texture-set folder (e.g. made by splatfx-texpick).
 // It does not upload anything: the GL renderer does.
-// Targets: everything here is in splatfx::core except load() and save(),
-// which read and write image files and are defined in splatfx::io (link it
-// to use them; a core-only program that calls them fails to link).
+// Reading and writing texture-set folders is splatfx::io:
+// loadTextureSet / saveTextureSet in splatfx/texture_set_io.hpp.
 //
 //   auto raw = splatfx::TextureSet::turbulence({.count = 8, .size = 32, .seed = 7});
 //   auto splats = raw.windowed(splatfx::Footprint{});
@@ -67,8 +66,6 @@ public:
 
     // Perlin turbulence (sum of |noise| octaves), normalized to [0, 1].
     static TextureSet turbulence(const TurbulenceDesc& desc);
-    // Loads a texture-set folder (see above). Errors name the file. splatfx::io.
-    static Result<TextureSet> load(const std::string& folder);
     // One texture per image file; all must be square and the same size.
     static Result<TextureSet> fromImages(const std::vector<Image>& images, bool keepColor);
     // desc.count square windows of desc.size pixels at seeded positions
@@ -77,8 +74,6 @@ public:
     // names it with desc.sourceName), when its pixels do not match its size,
     // or as fromImages fails. Pure: reading the file is the caller's part.
     static Result<TextureSet> sampleImage(const Image& source, const ImageSampleDesc& desc);
-    // Writes a texture-set folder atomically (temporary folder, then rename). splatfx::io.
-    Status save(const std::string& folder, const std::string& provenanceJson = "{}") const;
 
     // Figure 2: grayscale (unless color), contrast kept, multiplied by the
     // footprint weight over the texture's extent. Opacity detail ends up in A.

@@ -11,6 +11,7 @@
 #include "grid/number_text.hpp"
 #include "splatfx/presets.hpp"
 #include "splatfx/scene_file.hpp"
+#include "splatfx/texture_set_io.hpp"
 
 using namespace splatfx;
 using namespace splatfx::capi;
@@ -371,7 +372,7 @@ splatfx_status splatfx_texture_set_load(const char* folder, splatfx_texture_set*
         if (!out) return invalid("out is NULL");
         *out = nullptr;
         if (!folder) return invalid("folder is NULL");
-        Result<TextureSet> set = TextureSet::load(folder);
+        Result<TextureSet> set = loadTextureSet(folder);
         if (!set) return failure(SPLATFX_ERROR_FILE, set.error());
         *out = new splatfx_texture_set{Magic::TextureSet, std::move(*set)};
         return success();

@@ -6,7 +6,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "checked_file.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 
 namespace splatfx {
 

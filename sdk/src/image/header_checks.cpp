@@ -5,7 +5,7 @@
 #include <fstream>
 #include <vector>
 
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 
 namespace splatfx::detail {
 

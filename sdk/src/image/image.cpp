@@ -1,4 +1,4 @@
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 
 #include <algorithm>
 #include <cerrno>

@@ -7,7 +7,7 @@
 #include <sstream>
 #include <system_error>
 
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 
 namespace splatfx {
 

@@ -1,8 +1,10 @@
 // Texture-set folders (manifest.json plus images) in and out of files:
-// TextureSet::load and TextureSet::save. They read and write images through
+// loadTextureSet and saveTextureSet. They read and write images through
 // OpenImageIO, so they live in splatfx::io, not in the GL-free, file-free
 // core (sdk/src/texture holds the in-memory and procedural parts).
-#include "splatfx/texture_set.hpp"
+#include "splatfx/texture_set_io.hpp"
+
+#include "splatfx/image_io.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -21,7 +23,7 @@ namespace {
 constexpr std::uintmax_t kMaxManifestBytes = 1u << 20; // 1 MiB: 4096 names and provenance fit with room to spare
 } // namespace
 
-Result<TextureSet> TextureSet::load(const std::string& folder) {
+Result<TextureSet> loadTextureSet(const std::string& folder) {
     const fs::path dir(folder);
     const fs::path manifestPath = dir / "manifest.json";
     std::error_code ec;
@@ -78,7 +80,7 @@ Result<TextureSet> TextureSet::load(const std::string& folder) {
             return makeError(at + " '" + name + "' has no alpha channel, but field 'windowed' says the detail is stored in alpha");
         images.push_back(std::move(*img));
     }
-    auto set = fromImages(images, color);
+    auto set = TextureSet::fromImages(images, color);
     if (!set) return makeError("texture set '" + folder + "': " + set.error());
     if (windowed) {
         // A windowed set stores the footprint-weighted detail in alpha.
@@ -98,8 +100,8 @@ Result<TextureSet> TextureSet::load(const std::string& folder) {
     return set;
 }
 
-Status TextureSet::save(const std::string& folder, const std::string& provenanceJson) const {
-    if (layers.empty()) return makeError("cannot save texture set '" + folder + "': it has no textures");
+Status saveTextureSet(const TextureSet& set, const std::string& folder, const std::string& provenanceJson) {
+    if (set.layers.empty()) return makeError("cannot save texture set '" + folder + "': it has no textures");
     json provenance;
     try {
         provenance = json::parse(provenanceJson);
@@ -123,20 +125,20 @@ Status TextureSet::save(const std::string& folder, const std::string& provenance
     json m;
     m["format"] = "splatfx-texture-set";
     m["version"] = 1;
-    m["color"] = color;
-    m["windowed"] = isWindowed;
-    m["size"] = size;
+    m["color"] = set.color;
+    m["windowed"] = set.isWindowed;
+    m["size"] = set.size;
     m["textures"] = json::array();
-    for (size_t k = 0; k < layers.size(); ++k) {
+    for (size_t k = 0; k < set.layers.size(); ++k) {
         char name[32];
         std::snprintf(name, sizeof name, "t%03zu.png", k);
         Image img;
-        img.width = img.height = size;
-        img.channels = isWindowed ? 4 : (color ? 3 : 1);
-        img.pixels.resize(size_t(size) * size * img.channels);
-        for (int p = 0; p < size * size; ++p)
+        img.width = img.height = set.size;
+        img.channels = set.isWindowed ? 4 : (set.color ? 3 : 1);
+        img.pixels.resize(size_t(set.size) * set.size * img.channels);
+        for (int p = 0; p < set.size * set.size; ++p)
             for (int c = 0; c < img.channels; ++c) {
-                const float* t = &layers[k][size_t(p) * 4];
+                const float* t = &set.layers[k][size_t(p) * 4];
                 img.pixels[size_t(p) * img.channels + c] = t[img.channels == 1 ? 0 : c];
             }
         // Windowed RGBA: alpha is opacity, colour is independent of it.

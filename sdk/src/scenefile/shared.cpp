@@ -7,8 +7,9 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "scenefile/reader.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 #include "splatfx/presets.hpp"
+#include "splatfx/texture_set_io.hpp"
 
 namespace splatfx::scenefile {
 
@@ -225,7 +226,7 @@ std::optional<TextureSpec> readTextureSpec(Context& c, const std::string& path, 
 
 Result<TextureSet> buildTextureSet(const TextureSpec& t) {
     switch (t.kind) {
-    case TextureSpec::Kind::Folder: return TextureSet::load(t.folder);
+    case TextureSpec::Kind::Folder: return loadTextureSet(t.folder);
     case TextureSpec::Kind::Faces: return presets::proceduralFaces(t.count, t.size, t.seed);
     case TextureSpec::Kind::SampleImage: return sampleImageFile(t);
     case TextureSpec::Kind::Procedural: break;
@@ -240,7 +241,7 @@ std::optional<TextureSet> presetSet(Context& c, const std::string& effectPath, c
     const std::string key = std::filesystem::weakly_canonical(t->folder, ec).string();
     if (!ec)
         if (auto it = c.folders.find(key); it != c.folders.end()) return it->second;
-    Result<TextureSet> set = TextureSet::load(t->folder);
+    Result<TextureSet> set = loadTextureSet(t->folder);
     if (!set) return c.d.error(effectPath, set.error()), std::nullopt;
     if (!ec) c.folders.emplace(key, *set);
     return std::move(*set);

@@ -8,7 +8,7 @@
 #include <utility>
 
 #include "scenefile/reader.hpp"
-#include "splatfx/image.hpp"
+#include "splatfx/image_io.hpp"
 #include "splatfx/volume.hpp"
 
 namespace splatfx::scenefile {

@@ -82,7 +82,7 @@ struct RendererDesc {
     // error grows with the fog's variation across a splat (for a constant fog
     // k, |df| <= k times the splat's drawn radius). Default false (per fragment).
     bool fogPerSplat = false;
-    // The depth cut (issue 15, docs/architecture.md "The depth cut"): each
+    // The depth cut (docs/architecture.md "The depth cut"): each
     // fragment keeps the share of its kernel's line integral that lies
     // between the near plane and the host's opaque depth on its pixel ray
     // (Footprint::fractionBefore), instead of the all-or-nothing depth test
@@ -91,7 +91,7 @@ struct RendererDesc {
     // the default). The host depth is read from Target::depthTexture or the
     // target framebuffer's depth attachment when it is a single-sampled
     // texture; without one only the near plane is cut exactly and the host
-    // surface is tested at the splat plane as before. false: that plain test
+    // surface is tested at the splat plane. false: that plain test
     // everywhere (pair it with SplatBuilderDesc::nearFade = true). Default true.
     bool depthCut = true;
 };
@@ -123,7 +123,7 @@ class SplatPass;
 struct DrawStats {
     std::uint64_t splats = 0;
     std::uint64_t drawCalls = 0;
-    // Depth cut (issue 15): splats drawn with the near-plane cut, those whose
+    // Depth cut: splats drawn with the near-plane cut, those whose
     // polygon crosses the eye plane (drawn as a screen-covering quad), those
     // drawn with the host-depth cut, and those skipped as wholly behind the
     // host surface; whether the host depth was read.
@@ -146,7 +146,7 @@ public:
     // Expects upload() to have been called.
     void draw(std::span<const Splat> splats, const Camera& camera, const Target& target);
 
-    // Per-fragment fog (issue 14, docs/fog.md): from the next draw() on,
+    // Per-fragment fog (docs/fog.md): from the next draw() on,
     // every splat fragment becomes f c + (1 - f) alpha C_fog (premultiplied,
     // alpha unchanged), f the transmittance from the camera's eye to the
     // fragment's world position at timeSec. Compiles the fog variant of the

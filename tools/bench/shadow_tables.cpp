@@ -1,18 +1,19 @@
-// Shadow-table build time and accuracy against shadow tracing, for the
-// paper's 1560-voxel effect size (Ebert & Parent 1990, Table 2's question on
-// this machine). Prints one table; not a test (speed is never asserted).
+// splatfx-bench shadowtables: shadow-table build time and accuracy against
+// shadow tracing, for the paper's 1560-voxel effect size (Ebert & Parent
+// 1990, Table 2's question on this machine), on the CPU. Prints one table
+// per light (docs/lighting.md).
 //
-//   build/tests/lighting/splatfx_shadow_bench [repeats]
+//   splatfx-bench shadowtables [--repeats N]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <ctime>
 #include <vector>
 
+#include "commands.hpp"
+#include "options.hpp"
 #include "splatfx/lighting.hpp"
-#include "test_scenes.hpp"
 
 using namespace splatfx;
 using Clock = std::chrono::steady_clock;
@@ -41,11 +42,27 @@ Timing medianMs(int repeats, F&& f) {
     return {wall[wall.size() / 2], cpu[cpu.size() / 2]};
 }
 
+// 12x26x5 voxels at spacing 0.25, a soft column thinning upwards (the
+// lighting tests' 1560-voxel effect).
+Grid column1560() {
+    Grid g = *Grid::box({12, 26, 5}, glm::vec3(0.25f));
+    for (Voxel& v : g.voxels) {
+        const glm::vec3 q((float(v.cell.x) - 5.5f) / 6.0f, float(v.cell.y) / 25.0f, (float(v.cell.z) - 2.0f) / 2.5f);
+        v.opacity = 0.7f * std::exp(-2.0f * (q.x * q.x + q.z * q.z)) * (1.0f - 0.8f * q.y);
+    }
+    return g;
+}
+
 } // namespace
 
-int main(int argc, char** argv) {
-    const int repeats = argc > 1 ? std::max(1, std::atoi(argv[1])) : 5;
-    const Grid grid = test::effect1560();
+int runShadowTables(int argc, char** argv) {
+    int repeats = 5;
+    CLI::App app{"Shadow tables (16^3 .. 128^3) against tracing every voxel, for a 1560-voxel effect lit by a sun and by a point light\n"
+                 "inside it: median build and lookup time (wall and CPU) and transmittance error, on the CPU.",
+                 "splatfx-bench shadowtables"};
+    cli::addNumber(app, "--repeats", repeats, 1, 1000, "runs per timing (the median is printed)");
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+    const Grid grid = column1560();
     auto field = DensityField::fromGrid(grid);
     if (!field) {
         std::fprintf(stderr, "%s\n", field.error().c_str());

@@ -1,38 +1,34 @@
-// volume_measure: figures for docs/volume.md. A cloud field, a flight through
-// it, and per frame the tetrahedra emitted against the full-resolution count
-// and the CPU time of LodVolume::update.
+// splatfx-bench lodrefine: figures for docs/volume.md, on the CPU. A cloud
+// field, a flight through it, and per frame the tetrahedra emitted against
+// the full-resolution count and the CPU time of LodVolume::update.
 //
-//   volume_measure [--dims X Y Z] [--c DETAIL] [--C MIN_ACCURACY] [--frames N] [--average]
+//   splatfx-bench lodrefine [--dims X Y Z] [--c DETAIL] [--C MIN_ACCURACY] [--frames N] [--average]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "commands.hpp"
+#include "options.hpp"
 #include "splatfx/volume.hpp"
 
-int main(int argc, char** argv) {
+int runLodRefine(int argc, char** argv) {
     glm::ivec3 dims(257, 257, 33);
     float detailC = 10.0f, minC = 4.0f;
     int frames = 120;
     bool average = false;
-    for (int i = 1; i < argc; ++i) {
-        if (!std::strcmp(argv[i], "--dims") && i + 3 < argc) {
-            dims = {std::atoi(argv[i + 1]), std::atoi(argv[i + 2]), std::atoi(argv[i + 3])};
-            i += 3;
-        } else if (!std::strcmp(argv[i], "--c") && i + 1 < argc) detailC = float(std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--C") && i + 1 < argc) minC = float(std::atof(argv[++i]));
-        else if (!std::strcmp(argv[i], "--frames") && i + 1 < argc) frames = std::atoi(argv[++i]);
-        else if (!std::strcmp(argv[i], "--average")) average = true;
-        else {
-            std::fprintf(stderr, "usage: %s [--dims X Y Z] [--c DETAIL] [--C MIN_ACCURACY] [--frames N] [--average]\n", argv[0]);
-            return 2;
-        }
-    }
+    CLI::App app{"LOD cloud volume refinement on the CPU: a cloud field, a flight through it; tetrahedra emitted per frame against the\n"
+                 "full-resolution count, LodVolume::update time, memory, near-plane clipping, error against the finest level.",
+                 "splatfx-bench lodrefine"};
+    cli::addInts(app, "--dims", &dims.x, 3, 2, 4097, "grid points of the cloud field per axis", "X Y Z");
+    cli::addNumber(app, "--c", detailC, 0.0f, 1.0e6f, "detail knob c of the refinement");
+    cli::addNumber(app, "--C", minC, 0.0f, 1.0e6f, "minimum accuracy C of the octree");
+    cli::addNumber(app, "--frames", frames, 1, 100000, "frames of the flight");
+    app.add_flag("--average", average, "Delta from the average, not the maximum, error");
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     using Clock = std::chrono::steady_clock;
     auto ms = [](Clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); };
 
