@@ -137,7 +137,7 @@ struct EffectStatus {
     std::uint64_t framesSkipped = 0;     // updates where it was not (no work done)
     std::uint64_t catchUps = 0;          // returns of a stateful kind after being skipped (AdvanceResult::caughtUp)
     std::uint64_t splatsDrawn = 0;       // splats emitted at the last emit()
-    std::uint64_t tetrahedraDrawn = 0;   // tetrahedra emitted at the last prepare()
+    std::uint64_t tetrahedraDrawn = 0;   // tetrahedra emitted at the last prepare() (emit() takes none)
     Aabb bounds;                         // world bounds used for the last decision
     bool lit = false;                    // lit at the last emit()
     std::uint64_t shadowTableBuilds = 0; // self-shadowing tables built (cumulative)
