@@ -286,6 +286,18 @@ static void test_files(void) {
           (unsigned long long)st.drawn, (unsigned long long)st.splats);
     splatfx_scene_destroy(scene);
 
+    /* A file with one effect and one cloud volume: the C ids are the effects' alone (as before the
+     * Scene held volumes in the same list); the frame's counts include the volume. */
+    scene = NULL;
+    CHECK_OK(splatfx_scene_load_file(SPLATFX_SOURCE_DIR "/samples/16-cloud-flight/scene.json", m, NULL, &scene, err), err);
+    CHECK(splatfx_scene_effect_count(scene) == 1, "sample 16 has %u effects", splatfx_scene_effect_count(scene));
+    CHECK_OK(splatfx_scene_set_effect_enabled(scene, 0, 1, err), err);
+    CHECK_FAILS(splatfx_scene_set_effect_enabled(scene, 1, 0, err), err, SPLATFX_ERROR_NOT_FOUND, "id 1 is not an effect of this scene (it has 1)");
+    CHECK_OK(splatfx_scene_prepare(scene, 0.0, &cam, m, frame, err), err);
+    CHECK_OK(splatfx_frame_get_stats(frame, &st, err), err);
+    CHECK(st.declared == 2, "sample 16: declared %llu (the effect and the cloud)", (unsigned long long)st.declared);
+    splatfx_scene_destroy(scene);
+
     splatfx_scene* missing = (splatfx_scene*)&err;
     CHECK_FAILS(splatfx_scene_load_file("/nonexistent/scene.json", m, NULL, &missing, err), err, SPLATFX_ERROR_FILE, "/nonexistent/scene.json");
     CHECK(missing == NULL, "a failed load leaves *out NULL");

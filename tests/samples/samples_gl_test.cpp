@@ -149,7 +149,7 @@ TEST_F(SamplesGL, RendererSettingsChangeOnALoadedScene) {
     EXPECT_LT(sum / double(bilinear.pixels.size()), 2.0 / 255.0) << "same scene, same frame";
 }
 
-// [issue 17] Sample 23 draws its heightmap terrain from the LOD ground fog's
+// Sample 23 draws its heightmap terrain from the LOD ground fog's
 // mesh ("terrainGeometry"): the host draws exactly the triangles
 // GroundFog::update gives for that camera (the fog's bottom), fewer than the
 // full-resolution heightmap's.
@@ -160,15 +160,15 @@ TEST_F(SamplesGL, LodGroundFogTerrainIsTheHostsTerrain) {
     const double t = 1.0;
     const glm::ivec2 size{160, 120};
     render(*player, {t}, size);
-    const splatfx::VolumeId id = player->file().groundFogTerrain[0].fog;
+    const splatfx::EffectId id = player->file().groundFogTerrain[0].fog;
     splatfx::LodFrame scratch;
     std::vector<glm::vec3> tris;
-    ASSERT_TRUE(
-        player->file().scene.groundFog(id).update(player->cameraAt(t, size), player->file().scene.groundFogOptions(id).refine, scratch, &tris));
+    ASSERT_NE(player->file().scene.findGroundFog(id), nullptr);
+    ASSERT_TRUE(player->file().scene.findGroundFog(id)->update(player->cameraAt(t, size), player->file().scene.options(id).refine, scratch, &tris));
     ASSERT_GT(tris.size(), 0u);
     EXPECT_EQ(player->geometry().stats().triangles, tris.size() / 3);
-    // The host drew the terrain prepare() refined (VolumeOptions::keepTerrain), not a second refinement.
-    EXPECT_TRUE(player->file().scene.groundFogOptions(id).keepTerrain);
+    // The host drew the terrain prepare() refined (EffectOptions::keepTerrain), not a second refinement.
+    EXPECT_TRUE(player->file().scene.options(id).keepTerrain);
     EXPECT_EQ(player->file().scene.groundFogTerrain(id), tris);
     EXPECT_LT(tris.size() / 3, 2u * 200u * 170u) << "the 201x171 heightmap at full resolution";
 }

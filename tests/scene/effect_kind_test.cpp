@@ -54,12 +54,12 @@ public:
         mTime = timeSec;
         return {.steps = gap ? 1 : 0, .caughtUp = gap && context.resumed};
     }
-    std::size_t emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options) const override {
+    EmitResult emit(const EmitContext& context) override {
         ++mCalls.emits;
-        mCalls.lastEmit = options;
-        const std::size_t before = builder.splats().size();
-        builder.add(mGrid, materials, {.textured = false, .opacityScale = options.opacityScale});
-        return builder.splats().size() - before;
+        mCalls.lastEmit = context.draw;
+        const std::size_t before = context.splats.splats().size();
+        context.splats.add(mGrid, context.materials, {.textured = false, .opacityScale = context.draw.opacityScale});
+        return {.splats = context.splats.splats().size() - before};
     }
     double time() const override { return mTime; }
     std::uint64_t costCells() const override { return mGrid.voxels.size(); }

@@ -65,7 +65,9 @@ TEST(SceneFileHeightmap, TerrainAndGroundFogShareEverySamplePoint) {
     EXPECT_EQ(fs::path(g.heightmapPath), t.dir / "dem.pgm");
     EXPECT_FLOAT_EQ(g.heightmapSpacing, spacing);
     EXPECT_FLOAT_EQ(g.heightmapScale, scale);
-    ASSERT_EQ(r->scene.groundFogCount(), 1u);
+    ASSERT_EQ(r->volumes.size(), 1u);
+    const splatfx::EffectId fogId = r->volumes[0].id;
+    ASSERT_NE(r->scene.findGroundFog(fogId), nullptr);
 
     // Every vertex of every emitted tetrahedron is either a terrain sample of
     // the step-2 grid (the heightmap geometry's own point, placed at `pos`)
@@ -95,7 +97,7 @@ TEST(SceneFileHeightmap, TerrainAndGroundFogShareEverySamplePoint) {
         }
     EXPECT_GT(onTerrain, 0u);
     // Disabled: nothing reaches the frame.
-    r->scene.groundFogOptions(0).enabled = false;
+    r->scene.setEnabled(fogId, false);
     splatfx::Frame off;
     r->scene.prepare(0.0, cam, m, off);
     EXPECT_TRUE(off.volumes().empty());
@@ -143,7 +145,8 @@ TEST(SceneFileHeightmap, GroundFogLodKeys) {
     ASSERT_TRUE(lod) << lod.error();
     ASSERT_TRUE(full) << full.error();
     EXPECT_TRUE(lod->groundFogTerrain.empty());
-    const splatfx::VolumeOptions& o = lod->scene.groundFogOptions(0);
+    ASSERT_EQ(lod->volumes.size(), 1u);
+    const splatfx::EffectOptions& o = lod->scene.options(lod->volumes[0].id);
     EXPECT_FLOAT_EQ(o.refine.detailC, 0.5f);
     EXPECT_FALSE(o.refine.morph);
     const splatfx::Camera cam = splatfx::Camera::lookAt({0, 600, 900}, {0, 0, 0}, {0, 1, 0}, glm::radians(40.0f), {64, 48}, 0.5f, 5000.0f);

@@ -1,4 +1,4 @@
-// [clouds, issue 17] Volumes in the Frame: the interleaved back-to-front draw
+// Volumes in the Frame: the interleaved back-to-front draw
 // order of splats and tetrahedra, and Scene::prepare refining the volumes in view.
 #include <gtest/gtest.h>
 
@@ -101,7 +101,7 @@ TEST(FrameVolumes, ScenePreparesTheVolumesInView) {
     auto table = PreIntegrationTable::create(*tf, {.scalarResolution = 8, .lengthResolution = 8, .maxLengthWorld = 28.0f});
     ASSERT_TRUE(table);
     Scene scene;
-    const VolumeId id = scene.addVolume(std::move(*vol), std::move(*tf), std::move(*table), {.name = "cloud"});
+    const EffectId id = scene.add(std::move(*vol), std::move(*tf), std::move(*table), {.name = "cloud"});
     Materials materials{Footprint{}};
     Frame frame;
     scene.prepare(0.0, axisCamera(), materials, frame);
@@ -115,7 +115,7 @@ TEST(FrameVolumes, ScenePreparesTheVolumesInView) {
     const Camera away = Camera::lookAt({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, glm::radians(60.0f), {64, 48}, 0.1f, 1000.0f);
     scene.prepare(1.0, away, materials, frame);
     EXPECT_TRUE(frame.volumes().empty());
-    scene.volumeOptions(id).enabled = false;
+    scene.setEnabled(id, false);
     scene.prepare(2.0, axisCamera(), materials, frame);
     EXPECT_TRUE(frame.volumes().empty());
 }
@@ -129,9 +129,13 @@ TEST(FrameVolumes, SceneFileVolumesBlock) {
                      "coverage": 0.6, "featureCells": 6, "tableScalars": 8, "tableLengths": 8}]})";
     auto f = parseSceneFile(ok, "mem/scene.json", materials);
     ASSERT_TRUE(f) << f.error();
-    ASSERT_EQ(f->scene.volumeCount(), 1u);
-    EXPECT_EQ(f->scene.volume(0).pointDims(), glm::ivec3(17, 9, 17));
-    EXPECT_EQ(f->scene.volumeOptions(0).name, "cumulus");
+    ASSERT_EQ(f->volumes.size(), 1u);
+    const EffectId id = f->volumes[0].id;
+    ASSERT_NE(f->scene.findLodVolume(id), nullptr);
+    EXPECT_EQ(f->scene.findLodVolume(id)->pointDims(), glm::ivec3(17, 9, 17));
+    EXPECT_EQ(f->scene.options(id).name, "cumulus");
+    EXPECT_EQ(f->volumes[0].name, "cumulus");
+    EXPECT_EQ(f->volumes[0].kind, "clouds");
     const std::string bad = R"({"format": "splatfx-scene", "version": 1, "volumes": [{"kind": "smoke", "dims": [1, 9, 17]}]})";
     auto g = parseSceneFile(bad, "mem/scene.json", materials);
     ASSERT_FALSE(g);

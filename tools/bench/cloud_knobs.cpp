@@ -85,12 +85,12 @@ int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
         auto table =
             splatfx::PreIntegrationTable::create(*tf, {.scalarResolution = k.table.x, .lengthResolution = k.table.y, .maxLengthWorld = longest});
         if (!table) return std::fprintf(stderr, "clouds knobs: %s\n", table.error().c_str()), false;
-        scene.addVolume(std::move(*vol), *tf, std::move(*table), {.name = "clouds", .refine = {.detailC = k.detailC}});
+        scene.add(std::move(*vol), *tf, std::move(*table), {.name = "clouds", .refine = {.detailC = k.detailC}});
         return true;
     };
     splatfx::Scene finest;
     if (!makeScene({}, finest)) return 1;
-    const splatfx::LodVolume& ref = finest.volume(0);
+    const splatfx::LodVolume& ref = *finest.findLodVolume(0);
     const glm::vec3 ext = glm::vec3(ref.pointDims() - 1) * ref.spacingWorld();
 
     std::vector<View> views;

@@ -54,7 +54,7 @@ struct Options {
 
 struct CloudSet {
     splatfx::Scene scene;
-    splatfx::VolumeId id = 0;
+    splatfx::EffectId id = 0;
     std::size_t tableBytes = 0, volumeBytes = 0;
     std::uint64_t full = 0;
     glm::vec3 ext{0.0f};
@@ -75,7 +75,7 @@ bool makeClouds(glm::ivec3 dims, float detailC, CloudSet& out) {
     out.volumeBytes = vol->memoryBytes();
     out.full = vol->fullResolutionTets();
     out.ext = glm::vec3(vol->pointDims() - 1) * vol->spacingWorld();
-    out.id = out.scene.addVolume(std::move(*vol), std::move(*tf), std::move(*table), {.name = "clouds", .refine = {.detailC = detailC}});
+    out.id = out.scene.add(std::move(*vol), std::move(*tf), std::move(*table), {.name = "clouds", .refine = {.detailC = detailC}});
     return true;
 }
 
@@ -243,7 +243,7 @@ int runClouds(int argc, char** argv) {
         const Mode modes[] = {{"finest level", 1e9f, true}, {"LOD, morphing", o.popDetailC, true}, {"LOD, no morphing", o.popDetailC, false}};
         double finestMax = 0, finestP99 = 0;
         for (const Mode& m : modes) {
-            cs.scene.volumeOptions(cs.id).refine = {.detailC = m.c, .morph = m.morph};
+            cs.scene.options(cs.id).refine = {.detailC = m.c, .morph = m.morph};
             splatfx::Frame frame;
             splatfx::Image prev;
             std::vector<double> change;

@@ -112,7 +112,7 @@ int runGroundFog(int argc, char** argv) {
         auto fr = splatfx::gl::FrameRenderer::create();
         if (!table || !fr) return std::fprintf(stderr, "table/renderer failed\n"), 1;
         layers[k].bytes = fog->memoryBytes();
-        layers[k].scene.addGroundFog(std::move(*fog), std::move(*tf), std::move(*table), {.name = "fog", .refine = {.detailC = o.detailC}});
+        layers[k].scene.add(std::move(*fog), std::move(*tf), std::move(*table), {.name = "fog", .refine = {.detailC = o.detailC}});
         layers[k].renderer = std::make_unique<splatfx::gl::FrameRenderer>(std::move(*fr));
     }
     auto fb = splatfx::gl::Framebuffer::create({.width = o.size.x, .height = o.size.y, .color = splatfx::gl::Precision::F32});
@@ -136,7 +136,7 @@ int runGroundFog(int argc, char** argv) {
         splatfx::Image fullImg;
         for (Mode& m : modes) {
             Layer& l = layers[m.layer];
-            l.scene.groundFogOptions(0).refine = {.detailC = o.detailC, .morph = m.morph};
+            l.scene.options(0).refine = {.detailC = o.detailC, .morph = m.morph};
             splatfx::Frame frame;
             const auto a = Clock::now();
             l.scene.prepare(1.0 + f / 24.0, cam, materials, frame);

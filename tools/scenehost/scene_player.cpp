@@ -16,8 +16,13 @@ struct ScenePlayer::Impl {
     std::optional<splatfx::gl::FrameRenderer> renderer;
     splatfx::Frame frame;
     FrameStats stats;
-    // [issue 17] heightmap objects drawn from a LOD ground fog's terrain mesh (groundFog "terrainGeometry")
-    std::vector<std::pair<std::size_t, splatfx::VolumeId>> lodTerrain;
+    // Heightmap objects drawn from a LOD ground fog's terrain mesh (groundFog "terrainGeometry").
+    struct LodTerrain {
+        std::size_t object = 0;
+        splatfx::EffectId fog = 0;
+        bool meshSet = false; // the object's mesh is a LOD terrain, no longer the heightmap's own
+    };
+    std::vector<LodTerrain> lodTerrain;
     splatfx::LodFrame scratch;
     std::vector<glm::vec3> terrain;
 };
@@ -51,7 +56,7 @@ splatfx::Status ScenePlayer::setupGl(Impl& impl, const std::string& path, const 
     for (const splatfx::GroundFogTerrain& link : impl.file->groundFogTerrain) {
         const long i = impl.geometry->find(link.geometry); // the scene file checked it names a heightmap
         if (i < 0) return splatfx::makeError(path + ": groundFog terrainGeometry '" + link.geometry + "' not found");
-        impl.lodTerrain.emplace_back(std::size_t(i), link.fog);
+        impl.lodTerrain.push_back({std::size_t(i), link.fog});
     }
     // A scene of geometry only still needs one row for the renderer to upload.
     if (impl.materials.colorTableCount() == 0) impl.materials.addColorTable(splatfx::ColorTable::constant(glm::vec4(1.0f)));
@@ -127,16 +132,23 @@ void ScenePlayer::renderFrame(double t, const splatfx::Camera& camera, unsigned 
     splatfx::SceneFile& f = *p.file;
     FrameStats& s = p.stats;
 
-    // [issue 17] The LOD terrain of ground-fog layers replaces their heightmap
-    // objects' meshes (the same morphed triangulation as the fog's bottom): the
-    // one prepare() refined (VolumeOptions::keepTerrain, set by the scene file),
-    // or, for a layer switched off, refined here for the terrain alone.
-    for (const auto& [object, fog] : p.lodTerrain) {
+    // The LOD terrain of ground-fog layers replaces their heightmap objects'
+    // meshes (the same morphed triangulation as the fog's bottom): the one
+    // prepare() refined (EffectOptions::keepTerrain, set by the scene file),
+    // or, for a layer switched off, refined here for the terrain alone. A
+    // layer the Scene culled has its whole terrain out of view too, so its
+    // mesh may stay as it was, once it is a LOD terrain at all.
+    for (Impl::LodTerrain& t : p.lodTerrain) {
         if (!options.drawGeometry) continue;
-        if (f.scene.groundFogOptions(fog).enabled) {
-            if (!f.scene.groundFogTerrain(fog).empty()) p.geometry->setWorldTriangles(object, f.scene.groundFogTerrain(fog));
-        } else if (f.scene.groundFog(fog).update(camera, f.scene.groundFogOptions(fog).refine, p.scratch, &p.terrain)) {
-            p.geometry->setWorldTriangles(object, p.terrain);
+        const splatfx::GroundFog* layer = f.scene.findGroundFog(t.fog);
+        const std::vector<glm::vec3>& kept = f.scene.groundFogTerrain(t.fog);
+        if (f.scene.options(t.fog).enabled && !kept.empty()) {
+            p.geometry->setWorldTriangles(t.object, kept);
+            t.meshSet = true;
+        } else if ((!f.scene.options(t.fog).enabled || !t.meshSet) && layer &&
+                   layer->update(camera, f.scene.options(t.fog).refine, p.scratch, &p.terrain)) {
+            p.geometry->setWorldTriangles(t.object, p.terrain);
+            t.meshSet = true;
         }
     }
 

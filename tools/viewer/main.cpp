@@ -309,19 +309,23 @@ struct Viewer {
         if (player && ImGui::CollapsingHeader("Effects", ImGuiTreeNodeFlags_DefaultOpen)) {
             splatfx::Scene& scene = player->file().scene;
             const auto& perEffect = player->stats().splatsPerEffect;
+            // One row per entry of any kind: the Scene switches each off by its id alike.
+            auto row = [&](splatfx::EffectId id, const std::string& name, const std::string& kind, unsigned long long count, const char* what) {
+                ImGui::PushID(int(id));
+                bool on = scene.options(id).enabled;
+                if (ImGui::Checkbox("##on", &on)) scene.setEnabled(id, on);
+                ImGui::SameLine();
+                ImGui::Text("%s (%s)%s %llu %s", name.c_str(), kind.c_str(), scene.status(id).needed ? "" : " [skipped]", count, what);
+                ImGui::SameLine();
+                if (ImGui::SmallButton("inside")) jumpInside(id);
+                ImGui::PopID();
+            };
             for (std::size_t i = 0; i < player->file().effects.size(); ++i) {
                 const splatfx::SceneEffectInfo& info = player->file().effects[i];
-                ImGui::PushID(int(info.id));
-                bool on = scene.options(info.id).enabled;
-                if (ImGui::Checkbox("##on", &on)) scene.setEnabled(info.id, on);
-                ImGui::SameLine();
-                const splatfx::EffectStatus& st = scene.status(info.id);
-                ImGui::Text("%s (%s)%s %llu splats", info.name.c_str(), info.kind.c_str(), st.needed ? "" : " [skipped]",
-                            (unsigned long long)(i < perEffect.size() ? perEffect[i] : 0));
-                ImGui::SameLine();
-                if (ImGui::SmallButton("inside")) jumpInside(info.id);
-                ImGui::PopID();
+                row(info.id, info.name, info.kind, i < perEffect.size() ? perEffect[i] : 0, "splats");
             }
+            for (const splatfx::SceneVolumeInfo& info : player->file().volumes)
+                row(info.id, info.name, info.kind, scene.status(info.id).tetrahedraDrawn, "tetrahedra");
         }
         if (ImGui::CollapsingHeader("Scene file (edit, then Apply)")) {
             static std::vector<char> buf;

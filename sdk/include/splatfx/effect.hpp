@@ -152,7 +152,13 @@ public:
     // Adds every layer's (grid, style) to the builder (after builder.begin).
     // Expects materials with the footprint radius given in the desc and the
     // layers' texture sets and colour tables. Returns the splats added.
-    std::size_t emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options = {}) const override;
+    std::size_t emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options = {}) const;
+    // EffectKind: emit(context.splats, context.materials, context.draw).
+    EmitResult emit(const EmitContext& context) override;
+    // EffectKind: every layer's voxels with the opacity the splat builder
+    // draws them with (style and draw opacity scales, colour-table alpha), on
+    // the whole effect's lattice.
+    bool lightingDensity(const Materials& materials, const EmitOptions& draw, Grid& out) const override;
 
     // Conservative world box of every splat over [t0, t1] (seconds): lattice
     // extent, motion over the interval, and the splat extent (footprint

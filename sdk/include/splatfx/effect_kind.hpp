@@ -1,29 +1,33 @@
-// splatfx/effect_kind.hpp: the one interface a Scene schedules effects by,
-// and the extension point for new kinds of effect.
+// splatfx/effect_kind.hpp: the one interface a Scene holds every effect by,
+// and the extension point for new kinds.
 //
-// An EffectKind is anything that occupies a world box over time, can say
-// whether it has material now, can be brought to a time t, and can emit
-// splats into a frame. Scene (scene.hpp) decides per frame which kinds are
-// needed (enabled, in range, in view by bounds(), alive()) and calls
-// advanceTo() and emit() on exactly those; it knows nothing else about them.
-// The kinds the SDK ships are all behind `Effect` (effect.hpp): the
-// stateless grid effect (base grid + Motion + growth + texture dynamics,
-// King et al. 1999 sec. 3.1-3.3, evaluated at t directly), the stateful
-// solver effect (FluidSolver + emitters + texture propagation, stepped, and
-// caught up in bounded coarse steps after a gap), the procedural gas (Ebert &
-// Parent's turbulent densities sampled at t) and the sequence effect (a baked
-// simulation played back, e.g. imported from OpenVDB).
+// An effect kind is anything volumetric a Scene holds: it occupies a world
+// box over time, can say whether it has material now, can be brought to a
+// time t, emits what it draws into a frame (splats into the frame's
+// SplatBuilder, or tetrahedra into the frame's volumes), and may expose the
+// density the scene's lights see. Scene (scene.hpp) decides per frame which
+// effects are needed (enabled, in range, in view by bounds(), alive()) and
+// calls advanceTo() and emit() on exactly those; it knows nothing else about
+// them. The SDK ships:
+//   - Effect (effect.hpp): grid effects, solver effects, procedural gases and
+//     played-back sequences (e.g. OpenVDB), drawn as splats and lit by the
+//     scene's lights (lightingDensity);
+//   - LOD volumes (volume.hpp, LodVolume: clouds) and ground fog layers
+//     (volume.hpp, GroundFog), drawn as projected tetrahedra; they are added
+//     with Scene::add(LodVolume, ...) and Scene::add(GroundFog, ...) and are
+//     not lit by the scene's lights (their light is part of the volume data).
 // It does not own materials, sort or render (the Frame and the renderer do).
 //
-// How to add a kind (a cloud volume, a procedural gas):
-//   1. derive from EffectKind and implement the six functions below. bounds()
-//      must be conservative (every splat emit() can produce over [t0, t1],
-//      splat extent included), or the Scene culls material that is visible;
+// How to add a kind:
+//   1. derive from EffectKind and implement the six pure functions below.
+//      bounds() must be conservative (every primitive emit() can produce over
+//      [t0, t1], splat extent included), or the Scene culls what is visible;
 //   2. a stateless kind evaluates advanceTo(t) directly; a stateful one steps
 //      from time() to t, and when AdvanceContext::resumed is set it catches up
 //      in at most AdvanceContext::maxCatchUpSteps steps (bounded cost) and
 //      reports it in AdvanceResult::caughtUp;
-//   3. add it with Scene::add(std::make_unique<MyKind>(...), options). Scene,
+//   3. to be lit, override lightingDensity();
+//   4. add it with Scene::add(std::make_unique<MyKind>(...), options). Scene,
 //      Frame and the renderer need no change. (A scene-file kind also needs
 //      its reader under sdk/src/scenefile; the loader budgets costCells().)
 //
@@ -36,14 +40,18 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
+#include "splatfx/frame.hpp"
+#include "splatfx/grid.hpp"
 #include "splatfx/materials.hpp"
 #include "splatfx/motion.hpp"
 #include "splatfx/splats.hpp"
+#include "splatfx/volume.hpp"
 
 namespace splatfx {
 
-// How one emit() is drawn; Scene combines the caller's with EffectOptions::draw.
+// How splats are drawn; Scene combines the caller's with EffectOptions::draw.
 struct EmitOptions {
     bool textured = true;      // false: traditional splats for every layer (Fig. 1a); default true
     float opacityScale = 1.0f; // multiplies each layer's style.opacityScale; default 1
@@ -73,12 +81,33 @@ struct AdvanceResult {
     bool caughtUp = false; // a resumed stateful kind covered a skipped interval
 };
 
+// Where emit() puts what it draws, and how; filled by the Scene from
+// EffectOptions and the caller's options.
+struct EmitContext {
+    SplatBuilder& splats; // splats go here (after splats.begin); splats.camera() is the frame's camera
+    // Tetrahedra go here, one FrameVolume per kind and frame. Null when the
+    // caller takes splats only (Scene::emit into a host's builder): kinds
+    // drawn as tetrahedra then add nothing.
+    std::vector<FrameVolume>* volumes = nullptr;
+    const Materials& materials;
+    EmitOptions draw{};     // splat kinds: textured, opacity scale
+    LodRefineDesc refine{}; // kinds drawn as LOD tetrahedra: the per-frame refinement (c, morphing, culling, clipping)
+    // Ground fog: keep the terrain triangles the refinement stands on
+    // (Scene::groundFogTerrain), so a host draws its terrain from the same mesh.
+    bool keepTerrain = false;
+};
+
+struct EmitResult {
+    std::size_t splats = 0;     // splats added to EmitContext::splats
+    std::size_t tetrahedra = 0; // tetrahedra added to EmitContext::volumes
+};
+
 class EffectKind {
 public:
     virtual ~EffectKind() = default;
 
-    // Conservative world box of every splat emit() can produce at any time in
-    // [t0, t1] (seconds; either order). Empty when the kind draws nothing.
+    // Conservative world box of every primitive emit() can produce at any
+    // time in [t0, t1] (seconds; either order). Empty when the kind draws nothing.
     virtual Aabb bounds(double t0, double t1) const = 0;
     // Whether material is present at timeSec (so advancing and drawing can matter).
     // Called only for kinds in view; must be cheap and must not advance.
@@ -86,14 +115,27 @@ public:
     // Brings the kind to timeSec (>= time() for stateful kinds; stateless
     // kinds accept any finite t >= 0).
     virtual AdvanceResult advanceTo(double timeSec, const AdvanceContext& context) = 0;
-    // Adds the splats of the kind's current state to the builder (after
-    // builder.begin). Returns the number of splats added.
-    virtual std::size_t emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options) const = 0;
+    // Adds what the kind draws in its current state for the camera of
+    // context.splats. Not const: a view-dependent kind (LOD) keeps per-frame
+    // state (morphing) between frames.
+    virtual EmitResult emit(const EmitContext& context) = 0;
     // The time the kind's state is at, in seconds.
     virtual double time() const = 0;
     // Cells or voxels one advance evaluates: the size budget a loader (scene
-    // files) checks against kMaxVoxels.
+    // files) checks against kMaxVoxels. 0 for kinds whose advance costs nothing.
     virtual std::uint64_t costCells() const = 0;
+
+    // What the scene's lights see of the kind in its current state: fills
+    // `out` with its density as emit() draws it with `draw` (voxels whose
+    // opacity is the drawn one, the grid's dims, spacing and transform) and
+    // returns true. The Scene then colours the splats the kind emitted by the
+    // lights (self-shadowed) and lets it cast the frame's shadow
+    // (EffectOptions::lighting). Default false: the kind is drawn unlit and
+    // casts no shadow.
+    virtual bool lightingDensity(const Materials& materials, const EmitOptions& draw, Grid& out) const {
+        (void)materials, (void)draw, (void)out;
+        return false;
+    }
 
 protected:
     EffectKind() = default;

@@ -1,31 +1,39 @@
-// splatfx/scene.hpp: many effects, and only the ones the camera needs get work.
+// splatfx/scene.hpp: the effects a level declares, and only the ones the
+// camera needs get work.
 //
-// A Scene holds the effects a level declares and, every frame, decides which
-// are needed now: enabled, within range of the camera, alive (emitting, or
-// with material left), and inside the view frustum by conservative bounds
-// that include their motion and the extent of their splats. Only those are
-// simulated and drawn. It sees every effect through EffectKind
-// (effect_kind.hpp: bounds, alive, advanceTo, emit), so new kinds are added
-// with add(std::unique_ptr<EffectKind>) and no change here. An effect that
-// was skipped comes back exactly as it would have been: stateless effects
-// are evaluated at the current time directly, solver effects catch up over
-// the skipped interval in at most `maxCatchUpSteps` coarse steps (bounded
-// cost; its error against full simulation is measured in docs/BENCHMARKS.md).
+// A Scene holds effects of every kind in one list, behind one interface
+// (EffectKind, effect_kind.hpp): splat effects (Effect: grid, solver,
+// procedural gas, played-back sequence), LOD volumes (clouds) and ground fog
+// layers (volume.hpp), and any kind a host adds. Every effect has one
+// EffectId, one EffectOptions and one EffectStatus. Every frame the Scene
+// decides which effects are needed now: enabled, within range of the camera,
+// inside the view frustum by their conservative world bounds (motion and
+// splat extent included), and alive (emitting, or with material left). Only
+// those are advanced and emitted into the Frame: splats into its builder,
+// tetrahedra into its volumes. A skipped effect comes back exactly as it
+// would have been: stateless kinds are evaluated at the current time
+// directly, solver effects catch up over the skipped interval in at most
+// `maxCatchUpSteps` coarse steps (bounded cost; its error against full
+// simulation is measured in docs/BENCHMARKS.md).
 // It also holds lights (addLight) and lights the effects that opt in
-// (EffectOptions::lighting): their splat colours follow Ebert & Parent's
-// low-albedo model with self-shadowing, and prepare() puts the gas's shadow
-// on the scene into Frame::shadow() (docs/lighting.md, "In a Scene").
-// It does not render, load files, or own GL resources.
+// (EffectOptions::lighting) and whose kind exposes the density the light sees
+// (EffectKind::lightingDensity: every Effect does; LOD volumes and ground fog
+// do not, their light is part of their data): their splat colours follow Ebert & Parent's low-albedo model with
+// self-shadowing, and prepare() puts their shadow on the scene into
+// Frame::shadow() (docs/lighting.md, "In a Scene"). And the scene's fog
+// (setFog), handed to every Frame.
+// It does not render, load files, or own GL resources. Its frustum test is
+// per effect; a LOD volume's refinement culls its own nodes inside
+// (LodRefineDesc::frustumCull).
 //
 //   splatfx::Scene scene;
 //   auto id = scene.add(*splatfx::presets::fire(materials), {.name = "campfire", .rangeWorld = 80});
 //   scene.prepare(timeSec, camera, materials, frame);   // per frame: decide, simulate, emit, sort
-//   frameRenderer->render(frame, hostTarget);            // gl/frame_renderer.hpp
 //
 // prepare() is update() + emit() into a Frame + the sort; the two halves stay
-// public for hosts that feed their own SplatBuilder. LOD volumes (clouds,
-// volume.hpp) are a second list (addVolume): prepare() refines those in view
-// into the Frame's volumes.
+// public for hosts that feed their own SplatBuilder (emit() then adds splats
+// only: kinds drawn as tetrahedra need a Frame). gl::FrameRenderer
+// (gl/frame_renderer.hpp) draws the Frame.
 //
 // Threading: one thread at a time.
 #pragma once
@@ -49,9 +57,11 @@
 
 namespace splatfx {
 
+// One id space for every effect a Scene holds, of any kind: ids are 0, 1, ...
+// in the order of add().
 using EffectId = std::uint32_t;
 
-// ---- lighting (issue 16; docs/lighting.md, "In a Scene")
+// How a lit effect shadows itself (docs/lighting.md, "In a Scene").
 enum class SelfShadow {
     Off,    // every voxel sees the lights unattenuated
     Traced, // each splat traces to each light through the effect's field (the reference)
@@ -62,7 +72,8 @@ enum class SelfShadow {
 // effect draws its colour tables' colours and costs nothing more.
 // A lit effect's splats get colour = table colour * lightPoints(...) factor
 // at each splat's centre (per splat, on the CPU; the GL pass is unchanged).
-// Only effects added as an Effect are lit (other kinds stay unlit).
+// Only kinds that expose the density the light sees are lit
+// (EffectKind::lightingDensity: every Effect); the others stay unlit.
 struct EffectLighting {
     bool enabled = false; // default false (unlit)
     // Albedo, phase lobes, emission, ambient, multipleScattering; its
@@ -86,6 +97,9 @@ struct SceneShadowDesc {
     std::uint64_t memoryBudgetBytes = 64ull << 20; // as ShadowTableDesc; default 64 MiB
 };
 
+// How the Scene treats one effect. Every field applies to every kind; a
+// field a kind has no use for (catch-up for a stateless kind, refine for a
+// splat effect) is ignored by it.
 struct EffectOptions {
     std::string name;                                          // for counters and messages; default empty
     float rangeWorld = std::numeric_limits<float>::infinity(); // skipped beyond this distance from its bounds; default no limit
@@ -99,87 +113,117 @@ struct EffectOptions {
     // are all off and whose total density is below this is dead: not
     // simulated, not drawn.
     double deadDensity = 1e-4; // default 1e-4
-    // How the effect is drawn (textured or traditional, opacity scale);
+    // How splats are drawn (textured or traditional, opacity scale);
     // combined with the options given to prepare()/emit(). Default EmitOptions{}.
     EmitOptions draw{};
-    EffectLighting lighting{}; // lighting (issue 16); default unlit
+    EffectLighting lighting{}; // default unlit
+    // LOD volumes and ground fog: the per-frame refinement (c, morphing,
+    // per-node frustum culling, near clipping). Default LodRefineDesc{}.
+    LodRefineDesc refine{};
+    // Ground fog: prepare() keeps the terrain triangles its refinement stands
+    // on (groundFogTerrain), so a host draws its terrain from the same LOD
+    // mesh without refining it twice. Default false.
+    bool keepTerrain = false;
 };
 
 // Why an effect was or was not needed at the last update, and what it cost.
 struct EffectStatus {
     bool enabled = true;
     bool inRange = false;
-    bool inView = false;             // in range and inside the frustum
-    bool alive = false;              // in view and with material present (only tested when in view)
-    bool needed = false;             // enabled && inRange && inView && alive
-    std::uint64_t framesNeeded = 0;  // updates where it was needed
-    std::uint64_t framesSkipped = 0; // updates where it was not (no work done)
-    std::uint64_t catchUps = 0;      // returns of a stateful kind after being skipped (AdvanceResult::caughtUp)
-    std::uint64_t splatsDrawn = 0;   // splats emitted at the last emit()
-    Aabb bounds;                     // world bounds used for the last decision
-    // ---- lighting (issue 16)
+    bool inView = false;                 // in range and inside the frustum
+    bool alive = false;                  // in view and with material present (only tested when in view)
+    bool needed = false;                 // enabled && inRange && inView && alive
+    std::uint64_t framesNeeded = 0;      // updates where it was needed
+    std::uint64_t framesSkipped = 0;     // updates where it was not (no work done)
+    std::uint64_t catchUps = 0;          // returns of a stateful kind after being skipped (AdvanceResult::caughtUp)
+    std::uint64_t splatsDrawn = 0;       // splats emitted at the last emit()
+    std::uint64_t tetrahedraDrawn = 0;   // tetrahedra emitted at the last prepare() (emit() takes none)
+    Aabb bounds;                         // world bounds used for the last decision
     bool lit = false;                    // lit at the last emit()
     std::uint64_t shadowTableBuilds = 0; // self-shadowing tables built (cumulative)
     std::uint64_t shadowTableReuses = 0; // ... and reused unchanged (cumulative)
 };
 
+// Every count covers effects of every kind.
 struct SceneCounters {
-    std::size_t declared = 0;  // effects in the scene
-    std::size_t needed = 0;    // needed at the last update (= simulated and drawn)
-    std::size_t simulated = 0; // effects that did dynamics work at the last update
-    std::uint64_t splats = 0;  // splats emitted at the last emit()
-    // ---- lighting (issue 16)
+    std::size_t declared = 0;            // effects in the scene
+    std::size_t needed = 0;              // needed at the last update (= advanced and emitted)
+    std::size_t simulated = 0;           // effects advanced to the time at the last update
+    std::uint64_t splats = 0;            // splats emitted at the last emit()
+    std::uint64_t tetrahedra = 0;        // tetrahedra emitted at the last prepare()
     std::size_t litEffects = 0;          // effects lit at the last emit()
     std::uint64_t shadowTableBuilds = 0; // self-shadowing and scene-shadow tables built at the last emit()
     std::uint64_t shadowTableReuses = 0; // ... reused unchanged at the last emit()
     std::uint64_t sceneShadowBuilds = 0; // scene-shadow table builds (cumulative)
 };
 
-// ---- [clouds, issue 17] LOD volumes, drawn as projected tetrahedra ----
-using VolumeId = std::uint32_t;
-struct VolumeOptions {
-    std::string name;       // for messages; default empty
-    bool enabled = true;    // default true
-    LodRefineDesc refine{}; // per-frame refinement (c, morphing, culling); default LodRefineDesc{}
-    // Ground fog only: prepare() keeps the frame's terrain triangles
-    // (groundFogTerrain), so a host draws its terrain from the same LOD mesh
-    // without refining it twice. Default false.
-    bool keepTerrain = false;
-};
-// ---- end [clouds] ----
-
 class Scene {
 public:
-    // An Effect (grid or solver); effect(id) returns it.
+    // ---- Effects: one list, one id space -----------------------------------
+    // An Effect (grid, solver, procedural gas, sequence), drawn as splats.
     EffectId add(Effect effect, EffectOptions options = {});
+    // A LOD volume (clouds) with the transfer function its zero-opacity test
+    // uses and the table it is drawn with, refined by options.refine.
+    EffectId add(LodVolume volume, TransferFunction transfer, PreIntegrationTable table, EffectOptions options = {});
+    // A ground fog layer with its transfer function and table, refined by
+    // options.refine (a layer made with GroundFogDesc::lod).
+    EffectId add(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, EffectOptions options = {});
     // Any other kind (effect_kind.hpp). Expects kind != nullptr.
     EffectId add(std::unique_ptr<EffectKind> kind, EffectOptions options = {});
+    // Effects of every kind; ids are [0, size()).
     std::size_t size() const { return mEntries.size(); }
-    // Every entry through the interface the Scene schedules by.
+
+    // Every effect through the interface the Scene schedules by.
     EffectKind& kind(EffectId id) { return *mEntries.at(id).kind; }
     const EffectKind& kind(EffectId id) const { return *mEntries.at(id).kind; }
-    // The Effect of an entry added as an Effect; nullptr for other kinds.
-    Effect* findEffect(EffectId id) { return mEntries.at(id).effect; }
-    const Effect* findEffect(EffectId id) const { return mEntries.at(id).effect; }
-    // Expects an entry added as an Effect (asserts otherwise; use findEffect
-    // or kind for other kinds).
+    // The effect as its concrete kind; nullptr when it is of another kind.
+    Effect* findEffect(EffectId id);
+    const Effect* findEffect(EffectId id) const;
+    LodVolume* findLodVolume(EffectId id);
+    const LodVolume* findLodVolume(EffectId id) const;
+    const GroundFog* findGroundFog(EffectId id) const;
+    // Expects an Effect (asserts otherwise; use findEffect for any kind).
     Effect& effect(EffectId id);
     const Effect& effect(EffectId id) const;
-    const EffectOptions& options(EffectId id) const { return mEntries.at(id).options; }
-    void setEnabled(EffectId id, bool enabled) { mEntries.at(id).options.enabled = enabled; }
 
+    // Options take effect at the next update() / prepare().
+    const EffectOptions& options(EffectId id) const { return mEntries.at(id).options; }
+    EffectOptions& options(EffectId id) { return mEntries.at(id).options; }
+    void setEnabled(EffectId id, bool enabled) { mEntries.at(id).options.enabled = enabled; }
+    // Replaces the transfer function and table of a LOD volume or ground fog
+    // layer (the GL pass re-uploads it). Expects one of those kinds (asserts otherwise).
+    void setTransfer(EffectId id, TransferFunction transfer, PreIntegrationTable table);
+    // The terrain the last prepare() refined for a ground fog layer with
+    // options.keepTerrain (GroundFog::update's terrainTriangles). Empty
+    // otherwise: for other kinds, and when the layer was not needed (disabled,
+    // out of range or out of view: then no part of its terrain is in view
+    // either) or its update failed.
+    const std::vector<glm::vec3>& groundFogTerrain(EffectId id) const;
+
+    const EffectStatus& status(EffectId id) const { return mEntries.at(id).status; }
+    const SceneCounters& counters() const { return mCounters; }
+    double time() const { return mTime; }
+
+    // ---- Frames ------------------------------------------------------------
     // Decides what is needed for this camera at timeSec (non-decreasing
     // across calls) and brings exactly those effects to timeSec.
     void update(double timeSec, const Camera& camera);
     // Adds the splats of the effects the last update() found needed, each
     // drawn with its EffectOptions::draw combined with `options` (textured
-    // only if both are; opacity scales multiply).
+    // only if both are; opacity scales multiply). Kinds drawn as tetrahedra
+    // add nothing here (they need a Frame: prepare()).
     std::size_t emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options = {});
-    // One frame: update(timeSec, camera), then frame.begin, emit into it,
-    // frame.end (one back-to-front sort), and the frame's counters.
+    // One frame: update(timeSec, camera), then frame.begin, every needed
+    // effect emitted into it in id order (splats, tetrahedra), the lit
+    // effects' shadow, frame.end (one back-to-front sort), the fog, and the
+    // frame's counters.
     void prepare(double timeSec, const Camera& camera, const Materials& materials, Frame& frame, const EmitOptions& options = {});
 
-    // ---- lighting (issue 16; docs/lighting.md, "In a Scene")
+    // True when any part of the box may be inside the camera's frustum
+    // (conservative: boxes near a frustum corner may pass).
+    static bool inFrustum(const Aabb& box, const Camera& camera);
+
+    // ---- Lights (docs/lighting.md, "In a Scene") ---------------------------
     // Adds a light; fails on an invalid light (the message names the field).
     Result<std::size_t> addLight(const Light& light);
     // Replaces light i (expects i < lights().size()); fails as addLight.
@@ -193,92 +237,40 @@ public:
     // The last lighting failure (a bad EffectLighting or SceneShadowDesc: the
     // effect is drawn unlit, or no scene shadow); empty when the last emit() had none.
     const std::string& lightingError() const { return mLightingError; }
-    // --- Fog (issue 14) ---------------------------------------------------
+
+    // ---- Fog (docs/fog.md) -------------------------------------------------
     // The scene's fog, handed to every Frame prepare() fills (Frame::setFog).
     // A Fog is a pure function of time: it costs nothing while out of view.
     void setFog(Fog fog) { mFog = std::make_shared<const Fog>(std::move(fog)); }
     void clearFog() { mFog.reset(); }
     const Fog* fog() const { return mFog.get(); }
-    // --- end fog -----------------------------------------------------------
-
-    const EffectStatus& status(EffectId id) const { return mEntries.at(id).status; }
-    const SceneCounters& counters() const { return mCounters; }
-    double time() const { return mTime; }
-
-    // True when any part of the box may be inside the camera's frustum
-    // (conservative: boxes near a frustum corner may pass).
-    static bool inFrustum(const Aabb& box, const Camera& camera);
-
-    // ---- [clouds, issue 17] LOD volumes ----
-    // A volume with the transfer function its zero-opacity test uses and the
-    // table it is drawn with. prepare() refines every enabled volume whose box
-    // is in view (LodVolume::update) and adds its tetrahedra to the Frame.
-    VolumeId addVolume(LodVolume volume, TransferFunction transfer, PreIntegrationTable table, VolumeOptions options = {});
-    std::size_t volumeCount() const { return mVolumes.size(); }
-    LodVolume& volume(VolumeId id) { return mVolumes.at(id)->volume; }
-    VolumeOptions& volumeOptions(VolumeId id) { return mVolumes.at(id)->options; }
-    // Replaces the transfer function and table (the GL pass re-uploads it).
-    void setVolumeTransfer(VolumeId id, TransferFunction transfer, PreIntegrationTable table);
-    // ---- end [clouds] ----
-    // ---- (issue 17) Ground fog (prisms over a terrain, volume.hpp GroundFog) ----
-    // prepare() emits every enabled layer (GroundFog::update: back to front,
-    // near-clipped) as one more Frame volume, drawn by the same pass as the
-    // clouds; options.refine is the LOD refinement (detailC, morph, clipNear) of a layer made with GroundFogDesc::lod.
-    VolumeId addGroundFog(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, VolumeOptions options = {});
-    std::size_t groundFogCount() const { return mGroundFogs.size(); }
-    VolumeOptions& groundFogOptions(VolumeId id) { return mGroundFogs.at(id)->options; }
-    // The layer itself (e.g. for its LOD terrain: GroundFog::update's terrainTriangles).
-    const GroundFog& groundFog(VolumeId id) const { return mGroundFogs.at(id)->fog; }
-    // The terrain the last prepare() refined for a layer with options.keepTerrain
-    // (GroundFog::update's terrainTriangles); empty otherwise, and when the layer is
-    // disabled or its update failed.
-    const std::vector<glm::vec3>& groundFogTerrain(VolumeId id) const { return mGroundFogs.at(id)->terrain; }
-    // ---- end ----
 
 private:
-    // ---- lighting (issue 16): what a lit effect keeps between frames (scene_lighting.cpp).
+    // What a lit effect keeps between frames (scene_lighting.cpp).
     struct LitState {
-        Grid densityGrid;                       // the layers' voxels, opacity as the splats draw it (scratch)
+        Grid densityGrid;                       // the density the light sees (EffectKind::lightingDensity; scratch)
         DensityField field;                     // what the light sees; its fingerprint says when it changed
         ShadowTables tables;                    // self-shadowing, one per light
         glm::ivec3 tableDims{0};                // what `tables` was made with
         std::vector<glm::vec3> points, factors; // scratch: splat centres and their light factors
     };
     struct Entry {
-        std::unique_ptr<EffectKind> kind; // never null
-        Effect* effect = nullptr;         // kind as an Effect, if it was added as one
+        std::unique_ptr<EffectKind> kind; // never null; on the heap, so what a Frame points at stays put
         EffectOptions options;
         EffectStatus status;
-        std::unique_ptr<LitState> lit; // lighting (issue 16): made when first lit
+        std::unique_ptr<LitState> lit; // made when first lit
     };
-    EffectId push(Entry entry);
-    // lighting (issue 16): lights the splats [first, end) the entry just emitted.
+    EffectId push(std::unique_ptr<EffectKind> kind, EffectOptions options);
+    // Emits every needed effect in id order; `volumes` null: splats only.
+    std::size_t emitInto(SplatBuilder& builder, std::vector<FrameVolume>* volumes, const Materials& materials, const EmitOptions& options);
+    // Lights the splats [first, end) the entry just emitted.
     void lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first, const EmitOptions& draw);
     void shadeScene(Frame& frame); // fills frame.shadow()
 
     std::vector<Entry> mEntries;
-    // [clouds] Boxed so the table addresses the Frame points at stay put.
-    struct VolumeEntry {
-        LodVolume volume;
-        TransferFunction transfer;
-        PreIntegrationTable table;
-        std::uint64_t tableVersion = 1;
-        VolumeOptions options;
-    };
-    std::vector<std::unique_ptr<VolumeEntry>> mVolumes;
-    struct GroundFogEntry {
-        GroundFog fog;
-        TransferFunction transfer;
-        PreIntegrationTable table;
-        VolumeOptions options;
-        std::vector<glm::vec3> terrain; // options.keepTerrain
-    };
-    std::vector<std::unique_ptr<GroundFogEntry>> mGroundFogs;
-    void prepareVolumes(const Camera& camera, Frame& frame); // [clouds]
     SceneCounters mCounters;
     double mTime = 0.0;
     bool mUpdated = false;
-    // ---- lighting (issue 16)
     std::vector<Light> mLights;
     SceneShadowDesc mSceneShadowDesc;
     ShadowTable mSceneShadow;
@@ -287,7 +279,7 @@ private:
     std::uint64_t mSceneShadowLastBuilds = 0;
     const ShadowTable* mSceneShadowSource = nullptr; // mSceneShadow, or a lit effect's own table it shares
     std::string mLightingError;
-    std::shared_ptr<const Fog> mFog; // issue 14; default none
+    std::shared_ptr<const Fog> mFog; // default none
 };
 
 } // namespace splatfx

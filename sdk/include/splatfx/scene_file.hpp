@@ -125,20 +125,29 @@ struct SceneEffectInfo {
     bool traditional = false; // drawn with plain footprints (Fig. 1a); default false
 };
 
-// A LOD ground-fog layer whose terrain mesh the host draws in
-// place of a heightmap geometry (groundFog key "terrainGeometry"), so the
-// terrain and the fog's bottom are one mesh.
+// What the file said about each volume (clouds, ground fog), beside the
+// Scene entry built for it.
+struct SceneVolumeInfo {
+    EffectId id = 0;  // in SceneFile::scene
+    std::string name; // default "volume<i>"
+    std::string kind; // "clouds" or "groundFog"
+};
+
+// A LOD ground-fog layer whose terrain mesh the host draws in place of a
+// heightmap geometry (groundFog key "terrainGeometry"), so the terrain and
+// the fog's bottom are one mesh.
 struct GroundFogTerrain {
     std::string geometry; // the heightmap geometry's name
-    VolumeId fog = 0;     // Scene::groundFog(fog)
+    EffectId fog = 0;     // the layer in SceneFile::scene (Scene::groundFogTerrain(fog), findGroundFog(fog))
 };
 
 struct SceneFile {
     std::string path;       // the file as given
     std::string title;      // default empty
     std::uint32_t seed = 1; // scene seed after SceneFileOptions::seed; default 1
-    Scene scene;            // one entry per effect, in file order
+    Scene scene;            // the file's effects, then its volumes, each in file order
     std::vector<SceneEffectInfo> effects;
+    std::vector<SceneVolumeInfo> volumes;
     std::vector<GeometryDesc> geometry;
     CameraPath camera;
     OutputSettings output;

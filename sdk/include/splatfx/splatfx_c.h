@@ -324,7 +324,8 @@ SPLATFX_C_API splatfx_status splatfx_scene_add_ghosts(splatfx_scene* scene, spla
 SPLATFX_C_API splatfx_status splatfx_scene_load_file(const char* path, splatfx_materials* materials, const uint32_t* seed, splatfx_scene** out,
                                                      splatfx_error* error);
 
-/* Effects in the scene. 0 for NULL. */
+/* Effects added (splatfx_scene_add_*) or loaded (a scene file's "effects";
+ * its "volumes" have no id here): their ids are 0 .. count - 1. 0 for NULL. */
 SPLATFX_C_API uint32_t splatfx_scene_effect_count(const splatfx_scene* scene);
 SPLATFX_C_API splatfx_status splatfx_scene_set_effect_enabled(splatfx_scene* scene, uint32_t id, int enabled, splatfx_error* error);
 
@@ -353,10 +354,10 @@ SPLATFX_C_API splatfx_status splatfx_frame_create(splatfx_frame** out, splatfx_e
 SPLATFX_C_API void splatfx_frame_destroy(splatfx_frame* frame);
 
 typedef struct splatfx_frame_stats {
-    uint64_t declared;  /* effects in the scene */
+    uint64_t declared;  /* effects in the scene, the volumes of a scene file (clouds, ground fog) included */
     uint64_t needed;    /* in view, in range, alive and enabled (= simulated and drawn) */
     uint64_t simulated; /* effects that did dynamics work for this frame */
-    uint64_t drawn;     /* effects that emitted at least one splat */
+    uint64_t drawn;     /* effects that emitted at least one splat or tetrahedron */
     uint64_t splats;    /* splats in the frame */
     double time_sec;    /* the time it was prepared at */
 } splatfx_frame_stats;

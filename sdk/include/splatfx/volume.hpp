@@ -37,6 +37,7 @@
 #include <glm/glm.hpp>
 
 #include "splatfx/camera.hpp"
+#include "splatfx/motion.hpp"
 #include "splatfx/result.hpp"
 
 namespace splatfx {
@@ -228,6 +229,8 @@ public:
     glm::vec3 originWorld() const { return mOrigin; }
     float spacingWorld() const { return mSpacing; }
     float minAccuracyC() const { return mC; }
+    // The world box of the (padded) grid: every tetrahedron update() emits lies in it.
+    Aabb boundsWorld() const { return {mOrigin, mOrigin + glm::vec3(mDims - 1) * mSpacing}; }
     bool hasLengthScale() const { return !mLength.empty(); }
     std::size_t memoryBytes() const;
     std::uint64_t fullResolutionTets() const;
@@ -417,7 +420,7 @@ struct GroundFogDesc {
 // Memory: full resolution keeps the desc (8 bytes per grid point). LOD keeps
 // 16 bytes per padded point (terrain, thickness, Delta, r as floats) and not
 // the desc's arrays; bytesFor() is exact.
-// In a Scene: Scene::addGroundFog (VolumeOptions::refine is the refine desc);
+// In a Scene: Scene::add(GroundFog, ...) (EffectOptions::refine is the refine desc);
 // in scene files: volumes kind "groundFog" (keys "lod", "detailC", "minAccuracyC", "morph",
 // "terrainGeometry", "densityDepthWorld").
 class GroundFog {
@@ -438,6 +441,11 @@ public:
     // with it so the two agree); triangles wholly in the padding are left out.
     // Fails on a non-finite camera or a bad refine field.
     Status update(const Camera& camera, const LodRefineDesc& refine, LodFrame& out, std::vector<glm::vec3>* terrainTriangles = nullptr) const;
+    // The world box every prism and terrain triangle update() emits lies in:
+    // x and z over the grid (the LOD's padded grid, where fog tapers off),
+    // y from the lowest terrain to the highest fog top (morphing only
+    // interpolates between heights, so it stays inside).
+    Aabb boundsWorld() const { return mBounds; }
     // Prisms with fog at full resolution (the LOD emits fewer).
     std::uint64_t prismCount() const { return mPrisms; }
     bool lod() const { return mDesc.lod; }
@@ -450,6 +458,7 @@ public:
 private:
     GroundFogDesc mDesc;
     std::uint64_t mPrisms = 0;
+    Aabb mBounds;
     // LOD (desc.lod): padded mN x mN grid, x fastest.
     int mN = 0, mMaxDepth = 0;
     double mMaxThickness = 0.0;

@@ -118,10 +118,10 @@ Outcome addPreset(splatfx_scene* scene, splatfx_materials* materials, const spla
     Outcome failed;
     std::optional<Effect> effect = build(materials->value, failed);
     if (!effect) return failed;
-    const EffectId id = scene->value.add(std::move(*effect), std::move(opts));
+    scene->effects.push_back(scene->value.add(std::move(*effect), std::move(opts)));
     scene->materials = materials->identity;
     scene->hasMaterials = true;
-    if (outId) *outId = id;
+    if (outId) *outId = std::uint32_t(scene->effects.size() - 1);
     return success();
 }
 
@@ -494,6 +494,7 @@ splatfx_status splatfx_scene_load_file(const char* path, splatfx_materials* mate
         if (!file) return failure(SPLATFX_ERROR_FILE, file.error());
         auto scene = std::make_unique<splatfx_scene>();
         scene->value = std::move(file->scene); // before any prepare: nothing in it points at itself yet
+        for (const SceneEffectInfo& e : file->effects) scene->effects.push_back(e.id);
         scene->materials = materials->identity;
         scene->hasMaterials = true;
         *out = scene.release();
@@ -502,16 +503,16 @@ splatfx_status splatfx_scene_load_file(const char* path, splatfx_materials* mate
 }
 
 uint32_t splatfx_scene_effect_count(const splatfx_scene* scene) {
-    return scene && scene->magic == Magic::Scene ? std::uint32_t(scene->value.size()) : 0;
+    return scene && scene->magic == Magic::Scene ? std::uint32_t(scene->effects.size()) : 0;
 }
 
 splatfx_status splatfx_scene_set_effect_enabled(splatfx_scene* scene, uint32_t id, int enabled, splatfx_error* error) {
     return guard("splatfx_scene_set_effect_enabled", error, [&] {
         if (auto bad = checkHandle(scene, Magic::Scene, "scene", "splatfx_scene")) return *bad;
-        if (id >= scene->value.size())
+        if (id >= scene->effects.size())
             return failure(SPLATFX_ERROR_NOT_FOUND,
-                           "id " + std::to_string(id) + " is not an effect of this scene (it has " + std::to_string(scene->value.size()) + ")");
-        scene->value.setEnabled(id, enabled != 0);
+                           "id " + std::to_string(id) + " is not an effect of this scene (it has " + std::to_string(scene->effects.size()) + ")");
+        scene->value.setEnabled(scene->effects[id], enabled != 0);
         return success();
     });
 }

@@ -14,6 +14,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "splatfx/splatfx_c.h"
 
@@ -112,6 +113,9 @@ struct splatfx_scene {
     // other materials, so adding or preparing with others is refused.
     std::weak_ptr<int> materials;
     bool hasMaterials = false;
+    // The C API's effect ids (0, 1, ... in the order added or loaded) as ids
+    // of `value`, which also holds the volumes a scene file declares.
+    std::vector<splatfx::EffectId> effects;
 };
 
 struct splatfx_frame {

@@ -3,9 +3,12 @@
 // It only forwards: no function here branches on the kind.
 #include "splatfx/effect.hpp"
 
+#include <algorithm>
 #include <cassert>
+#include <cmath>
 
 #include "effect_body.hpp"
+#include "splat/color_table_entry.hpp"
 
 namespace splatfx {
 
@@ -59,6 +62,30 @@ const EffectLayer& Effect::layer(std::size_t i) const { return mBody->layers.at(
 std::size_t Effect::emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options) const {
     return mBody->emit(builder, materials, options);
 }
+EmitResult Effect::emit(const EmitContext& context) { return {.splats = emit(context.splats, context.materials, context.draw)}; }
+
+bool Effect::lightingDensity(const Materials& materials, const EmitOptions& draw, Grid& out) const {
+    // The light sees the opacity the splats are drawn with (style and draw
+    // scales, table alpha), so the self-shadow matches the splats' own optical depth.
+    const Grid& whole = grid();
+    out.dims = whole.dims;
+    out.spacing = whole.spacing;
+    out.transform = whole.transform;
+    out.voxels.clear();
+    for (std::size_t li = 0; li < layerCount(); ++li) {
+        const SplatStyle& style = layer(li).style;
+        const ColorTable* table = style.colorTable < materials.colorTableCount() ? &materials.colorTable(style.colorTable) : nullptr;
+        const float scale = style.opacityScale * draw.opacityScale;
+        const float k = std::isfinite(scale) ? std::max(scale, 0.0f) : 0.0f;
+        for (Voxel v : layerGrid(li).voxels) {
+            if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord)) continue;
+            v.opacity = std::clamp(v.opacity * k, 0.0f, 1.0f) * detail::colorTableEntry(table, v.colorCoord).a;
+            if (v.opacity > 0.0f) out.voxels.push_back(v);
+        }
+    }
+    return true;
+}
+
 Aabb Effect::bounds(double t0, double t1) const { return mBody->bounds(t0, t1); }
 bool Effect::alive(double timeSec, const AliveHints& hints) const { return mBody->alive(timeSec, hints); }
 AdvanceResult Effect::advanceTo(double timeSec, const AdvanceContext& context) { return mBody->advanceTo(timeSec, context); }

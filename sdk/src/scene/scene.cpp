@@ -4,37 +4,73 @@
 #include <cassert>
 #include <cmath>
 
+#include "volume_kinds.hpp"
+
 namespace splatfx {
 
-EffectId Scene::add(Effect effect, EffectOptions options) {
-    auto owned = std::make_unique<Effect>(std::move(effect));
-    Effect* asEffect = owned.get();
-    return push(Entry{std::move(owned), asEffect, std::move(options), {}, nullptr});
+EffectId Scene::add(Effect effect, EffectOptions options) { return push(std::make_unique<Effect>(std::move(effect)), std::move(options)); }
+
+EffectId Scene::add(LodVolume volume, TransferFunction transfer, PreIntegrationTable table, EffectOptions options) {
+    return push(std::make_unique<detail::LodVolumeKind>(std::move(volume), std::move(transfer), std::move(table)), std::move(options));
+}
+
+EffectId Scene::add(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, EffectOptions options) {
+    return push(std::make_unique<detail::GroundFogKind>(std::move(fog), std::move(transfer), std::move(table)), std::move(options));
 }
 
 EffectId Scene::add(std::unique_ptr<EffectKind> kind, EffectOptions options) {
     assert(kind && "Scene::add: kind must not be null");
-    // An Effect handed over as a kind is still one: effect(id) should find it.
-    Effect* asEffect = dynamic_cast<Effect*>(kind.get());
-    return push(Entry{std::move(kind), asEffect, std::move(options), {}, nullptr});
+    return push(std::move(kind), std::move(options));
 }
 
-EffectId Scene::push(Entry entry) {
-    mEntries.push_back(std::move(entry));
+EffectId Scene::push(std::unique_ptr<EffectKind> kind, EffectOptions options) {
+    mEntries.push_back(Entry{std::move(kind), std::move(options), {}, nullptr});
     mCounters.declared = mEntries.size();
     return EffectId(mEntries.size() - 1);
 }
 
+Effect* Scene::findEffect(EffectId id) { return dynamic_cast<Effect*>(mEntries.at(id).kind.get()); }
+const Effect* Scene::findEffect(EffectId id) const { return dynamic_cast<const Effect*>(mEntries.at(id).kind.get()); }
+
+LodVolume* Scene::findLodVolume(EffectId id) {
+    auto* k = dynamic_cast<detail::LodVolumeKind*>(mEntries.at(id).kind.get());
+    return k ? &k->volume() : nullptr;
+}
+
+const LodVolume* Scene::findLodVolume(EffectId id) const {
+    const auto* k = dynamic_cast<const detail::LodVolumeKind*>(mEntries.at(id).kind.get());
+    return k ? &k->volume() : nullptr;
+}
+
+const GroundFog* Scene::findGroundFog(EffectId id) const {
+    const auto* k = dynamic_cast<const detail::GroundFogKind*>(mEntries.at(id).kind.get());
+    return k ? &k->volume() : nullptr;
+}
+
 Effect& Scene::effect(EffectId id) {
-    Effect* e = mEntries.at(id).effect;
+    Effect* e = findEffect(id);
     assert(e && "Scene::effect: this entry is not an Effect; use Scene::kind or Scene::findEffect");
     return *e;
 }
 
 const Effect& Scene::effect(EffectId id) const {
-    const Effect* e = mEntries.at(id).effect;
+    const Effect* e = findEffect(id);
     assert(e && "Scene::effect: this entry is not an Effect; use Scene::kind or Scene::findEffect");
     return *e;
+}
+
+void Scene::setTransfer(EffectId id, TransferFunction transfer, PreIntegrationTable table) {
+    auto* k = dynamic_cast<detail::TetraKind*>(mEntries.at(id).kind.get());
+    assert(k && "Scene::setTransfer: this entry is neither a LOD volume nor ground fog");
+    if (k) k->setTransfer(std::move(transfer), std::move(table));
+}
+
+const std::vector<glm::vec3>& Scene::groundFogTerrain(EffectId id) const {
+    static const std::vector<glm::vec3> kNone;
+    const Entry& e = mEntries.at(id);
+    const auto* k = dynamic_cast<const detail::GroundFogKind*>(e.kind.get());
+    // A layer not needed was not emitted: what it kept is an older frame's.
+    return k && e.status.needed ? k->terrain() : kNone;
 }
 
 bool Scene::inFrustum(const Aabb& box, const Camera& camera) {
@@ -89,9 +125,9 @@ void Scene::update(double timeSec, const Camera& camera) {
     }
 }
 
-std::size_t Scene::emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options) {
-    std::size_t total = 0;
-    // ---- lighting (issue 16): per-emit counters (scene_lighting.cpp)
+std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* volumes, const Materials& materials, const EmitOptions& options) {
+    std::size_t splats = 0, tetrahedra = 0;
+    // Per-emit lighting counters (scene_lighting.cpp).
     mLightingError.clear();
     mCounters.litEffects = 0;
     mCounters.shadowTableBuilds = mCounters.shadowTableReuses = 0;
@@ -99,26 +135,39 @@ std::size_t Scene::emit(SplatBuilder& builder, const Materials& materials, const
         const EmitOptions draw{.textured = e.options.draw.textured && options.textured,
                                .opacityScale = e.options.draw.opacityScale * options.opacityScale};
         const std::size_t first = builder.splats().size();
-        e.status.splatsDrawn = e.status.needed ? e.kind->emit(builder, materials, draw) : 0;
-        total += e.status.splatsDrawn;
-        // ---- lighting (issue 16): colour the splats just emitted; unlit effects skip this.
+        EmitResult r;
+        if (e.status.needed)
+            r = e.kind->emit(EmitContext{.splats = builder,
+                                         .volumes = volumes,
+                                         .materials = materials,
+                                         .draw = draw,
+                                         .refine = e.options.refine,
+                                         .keepTerrain = e.options.keepTerrain});
+        e.status.splatsDrawn = r.splats;
+        e.status.tetrahedraDrawn = r.tetrahedra;
+        splats += r.splats;
+        tetrahedra += r.tetrahedra;
+        // Colour the splats just emitted; unlit effects skip this.
         e.status.lit = false;
         if (e.status.needed && e.options.lighting.enabled && !mLights.empty()) lightEmitted(e, builder, materials, first, draw);
     }
-    mCounters.splats = total;
-    return total;
+    mCounters.splats = splats;
+    mCounters.tetrahedra = tetrahedra;
+    return splats;
+}
+
+std::size_t Scene::emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options) {
+    return emitInto(builder, nullptr, materials, options);
 }
 
 void Scene::prepare(double timeSec, const Camera& camera, const Materials& materials, Frame& frame, const EmitOptions& options) {
     update(timeSec, camera);
     frame.begin(timeSec, camera);
-    emit(frame.builder(), materials, options);
-    shadeScene(frame);             // lighting (issue 16): the shadow on the scene, into frame.shadow()
-    prepareVolumes(camera, frame); // [clouds]
+    emitInto(frame.builder(), &frame.volumes(), materials, options);
+    shadeScene(frame); // the lit effects' shadow on the scene, into frame.shadow()
     frame.end();
-    frame.setFog(mFog); // fog (issue 14)
+    frame.setFog(mFog);
     FrameCounters& c = frame.counters();
-    // ---- lighting (issue 16)
     c.litEffects = mCounters.litEffects;
     c.shadowTableBuilds = mCounters.shadowTableBuilds;
     c.shadowTableReuses = mCounters.shadowTableReuses;
@@ -126,55 +175,7 @@ void Scene::prepare(double timeSec, const Camera& camera, const Materials& mater
     c.needed = mCounters.needed;
     c.simulated = mCounters.simulated;
     c.drawn = 0;
-    for (const Entry& e : mEntries) c.drawn += e.status.splatsDrawn > 0 ? 1 : 0;
-}
-
-// ---- [clouds, issue 17] LOD volumes ----
-VolumeId Scene::addVolume(LodVolume volume, TransferFunction transfer, PreIntegrationTable table, VolumeOptions options) {
-    mVolumes.push_back(std::make_unique<VolumeEntry>(VolumeEntry{std::move(volume), std::move(transfer), std::move(table), 1, std::move(options)}));
-    return VolumeId(mVolumes.size() - 1);
-}
-
-void Scene::setVolumeTransfer(VolumeId id, TransferFunction transfer, PreIntegrationTable table) {
-    VolumeEntry& e = *mVolumes.at(id);
-    e.transfer = std::move(transfer);
-    e.table = std::move(table);
-    ++e.tableVersion;
-}
-
-void Scene::prepareVolumes(const Camera& camera, Frame& frame) {
-    for (auto& owned : mVolumes) {
-        VolumeEntry& e = *owned;
-        if (!e.options.enabled) continue;
-        const glm::vec3 lo = e.volume.originWorld();
-        const glm::vec3 hi = lo + glm::vec3(e.volume.pointDims() - 1) * e.volume.spacingWorld();
-        if (!inFrustum(Aabb{lo, hi}, camera)) continue;
-        FrameVolume& fv = frame.volumes().emplace_back();
-        fv.table = &e.table;
-        fv.tableVersion = e.tableVersion;
-        // A failed update (non-finite camera, bad refine field) draws nothing for this volume.
-        if (!e.volume.update(camera, e.options.refine, &e.transfer, fv.lod)) frame.volumes().pop_back();
-    }
-    for (auto& owned : mGroundFogs) { // ground fog layers
-        GroundFogEntry& e = *owned;
-        e.terrain.clear();
-        if (!e.options.enabled) continue;
-        FrameVolume& fv = frame.volumes().emplace_back();
-        fv.table = &e.table;
-        fv.tableVersion = 1;
-        // refine: the LOD terrain's c, morphing
-        if (!e.fog.update(camera, e.options.refine, fv.lod, e.options.keepTerrain ? &e.terrain : nullptr)) {
-            frame.volumes().pop_back();
-            e.terrain.clear();
-        }
-    }
-}
-
-//
-VolumeId Scene::addGroundFog(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, VolumeOptions options) {
-    mGroundFogs.push_back(
-        std::make_unique<GroundFogEntry>(GroundFogEntry{std::move(fog), std::move(transfer), std::move(table), std::move(options), {}}));
-    return VolumeId(mGroundFogs.size() - 1);
+    for (const Entry& e : mEntries) c.drawn += e.status.splatsDrawn > 0 || e.status.tetrahedraDrawn > 0 ? 1 : 0;
 }
 
 } // namespace splatfx

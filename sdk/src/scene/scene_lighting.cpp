@@ -1,4 +1,4 @@
-// Scene lighting (issue 16; docs/lighting.md, "In a Scene"): lit effects'
+// Scene lighting (docs/lighting.md, "In a Scene"): lit effects'
 // splats get their colour from the low-albedo model (lightPoints at each
 // splat's centre, self-shadowed by tracing or by shadow tables rebuilt only
 // when the effect's density or a light changed), and one shadow table over
@@ -7,19 +7,11 @@
 #include <algorithm>
 #include <cmath>
 
+#include "splat/color_table_entry.hpp"
 #include "splatfx/scene.hpp"
 
 namespace splatfx {
 namespace {
-
-// The colour-table entry at t, exactly as the splat builder reads it (splats.cpp, tableAt).
-glm::vec4 tableAt(const ColorTable* table, float t) {
-    if (!table || table->entries.size() < 2) return glm::vec4(1.0f);
-    const std::vector<glm::vec4>& e = table->entries;
-    const float f = std::clamp(t, 0.0f, 1.0f) * float(e.size() - 1);
-    const std::size_t i = std::min(std::size_t(f), e.size() - 2);
-    return glm::clamp(glm::mix(e[i], e[i + 1], f - float(i)), glm::vec4(0.0f), glm::vec4(1.0f));
-}
 
 // Lit linear colour into the splat's RGBA8: a colour brighter than 1 in any
 // channel is scaled down by its largest channel, keeping its hue (a clamp per
@@ -51,33 +43,15 @@ Status Scene::setLight(std::size_t i, const Light& light) {
 }
 
 void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first, const EmitOptions& draw) {
-    if (!e.effect) return; // other kinds: unlit
     const EffectLighting& L = e.options.lighting;
     const std::string at = "effect '" + e.options.name + "': lighting.";
     if (!e.lit) e.lit = std::make_unique<LitState>();
     LitState& lit = *e.lit;
-    const Effect& fx = *e.effect;
 
-    // The density the light sees: every layer's voxels with the opacity the
-    // splat builder draws them with (style and draw scales, table alpha), so
-    // the self-shadow matches the splats' own optical depth.
+    // The density the light sees, as the kind draws it; kinds the lights
+    // cannot see stay unlit.
     Grid& dg = lit.densityGrid;
-    const Grid& whole = fx.grid();
-    dg.dims = whole.dims;
-    dg.spacing = whole.spacing;
-    dg.transform = whole.transform;
-    dg.voxels.clear();
-    for (std::size_t li = 0; li < fx.layerCount(); ++li) {
-        const SplatStyle& style = fx.layer(li).style;
-        const ColorTable* table = style.colorTable < materials.colorTableCount() ? &materials.colorTable(style.colorTable) : nullptr;
-        const float scale = style.opacityScale * draw.opacityScale;
-        const float k = std::isfinite(scale) ? std::max(scale, 0.0f) : 0.0f;
-        for (Voxel v : fx.layerGrid(li).voxels) {
-            if (!std::isfinite(v.opacity) || !std::isfinite(v.colorCoord)) continue;
-            v.opacity = std::clamp(v.opacity * k, 0.0f, 1.0f) * tableAt(table, v.colorCoord).a;
-            if (v.opacity > 0.0f) dg.voxels.push_back(v);
-        }
-    }
+    if (!e.kind->lightingDensity(materials, draw, dg)) return;
     auto field = DensityField::fromGrid(dg);
     if (!field) {
         mLightingError = at + "density: " + field.error();
@@ -114,7 +88,7 @@ void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& mater
     lit.points.resize(n);
     for (std::size_t i = 0; i < n; ++i) lit.points[i] = splats[first + i].center;
     const glm::mat3 shape =
-        glm::mat3(whole.transform) * glm::mat3(glm::vec3(whole.spacing.x, 0, 0), glm::vec3(0, whole.spacing.y, 0), glm::vec3(0, 0, whole.spacing.z));
+        glm::mat3(dg.transform) * glm::mat3(glm::vec3(dg.spacing.x, 0, 0), glm::vec3(0, dg.spacing.y, 0), glm::vec3(0, 0, dg.spacing.z));
     const float det = std::abs(glm::determinant(shape));
     const float voxelSize = std::isfinite(det) ? std::cbrt(det) : 0.0f;
     if (Status s = lightPoints(lit.points, voxelSize, builder.camera().eye(), mLights, shadows, L.gas, lit.factors); !s) {
@@ -126,7 +100,7 @@ void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& mater
         const std::uint32_t row = std::uint32_t(std::lround(sp.colorRow));
         const ColorTable* table = row < materials.colorTableCount() ? &materials.colorTable(row) : nullptr;
         // The top byte is the depth cut's along-ray scale (splats.hpp, rayScaleCode): kept.
-        sp.color = (packLit(glm::vec3(tableAt(table, sp.colorCoord)) * lit.factors[i]) & 0x00ffffffu) | (sp.color & 0xff000000u);
+        sp.color = (packLit(glm::vec3(detail::colorTableEntry(table, sp.colorCoord)) * lit.factors[i]) & 0x00ffffffu) | (sp.color & 0xff000000u);
     }
     e.status.lit = true;
     ++mCounters.litEffects;

@@ -63,7 +63,7 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     o.integer("tableLengths", lengthRes, 2, 512);
     bool sortFree = false;
     o.boolean("sortFree", sortFree);
-    // The LOD terrain (GroundFogDesc::lod; c and morphing are per frame, VolumeOptions::refine).
+    // The LOD terrain (GroundFogDesc::lod; c and morphing are per frame, EffectOptions::refine).
     bool lod = false, morph = true;
     float detailC = 1.0f, minAccuracyC = 4.0f;
     o.boolean("lod", lod);
@@ -161,8 +161,9 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     LodRefineDesc refine;
     refine.detailC = detailC;
     refine.morph = morph;
-    const VolumeId id = out.scene.addGroundFog(std::move(*layer), std::move(*tf), std::move(*table),
-                                               {.name = name, .enabled = enabled, .refine = refine, .keepTerrain = !terrainGeometry.empty()});
+    const EffectId id = out.scene.add(std::move(*layer), std::move(*tf), std::move(*table),
+                                      {.name = name, .enabled = enabled, .refine = refine, .keepTerrain = !terrainGeometry.empty()});
+    out.volumes.push_back({id, name, "groundFog"});
     if (!terrainGeometry.empty()) out.groundFogTerrain.push_back({terrainGeometry, id});
 }
 
@@ -253,8 +254,9 @@ void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& 
             c.d.error(p, table.error());
             continue;
         }
-        out.scene.addVolume(std::move(*vol), std::move(*tf), std::move(*table),
-                            {.name = name, .enabled = enabled, .refine = {.detailC = detailC, .morph = morph}});
+        const EffectId id = out.scene.add(std::move(*vol), std::move(*tf), std::move(*table),
+                                          {.name = name, .enabled = enabled, .refine = {.detailC = detailC, .morph = morph}});
+        out.volumes.push_back({id, name, "clouds"});
     }
 }
 

@@ -470,6 +470,21 @@ Result<GroundFog> GroundFog::create(const GroundFogDesc& desc) {
         return makeError("GroundFogDesc.minAccuracyC must be finite and > 0, got " + std::to_string(desc.minAccuracyC));
     GroundFog fog;
     fog.mDesc = desc;
+    // Heights: every vertex update() emits has a terrain height or a fog top,
+    // or (LOD) a morph between such heights of the same kind, which stays
+    // inside their range.
+    float lowest = std::numeric_limits<float>::infinity(), highest = -lowest;
+    for (std::size_t i = 0; i < n; ++i) {
+        lowest = std::min({lowest, desc.terrainHeight[i], desc.fogTop[i]});
+        highest = std::max({highest, desc.terrainHeight[i], desc.fogTop[i]});
+    }
+    // Across: the grid, or the LOD's padded grid (set below), where fog tapers off.
+    const auto across = [&](int pointsX, int pointsZ) {
+        fog.mBounds =
+            Aabb{{desc.originWorld.x, lowest, desc.originWorld.z},
+                 {desc.originWorld.x + float(pointsX - 1) * desc.spacingWorld, highest, desc.originWorld.z + float(pointsZ - 1) * desc.spacingWorld}};
+    };
+    across(desc.dims.x, desc.dims.y);
     for (int j = 0; j + 1 < desc.dims.y; ++j)
         for (int i = 0; i + 1 < desc.dims.x; ++i) {
             // Two triangles per cell; a prism counts if any of its vertices has fog.
@@ -490,6 +505,7 @@ Result<GroundFog> GroundFog::create(const GroundFogDesc& desc) {
     const int side = (1 << levels) + 1;
     fog.mN = side;
     fog.mMaxDepth = 2 * levels;
+    across(side, side);
     const std::size_t np = std::size_t(side) * std::size_t(side);
     fog.mHeight.resize(np);
     fog.mThickness.resize(np);
