@@ -1,0 +1,48 @@
+// Nearest-depth upsampling of the premultiplied low-resolution image (ScaledRenderer).
+layout(binding = 0) uniform sampler2D uLowColor;
+layout(binding = 1) uniform sampler2D uLowDepth;
+layout(binding = 2) uniform sampler2D uHostDepth;
+uniform ivec4 uHostRect;
+uniform ivec2 uViewportOrigin; // the host viewport's corner in window pixels
+uniform int uScale;
+uniform int uUseDepth;
+uniform float uThreshold;
+uniform vec4 uDepthToView; // (a, b, c, d): view depth = |(a n + b) / (c n + d)|, n = ndc z (inverse projection's z and w rows)
+layout(location = 0) out vec4 oColor;
+
+float viewDepth(float d) {
+    float n = 2.0 * d - 1.0;
+    return abs((uDepthToView.x * n + uDepthToView.y) / (uDepthToView.z * n + uDepthToView.w));
+}
+
+void main() {
+    ivec2 p = ivec2(gl_FragCoord.xy) - uViewportOrigin;
+    ivec2 lowSize = textureSize(uLowColor, 0);
+    // Low-resolution texel centres sit at (i + 0.5) * scale full-resolution pixels.
+    vec2 q = (vec2(p) + 0.5) / float(uScale) - 0.5;
+    ivec2 b = ivec2(floor(q));
+    vec2 f = q - vec2(b);
+    ivec2 t[4] = ivec2[4](b, b + ivec2(1, 0), b + ivec2(0, 1), b + ivec2(1, 1));
+    float w[4] = float[4]((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y), (1.0 - f.x) * f.y, f.x * f.y);
+    vec4 c[4];
+    for (int k = 0; k < 4; ++k) {
+        t[k] = clamp(t[k], ivec2(0), lowSize - 1);
+        c[k] = texelFetch(uLowColor, t[k], 0);
+    }
+    // Nothing drawn near this pixel: blending zero would leave the host unchanged.
+    if (max(max(c[0].a, c[1].a), max(c[2].a, c[3].a)) <= 0.0) discard;
+    vec4 bilinear = c[0] * w[0] + c[1] * w[1] + c[2] * w[2] + c[3] * w[3];
+    if (uUseDepth == 0) {
+        oColor = bilinear;
+        return;
+    }
+    float z = viewDepth(texelFetch(uHostDepth, uHostRect.xy + p, 0).r);
+    float worst = 0.0, best = 1e30;
+    int nearest = 0;
+    for (int k = 0; k < 4; ++k) {
+        float dz = abs(viewDepth(texelFetch(uLowDepth, t[k], 0).r) - z);
+        worst = max(worst, dz);
+        if (dz < best) { best = dz; nearest = k; }
+    }
+    oColor = worst <= uThreshold * z ? bilinear : c[nearest];
+}
