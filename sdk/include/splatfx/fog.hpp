@@ -26,6 +26,7 @@
 // called from any number of threads at once.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -185,10 +186,16 @@ public:
     // in double relative to `reference` (world): the shader's positions are
     // world - reference. Pass the eye (or a point near the rays) every frame.
     std::vector<glm::vec4> glslParameters(double tSec, glm::dvec3 reference) const;
+    // Identifies the structure of fogGlsl(*this)'s source (the terms' kinds,
+    // polynomial shapes, counts; not the parameters): two fogs with equal keys
+    // get the same source for the same options, so a pass rebuilds its
+    // programs only when the key changes. Never 0. Computed once by create().
+    std::uint64_t glslKey() const { return mGlslKey; }
 
 private:
     Fog() = default;
     FogDesc mDesc; // validated; Line axes normalized
+    std::uint64_t mGlslKey = 0;
 };
 
 // Options of the GLSL generator.
@@ -202,7 +209,10 @@ struct FogGlslOptions {
     int maxPolynomialCells = 1024;
 };
 
-// GLSL 4.50 source (no #version line: include it in any stage) defining
+// GLSL 4.50 source (no #version line: include it in any stage): the SDK's
+// fog.glsl (the closed forms every fog shares, the same text the GL passes
+// compile) followed by this fog's terms (the parameter array, a function per
+// polynomial, their sum), defining
 //   uniform vec4 <prefix>_params[N];
 //   uniform vec3 <prefix>_colour;  uniform float <prefix>_far;   (set by the host: FogDesc colour, farDistanceWorld)
 //   float <prefix>_optical_depth(vec3 oRel, vec3 pRel)   // positions relative to the reference point

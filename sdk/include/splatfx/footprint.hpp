@@ -7,7 +7,7 @@
 // anisotropic voxel (non-cubic spacing, a stretch) is a linear map of this
 // kernel and projects to an ellipse (see splats.hpp).
 //
-// The partial line integral (issue 15, Ebert & Parent 1990's volume
+// The partial line integral (Ebert & Parent 1990's volume
 // "sections" in front of a surface): exactBefore(r, s) integrates the kernel
 // along the ray at distance r from its centre over ray parameter (-inf, s],
 // s measured from the ray's closest approach to the centre, both in kernel
@@ -108,7 +108,7 @@ private:
 };
 
 // GLSL (450 core) for the partial table, to prepend to a shader that cuts
-// splats at a depth (the splat pass; the fragment-list pass of issue 15).
+// splats at a depth (the splat pass; the fragment-list pass).
 // Declares
 //   layout(binding = <binding>) uniform sampler2D splatfx_partial_table;
 //   float splatfx_partial_before(float r, float s);
@@ -117,7 +117,8 @@ private:
 // parameter from the closest-approach point, both kernel (voxel) units;
 // returns the fraction of F(r) at ray parameter <= s, in [0, 1], the same
 // bilinear lookup as Footprint::fractionBefore. The radius and table size
-// are baked in as constants. The pass binds a texture made from
+// are baked in as constants (the text is the GL passes' own, from the SDK's
+// GLSL file partial.glsl). The pass binds a texture made from
 // partialTable() (partialCols wide, partialRows high, R32F, GL_LINEAR,
 // clamp to edge) to unit `binding`. docs/architecture.md, "The depth cut",
 // says how a fragment computes r and s.

@@ -302,6 +302,7 @@ private:
 // lightInTable()), and
 //   float splatfx_shadow(vec3 worldPos); // transmittance towards the light, [0, 1]
 // which matches ShadowTable::transmittance up to the texture unit's filtering precision.
+// The text is the SDK's GLSL file shadow.glsl, embedded at build time.
 std::string shadowGlsl();
 
 // ---------------------------------------------------------------- [SECTION] lighting

@@ -1,5 +1,5 @@
 // splatfx/transparency.hpp: the GLSL include through which a host's
-// transparent surfaces join the frame's per-pixel fragment lists (issue 15).
+// transparent surfaces join the frame's per-pixel fragment lists.
 //
 // With HostTarget::transparentToLists set, gl::FrameRenderer runs the host's
 // transparent hook with the lists bound; every fragment of the host's
@@ -23,12 +23,6 @@
 #include <string>
 
 namespace splatfx {
-
-// Binding points the include uses (the frame renderer binds them only while
-// the transparent hook runs, and restores them after).
-inline constexpr int kTransparentNodeBinding = 6;    // shader storage buffer: the node pool
-inline constexpr int kTransparentCounterBinding = 7; // shader storage buffer: counters and the viewport
-inline constexpr int kTransparentHeadImageUnit = 6;  // image unit: the surface list heads (r32ui)
 
 // Bytes one surface node takes on the GPU: premultiplied RGBA as four
 // halves (8), the window depth (4), the link (4).
@@ -55,7 +49,10 @@ inline constexpr std::size_t kTransparentSectionBytesPerPixel = 8; // per sectio
 // gl_FragCoord.z (or any value in [0, 1] in the same mapping). Fragments of
 // zero colour and zero alpha are not stored (they change nothing). It also
 // declares layout(early_fragment_tests), so the host's opaque depth hides
-// transparent fragments behind it before they are stored.
+// transparent fragments behind it before they are stored. The storage's
+// binding points are written in the text (the frame renderer binds them only
+// while the transparent hook runs, and restores them after): the host binds
+// nothing.
 std::string transparentGlsl();
 
 } // namespace splatfx

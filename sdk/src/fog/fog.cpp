@@ -360,6 +360,13 @@ Result<Fog> Fog::create(FogDesc desc) {
     if (Status s = checkNonNegative(desc); !s) return Error{s.error()};
     Fog fog;
     fog.mDesc = std::move(desc);
+    // The structure key (Fog::glslKey): a hash of the GLSL of the default
+    // options, made once here so that a pass compares two integers per frame.
+    auto glsl = fogGlsl(fog);
+    if (!glsl) return makeError(glsl.error());
+    std::uint64_t h = 1469598103934665603ull; // FNV-1a
+    for (unsigned char c : glsl->source) h = (h ^ c) * 1099511628211ull;
+    fog.mGlslKey = h | 1u; // never 0 (0: no fog)
     return fog;
 }
 

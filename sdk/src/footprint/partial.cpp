@@ -9,6 +9,8 @@
 
 #include "splatfx/footprint.hpp"
 
+#include "glsl/glsl_files.hpp"
+
 namespace splatfx {
 namespace {
 
@@ -130,31 +132,17 @@ void buildPartialTable(const Footprint& fp, double R, int rows, int cols, std::v
 }
 
 std::string partialGlsl(const Footprint& fp, int binding) {
+    // partial.glsl (render/gl/glsl) with this footprint's constants in place of its names.
     const int rows = fp.partialRows(), cols = fp.partialCols();
-    const double R = fp.radius();
-    std::string s;
-    s += "// splatfx partial line integral (issue 15; Footprint::fractionBefore in GLSL).\n";
-    s += "layout(binding = " + std::to_string(binding) + ") uniform sampler2D splatfx_partial_table;\n";
-    s += "// Fraction of the footprint F(r) at ray parameter <= s; r, s in kernel (voxel) units,\n";
-    s += "// s signed along the ray from its closest approach to the kernel centre.\n";
-    s += "float splatfx_partial_before(float r, float s) {\n";
-    s += "    const float R = " + num(R) + ";\n";
-    s += "    float chord = sqrt(max(R * R - r * r, 0.0));\n";
-    s += "    float x = clamp(s / max(chord, 1e-6), -1.0, 1.0) * 0.5 + 0.5;\n";
-    s += "    float y = min(abs(r) / R, 1.0);\n";
-    // Texel centres: entry j at (j + 0.5) / cols, so GL_LINEAR reproduces the CPU's bilinear lookup.
-    s += "    vec2 tc = vec2(x * " + num(double(cols - 1) / cols) + " + " + num(0.5 / cols) + ", y * " + num(double(rows - 1) / rows) + " + " +
-         num(0.5 / rows) + ");\n";
-    s += "    return texture(splatfx_partial_table, tc).r;\n";
-    s += "}\n";
-    s += "// World length of one kernel unit along a splat's centre ray (splats.hpp, splatRayScale):\n";
-    s += "// axisU, axisV its half-axes, code01 the top byte of Splat::color as a normalized float.\n";
-    s += "float splatfx_ray_scale(vec3 axisU, vec3 axisV, float code01) {\n";
-    s += "    float code = floor(code01 * 255.0 + 0.5);\n";
-    s += "    float rho = code > 254.5 ? 1.0 : exp2((code - 127.0) / 32.0);\n";
-    s += "    return rho * sqrt(length(cross(axisU, axisV))) / " + num(double(fp.radius())) + ";\n";
-    s += "}\n";
-    return s;
+    const std::string b = std::to_string(binding), r = num(double(fp.radius())), rf = r;
+    const std::string xs = num(double(cols - 1) / cols), xb = num(0.5 / cols), ys = num(double(rows - 1) / rows), yb = num(0.5 / rows);
+    return glsl::substitute(std::string(glsl::file("partial.glsl")), {{"SPLATFX_PARTIAL_BINDING", b},
+                                                                      {"SPLATFX_PARTIAL_RADIUS", r},
+                                                                      {"SPLATFX_PARTIAL_RADIUS_F", rf},
+                                                                      {"SPLATFX_PARTIAL_X_SCALE", xs},
+                                                                      {"SPLATFX_PARTIAL_X_BIAS", xb},
+                                                                      {"SPLATFX_PARTIAL_Y_SCALE", ys},
+                                                                      {"SPLATFX_PARTIAL_Y_BIAS", yb}});
 }
 
 } // namespace splatfx

@@ -11,109 +11,11 @@
 
 #include "context_check.hpp"
 #include "saved_state.hpp"
-#include "splatfx/gl/program.hpp"
 
 namespace splatfx::gl::detail {
-namespace {
-
-// One triangle covering the viewport.
-constexpr const char* kFullscreenVertex = R"(#version 450 core
-void main() {
-    vec2 p = vec2(float((gl_VertexID & 1) * 4 - 1), float((gl_VertexID & 2) * 2 - 1));
-    gl_Position = vec4(p, 0.0, 1.0);
-}
-)";
-
-// After "#version", the MODE define and fogGlsl()'s source.
-constexpr const char* kFogFragment = R"(
-layout(binding = 0) uniform sampler2D uDepth; // host depth, framebuffer-sized
-uniform mat4 uInvRel;  // NDC -> world relative to the eye (inverse projection, then the view's rotation)
-uniform vec2 uOrigin;  // viewport origin, framebuffer pixels
-uniform vec2 uSize;    // viewport size, pixels
-
-// The point behind window position xy at window depth d, relative to the eye.
-// False for NaN or a depth outside [0, 1] (fully fogged, as Fog::transmittance does).
-bool hostPoint(vec2 xy, float d, out vec3 rel) {
-    rel = vec3(0.0);
-    if (isnan(d) || !(d >= 0.0 && d <= 1.0)) return false;
-    vec2 ndc = (xy - uOrigin) / uSize * 2.0 - 1.0;
-    vec4 h = uInvRel * vec4(ndc, 2.0 * d - 1.0, 1.0); // d = 1 (sky): the far-plane point
-    rel = h.xyz / h.w;
-    return !(any(isnan(rel)) || any(isinf(rel)));
-}
-const float kInvalidDistance = 3.0e38;
-float hostDistance(vec2 xy, float d) {
-    vec3 rel;
-    return hostPoint(xy, d, rel) ? length(rel) : kInvalidDistance;
-}
-float hostTransmittance(vec2 xy, float d, out float dist) {
-    vec3 rel;
-    if (!hostPoint(xy, d, rel)) {
-        dist = kInvalidDistance;
-        return 0.0;
-    }
-    dist = length(rel);
-    if (splatfx_fog_far > 0.0 && dist > splatfx_fog_far) return 0.0; // sec. 4.2: no evaluation
-    return splatfx_fog_transmittance(vec3(0.0), rel);
-}
-
-#if MODE == 0 // per pixel, blended into the host colour
-layout(location = 0) out vec4 oColor;
-void main() {
-    float dist;
-    float f = hostTransmittance(gl_FragCoord.xy, texelFetch(uDepth, ivec2(gl_FragCoord.xy), 0).r, dist);
-    oColor = vec4((1.0 - f) * splatfx_fog_colour, 1.0 - f); // premultiplied: dst' = (1 - f) C_fog + f dst
-}
-#elif MODE == 1 // reduced: (f, distance) at the full-resolution pixel under each fog texel's centre
-uniform vec2 uFogSize;
-layout(location = 0) out vec2 oFog;
-void main() {
-    vec2 xy = uOrigin + gl_FragCoord.xy / uFogSize * uSize;
-    ivec2 pix = ivec2(floor(xy));
-    float dist;
-    float f = hostTransmittance(vec2(pix) + 0.5, texelFetch(uDepth, pix, 0).r, dist);
-    oFog = vec2(f, dist);
-}
-#else // reduced: depth-aware (joint bilinear) upsampling, blended into the host colour
-layout(binding = 1) uniform sampler2D uFog;
-uniform vec2 uFogSize;
-uniform float uThreshold;
-layout(location = 0) out vec4 oColor;
-void main() {
-    float dist = hostDistance(gl_FragCoord.xy, texelFetch(uDepth, ivec2(gl_FragCoord.xy), 0).r);
-    vec2 g = (gl_FragCoord.xy - uOrigin) / uSize * uFogSize - 0.5;
-    ivec2 g0 = ivec2(floor(g));
-    vec2 a = g - vec2(g0);
-    ivec2 last = ivec2(uFogSize) - 1;
-    float wsum = 0.0, fsum = 0.0, best = 3.4e38, fbest = 0.0;
-    for (int j = 0; j < 2; ++j)
-        for (int i = 0; i < 2; ++i) {
-            vec2 s = texelFetch(uFog, clamp(g0 + ivec2(i, j), ivec2(0), last), 0).rg;
-            float w = (i == 0 ? 1.0 - a.x : a.x) * (j == 0 ? 1.0 - a.y : a.y);
-            float diff = abs(s.y - dist);
-            // Neighbours on the same surface (relative distance within the threshold) are interpolated;
-            // when none is, the one nearest in distance is taken (no fog bleeding across silhouettes).
-            if (diff <= uThreshold * dist) {
-                wsum += w;
-                fsum += w * s.x;
-            }
-            if (diff < best) {
-                best = diff;
-                fbest = s.x;
-            }
-        }
-    float f = wsum > 1e-6 ? fsum / wsum : fbest;
-    oColor = vec4((1.0 - f) * splatfx_fog_colour, 1.0 - f);
-}
-#endif
-)";
-
-} // namespace
 
 FogPass::~FogPass() {
     if (!contextIsCurrent()) return;
-    for (Prog* p : {&mFull, &mLow, &mUp})
-        if (p->id) glDeleteProgram(p->id);
     if (mVao) glDeleteVertexArrays(1, &mVao);
     if (mFbo) glDeleteFramebuffers(1, &mFbo);
     if (mTexture) glDeleteTextures(1, &mTexture);
@@ -121,27 +23,15 @@ FogPass::~FogPass() {
 }
 
 Status FogPass::build(const Fog& fog) {
+    if (fog.glslKey() == mFogKey) return {}; // the same structure: the same programs
     auto glsl = fogGlsl(fog);
     if (!glsl) return makeError("fog pass: " + glsl.error());
-    if (glsl->source == mSource) return {};
-    for (Prog* p : {&mFull, &mLow, &mUp})
-        if (p->id) glDeleteProgram(p->id), *p = {};
-    mSource.clear();
-    const char* modes[3] = {"#define MODE 0\n", "#define MODE 1\n", "#define MODE 2\n"};
-    Prog* progs[3] = {&mFull, &mLow, &mUp};
+    mPrograms.release([](const glsl::ProgramKey&) { return true; });
+    mFogKey = 0;
     for (int m = 0; m < 3; ++m) {
-        auto linked = linkProgram({kFullscreenVertex}, {"#version 450 core\n", modes[m], glsl->source.c_str(), kFogFragment}, "fog pass");
-        if (!linked) return makeError(linked.error());
-        Prog& p = *progs[m];
-        p.id = *linked;
-        p.uInvRel = glGetUniformLocation(p.id, "uInvRel");
-        p.uOrigin = glGetUniformLocation(p.id, "uOrigin");
-        p.uSize = glGetUniformLocation(p.id, "uSize");
-        p.uParams = glGetUniformLocation(p.id, glsl->uniformName.c_str());
-        p.uColour = glGetUniformLocation(p.id, "splatfx_fog_colour");
-        p.uFar = glGetUniformLocation(p.id, "splatfx_fog_far");
-        p.uFogSize = glGetUniformLocation(p.id, "uFogSize");
-        p.uThreshold = glGetUniformLocation(p.id, "uThreshold");
+        auto p = mPrograms.get({glsl::ProgramId::FogPass, {m}, fog.glslKey()}, {.fog = glsl->source});
+        if (!p) return makeError(p.error());
+        mModes[m] = *p;
     }
     if (!mVao) glCreateVertexArrays(1, &mVao);
     if (!mSampler) {
@@ -152,7 +42,7 @@ Status FogPass::build(const Fog& fog) {
         glSamplerParameteri(mSampler, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
         glSamplerParameteri(mSampler, GL_TEXTURE_COMPARE_MODE, GL_NONE);
     }
-    mSource = glsl->source;
+    mFogKey = fog.glslKey();
     return {};
 }
 
@@ -196,23 +86,24 @@ Status FogPass::draw(const Fog& fog, double timeSec, const Camera& camera, const
     glBindSampler(0, mSampler);
     glBindSampler(1, mSampler);
 
-    auto common = [&](const Prog& p) {
+    auto common = [&](const ProgramLibrary::Program& p) {
+        using namespace glsl::fog_pass;
         glUseProgram(p.id);
-        glUniformMatrix4fv(p.uInvRel, 1, GL_FALSE, glm::value_ptr(invRel));
-        glUniform2f(p.uOrigin, float(target.x), float(target.y));
-        glUniform2f(p.uSize, float(target.width), float(target.height));
-        glUniform4fv(p.uParams, GLsizei(mParams.size()), glm::value_ptr(mParams[0]));
-        glUniform3f(p.uColour, float(col.x), float(col.y), float(col.z));
-        glUniform1f(p.uFar, float(fog.desc().farDistanceWorld));
-        if (p.uFogSize >= 0) glUniform2f(p.uFogSize, float(textureSize.x), float(textureSize.y));
-        if (p.uThreshold >= 0) glUniform1f(p.uThreshold, std::max(depthThreshold, 0.0f));
+        glUniformMatrix4fv(p.uniform(InvRel), 1, GL_FALSE, glm::value_ptr(invRel));
+        glUniform2f(p.uniform(Origin), float(target.x), float(target.y));
+        glUniform2f(p.uniform(Size), float(target.width), float(target.height));
+        glUniform4fv(p.uniform(FogParams), GLsizei(mParams.size()), glm::value_ptr(mParams[0]));
+        glUniform3f(p.uniform(FogColour), float(col.x), float(col.y), float(col.z));
+        glUniform1f(p.uniform(FogFar), float(fog.desc().farDistanceWorld));
+        if (p.uniform(FogSize) >= 0) glUniform2f(p.uniform(FogSize), float(textureSize.x), float(textureSize.y));
+        if (p.uniform(Threshold) >= 0) glUniform1f(p.uniform(Threshold), std::max(depthThreshold, 0.0f));
     };
 
     if (reduced) {
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, mFbo);
         glViewport(0, 0, textureSize.x, textureSize.y);
         glDisable(GL_BLEND);
-        common(mLow);
+        common(*mModes[1]);
         glDrawArrays(GL_TRIANGLES, 0, 3);
     }
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
@@ -224,9 +115,9 @@ Status FogPass::draw(const Fog& fog, double timeSec, const Camera& camera, const
     glBlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
     if (reduced) {
         glBindTextureUnit(1, mTexture);
-        common(mUp);
+        common(*mModes[2]);
     } else {
-        common(mFull);
+        common(*mModes[0]);
     }
     glDrawArrays(GL_TRIANGLES, 0, 3);
 

@@ -17,7 +17,7 @@
 // bilinear weights that drop neighbours at another depth.
 #pragma once
 
-#include <string>
+#include <cstdint>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -26,6 +26,7 @@
 #include "splatfx/fog.hpp"
 #include "splatfx/result.hpp"
 #include "passes/pass.hpp"
+#include "program_library.hpp"
 
 namespace splatfx::gl::detail {
 
@@ -47,12 +48,10 @@ public:
 
 private:
     Status build(const Fog& fog);
-    struct Prog {
-        unsigned id = 0;
-        int uInvRel = -1, uOrigin = -1, uSize = -1, uParams = -1, uColour = -1, uFar = -1, uFogSize = -1, uThreshold = -1;
-    };
-    Prog mFull, mLow, mUp; // per pixel; reduced: evaluate into the texture; upsample and blend
-    std::string mSource;   // generated GLSL the programs were built from
+    ProgramLibrary mPrograms;
+    // Per pixel; reduced: evaluate into the texture; upsample and blend (MODE 0, 1, 2).
+    const ProgramLibrary::Program* mModes[3] = {};
+    std::uint64_t mFogKey = 0; // Fog::glslKey() the programs were built for
     unsigned mVao = 0, mFbo = 0, mTexture = 0, mSampler = 0;
     glm::ivec2 mTextureSize{0};
     std::vector<glm::vec4> mParams;

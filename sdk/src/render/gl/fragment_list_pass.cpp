@@ -17,11 +17,11 @@
 
 #include "context_check.hpp"
 #include "partial_texture.hpp"
-#include "scaled_shaders.hpp"
-#include "shaders.hpp"
-#include "splatfx/gl/program.hpp"
+#include "program_library.hpp"
+#include "splat_vertex.hpp"
 #include "splatfx/footprint.hpp"
 #include "splatfx/transparency.hpp"
+#include "transparent_bindings.hpp"
 
 namespace splatfx::gl::detail {
 namespace {
@@ -29,364 +29,8 @@ namespace {
 constexpr GLuint kEnd = 0xffffffffu;
 constexpr int kCounterWords = 12;
 constexpr GLsizeiptr kCounterBytes = kCounterWords * 4;
-
-// Splat fragments into their sections. Compiled after "#version 450 core",
-// the splat vertex shader's defines (FOG 0, CUT 0|1 with HOST_DEPTH and
-// NEAR_CUT equal to CUT, GENERAL 0), "#define SECTIONS n", partialGlsl()
-// (CUT 1) and transparentGlsl().
-constexpr const char* kSectionFragment = R"(
-layout(binding = 0) uniform sampler2DArray uLayers;
-layout(binding = 2) uniform sampler2DArray uDepths; // the pixel's nearest SECTIONS - 1 surface depths, sorted; 2.0: none
-uniform ivec2 uOrigin; // the lists' viewport origin
-in vec2 vTex;
-flat in float vDensity;
-flat in vec3 vLayers;
-flat in vec3 vColor;
-layout(location = 0) out vec4 oSection[SECTIONS];
-
-#if CUT
-// The kernel's partial line integral (issue 15 item 1; PARTIAL_API.md and
-// the splat pass's shader, whose vertex stage this program shares).
-uniform vec3 uForward;
-uniform float uNearZ;
-uniform int uPersp;
-uniform float uKernelRadius;
-layout(binding = 1) uniform sampler2D uHostDepth;
-uniform vec4 uDepthToView; // inverse projection's (z, w) rows at (z, w) columns
-flat in float vScale;
-in vec3 vRel;
-#if GENERAL
-// The polygon crosses the eye plane (the camera inside the kernel): the
-// vertex stage covers the screen and each fragment meets its ray with the
-// splat plane, as the splat pass's general variant does (shaders.hpp).
-uniform mat4 uInvViewProj;
-uniform vec4 uViewport; // x, y, width, height
-uniform vec3 uEye;
-uniform float uCut;
-uniform int uOctagon;
-flat in vec3 vCenter;
-flat in vec3 vAxisU;
-flat in vec3 vAxisV;
-#endif
-float gR, gTP, gInvCos, gInvL, gLo, gHi;
-float viewDepth(float windowDepth) {
-    float nz = windowDepth * 2.0 - 1.0;
-    return abs((uDepthToView.x * nz + uDepthToView.y) / (uDepthToView.z * nz + uDepthToView.w));
-}
-// Share of the kernel's line integral on this ray in front of view depth z.
-float beforeView(float z) { return splatfx_partial_before(gR, (z * gInvCos - gTP) * gInvL); }
-// The share of this fragment's optical depth (between the near plane and the
-// host's opaque surface) in front of window depth d: non-decreasing in d.
-float sectionFraction(float d) { return clamp(beforeView(viewDepth(d)), gLo, gHi) - gLo; }
-#else
-// Without the cut the kernel is concentrated on its plane: a step at the
-// plane's depth (LEQUAL, as the ordered blend's depth test).
-float sectionFraction(float d) { return gl_FragCoord.z <= d ? 1.0 : 0.0; }
-#endif
-
-void main() {
-    vec4 acc[SECTIONS];
-    for (int k = 0; k < SECTIONS; ++k) acc[k] = vec4(0.0);
-#if CUT && GENERAL
-    vec2 ndc = (gl_FragCoord.xy - uViewport.xy) / uViewport.zw * 2.0 - 1.0;
-    vec4 farPoint = uInvViewProj * vec4(ndc, 1.0, 1.0);
-    vec3 dir = normalize(farPoint.xyz / farPoint.w - uEye);
-    vec3 nrm = cross(vAxisU, vAxisV);
-    float dn = dot(dir, nrm);
-    if (abs(dn) <= 1e-6 * length(nrm)) discard; // edge-on
-    float tPlane = dot(vCenter - uEye, nrm) / dn; // the line, so a plane just behind the eye still gives its tail in front
-    vec3 g = uEye + tPlane * dir - vCenter;
-    float g00 = dot(vAxisU, vAxisU), g01 = dot(vAxisU, vAxisV), g11 = dot(vAxisV, vAxisV);
-    float b0 = dot(vAxisU, g), b1 = dot(vAxisV, g);
-    vec2 uvk = vec2(g11 * b0 - g01 * b1, g00 * b1 - g01 * b0) / (g00 * g11 - g01 * g01);
-    if (max(abs(uvk.x), abs(uvk.y)) > uCut || (uOctagon != 0 && abs(uvk.x) + abs(uvk.y) > uCut * 1.41421356)) discard;
-    vec2 tex = vec2(0.5 + 0.5 * uvk.x, 0.5 - 0.5 * uvk.y);
-#else
-    vec2 tex = vTex;
-#endif
-    vec4 t = texture(uLayers, vec3(tex, vLayers.x));
-    if (vLayers.z > 0.0) t = mix(t, texture(uLayers, vec3(tex, vLayers.y)), vLayers.z);
-#if CUT
-#if GENERAL
-    gTP = tPlane;
-    gInvCos = 1.0 / dot(dir, uForward);
-#else
-    vec2 uvk = vec2(2.0 * vTex.x - 1.0, 1.0 - 2.0 * vTex.y);
-    float zP = dot(vRel, uForward);
-    gTP = uPersp != 0 ? length(vRel) : zP; // along the ray from the eye (ortho: from its plane)
-    gInvCos = uPersp != 0 ? gTP / zP : 1.0;
-#endif
-    gR = uKernelRadius * length(uvk);
-    gInvL = 1.0 / vScale;
-    // The near and host cuts only where the CPU found the support may meet
-    // them (per-draw variants: a software rasterizer runs masked branches).
-#if NEAR_CUT
-    gLo = beforeView(uNearZ);
-#else
-    gLo = 0.0;
-#endif
-#if HOST_DEPTH
-    gHi = max(beforeView(viewDepth(texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r)), gLo);
-#else
-    gHi = 1.0;
-#endif
-    float total = gHi - gLo;
-#else
-    float total = 1.0;
-#endif
-    float tau = vDensity * t.a; // log2 optical depth of the whole (uncut) fragment
-    vec3 colour = vColor * t.rgb;
-    if (tau > 0.0 && total > 0.0) {
-        ivec2 p = ivec2(gl_FragCoord.xy) - uOrigin;
-        // base: surfaces wholly in front; cuts: those inside the kernel, near to far.
-        int base = 0, n = 0;
-        float cuts[SECTIONS];
-        float fracs[SECTIONS];
-        // The pixel's surfaces, nearest first, from the depth layers the
-        // prepare pass sorted (a texture: on Mesa's llvmpipe a fragment
-        // shader's storage-buffer reads return wrong data in partially
-        // covered blocks, so the lists are walked only in compute shaders).
-        for (int k = 0; k < SECTIONS - 1; ++k) {
-            float d = texelFetch(uDepths, ivec3(p, k), 0).r;
-            if (d > 1.5) break; // no more surfaces
-            float f = sectionFraction(d);
-            if (f <= 0.0) { ++base; continue; }
-            if (f >= total) break; // this and every farther surface lie behind the kernel
-            cuts[n] = d;
-            fracs[n] = f;
-            ++n;
-        }
-        // Bounded loop, no continue: llvmpipe dropped the last trip of the
-        // data-dependent form of this loop (the section behind the last cut).
-        float before = 0.0;
-        for (int k = 0; k <= SECTIONS; ++k) {
-            if (k > n) break;
-            float F = k < n ? fracs[k] : total;
-            float frac = max(F - before, 0.0);
-            before = max(before, F);
-            if (frac > 0.0) {
-                // A section's alpha from its share: the sections' transmittances
-                // multiply back to the (cut) splat's.
-                float a = 1.0 - exp2(-tau * frac);
-                int s = min(base + k, SECTIONS - 1); // base + n <= SECTIONS - 1 by construction
-                // Nearer parts first; a constant index per target.
-                for (int q = 0; q < SECTIONS; ++q)
-                    if (q == s) acc[q] += (1.0 - acc[q].a) * vec4(colour * a, a);
-            }
-        }
-    }
-    for (int k = 0; k < SECTIONS; ++k) oSection[k] = acc[k];
-}
-)";
-
-// The prepare pass: each pixel's nearest `layers` surface depths, sorted,
-// into a texture array for the section shader (2.0 past the last).
-constexpr const char* kPrepareCompute = R"(
-layout(local_size_x = 8, local_size_y = 8) in;
-layout(binding = 2) uniform usampler2D uHeads;
-layout(r32f, binding = 5) writeonly uniform image2DArray uDepthsOut;
-uniform ivec2 uSize;
-uniform int uLayers;
-void main() {
-    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-    if (p.x >= uSize.x || p.y >= uSize.y) return;
-    float d[7];
-    int n = 0, all = 0;
-    for (uint i = texelFetch(uHeads, p, 0).x; i != splatfx_kEnd; i = splatfx_nodes[i].next) {
-        float z = uintBitsToFloat(splatfx_nodes[i].depthBits);
-        ++all;
-        if (n == uLayers && z >= d[n - 1]) continue;
-        int j = n < uLayers ? n++ : n - 1; // full: the farthest kept one drops out
-        while (j > 0 && z < d[j - 1]) {
-            d[j] = d[j - 1];
-            --j;
-        }
-        d[j] = z;
-    }
-    for (int k = 0; k < uLayers; ++k) imageStore(uDepthsOut, ivec3(p, k), vec4(k < n ? d[k] : 2.0));
-    // More surfaces than the section targets separate: the gas behind the
-    // extra ones is composited after the last kept surface (counted).
-    if (all > uLayers) atomicAdd(splatfx_sectionOverflow, 1u);
-}
-)";
-
-// Run after the host's surfaces, one invocation per 16 x 16 tile (an
-// invocation per pixel costs llvmpipe more in dispatch than the walk): the
-// most surfaces on one pixel, and per tile the nearest and farthest surface
-// window depth stored on any of its pixels (as float bits: window depths are
-// in [0, 1], where the bits order like the values; an empty tile reads
-// (0xffffffff, 0)). Read back so the CPU can send the splats that lie wholly
-// behind, or wholly in front of, every surface they cover to the ordinary
-// splat pass (FragmentListPass::split). One work group per tile.
+// The surface depth range tiles (glsl/list_tile_range.comp: 16 x 16 pixels per tile).
 constexpr int kRangeTile = 16;
-constexpr const char* kTileRangeCompute = R"(
-layout(local_size_x = 8, local_size_y = 1) in;
-layout(binding = 2) uniform usampler2D uHeads;
-layout(rgba32ui, binding = 5) writeonly uniform uimage2D uTileRange;
-uniform ivec2 uSize;
-uniform ivec2 uTiles;
-void main() {
-    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
-    if (t.x >= uTiles.x) return;
-    ivec2 first = t * 16, last = min(first + 16, uSize);
-    uint lo = 0xffffffffu, hi = 0u, most = 0u;
-    for (int y = first.y; y < last.y; ++y)
-        for (int x = first.x; x < last.x; ++x) {
-            uint count = 0u;
-            for (uint i = texelFetch(uHeads, ivec2(x, y), 0).x; i != splatfx_kEnd; i = splatfx_nodes[i].next) {
-                uint z = floatBitsToUint(abs(uintBitsToFloat(splatfx_nodes[i].depthBits))); // -0 as +0
-                lo = min(lo, z);
-                hi = max(hi, z);
-                ++count;
-            }
-            most = max(most, count);
-        }
-    imageStore(uTileRange, t, uvec4(lo, hi, most, 0u));
-    // The most surfaces on one pixel (here rather than per fragment in the
-    // include: one atomic per tile instead of two per surface fragment).
-    if (most > 0u) atomicMax(splatfx_maxSurfaces, most);
-}
-)";
-
-// Per 16 x 16 tile, the nearest host opaque depth (window depth), one
-// invocation per tile: only for frames with splats to section (their
-// near / host cut variants, FragmentListPass::split).
-constexpr const char* kHostTileCompute = R"(
-layout(local_size_x = 8, local_size_y = 1) in;
-layout(binding = 3) uniform sampler2D uHostDepth;
-layout(r32f, binding = 5) writeonly uniform image2D uHostTiles;
-uniform ivec2 uSize, uTiles, uOrigin; // the lists' viewport size, the tiles, its origin in the depth texture
-void main() {
-    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
-    if (t.x >= uTiles.x) return;
-    ivec2 first = t * 16, last = min(first + 16, uSize);
-    float host = 1.0;
-    for (int y = first.y; y < last.y; ++y)
-        for (int x = first.x; x < last.x; ++x) host = min(host, texelFetch(uHostDepth, ivec2(x, y) + uOrigin, 0).r);
-    imageStore(uHostTiles, t, vec4(max(host, 0.0)));
-}
-)";
-
-// The resolve, one invocation per pixel. Compiled after "#version 450
-// core", "#define K n" and transparentGlsl() without its
-// early_fragment_tests line. A compute shader, not a full-screen draw: on
-// Mesa's llvmpipe the fragment version read wrong list data in the partially
-// covered blocks along its triangles' edges (a band of wrong pixels).
-constexpr const char* kResolveCompute = R"(
-#if FRAG
-// The fragment variant: nodes through a texture buffer view of the pool
-// (RGBA32UI: rg, ba, depth bits, next), composited "over" the framebuffer
-// by the blend unit. No storage-buffer access (see above).
-layout(binding = 4) uniform usamplerBuffer uNodes;
-layout(location = 0) out vec4 oColor;
-const uint splatfx_kEnd = 0xffffffffu;
-#define NODE(i) texelFetch(uNodes, int(i))
-#else
-layout(local_size_x = 8, local_size_y = 8) in;
-layout(rgba16f, binding = 5) writeonly uniform image2D uResolved;
-#define NODE(i) uvec4(splatfx_nodes[i].rg, splatfx_nodes[i].ba, splatfx_nodes[i].depthBits, splatfx_nodes[i].next)
-#endif
-layout(binding = 1) uniform sampler2DArray uSections;
-layout(binding = 2) uniform usampler2D uHeads;
-uniform ivec2 uOrigin;      // the lists' viewport origin in the section targets
-uniform ivec2 uSize;        // the lists' viewport size
-uniform int uSectionCount;  // 0: the splats were not drawn into sections
-
-vec4 over(vec4 front, vec4 back) { return front + (1.0 - front.a) * back; }
-vec4 section(ivec2 p, int k) { return k < uSectionCount ? texelFetch(uSections, ivec3(p + uOrigin, k), 0) : vec4(0.0); }
-
-void main() {
-#if FRAG
-    ivec2 p = ivec2(gl_FragCoord.xy) - uOrigin;
-    if (p.x < 0 || p.y < 0 || p.x >= uSize.x || p.y >= uSize.y) discard;
-#else
-    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-    if (p.x >= uSize.x || p.y >= uSize.y) return;
-#endif
-#if FRAG && K == 1
-    // At most one surface on any pixel (the variant is chosen so): no walk, no sort.
-    uint i = texelFetch(uHeads, p, 0).x;
-    vec4 acc = section(p, 0);
-    if (i != splatfx_kEnd) {
-        uvec4 node = NODE(i);
-        acc = over(over(acc, vec4(unpackHalf2x16(node.x), unpackHalf2x16(node.y))), section(p, 1));
-    } else {
-        acc = over(acc, section(p, 1));
-    }
-#else
-    float eDepth[K];
-    vec4 eColour[K];
-    int n = 0;
-    uint merged = 0u;
-    uint i = texelFetch(uHeads, p, 0).x;
-    while (i != splatfx_kEnd) {
-        uvec4 node = NODE(i);
-        i = node.w;
-        float d = uintBitsToFloat(node.z);
-        vec4 c = vec4(unpackHalf2x16(node.x), unpackHalf2x16(node.y));
-        if (n == K) {
-            // Full: the farthest two of the K + 1 become one ("over").
-            ++merged;
-            if (d >= eDepth[K - 1]) {
-                eColour[K - 1] = over(eColour[K - 1], c);
-                continue;
-            }
-            vec4 last = eColour[K - 1];
-            int j = K - 1;
-            while (j > 0 && d < eDepth[j - 1]) {
-                eDepth[j] = eDepth[j - 1];
-                eColour[j] = eColour[j - 1];
-                --j;
-            }
-            eDepth[j] = d;
-            eColour[j] = c;
-            eColour[K - 1] = over(eColour[K - 1], last);
-            continue;
-        }
-        int j = n++;
-        while (j > 0 && d < eDepth[j - 1]) {
-            eDepth[j] = eDepth[j - 1];
-            eColour[j] = eColour[j - 1];
-            --j;
-        }
-        eDepth[j] = d;
-        eColour[j] = c;
-    }
-#if !FRAG
-    if (merged > 0u) {
-        atomicAdd(splatfx_overflowPixels, 1u);
-        atomicAdd(splatfx_mergedNodes, merged);
-    }
-#endif
-    // Front to back: section 0, surface 0, section 1, ... The sections past
-    // the last kept surface (more surfaces than sections or than K) follow it.
-    vec4 acc = section(p, 0);
-    for (int k = 0; k < n; ++k) {
-        acc = over(acc, eColour[k]);
-        if (k + 1 < n) acc = over(acc, section(p, k + 1));
-    }
-    for (int k = max(n, 1); k < uSectionCount; ++k) acc = over(acc, section(p, k));
-#endif
-#if FRAG
-    if (acc == vec4(0.0)) discard;
-    oColor = acc;
-#else
-    imageStore(uResolved, p, acc);
-#endif
-}
-)";
-
-// The resolved image "over" the framebuffer.
-constexpr const char* kListCompositeFragment = R"(#version 450 core
-layout(binding = 1) uniform sampler2D uResolved;
-uniform ivec2 uOrigin;
-layout(location = 0) out vec4 oColor;
-void main() {
-    vec4 c = texelFetch(uResolved, ivec2(gl_FragCoord.xy) - uOrigin, 0);
-    if (c == vec4(0.0)) discard;
-    oColor = c;
-}
-)";
 
 // A per-tile texture of `tiles` texels in `format`, (re)made when the target's tile grid changes.
 void fitTileTexture(GLuint& texture, glm::ivec2& size, glm::ivec2 tiles, GLenum format) {
@@ -403,78 +47,67 @@ struct FragmentListPass::Impl {
     int perPixel = 8;
     struct SectionProgram {
         int sections = 0;
-        GLuint id = 0;
-        GLint uViewProj = -1, uOctagon = -1, uCut = -1, uOrigin = -1;
-        GLint uEye = -1, uForward = -1, uNearZ = -1, uPersp = -1, uKernelRadius = -1, uDepthToView = -1;
-        GLint uInvViewProj = -1, uViewport = -1; // general variant
+        GLuint id = 0; // program->id; 0: not built
+        const ProgramLibrary::Program* program = nullptr;
     };
+    using Program = ProgramLibrary::Program;
+    ProgramLibrary library;
     // [kind][2, 4, 8 sections]; kinds: 0 plain; cut with 1 near and host
     // cuts, 2 the same general (the polygon crosses the eye plane), 3 no
     // near or host cut, 4 near only, 5 host only (3-5 built on first use).
     static constexpr int kKinds = 6;
     SectionProgram sectionPrograms[kKinds][3];
     static int cutKind(unsigned needs) { return needs == 3 ? 1 : needs == 0 ? 3 : needs == 1 ? 4 : 5; }
-    PartialTexture partial;    // the footprint's partial-integral table (cut programs)
-    std::string partialSource; // partialGlsl() the cut programs were built from
+    PartialTexture partial;       // the footprint's partial-integral table (cut programs)
+    std::string partialSource;    // partialGlsl() the cut programs were built from
+    std::uint64_t partialKey = 0; // its hash (the cut programs' key)
     float kernelRadius = 1.0f;
     std::string programError;
 
     // Builds the three section programs of one kind (kind 0: plain; 1: cut
     // with the partial integral; 2: cut, general: the polygon crosses the eye plane).
     bool buildSections(int kind) {
+        using namespace glsl::section;
         const bool cut = kind > 0;
-        const std::string include = transparentGlsl();
         const int counts[3] = {2, 4, kTransparentMaxSections};
         const bool nearCut = kind == 1 || kind == 2 || kind == 4, hostCut = kind == 1 || kind == 2 || kind == 5;
-        const std::string head = std::string("#version 450 core\n#define FOG 0\n#define FOG_PER_SPLAT 0\n") +
-                                 (cut ? "#define CUT 1\n" : "#define CUT 0\n") + (hostCut ? "#define HOST_DEPTH 1\n" : "#define HOST_DEPTH 0\n") +
-                                 (nearCut ? "#define NEAR_CUT 1\n" : "#define NEAR_CUT 0\n") +
-                                 (kind == 2 ? "#define GENERAL 1\n" : "#define GENERAL 0\n") + "#define CROSSFADE 1\n";
-        const char* partialSrc = cut ? partialSource.c_str() : "";
+        glsl::ProgramKey key{glsl::ProgramId::ListSection};
+        key.values[CUT] = cut ? 1 : 0;
+        key.values[HOST_DEPTH] = hostCut ? 1 : 0;
+        key.values[NEAR_CUT] = nearCut ? 1 : 0;
+        key.values[GENERAL] = kind == 2 ? 1 : 0;
+        key.values[CROSSFADE] = 1;
+        key.dataKey = cut ? partialKey : 0;
         for (int v = 0; v < 3; ++v) {
             SectionProgram& p = sectionPrograms[kind][v];
-            if (p.id) glDeleteProgram(p.id), p = {};
-            const std::string def = "#define SECTIONS " + std::to_string(counts[v]) + "\n";
-            auto linked = linkProgram({head.c_str(), partialSrc, kSplatVertex},
-                                      {head.c_str(), def.c_str(), partialSrc, include.c_str(), kSectionFragment}, "fragment lists (splat sections)");
+            p = {};
+            key.values[SECTIONS] = counts[v];
+            auto linked = library.get(key, {.partial = cut ? std::string_view(partialSource) : std::string_view()});
             if (!linked) {
                 programError = linked.error();
                 return false;
             }
             p.sections = counts[v];
-            p.id = *linked;
-            auto loc = [&](const char* name) { return glGetUniformLocation(p.id, name); };
-            p.uViewProj = loc("uViewProj");
-            p.uOctagon = loc("uOctagon");
-            p.uCut = loc("uCut");
-            p.uOrigin = loc("uOrigin");
-            p.uEye = loc("uEye");
-            p.uForward = loc("uForward");
-            p.uNearZ = loc("uNearZ");
-            p.uPersp = loc("uPersp");
-            p.uKernelRadius = loc("uKernelRadius");
-            p.uDepthToView = loc("uDepthToView");
-            p.uInvViewProj = loc("uInvViewProj");
-            p.uViewport = loc("uViewport");
+            p.program = *linked;
+            p.id = p.program->id;
         }
         return true;
     }
-    std::vector<std::pair<int, GLuint>> resolvePrograms; // (K, program), K ascending
+    std::vector<std::pair<int, const Program*>> resolvePrograms; // (K, program), K ascending
     // The fragment resolve by K (built on first use), reading the pool
     // through a texture buffer view when it fits GL_MAX_TEXTURE_BUFFER_SIZE.
-    std::vector<std::pair<int, GLuint>> fragmentResolvePrograms;
+    std::vector<std::pair<int, const Program*>> fragmentResolvePrograms;
     GLuint poolView = 0;
     bool poolViewed = false;
-    GLuint fragmentResolve(int k) {
+    const Program* fragmentResolve(int k) {
         for (const auto& fp : fragmentResolvePrograms)
             if (fp.first == k) return fp.second;
-        const std::string def = "#version 450 core\n#define FRAG 1\n#define K " + std::to_string(k) + "\n";
-        auto prog = linkProgram({kFullscreenVertex}, {def.c_str(), kResolveCompute}, "fragment lists (resolve, fragment)");
-        const GLuint id = prog ? *prog : 0; // 0: this GL cannot build it; the compute resolve is used
-        fragmentResolvePrograms.push_back({k, id});
-        return id;
+        auto prog = library.get({glsl::ProgramId::ListResolveFrag, {k}});
+        const Program* p = prog ? *prog : nullptr; // null: this GL cannot build it; the compute resolve is used
+        fragmentResolvePrograms.push_back({k, p});
+        return p;
     }
-    GLuint compositeProgram = 0, prepareProgram = 0, rangeProgram = 0, hostTileProgram = 0;
+    const Program *compositeProgram = nullptr, *prepareProgram = nullptr, *rangeProgram = nullptr, *hostTileProgram = nullptr;
     GLuint hostTiles = 0; // R32F per tile: the nearest host depth (split(), frames with sections only)
     glm::ivec2 hostTileSize{0};
     std::vector<float> hostTileDepth;
@@ -504,17 +137,7 @@ struct FragmentListPass::Impl {
 
     ~Impl() {
         if (!contextIsCurrent()) return;
-        for (const auto& kind : sectionPrograms)
-            for (const SectionProgram& p : kind)
-                if (p.id) glDeleteProgram(p.id);
-        for (const auto& rp : resolvePrograms) glDeleteProgram(rp.second);
-        for (const auto& fp : fragmentResolvePrograms)
-            if (fp.second) glDeleteProgram(fp.second);
         if (poolView) glDeleteTextures(1, &poolView);
-        if (compositeProgram) glDeleteProgram(compositeProgram);
-        if (prepareProgram) glDeleteProgram(prepareProgram);
-        if (rangeProgram) glDeleteProgram(rangeProgram);
-        if (hostTileProgram) glDeleteProgram(hostTileProgram);
         if (hostTiles) glDeleteTextures(1, &hostTiles);
         if (tileRange) glDeleteTextures(1, &tileRange);
         if (depths) glDeleteTextures(1, &depths);
@@ -592,50 +215,32 @@ Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel, const R
     auto impl = std::make_unique<Impl>();
     impl->perPixel = std::clamp(fragmentsPerPixel, 1, kMaxFragmentsPerPixel);
     if (!impl->buildSections(0)) return makeError(impl->programError);
-    const std::string include = transparentGlsl();
-    std::string computeInclude = include;
-    const std::string early = "layout(early_fragment_tests) in;\n";
-    if (const std::size_t at = computeInclude.find(early); at != std::string::npos) computeInclude.erase(at, early.size());
-    // ... and without the emit function (gl_FragCoord: fragment shaders only).
-    const std::size_t fn = computeInclude.find("vec4 splatfx_emitTransparent("), fnEnd = computeInclude.find("// ---- end splatfx");
-    if (fn != std::string::npos && fnEnd != std::string::npos) computeInclude.erase(fn, fnEnd - fn);
     // Resolve variants for K = 1, 2, 4, ... below the budget and the budget
     // itself: a frame with few surfaces per pixel runs the smallest that holds
     // them (the per-pixel arrays cost in proportion to K on a CPU rasterizer).
     for (int k = 1;; k = std::min(2 * k, impl->perPixel)) {
-        const std::string def = "#define K " + std::to_string(k) + "\n";
-        auto resolve = linkComputeProgram({"#version 450 core\n#define FRAG 0\n", def.c_str(), computeInclude.c_str(), kResolveCompute},
-                                          "fragment lists (resolve)");
+        auto resolve = impl->library.get({glsl::ProgramId::ListResolve, {k}});
         if (!resolve) return makeError(resolve.error());
         impl->resolvePrograms.push_back({k, *resolve});
         if (k == impl->perPixel) break;
     }
-    auto prepare = linkComputeProgram({"#version 450 core\n", computeInclude.c_str(), kPrepareCompute}, "fragment lists (prepare)");
+    auto prepare = impl->library.get({glsl::ProgramId::ListPrepare});
     if (!prepare) return makeError(prepare.error());
     impl->prepareProgram = *prepare;
-    auto range = linkComputeProgram({"#version 450 core\n", computeInclude.c_str(), kTileRangeCompute}, "fragment lists (tile depth range)");
+    auto range = impl->library.get({glsl::ProgramId::ListTileRange});
     if (!range) return makeError(range.error());
     impl->rangeProgram = *range;
-    auto hostTile = linkComputeProgram({"#version 450 core\n", kHostTileCompute}, "fragment lists (host depth tiles)");
+    auto hostTile = impl->library.get({glsl::ProgramId::ListHostTiles});
     if (!hostTile) return makeError(hostTile.error());
     impl->hostTileProgram = *hostTile;
     for (int c = 0; c < 256; ++c) impl->rho[std::size_t(c)] = rayScaleRho(std::uint8_t(c));
-    auto composite = linkProgram({kFullscreenVertex}, {kListCompositeFragment}, "fragment lists (composite)");
+    auto composite = impl->library.get({glsl::ProgramId::ListComposite});
     if (!composite) return makeError(composite.error());
     impl->compositeProgram = *composite;
 
     glCreateVertexArrays(1, &impl->vao);
     glCreateVertexArrays(1, &impl->emptyVao);
-    glVertexArrayBindingDivisor(impl->vao, 0, 1);
-    // The Splat struct as gl::Renderer reads it (renderer.cpp).
-    for (GLuint a = 0; a < 3; ++a) glVertexArrayAttribFormat(impl->vao, a, 4, GL_FLOAT, GL_FALSE, a * 16);
-    glVertexArrayAttribIFormat(impl->vao, 3, 2, GL_UNSIGNED_SHORT, offsetof(Splat, layer));
-    glVertexArrayAttribFormat(impl->vao, 4, 1, GL_FLOAT, GL_FALSE, offsetof(Splat, blend));
-    glVertexArrayAttribFormat(impl->vao, 5, 4, GL_UNSIGNED_BYTE, GL_TRUE, offsetof(Splat, color));
-    for (GLuint a = 0; a < 6; ++a) {
-        glEnableVertexArrayAttrib(impl->vao, a);
-        glVertexArrayAttribBinding(impl->vao, a, 0);
-    }
+    setSplatVertexLayout(impl->vao);
     glCreateBuffers(1, &impl->counters);
     glNamedBufferStorage(impl->counters, kCounterBytes, nullptr, GL_DYNAMIC_STORAGE_BIT);
     FragmentListPass pass(std::move(impl));
@@ -647,12 +252,13 @@ Status FragmentListPass::upload(const Materials& materials) {
     Impl& r = *mImpl;
     r.partial.update(materials.footprint());
     r.kernelRadius = materials.footprint().radius();
-    const std::string partial = partialGlsl(materials.footprint(), 3);
+    std::string partial = partialGlsl(materials.footprint(), 3);
     if (partial == r.partialSource) return {};
-    r.partialSource = partial;
-    for (int kind = 3; kind < Impl::kKinds; ++kind)
-        for (Impl::SectionProgram& p : r.sectionPrograms[kind])
-            if (p.id) glDeleteProgram(p.id), p = {};
+    r.library.release([](const glsl::ProgramKey& k) { return k.id == glsl::ProgramId::ListSection && k.values[glsl::section::CUT] != 0; });
+    r.partialKey = std::hash<std::string>{}(partial);
+    r.partialSource = std::move(partial);
+    for (int kind = 1; kind < Impl::kKinds; ++kind)
+        for (Impl::SectionProgram& p : r.sectionPrograms[kind]) p = {};
     if (!r.buildSections(1) || !r.buildSections(2)) {
         r.partialSource.clear();
         return makeError("fragment lists: " + r.programError);
@@ -691,9 +297,9 @@ Status FragmentListPass::collectSurfaces(const PassTarget& target, const std::fu
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
     const int tilesX = (target.width + kRangeTile - 1) / kRangeTile, tilesY = (target.height + kRangeTile - 1) / kRangeTile;
     fitTileTexture(r.tileRange, r.tileSize, {tilesX, tilesY}, GL_RGBA32UI);
-    glUseProgram(r.rangeProgram);
-    glUniform2i(glGetUniformLocation(r.rangeProgram, "uSize"), target.width, target.height);
-    glUniform2i(glGetUniformLocation(r.rangeProgram, "uTiles"), tilesX, tilesY);
+    glUseProgram(r.rangeProgram->id);
+    glUniform2i(r.rangeProgram->uniform(glsl::lists::Size), target.width, target.height);
+    glUniform2i(r.rangeProgram->uniform(glsl::lists::Tiles), tilesX, tilesY);
     glBindTextureUnit(2, r.heads);
     glBindImageTexture(5, r.tileRange, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32UI);
     glDispatchCompute(GLuint((tilesX + 7) / 8), GLuint(tilesY), 1);
@@ -795,10 +401,10 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
     r.tileHost.clear();
     if (s.frontBegin > s.behindEnd && depthCut && target.depthTexture) {
         fitTileTexture(r.hostTiles, r.hostTileSize, {tilesX, tilesY}, GL_R32F);
-        glUseProgram(r.hostTileProgram);
-        glUniform2i(glGetUniformLocation(r.hostTileProgram, "uSize"), target.width, target.height);
-        glUniform2i(glGetUniformLocation(r.hostTileProgram, "uTiles"), tilesX, tilesY);
-        glUniform2i(glGetUniformLocation(r.hostTileProgram, "uOrigin"), target.x, target.y);
+        glUseProgram(r.hostTileProgram->id);
+        glUniform2i(r.hostTileProgram->uniform(glsl::lists::Size), target.width, target.height);
+        glUniform2i(r.hostTileProgram->uniform(glsl::lists::Tiles), tilesX, tilesY);
+        glUniform2i(r.hostTileProgram->uniform(glsl::lists::Origin), target.x, target.y);
         glBindTextureUnit(3, target.depthTexture);
         glBindImageTexture(5, r.hostTiles, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
         glDispatchCompute(GLuint((tilesX + 7) / 8), GLuint(tilesY), 1);
@@ -854,9 +460,9 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t b
         r.depthLayers = layers;
         r.depthSize = {target.width, target.height};
     }
-    glUseProgram(r.prepareProgram);
-    glUniform2i(glGetUniformLocation(r.prepareProgram, "uSize"), target.width, target.height);
-    glUniform1i(glGetUniformLocation(r.prepareProgram, "uLayers"), layers);
+    glUseProgram(r.prepareProgram->id);
+    glUniform2i(r.prepareProgram->uniform(glsl::lists::Size), target.width, target.height);
+    glUniform1i(r.prepareProgram->uniform(glsl::lists::Layers), layers);
     glBindTextureUnit(2, r.heads);
     glBindImageTexture(5, r.depths, 0, GL_TRUE, 0, GL_WRITE_ONLY, GL_R32F);
     glDispatchCompute(GLuint((target.width + 7) / 8), GLuint((target.height + 7) / 8), 1);
@@ -908,19 +514,19 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t b
     const Impl::SectionProgram* generalProg = &r.sectionPrograms[2][variant];
     auto setUniforms = [&](const Impl::SectionProgram& p) {
         glUseProgram(p.id);
-        glUniformMatrix4fv(p.uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
-        glUniform1i(p.uOctagon, trimCorners ? 1 : 0);
-        glUniform1f(p.uCut, extent);
-        glUniform2i(p.uOrigin, target.x, target.y);
+        glUniformMatrix4fv(p.program->uniform(glsl::section::ViewProj), 1, GL_FALSE, glm::value_ptr(vp));
+        glUniform1i(p.program->uniform(glsl::section::Octagon), trimCorners ? 1 : 0);
+        glUniform1f(p.program->uniform(glsl::section::Cut), extent);
+        glUniform2i(p.program->uniform(glsl::section::Origin), target.x, target.y);
         if (!partial) return;
-        glUniform3f(p.uEye, eye.x, eye.y, eye.z);
-        glUniform3f(p.uForward, fwd.x, fwd.y, fwd.z);
-        glUniform1f(p.uNearZ, nearZ);
-        glUniform1i(p.uPersp, camera.perspective() ? 1 : 0);
-        glUniform1f(p.uKernelRadius, r.kernelRadius);
-        glUniform4f(p.uDepthToView, invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
-        glUniformMatrix4fv(p.uInvViewProj, 1, GL_FALSE, glm::value_ptr(invVp));
-        glUniform4f(p.uViewport, float(target.x), float(target.y), float(target.width), float(target.height));
+        glUniform3f(p.program->uniform(glsl::section::Eye), eye.x, eye.y, eye.z);
+        glUniform3f(p.program->uniform(glsl::section::Forward), fwd.x, fwd.y, fwd.z);
+        glUniform1f(p.program->uniform(glsl::section::NearZ), nearZ);
+        glUniform1i(p.program->uniform(glsl::section::Persp), camera.perspective() ? 1 : 0);
+        glUniform1f(p.program->uniform(glsl::section::KernelRadius), r.kernelRadius);
+        glUniform4f(p.program->uniform(glsl::section::DepthToView), invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+        glUniformMatrix4fv(p.program->uniform(glsl::section::InvViewProj), 1, GL_FALSE, glm::value_ptr(invVp));
+        glUniform4f(p.program->uniform(glsl::section::Viewport), float(target.x), float(target.y), float(target.width), float(target.height));
     };
     if (partial) {
         glBindTextureUnit(1, target.depthTexture);
@@ -974,7 +580,7 @@ void FragmentListPass::resolve(const PassTarget& target) {
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
     GLuint maxSurfaces = 0;
     glGetNamedBufferSubData(r.counters, 6 * 4, 4, &maxSurfaces);
-    GLuint program = r.resolvePrograms.back().second;
+    const Impl::Program* program = r.resolvePrograms.back().second;
     int programK = r.resolvePrograms.back().first;
     for (const auto& rp : r.resolvePrograms)
         if (GLuint(rp.first) >= maxSurfaces) {
@@ -986,7 +592,7 @@ void FragmentListPass::resolve(const PassTarget& target) {
     // count): one full-screen draw resolves and composites at once. A
     // compute dispatch costs llvmpipe several times a draw per pixel, and
     // the RGBA16F image between the two goes.
-    const GLuint fragmentProgram = GLuint(programK) >= maxSurfaces && r.poolViewed ? r.fragmentResolve(programK) : 0;
+    const Impl::Program* fragmentProgram = GLuint(programK) >= maxSurfaces && r.poolViewed ? r.fragmentResolve(programK) : nullptr;
     if (fragmentProgram) {
         glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
         glViewport(target.x, target.y, target.width, target.height);
@@ -995,10 +601,10 @@ void FragmentListPass::resolve(const PassTarget& target) {
         glBlendEquation(GL_FUNC_ADD);
         glDisable(GL_DEPTH_TEST);
         glDepthMask(GL_FALSE);
-        glUseProgram(fragmentProgram);
-        glUniform1i(glGetUniformLocation(fragmentProgram, "uSectionCount"), r.sectionsThisFrame);
-        glUniform2i(glGetUniformLocation(fragmentProgram, "uOrigin"), target.x, target.y);
-        glUniform2i(glGetUniformLocation(fragmentProgram, "uSize"), target.width, target.height);
+        glUseProgram(fragmentProgram->id);
+        glUniform1i(fragmentProgram->uniform(glsl::lists::SectionCount), r.sectionsThisFrame);
+        glUniform2i(fragmentProgram->uniform(glsl::lists::Origin), target.x, target.y);
+        glUniform2i(fragmentProgram->uniform(glsl::lists::Size), target.width, target.height);
         if (r.sectionsThisFrame > 0) glBindTextureUnit(1, r.sections);
         glBindTextureUnit(2, r.heads);
         glBindTextureUnit(4, r.poolView);
@@ -1006,10 +612,10 @@ void FragmentListPass::resolve(const PassTarget& target) {
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glBindTextureUnit(4, 0);
     } else {
-        glUseProgram(program);
-        glUniform1i(glGetUniformLocation(program, "uSectionCount"), r.sectionsThisFrame);
-        glUniform2i(glGetUniformLocation(program, "uOrigin"), target.x, target.y);
-        glUniform2i(glGetUniformLocation(program, "uSize"), target.width, target.height);
+        glUseProgram(program->id);
+        glUniform1i(program->uniform(glsl::lists::SectionCount), r.sectionsThisFrame);
+        glUniform2i(program->uniform(glsl::lists::Origin), target.x, target.y);
+        glUniform2i(program->uniform(glsl::lists::Size), target.width, target.height);
         if (r.sectionsThisFrame > 0) glBindTextureUnit(1, r.sections);
         glBindTextureUnit(2, r.heads);
         glBindImageTexture(5, r.resolved, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
@@ -1024,8 +630,8 @@ void FragmentListPass::resolve(const PassTarget& target) {
         glBlendEquation(GL_FUNC_ADD);
         glDisable(GL_DEPTH_TEST);
         glDepthMask(GL_FALSE);
-        glUseProgram(r.compositeProgram);
-        glUniform2i(glGetUniformLocation(r.compositeProgram, "uOrigin"), target.x, target.y);
+        glUseProgram(r.compositeProgram->id);
+        glUniform2i(r.compositeProgram->uniform(glsl::lists::Origin), target.x, target.y);
         glBindTextureUnit(1, r.resolved);
         glBindVertexArray(r.emptyVao);
         glDrawArrays(GL_TRIANGLES, 0, 3);

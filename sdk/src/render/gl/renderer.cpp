@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <map>
 #include <cassert>
 #include <cstddef>
 #include <cstring>
@@ -19,11 +18,14 @@
 #include "host_depth.hpp"
 #include "partial_texture.hpp"
 #include "saved_state.hpp"
-#include "splatfx/gl/program.hpp"
-#include "shaders.hpp"
+#include "program_library.hpp"
+#include "splat_vertex.hpp"
 
 namespace splatfx::gl {
 namespace {
+
+// The host depth tiles' size (glsl/depth_tiles.frag reads 16 x 16 pixels per tile).
+constexpr int kCutTile = 16;
 
 // An n x n RGBA layer resampled to (factor n)^2 with GL's bilinear rule
 // (texel centres at (i + 0.5) / size, clamped at the edges), so that
@@ -56,35 +58,29 @@ const float* upsampleBilinear(const float* src, int n, int factor, std::vector<f
 struct Renderer::Impl {
     RendererDesc desc;
     DrawStats stats;
-    // Programs by variant (kCrossfade | kFog | ...), compiled on first use:
+    // Programs by variant (kCrossfade | kFog | ...), compiled on first use
+    // (the program library's key: these bits as the splat program's defines):
     // each draw run picks the cheapest variant that is exact for its splats.
     enum Variant : unsigned { kCrossfade = 1, kFog = 2, kCut = 4, kHostDepth = 8, kNear = 16, kGeneral = 32 };
-    struct Program {
-        GLuint id = 0;
-        GLint uViewProj = -1, uOctagon = -1, uCut = -1;
-        // Fog (issue 14)
-        GLint uFogEye = -1, uParams = -1, uColour = -1, uFar = -1;
-        // Depth cut (issue 15)
-        GLint uEye = -1, uForward = -1, uNearZ = -1, uPersp = -1, uKernelRadius = -1, uDepthToView = -1, uInvViewProj = -1, uViewport = -1;
-    };
-    std::map<unsigned, Program> programs;
+    using Program = detail::ProgramLibrary::Program;
+    detail::ProgramLibrary library;
     std::string programError; // the last variant that failed to build (never expected: a shader bug)
-    std::string fogSource;    // generated GLSL the fog programs were built from
-    std::string fogUniform;
-    int fogVec4s = 0;
+    std::string fogSource;    // fogGlsl() the fog programs are built from (empty: none)
+    std::uint64_t fogKey = 0; // its Fog::glslKey()
     const Fog* fog = nullptr;
     double fogTimeSec = 0.0;
     std::vector<glm::vec4> fogParams;
     // Depth cut (issue 15): the partial table, its GLSL, per-splat classes.
     detail::PartialTexture partial;
     std::string partialSource;
+    std::uint64_t partialKey = 0; // a hash of partialSource (the cut programs' key)
     float kernelRadius = 1.6f;
     std::array<float, 256> rho{}; // rayScaleRho by code
     std::vector<std::uint8_t> classes;
     // The host depth as view depth (R32F, the target's size), its framebuffer and program.
     // The host view-depth range per kCutTile tile (RG32F), read back per draw.
-    GLuint tiles = 0, tilesFbo = 0, tilesProgram = 0, tilesVao = 0;
-    GLint uTilesDepthToView = -1, uTilesTarget = -1;
+    GLuint tiles = 0, tilesFbo = 0, tilesVao = 0;
+    const Program* tilesProgram = nullptr;
     std::vector<float> tileRange;
     int tilesW = 0, tilesH = 0;
     GLuint vao = 0, instances = 0, layers = 0;
@@ -102,14 +98,12 @@ struct Renderer::Impl {
     int upsample = 1;
 
     const Program* program(unsigned variant);
+    // Drops the splat programs with any of the variant bits of `mask`.
     void dropPrograms(unsigned mask) {
-        for (auto it = programs.begin(); it != programs.end();)
-            if (it->first & mask) {
-                if (it->second.id) glDeleteProgram(it->second.id);
-                it = programs.erase(it);
-            } else {
-                ++it;
-            }
+        library.release([mask](const glsl::ProgramKey& k) {
+            using namespace glsl::splat;
+            return k.id == glsl::ProgramId::Splat && (((mask & kFog) && k.values[FOG]) || ((mask & kCut) && k.values[CUT]));
+        });
     }
 
     void grow(std::size_t splats) {
@@ -135,58 +129,34 @@ struct Renderer::Impl {
         if (!detail::contextIsCurrent()) return;
         for (GLsync f : fences)
             if (f) glDeleteSync(f);
-        for (const auto& p : programs)
-            if (p.second.id) glDeleteProgram(p.second.id);
         if (vao) glDeleteVertexArrays(1, &vao);
         if (tilesVao) glDeleteVertexArrays(1, &tilesVao);
         if (tiles) glDeleteTextures(1, &tiles);
         if (tilesFbo) glDeleteFramebuffers(1, &tilesFbo);
-        if (tilesProgram) glDeleteProgram(tilesProgram);
         if (instances) glDeleteBuffers(1, &instances);
         if (layers) glDeleteTextures(1, &layers);
     }
 };
 
 const Renderer::Impl::Program* Renderer::Impl::program(unsigned v) {
-    if (auto it = programs.find(v); it != programs.end()) return it->second.id ? &it->second : nullptr;
-    Program& p = programs[v];
-    const bool cut = v & kCut;
-    std::string head = "#version 450 core\n";
-    head += (v & kFog) ? "#define FOG 1\n" : "#define FOG 0\n";
-    head += (v & kFog) && desc.fogPerSplat ? "#define FOG_PER_SPLAT 1\n" : "#define FOG_PER_SPLAT 0\n";
-    head += cut ? "#define CUT 1\n" : "#define CUT 0\n";
-    head += cut && (v & kHostDepth) ? "#define HOST_DEPTH 1\n" : "#define HOST_DEPTH 0\n";
-    head += cut && (v & (kNear | kGeneral)) ? "#define NEAR_CUT 1\n" : "#define NEAR_CUT 0\n";
-    head += cut && (v & kGeneral) ? "#define GENERAL 1\n" : "#define GENERAL 0\n";
-    const std::string fs = head + ((v & kCrossfade) ? "#define CROSSFADE 1\n" : "#define CROSSFADE 0\n");
-    const char* fogSrc = (v & kFog) ? fogSource.c_str() : "";
-    const char* partialSrc = cut ? partialSource.c_str() : "";
-    auto linked = linkProgram({head.c_str(), fogSrc, partialSrc, detail::kSplatVertex}, {fs.c_str(), fogSrc, partialSrc, detail::kSplatFragment},
-                              (v & kFog) ? "splat (fog)" : "splat");
-    if (!linked) {
-        programError = linked.error();
+    using namespace glsl::splat;
+    const bool cut = v & kCut, fogged = v & kFog;
+    glsl::ProgramKey key{glsl::ProgramId::Splat};
+    key.values[FOG] = fogged ? 1 : 0;
+    key.values[FOG_PER_SPLAT] = fogged && desc.fogPerSplat ? 1 : 0;
+    key.values[CUT] = cut ? 1 : 0;
+    key.values[HOST_DEPTH] = cut && (v & kHostDepth) ? 1 : 0;
+    key.values[NEAR_CUT] = cut && (v & (kNear | kGeneral)) ? 1 : 0;
+    key.values[GENERAL] = cut && (v & kGeneral) ? 1 : 0;
+    key.values[CROSSFADE] = (v & kCrossfade) ? 1 : 0;
+    key.dataKey = (fogged ? fogKey : 0u) * 1099511628211ull + (cut ? partialKey : 0u);
+    auto p = library.get(key, {.fog = fogged ? std::string_view(fogSource) : std::string_view(),
+                               .partial = cut ? std::string_view(partialSource) : std::string_view()});
+    if (!p) {
+        programError = p.error();
         return nullptr;
     }
-    p.id = *linked;
-    auto loc = [&](const char* name) { return glGetUniformLocation(p.id, name); };
-    p.uViewProj = loc("uViewProj");
-    p.uOctagon = loc("uOctagon");
-    p.uCut = loc("uCut");
-    if (v & kFog) {
-        p.uFogEye = loc("uFogEye");
-        p.uParams = loc(fogUniform.c_str());
-        p.uColour = loc("splatfx_fog_colour");
-        p.uFar = loc("splatfx_fog_far");
-    }
-    p.uEye = loc("uEye");
-    p.uForward = loc("uForward");
-    p.uNearZ = loc("uNearZ");
-    p.uPersp = loc("uPersp");
-    p.uKernelRadius = loc("uKernelRadius");
-    p.uDepthToView = loc("uDepthToView");
-    p.uInvViewProj = loc("uInvViewProj");
-    p.uViewport = loc("uViewport");
-    return &p;
+    return *p;
 }
 
 Renderer::Renderer(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
@@ -214,17 +184,7 @@ Result<Renderer> Renderer::create(const RendererDesc& desc) {
     glCreateVertexArrays(1, &impl->vao);
     impl->grow(0);
     if (!impl->mapped) return makeError("splatfx::gl::Renderer::create: cannot map a persistent instance buffer");
-    glVertexArrayBindingDivisor(impl->vao, 0, 1);
-    // The Splat struct as vertex attributes (one per instance):
-    // three vec4s, the layer pair as two u16, blend, and the RGBA8 colour.
-    for (GLuint a = 0; a < 3; ++a) glVertexArrayAttribFormat(impl->vao, a, 4, GL_FLOAT, GL_FALSE, a * 16);
-    glVertexArrayAttribIFormat(impl->vao, 3, 2, GL_UNSIGNED_SHORT, offsetof(Splat, layer));
-    glVertexArrayAttribFormat(impl->vao, 4, 1, GL_FLOAT, GL_FALSE, offsetof(Splat, blend));
-    glVertexArrayAttribFormat(impl->vao, 5, 4, GL_UNSIGNED_BYTE, GL_TRUE, offsetof(Splat, color));
-    for (GLuint a = 0; a < 6; ++a) {
-        glEnableVertexArrayAttrib(impl->vao, a);
-        glVertexArrayAttribBinding(impl->vao, a, 0);
-    }
+    detail::setSplatVertexLayout(impl->vao);
     return Renderer(std::move(impl));
 }
 
@@ -278,19 +238,17 @@ Status Renderer::upload(const Materials& materials) {
     // Depth cut (issue 15): the footprint's partial table and its lookup.
     r.partial.update(materials.footprint());
     r.kernelRadius = materials.footprint().radius();
-    const std::string partial = partialGlsl(materials.footprint(), 2);
+    std::string partial = partialGlsl(materials.footprint(), 2);
     if (partial != r.partialSource) {
         r.dropPrograms(Impl::kCut);
-        r.partialSource = partial;
+        r.partialKey = std::hash<std::string>{}(partial);
+        r.partialSource = std::move(partial);
     }
     if (r.desc.depthCut && !r.program(Impl::kCut)) return makeError("splatfx::gl::Renderer::upload: " + r.programError);
     if (r.desc.depthCut && !r.tilesProgram) {
-        auto tiles = linkProgram({"#version 450 core\n", detail::kDepthToViewVertex}, {"#version 450 core\n", detail::kDepthTilesFragment},
-                                 "splat depth cut (host depth tiles)");
+        auto tiles = r.library.get({glsl::ProgramId::DepthTiles});
         if (!tiles) return makeError("splatfx::gl::Renderer::upload: " + tiles.error());
         r.tilesProgram = *tiles;
-        r.uTilesDepthToView = glGetUniformLocation(r.tilesProgram, "uDepthToView");
-        r.uTilesTarget = glGetUniformLocation(r.tilesProgram, "uTarget");
         glCreateVertexArrays(1, &r.tilesVao);
     }
     return {};
@@ -301,19 +259,19 @@ Status Renderer::setFog(const Fog* fog, double timeSec) {
     r.fog = fog && !fog->empty() ? fog : nullptr; // zero terms: clear air, the plain shaders
     r.fogTimeSec = timeSec;
     if (!r.fog) return {};
+    if (r.fog->glslKey() == r.fogKey) return {}; // the same structure: the same programs
     auto glsl = fogGlsl(*r.fog);
     if (!glsl) {
         r.fog = nullptr;
         return makeError("splatfx::gl::Renderer::setFog: " + glsl.error());
     }
-    if (glsl->source == r.fogSource) return {};
     r.dropPrograms(Impl::kFog);
-    r.fogSource = glsl->source;
-    r.fogUniform = glsl->uniformName;
-    r.fogVec4s = glsl->vec4Count;
+    r.fogSource = std::move(glsl->source);
+    r.fogKey = r.fog->glslKey();
     if (!r.program(Impl::kFog | (r.desc.depthCut && !r.partialSource.empty() ? Impl::kCut : 0u))) {
         r.fog = nullptr;
         r.fogSource.clear();
+        r.fogKey = 0;
         return makeError(r.programError);
     }
     return {};
@@ -359,7 +317,7 @@ void Renderer::drawResolved(std::span<const Splat> splats, const Camera& camera,
     const GLuint depthTex = cut && r.desc.depthTest && r.tilesProgram ? target.depthTexture : 0;
     r.stats.cutHostDepth = depthTex != 0;
     const glm::mat4 invProj = glm::inverse(camera.proj);
-    const int tile = detail::kCutTile;
+    const int tile = kCutTile;
     const int tilesX = (target.width + tile - 1) / tile, tilesY = (target.height + tile - 1) / tile;
     if (depthTex) {
         if (r.tilesW != tilesX || r.tilesH != tilesY) {
@@ -378,9 +336,9 @@ void Renderer::drawResolved(std::span<const Splat> splats, const Camera& camera,
         glBindVertexArray(r.tilesVao);
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, r.tilesFbo);
         glViewport(0, 0, tilesX, tilesY);
-        glUseProgram(r.tilesProgram);
-        glUniform4f(r.uTilesDepthToView, invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
-        glUniform4i(r.uTilesTarget, target.x, target.y, target.width, target.height);
+        glUseProgram(r.tilesProgram->id);
+        glUniform4f(r.tilesProgram->uniform(glsl::depth_tiles::DepthToView), invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+        glUniform4i(r.tilesProgram->uniform(glsl::depth_tiles::Target), target.x, target.y, target.width, target.height);
         glBindTextureUnit(1, depthTex);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         r.tileRange.resize(std::size_t(tilesX) * std::size_t(tilesY) * 2);
@@ -486,24 +444,24 @@ void Renderer::drawResolved(std::span<const Splat> splats, const Camera& camera,
         glUseProgram(p->id);
         if (variant & Impl::kFog) {
             // Parameters in double relative to the eye, rounded to float once (docs/fog.md, GLSL).
-            glUniform3f(p->uFogEye, eye.x, eye.y, eye.z);
-            glUniform4fv(p->uParams, GLsizei(r.fogParams.size()), glm::value_ptr(r.fogParams[0]));
+            glUniform3f(p->uniform(glsl::splat::FogEye), eye.x, eye.y, eye.z);
+            glUniform4fv(p->uniform(glsl::splat::FogParams), GLsizei(r.fogParams.size()), glm::value_ptr(r.fogParams[0]));
             const glm::dvec3 col = r.fog->desc().colour;
-            glUniform3f(p->uColour, float(col.x), float(col.y), float(col.z));
-            glUniform1f(p->uFar, float(r.fog->desc().farDistanceWorld));
+            glUniform3f(p->uniform(glsl::splat::FogColour), float(col.x), float(col.y), float(col.z));
+            glUniform1f(p->uniform(glsl::splat::FogFar), float(r.fog->desc().farDistanceWorld));
         }
-        glUniformMatrix4fv(p->uViewProj, 1, GL_FALSE, glm::value_ptr(vp));
-        glUniform1i(p->uOctagon, r.desc.trimCorners ? 1 : 0);
-        glUniform1f(p->uCut, cutExtent);
+        glUniformMatrix4fv(p->uniform(glsl::splat::ViewProj), 1, GL_FALSE, glm::value_ptr(vp));
+        glUniform1i(p->uniform(glsl::splat::Octagon), r.desc.trimCorners ? 1 : 0);
+        glUniform1f(p->uniform(glsl::splat::Cut), cutExtent);
         if (variant & Impl::kCut) {
-            glUniform3f(p->uEye, eye.x, eye.y, eye.z);
-            glUniform3f(p->uForward, fwd.x, fwd.y, fwd.z);
-            glUniform1f(p->uNearZ, nearZ);
-            glUniform1i(p->uPersp, persp ? 1 : 0);
-            glUniform1f(p->uKernelRadius, r.kernelRadius);
-            glUniform4f(p->uDepthToView, invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
-            glUniformMatrix4fv(p->uInvViewProj, 1, GL_FALSE, glm::value_ptr(invVp));
-            glUniform4f(p->uViewport, float(target.x), float(target.y), float(target.width), float(target.height));
+            glUniform3f(p->uniform(glsl::splat::Eye), eye.x, eye.y, eye.z);
+            glUniform3f(p->uniform(glsl::splat::Forward), fwd.x, fwd.y, fwd.z);
+            glUniform1f(p->uniform(glsl::splat::NearZ), nearZ);
+            glUniform1i(p->uniform(glsl::splat::Persp), persp ? 1 : 0);
+            glUniform1f(p->uniform(glsl::splat::KernelRadius), r.kernelRadius);
+            glUniform4f(p->uniform(glsl::splat::DepthToView), invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+            glUniformMatrix4fv(p->uniform(glsl::splat::InvViewProj), 1, GL_FALSE, glm::value_ptr(invVp));
+            glUniform4f(p->uniform(glsl::splat::Viewport), float(target.x), float(target.y), float(target.width), float(target.height));
         }
         glDrawArraysInstancedBaseInstance(GL_TRIANGLE_STRIP, 0, corners, GLsizei(end - begin), GLuint(first + begin));
         ++r.stats.drawCalls;

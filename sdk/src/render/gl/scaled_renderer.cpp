@@ -12,8 +12,7 @@
 #include "host_depth.hpp"
 #include "formats.hpp"
 #include "saved_state.hpp"
-#include "splatfx/gl/program.hpp"
-#include "scaled_shaders.hpp"
+#include "program_library.hpp"
 
 namespace splatfx::gl {
 namespace {
@@ -40,7 +39,10 @@ glm::ivec4 splatBounds(std::span<const Splat> splats, const Camera& camera, int 
 struct ScaledRenderer::Impl {
     ScaledRendererDesc desc;
     std::optional<Renderer> inner;
-    GLuint downsample = 0, composite = 0, emptyVao = 0;
+    detail::ProgramLibrary programs;
+    const detail::ProgramLibrary::Program* downsample = nullptr;
+    const detail::ProgramLibrary::Program* composite = nullptr;
+    GLuint emptyVao = 0;
     GLuint fbo = 0, color = 0, depth = 0;
     int lowW = 0, lowH = 0;
     // Private copy of the host depth: sampling a texture attached to the
@@ -56,8 +58,6 @@ struct ScaledRenderer::Impl {
 
     ~Impl() {
         if (!detail::contextIsCurrent()) return; // the context took our objects with it
-        if (downsample) glDeleteProgram(downsample);
-        if (composite) glDeleteProgram(composite);
         if (emptyVao) glDeleteVertexArrays(1, &emptyVao);
         if (hostCopy) glDeleteTextures(1, &hostCopy);
         releaseTarget();
@@ -109,10 +109,10 @@ Result<ScaledRenderer> ScaledRenderer::create(const ScaledRendererDesc& desc) {
     auto impl = std::make_unique<Impl>();
     impl->desc = desc;
     impl->inner = std::move(*inner);
-    auto down = linkProgram({detail::kFullscreenVertex}, {detail::kDepthDownsampleFragment}, "depth downsample");
+    auto down = impl->programs.get({glsl::ProgramId::DepthDownsample});
     if (!down) return makeError(down.error());
     impl->downsample = *down;
-    auto comp = linkProgram({detail::kFullscreenVertex}, {detail::kCompositeFragment}, "upsample composite");
+    auto comp = impl->programs.get({glsl::ProgramId::ScaledComposite});
     if (!comp) return makeError(comp.error());
     impl->composite = *comp;
     glCreateVertexArrays(1, &impl->emptyVao);
@@ -197,9 +197,9 @@ PassTarget ScaledRenderer::beginResolved(const PassTarget& target, glm::ivec4 bo
         glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_ALWAYS);
-        glUseProgram(r.downsample);
-        glUniform4iv(glGetUniformLocation(r.downsample, "uHostRect"), 1, hostRect);
-        glUniform1i(glGetUniformLocation(r.downsample, "uScale"), s);
+        glUseProgram(r.downsample->id);
+        glUniform4iv(r.downsample->uniform(glsl::downsample::HostRect), 1, hostRect);
+        glUniform1i(r.downsample->uniform(glsl::downsample::Scale), s);
         glBindTextureUnit(2, r.hostCopy);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -231,14 +231,14 @@ void ScaledRenderer::composite(const Camera& camera) {
     glDepthMask(GL_FALSE);
     glDisable(GL_CULL_FACE);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glUseProgram(r.composite);
-    glUniform4iv(glGetUniformLocation(r.composite, "uHostRect"), 1, hostRect);
-    glUniform2i(glGetUniformLocation(r.composite, "uViewportOrigin"), target.x, target.y);
-    glUniform1i(glGetUniformLocation(r.composite, "uScale"), r.desc.scale);
-    glUniform1i(glGetUniformLocation(r.composite, "uUseDepth"), r.useDepth ? 1 : 0);
-    glUniform1f(glGetUniformLocation(r.composite, "uThreshold"), r.desc.depthThreshold);
+    glUseProgram(r.composite->id);
+    glUniform4iv(r.composite->uniform(glsl::composite::HostRect), 1, hostRect);
+    glUniform2i(r.composite->uniform(glsl::composite::ViewportOrigin), target.x, target.y);
+    glUniform1i(r.composite->uniform(glsl::composite::Scale), r.desc.scale);
+    glUniform1i(r.composite->uniform(glsl::composite::UseDepth), r.useDepth ? 1 : 0);
+    glUniform1f(r.composite->uniform(glsl::composite::Threshold), r.desc.depthThreshold);
     const glm::mat4 invProj = glm::inverse(camera.proj);
-    glUniform4f(glGetUniformLocation(r.composite, "uDepthToView"), invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+    glUniform4f(r.composite->uniform(glsl::composite::DepthToView), invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
     glBindTextureUnit(0, r.color);
     glBindTextureUnit(1, r.depth);
     if (r.useDepth) glBindTextureUnit(2, r.hostCopy);

@@ -15,7 +15,7 @@
 
 #include "context_check.hpp"
 #include "saved_state.hpp"
-#include "splatfx/gl/program.hpp"
+#include "program_library.hpp"
 
 namespace splatfx::gl::detail {
 namespace {
@@ -30,141 +30,15 @@ constexpr int kVec4PerTet = 10;
 // tetrahedron (dot(p1-p0, cross(p2-p0, p3-p0)) > 0): opposite 0, 1, 2, 3.
 constexpr std::uint32_t kTetraFaces[12] = {1, 2, 3, 0, 3, 2, 0, 1, 3, 0, 2, 1};
 
-constexpr const char* kTetraVertex = R"(
-layout(std430, binding = 0) readonly buffer Tets { vec4 uTets[]; };
-uniform mat4 uViewProjRel; // proj * view * translate(eye)
-uniform int uFirst;
-out vec3 vRel;
-// The per-tetrahedron functions as flat varyings: the fragment reads no buffer.
-flat out vec4 vPlane[4];
-flat out vec4 vScalar;
-flat out vec4 vLength;
-// Vertex 4 t + k is corner k of the draw's tetrahedron t: the index buffer
-// (kTetraFaces) makes its four faces of the four corners, so each corner is
-// shaded once, not once per face.
-void main() {
-    int tet = uFirst + gl_VertexID / 4;
-    vec3 p = uTets[tet * 10 + gl_VertexID % 4].xyz;
-    vRel = p;
-    for (int i = 0; i < 4; ++i) vPlane[i] = uTets[tet * 10 + 4 + i];
-    vScalar = uTets[tet * 10 + 8];
-    vLength = uTets[tet * 10 + 9];
-    gl_Position = uViewProjRel * vec4(p, 1.0);
-}
-)";
-
-constexpr const char* kTetraFragment = R"(
-layout(binding = 1) uniform sampler2D uHostDepth;
-layout(binding = 2) uniform sampler3D uTable;
-uniform vec3 uForward;      // unit view direction
-uniform vec4 uDepthToView;  // inverse projection's (z, w) rows at (z, w) columns
-uniform vec3 uTexScale;     // (n-1)/n, (n-1)/n, (m-1)/m: texel centres at the table's samples
-uniform vec3 uTexOffset;    // 0.5/n, 0.5/n, 0.5/m
-uniform float uMaxLength;   // the table's maxLengthWorld
-in vec3 vRel;
-flat in vec4 vPlane[4];
-flat in vec4 vScalar;
-flat in vec4 vLength;
-layout(location = 0) out vec4 oColor;
-
-#if FOG
-// (issue 14) One medium with the clouds: the segment's premultiplied
-// colour becomes f c + (1 - f) alpha C_fog (alpha unchanged), as every splat
-// fragment does, f = the fog's transmittance from the eye (the origin of the
-// eye-relative positions here) to one point of the segment. The point is the
-// segment's opacity centroid for a homogeneous segment of the same alpha:
-// with tau = -ln(1 - alpha), w = 1/tau - 1/(e^tau - 1) of the way in (1/2 for
-// thin segments, the entry for opaque ones), so the error is second order in
-// the fog's optical depth across the segment (docs/fog.md, "Tetrahedra").
-vec4 fogSegment(vec4 c, vec3 pf, vec3 pb) {
-    float a = clamp(c.a, 0.0, 1.0);
-    float tau = -log(max(1.0 - a, 1.0e-30));
-    float w = tau < 1.0e-2 ? 0.5 - tau / 12.0 : 1.0 / tau - 1.0 / (exp(min(tau, 80.0)) - 1.0);
-    float f = splatfx_fog_transmittance(vec3(0.0), mix(pf, pb, w));
-    return vec4(f * c.rgb + (1.0 - f) * c.a * splatfx_fog_colour, c.a);
-}
-#define FOGGED(c) fogSegment(c, pf, pb)
-#else
-#define FOGGED(c) (c)
-#endif
-
-vec4 table(float sf, float sb, float l) {
-    return texture(uTable, vec3(clamp(sf, 0.0, 1.0), clamp(sb, 0.0, 1.0), l / uMaxLength) * uTexScale + uTexOffset);
-}
-
-void main() {
-    // Compiled per camera kind and host depth (#defines), so no lane pays for
-    // a branch it does not take (llvmpipe runs both sides of divergent code).
-#if PERSPECTIVE
-    // The fragment lies on the entry face: the ray from the eye enters here.
-    float tIn = length(vRel);
-    vec3 d = vRel / tIn, o = vec3(0.0);
-    float tOut = 3.0e38;
-    for (int i = 0; i < 4; ++i) {
-        // lambda_i(t) = w + s t >= 0 inside (o = 0): only the leaving planes bound tOut.
-        float s = dot(vPlane[i].xyz, d);
-        if (s < 0.0) tOut = min(tOut, -vPlane[i].w / s);
-    }
-#else
-    vec3 d = uForward, o = vRel - d * dot(vRel, d); // o on the plane through the eye
-    float tIn = -3.0e38, tOut = 3.0e38;
-    for (int i = 0; i < 4; ++i) {
-        float a = dot(vPlane[i].xyz, o) + vPlane[i].w, s = dot(vPlane[i].xyz, d);
-        if (s > 0.0) tIn = max(tIn, -a / s);
-        else if (s < 0.0) tOut = min(tOut, -a / s);
-    }
-#endif
-#if HAS_DEPTH
-    // The ray ends at the host's surface: the segment is cut there, and the
-    // scalars below are interpolated at the cut (exact inside a tetrahedron).
-    // View depth from the stored depth: |(a n + b) / (c n + d)| with the
-    // inverse projection's z and w rows; along the ray t = depth / dot(d, forward).
-    float nz = texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r * 2.0 - 1.0;
-    float zView = abs((uDepthToView.x * nz + uDepthToView.y) / (uDepthToView.z * nz + uDepthToView.w));
-#if PERSPECTIVE
-    tOut = min(tOut, zView / dot(d, uForward));
-#else
-    tOut = min(tOut, zView);
-#endif
-#endif
-    if (!(tOut > tIn)) discard;
-    vec4 S = vScalar, M = vLength;
-    vec3 pf = o + tIn * d, pb = o + tOut * d;
-    float sf = dot(S.xyz, pf) + S.w, sb = dot(S.xyz, pb) + S.w;
-    float mf = dot(M.xyz, pf) + M.w, mb = dot(M.xyz, pb) + M.w;
-    // The table assumes a constant length scale along the segment (eq. 9):
-    // the mean of the ends, exact for constant m (docs/volume.md).
-    float l = (tOut - tIn) * max(0.5 * (mf + mb), 0.0);
-    if (l <= uMaxLength) {
-        oColor = FOGGED(table(sf, sb, l));
-        return;
-    }
-    // Longer than the table: equal pieces (the scalar is linear, so each is
-    // a segment), front to back, as PreIntegrationTable::lookup does.
-    int n = min(int(ceil(l / uMaxLength)), 256);
-    float piece = l / float(n);
-    vec4 acc = vec4(0.0);
-    for (int k = 0; k < n && acc.a < 0.99999; ++k) {
-        vec4 c = table(mix(sf, sb, float(k) / float(n)), mix(sf, sb, float(k + 1) / float(n)), piece);
-        acc += (1.0 - acc.a) * c;
-    }
-    oColor = FOGGED(acc);
-}
-)";
-
 } // namespace
 
 struct TetraPass::Impl {
-    struct Program {
-        GLuint id = 0;
-        GLint uViewProjRel = -1, uFirst = -1, uForward = -1, uDepthToView = -1, uTexScale = -1, uTexOffset = -1, uMaxLength = -1;
-        GLint uFogParams = -1, uFogColour = -1, uFogFar = -1; // fog variants only
-    };
-    Program programs[4]; // [perspective * 2 + host depth]
-    // (issue 14) The fog variants, built for the structure of the last fog seen.
-    Program fogPrograms[4];
-    std::string fogSource;
-    std::string fogUniform;
+    ProgramLibrary library;
+    using Program = ProgramLibrary::Program;
+    const Program* programs[4] = {}; // [perspective * 2 + host depth]
+    // The fog variants, built for the structure of the last fog seen (Fog::glslKey).
+    const Program* fogPrograms[4] = {};
+    std::uint64_t fogKey = 0;
     const Fog* fog = nullptr;
     double fogTimeSec = 0.0;
     GLuint vao = 0, ssbo = 0;
@@ -193,36 +67,11 @@ struct TetraPass::Impl {
     ~Impl() {
         if (!contextIsCurrent()) return;
         for (const Table& t : tables) glDeleteTextures(1, &t.texture);
-        for (const Program& p : programs)
-            if (p.id) glDeleteProgram(p.id);
-        for (const Program& p : fogPrograms)
-            if (p.id) glDeleteProgram(p.id);
         if (vao) glDeleteVertexArrays(1, &vao);
         if (ssbo) glDeleteBuffers(1, &ssbo);
         if (indices) glDeleteBuffers(1, &indices);
     }
 };
-
-namespace {
-TetraPass::Impl::Program locate(GLuint id, const std::string& fogUniform) {
-    TetraPass::Impl::Program p;
-    p.id = id;
-    auto loc = [&](const char* n) { return glGetUniformLocation(id, n); };
-    p.uViewProjRel = loc("uViewProjRel");
-    p.uFirst = loc("uFirst");
-    p.uForward = loc("uForward");
-    p.uDepthToView = loc("uDepthToView");
-    p.uTexScale = loc("uTexScale");
-    p.uTexOffset = loc("uTexOffset");
-    p.uMaxLength = loc("uMaxLength");
-    if (!fogUniform.empty()) {
-        p.uFogParams = loc(fogUniform.c_str());
-        p.uFogColour = loc("splatfx_fog_colour");
-        p.uFogFar = loc("splatfx_fog_far");
-    }
-    return p;
-}
-} // namespace
 
 TetraPass::TetraPass(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
 TetraPass::TetraPass(TetraPass&&) noexcept = default;
@@ -230,58 +79,45 @@ TetraPass& TetraPass::operator=(TetraPass&&) noexcept = default;
 TetraPass::~TetraPass() = default;
 const TetraStats& TetraPass::stats() const { return mImpl->stats; }
 
-namespace {
-// Compiles variant v (perspective * 2 + host depth) after `fogSource` (empty: no fog).
-Result<GLuint> buildTetraProgram(int v, const std::string& fogSource) {
-    const char* persp = (v & 2) ? "#define PERSPECTIVE 1\n" : "#define PERSPECTIVE 0\n";
-    const char* depth = (v & 1) ? "#define HAS_DEPTH 1\n" : "#define HAS_DEPTH 0\n";
-    const char* fog = fogSource.empty() ? "#define FOG 0\n" : "#define FOG 1\n";
-    return linkProgram({"#version 450 core\n", kTetraVertex}, {"#version 450 core\n", persp, depth, fog, fogSource.c_str(), kTetraFragment},
-                       fogSource.empty() ? "tetrahedra" : "tetrahedra (fog)");
-}
-} // namespace
-
 Result<TetraPass> TetraPass::create() {
     if (!contextIsCurrent()) return makeError("splatfx::gl tetrahedra pass: no OpenGL context is current on this thread");
     auto impl = std::make_unique<Impl>();
     Impl& r = *impl;
     for (int v = 0; v < 4; ++v) {
-        auto linked = buildTetraProgram(v, {});
-        if (!linked) return makeError(linked.error());
-        r.programs[v] = locate(*linked, {});
+        auto p = r.library.get({glsl::ProgramId::Tetra, {(v & 2) ? 1 : 0, v & 1, 0}});
+        if (!p) return makeError(p.error());
+        r.programs[v] = *p;
     }
     glCreateVertexArrays(1, &r.vao); // no attributes: everything comes from the buffer
     glCreateBuffers(1, &r.ssbo);
     return TetraPass(std::move(impl));
 }
 
-// (issue 14)
 Status TetraPass::setFog(const Fog* fog, double timeSec) {
     Impl& r = *mImpl;
     r.fog = fog && !fog->empty() ? fog : nullptr; // zero terms: clear air, the plain programs
     r.fogTimeSec = timeSec;
     if (!r.fog) return {};
+    if (r.fog->glslKey() == r.fogKey) return {}; // the same structure: the same programs
     auto glsl = fogGlsl(*r.fog);
     if (!glsl) {
         r.fog = nullptr;
         return makeError("splatfx::gl tetrahedra pass: " + glsl.error());
     }
-    if (glsl->source == r.fogSource) return {};
-    for (Impl::Program& p : r.fogPrograms)
-        if (p.id) glDeleteProgram(p.id), p = {};
-    r.fogSource.clear();
+    r.library.release([](const glsl::ProgramKey& k) { return k.values[glsl::tetra::FOG] != 0; });
+    for (auto& p : r.fogPrograms) p = nullptr;
+    r.fogKey = 0;
     for (int v = 0; v < 4; ++v) {
-        auto linked = buildTetraProgram(v, glsl->source);
-        if (!linked) {
-            for (Impl::Program& p : r.fogPrograms)
-                if (p.id) glDeleteProgram(p.id), p = {};
+        auto p = r.library.get({glsl::ProgramId::Tetra, {(v & 2) ? 1 : 0, v & 1, 1}, r.fog->glslKey()}, {.fog = glsl->source});
+        if (!p) {
+            r.library.release([](const glsl::ProgramKey& k) { return k.values[glsl::tetra::FOG] != 0; });
+            for (auto& q : r.fogPrograms) q = nullptr;
             r.fog = nullptr;
-            return makeError(linked.error());
+            return makeError(p.error());
         }
-        r.fogPrograms[v] = locate(*linked, glsl->uniformName);
+        r.fogPrograms[v] = *p;
     }
-    r.fogSource = glsl->source;
-    r.fogUniform = glsl->uniformName;
+    r.fogKey = r.fog->glslKey();
     return {};
 }
 
@@ -448,29 +284,29 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 
     const int variant = (camera.perspective() ? 2 : 0) + (hostDepth ? 1 : 0);
-    const bool fogged = r.fog && r.fogPrograms[variant].id;
-    const Impl::Program& p = fogged ? r.fogPrograms[variant] : r.programs[variant];
+    const bool fogged = r.fog && r.fogPrograms[variant];
+    const Impl::Program& p = fogged ? *r.fogPrograms[variant] : *r.programs[variant];
     glUseProgram(p.id);
     if (fogged) {
         // Parameters in double relative to the eye the records are relative to (docs/fog.md, GLSL).
         const std::vector<glm::vec4> fp = r.fog->glslParameters(r.fogTimeSec, glm::dvec3(r.eye));
-        glUniform4fv(p.uFogParams, GLsizei(fp.size()), glm::value_ptr(fp[0]));
+        glUniform4fv(p.uniform(glsl::tetra::FogParams), GLsizei(fp.size()), glm::value_ptr(fp[0]));
         const glm::dvec3 col = r.fog->desc().colour;
-        glUniform3f(p.uFogColour, float(col.x), float(col.y), float(col.z));
-        glUniform1f(p.uFogFar, float(r.fog->desc().farDistanceWorld));
+        glUniform3f(p.uniform(glsl::tetra::FogColour), float(col.x), float(col.y), float(col.z));
+        glUniform1f(p.uniform(glsl::tetra::FogFar), float(r.fog->desc().farDistanceWorld));
         ++r.stats.foggedDraws;
     }
     const glm::mat4 vpRel = vp * glm::translate(glm::mat4(1.0f), r.eye);
-    glUniformMatrix4fv(p.uViewProjRel, 1, GL_FALSE, glm::value_ptr(vpRel));
-    glUniform1i(p.uFirst, GLint(r.recordBase[volume] + a));
+    glUniformMatrix4fv(p.uniform(glsl::tetra::ViewProjRel), 1, GL_FALSE, glm::value_ptr(vpRel));
+    glUniform1i(p.uniform(glsl::tetra::First), GLint(r.recordBase[volume] + a));
     const glm::vec3 f = camera.forward();
-    glUniform3f(p.uForward, f.x, f.y, f.z);
+    glUniform3f(p.uniform(glsl::tetra::Forward), f.x, f.y, f.z);
     const glm::mat4 invProj = glm::inverse(camera.proj);
-    glUniform4f(p.uDepthToView, invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+    glUniform4f(p.uniform(glsl::tetra::DepthToView), invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
     const glm::vec3 n(table.dims());
-    glUniform3f(p.uTexScale, (n.x - 1.0f) / n.x, (n.y - 1.0f) / n.y, (n.z - 1.0f) / n.z);
-    glUniform3f(p.uTexOffset, 0.5f / n.x, 0.5f / n.y, 0.5f / n.z);
-    glUniform1f(p.uMaxLength, table.maxLengthWorld());
+    glUniform3f(p.uniform(glsl::tetra::TexScale), (n.x - 1.0f) / n.x, (n.y - 1.0f) / n.y, (n.z - 1.0f) / n.z);
+    glUniform3f(p.uniform(glsl::tetra::TexOffset), 0.5f / n.x, 0.5f / n.y, 0.5f / n.z);
+    glUniform1f(p.uniform(glsl::tetra::MaxLength), table.maxLengthWorld());
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, r.ssbo);
     glBindTextureUnit(1, hostDepth);
     glBindTextureUnit(2, tex.texture);

@@ -1,35 +1,4 @@
-// GLSL for ScaledRenderer's two passes (private to the GL backend).
-#pragma once
-
-namespace splatfx::gl::detail {
-
-// One triangle covering the viewport, from gl_VertexID; no vertex buffer.
-inline constexpr const char* kFullscreenVertex = R"(#version 450 core
-void main() {
-    vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);
-    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
-}
-)";
-
-// Low-resolution depth: the farthest host depth in each scale x scale block.
-inline constexpr const char* kDepthDownsampleFragment = R"(#version 450 core
-layout(binding = 2) uniform sampler2D uHostDepth;
-uniform ivec4 uHostRect; // x, y, width, height of the host depth region to read
-uniform int uScale;
-void main() {
-    ivec2 base = ivec2(gl_FragCoord.xy) * uScale;
-    float far = 0.0;
-    for (int j = 0; j < uScale; ++j)
-        for (int i = 0; i < uScale; ++i) {
-            ivec2 p = min(base + ivec2(i, j), uHostRect.zw - 1);
-            far = max(far, texelFetch(uHostDepth, uHostRect.xy + p, 0).r);
-        }
-    gl_FragDepth = far;
-}
-)";
-
-// Nearest-depth upsampling of the premultiplied low-resolution image.
-inline constexpr const char* kCompositeFragment = R"(#version 450 core
+// Nearest-depth upsampling of the premultiplied low-resolution image (ScaledRenderer).
 layout(binding = 0) uniform sampler2D uLowColor;
 layout(binding = 1) uniform sampler2D uLowDepth;
 layout(binding = 2) uniform sampler2D uHostDepth;
@@ -77,6 +46,3 @@ void main() {
     }
     oColor = worst <= uThreshold * z ? bilinear : c[nearest];
 }
-)";
-
-} // namespace splatfx::gl::detail

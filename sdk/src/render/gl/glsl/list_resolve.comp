@@ -1,0 +1,2 @@
+#define FRAG 0
+#include "list_resolve.glsl"

@@ -1,0 +1,2 @@
+#define FRAG 1
+#include "list_resolve.glsl"

@@ -1,0 +1,26 @@
+// The gas's shadow on host surfaces (splatfx::shadowGlsl; docs/lighting.md).
+// Mirrors ShadowTable::opticalDepth: the slab test moves a point outside the
+// table along its ray to the light to where it enters the table. A zero
+// direction component becomes +-1e30 in 1/d, which keeps points inside that
+// slab unconstrained and those outside it rejected, with no 0 * inf.
+uniform sampler3D splatfx_shadowTable; // R32F: optical depth towards the light, log2 units
+uniform mat4 splatfx_worldToTable;     // world to the table's box [0, 1]^3
+uniform vec4 splatfx_shadowLight;      // table space: position (w = 1) or travel direction (w = 0)
+
+float splatfx_shadow(vec3 worldPos) {
+    vec3 p = (splatfx_worldToTable * vec4(worldPos, 1.0)).xyz;
+    bool isPoint = splatfx_shadowLight.w > 0.5;
+    vec3 d = isPoint ? splatfx_shadowLight.xyz - p : -splatfx_shadowLight.xyz;
+    vec3 s = vec3(greaterThanEqual(d, vec3(0.0))) * 2.0 - 1.0;
+    vec3 inv = s / max(abs(d), vec3(1e-30));
+    vec3 ta = -p * inv, tb = (vec3(1.0) - p) * inv;
+    vec3 tlo = min(ta, tb), thi = max(ta, tb);
+    float tNear = max(max(max(tlo.x, tlo.y), tlo.z), 0.0);
+    float tFar = min(min(thi.x, thi.y), thi.z);
+    if (isPoint) tFar = min(tFar, 1.0);
+    if (tNear > tFar) return 1.0;
+    vec3 q = clamp(p + d * tNear, vec3(0.0), vec3(1.0));
+    vec3 n = vec3(textureSize(splatfx_shadowTable, 0));
+    float depth = texture(splatfx_shadowTable, (q * (n - 1.0) + 0.5) / n).r;
+    return exp2(-depth);
+}
