@@ -6,14 +6,14 @@
 #include <memory>
 #include <string>
 
-#include "fog_pass.hpp"
-#include "fragment_list_pass.hpp"
+#include "passes/fog_pass.hpp"
+#include "passes/fragment_list_pass.hpp"
 #include "host_depth.hpp"
 #include "passes/host_pass.hpp"
 #include "passes/splat_pass.hpp"
-#include "shadow_pass.hpp"
+#include "passes/shadow_pass.hpp"
 #include "splatfx/gl/frame_plan.hpp"
-#include "tetra_pass.hpp"
+#include "passes/tetra_pass.hpp"
 
 namespace splatfx::gl {
 

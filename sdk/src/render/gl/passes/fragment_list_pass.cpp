@@ -15,13 +15,13 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
-#include "context_check.hpp"
-#include "partial_texture.hpp"
-#include "program_library.hpp"
-#include "splat_vertex.hpp"
+#include "render/gl/context_check.hpp"
+#include "render/gl/partial_texture.hpp"
+#include "render/gl/program_library.hpp"
+#include "render/gl/splat_vertex.hpp"
 #include "splatfx/footprint.hpp"
 #include "splatfx/transparency.hpp"
-#include "transparent_bindings.hpp"
+#include "render/gl/transparent_bindings.hpp"
 
 namespace splatfx::gl::detail {
 namespace {

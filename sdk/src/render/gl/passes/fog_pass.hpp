@@ -25,8 +25,8 @@
 #include "splatfx/camera.hpp"
 #include "splatfx/fog.hpp"
 #include "splatfx/result.hpp"
-#include "passes/pass.hpp"
-#include "program_library.hpp"
+#include "pass.hpp"
+#include "render/gl/program_library.hpp"
 
 namespace splatfx::gl::detail {
 

@@ -30,7 +30,7 @@
 #include "splatfx/fog.hpp"
 #include "splatfx/frame.hpp"
 #include "splatfx/result.hpp"
-#include "passes/pass.hpp"
+#include "pass.hpp"
 
 namespace splatfx::gl::detail {
 

@@ -13,9 +13,9 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
-#include "context_check.hpp"
-#include "saved_state.hpp"
-#include "program_library.hpp"
+#include "render/gl/context_check.hpp"
+#include "render/gl/saved_state.hpp"
+#include "render/gl/program_library.hpp"
 
 namespace splatfx::gl::detail {
 namespace {

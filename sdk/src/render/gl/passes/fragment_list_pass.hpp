@@ -53,8 +53,8 @@
 #include "splatfx/materials.hpp"
 #include "splatfx/result.hpp"
 #include "splatfx/splats.hpp"
-#include "passes/pass.hpp"
-#include "saved_state.hpp"
+#include "pass.hpp"
+#include "render/gl/saved_state.hpp"
 #include "splatfx/gl/renderer.hpp"
 
 namespace splatfx::gl::detail {

@@ -9,8 +9,8 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
-#include "context_check.hpp"
-#include "saved_state.hpp"
+#include "render/gl/context_check.hpp"
+#include "render/gl/saved_state.hpp"
 
 namespace splatfx::gl::detail {
 

@@ -8,7 +8,7 @@
 
 #include "splatfx/frame.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
-#include "passes/pass.hpp"
+#include "pass.hpp"
 
 namespace splatfx::gl::detail {
 
