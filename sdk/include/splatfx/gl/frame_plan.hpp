@@ -81,9 +81,12 @@ struct PlanStep {
 };
 
 struct FramePlan {
-    PassTarget target;           // the host's viewport and depth, resolved once
-    const Fog* fog = nullptr;    // the frame's fog (null: clear air)
-    double timeSec = 0.0;        // the frame's time (the fog's)
+    PassTarget target;        // the host's viewport and depth, resolved once
+    const Fog* fog = nullptr; // the frame's fog (null: clear air)
+    double timeSec = 0.0;     // the frame's time (the fog's)
+    // The fog's parameters at timeSec relative to the frame camera's eye
+    // (Fog::glslParameters), computed once a frame for every fogged pass.
+    std::vector<glm::vec4> fogParameters;
     bool tetrahedra = false;     // the frame has tetrahedra to draw
     bool reduced = false;        // splats at 1/resolutionScale per axis
     bool fogHost = false;        // HostFog is among the steps

@@ -172,6 +172,9 @@ private:
     friend class ScaledRenderer;
     // draw() with the host depth already resolved (no framebuffer query).
     void drawResolved(std::span<const Splat> splats, const Camera& camera, const PassTarget& target);
+    // The fog parameters of the frame being drawn (computed once a frame by
+    // the frame renderer; null: draw() computes them from setFog's fog and time).
+    void setFrameFogParameters(const std::vector<glm::vec4>* params);
     struct Impl;
     explicit Renderer(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> mImpl;

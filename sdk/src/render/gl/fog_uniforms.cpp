@@ -7,6 +7,8 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "fog_state.hpp"
+
 namespace splatfx::gl {
 
 Status setFogUniforms(unsigned program, const Fog& fog, double timeSec, glm::dvec3 eye, const FogGlslOptions& options) {
@@ -22,11 +24,19 @@ Status setFogUniforms(unsigned program, const Fog& fog, double timeSec, glm::dve
     if (int(p.size()) != glsl->vec4Count)
         return makeError("setFogUniforms: the include expects " + std::to_string(glsl->vec4Count) + " parameters, this fog has " +
                          std::to_string(p.size()));
-    if (params >= 0) glProgramUniform4fv(program, params, GLsizei(p.size()), glm::value_ptr(p[0]));
-    const glm::dvec3 c = fog.desc().colour;
-    if (colour >= 0) glProgramUniform3f(program, colour, float(c.x), float(c.y), float(c.z));
-    if (far >= 0) glProgramUniform1f(program, far, float(fog.desc().farDistanceWorld));
+    detail::setFogUniforms(program, {.params = params, .colour = colour, .far = far}, fog, p);
     return {};
 }
+
+namespace detail {
+
+void setFogUniforms(unsigned program, const FogLocations& at, const Fog& fog, std::span<const glm::vec4> params) {
+    if (at.params >= 0 && !params.empty()) glProgramUniform4fv(program, at.params, GLsizei(params.size()), glm::value_ptr(params[0]));
+    const glm::dvec3 c = fog.desc().colour;
+    if (at.colour >= 0) glProgramUniform3f(program, at.colour, float(c.x), float(c.y), float(c.z));
+    if (at.far >= 0) glProgramUniform1f(program, at.far, float(fog.desc().farDistanceWorld));
+}
+
+} // namespace detail
 
 } // namespace splatfx::gl

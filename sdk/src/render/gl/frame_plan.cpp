@@ -63,6 +63,7 @@ FramePlan planFrame(const Frame& frame, const HostTarget& host, const FrameRende
                    .depthTexture = multisampled ? 0u : depth.texture};
     plan.fog = frame.fog() && !frame.fog()->empty() ? frame.fog() : nullptr;
     plan.timeSec = frame.time();
+    if (plan.fog) plan.fogParameters = plan.fog->glslParameters(plan.timeSec, glm::dvec3(camera.eye()));
     plan.tetrahedra =
         std::any_of(frame.volumes().begin(), frame.volumes().end(), [](const FrameVolume& v) { return v.table && !v.lod.tets.empty(); });
     plan.reduced = desc.resolutionScale != 1;

@@ -15,6 +15,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "context_check.hpp"
+#include "fog_state.hpp"
 #include "host_depth.hpp"
 #include "partial_texture.hpp"
 #include "saved_state.hpp"
@@ -70,6 +71,7 @@ struct Renderer::Impl {
     const Fog* fog = nullptr;
     double fogTimeSec = 0.0;
     std::vector<glm::vec4> fogParams;
+    const std::vector<glm::vec4>* frameFogParams = nullptr; // the frame renderer's, for this frame (setFrameFogParameters)
     // Depth cut (issue 15): the partial table, its GLSL, per-splat classes.
     detail::PartialTexture partial;
     std::string partialSource;
@@ -254,6 +256,8 @@ Status Renderer::upload(const Materials& materials) {
     return {};
 }
 
+void Renderer::setFrameFogParameters(const std::vector<glm::vec4>* params) { mImpl->frameFogParams = params; }
+
 Status Renderer::setFog(const Fog* fog, double timeSec) {
     Impl& r = *mImpl;
     r.fog = fog && !fog->empty() ? fog : nullptr; // zero terms: clear air, the plain shaders
@@ -427,7 +431,9 @@ void Renderer::drawResolved(std::span<const Splat> splats, const Camera& camera,
     const bool fogged = r.fog && !r.fogSource.empty();
     const unsigned base = (anyCrossfade ? Impl::kCrossfade : 0u) | (fogged ? Impl::kFog : 0u) | (cut ? Impl::kCut : 0u);
     const glm::mat4 invVp = glm::inverse(vp);
-    if (fogged) r.fogParams = r.fog->glslParameters(r.fogTimeSec, glm::dvec3(eye));
+    // The frame renderer hands over the frame's parameters (computed once a frame); alone, compute them here.
+    if (fogged && !r.frameFogParams) r.fogParams = r.fog->glslParameters(r.fogTimeSec, glm::dvec3(eye));
+    const std::span<const glm::vec4> fogParams = r.frameFogParams ? std::span<const glm::vec4>(*r.frameFogParams) : r.fogParams;
     glBindTextureUnit(0, r.layers);
     if (cut) {
         glBindTextureUnit(1, depthTex);
@@ -445,10 +451,10 @@ void Renderer::drawResolved(std::span<const Splat> splats, const Camera& camera,
         if (variant & Impl::kFog) {
             // Parameters in double relative to the eye, rounded to float once (docs/fog.md, GLSL).
             glUniform3f(p->uniform(glsl::splat::FogEye), eye.x, eye.y, eye.z);
-            glUniform4fv(p->uniform(glsl::splat::FogParams), GLsizei(r.fogParams.size()), glm::value_ptr(r.fogParams[0]));
-            const glm::dvec3 col = r.fog->desc().colour;
-            glUniform3f(p->uniform(glsl::splat::FogColour), float(col.x), float(col.y), float(col.z));
-            glUniform1f(p->uniform(glsl::splat::FogFar), float(r.fog->desc().farDistanceWorld));
+            detail::setFogUniforms(
+                p->id,
+                {.params = p->uniform(glsl::splat::FogParams), .colour = p->uniform(glsl::splat::FogColour), .far = p->uniform(glsl::splat::FogFar)},
+                *r.fog, fogParams);
         }
         glUniformMatrix4fv(p->uniform(glsl::splat::ViewProj), 1, GL_FALSE, glm::value_ptr(vp));
         glUniform1i(p->uniform(glsl::splat::Octagon), r.desc.trimCorners ? 1 : 0);

@@ -10,6 +10,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "render/gl/context_check.hpp"
+#include "render/gl/fog_state.hpp"
 #include "render/gl/saved_state.hpp"
 
 namespace splatfx::gl::detail {
@@ -67,8 +68,8 @@ Status FogPass::draw(const Fog& fog, double timeSec, const Camera& camera, const
     const glm::dmat4 rot{glm::dmat3(invView)};
     const glm::mat4 invRel(rot * glm::inverse(glm::dmat4(camera.proj)));
     const glm::dvec3 eye(camera.eye());
-    mParams = fog.glslParameters(timeSec, eye);
-    const glm::dvec3 col = fog.desc().colour;
+    if (!mFrameParams) mParams = fog.glslParameters(timeSec, eye);
+    const std::span<const glm::vec4> params = mFrameParams ? std::span<const glm::vec4>(*mFrameParams) : mParams;
 
     SavedState saved;
     saved.save({.texture2DUnits = 2, .scissor = false});
@@ -92,9 +93,7 @@ Status FogPass::draw(const Fog& fog, double timeSec, const Camera& camera, const
         glUniformMatrix4fv(p.uniform(InvRel), 1, GL_FALSE, glm::value_ptr(invRel));
         glUniform2f(p.uniform(Origin), float(target.x), float(target.y));
         glUniform2f(p.uniform(Size), float(target.width), float(target.height));
-        glUniform4fv(p.uniform(FogParams), GLsizei(mParams.size()), glm::value_ptr(mParams[0]));
-        glUniform3f(p.uniform(FogColour), float(col.x), float(col.y), float(col.z));
-        glUniform1f(p.uniform(FogFar), float(fog.desc().farDistanceWorld));
+        setFogUniforms(p.id, {.params = p.uniform(FogParams), .colour = p.uniform(FogColour), .far = p.uniform(FogFar)}, fog, params);
         if (p.uniform(FogSize) >= 0) glUniform2f(p.uniform(FogSize), float(textureSize.x), float(textureSize.y));
         if (p.uniform(Threshold) >= 0) glUniform1f(p.uniform(Threshold), std::max(depthThreshold, 0.0f));
     };
@@ -136,7 +135,9 @@ void FogPass::prepare(const FramePlan&, const Frame&) {
 void FogPass::execute(const PlanStep& step, StepContext& context) {
     assert(step.kind == StepKind::HostFog && context.plan.fog);
     (void)step;
+    mFrameParams = &context.plan.fogParameters;
     const Status s = draw(*context.plan.fog, context.plan.timeSec, context.frame.camera(), context.plan.target);
+    mFrameParams = nullptr;
     mDrawn = bool(s);
     if (!s) mError = s.error();
 }

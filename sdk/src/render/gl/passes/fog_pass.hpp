@@ -55,6 +55,7 @@ private:
     unsigned mVao = 0, mFbo = 0, mTexture = 0, mSampler = 0;
     glm::ivec2 mTextureSize{0};
     std::vector<glm::vec4> mParams;
+    const std::vector<glm::vec4>* mFrameParams = nullptr; // the plan's, while a step runs
     glm::ivec2 mAskedSize{0};
     float mDepthThreshold = 0.05f;
     bool mDrawn = false;

@@ -25,6 +25,7 @@ Status SplatPass::upload(const Materials& materials) { return mFull ? mFull->upl
 void SplatPass::prepare(const FramePlan& plan, const Frame&) {
     mDrawCalls = 0;
     const Status s = active().setFog(plan.fog, plan.timeSec);
+    active().setFrameFogParameters(plan.fog ? &plan.fogParameters : nullptr);
     mFogError = s ? std::string() : s.error();
     mFogged = plan.fog && s;
 }

@@ -14,6 +14,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "render/gl/context_check.hpp"
+#include "render/gl/fog_state.hpp"
 #include "render/gl/saved_state.hpp"
 #include "render/gl/program_library.hpp"
 
@@ -289,11 +290,11 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     glUseProgram(p.id);
     if (fogged) {
         // Parameters in double relative to the eye the records are relative to (docs/fog.md, GLSL).
-        const std::vector<glm::vec4> fp = r.fog->glslParameters(r.fogTimeSec, glm::dvec3(r.eye));
-        glUniform4fv(p.uniform(glsl::tetra::FogParams), GLsizei(fp.size()), glm::value_ptr(fp[0]));
-        const glm::dvec3 col = r.fog->desc().colour;
-        glUniform3f(p.uniform(glsl::tetra::FogColour), float(col.x), float(col.y), float(col.z));
-        glUniform1f(p.uniform(glsl::tetra::FogFar), float(r.fog->desc().farDistanceWorld));
+        std::vector<glm::vec4> own;
+        if (!mFrameParams) own = r.fog->glslParameters(r.fogTimeSec, glm::dvec3(r.eye));
+        setFogUniforms(
+            p.id, {.params = p.uniform(glsl::tetra::FogParams), .colour = p.uniform(glsl::tetra::FogColour), .far = p.uniform(glsl::tetra::FogFar)},
+            *r.fog, mFrameParams ? std::span<const glm::vec4>(*mFrameParams) : own);
         ++r.stats.foggedDraws;
     }
     const glm::mat4 vpRel = vp * glm::translate(glm::mat4(1.0f), r.eye);
@@ -354,8 +355,10 @@ void TetraPass::execute(const PlanStep& step, StepContext& context) {
         return;
     }
     assert(step.kind == StepKind::Tetrahedra);
+    mFrameParams = &context.plan.fogParameters;
     draw(context.frame, step.volume, std::uint32_t(step.begin), std::uint32_t(step.end),
          step.target == StepTarget::Reduced ? context.reduced : context.plan.target);
+    mFrameParams = nullptr;
 }
 
 void TetraPass::report(FrameRenderStats& stats) const {

@@ -76,7 +76,8 @@ private:
     std::unique_ptr<Impl> mImpl;
     std::string mFogError;
     bool mFogged = false;
-    bool mActive = false; // the frame has tetrahedra
+    bool mActive = false;                                 // the frame has tetrahedra
+    const std::vector<glm::vec4>* mFrameParams = nullptr; // the plan's fog parameters, while a step runs
 };
 
 } // namespace splatfx::gl::detail
