@@ -242,7 +242,11 @@ struct Viewer {
         if (!error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", error.c_str());
         // What the frame renderer could not do as asked (FrameRenderStats::notes): said where the user looks.
         if (player)
-            for (const std::string& note : player->renderer().stats().notes) ImGui::TextColored(ImVec4(1, 0.8f, 0.3f, 1), "note: %s", note.c_str());
+            for (const std::string& note : player->renderer().stats().notes) {
+                ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.8f, 0.3f, 1));
+                ImGui::TextWrapped("note: %s", note.c_str());
+                ImGui::PopStyleColor();
+            }
         ImGui::Separator();
 
         if (ImGui::CollapsingHeader("Scene", ImGuiTreeNodeFlags_DefaultOpen)) {
