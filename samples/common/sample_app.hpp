@@ -35,7 +35,7 @@ struct FrameContext {
     int index = 0;        // frame number
     double timeSec = 0.0; // index / fps: animation time never depends on the wall clock
     glm::ivec2 size{0};
-    splatfx::gl::Target target;
+    splatfx::gl::PassTarget target;
     // Headless: the run's output set, for extra files beside the frames
     // (write at outputs->path(f), then outputs->add(f)); null when windowed.
     splatfx::OutputSet* outputs = nullptr;

@@ -200,7 +200,7 @@ TEST_F(RendererGL, OpaqueObjectInsideTheFireHidesExactlyTheSplatsBehindIt) {
     auto rNoDepth = gl::Renderer::create({.depthTest = false, .depthCut = false});
     ASSERT_TRUE(rNoDepth->upload(f.materials));
     HostQuad quad;
-    const gl::Target target{.framebuffer = 0, .width = size.x, .height = size.y};
+    const gl::PassTarget target{.framebuffer = 0, .width = size.x, .height = size.y};
 
     auto fbA = gl::Framebuffer::create({.width = size.x, .height = size.y});
     fbA->clear({0, 0, 0, 1});

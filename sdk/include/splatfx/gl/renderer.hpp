@@ -88,7 +88,7 @@ struct RendererDesc {
     // (Footprint::fractionBefore), instead of the all-or-nothing depth test
     // at the splat plane, so geometry inside an effect and a camera inside
     // one show no popping (pair it with SplatBuilderDesc::nearFade = false,
-    // the default). The host depth is read from Target::depthTexture or the
+    // the default). The host depth is read from PassTarget::depthTexture or the
     // target framebuffer's depth attachment when it is a single-sampled
     // texture; without one only the near plane is cut exactly and the host
     // surface is tested at the splat plane. false: that plain test
@@ -96,20 +96,15 @@ struct RendererDesc {
     bool depthCut = true;
 };
 
-// Where to draw: the host's framebuffer object (0 = default framebuffer) and viewport.
-struct Target {
-    unsigned framebuffer = 0;
-    int x = 0, y = 0;
-    int width = 0, height = 0;
-    // The host's depth as a GL texture (depth format, single-sampled, the
-    // framebuffer's size) for RendererDesc::depthCut; 0: the framebuffer's
-    // depth attachment if it is a texture, else none. Default 0.
-    unsigned depthTexture = 0;
-};
-
-// A Target whose host depth is resolved: what every pass of gl::FrameRenderer
-// draws into (frame_plan.hpp). depthTexture is the single-sampled texture the
-// passes read, or 0 when the host has none they can read (no lookup follows).
+// Where a pass draws: the host's framebuffer object (0 = the default
+// framebuffer), the viewport, and the host's depth as a GL texture (depth
+// format, single-sampled, the framebuffer's size) for RendererDesc::depthCut
+// and the reduced-resolution upsampling. depthTexture 0: Renderer::draw and
+// ScaledRenderer::draw / begin use the framebuffer's depth attachment when it
+// is a single-sampled texture, else none. A FramePlan's target
+// (frame_plan.hpp) has that lookup done: there 0 means none the passes can
+// read. The one other target is the frame renderer's HostTarget, which adds
+// the host's hooks and takes its size from the camera.
 struct PassTarget {
     unsigned framebuffer = 0;
     int x = 0, y = 0, width = 0, height = 0;
@@ -118,6 +113,7 @@ struct PassTarget {
 
 namespace detail {
 class SplatPass;
+class ProgramLibrary;
 }
 
 struct DrawStats {
@@ -144,7 +140,7 @@ public:
     Status upload(const Materials& materials);
     // Draws splats (already sorted back to front) with camera's matrices.
     // Expects upload() to have been called.
-    void draw(std::span<const Splat> splats, const Camera& camera, const Target& target);
+    void draw(std::span<const Splat> splats, const Camera& camera, const PassTarget& target);
 
     // Per-fragment fog (docs/fog.md): from the next draw() on,
     // every splat fragment becomes f c + (1 - f) alpha C_fog (premultiplied,
@@ -170,6 +166,8 @@ public:
 private:
     friend class detail::SplatPass;
     friend class ScaledRenderer;
+    // create() with the program library of the frame renderer it draws for.
+    static Result<Renderer> create(const RendererDesc& desc, std::shared_ptr<detail::ProgramLibrary> programs);
     // draw() with the host depth already resolved (no framebuffer query).
     void drawResolved(std::span<const Splat> splats, const Camera& camera, const PassTarget& target);
     // The fog parameters of the frame being drawn (computed once a frame by

@@ -65,7 +65,7 @@ public:
     // The target's depthTexture (0: the framebuffer's depth attachment when it
     // is a texture) is downsampled for the test and the upsampling; with none,
     // no depth test and plain bilinear upsampling.
-    void draw(std::span<const Splat> splats, const Camera& camera, const Target& target);
+    void draw(std::span<const Splat> splats, const Camera& camera, const PassTarget& target);
 
     // draw() in steps, for more than one pass into the reduced image (gl::FrameRenderer
     // draws a frame's tetrahedra and splats into it in one back-to-front order):
@@ -79,7 +79,7 @@ public:
     // pixels, premultiplied RGBA cleared to 0, whose depth attachment
     // (depthTexture) holds the host depth downsampled (farthest of each
     // block; 1.0 without a host depth).
-    PassTarget begin(const Target& target, glm::ivec4 box);
+    PassTarget begin(const PassTarget& target, glm::ivec4 box);
     void drawSplats(std::span<const Splat> splats, const Camera& camera);
     void composite(const Camera& camera);
 
@@ -89,6 +89,8 @@ public:
 
 private:
     friend class detail::SplatPass;
+    // create() with the program library of the frame renderer it draws for.
+    static Result<ScaledRenderer> create(const ScaledRendererDesc& desc, std::shared_ptr<detail::ProgramLibrary> programs);
     // draw() and begin() with the host depth already resolved.
     void drawResolved(std::span<const Splat> splats, const Camera& camera, const PassTarget& target);
     PassTarget beginResolved(const PassTarget& target, glm::ivec4 box);

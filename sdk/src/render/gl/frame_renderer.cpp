@@ -18,10 +18,10 @@
 namespace splatfx::gl {
 
 struct FrameRenderer::Impl {
-    Impl(const FrameRendererDesc& d, detail::SplatPass s, detail::TetraPass t, detail::FragmentListPass l)
+    Impl(const FrameRendererDesc& d, const detail::Programs& programs, detail::SplatPass s, detail::TetraPass t, detail::FragmentListPass l)
         : desc(d),
           shadow(d.shadowTextureUnit),
-          fog(d.fogTextureSize, d.fogDepthThreshold),
+          fog(d.fogTextureSize, d.fogDepthThreshold, programs),
           splats(std::move(s)),
           tetra(std::move(t)),
           lists(std::move(l)) {}
@@ -72,13 +72,15 @@ Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
     if (desc.fragmentsPerPixel < 1 || desc.fragmentsPerPixel > detail::FragmentListPass::kMaxFragmentsPerPixel)
         return makeError("FrameRendererDesc::fragmentsPerPixel must be in [1, " + std::to_string(detail::FragmentListPass::kMaxFragmentsPerPixel) +
                          "], got " + std::to_string(desc.fragmentsPerPixel));
-    auto splats = detail::SplatPass::create(desc);
+    // One program library for every pass (each releases only its own programs).
+    const auto programs = std::make_shared<detail::ProgramLibrary>();
+    auto splats = detail::SplatPass::create(desc, programs);
     if (!splats) return makeError(splats.error());
-    auto tetra = detail::TetraPass::create();
+    auto tetra = detail::TetraPass::create(programs);
     if (!tetra) return makeError(tetra.error());
-    auto lists = detail::FragmentListPass::create(desc.fragmentsPerPixel, desc.splats);
+    auto lists = detail::FragmentListPass::create(desc.fragmentsPerPixel, desc.splats, programs);
     if (!lists) return makeError(lists.error());
-    auto impl = std::make_unique<Impl>(desc, std::move(*splats), std::move(*tetra), std::move(*lists));
+    auto impl = std::make_unique<Impl>(desc, programs, std::move(*splats), std::move(*tetra), std::move(*lists));
     impl->stats.resolutionScale = desc.resolutionScale;
     return FrameRenderer(std::move(impl));
 }

@@ -18,7 +18,7 @@ HostDepth queryHostDepth(unsigned framebuffer, unsigned texture) {
     return {.texture = texture, .samples = samples};
 }
 
-PassTarget resolveTarget(const Target& target) {
+PassTarget resolveTarget(const PassTarget& target) {
     const HostDepth depth = queryHostDepth(target.framebuffer, target.depthTexture);
     return {.framebuffer = target.framebuffer,
             .x = target.x,

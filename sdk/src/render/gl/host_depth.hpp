@@ -9,7 +9,7 @@ namespace splatfx::gl::detail {
 // attachment (the default framebuffer's depth is never one); with its sample count.
 HostDepth queryHostDepth(unsigned framebuffer, unsigned texture);
 
-// A Target resolved: the depth single-sampled, or 0.
-PassTarget resolveTarget(const Target& target);
+// A bare renderer's target with its depth looked up: single-sampled, or 0.
+PassTarget resolveTarget(const PassTarget& target);
 
 } // namespace splatfx::gl::detail

@@ -11,11 +11,15 @@
 //   glUseProgram((*p)->id);
 //   glUniform1i((*p)->uniform(glsl::tetra::First), first);
 //
-// It does not bind anything or own other GL state. Threading: the GL thread,
-// with the context its programs belong to current.
+// A gl::FrameRenderer's passes share one library (Programs); a bare Renderer
+// or ScaledRenderer makes its own. Each program id belongs to one pass, and a
+// pass releases only its own ids. It does not bind anything or own other GL
+// state. Threading: the GL thread, with the context its programs belong to
+// current.
 #pragma once
 
 #include <map>
+#include <memory>
 #include <vector>
 
 #include "glsl/programs.hpp"
@@ -34,16 +38,6 @@ public:
     ProgramLibrary() = default;
     ProgramLibrary(const ProgramLibrary&) = delete;
     ProgramLibrary& operator=(const ProgramLibrary&) = delete;
-    // Moving keeps every Program pointer valid (the programs move with their map nodes).
-    ProgramLibrary(ProgramLibrary&& other) noexcept : mPrograms(std::move(other.mPrograms)) { other.mPrograms.clear(); }
-    ProgramLibrary& operator=(ProgramLibrary&& other) noexcept {
-        if (this != &other) {
-            release([](const glsl::ProgramKey&) { return true; });
-            mPrograms = std::move(other.mPrograms);
-            other.mPrograms.clear();
-        }
-        return *this;
-    }
     ~ProgramLibrary(); // deletes the programs while their context is current
 
     // The program of `key`, compiled and linked on first use from `data`
@@ -51,12 +45,12 @@ public:
     // valid until release() drops the program. On failure the message names
     // the variant and carries the driver's log; the failure is not cached.
     Result<const Program*> get(const glsl::ProgramKey& key, const glsl::ProgramData& data = {});
-    // Deletes every program `drop` returns true for (e.g. the fog variants of
-    // a fog structure no longer drawn).
+    // Deletes every program of `id` that `drop` returns true for (e.g. the
+    // fog variants of a fog structure no longer drawn).
     template <class Pred>
-    void release(Pred drop) {
+    void release(glsl::ProgramId id, Pred drop) {
         for (auto it = mPrograms.begin(); it != mPrograms.end();)
-            if (drop(it->first)) {
+            if (it->first.id == id && drop(it->first)) {
                 destroy(it->second);
                 it = mPrograms.erase(it);
             } else {
@@ -68,5 +62,8 @@ private:
     static void destroy(const Program& p);
     std::map<glsl::ProgramKey, Program> mPrograms;
 };
+
+// The library shared by the passes of one frame renderer.
+using Programs = std::shared_ptr<ProgramLibrary>;
 
 } // namespace splatfx::gl::detail

@@ -64,7 +64,7 @@ struct Renderer::Impl {
     // each draw run picks the cheapest variant that is exact for its splats.
     enum Variant : unsigned { kCrossfade = 1, kFog = 2, kCut = 4, kHostDepth = 8, kNear = 16, kGeneral = 32 };
     using Program = detail::ProgramLibrary::Program;
-    detail::ProgramLibrary library;
+    detail::Programs library;
     std::string programError; // the last variant that failed to build (never expected: a shader bug)
     std::string fogSource;    // fogGlsl() the fog programs are built from (empty: none)
     std::uint64_t fogKey = 0; // its Fog::glslKey()
@@ -102,9 +102,9 @@ struct Renderer::Impl {
     const Program* program(unsigned variant);
     // Drops the splat programs with any of the variant bits of `mask`.
     void dropPrograms(unsigned mask) {
-        library.release([mask](const glsl::ProgramKey& k) {
+        library->release(glsl::ProgramId::Splat, [mask](const glsl::ProgramKey& k) {
             using namespace glsl::splat;
-            return k.id == glsl::ProgramId::Splat && (((mask & kFog) && k.values[FOG]) || ((mask & kCut) && k.values[CUT]));
+            return ((mask & kFog) && k.values[FOG]) || ((mask & kCut) && k.values[CUT]);
         });
     }
 
@@ -152,7 +152,7 @@ const Renderer::Impl::Program* Renderer::Impl::program(unsigned v) {
     key.values[GENERAL] = cut && (v & kGeneral) ? 1 : 0;
     key.values[CROSSFADE] = (v & kCrossfade) ? 1 : 0;
     key.dataKey = (fogged ? fogKey : 0u) * 1099511628211ull + (cut ? partialKey : 0u);
-    auto p = library.get(key, {.fog = fogged ? std::string_view(fogSource) : std::string_view(),
+    auto p = library->get(key, {.fog = fogged ? std::string_view(fogSource) : std::string_view(),
                                .partial = cut ? std::string_view(partialSource) : std::string_view()});
     if (!p) {
         programError = p.error();
@@ -171,13 +171,16 @@ unsigned Renderer::layerTexture() const { return mImpl->layers; }
 TextureSampling Renderer::sampling() const { return mImpl->sampling; }
 int Renderer::upsampleFactor() const { return mImpl->upsample; }
 
-Result<Renderer> Renderer::create(const RendererDesc& desc) {
+Result<Renderer> Renderer::create(const RendererDesc& desc) { return create(desc, std::make_shared<detail::ProgramLibrary>()); }
+
+Result<Renderer> Renderer::create(const RendererDesc& desc, detail::Programs programs) {
     if (!detail::contextIsCurrent()) return makeError("splatfx::gl::Renderer::create: no OpenGL context is current on this thread");
     if (epoxy_gl_version() < 45)
         return makeError("splatfx::gl::Renderer::create: OpenGL 4.5 is required, the current context has " + std::to_string(epoxy_gl_version() / 10) +
                          "." + std::to_string(epoxy_gl_version() % 10));
     auto impl = std::make_unique<Impl>();
     impl->desc = desc;
+    impl->library = std::move(programs);
     for (int c = 0; c < 256; ++c) impl->rho[size_t(c)] = rayScaleRho(std::uint8_t(c));
     // The plain program now, so a broken build of the shaders fails here
     // (the cut variants need the materials' footprint: built at upload).
@@ -248,7 +251,7 @@ Status Renderer::upload(const Materials& materials) {
     }
     if (r.desc.depthCut && !r.program(Impl::kCut)) return makeError("splatfx::gl::Renderer::upload: " + r.programError);
     if (r.desc.depthCut && !r.tilesProgram) {
-        auto tiles = r.library.get({glsl::ProgramId::DepthTiles});
+        auto tiles = r.library->get({glsl::ProgramId::DepthTiles});
         if (!tiles) return makeError("splatfx::gl::Renderer::upload: " + tiles.error());
         r.tilesProgram = *tiles;
         glCreateVertexArrays(1, &r.tilesVao);
@@ -283,7 +286,7 @@ Status Renderer::setFog(const Fog* fog, double timeSec) {
 
 namespace {} // namespace
 
-void Renderer::draw(std::span<const Splat> splats, const Camera& camera, const Target& target) {
+void Renderer::draw(std::span<const Splat> splats, const Camera& camera, const PassTarget& target) {
     drawResolved(splats, camera, detail::resolveTarget(target));
 }
 

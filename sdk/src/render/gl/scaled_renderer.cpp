@@ -39,7 +39,7 @@ glm::ivec4 splatBounds(std::span<const Splat> splats, const Camera& camera, int 
 struct ScaledRenderer::Impl {
     ScaledRendererDesc desc;
     std::optional<Renderer> inner;
-    detail::ProgramLibrary programs;
+    detail::Programs programs;
     const detail::ProgramLibrary::Program* downsample = nullptr;
     const detail::ProgramLibrary::Program* composite = nullptr;
     GLuint emptyVao = 0;
@@ -98,21 +98,26 @@ const Renderer& ScaledRenderer::renderer() const { return *mImpl->inner; }
 Renderer& ScaledRenderer::renderer() { return *mImpl->inner; }
 
 Result<ScaledRenderer> ScaledRenderer::create(const ScaledRendererDesc& desc) {
+    return create(desc, std::make_shared<detail::ProgramLibrary>());
+}
+
+Result<ScaledRenderer> ScaledRenderer::create(const ScaledRendererDesc& desc, detail::Programs programs) {
     if (desc.scale != 1 && desc.scale != 2 && desc.scale != 4)
         return makeError("ScaledRendererDesc::scale must be 1, 2 or 4 (got " + std::to_string(desc.scale) + ")");
     if (!(desc.depthThreshold > 0.0f))
         return makeError("ScaledRendererDesc::depthThreshold must be positive (got " + std::to_string(desc.depthThreshold) + ")");
     RendererDesc innerDesc = desc.renderer;
     innerDesc.restoreState = false; // draw() saves and restores once around all three passes
-    auto inner = Renderer::create(innerDesc);
+    auto inner = Renderer::create(innerDesc, programs);
     if (!inner) return makeError(inner.error());
     auto impl = std::make_unique<Impl>();
     impl->desc = desc;
     impl->inner = std::move(*inner);
-    auto down = impl->programs.get({glsl::ProgramId::DepthDownsample});
+    impl->programs = std::move(programs);
+    auto down = impl->programs->get({glsl::ProgramId::DepthDownsample});
     if (!down) return makeError(down.error());
     impl->downsample = *down;
-    auto comp = impl->programs.get({glsl::ProgramId::ScaledComposite});
+    auto comp = impl->programs->get({glsl::ProgramId::ScaledComposite});
     if (!comp) return makeError(comp.error());
     impl->composite = *comp;
     glCreateVertexArrays(1, &impl->emptyVao);
@@ -121,15 +126,15 @@ Result<ScaledRenderer> ScaledRenderer::create(const ScaledRendererDesc& desc) {
 
 Status ScaledRenderer::upload(const Materials& materials) { return mImpl->inner->upload(materials); }
 
-void ScaledRenderer::draw(std::span<const Splat> splats, const Camera& camera, const Target& target) {
+void ScaledRenderer::draw(std::span<const Splat> splats, const Camera& camera, const PassTarget& target) {
     drawResolved(splats, camera, detail::resolveTarget(target));
 }
 
-PassTarget ScaledRenderer::begin(const Target& target, glm::ivec4 box) { return beginResolved(detail::resolveTarget(target), box); }
+PassTarget ScaledRenderer::begin(const PassTarget& target, glm::ivec4 box) { return beginResolved(detail::resolveTarget(target), box); }
 
 void ScaledRenderer::drawResolved(std::span<const Splat> splats, const Camera& camera, const PassTarget& target) {
     Impl& r = *mImpl;
-    assert(target.width > 0 && target.height > 0 && "Target::width and height must be positive");
+    assert(target.width > 0 && target.height > 0 && "PassTarget::width and height must be positive");
     if (r.desc.scale == 1) {
         detail::SavedState saved;
         if (r.desc.renderer.restoreState) saved.save({.texture2DUnits = 3, .scissor = true});
@@ -149,7 +154,7 @@ void ScaledRenderer::drawResolved(std::span<const Splat> splats, const Camera& c
 
 PassTarget ScaledRenderer::beginResolved(const PassTarget& target, glm::ivec4 box) {
     Impl& r = *mImpl;
-    assert(target.width > 0 && target.height > 0 && "Target::width and height must be positive");
+    assert(target.width > 0 && target.height > 0 && "PassTarget::width and height must be positive");
     assert(!r.open && "ScaledRenderer::begin: composite() the previous layer first");
     // The passes bind GL_TEXTURE_2D on units 0-2 (colour, depth, host depth
     // copy), the texture array on unit 0, and scissor to the box.

@@ -27,10 +27,10 @@ Status FogPass::build(const Fog& fog) {
     if (fog.glslKey() == mFogKey) return {}; // the same structure: the same programs
     auto glsl = fogGlsl(fog);
     if (!glsl) return makeError("fog pass: " + glsl.error());
-    mPrograms.release([](const glsl::ProgramKey&) { return true; });
+    mPrograms->release(glsl::ProgramId::FogPass, [](const glsl::ProgramKey&) { return true; });
     mFogKey = 0;
     for (int m = 0; m < 3; ++m) {
-        auto p = mPrograms.get({glsl::ProgramId::FogPass, {m}, fog.glslKey()}, {.fog = glsl->source});
+        auto p = mPrograms->get({glsl::ProgramId::FogPass, {m}, fog.glslKey()}, {.fog = glsl->source});
         if (!p) return makeError(p.error());
         mModes[m] = *p;
     }

@@ -34,7 +34,8 @@ class FogPass final : public Pass {
 public:
     // textureSize (0, 0): per pixel; else the reduced fog texture's size.
     // depthThreshold: relative distance difference still one surface when upsampling.
-    FogPass(glm::ivec2 textureSize, float depthThreshold) : mAskedSize(textureSize), mDepthThreshold(depthThreshold) {}
+    FogPass(glm::ivec2 textureSize, float depthThreshold, Programs programs)
+        : mPrograms(std::move(programs)), mAskedSize(textureSize), mDepthThreshold(depthThreshold) {}
     FogPass(const FogPass&) = delete;
     FogPass& operator=(const FogPass&) = delete;
     ~FogPass();
@@ -48,7 +49,7 @@ public:
 
 private:
     Status build(const Fog& fog);
-    ProgramLibrary mPrograms;
+    Programs mPrograms;
     // Per pixel; reduced: evaluate into the texture; upsample and blend (MODE 0, 1, 2).
     const ProgramLibrary::Program* mModes[3] = {};
     std::uint64_t mFogKey = 0; // Fog::glslKey() the programs were built for

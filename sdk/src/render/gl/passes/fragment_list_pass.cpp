@@ -51,7 +51,7 @@ struct FragmentListPass::Impl {
         const ProgramLibrary::Program* program = nullptr;
     };
     using Program = ProgramLibrary::Program;
-    ProgramLibrary library;
+    Programs library;
     // [kind][2, 4, 8 sections]; kinds: 0 plain; cut with 1 near and host
     // cuts, 2 the same general (the polygon crosses the eye plane), 3 no
     // near or host cut, 4 near only, 5 host only (3-5 built on first use).
@@ -82,7 +82,7 @@ struct FragmentListPass::Impl {
             SectionProgram& p = sectionPrograms[kind][v];
             p = {};
             key.values[SECTIONS] = counts[v];
-            auto linked = library.get(key, {.partial = cut ? std::string_view(partialSource) : std::string_view()});
+            auto linked = library->get(key, {.partial = cut ? std::string_view(partialSource) : std::string_view()});
             if (!linked) {
                 programError = linked.error();
                 return false;
@@ -102,7 +102,7 @@ struct FragmentListPass::Impl {
     const Program* fragmentResolve(int k) {
         for (const auto& fp : fragmentResolvePrograms)
             if (fp.first == k) return fp.second;
-        auto prog = library.get({glsl::ProgramId::ListResolveFrag, {k}});
+        auto prog = library->get({glsl::ProgramId::ListResolveFrag, {k}});
         const Program* p = prog ? *prog : nullptr; // null: this GL cannot build it; the compute resolve is used
         fragmentResolvePrograms.push_back({k, p});
         return p;
@@ -211,30 +211,31 @@ FragmentListPass& FragmentListPass::operator=(FragmentListPass&&) noexcept = def
 FragmentListPass::~FragmentListPass() = default;
 const FragmentListStats& FragmentListPass::stats() const { return mImpl->stats; }
 
-Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel, const RendererDesc& splats) {
+Result<FragmentListPass> FragmentListPass::create(int fragmentsPerPixel, const RendererDesc& splats, Programs programs) {
     auto impl = std::make_unique<Impl>();
+    impl->library = std::move(programs);
     impl->perPixel = std::clamp(fragmentsPerPixel, 1, kMaxFragmentsPerPixel);
     if (!impl->buildSections(0)) return makeError(impl->programError);
     // Resolve variants for K = 1, 2, 4, ... below the budget and the budget
     // itself: a frame with few surfaces per pixel runs the smallest that holds
     // them (the per-pixel arrays cost in proportion to K on a CPU rasterizer).
     for (int k = 1;; k = std::min(2 * k, impl->perPixel)) {
-        auto resolve = impl->library.get({glsl::ProgramId::ListResolve, {k}});
+        auto resolve = impl->library->get({glsl::ProgramId::ListResolve, {k}});
         if (!resolve) return makeError(resolve.error());
         impl->resolvePrograms.push_back({k, *resolve});
         if (k == impl->perPixel) break;
     }
-    auto prepare = impl->library.get({glsl::ProgramId::ListPrepare});
+    auto prepare = impl->library->get({glsl::ProgramId::ListPrepare});
     if (!prepare) return makeError(prepare.error());
     impl->prepareProgram = *prepare;
-    auto range = impl->library.get({glsl::ProgramId::ListTileRange});
+    auto range = impl->library->get({glsl::ProgramId::ListTileRange});
     if (!range) return makeError(range.error());
     impl->rangeProgram = *range;
-    auto hostTile = impl->library.get({glsl::ProgramId::ListHostTiles});
+    auto hostTile = impl->library->get({glsl::ProgramId::ListHostTiles});
     if (!hostTile) return makeError(hostTile.error());
     impl->hostTileProgram = *hostTile;
     for (int c = 0; c < 256; ++c) impl->rho[std::size_t(c)] = rayScaleRho(std::uint8_t(c));
-    auto composite = impl->library.get({glsl::ProgramId::ListComposite});
+    auto composite = impl->library->get({glsl::ProgramId::ListComposite});
     if (!composite) return makeError(composite.error());
     impl->compositeProgram = *composite;
 
@@ -254,7 +255,7 @@ Status FragmentListPass::upload(const Materials& materials) {
     r.kernelRadius = materials.footprint().radius();
     std::string partial = partialGlsl(materials.footprint(), 3);
     if (partial == r.partialSource) return {};
-    r.library.release([](const glsl::ProgramKey& k) { return k.id == glsl::ProgramId::ListSection && k.values[glsl::section::CUT] != 0; });
+    r.library->release(glsl::ProgramId::ListSection, [](const glsl::ProgramKey& k) { return k.values[glsl::section::CUT] != 0; });
     r.partialKey = std::hash<std::string>{}(partial);
     r.partialSource = std::move(partial);
     for (int kind = 1; kind < Impl::kKinds; ++kind)

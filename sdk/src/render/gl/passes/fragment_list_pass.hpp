@@ -54,6 +54,7 @@
 #include "splatfx/result.hpp"
 #include "splatfx/splats.hpp"
 #include "pass.hpp"
+#include "render/gl/program_library.hpp"
 #include "render/gl/saved_state.hpp"
 #include "splatfx/gl/renderer.hpp"
 
@@ -81,7 +82,7 @@ public:
     // fragmentsPerPixel in [1, kMaxFragmentsPerPixel] (checked by the caller).
     static constexpr int kMaxFragmentsPerPixel = 128;
     // splats: the splat pass's settings (the sections cut and trim as it does).
-    static Result<FragmentListPass> create(int fragmentsPerPixel, const RendererDesc& splats);
+    static Result<FragmentListPass> create(int fragmentsPerPixel, const RendererDesc& splats, Programs programs);
     FragmentListPass(FragmentListPass&&) noexcept;
     FragmentListPass& operator=(FragmentListPass&&) noexcept;
     ~FragmentListPass();

@@ -5,15 +5,16 @@
 
 namespace splatfx::gl::detail {
 
-Result<SplatPass> SplatPass::create(const FrameRendererDesc& desc) {
+Result<SplatPass> SplatPass::create(const FrameRendererDesc& desc, Programs programs) {
     SplatPass pass;
     if (desc.resolutionScale == 1) {
-        auto r = Renderer::create(desc.splats);
+        auto r = Renderer::create(desc.splats, std::move(programs));
         if (!r) return makeError(r.error());
         pass.mFull.emplace(std::move(*r));
     } else {
         auto r = ScaledRenderer::create(
-            {.scale = desc.resolutionScale, .renderer = desc.splats, .precision = desc.reducedPrecision, .depthThreshold = desc.depthThreshold});
+            {.scale = desc.resolutionScale, .renderer = desc.splats, .precision = desc.reducedPrecision, .depthThreshold = desc.depthThreshold},
+            std::move(programs));
         if (!r) return makeError(r.error());
         pass.mReduced.emplace(std::move(*r));
     }

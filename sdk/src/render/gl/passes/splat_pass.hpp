@@ -9,6 +9,7 @@
 #include <string>
 
 #include "pass.hpp"
+#include "render/gl/program_library.hpp"
 #include "splatfx/gl/renderer.hpp"
 #include "splatfx/gl/scaled_renderer.hpp"
 
@@ -16,7 +17,7 @@ namespace splatfx::gl::detail {
 
 class SplatPass final : public Pass {
 public:
-    static Result<SplatPass> create(const FrameRendererDesc& desc);
+    static Result<SplatPass> create(const FrameRendererDesc& desc, Programs programs);
 
     Status upload(const Materials& materials) override;
     void prepare(const FramePlan& plan, const Frame& frame) override; // the fog variant

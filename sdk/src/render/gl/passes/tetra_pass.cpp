@@ -34,7 +34,7 @@ constexpr std::uint32_t kTetraFaces[12] = {1, 2, 3, 0, 3, 2, 0, 1, 3, 0, 2, 1};
 } // namespace
 
 struct TetraPass::Impl {
-    ProgramLibrary library;
+    Programs library;
     using Program = ProgramLibrary::Program;
     const Program* programs[4] = {}; // [perspective * 2 + host depth]
     // The fog variants, built for the structure of the last fog seen (Fog::glslKey).
@@ -80,12 +80,13 @@ TetraPass& TetraPass::operator=(TetraPass&&) noexcept = default;
 TetraPass::~TetraPass() = default;
 const TetraStats& TetraPass::stats() const { return mImpl->stats; }
 
-Result<TetraPass> TetraPass::create() {
+Result<TetraPass> TetraPass::create(Programs programs) {
     if (!contextIsCurrent()) return makeError("splatfx::gl tetrahedra pass: no OpenGL context is current on this thread");
     auto impl = std::make_unique<Impl>();
     Impl& r = *impl;
+    r.library = std::move(programs);
     for (int v = 0; v < 4; ++v) {
-        auto p = r.library.get({glsl::ProgramId::Tetra, {(v & 2) ? 1 : 0, v & 1, 0}});
+        auto p = r.library->get({glsl::ProgramId::Tetra, {(v & 2) ? 1 : 0, v & 1, 0}});
         if (!p) return makeError(p.error());
         r.programs[v] = *p;
     }
@@ -105,13 +106,13 @@ Status TetraPass::setFog(const Fog* fog, double timeSec) {
         r.fog = nullptr;
         return makeError("splatfx::gl tetrahedra pass: " + glsl.error());
     }
-    r.library.release([](const glsl::ProgramKey& k) { return k.values[glsl::tetra::FOG] != 0; });
+    r.library->release(glsl::ProgramId::Tetra, [](const glsl::ProgramKey& k) { return k.values[glsl::tetra::FOG] != 0; });
     for (auto& p : r.fogPrograms) p = nullptr;
     r.fogKey = 0;
     for (int v = 0; v < 4; ++v) {
-        auto p = r.library.get({glsl::ProgramId::Tetra, {(v & 2) ? 1 : 0, v & 1, 1}, r.fog->glslKey()}, {.fog = glsl->source});
+        auto p = r.library->get({glsl::ProgramId::Tetra, {(v & 2) ? 1 : 0, v & 1, 1}, r.fog->glslKey()}, {.fog = glsl->source});
         if (!p) {
-            r.library.release([](const glsl::ProgramKey& k) { return k.values[glsl::tetra::FOG] != 0; });
+            r.library->release(glsl::ProgramId::Tetra, [](const glsl::ProgramKey& k) { return k.values[glsl::tetra::FOG] != 0; });
             for (auto& q : r.fogPrograms) q = nullptr;
             r.fog = nullptr;
             return makeError(p.error());

@@ -31,6 +31,7 @@
 #include "splatfx/frame.hpp"
 #include "splatfx/result.hpp"
 #include "pass.hpp"
+#include "render/gl/program_library.hpp"
 
 namespace splatfx::gl::detail {
 
@@ -46,7 +47,7 @@ struct TetraStats {
 
 class TetraPass final : public Pass {
 public:
-    static Result<TetraPass> create();
+    static Result<TetraPass> create(Programs programs);
     TetraPass(TetraPass&&) noexcept;
     TetraPass& operator=(TetraPass&&) noexcept;
     ~TetraPass();
