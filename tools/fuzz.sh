@@ -26,7 +26,7 @@ CC_FUZZ="${CC_FUZZ:-clang}" # the C API's C tests share the instrumentation flag
 command -v "$CXX_FUZZ" >/dev/null || { echo "fuzz: $CXX_FUZZ not found (Debian: apt-get install clang libclang-rt-dev)" >&2; exit 1; }
 echo "fuzz: configuring $BUILD_DIR with $CXX_FUZZ"
 cmake -S . -B "$BUILD_DIR" -DCMAKE_CXX_COMPILER="$CXX_FUZZ" -DCMAKE_C_COMPILER="$CC_FUZZ" -DSPLATFX_FUZZ=ON \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DSPLATFX_CHECK_GLSL=OFF \
   -DSPLATFX_BUILD_TESTS=ON -DSPLATFX_BUILD_TOOLS=ON -DSPLATFX_BUILD_SAMPLES=OFF >/dev/null
 targets=()
 for t in $FUZZ_TARGETS; do targets+=("fuzz_$t"); done

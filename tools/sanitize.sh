@@ -21,8 +21,12 @@ JOBS="${JOBS:-$(nproc)}"
 start=$(date +%s)
 tools/setup-deps.sh
 echo "sanitize: configuring $BUILD_DIR (GCC, SPLATFX_SANITIZE=ON)"
-cmake -S . -B "$BUILD_DIR" -DSPLATFX_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DSPLATFX_BUILD_TESTS=ON -DSPLATFX_BUILD_TOOLS="${SPLATFX_SANITIZE_TOOLS:-ON}" -DSPLATFX_BUILD_SAMPLES="${SPLATFX_SANITIZE_TOOLS:-ON}" >/dev/null
+# -O1 -g1 (line tables: every report still names file and line): the sanitized build is the
+# longest step of CI, and these flags compile in 0.58 of the time of -O2 -g (measured on
+# tests/render/renderer_gl_test.cpp, 10.9 s against 18.9 s). The GLSL is the same as the
+# plain build's, which checks every variant: no second check here.
+cmake -S . -B "$BUILD_DIR" -DSPLATFX_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
+  -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DSPLATFX_CHECK_GLSL=OFF -DSPLATFX_BUILD_TESTS=ON -DSPLATFX_BUILD_TOOLS="${SPLATFX_SANITIZE_TOOLS:-ON}" -DSPLATFX_BUILD_SAMPLES="${SPLATFX_SANITIZE_TOOLS:-ON}" >/dev/null
 echo "sanitize: building with $JOBS jobs"
 cmake --build "$BUILD_DIR" -j"$JOBS"
 built=$(date +%s)

@@ -30,6 +30,18 @@ Status setFogUniforms(unsigned program, const Fog& fog, double timeSec, glm::dve
 
 namespace detail {
 
+Result<FogChange> fogChange(const Fog* fog, std::uint64_t builtKey) {
+    if (!fog || fog->empty()) return FogChange{};
+    if (fog->glslKey() == builtKey) return FogChange{.fog = fog, .rebuild = std::nullopt}; // the same structure: the same programs
+    auto glsl = fogGlsl(*fog);
+    if (!glsl) return makeError(glsl.error());
+    return FogChange{.fog = fog, .rebuild = std::move(glsl->source)};
+}
+
+} // namespace detail
+
+namespace detail {
+
 void setFogUniforms(unsigned program, const FogLocations& at, const Fog& fog, std::span<const glm::vec4> params) {
     if (at.params >= 0 && !params.empty()) glProgramUniform4fv(program, at.params, GLsizei(params.size()), glm::value_ptr(params[0]));
     const glm::dvec3 c = fog.desc().colour;

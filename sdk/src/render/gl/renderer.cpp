@@ -19,6 +19,7 @@
 #include "host_depth.hpp"
 #include "partial_texture.hpp"
 #include "saved_state.hpp"
+#include "over_state.hpp"
 #include "program_library.hpp"
 #include "splat_vertex.hpp"
 
@@ -263,17 +264,13 @@ void Renderer::setFrameFogParameters(const std::vector<glm::vec4>* params) { mIm
 
 Status Renderer::setFog(const Fog* fog, double timeSec) {
     Impl& r = *mImpl;
-    r.fog = fog && !fog->empty() ? fog : nullptr; // zero terms: clear air, the plain shaders
     r.fogTimeSec = timeSec;
-    if (!r.fog) return {};
-    if (r.fog->glslKey() == r.fogKey) return {}; // the same structure: the same programs
-    auto glsl = fogGlsl(*r.fog);
-    if (!glsl) {
-        r.fog = nullptr;
-        return makeError("splatfx::gl::Renderer::setFog: " + glsl.error());
-    }
+    auto change = detail::fogChange(fog, r.fogKey);
+    r.fog = change ? change->fog : nullptr;
+    if (!change) return makeError("splatfx::gl::Renderer::setFog: " + change.error());
+    if (!change->rebuild) return {};
     r.dropPrograms(Impl::kFog);
-    r.fogSource = std::move(glsl->source);
+    r.fogSource = std::move(*change->rebuild);
     r.fogKey = r.fog->glslKey();
     if (!r.program(Impl::kFog | (r.desc.depthCut && !r.partialSource.empty() ? Impl::kCut : 0u))) {
         r.fog = nullptr;
@@ -414,20 +411,9 @@ void Renderer::drawResolved(std::span<const Splat> splats, const Camera& camera,
         anyCrossfade |= sp.blend > 0.0f;
     }
 
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
-    glViewport(target.x, target.y, target.width, target.height);
-    glEnable(GL_BLEND);
-    glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-    glBlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
     // With the host depth read, the cut replaces the hardware test (the
     // depth texture is read, never written: the test and writes are off).
-    if (r.desc.depthTest && !depthTex) {
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_LEQUAL);
-    } else {
-        glDisable(GL_DEPTH_TEST);
-    }
-    glDepthMask(GL_FALSE);
+    detail::setOverState(target.framebuffer, target, r.desc.depthTest && !depthTex ? detail::DepthTest::LessEqual : detail::DepthTest::Off);
     glDisable(GL_CULL_FACE);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 

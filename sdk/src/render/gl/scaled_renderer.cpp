@@ -12,6 +12,7 @@
 #include "host_depth.hpp"
 #include "formats.hpp"
 #include "saved_state.hpp"
+#include "over_state.hpp"
 #include "program_library.hpp"
 
 namespace splatfx::gl {
@@ -227,13 +228,7 @@ void ScaledRenderer::composite(const Camera& camera) {
     const GLint hostRect[4] = {0, 0, target.width, target.height};
     glEnable(GL_SCISSOR_TEST);
     glScissor(target.x + r.fullBox.x, target.y + r.fullBox.y, r.fullBox.z - r.fullBox.x, r.fullBox.w - r.fullBox.y);
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
-    glViewport(target.x, target.y, target.width, target.height);
-    glEnable(GL_BLEND);
-    glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-    glBlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
-    glDisable(GL_DEPTH_TEST);
-    glDepthMask(GL_FALSE);
+    detail::setOverState(target.framebuffer, target, detail::DepthTest::Off);
     glDisable(GL_CULL_FACE);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glUseProgram(r.composite->id);

@@ -11,6 +11,7 @@
 
 #include "render/gl/context_check.hpp"
 #include "render/gl/fog_state.hpp"
+#include "render/gl/over_state.hpp"
 #include "render/gl/saved_state.hpp"
 
 namespace splatfx::gl::detail {
@@ -105,13 +106,9 @@ Status FogPass::draw(const Fog& fog, double timeSec, const Camera& camera, const
         common(*mModes[1]);
         glDrawArrays(GL_TRIANGLES, 0, 3);
     }
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
-    glViewport(target.x, target.y, target.width, target.height);
-    glEnable(GL_BLEND);
     // The fog as a premultiplied layer ((1 - f) C_fog, 1 - f) over the host
     // image: dst' = (1 - f) C_fog + f dst, eq. 5, with no copy of the colour.
-    glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-    glBlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
+    setOverState(target.framebuffer, target, DepthTest::Off);
     if (reduced) {
         glBindTextureUnit(1, mTexture);
         common(*mModes[2]);

@@ -17,6 +17,7 @@
 
 #include "render/gl/context_check.hpp"
 #include "render/gl/partial_texture.hpp"
+#include "render/gl/over_state.hpp"
 #include "render/gl/program_library.hpp"
 #include "render/gl/splat_vertex.hpp"
 #include "splatfx/footprint.hpp"
@@ -284,14 +285,7 @@ Status FragmentListPass::collectSurfaces(const PassTarget& target, const std::fu
     glBindImageTexture(kTransparentHeadImageUnit, r.heads, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     if (drawSurfaces) {
-        glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
-        glViewport(target.x, target.y, target.width, target.height);
-        glEnable(GL_BLEND);
-        glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-        glBlendEquation(GL_FUNC_ADD);
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_LEQUAL);
-        glDepthMask(GL_FALSE);
+        setOverState(target.framebuffer, target, DepthTest::LessEqual);
         drawSurfaces();
     }
     // The survey of the lists (kTileRangeCompute).
@@ -483,18 +477,11 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t b
     GLenum bufs[kTransparentMaxSections];
     for (int k = 0; k < kTransparentMaxSections; ++k) bufs[k] = k < prog->sections ? GL_COLOR_ATTACHMENT0 + GLenum(k) : GL_NONE;
     glNamedFramebufferDrawBuffers(r.sectionFbo, kTransparentMaxSections, bufs);
-    glBindFramebuffer(GL_FRAMEBUFFER, r.sectionFbo);
-    glViewport(target.x, target.y, target.width, target.height);
     glDisable(GL_SCISSOR_TEST);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     const GLfloat clear[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     for (int k = 0; k < prog->sections; ++k) glClearNamedFramebufferfv(r.sectionFbo, GL_COLOR, k, clear);
-    glEnable(GL_BLEND);
-    glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-    glBlendEquation(GL_FUNC_ADD);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LEQUAL);
-    glDepthMask(GL_FALSE);
+    setOverState(r.sectionFbo, target, DepthTest::LessEqual);
     glDisable(GL_CULL_FACE);
     // Perspective with the cut: a polygon that crosses (or nearly) the eye
     // plane takes the general variant (screen-covering, each fragment meets
@@ -594,43 +581,30 @@ void FragmentListPass::resolve(const PassTarget& target) {
     // compute dispatch costs llvmpipe several times a draw per pixel, and
     // the RGBA16F image between the two goes.
     const Impl::Program* fragmentProgram = GLuint(programK) >= maxSurfaces && r.poolViewed ? r.fragmentResolve(programK) : nullptr;
-    if (fragmentProgram) {
-        glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
-        glViewport(target.x, target.y, target.width, target.height);
-        glEnable(GL_BLEND);
-        glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-        glBlendEquation(GL_FUNC_ADD);
-        glDisable(GL_DEPTH_TEST);
-        glDepthMask(GL_FALSE);
-        glUseProgram(fragmentProgram->id);
-        glUniform1i(fragmentProgram->uniform(glsl::lists::SectionCount), r.sectionsThisFrame);
-        glUniform2i(fragmentProgram->uniform(glsl::lists::Origin), target.x, target.y);
-        glUniform2i(fragmentProgram->uniform(glsl::lists::Size), target.width, target.height);
+    // Both resolves read the lists and the sections the same way.
+    auto useResolve = [&](const Impl::Program& p) {
+        glUseProgram(p.id);
+        glUniform1i(p.uniform(glsl::lists::SectionCount), r.sectionsThisFrame);
+        glUniform2i(p.uniform(glsl::lists::Origin), target.x, target.y);
+        glUniform2i(p.uniform(glsl::lists::Size), target.width, target.height);
         if (r.sectionsThisFrame > 0) glBindTextureUnit(1, r.sections);
         glBindTextureUnit(2, r.heads);
+    };
+    if (fragmentProgram) {
+        setOverState(target.framebuffer, target, DepthTest::Off);
+        useResolve(*fragmentProgram);
         glBindTextureUnit(4, r.poolView);
         glBindVertexArray(r.emptyVao);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glBindTextureUnit(4, 0);
     } else {
-        glUseProgram(program->id);
-        glUniform1i(program->uniform(glsl::lists::SectionCount), r.sectionsThisFrame);
-        glUniform2i(program->uniform(glsl::lists::Origin), target.x, target.y);
-        glUniform2i(program->uniform(glsl::lists::Size), target.width, target.height);
-        if (r.sectionsThisFrame > 0) glBindTextureUnit(1, r.sections);
-        glBindTextureUnit(2, r.heads);
+        useResolve(*program);
         glBindImageTexture(5, r.resolved, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
         glDispatchCompute(GLuint((target.width + 7) / 8), GLuint((target.height + 7) / 8), 1);
         glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
         glBindImageTexture(5, 0, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA16F);
 
-        glBindFramebuffer(GL_FRAMEBUFFER, target.framebuffer);
-        glViewport(target.x, target.y, target.width, target.height);
-        glEnable(GL_BLEND);
-        glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-        glBlendEquation(GL_FUNC_ADD);
-        glDisable(GL_DEPTH_TEST);
-        glDepthMask(GL_FALSE);
+        setOverState(target.framebuffer, target, DepthTest::Off);
         glUseProgram(r.compositeProgram->id);
         glUniform2i(r.compositeProgram->uniform(glsl::lists::Origin), target.x, target.y);
         glBindTextureUnit(1, r.resolved);

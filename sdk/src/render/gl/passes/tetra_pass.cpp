@@ -16,6 +16,7 @@
 #include "render/gl/context_check.hpp"
 #include "render/gl/fog_state.hpp"
 #include "render/gl/saved_state.hpp"
+#include "render/gl/over_state.hpp"
 #include "render/gl/program_library.hpp"
 
 namespace splatfx::gl::detail {
@@ -97,20 +98,16 @@ Result<TetraPass> TetraPass::create(Programs programs) {
 
 Status TetraPass::setFog(const Fog* fog, double timeSec) {
     Impl& r = *mImpl;
-    r.fog = fog && !fog->empty() ? fog : nullptr; // zero terms: clear air, the plain programs
     r.fogTimeSec = timeSec;
-    if (!r.fog) return {};
-    if (r.fog->glslKey() == r.fogKey) return {}; // the same structure: the same programs
-    auto glsl = fogGlsl(*r.fog);
-    if (!glsl) {
-        r.fog = nullptr;
-        return makeError("splatfx::gl tetrahedra pass: " + glsl.error());
-    }
+    auto change = fogChange(fog, r.fogKey);
+    r.fog = change ? change->fog : nullptr;
+    if (!change) return makeError("splatfx::gl tetrahedra pass: " + change.error());
+    if (!change->rebuild) return {};
     r.library->release(glsl::ProgramId::Tetra, [](const glsl::ProgramKey& k) { return k.values[glsl::tetra::FOG] != 0; });
     for (auto& p : r.fogPrograms) p = nullptr;
     r.fogKey = 0;
     for (int v = 0; v < 4; ++v) {
-        auto p = r.library->get({glsl::ProgramId::Tetra, {(v & 2) ? 1 : 0, v & 1, 1}, r.fog->glslKey()}, {.fog = glsl->source});
+        auto p = r.library->get({glsl::ProgramId::Tetra, {(v & 2) ? 1 : 0, v & 1, 1}, r.fog->glslKey()}, {.fog = *change->rebuild});
         if (!p) {
             r.library->release(glsl::ProgramId::Tetra, [](const glsl::ProgramKey& k) { return k.values[glsl::tetra::FOG] != 0; });
             for (auto& q : r.fogPrograms) q = nullptr;
@@ -267,18 +264,9 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     glGetIntegerv(GL_FRONT_FACE, &prevFrontFace);
     const GLboolean prevClamp = glIsEnabled(GL_DEPTH_CLAMP);
 
-    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, target.framebuffer);
-    glViewport(target.x, target.y, target.width, target.height);
-    glEnable(GL_BLEND);
-    glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
-    glBlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
-    glDepthMask(GL_FALSE);
-    if (hostDepth) {
-        glDisable(GL_DEPTH_TEST); // the shader cuts each segment at the host depth
-    } else {
-        glEnable(GL_DEPTH_TEST); // no depth texture: whole fragments behind the host are dropped
-        glDepthFunc(GL_LEQUAL);
-    }
+    // With the host depth the shader cuts each segment there; without it
+    // whole fragments behind the host are dropped.
+    setOverState(target.framebuffer, target, hostDepth ? DepthTest::Off : DepthTest::LessEqual);
     glEnable(GL_DEPTH_CLAMP); // the CPU clipped at the near plane; GL must not clip again by rounding
     glEnable(GL_CULL_FACE);
     glCullFace(GL_BACK);
