@@ -1,37 +1,28 @@
 #!/usr/bin/env bash
 # Fuzz the SDK's input boundaries with libFuzzer (issue 13, item 7).
-#   tools/fuzz.sh              configure build-fuzz/ (clang, SPLATFX_FUZZ=ON: the SDK
-#                              itself instrumented), build, run every target
+#   tools/fuzz.sh              build the fuzz targets in build-asan/ (the instrumented build
+#                              tools/sanitize.sh shares: tools/instrumented-build.sh), run
+#                              every target
 #   FUZZ_SECONDS=600 tools/fuzz.sh        longer runs (default 60 s per target)
 #   FUZZ_TARGETS="scene_file image" ...   a subset (default: all)
 #   FUZZ_RUNS=20000 tools/fuzz.sh         a fixed number of inputs per target instead of
 #                              a time: with the fixed seed the same inputs every run (CI
 #                              uses this, so a finding there is a change's, not luck's)
 # Each target starts from its seeds (tests/fuzz/corpus/<t>/) and past crashes
-# (tests/fuzz/regressions/<t>/); the working corpus grows in build-fuzz/corpus/<t>/.
+# (tests/fuzz/regressions/<t>/); the working corpus grows in build-asan/corpus/<t>/.
 # Any finding (crash, sanitizer report, leak, timeout, out-of-memory) fails the
-# script and leaves the input in build-fuzz/findings/<t>/: commit it under
+# script and leaves the input in build-asan/findings/<t>/: commit it under
 # tests/fuzz/regressions/<t>/ with the fix, where fuzz_replay_<t> (a normal
 # test) replays it from then on.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-BUILD_DIR="${BUILD_DIR:-build-fuzz}"
-JOBS="${JOBS:-$(nproc)}"
+BUILD_DIR="${BUILD_DIR:-build-asan}"
+export BUILD_DIR
 FUZZ_SECONDS="${FUZZ_SECONDS:-60}"
 FUZZ_TARGETS="${FUZZ_TARGETS:-scene_file texture_set image mesh}"
-CXX_FUZZ="${CXX_FUZZ:-clang++}"
-CC_FUZZ="${CC_FUZZ:-clang}" # the C API's C tests share the instrumentation flags, which gcc does not know
-
-[ "$CXX_FUZZ" = clang++ ] && tools/setup-deps.sh --fuzz
-command -v "$CXX_FUZZ" >/dev/null || { echo "fuzz: $CXX_FUZZ not found (Debian: apt-get install clang libclang-rt-dev)" >&2; exit 1; }
-echo "fuzz: configuring $BUILD_DIR with $CXX_FUZZ"
-cmake -S . -B "$BUILD_DIR" -DCMAKE_CXX_COMPILER="$CXX_FUZZ" -DCMAKE_C_COMPILER="$CC_FUZZ" -DSPLATFX_FUZZ=ON \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DSPLATFX_CHECK_GLSL=OFF \
-  -DSPLATFX_BUILD_TESTS=ON -DSPLATFX_BUILD_TOOLS=ON -DSPLATFX_BUILD_SAMPLES=OFF >/dev/null
 targets=()
 for t in $FUZZ_TARGETS; do targets+=("fuzz_$t"); done
-echo "fuzz: building ${targets[*]} with $JOBS jobs"
-cmake --build "$BUILD_DIR" -j"$JOBS" --target "${targets[@]}"
+tools/instrumented-build.sh "${targets[@]}"
 
 # Mesa/assimp/OpenImageIO are not instrumented; leaks inside them are not ours
 # (the same suppressions as the sanitizer suite), and leak checks stay on for the rest.

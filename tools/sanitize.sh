@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer
-# (GCC; issue 13, item 8), GL tests included (headless Mesa llvmpipe).
+# The whole test suite under AddressSanitizer + UndefinedBehaviorSanitizer, GL tests
+# included (headless Mesa llvmpipe), on the instrumented build tools/fuzz.sh shares
+# (tools/instrumented-build.sh: clang, build-asan/).
 #   tools/sanitize.sh                 configure build-asan/, build everything, run ctest
 #   CTEST_ARGS="-L cpu" tools/sanitize.sh   a subset
 # Leak checking is on for every test that does not create a GL context (label
@@ -12,23 +13,15 @@
 # can match those allocations. Measured on 2026-12-01: with leak checking on,
 # every process that made a context reported the same 128 + 112 bytes from
 # that frame and nothing else.
-#   SPLATFX_SANITIZE_TOOLS=OFF tools/sanitize.sh   the SDK and its tests only (faster)
-# UBSan stops at the first report (halt_on_error), so a report fails its test.
+# UBSan stops at the first report (-fno-sanitize-recover), so a report fails its test.
+# (GCC's sanitizers: configure any build dir with -DSPLATFX_SANITIZE=ON.)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BUILD_DIR="${BUILD_DIR:-build-asan}"
 JOBS="${JOBS:-$(nproc)}"
+export BUILD_DIR JOBS
 start=$(date +%s)
-tools/setup-deps.sh
-echo "sanitize: configuring $BUILD_DIR (GCC, SPLATFX_SANITIZE=ON)"
-# -O1 -g1 (line tables: every report still names file and line): the sanitized build is the
-# longest step of CI, and these flags compile in 0.58 of the time of -O2 -g (measured on
-# tests/render/renderer_gl_test.cpp, 10.9 s against 18.9 s). The GLSL is the same as the
-# plain build's, which checks every variant: no second check here.
-cmake -S . -B "$BUILD_DIR" -DSPLATFX_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
-  -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DSPLATFX_CHECK_GLSL=OFF -DSPLATFX_BUILD_TESTS=ON -DSPLATFX_BUILD_TOOLS="${SPLATFX_SANITIZE_TOOLS:-ON}" -DSPLATFX_BUILD_SAMPLES="${SPLATFX_SANITIZE_TOOLS:-ON}" >/dev/null
-echo "sanitize: building with $JOBS jobs"
-cmake --build "$BUILD_DIR" -j"$JOBS"
+tools/instrumented-build.sh
 built=$(date +%s)
 # Fast unwinding on malloc (the default): with fast_unwind_on_malloc=0 llvmpipe's
 # allocations make one GL test take over 5 minutes. The fuzz replays, whose
