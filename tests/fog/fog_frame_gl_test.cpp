@@ -148,7 +148,17 @@ TEST_F(FogFrameGL, SplatsAndHostInFogAgreeWithTheReferenceWithinSplatErrorPlusFo
 
 // A host depth texture with every hard value: a surface, sky (1.0), NaN,
 // beyond 1 and below 0; per pixel against the reference's host fog.
-TEST_F(FogFrameGL, HostFogHandlesSkyNaNAndOutOfRangeDepth) {
+// The host fog alone: a depth texture holding `depthAt(x, y)` (GL rows,
+// bottom first) under `camera`, fogged by the frame renderer, and the
+// splat-exact reference of the same (its depth is what the texture holds: a
+// driver may clamp out-of-range values on upload).
+struct HostFogRun {
+    Image got, want, depth;
+    SplatExactStats reference;
+};
+template <class DepthAt>
+HostFogRun renderHostFog(const Camera& camera, const Fog& fog, DepthAt depthAt) {
+    HostFogRun run;
     GLuint fbo = 0, colour = 0, depthTex = 0;
     glCreateFramebuffers(1, &fbo);
     glCreateTextures(GL_TEXTURE_2D, 1, &colour);
@@ -157,71 +167,102 @@ TEST_F(FogFrameGL, HostFogHandlesSkyNaNAndOutOfRangeDepth) {
     glTextureStorage2D(depthTex, 1, GL_DEPTH_COMPONENT32F, kSize.x, kSize.y);
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, colour, 0);
     glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, depthTex, 0);
-    ASSERT_EQ(glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER), GLenum(GL_FRAMEBUFFER_COMPLETE));
-
-    // Columns in bands: a ramp of surfaces, 1.0, NaN, 1.5, -0.5 (GL bottom row first).
+    EXPECT_EQ(glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER), GLenum(GL_FRAMEBUFFER_COMPLETE));
     std::vector<float> d(size_t(kSize.x) * kSize.y);
-    const float nan = std::numeric_limits<float>::quiet_NaN();
     for (int y = 0; y < kSize.y; ++y)
-        for (int x = 0; x < kSize.x; ++x) {
-            const int band = x / 13;
-            d[size_t(y) * kSize.x + x] = band == 0 ? 0.9f + 0.1f * float(y) / kSize.y : band == 1 ? 1.0f : band == 2 ? nan : band == 3 ? 1.5f : -0.5f;
-        }
+        for (int x = 0; x < kSize.x; ++x) d[size_t(y) * kSize.x + x] = depthAt(x, y);
     glTextureSubImage2D(depthTex, 0, 0, 0, kSize.x, kSize.y, GL_DEPTH_COMPONENT, GL_FLOAT, d.data());
-    // What the texture holds (a driver may clamp out-of-range values on upload), top row first for the reference.
     std::vector<float> held(d.size());
     glGetTextureImage(depthTex, 0, GL_DEPTH_COMPONENT, GL_FLOAT, GLsizei(held.size() * 4), held.data());
-    Image depth;
-    depth.width = kSize.x, depth.height = kSize.y, depth.channels = 1;
-    depth.pixels.resize(held.size());
+    run.depth.width = kSize.x, run.depth.height = kSize.y, run.depth.channels = 1;
+    run.depth.pixels.resize(held.size());
     for (int y = 0; y < kSize.y; ++y)
-        for (int x = 0; x < kSize.x; ++x) depth.pixels[size_t(y) * kSize.x + x] = held[size_t(kSize.y - 1 - y) * kSize.x + x];
+        for (int x = 0; x < kSize.x; ++x) run.depth.pixels[size_t(y) * kSize.x + x] = held[size_t(kSize.y - 1 - y) * kSize.x + x];
 
-    const Fog fog = testFog();
     Frame frame;
-    frame.begin(0.0, testCamera());
+    frame.begin(0.0, camera);
     frame.end();
     frame.setFog(std::make_shared<const Fog>(fog));
     Materials mat{Footprint{}};
     mat.addColorTable(ColorTable::constant(glm::vec4(1.0f)));
     auto fr = gl::FrameRenderer::create();
-    ASSERT_TRUE(fr) << fr.error();
-    ASSERT_TRUE(fr->upload(mat));
+    EXPECT_TRUE(fr) << fr.error();
+    if (!fr) return run;
+    EXPECT_TRUE(fr->upload(mat));
     const float clear[4] = {kBackground.r, kBackground.g, kBackground.b, kBackground.a};
     glClearNamedFramebufferfv(fbo, GL_COLOR, 0, clear);
     fr->render(frame, {.framebuffer = fbo, .depthTexture = depthTex});
     EXPECT_TRUE(fr->stats().fog.host) << fr->stats().fog.error;
-    Image got;
-    got.width = kSize.x, got.height = kSize.y, got.channels = 4;
+    run.got.width = kSize.x, run.got.height = kSize.y, run.got.channels = 4;
     std::vector<float> raw(size_t(kSize.x) * kSize.y * 4);
     glGetTextureImage(colour, 0, GL_RGBA, GL_FLOAT, GLsizei(raw.size() * 4), raw.data());
-    got.pixels.resize(raw.size());
+    run.got.pixels.resize(raw.size());
     for (int y = 0; y < kSize.y; ++y)
         std::copy_n(raw.begin() + std::ptrdiff_t(size_t(kSize.y - 1 - y) * kSize.x * 4), kSize.x * 4,
-                    got.pixels.begin() + std::ptrdiff_t(size_t(y) * kSize.x * 4));
-
-    SplatExactDesc rd;
-    rd.host.background = kBackground;
-    rd.host.depth = &depth;
-    rd.fog = &fog;
-    SplatExactStats st;
-    auto ref = renderSplatExact({}, frame.camera(), mat, rd, &st);
-    ASSERT_TRUE(ref) << ref.error();
-    // No splats: only the host fog's float error (as above; depth up to 1.0:
-    // the unprojection's conditioning is at most (f + n) / (2 n) = 300).
-    const double bound = 2.0 * tauFloatBound(fog, 36.0, 0.7, 300.0 * 8.0 * kEps) + 2.0 * st.fogMaxErrorEstimate + 1e-6;
-    EXPECT_LE(maxDiff(got, *ref), bound);
-    for (int y = 0; y < kSize.y; ++y)
-        for (int x = 26; x < kSize.x; ++x) {
-            const float dv = depth.at(x, y, 0);
-            if (std::isnan(dv) || dv < 0.0f || dv > 1.0f) {
-                ASSERT_NEAR(got.at(x, y, 0), fog.desc().colour.x, 1e-6) << "invalid depth is fully fogged at " << x << "," << y;
-            }
-        }
-    for (float v : got.pixels) ASSERT_TRUE(std::isfinite(v));
+                    run.got.pixels.begin() + std::ptrdiff_t(size_t(y) * kSize.x * 4));
     glDeleteFramebuffers(1, &fbo);
     glDeleteTextures(1, &colour);
     glDeleteTextures(1, &depthTex);
+
+    SplatExactDesc rd;
+    rd.host.background = kBackground;
+    rd.host.depth = &run.depth;
+    rd.fog = &fog;
+    auto ref = renderSplatExact({}, frame.camera(), mat, rd, &run.reference);
+    EXPECT_TRUE(ref) << ref.error();
+    if (ref) run.want = std::move(*ref);
+    return run;
+}
+
+TEST_F(FogFrameGL, HostFogHandlesSkyNaNAndOutOfRangeDepth) {
+    // Columns in bands: a ramp of surfaces, 1.0, NaN, 1.5, -0.5 (GL bottom row first).
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const Fog fog = testFog();
+    const HostFogRun run = renderHostFog(testCamera(), fog, [&](int x, int y) {
+        const int band = x / 13;
+        return band == 0 ? 0.9f + 0.1f * float(y) / kSize.y : band == 1 ? 1.0f : band == 2 ? nan : band == 3 ? 1.5f : -0.5f;
+    });
+    ASSERT_FALSE(run.want.pixels.empty());
+    // No splats: only the host fog's float error (as above; the unprojection
+    // blends 1 / view depth between its values at depth 0 and 1, each point's
+    // relative error a few roundings: 8 eps).
+    const double bound = 2.0 * tauFloatBound(fog, 36.0, 0.7, 8.0 * kEps) + 2.0 * run.reference.fogMaxErrorEstimate + 1e-6;
+    EXPECT_LE(maxDiff(run.got, run.want), bound);
+    for (int y = 0; y < kSize.y; ++y)
+        for (int x = 26; x < kSize.x; ++x) {
+            const float dv = run.depth.at(x, y, 0);
+            if (std::isnan(dv) || dv < 0.0f || dv > 1.0f) {
+                ASSERT_NEAR(run.got.at(x, y, 0), fog.desc().colour.x, 1e-6) << "invalid depth is fully fogged at " << x << "," << y;
+            }
+        }
+    for (float v : run.got.pixels) ASSERT_TRUE(std::isfinite(v));
+}
+
+// Engines' near / far ratios: the sky (depth 1) and surfaces close to the far
+// plane keep their fog distance. A float inverse projection loses it there
+// (its w at depth 1 is the difference of two terms of size 1 / (2 near) whose
+// sum is 1 / far: at near 0.01, far 1e5 the sky's fog distance was off by 22 %
+// against POV-Ray's media); the pass blends 1 / view depth between its values
+// at depth 0 and 1 instead, so its error stays a few roundings at any ratio.
+// The far plane is the one the (float) projection matrix itself implies, the
+// one the GPU's depth values follow.
+TEST_F(FogFrameGL, HostFogKeepsTheSkyAtLargeFarOverNear) {
+    for (const glm::vec2 nearFar : {glm::vec2(0.05f, 1e4f), glm::vec2(0.01f, 1e5f), glm::vec2(0.1f, 3e5f)}) {
+        SCOPED_TRACE("near " + std::to_string(nearFar.x) + ", far " + std::to_string(nearFar.y));
+        // About one optical depth at the far plane: the fog there is neither clear nor saturated.
+        FogDesc fd;
+        fd.terms.push_back(FogTerm::constant(0.7 / nearFar.y));
+        fd.terms.push_back(FogTerm::cosine(0.3 / nearFar.y, 3.0 / nearFar.y, {1.0, 0.3, 0.0}, 0.4));
+        fd.colour = {0.7, 0.75, 0.8};
+        const Fog fog = *Fog::create(fd);
+        const Camera cam = Camera::lookAt({0.4f, 0.3f, 5.0f}, {0, 0, 0}, {0, 1, 0}, 0.9f, kSize, nearFar.x, nearFar.y);
+        // Sky on the right half; on the left, depths within 1e-4 of the far plane.
+        const HostFogRun run = renderHostFog(cam, fog, [&](int x, int y) { return x >= kSize.x / 2 ? 1.0f : 1.0f - 1e-4f * float(y + 1) / kSize.y; });
+        ASSERT_FALSE(run.want.pixels.empty());
+        const double densityMax = 1.0 / nearFar.y, lengthMax = 1.2 * nearFar.y;
+        const double bound = 2.0 * tauFloatBound(fog, lengthMax, densityMax, 8.0 * kEps) + 2.0 * run.reference.fogMaxErrorEstimate + 1e-6;
+        EXPECT_LE(maxDiff(run.got, run.want), bound);
+    }
 }
 
 // Reduced fog textures: each pixel's upsampled f is a convex combination of the

@@ -38,6 +38,7 @@
 
 #include "scene_player.hpp"
 #include "splatfx/context.hpp"
+#include "splatfx/gl/framebuffer.hpp"
 #include "splatfx/image_io.hpp"
 
 namespace fs = std::filesystem;
@@ -93,6 +94,7 @@ constexpr SamplingChoice kSamplings[] = {
 struct Viewer {
     Args args;
     std::optional<scenehost::ScenePlayer> player;
+    std::optional<splatfx::gl::Framebuffer> target; // what the frame is drawn into, then copied to the window
     std::string path;
     std::string error;
     std::vector<std::string> catalogue; // scene files next to the current one
@@ -416,7 +418,25 @@ static int viewerMain(int argc, char** argv) {
         if (v.player && fbSize.x > 0 && fbSize.y > 0) {
             if (!v.paused && frameIndex > 0) v.time += double(dt) * v.timeRate;
             const splatfx::Camera cam = v.camera(fbSize);
-            v.player->renderFrame(v.time, cam, 0, v.frame);
+            // Into a framebuffer of our own, as splatfx-render draws (the same
+            // RGBA8 colour and a depth texture), then copied to the window: a
+            // window's default framebuffer has no depth texture, so the passes
+            // that read the host depth (the host fog, the depth cut) would not
+            // run there and the viewer would show another image than the tool.
+            if (!v.target || v.target->width() != fbSize.x || v.target->height() != fbSize.y) {
+                v.target.reset();
+                auto fb = splatfx::gl::Framebuffer::create({.width = fbSize.x, .height = fbSize.y});
+                if (!fb) {
+                    std::fprintf(stderr, "splatfx-viewer: %s\n", fb.error().c_str());
+                    rc = 1;
+                    break;
+                }
+                v.target.emplace(std::move(*fb));
+            }
+            v.player->renderFrame(v.time, cam, v.target->handle(), v.frame);
+            glBlitNamedFramebuffer(v.target->handle(), 0, 0, 0, fbSize.x, fbSize.y, 0, 0, fbSize.x, fbSize.y, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+            glViewport(0, 0, fbSize.x, fbSize.y);
         } else {
             glBindFramebuffer(GL_FRAMEBUFFER, 0);
             glViewport(0, 0, fbSize.x, fbSize.y);
@@ -435,6 +455,7 @@ static int viewerMain(int argc, char** argv) {
         }
     }
     v.player.reset(); // its GL objects go while the window's context is still current
+    v.target.reset();
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext();

@@ -28,8 +28,8 @@ constexpr const char* kDownsampleUniforms[] = {"uHostRect", "uScale"};
 static_assert(std::size(kDownsampleUniforms) == downsample::UniformCount);
 constexpr const char* kCompositeUniforms[] = {"uHostRect", "uViewportOrigin", "uScale", "uUseDepth", "uThreshold", "uDepthToView"};
 static_assert(std::size(kCompositeUniforms) == composite::UniformCount);
-constexpr const char* kFogPassUniforms[] = {"uInvRel",         "uOrigin",  "uSize",     "splatfx_fog_params", "splatfx_fog_colour",
-                                            "splatfx_fog_far", "uFogSize", "uThreshold"};
+constexpr const char* kFogPassUniforms[] = {"uRay",  "uDepthAxis", "uDepthMap", "uOrigin", "uSize", "splatfx_fog_params", "splatfx_fog_colour", "splatfx_fog_far",
+                                            "uFogSize", "uThreshold"};
 static_assert(std::size(kFogPassUniforms) == fog_pass::UniformCount);
 constexpr const char* kTetraUniforms[] = {"uViewProjRel", "uFirst",     "uForward",           "uDepthToView",       "uTexScale",
                                           "uTexOffset",   "uMaxLength", "splatfx_fog_params", "splatfx_fog_colour", "splatfx_fog_far"};

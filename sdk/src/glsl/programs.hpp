@@ -123,7 +123,7 @@ enum Uniform { HostRect, ViewportOrigin, Scale, UseDepth, Threshold, DepthToView
 }
 namespace fog_pass {
 enum Define { MODE };
-enum Uniform { InvRel, Origin, Size, FogParams, FogColour, FogFar, FogSize, Threshold, UniformCount };
+enum Uniform { Ray, DepthAxis, DepthMap, Origin, Size, FogParams, FogColour, FogFar, FogSize, Threshold, UniformCount };
 } // namespace fog_pass
 namespace tetra {
 enum Define { PERSPECTIVE, HAS_DEPTH, FOG };

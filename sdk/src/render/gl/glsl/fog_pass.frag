@@ -3,18 +3,34 @@
 // upsampling, blended into the host colour.
 #include "fog.glsl"
 layout(binding = 0) uniform sampler2D uDepth; // host depth, framebuffer-sized
-uniform mat4 uInvRel;  // NDC -> world relative to the eye (inverse projection, then the view's rotation)
-uniform vec2 uOrigin;  // viewport origin, framebuffer pixels
-uniform vec2 uSize;    // viewport size, pixels
+// Window position and depth -> world position relative to the eye, without a
+// 4x4 inverse projection: its w at depth 1 is the difference of two terms of
+// size 1 / (2 near) whose true value is 1 / far, which float cannot hold when
+// far / near is large. Instead (FogPass::draw, in double on the CPU):
+//  perspective: the view depth's inverse is affine in the window depth, so it
+//    is the blend (1 - d) a + d b of its values at d = 0 and d = 1 (1 / near
+//    and 1 / far: each term positive, nothing cancels, and d = 1 gives 1 / far
+//    exactly; 0 for an infinite far plane), and the point is the ray through
+//    the pixel at view depth 1 (uRay * (ndc, 1), rotated to world) over it;
+//  orthographic: the point is affine in (ndc, d): uRay * (ndc, 1) + d uDepthAxis.
+uniform mat3 uRay;       // (ndc.x, ndc.y, 1) -> eye-relative world point (view depth 1, or d = 0 orthographic)
+uniform vec3 uDepthAxis; // orthographic: the world offset from d = 0 to d = 1
+uniform vec3 uDepthMap;  // (a, b, 1: perspective / 0: orthographic)
+uniform vec2 uOrigin;    // viewport origin, framebuffer pixels
+uniform vec2 uSize;      // viewport size, pixels
 
 // The point behind window position xy at window depth d, relative to the eye.
-// False for NaN or a depth outside [0, 1] (fully fogged, as Fog::transmittance does).
+// False for NaN or a depth outside [0, 1] (fully fogged, as Fog::transmittance
+// does), and for the sky under an infinite far plane (no finite point).
 bool hostPoint(vec2 xy, float d, out vec3 rel) {
     rel = vec3(0.0);
     if (isnan(d) || !(d >= 0.0 && d <= 1.0)) return false;
     vec2 ndc = (xy - uOrigin) / uSize * 2.0 - 1.0;
-    vec4 h = uInvRel * vec4(ndc, 2.0 * d - 1.0, 1.0); // d = 1 (sky): the far-plane point
-    rel = h.xyz / h.w;
+    vec3 ray = uRay * vec3(ndc, 1.0);
+    if (uDepthMap.z > 0.5)
+        rel = ray / ((1.0 - d) * uDepthMap.x + d * uDepthMap.y); // d = 1 (sky): the far-plane point
+    else
+        rel = ray + d * uDepthAxis;
     return !(any(isnan(rel)) || any(isinf(rel)));
 }
 const float kInvalidDistance = 3.0e38;

@@ -16,6 +16,36 @@
 
 namespace splatfx::gl::detail {
 
+HostUnprojection hostUnprojection(const Camera& camera) {
+    // In double from the projection's own (float) entries. inverse(view) =
+    // [R^T | eye], so its rotation alone takes view space to eye-relative world.
+    const glm::dmat4 invProj = glm::inverse(glm::dmat4(camera.proj));
+    const glm::dmat3 rot(glm::inverse(glm::dmat4(camera.view)));
+    auto viewPoint = [&](double x, double y, double z) {
+        const glm::dvec4 h = invProj * glm::dvec4(x, y, z, 1.0);
+        return glm::dvec3(h) / h.w;
+    };
+    HostUnprojection u;
+    if (camera.perspective()) {
+        // The pixel's ray at view depth 1 is affine in ndc.xy; the inverse view
+        // depth is affine in the window depth d (1/z = (P22 - P23 z_ndc) / P32).
+        auto unitDepth = [&](double x, double y) {
+            const glm::dvec3 p = viewPoint(x, y, 0.0);
+            return p / -p.z;
+        };
+        const glm::dvec3 o = unitDepth(0.0, 0.0);
+        u.ray = glm::mat3(rot * glm::dmat3(unitDepth(1.0, 0.0) - o, unitDepth(0.0, 1.0) - o, o));
+        const glm::dmat4 P(camera.proj);
+        auto inverseDepth = [&](double ndcZ) { return (P[2][2] - P[2][3] * ndcZ) / P[3][2]; };
+        u.depthMap = glm::vec3(float(inverseDepth(-1.0)), float(inverseDepth(1.0)), 1.0f);
+    } else {
+        const glm::dvec3 o = viewPoint(0.0, 0.0, -1.0);
+        u.ray = glm::mat3(rot * glm::dmat3(viewPoint(1.0, 0.0, -1.0) - o, viewPoint(0.0, 1.0, -1.0) - o, o));
+        u.depthAxis = glm::vec3(rot * (viewPoint(0.0, 0.0, 1.0) - o));
+    }
+    return u;
+}
+
 FogPass::~FogPass() {
     if (!contextIsCurrent()) return;
     if (mVao) glDeleteVertexArrays(1, &mVao);
@@ -63,11 +93,7 @@ Status FogPass::draw(const Fog& fog, double timeSec, const Camera& camera, const
         mTextureSize = textureSize;
     }
 
-    // NDC -> world relative to the eye, in double: inverse(view) = [R^T | eye],
-    // so dropping its translation gives positions relative to the eye directly.
-    const glm::dmat4 invView = glm::inverse(glm::dmat4(camera.view));
-    const glm::dmat4 rot{glm::dmat3(invView)};
-    const glm::mat4 invRel(rot * glm::inverse(glm::dmat4(camera.proj)));
+    const HostUnprojection unproject = hostUnprojection(camera);
     const glm::dvec3 eye(camera.eye());
     if (!mFrameParams) mParams = fog.glslParameters(timeSec, eye);
     const std::span<const glm::vec4> params = mFrameParams ? std::span<const glm::vec4>(*mFrameParams) : mParams;
@@ -91,7 +117,9 @@ Status FogPass::draw(const Fog& fog, double timeSec, const Camera& camera, const
     auto common = [&](const ProgramLibrary::Program& p) {
         using namespace glsl::fog_pass;
         glUseProgram(p.id);
-        glUniformMatrix4fv(p.uniform(InvRel), 1, GL_FALSE, glm::value_ptr(invRel));
+        glUniformMatrix3fv(p.uniform(Ray), 1, GL_FALSE, glm::value_ptr(unproject.ray));
+        glUniform3fv(p.uniform(DepthAxis), 1, glm::value_ptr(unproject.depthAxis));
+        glUniform3fv(p.uniform(DepthMap), 1, glm::value_ptr(unproject.depthMap));
         glUniform2f(p.uniform(Origin), float(target.x), float(target.y));
         glUniform2f(p.uniform(Size), float(target.width), float(target.height));
         setFogUniforms(p.id, {.params = p.uniform(FogParams), .colour = p.uniform(FogColour), .far = p.uniform(FogFar)}, fog, params);

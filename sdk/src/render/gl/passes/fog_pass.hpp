@@ -30,6 +30,15 @@
 
 namespace splatfx::gl::detail {
 
+// How fog_pass.frag turns a pixel and its window depth into a world position
+// relative to the eye (see there): precise at any far / near ratio.
+struct HostUnprojection {
+    glm::mat3 ray{0.0f};            // (ndc.x, ndc.y, 1) -> the point at view depth 1 (perspective) or at d = 0
+    glm::vec3 depthAxis{0.0f};      // orthographic: from d = 0 to d = 1
+    glm::vec3 depthMap{0.0f};       // perspective: (1 / view depth at d = 0, at d = 1, 1); orthographic: 0
+};
+HostUnprojection hostUnprojection(const Camera& camera);
+
 class FogPass final : public Pass {
 public:
     // textureSize (0, 0): per pixel; else the reduced fog texture's size.

@@ -88,7 +88,7 @@ public:
     ~FragmentListPass();
 
     // The footprint's partial-integral table and the cut programs (when it changed).
-    Status upload(const Materials& materials);
+    Status upload(const Materials& materials) override;
     // Sizes the lists to the target, empties them and binds them where
     // transparentGlsl() expects them; then runs drawSurfaces with the
     // target's framebuffer bound, premultiplied "over" blending, depth test

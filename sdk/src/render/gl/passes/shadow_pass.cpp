@@ -9,7 +9,7 @@ ShadowPass::~ShadowPass() {
     if (mTexture) glDeleteTextures(1, &mTexture);
 }
 
-bool ShadowPass::upload(const FrameShadow& shadow) {
+bool ShadowPass::uploadTable(const FrameShadow& shadow) {
     const bool valid = shadow.valid && shadow.dims.x > 0 && shadow.dims.y > 0 && shadow.dims.z > 0 &&
                        shadow.depth.size() == std::size_t(shadow.dims.x) * std::size_t(shadow.dims.y) * std::size_t(shadow.dims.z);
     if (mUploadedOnce && shadow.version == mVersion) return false;
@@ -62,7 +62,7 @@ ShadowBinding ShadowPass::binding() const {
 
 void ShadowPass::execute(const PlanStep& step, StepContext& context) {
     if (step.kind == StepKind::UploadShadow) {
-        if (upload(context.frame.shadow())) ++mUploads;
+        if (uploadTable(context.frame.shadow())) ++mUploads;
         bind();
     } else {
         unbind();

@@ -22,7 +22,7 @@ public:
     // Uploads the frame's shadow if it changed since the last upload (an
     // invalid shadow becomes a 1^3 zero-depth table: splatfx_shadow() = 1).
     // Returns whether it uploaded.
-    bool upload(const FrameShadow& shadow);
+    bool uploadTable(const FrameShadow& shadow);
     // Binds the table to the unit (saving what was bound there) / restores it.
     void bind();
     void unbind();

@@ -1,0 +1,25 @@
+# The viewer and splatfx-render show the same image of the same scene: the
+# first frame of a fogged sample (the host fog needs the host depth as a
+# texture, which a window's default framebuffer does not have: the viewer
+# draws into a framebuffer of its own and copies it to the window), compared
+# with OpenImageIO's idiff. Both are RGBA8: every channel within one step of
+# 255 (the copy to the window is exact; the tool's PNG is the same bytes).
+# Inputs: XVFB, VIEWER, RENDER, IDIFF, SCENE, NAME (the scene's output.name), OUT.
+file(REMOVE_RECURSE ${OUT})
+file(MAKE_DIRECTORY ${OUT})
+execute_process(COMMAND ${XVFB} -a -s "-screen 0 1280x720x24" ${VIEWER} ${SCENE} --size 200x150 --hide-ui --auto-quit-after 1
+                        --screenshot ${OUT}/viewer.png
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT EXISTS ${OUT}/viewer.png)
+  message(FATAL_ERROR "viewer failed (${rc}):\n${out}\n${err}")
+endif()
+execute_process(COMMAND ${RENDER} ${SCENE} --frames 1 --size 200x150 --quiet --out ${OUT}/render
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0 OR NOT EXISTS ${OUT}/render/${NAME}_0000.png)
+  message(FATAL_ERROR "splatfx-render failed (${rc}):\n${out}\n${err}")
+endif()
+execute_process(COMMAND ${IDIFF} -fail 0.004 -failpercent 0 ${OUT}/viewer.png ${OUT}/render/${NAME}_0000.png
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "the viewer's first frame differs from splatfx-render's (idiff exit ${rc}):\n${out}\n${err}")
+endif()
