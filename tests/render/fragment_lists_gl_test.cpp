@@ -469,9 +469,8 @@ TEST_F(FragmentListsGL, BudgetOfOneFragmentPerPixel) {
     // Pool, heads and counts, the resolved RGBA16F image, the section targets,
     // the sorted depths (R32F, one layer fewer than sections), the counters.
     EXPECT_EQ(s.lists.bytes,
-              std::size_t(pixels) *
-                      (kTransparentNodeBytes + kTransparentHeadBytesPerPixel + 8 +
-                       std::size_t(s.lists.sections) * kTransparentSectionBytesPerPixel + 4 * std::size_t(s.lists.sections - 1)) +
+              std::size_t(pixels) * (kTransparentNodeBytes + kTransparentHeadBytesPerPixel + 8 +
+                                     std::size_t(s.lists.sections) * kTransparentSectionBytesPerPixel + 4 * std::size_t(s.lists.sections - 1)) +
                   48 +
                   (16 + 4) * std::size_t((kSize.x + 15) / 16) *
                       std::size_t((kSize.y + 15) / 16)); // + per 16 x 16 tile the survey (RGBA32UI) and, with sections, the host depth (R32F)

@@ -114,7 +114,7 @@ struct PassTarget {
 namespace detail {
 class SplatPass;
 class ProgramLibrary;
-}
+} // namespace detail
 
 struct DrawStats {
     std::uint64_t splats = 0;

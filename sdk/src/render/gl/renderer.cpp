@@ -154,7 +154,7 @@ const Renderer::Impl::Program* Renderer::Impl::program(unsigned v) {
     key.values[CROSSFADE] = (v & kCrossfade) ? 1 : 0;
     key.dataKey = (fogged ? fogKey : 0u) * 1099511628211ull + (cut ? partialKey : 0u);
     auto p = library->get(key, {.fog = fogged ? std::string_view(fogSource) : std::string_view(),
-                               .partial = cut ? std::string_view(partialSource) : std::string_view()});
+                                .partial = cut ? std::string_view(partialSource) : std::string_view()});
     if (!p) {
         programError = p.error();
         return nullptr;

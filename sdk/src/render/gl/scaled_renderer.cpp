@@ -98,9 +98,7 @@ const ScaledRendererDesc& ScaledRenderer::desc() const { return mImpl->desc; }
 const Renderer& ScaledRenderer::renderer() const { return *mImpl->inner; }
 Renderer& ScaledRenderer::renderer() { return *mImpl->inner; }
 
-Result<ScaledRenderer> ScaledRenderer::create(const ScaledRendererDesc& desc) {
-    return create(desc, std::make_shared<detail::ProgramLibrary>());
-}
+Result<ScaledRenderer> ScaledRenderer::create(const ScaledRendererDesc& desc) { return create(desc, std::make_shared<detail::ProgramLibrary>()); }
 
 Result<ScaledRenderer> ScaledRenderer::create(const ScaledRendererDesc& desc, detail::Programs programs) {
     if (desc.scale != 1 && desc.scale != 2 && desc.scale != 4)

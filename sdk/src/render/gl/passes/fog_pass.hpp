@@ -2,8 +2,8 @@
 // private to the GL backend and owned by gl::FrameRenderer.
 //
 // Reads the host depth texture, unprojects each pixel to its world position
-// relative to the eye (inverse projection, then the view's rotation: no large
-// absolute coordinate reaches the shader), evaluates the transmittance f
+// relative to the eye (hostUnprojection: precise at any far / near, and no
+// large absolute coordinate reaches the shader), evaluates the transmittance f
 // from the eye to it with fogGlsl()'s closed forms and blends
 // C = f C_in + (1 - f) C_fog (eq. 5) into the host colour as a premultiplied
 // "over" layer ((1 - f) C_fog, 1 - f) with (ONE, ONE_MINUS_SRC_ALPHA): no copy
@@ -33,9 +33,9 @@ namespace splatfx::gl::detail {
 // How fog_pass.frag turns a pixel and its window depth into a world position
 // relative to the eye (see there): precise at any far / near ratio.
 struct HostUnprojection {
-    glm::mat3 ray{0.0f};            // (ndc.x, ndc.y, 1) -> the point at view depth 1 (perspective) or at d = 0
-    glm::vec3 depthAxis{0.0f};      // orthographic: from d = 0 to d = 1
-    glm::vec3 depthMap{0.0f};       // perspective: (1 / view depth at d = 0, at d = 1, 1); orthographic: 0
+    glm::mat3 ray{0.0f};       // (ndc.x, ndc.y, 1) -> the point at view depth 1 (perspective) or at d = 0
+    glm::vec3 depthAxis{0.0f}; // orthographic: from d = 0 to d = 1
+    glm::vec3 depthMap{0.0f};  // perspective: (1 / view depth at d = 0, at d = 1, 1); orthographic: 0
 };
 HostUnprojection hostUnprojection(const Camera& camera);
 
