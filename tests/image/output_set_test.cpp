@@ -307,3 +307,26 @@ TEST(OutputSet, AFailedMoveSaysWhy) {
     EXPECT_EQ(s.error().find("Success"), std::string::npos) << s.error();
     EXPECT_NE(s.error().find("Is a directory"), std::string::npos) << s.error();
 }
+
+// A publish cut short that cannot be finished yet (a folder stands where a
+// file goes): begin() fails saying why and keeps the complete staging folder,
+// so a later run can still finish it.
+TEST(OutputSet, AnUnfinishablePublishKeepsItsStagingFolder) {
+    const fs::path dir = freshFolder("unfinishable");
+    fs::create_directories(dir / ".shot.partial");
+    fs::create_directories(dir / "shot_0000.txt" / "inside");
+    writeText(dir / ".shot.partial/shot_0000.txt", "complete, not yet moved");
+    writeText(dir / ".shot.partial/.complete", "splatfx-outputs 1\nshot_0000.txt\n");
+    {
+        auto next = OutputSet::begin(dir.string(), "shot");
+        ASSERT_FALSE(next);
+        EXPECT_NE(next.error().find("finishing an interrupted publish in '" + dir.string() + "': cannot move 'shot_0000.txt'"), std::string::npos)
+            << next.error();
+        EXPECT_EQ(next.error().find("Success"), std::string::npos) << next.error();
+    }
+    EXPECT_EQ(readText(dir / ".shot.partial/shot_0000.txt"), "complete, not yet moved");
+    fs::remove_all(dir / "shot_0000.txt");
+    auto later = OutputSet::begin(dir.string(), "shot");
+    ASSERT_TRUE(later) << later.error();
+    EXPECT_EQ(readText(dir / "shot_0000.txt"), "complete, not yet moved");
+}

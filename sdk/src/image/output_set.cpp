@@ -111,7 +111,7 @@ int takeLock(const fs::path& path, bool wait, bool& busy, std::string& why) {
         while ((r = ::flock(fd, wait ? LOCK_EX : LOCK_EX | LOCK_NB)) != 0 && errno == EINTR) {}
         if (r != 0) {
             busy = errno == EWOULDBLOCK;
-            why = busy ? "held by another process" : std::strerror(errno);
+            why = busy ? "held by another process" : std::strerror(errno) + std::string(" (output sets need a file system with flock)");
             ::close(fd);
             return -1;
         }
@@ -236,8 +236,7 @@ Result<OutputSet> OutputSet::begin(const std::string& folder, const std::string&
         if (busy)
             return makeError("output folder '" + folder + "' is in use: another render is writing the set '" + name + "' there" +
                              lockHolder(impl->lockPath) + "; wait for it to finish or give this run another output folder");
-        return makeError("cannot lock the output set '" + name + "' in '" + folder + "' (" + impl->lockPath.string() + "): " + why +
-                         " (output sets need a file system with flock)");
+        return makeError("cannot lock the output set '" + name + "' in '" + folder + "' (" + impl->lockPath.string() + "): " + why);
     }
     char host[256] = {};
     if (::gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
@@ -246,25 +245,28 @@ Result<OutputSet> OutputSet::begin(const std::string& folder, const std::string&
         const ssize_t n = ::pwrite(impl->lock, holder.data(), holder.size(), 0);
         (void)n; // only informs a refused writer; the lock holds without it
     }
-    impl->staging = impl->folder / ("." + name + kStagingSuffix);
+    // Not impl->staging until created: a failed begin() must not remove a
+    // complete staging folder that a later run can still finish.
+    const fs::path staging = impl->folder / ("." + name + kStagingSuffix);
 
     FolderLock folderLock;
     if (Status s = lockFolder(impl->folder, folderLock); !s) return makeError(s.error());
     // A previous run's staging folder: finish its publish if it was complete, else drop it.
-    if (fs::exists(impl->staging, ec)) {
-        const std::vector<std::string> staged = readRecord(impl->staging / kCompleteFile);
+    if (fs::exists(staging, ec)) {
+        const std::vector<std::string> staged = readRecord(staging / kCompleteFile);
         if (!staged.empty()) {
-            if (Status s = publishStaged(impl->folder, name, impl->staging, staged, true); !s)
+            if (Status s = publishStaged(impl->folder, name, staging, staged, true); !s)
                 return makeError("finishing an interrupted publish in '" + folder + "': " + s.error());
         } else {
-            fs::remove_all(impl->staging, ec);
-            if (ec) return makeError("cannot remove the unfinished staging folder '" + impl->staging.string() + "': " + ec.message());
+            fs::remove_all(staging, ec);
+            if (ec) return makeError("cannot remove the unfinished staging folder '" + staging.string() + "': " + ec.message());
         }
     }
     if (Status s = refuseForeign(impl->folder, planned); !s) return makeError(s.error());
     ec.clear();
-    fs::create_directory(impl->staging, ec);
-    if (ec) return makeError("cannot create staging folder '" + impl->staging.string() + "': " + ec.message());
+    if (!fs::create_directory(staging, ec))
+        return makeError("cannot create staging folder '" + staging.string() + "': " + reason(ec, "it exists after it was removed"));
+    impl->staging = staging;
     return OutputSet(std::move(impl));
 }
 
