@@ -142,7 +142,9 @@ int parse(int argc, char** argv, Args& a) {
         "render-farm task: write only frames A..B (every STEP-th; indices from 0), exactly as a full run writes them; no GIF "
         "(see --assemble; docs/render-farm.md)",
         "A-B[:STEP]");
-    app.add_flag("--assemble", a.assemble, "write DIR/<name>.gif from the frames DIR/<name>_NNNN.png the tasks wrote (renders nothing)");
+    app.add_flag("--assemble", a.assemble,
+                 "write DIR/<name>.gif from the frames DIR/<name>_NNNN.png the tasks wrote, each checked against the tasks' run records "
+                 "(give the tasks' options; renders nothing)");
     app.add_option_function<std::vector<std::string>>(
            "--budget",
            [&a](const std::vector<std::string>& settings) {
@@ -244,7 +246,8 @@ std::string foreignFrame(const std::vector<render::RunRecord>& records, const re
 
 // --assemble: the whole sequence's GIF from the frames in the output folder
 // (written by range tasks, or a full run), as its own output set. Every
-// frame must be there and of the sequence's size; the GIF is then byte for
+// frame must be there, listed unchanged by a run record with the sequence's
+// settings, and of the sequence's size; the GIF is then byte for
 // byte the one a full run writes (the frames are 8-bit PNGs of the same
 // pixels the full run hands to its GIF writer, which keeps 8-bit RGB).
 int assemble(const Args& a) {
