@@ -1,5 +1,8 @@
 # splatfx-render: a good run leaves every frame and the GIF; a failed run
-# (--abort-after, or a bad scene file) leaves no GIF and no staging folder.
+# (--abort-after, or a bad scene file) leaves no GIF and no staging folder;
+# a second writer of the set, a user's file named like an output and an
+# empty --out are refused with a message, and nothing is lost.
+# Inputs: RENDER, SCENE (Fig. 1, output.name "figure1"), OUT, FLOCK (util-linux flock, may be empty).
 file(REMOVE_RECURSE ${OUT})
 
 execute_process(COMMAND ${RENDER} ${SCENE} --out ${OUT}/good --frames 3 --size 96x64 --quiet
@@ -58,5 +61,68 @@ execute_process(COMMAND ${RENDER} ${OUT}/bad/scene.json --out ${OUT}/bad/out --f
 string(FIND "${err}" "effects[0].dims: expected an array of 3 integers" at)
 if(rc EQUAL 0 OR at EQUAL -1 OR EXISTS ${OUT}/bad/out/bad.gif)
   message(FATAL_ERROR "a bad scene must fail with a message naming the field (rc ${rc}):\n${err}")
+endif()
+
+# A file hash of every file in a folder, hidden ones included, to show that a refused run changed nothing.
+function(folder_state var dir)
+  file(GLOB files LIST_DIRECTORIES false ${dir}/* ${dir}/.*)
+  list(SORT files)
+  set(state "")
+  foreach(f ${files})
+    file(SHA256 ${f} h)
+    list(APPEND state "${f}=${h}")
+  endforeach()
+  set(${var} "${state}" PARENT_SCOPE)
+endfunction()
+
+function(expect_refused what regex)
+  if(rc EQUAL 0 OR NOT err MATCHES "${regex}")
+    message(FATAL_ERROR "${what}: expected a refusal matching '${regex}' (rc ${rc}):\n${out}\n${err}")
+  endif()
+endfunction()
+
+# A user's own files named like the outputs, in no record (the first run into
+# a folder): refused before rendering, naming them; they keep their bytes.
+file(MAKE_DIRECTORY ${OUT}/users)
+file(WRITE ${OUT}/users/figure1_0001.png "the user's frame")
+file(WRITE ${OUT}/users/figure1.gif "the user's GIF")
+folder_state(before ${OUT}/users)
+execute_process(COMMAND ${RENDER} ${SCENE} --out ${OUT}/users --frames 3 --size 96x64 --quiet
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+expect_refused("a user's files in the way"
+  "refusing to overwrite '${OUT}/users/figure1_0001.png', '${OUT}/users/figure1.gif': no output record in '${OUT}/users' lists them, so splatfx did not write them; move them away or choose another output folder")
+folder_state(after ${OUT}/users)
+if(NOT before STREQUAL after)
+  message(FATAL_ERROR "a refused run changed the folder:\nbefore ${before}\nafter  ${after}")
+endif()
+string(FIND "${out}" "frame 0" rendered)
+if(NOT rendered EQUAL -1)
+  message(FATAL_ERROR "the refusal must come before any frame is rendered:\n${out}")
+endif()
+
+# A second writer of a set another process holds (flock stands in for a
+# render still running, deterministically): refused at once, naming the
+# folder; the published set is untouched.
+if(FLOCK)
+  folder_state(before ${OUT}/good)
+  execute_process(COMMAND ${FLOCK} ${OUT}/good/.figure1.lock ${RENDER} ${SCENE} --out ${OUT}/good --frames 3 --size 96x64 --quiet
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  expect_refused("a second writer"
+    "splatfx-render: output folder '${OUT}/good' is in use: another render is writing the set 'figure1' there; wait for it to finish or give this run another output folder")
+  file(REMOVE ${OUT}/good/.figure1.lock) # flock's own file
+  folder_state(after ${OUT}/good)
+  if(NOT before STREQUAL after)
+    message(FATAL_ERROR "a refused second writer changed the folder:\nbefore ${before}\nafter  ${after}")
+  endif()
+endif()
+
+# An empty --out (it wrote into the current folder): refused, the current folder untouched.
+file(MAKE_DIRECTORY ${OUT}/cwd)
+execute_process(COMMAND ${RENDER} ${SCENE} --out "" --frames 1 --size 96x64 --quiet WORKING_DIRECTORY ${OUT}/cwd
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+expect_refused("an empty --out" "splatfx-render: --out is empty: name the output folder \\('\\.' for the current one\\)")
+file(GLOB written ${OUT}/cwd/* ${OUT}/cwd/.*)
+if(written)
+  message(FATAL_ERROR "--out \"\" wrote into the current folder: ${written}")
 endif()
 message(STATUS "render tool outputs: ok")

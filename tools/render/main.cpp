@@ -7,7 +7,9 @@
 // DIR/.<name>.partial/, every write checked, moved into DIR only when all were
 // written; DIR/.<name>.outputs records them, so only files this tool wrote
 // are ever replaced or removed, and a run killed while publishing is
-// finished by the next one.
+// finished by the next one. A second run into the same set is refused while
+// the first holds its lock, and a file of an output's name that no record
+// lists (the user's own) is refused, named, before anything is rendered.
 //
 // Render farms (docs/render-farm.md): --range A-B[:STEP] writes only those
 // frames, bit for bit the frames a full run writes, by replaying the frames
@@ -15,12 +17,15 @@
 // task is its own output set, DIR/.<name>.frames-A-B[-every-STEP].outputs, so
 // it replaces only its own frames, never another task's, and writes no GIF;
 // --assemble writes the GIF from the frames in DIR once every task is done.
+// Every run also writes its run record (run_record.hpp): the settings that
+// decide the pixels and each frame's hash, which --assemble checks.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -28,6 +33,7 @@
 #include <unistd.h>
 
 #include "options.hpp"
+#include "run_record.hpp"
 #include "scene_player.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/framebuffer.hpp"
@@ -136,7 +142,9 @@ int parse(int argc, char** argv, Args& a) {
         "render-farm task: write only frames A..B (every STEP-th; indices from 0), exactly as a full run writes them; no GIF "
         "(see --assemble; docs/render-farm.md)",
         "A-B[:STEP]");
-    app.add_flag("--assemble", a.assemble, "write DIR/<name>.gif from the frames DIR/<name>_NNNN.png the tasks wrote (renders nothing)");
+    app.add_flag("--assemble", a.assemble,
+                 "write DIR/<name>.gif from the frames DIR/<name>_NNNN.png the tasks wrote, each checked against the tasks' run records "
+                 "(give the tasks' options; renders nothing)");
     app.add_option_function<std::vector<std::string>>(
            "--budget",
            [&a](const std::vector<std::string>& settings) {
@@ -165,6 +173,11 @@ int parse(int argc, char** argv, Args& a) {
         std::fprintf(stderr, "splatfx-render: no scene file given (try --help)\n");
         return 2;
     }
+    // An empty --out (an unset variable in a farm's command line) once wrote into the current folder.
+    if (a.out.empty()) {
+        std::fprintf(stderr, "splatfx-render: --out is empty: name the output folder ('.' for the current one)\n");
+        return 2;
+    }
     if (a.assemble && a.range) {
         std::fprintf(stderr, "splatfx-render: --assemble writes the GIF of the whole sequence; it takes no --range\n");
         return 2;
@@ -182,15 +195,66 @@ char* frameName(char (&buf)[128], const std::string& name, int i) {
     return buf;
 }
 
+// Everything that decides a frame's pixels besides its index: the scene
+// file's bytes (not the meshes and images it names) and the options.
+splatfx::Result<render::RunSettings> runSettings(const Args& a, const std::string& name, std::uint32_t seed, glm::ivec2 size, int frames, float fps) {
+    auto scene = render::hashFile(a.scene);
+    if (!scene) return splatfx::makeError(scene.error());
+    char rate[32];
+    std::snprintf(rate, sizeof rate, "%.9g", fps);
+    const splatfx::gl::RendererDesc& sp = a.renderer.splats;
+    using splatfx::gl::TextureSampling;
+    std::string sampling = sp.sampling == TextureSampling::Bilinear    ? "bilinear"
+                           : sp.sampling == TextureSampling::Nearest   ? "nearest"
+                           : sp.sampling == TextureSampling::Upsampled ? "upsampled" + (sp.upsample ? std::to_string(sp.upsample) : std::string())
+                                                                       : "auto";
+    const glm::ivec2 fog = a.renderer.fogTextureSize;
+    return render::RunSettings{
+        {"name", name},
+        {"scene", *scene},
+        {"seed", std::to_string(seed)},
+        {"size", std::to_string(size.x) + "x" + std::to_string(size.y)},
+        {"frames", std::to_string(frames)},
+        {"fps", rate},
+        {"traditional", a.traditional ? "yes" : "no"},
+        {"scale", std::to_string(a.renderer.resolutionScale)},
+        {"sampling", sampling},
+        {"fog-texture", fog.x > 0 ? std::to_string(fog.x) + "x" + std::to_string(fog.y) : std::string("per-pixel")},
+        {"depth-cut", sp.depthCut ? "yes" : "no"},
+    };
+}
+
+// Why the frame at `path` (index i) is not one a run of `wanted` wrote, or
+// "" when it is: a run record with these settings lists it with this hash.
+std::string foreignFrame(const std::vector<render::RunRecord>& records, const render::RunSettings& wanted, const std::string& folder,
+                         const std::string& file, int i, const std::string& hash) {
+    std::string differ;
+    bool listed = false;
+    for (const render::RunRecord& r : records) {
+        const auto it = r.frames.find(file);
+        if (it == r.frames.end() || it->second.first != i) continue;
+        listed = true;
+        if (it->second.second != hash) continue;
+        const std::string d = render::settingsDiffer(r.settings, wanted);
+        if (d.empty()) return {};
+        if (differ.empty()) differ = "rendered with " + d;
+    }
+    if (!differ.empty()) return differ;
+    if (listed) return "it is not the file its run wrote (replaced or changed since)";
+    return "no run record in '" + folder + "' lists it (not written by splatfx-render)";
+}
+
 // --assemble: the whole sequence's GIF from the frames in the output folder
 // (written by range tasks, or a full run), as its own output set. Every
-// frame must be there and of the sequence's size; the GIF is then byte for
+// frame must be there, listed unchanged by a run record with the sequence's
+// settings, and of the sequence's size; the GIF is then byte for
 // byte the one a full run writes (the frames are 8-bit PNGs of the same
 // pixels the full run hands to its GIF writer, which keeps 8-bit RGB).
 int assemble(const Args& a) {
     splatfx::Materials materials{splatfx::Footprint{}};
     splatfx::SceneFileOptions so;
     so.seed = a.seed;
+    so.budgets = a.budgets;
     auto file = splatfx::loadSceneFile(a.scene, materials, so);
     if (!file) return fail(file.error());
     const glm::ivec2 size = a.size.value_or(file->output.size);
@@ -210,7 +274,28 @@ int assemble(const Args& a) {
         return fail("--assemble: " + std::to_string(missing.size()) + " of the " + std::to_string(frames) + " frames are missing from '" + a.out +
                     "' (frame " + list + "); render them first (--range), with the same --frames");
     }
-    auto outputs = splatfx::OutputSet::begin(a.out, name + ".gif");
+    // Every frame must be one a run of this sequence wrote (same scene,
+    // seed, size and options; the file unchanged since), or the GIF would
+    // not be the full run's.
+    auto wanted = runSettings(a, name, file->seed, size, frames, fps);
+    if (!wanted) return fail("--assemble: " + wanted.error());
+    const std::vector<render::RunRecord> records = render::readRunRecords(a.out);
+    std::vector<std::string> foreign;
+    for (int i = 0; i < frames; ++i) {
+        frameName(png, name, i);
+        const std::string path = (fs::path(a.out) / png).string();
+        auto hash = render::hashFile(path);
+        if (!hash) return fail("--assemble: " + hash.error());
+        if (std::string why = foreignFrame(records, *wanted, a.out, png, i, *hash); !why.empty()) foreign.push_back("'" + path + "': " + why);
+    }
+    if (!foreign.empty()) {
+        std::string list;
+        for (std::size_t k = 0; k < foreign.size() && k < 4; ++k) list += (k ? "; " : "") + foreign[k];
+        if (foreign.size() > 4) list += "; ...";
+        return fail("--assemble: " + std::to_string(foreign.size()) + " of the " + std::to_string(frames) +
+                    " frames are not from this sequence: " + list + "; render them again with this sequence's options (--range)");
+    }
+    auto outputs = splatfx::OutputSet::begin(a.out, name + ".gif", {name + ".gif"});
     if (!outputs) return fail(outputs.error());
     splatfx::AnimationWriter gif(outputs->path(name + ".gif"), fps);
     for (int i = 0; i < frames; ++i) {
@@ -262,8 +347,21 @@ static int renderMain(int argc, char** argv) {
         setName += buf;
         if (a.range->step > 1) setName += "-every-" + std::to_string(a.range->step);
     }
-    auto outputs = splatfx::OutputSet::begin(a.out, setName);
+    auto settings = runSettings(a, name, file.seed, size, frames, fps);
+    if (!settings) return fail(settings.error());
+    // Every file this run will write, so that one of a user's is refused now, not after the work.
+    const std::string runRecord = "." + setName + ".run";
+    std::vector<std::string> planned;
+    for (int i = 0; i <= lastIndex; ++i)
+        if (whole || a.range->contains(i)) {
+            char png[128];
+            planned.push_back(frameName(png, name, i));
+        }
+    if (whole) planned.push_back(name + ".gif");
+    planned.push_back(runRecord);
+    auto outputs = splatfx::OutputSet::begin(a.out, setName, planned);
     if (!outputs) return fail(outputs.error());
+    std::map<std::string, std::pair<int, std::string>> hashes; // the run record's frames
 
     auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
     if (!fb) return fail(fb.error());
@@ -321,6 +419,9 @@ static int renderMain(int argc, char** argv) {
         char png[128];
         frameName(png, name, i);
         if (auto w = splatfx::writeImage(outputs->path(png), img); !w) return fail(w.error());
+        auto hash = render::hashFile(outputs->path(png));
+        if (!hash) return fail(hash.error());
+        hashes[png] = {i, *hash};
         outputs->add(png);
         if (gif)
             if (auto w = gif->add(img); !w) return fail(w.error());
@@ -338,6 +439,8 @@ static int renderMain(int argc, char** argv) {
         if (auto w = gif->finish(); !w) return fail(w.error());
         outputs->add(name + ".gif");
     }
+    if (auto w = splatfx::writeFileAtomically(outputs->path(runRecord), render::recordText(*settings, hashes)); !w) return fail(w.error());
+    outputs->add(runRecord);
     if (auto w = outputs->publish(); !w) return fail(w.error());
 
     const double sec = std::chrono::duration<double>(Clock::now() - start).count();

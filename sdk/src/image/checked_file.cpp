@@ -82,8 +82,9 @@ Status publishTemporary(const std::string& tmp, const std::string& target) {
     std::error_code ec;
     fs::rename(tmp, target, ec);
     if (ec) {
+        const std::string why = ec.message(); // before the clean-up's result replaces it (it read "Success")
         fs::remove(tmp, ec);
-        return makeError("cannot move '" + tmp + "' to '" + target + "': " + ec.message());
+        return makeError("cannot move '" + tmp + "' to '" + target + "': " + why);
     }
     // The rename is durable only once the folder is synced.
     const fs::path parent = fs::path(target).parent_path();
