@@ -142,7 +142,9 @@ TEST(LodVolume, AlternatingOrientationGivesAFaceToFaceFinestMesh) {
             std::sort(key.begin(), key.end());
             ++faces[key];
         }
-    for (const auto& [key, count] : faces) {
+    for (const auto& entry : faces) {
+        const auto& key = entry.first; // a plain reference: clang 14 cannot capture a structured binding
+        const int count = entry.second;
         bool boundary = false;
         for (int a = 0; a < 3; ++a) {
             auto coord = [&](int i) {
