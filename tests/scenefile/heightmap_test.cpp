@@ -78,7 +78,7 @@ TEST(SceneFileHeightmap, TerrainAndGroundFogShareEverySamplePoint) {
             terrain.push_back(pos + splatfx::heightmapPoint(i, j, t.w, t.h, float(t.codes[std::size_t(j * t.w + i)]) / 65535.0f, spacing, scale));
     const splatfx::Camera cam = splatfx::Camera::lookAt(pos + glm::vec3(0, 40, 30), pos, {0, 1, 0}, glm::radians(60.0f), {64, 48}, 0.5f, 500.0f);
     splatfx::Frame frame;
-    r->scene.prepare(0.0, cam, m, frame);
+    EXPECT_TRUE(r->scene.prepare(0.0, cam, m, frame));
     ASSERT_EQ(frame.volumes().size(), 1u);
     const auto& tets = frame.volumes()[0].lod.tets;
     ASSERT_GT(tets.size(), 0u) << "the valley lies under the fog top";
@@ -99,7 +99,7 @@ TEST(SceneFileHeightmap, TerrainAndGroundFogShareEverySamplePoint) {
     // Disabled: nothing reaches the frame.
     r->scene.setEnabled(fogId, false);
     splatfx::Frame off;
-    r->scene.prepare(0.0, cam, m, off);
+    EXPECT_TRUE(r->scene.prepare(0.0, cam, m, off));
     EXPECT_TRUE(off.volumes().empty());
 }
 

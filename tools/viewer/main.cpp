@@ -416,7 +416,9 @@ static int viewerMain(int argc, char** argv) {
         if (v.player && fbSize.x > 0 && fbSize.y > 0) {
             if (!v.paused && frameIndex > 0) v.time += double(dt) * v.timeRate;
             const splatfx::Camera cam = v.camera(fbSize);
-            v.player->renderFrame(v.time, cam, 0, v.frame);
+            // Past kMaxTimeSec (about 72.8 hours of scene time) the scene refuses the time: restart the clock.
+            if (v.time > splatfx::kMaxTimeSec) v.time = 0.0;
+            if (auto st = v.player->renderFrame(v.time, cam, 0, v.frame); !st) v.error = st.error();
         } else {
             glBindFramebuffer(GL_FRAMEBUFFER, 0);
             glViewport(0, 0, fbSize.x, fbSize.y);

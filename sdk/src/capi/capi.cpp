@@ -611,7 +611,8 @@ splatfx_status splatfx_scene_prepare(splatfx_scene* scene, double time_sec, cons
         if (!std::isfinite(time_sec)) return invalid("time_sec is " + str(float(time_sec)) + "; expected a finite number of seconds");
         if (time_sec < 0.0) return invalid("time_sec is " + str(float(time_sec)) + "; expected seconds >= 0");
         if (auto bad = checkCamera(*camera, "camera")) return *bad;
-        scene->value.prepare(time_sec, toCamera(*camera), materials->value, frame->value);
+        // Later than kMaxTimeSec (the dynamics' precision): the scene says so and changes nothing.
+        if (Status s = scene->value.prepare(time_sec, toCamera(*camera), materials->value, frame->value); !s) return invalid(s.error());
         frame->prepared = true;
         frame->materials = materials->identity;
         return success();
