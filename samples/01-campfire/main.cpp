@@ -60,7 +60,10 @@ struct Campfire {
     }
 
     void draw(double timeSec, glm::ivec2 size, unsigned framebuffer, bool textured) {
-        scene.prepare(timeSec, camera(size), materials, splatFrame, {.textured = textured});
+        if (auto s = scene.prepare(timeSec, camera(size), materials, splatFrame, {.textured = textured}); !s) {
+            std::fprintf(stderr, "campfire: %s\n", s.error().c_str());
+            return;
+        }
         renderer->render(splatFrame, {.framebuffer = framebuffer, .drawOpaque = clearBackground});
     }
 

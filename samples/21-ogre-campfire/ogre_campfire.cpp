@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <optional>
@@ -232,7 +233,10 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
         drawnCamera = convert();
         info.flipped = target->requiresTextureFlipping();
         if (!frameOptions.fire) return; // the depth copy is still made: tests compare frames with and without
-        scene.prepare(frameOptions.timeSec, drawnCamera, materials, frame);
+        if (auto s = scene.prepare(frameOptions.timeSec, drawnCamera, materials, frame); !s) {
+            std::fprintf(stderr, "ogre_campfire: %s\n", s.error().c_str());
+            return;
+        }
         // 4. Draw. OGRE drew its opaque geometry itself: no drawOpaque hook.
         // The viewport origin is OGRE's (GL's lower left).
         renderer->render(frame, {.framebuffer = unsigned(fbo), .x = vp[0], .y = vp[1], .depthTexture = depth});

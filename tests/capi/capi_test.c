@@ -350,6 +350,9 @@ static void test_bad_input(void) {
     CHECK_FAILS(splatfx_scene_prepare(scene, NAN, &cam, m, frame, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "time_sec is nan");
     CHECK_FAILS(splatfx_scene_prepare(scene, INFINITY, &cam, m, frame, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "time_sec is inf");
     CHECK_FAILS(splatfx_scene_prepare(scene, -1.0, &cam, m, frame, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "time_sec is -1");
+    /* Past what the dynamics hold exactly (kMaxTimeSec): a fire at 1e300 came back empty with SPLATFX_OK. */
+    CHECK_FAILS(splatfx_scene_prepare(scene, 1e300, &cam, m, frame, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                "splatfx_scene_prepare: time_sec is 1e+300; expected seconds <= 262144 (kMaxTimeSec");
 
     /* Cameras. */
     splatfx_camera bad = cam;

@@ -16,17 +16,17 @@ TEST(FogFrame, SceneHandsItsFogToEveryFrameAndClearsIt) {
     Materials mat{Footprint{}};
     Frame frame;
     const Camera cam = Camera::lookAt({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.9f, {16, 16});
-    scene.prepare(0.0, cam, mat, frame);
+    EXPECT_TRUE(scene.prepare(0.0, cam, mat, frame));
     EXPECT_EQ(frame.fog(), nullptr);
     scene.setFog(*Fog::create(paperFig6Fog()));
-    scene.prepare(0.1, cam, mat, frame);
+    EXPECT_TRUE(scene.prepare(0.1, cam, mat, frame));
     ASSERT_NE(frame.fog(), nullptr);
     EXPECT_EQ(frame.fog(), scene.fog());
     EXPECT_DOUBLE_EQ(frame.fog()->density({0, 0, 0}, 0.0), Fog::create(paperFig6Fog())->density({0, 0, 0}, 0.0));
     frame.begin(0.2, cam); // begin() keeps the fog (a setting, not content)
     EXPECT_NE(frame.fog(), nullptr);
     scene.clearFog();
-    scene.prepare(0.3, cam, mat, frame);
+    EXPECT_TRUE(scene.prepare(0.3, cam, mat, frame));
     EXPECT_EQ(frame.fog(), nullptr);
 }
 

@@ -32,7 +32,7 @@ struct LitScene {
         desc.layers = {EffectLayer{.style = {.colorTable = table, .textured = false}}};
         id = scene.add(*Effect::fromGrid(test::effect1560(), desc), {.name = "gas", .lighting = lighting});
     }
-    void prepare(double t) { scene.prepare(t, camera, materials, frame); }
+    void prepare(double t) { EXPECT_TRUE(scene.prepare(t, camera, materials, frame)); }
 };
 
 glm::vec3 unpack(std::uint32_t c) { return glm::vec3(float(c & 255u), float((c >> 8) & 255u), float((c >> 16) & 255u)) / 255.0f; }

@@ -147,7 +147,7 @@ TEST_F(FrameRendererGL, SceneFrameDrawsEachEffectItsOwnWay) {
     const EffectId plain = scene.add(std::move(*b), {.name = "plain", .draw = {.textured = false}});
     const Camera cam = Camera::lookAt({3, 3, 18}, {3, 3, 0}, {0, 1, 0}, 0.9f, kSize);
     Frame frame;
-    scene.prepare(0.25, cam, m, frame);
+    EXPECT_TRUE(scene.prepare(0.25, cam, m, frame));
     ASSERT_EQ(frame.counters().needed, 2u);
     EXPECT_EQ(frame.counters().drawn, 2u);
     std::uint64_t plainLayers = 0;

@@ -20,7 +20,7 @@ class SamplesGL : public splatfx::test::GLTest {};
 splatfx::Image render(scenehost::ScenePlayer& player, const std::vector<double>& times, glm::ivec2 size) {
     auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
     EXPECT_TRUE(fb.ok());
-    for (double t : times) player.renderFrame(t, player.cameraAt(t, size), fb->handle());
+    for (double t : times) EXPECT_TRUE(player.renderFrame(t, player.cameraAt(t, size), fb->handle()));
     return fb->read();
 }
 

@@ -87,7 +87,7 @@ TEST(EffectKind, ATestOnlyKindIsCulledOutOfViewAndEmittedInView) {
     Frame frame;
 
     // In view: advanced to t, emitted with its draw options times the caller's.
-    scene.prepare(0.5, towards, m, frame, {.opacityScale = 0.5f});
+    EXPECT_TRUE(scene.prepare(0.5, towards, m, frame, {.opacityScale = 0.5f}));
     EXPECT_TRUE(scene.status(cube).inView);
     EXPECT_TRUE(scene.status(cube).needed);
     EXPECT_EQ(calls.advances, 1);
@@ -100,7 +100,7 @@ TEST(EffectKind, ATestOnlyKindIsCulledOutOfViewAndEmittedInView) {
     EXPECT_EQ(frame.counters().drawn, 1u);
 
     // Out of view: neither advanced nor emitted, nothing in the frame.
-    for (int f = 1; f <= 10; ++f) scene.prepare(0.5 + f / 30.0, away, m, frame);
+    for (int f = 1; f <= 10; ++f) EXPECT_TRUE(scene.prepare(0.5 + f / 30.0, away, m, frame));
     EXPECT_FALSE(scene.status(cube).inView);
     EXPECT_FALSE(scene.status(cube).needed);
     EXPECT_EQ(calls.advances, 1);
@@ -110,14 +110,14 @@ TEST(EffectKind, ATestOnlyKindIsCulledOutOfViewAndEmittedInView) {
     EXPECT_EQ(scene.status(cube).framesSkipped, 10u);
 
     // Back in view: resumed, and the Scene counts the catch-up the kind reports.
-    scene.prepare(1.0, towards, m, frame);
+    EXPECT_TRUE(scene.prepare(1.0, towards, m, frame));
     EXPECT_EQ(calls.advances, 2);
     EXPECT_TRUE(calls.lastResumed);
     EXPECT_EQ(calls.lastAdvanceTo, 1.0);
     EXPECT_EQ(scene.status(cube).catchUps, 1u);
     EXPECT_EQ(frame.splats().size(), 8u);
     // Seen again next frame: not resumed.
-    scene.prepare(1.0 + 1.0 / 30.0, towards, m, frame);
+    EXPECT_TRUE(scene.prepare(1.0 + 1.0 / 30.0, towards, m, frame));
     EXPECT_FALSE(calls.lastResumed);
     EXPECT_EQ(scene.status(cube).catchUps, 1u);
 }
@@ -129,9 +129,9 @@ TEST(EffectKind, ADeadKindInViewIsNotAdvancedOrDrawn) {
     const EffectId cube = scene.add(std::make_unique<StaticCube>(glm::vec3(0, 3, 0), 1.0, calls));
     const Camera towards = lookingAt({0, 3, 0}, {0, 4, 20});
     Frame frame;
-    scene.prepare(0.5, towards, m, frame);
+    EXPECT_TRUE(scene.prepare(0.5, towards, m, frame));
     EXPECT_EQ(calls.advances, 1);
-    scene.prepare(1.5, towards, m, frame); // past its lifetime
+    EXPECT_TRUE(scene.prepare(1.5, towards, m, frame)); // past its lifetime
     EXPECT_TRUE(scene.status(cube).inView);
     EXPECT_FALSE(scene.status(cube).alive);
     EXPECT_FALSE(scene.status(cube).needed);

@@ -122,7 +122,7 @@ TEST(SceneKinds, OneIdSpaceAcrossKinds) {
     EXPECT_EQ(s.scene.options(s.cube).name, "cube");
 
     Frame frame;
-    s.scene.prepare(0.5, front(), s.materials, frame);
+    EXPECT_TRUE(s.scene.prepare(0.5, front(), s.materials, frame));
     for (EffectId id : {s.fire, s.clouds, s.fog, s.cube}) EXPECT_TRUE(s.scene.status(id).needed) << s.scene.options(id).name;
     EXPECT_GT(s.scene.status(s.fire).splatsDrawn, 0u);
     EXPECT_GT(s.scene.status(s.cube).splatsDrawn, 0u);
@@ -140,7 +140,7 @@ TEST(SceneKinds, OneIdSpaceAcrossKinds) {
 TEST(SceneKinds, CloudsAndGroundFogOutOfViewAreCulledAndSkipped) {
     FourKinds s;
     Frame frame;
-    s.scene.prepare(0.0, away(), s.materials, frame);
+    EXPECT_TRUE(s.scene.prepare(0.0, away(), s.materials, frame));
     for (EffectId id : {s.clouds, s.fog}) {
         const EffectStatus& st = s.scene.status(id);
         EXPECT_TRUE(st.inRange) << s.scene.options(id).name;
@@ -156,7 +156,7 @@ TEST(SceneKinds, CloudsAndGroundFogOutOfViewAreCulledAndSkipped) {
     // Only the fog in view: the cloud (above, out of a low, level view) stays culled.
     const Camera low = lookingAt({0, 0.5f, 0}, {0, 0.5f, 12});
     ASSERT_FALSE(Scene::inFrustum(s.scene.findLodVolume(s.clouds)->boundsWorld(), low)) << "the test's view must miss the cloud";
-    s.scene.prepare(0.1, low, s.materials, frame);
+    EXPECT_TRUE(s.scene.prepare(0.1, low, s.materials, frame));
     EXPECT_FALSE(s.scene.status(s.clouds).needed);
     EXPECT_EQ(s.scene.status(s.clouds).framesSkipped, 2u);
     EXPECT_TRUE(s.scene.status(s.fog).needed);
@@ -165,7 +165,7 @@ TEST(SceneKinds, CloudsAndGroundFogOutOfViewAreCulledAndSkipped) {
 
     // Out of range: the same test as for effects.
     s.scene.options(s.fog).rangeWorld = 5.0f;
-    s.scene.prepare(0.2, front(), s.materials, frame);
+    EXPECT_TRUE(s.scene.prepare(0.2, front(), s.materials, frame));
     EXPECT_FALSE(s.scene.status(s.fog).inRange);
     EXPECT_FALSE(s.scene.status(s.fog).needed);
     EXPECT_TRUE(s.scene.status(s.clouds).needed);
@@ -179,7 +179,7 @@ TEST(SceneKinds, AnyKindIsSwitchedOffById) {
         const EffectId id = EffectId(off);
         s.scene.setEnabled(id, false);
         Frame frame;
-        s.scene.prepare(0.5, front(), s.materials, frame);
+        EXPECT_TRUE(s.scene.prepare(0.5, front(), s.materials, frame));
         const EffectStatus& st = s.scene.status(id);
         EXPECT_FALSE(st.enabled) << s.scene.options(id).name;
         EXPECT_FALSE(st.needed) << s.scene.options(id).name;
@@ -197,7 +197,7 @@ TEST(SceneKinds, AnyKindIsSwitchedOffById) {
 TEST(SceneKinds, CountersCountEveryKind) {
     FourKinds s;
     Frame frame;
-    s.scene.prepare(0.5, front(), s.materials, frame);
+    EXPECT_TRUE(s.scene.prepare(0.5, front(), s.materials, frame));
     EXPECT_EQ(s.scene.counters().declared, 4u);
     EXPECT_EQ(s.scene.counters().needed, 4u);
     EXPECT_EQ(s.scene.counters().simulated, 4u);
@@ -206,7 +206,7 @@ TEST(SceneKinds, CountersCountEveryKind) {
     EXPECT_EQ(frame.counters().needed, 4u);
     EXPECT_EQ(frame.counters().drawn, 4u);
 
-    s.scene.prepare(0.6, away(), s.materials, frame);
+    EXPECT_TRUE(s.scene.prepare(0.6, away(), s.materials, frame));
     EXPECT_EQ(frame.counters().declared, 4u);
     EXPECT_EQ(frame.counters().needed, 0u);
     EXPECT_EQ(frame.counters().simulated, 0u);
@@ -231,7 +231,7 @@ TEST(SceneKinds, InViewVolumesEmitExactlyTheirOwnRefinement) {
         const GroundFog ownFog = fogLayer(0, 0, lod);
         for (int i = 0; i < 2; ++i) {
             const Camera cam = lookingAt({0, 2, 0}, {float(i), 6, 40});
-            scene.prepare(0.1 * i, cam, materials, frame);
+            EXPECT_TRUE(scene.prepare(0.1 * i, cam, materials, frame));
             LodFrame wantCloud, wantFog;
             ASSERT_TRUE(ownCloud.update(cam, refine, &ct, wantCloud));
             ASSERT_TRUE(ownFog.update(cam, refine, wantFog));
@@ -294,7 +294,7 @@ TEST(SceneKinds, LightingAppliesToEveryKindThatExposesADensity) {
     ASSERT_TRUE(s.scene.addLight(Light::directional({0.3f, -1.0f, 0.2f})));
     for (EffectId id : {s.fire, s.clouds, s.fog, s.cube}) s.scene.setLighting(id, {.enabled = true, .selfShadow = SelfShadow::Off});
     Frame frame;
-    s.scene.prepare(0.5, front(), s.materials, frame);
+    EXPECT_TRUE(s.scene.prepare(0.5, front(), s.materials, frame));
     EXPECT_TRUE(s.scene.lightingError().empty()) << s.scene.lightingError();
     EXPECT_TRUE(s.scene.status(s.fire).lit);
     EXPECT_TRUE(s.scene.status(s.cube).lit);

@@ -1,5 +1,6 @@
 // Need-driven scheduling (issue 6): hidden effects cost nothing and come back
 // exactly (stateless) or within the documented catch-up error (solver).
+#include <algorithm>
 #include <cmath>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -33,7 +34,7 @@ TEST(Scene, HiddenEffectsDoNoSimulationAndDrawNothing) {
     const Camera cam = lookingAt({0, 3, 0}, {0, 4, 20});
     SplatBuilder builder;
     for (int f = 0; f < 20; ++f) {
-        scene.update(f / 30.0, cam);
+        EXPECT_TRUE(scene.update(f / 30.0, cam));
         builder.begin(cam);
         scene.emit(builder, m);
     }
@@ -65,8 +66,8 @@ TEST(Scene, StatelessEffectReturnsExactlyAsItsAlwaysSimulatedTwin) {
     const Camera fixed = lookingAt({40, 3, 0}, {40, 5, 15});
     for (int f = 0; f < 200; ++f) {
         const double t = f / 30.0;
-        scheduled.update(t, sweeping(f));
-        always.update(t, fixed);
+        EXPECT_TRUE(scheduled.update(t, sweeping(f)));
+        EXPECT_TRUE(always.update(t, fixed));
         if (!scheduled.status(a).needed) continue;
         // Whenever the scheduled fire is seen, it is the twin, voxel for voxel.
         const auto& va = scheduled.effect(a).grid().voxels;
@@ -96,8 +97,8 @@ TEST(Scene, SolverEffectCatchesUpWithinTheDocumentedError) {
     int compared = 0;
     for (int f = 0; f < 240; ++f) {
         const double t = f / 30.0;
-        scheduled.update(t, sweeping(f));
-        always.update(t, fixed);
+        EXPECT_TRUE(scheduled.update(t, sweeping(f)));
+        EXPECT_TRUE(always.update(t, fixed));
         // Compare on the first frame back after a hidden stretch of 1 s.
         if (!scheduled.status(a).needed || f % 60 != 0 || f == 0) continue;
         const auto& da = scheduled.effect(a).solver()->density();
@@ -166,7 +167,7 @@ TEST(Scene, SpreadingFireIsNotCulledWhileVisible) {
     int visibleFrames = 0;
     for (int f = 0; f < 300; ++f) {
         const double t = f / 30.0;
-        scene.update(t, cam);
+        EXPECT_TRUE(scene.update(t, cam));
         twin.update(t);
         builder.begin(cam);
         twin.emit(builder, m);
@@ -175,4 +176,63 @@ TEST(Scene, SpreadingFireIsNotCulledWhileVisible) {
         ASSERT_TRUE(scene.status(id).needed) << "culled while visible at t " << t;
     }
     EXPECT_GT(visibleFrames, 50);
+}
+
+// A fire prepared at t = 1e300 came back empty with no error. Times outside
+// [0, kMaxTimeSec] are refused, naming the time and the bound, and change
+// neither the scene nor the frame; the bound itself is a time like any other.
+TEST(Scene, TimesBeyondWhatTheDynamicsHoldExactlyAreRefused) {
+    Materials m{Footprint{}};
+    Scene scene;
+    scene.add(*presets::fire(m, {.position = {0, 0, 0}}), {.name = "fire"});
+    const Camera cam = lookingAt({0, 1, 0}, {0, 3, 12});
+    Frame frame;
+    ASSERT_TRUE(scene.prepare(1.0, cam, m, frame));
+    const std::uint64_t splats = frame.counters().splats;
+    ASSERT_GT(splats, 0u);
+
+    Status s = scene.prepare(1e300, cam, m, frame);
+    ASSERT_FALSE(s);
+    EXPECT_EQ(s.error(), "Scene::prepare: timeSec is 1e+300; expected a finite number of seconds in [0, 262144] (kMaxTimeSec, about 72.8 hours: "
+                         "later times lose the dynamics' precision; restart the scene clock before then)");
+    for (double bad : {std::nextafter(kMaxTimeSec, 1e300), double(INFINITY), double(NAN), -1.0}) {
+        s = scene.prepare(bad, cam, m, frame);
+        ASSERT_FALSE(s) << bad;
+        EXPECT_NE(s.error().find("expected a finite number of seconds in [0, 262144]"), std::string::npos) << s.error();
+        s = scene.update(bad, cam);
+        ASSERT_FALSE(s) << bad;
+        EXPECT_EQ(s.error().rfind("Scene::update: timeSec is ", 0), 0u) << s.error();
+    }
+    EXPECT_EQ(scene.time(), 1.0) << "a refused time changes nothing";
+    EXPECT_EQ(frame.time(), 1.0);
+    EXPECT_EQ(frame.counters().splats, splats);
+
+    ASSERT_TRUE(scene.prepare(kMaxTimeSec, cam, m, frame));
+    EXPECT_EQ(scene.time(), kMaxTimeSec);
+    EXPECT_EQ(frame.counters().splats, splats) << "the same fire at the bound";
+}
+
+// Where kMaxTimeSec comes from: the cycling phase p = t * rate + start is a
+// double and its fraction the float cross-fade weight. Up to the bound, at
+// the largest rate scene files take, the fraction is right to a float's 24
+// bits (checked against long double); 64 times later it is not.
+TEST(Scene, TheTimeBoundIsWhereTheCyclingPhaseKeepsFloatPrecision) {
+    const CyclingDesc cy{.mode = Cycling::Ordered, .texturesPerSec = 1000.0f, .rateJitter = 0.0f, .randomStart = true};
+    auto worstError = [&](double t) {
+        double worst = 0.0;
+        for (int i = 0; i < 4096; ++i) {
+            const glm::ivec3 cell(i % 16, (i / 16) % 16, i / 256);
+            const TextureSample s = cycleSample(cell, t, cy, 7u);
+            // The same start the dynamics draw (randomStart), in long double.
+            const long double start = hashUnit(hashCell(cell, 7u, 0x5851f42du));
+            const long double p = (long double)t * 1000.0L + start;
+            const long double exact = p - std::floor(p);
+            worst = std::max(worst, double(std::fabs(exact - (long double)s.phase)));
+        }
+        return worst;
+    };
+    const double floatStep = std::ldexp(1.0, -24);
+    EXPECT_LE(worstError(kMaxTimeSec), floatStep);
+    EXPECT_LE(worstError(kMaxTimeSec - 1.0 / 3.0), floatStep);
+    EXPECT_GT(worstError(64.0 * kMaxTimeSec + 1.0 / 3.0), floatStep) << "if this holds, the bound could be raised";
 }

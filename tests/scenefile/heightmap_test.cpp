@@ -78,7 +78,7 @@ TEST(SceneFileHeightmap, TerrainAndGroundFogShareEverySamplePoint) {
             terrain.push_back(pos + splatfx::heightmapPoint(i, j, t.w, t.h, float(t.codes[std::size_t(j * t.w + i)]) / 65535.0f, spacing, scale));
     const splatfx::Camera cam = splatfx::Camera::lookAt(pos + glm::vec3(0, 40, 30), pos, {0, 1, 0}, glm::radians(60.0f), {64, 48}, 0.5f, 500.0f);
     splatfx::Frame frame;
-    r->scene.prepare(0.0, cam, m, frame);
+    EXPECT_TRUE(r->scene.prepare(0.0, cam, m, frame));
     ASSERT_EQ(frame.volumes().size(), 1u);
     const auto& tets = frame.volumes()[0].lod.tets;
     ASSERT_GT(tets.size(), 0u) << "the valley lies under the fog top";
@@ -99,7 +99,7 @@ TEST(SceneFileHeightmap, TerrainAndGroundFogShareEverySamplePoint) {
     // Disabled: nothing reaches the frame.
     r->scene.setEnabled(fogId, false);
     splatfx::Frame off;
-    r->scene.prepare(0.0, cam, m, off);
+    EXPECT_TRUE(r->scene.prepare(0.0, cam, m, off));
     EXPECT_TRUE(off.volumes().empty());
 }
 
@@ -151,11 +151,77 @@ TEST(SceneFileHeightmap, GroundFogLodKeys) {
     EXPECT_FALSE(o.refine.morph);
     const splatfx::Camera cam = splatfx::Camera::lookAt({0, 600, 900}, {0, 0, 0}, {0, 1, 0}, glm::radians(40.0f), {64, 48}, 0.5f, 5000.0f);
     splatfx::Frame a, b;
-    lod->scene.prepare(0.0, cam, m, a);
-    full->scene.prepare(0.0, cam, m, b);
+    EXPECT_TRUE(lod->scene.prepare(0.0, cam, m, a));
+    EXPECT_TRUE(full->scene.prepare(0.0, cam, m, b));
     ASSERT_EQ(a.volumes().size(), 1u);
     ASSERT_EQ(b.volumes().size(), 1u);
     EXPECT_EQ(a.volumes()[0].lod.stats.fullResolution, b.volumes()[0].lod.tets.size());
     EXPECT_LT(a.volumes()[0].lod.tets.size(), b.volumes()[0].lod.tets.size());
     EXPECT_GT(a.volumes()[0].lod.tets.size(), 0u);
+}
+
+// "terrainGeometry" ignored the named geometry's own heightmap, spacing,
+// heightScale and position: the layer now takes them from it (a layer giving
+// none of them builds what the same values written out build), and a value
+// the layer gives that disagrees, or a geometry it cannot follow, is refused
+// naming the field.
+TEST(SceneFileHeightmap, TerrainGeometryGivesTheLayerTheGeometrysTerrain) {
+    const TempTerrain t(15, 9, "terrain-geometry");
+    splatfx::Materials m(splatfx::Footprint{});
+    const std::string geometry =
+        R"("geometry": [{"name": "terrain", "type": "heightmap", "heightmap": "dem.pgm", "spacing": 2, "heightScale": 100, "position": [10, -1, 4]}], )";
+    auto taken = t.parse(geometry + R"("volumes": [{"kind": "groundFog", "fogTop": 200, "lod": true, "terrainGeometry": "terrain"}])", m);
+    auto written = t.parse(geometry + R"("volumes": [{"kind": "groundFog", "heightmap": "dem.pgm", "spacing": 2, "heightScale": 100,
+                                          "position": [10, -1, 4], "fogTop": 200, "lod": true}])",
+                           m);
+    auto agreeing = t.parse(geometry + R"("volumes": [{"kind": "groundFog", "heightmap": "./dem.pgm", "spacing": 2, "heightScale": 100,
+                                           "position": [10, -1, 4], "fogTop": 200, "lod": true, "terrainGeometry": "terrain"}])",
+                            m);
+    ASSERT_TRUE(taken) << taken.error();
+    ASSERT_TRUE(written) << written.error();
+    ASSERT_TRUE(agreeing) << agreeing.error();
+    ASSERT_EQ(taken->groundFogTerrain.size(), 1u);
+    EXPECT_EQ(taken->groundFogTerrain[0].geometry, "terrain");
+    const splatfx::GroundFog* a = taken->scene.findGroundFog(taken->volumes[0].id);
+    const splatfx::GroundFog* b = written->scene.findGroundFog(written->volumes[0].id);
+    ASSERT_TRUE(a && b);
+    EXPECT_EQ(a->boundsWorld().lo, b->boundsWorld().lo);
+    EXPECT_EQ(a->boundsWorld().hi, b->boundsWorld().hi);
+    // The same tetrahedra and the same terrain mesh, to the bit.
+    const splatfx::Camera cam = splatfx::Camera::lookAt({10, 300, 200}, {10, 0, 4}, {0, 1, 0}, glm::radians(50.0f), {64, 48}, 0.5f, 5000.0f);
+    splatfx::Frame fa, fb;
+    ASSERT_TRUE(taken->scene.prepare(0.0, cam, m, fa));
+    ASSERT_TRUE(written->scene.prepare(0.0, cam, m, fb));
+    ASSERT_EQ(fa.volumes().size(), 1u);
+    ASSERT_EQ(fb.volumes().size(), 1u);
+    const auto &ta = fa.volumes()[0].lod.tets, &tb = fb.volumes()[0].lod.tets;
+    ASSERT_GT(ta.size(), 0u);
+    ASSERT_EQ(ta.size(), tb.size());
+    for (std::size_t i = 0; i < ta.size(); ++i)
+        for (int k = 0; k < 4; ++k) ASSERT_EQ(ta[i].position[k], tb[i].position[k]) << "tetrahedron " << i;
+    // The terrain mesh the host draws for the geometry (keepTerrain): the same whether the layer takes the values or repeats them.
+    splatfx::Frame fc;
+    ASSERT_TRUE(agreeing->scene.prepare(0.0, cam, m, fc));
+    EXPECT_FALSE(taken->scene.groundFogTerrain(taken->volumes[0].id).empty());
+    EXPECT_EQ(taken->scene.groundFogTerrain(taken->volumes[0].id), agreeing->scene.groundFogTerrain(agreeing->volumes[0].id));
+
+    auto expectError = [&](const std::string& geo, const std::string& layerKeys, const std::string& message) {
+        auto r = t.parse(geo + R"("volumes": [{"kind": "groundFog", "fogTop": 200, "lod": true, "terrainGeometry": "terrain")" + layerKeys + "}]", m);
+        ASSERT_FALSE(r) << layerKeys;
+        EXPECT_NE(r.error().find(message), std::string::npos) << r.error();
+    };
+    expectError(geometry, R"(, "spacing": 1)",
+                "volumes[0].spacing: 1 disagrees with terrainGeometry 'terrain': its spacing is 2 (geometry[0].spacing); leave it out to take the "
+                "geometry's");
+    expectError(geometry, R"(, "heightScale": 50)", "volumes[0].heightScale: 50 disagrees with terrainGeometry 'terrain': its heightScale is 100");
+    expectError(geometry, R"(, "position": [0, 0, 0])",
+                "volumes[0].position: [0, 0, 0] disagrees with terrainGeometry 'terrain': its position is [10, -1, 4] (geometry[0].position)");
+    expectError(geometry, R"(, "heightmap": "other.pgm")", "volumes[0].heightmap: 'other.pgm' is not the file of terrainGeometry 'terrain'");
+    const std::string rotated = R"("geometry": [{"name": "terrain", "type": "heightmap", "heightmap": "dem.pgm", "rotationDeg": [0, 90, 0]}], )";
+    expectError(rotated, "", "volumes[0].terrainGeometry: geometry 'terrain' (geometry[0]) is rotated or scaled");
+    const std::string scaled = R"("geometry": [{"name": "terrain", "type": "heightmap", "heightmap": "dem.pgm", "scale": 2}], )";
+    expectError(scaled, "", "volumes[0].terrainGeometry: geometry 'terrain' (geometry[0]) is rotated or scaled");
+    const std::string moving = R"("geometry": [{"name": "cart", "type": "empty", "motion": {"velocity": [1, 0, 0]}},
+                                               {"name": "terrain", "type": "heightmap", "heightmap": "dem.pgm", "attachTo": "cart"}], )";
+    expectError(moving, "", "volumes[0].terrainGeometry: geometry 'terrain' (geometry[1]) moves");
 }

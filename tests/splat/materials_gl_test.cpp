@@ -39,7 +39,7 @@ Result<Effect> levelEffect(Materials& m, int i) {
 
 Image drawFrame(Scene& scene, const Materials& m, gl::FrameRenderer& r, gl::Framebuffer& fb, const Camera& cam, double t) {
     Frame frame;
-    scene.prepare(t, cam, m, frame);
+    EXPECT_TRUE(scene.prepare(t, cam, m, frame));
     r.render(frame, {.framebuffer = fb.handle(), .drawOpaque = [&] { fb.clear({0, 0, 0, 1}); }});
     return fb.read();
 }

@@ -104,7 +104,7 @@ TEST(FrameVolumes, ScenePreparesTheVolumesInView) {
     const EffectId id = scene.add(std::move(*vol), std::move(*tf), std::move(*table), {.name = "cloud"});
     Materials materials{Footprint{}};
     Frame frame;
-    scene.prepare(0.0, axisCamera(), materials, frame);
+    EXPECT_TRUE(scene.prepare(0.0, axisCamera(), materials, frame));
     ASSERT_EQ(frame.volumes().size(), 1u);
     EXPECT_NE(frame.volumes()[0].table, nullptr);
     EXPECT_GT(frame.volumes()[0].lod.tets.size(), 0u);
@@ -113,10 +113,10 @@ TEST(FrameVolumes, ScenePreparesTheVolumesInView) {
     EXPECT_EQ(frame.drawOrder()[0].kind, DrawBatch::Kind::Tetrahedra);
 
     const Camera away = Camera::lookAt({0, 0, 0}, {0, 0, 1}, {0, 1, 0}, glm::radians(60.0f), {64, 48}, 0.1f, 1000.0f);
-    scene.prepare(1.0, away, materials, frame);
+    EXPECT_TRUE(scene.prepare(1.0, away, materials, frame));
     EXPECT_TRUE(frame.volumes().empty());
     scene.setEnabled(id, false);
-    scene.prepare(2.0, axisCamera(), materials, frame);
+    EXPECT_TRUE(scene.prepare(2.0, axisCamera(), materials, frame));
     EXPECT_TRUE(frame.volumes().empty());
 }
 

@@ -142,7 +142,7 @@ int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
             std::vector<double> t;
             for (int f = -1; f < reps; ++f) { // one warm-up frame: the table upload, the shader
                 const auto a = Clock::now();
-                scene.prepare(1.0, v.camera, materials, frame);
+                if (auto s = scene.prepare(1.0, v.camera, materials, frame); !s) return std::fprintf(stderr, "%s\n", s.error().c_str()), 1;
                 fr->render(frame, bench::clearedTarget(*fb, {0.0f, 0.0f, 0.0f, 0.0f}));
                 glFinish();
                 if (f >= 0) t.push_back(std::chrono::duration<double, std::milli>(Clock::now() - a).count());

@@ -169,7 +169,7 @@ int runClouds(int argc, char** argv) {
             splatfx::Image fullImage;
             for (Pass& pass : passes) {
                 const auto a = Clock::now();
-                cs.scene.prepare(f / 60.0 + 1.0, cam, materials, frame);
+                if (auto s = cs.scene.prepare(f / 60.0 + 1.0, cam, materials, frame); !s) return std::fprintf(stderr, "%s\n", s.error().c_str()), 1;
                 const auto b = Clock::now();
                 pass.renderer->render(frame, bench::clearedTarget(*fb, {0.45f, 0.6f, 0.85f, 1.0f}));
                 glFinish();
@@ -250,7 +250,7 @@ int runClouds(int argc, char** argv) {
             double drawn = 0;
             for (int f = 0; f < o.popFrames; ++f) {
                 const splatfx::Camera cam = slowFlight(cs.ext, f, o.popStepWorld, o.popSize);
-                cs.scene.prepare(f / 60.0 + 1.0, cam, materials, frame);
+                if (auto s = cs.scene.prepare(f / 60.0 + 1.0, cam, materials, frame); !s) return std::fprintf(stderr, "%s\n", s.error().c_str()), 1;
                 fr->render(frame, bench::clearedTarget(*fb, {0.0f, 0.0f, 0.0f, 0.0f}));
                 drawn += double(fr->stats().tetrahedra.drawn);
                 splatfx::Image img = fb->read();
@@ -288,7 +288,7 @@ int runClouds(int argc, char** argv) {
         const splatfx::Camera cam =
             splatfx::Camera::lookAt(glm::vec3(-0.6f, -0.35f, 1.8f) * cs.ext, 0.5f * cs.ext, {0, 0, 1}, glm::radians(60.0f), o.fogSize, 0.1f, 5000.0f);
         splatfx::Frame frame;
-        cs.scene.prepare(1.0, cam, materials, frame);
+        if (auto s = cs.scene.prepare(1.0, cam, materials, frame); !s) return std::fprintf(stderr, "%s\n", s.error().c_str()), 1;
         auto shared = std::make_shared<const splatfx::Fog>(*fog);
         auto draw = [&](splatfx::gl::FrameRenderer& r, bool fogged) {
             frame.setFog(fogged ? shared : nullptr);

@@ -316,9 +316,10 @@ int cowPopping(const std::string& scenePath, int steps) {
         for (int i = 0; i <= steps; ++i) {
             const double t = 1.3 + i / 240.0;
             const splatfx::Camera cam = player->cameraAt(t, size);
-            player->renderFrame(t, cam, fb->handle(), {.opacityScale = 0.0f});
+            if (auto st = player->renderFrame(t, cam, fb->handle(), {.opacityScale = 0.0f}); !st)
+                return std::fprintf(stderr, "%s\n", st.error().c_str()), 1;
             const splatfx::Image bare = fb->read();
-            player->renderFrame(t, cam, fb->handle());
+            if (auto st = player->renderFrame(t, cam, fb->handle()); !st) return std::fprintf(stderr, "%s\n", st.error().c_str()), 1;
             splatfx::Image img = fb->read();
             for (size_t p = 0; p < img.pixels.size(); ++p) {
                 if (p % 4 == 0 && std::abs(img.pixels[p] - bare.pixels[p]) + std::abs(img.pixels[p + 1] - bare.pixels[p + 1]) > 1e-6f)

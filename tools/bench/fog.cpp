@@ -91,7 +91,10 @@ int runFog(int argc, char** argv) {
         std::vector<double> ms;
         for (int f = 0; f < frames + 2; ++f) {
             const auto a = Clock::now();
-            player->renderFrame(t, cam, fb->handle());
+            if (auto st = player->renderFrame(t, cam, fb->handle()); !st) {
+                std::fprintf(stderr, "fog: %s\n", st.error().c_str());
+                std::exit(1);
+            }
             glFinish();
             if (f >= 2) ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - a).count()); // 2 warm-up frames
             t += 1.0 / 60.0;
@@ -149,10 +152,10 @@ int runFog(int argc, char** argv) {
     for (Config& c : configs) {
         if (c.fog < 0 || c.tex.x == 0) continue;
         if (!use(c)) return 1;
-        player->renderFrame(t, cam, fb->handle());
+        if (auto st = player->renderFrame(t, cam, fb->handle()); !st) return std::fprintf(stderr, "%s\n", st.error().c_str()), 1;
         const splatfx::Image img = fb->read();
         if (!use({c.fog, {0, 0}})) return 1;
-        player->renderFrame(t, cam, fb->handle());
+        if (auto st = player->renderFrame(t, cam, fb->handle()); !st) return std::fprintf(stderr, "%s\n", st.error().c_str()), 1;
         const splatfx::Image perPixel = fb->read();
         double sum = 0.0, worst = 0.0;
         std::size_t n = 0;

@@ -139,7 +139,7 @@ int runGroundFog(int argc, char** argv) {
             l.scene.options(0).refine = {.detailC = o.detailC, .morph = m.morph};
             splatfx::Frame frame;
             const auto a = Clock::now();
-            l.scene.prepare(1.0 + f / 24.0, cam, materials, frame);
+            if (auto s = l.scene.prepare(1.0 + f / 24.0, cam, materials, frame); !s) return std::fprintf(stderr, "%s\n", s.error().c_str()), 1;
             const auto b = Clock::now();
             l.renderer->render(frame, bench::clearedTarget(*fb, {0.0f, 0.0f, 0.0f, 0.0f}));
             glFinish();

@@ -50,7 +50,7 @@ struct FrameDraw {
 // sort), then the frame renderer with the clear as the host's opaque pass,
 // and wait for the pixels (glFinish), so the time is CPU + GL.
 void drawFrame(splatfx::Scene& scene, const splatfx::Materials& m, FrameDraw& d, const splatfx::Camera& cam, double timeSec) {
-    scene.prepare(timeSec, cam, m, d.frame);
+    if (auto s = scene.prepare(timeSec, cam, m, d.frame); !s) std::fprintf(stderr, "%s\n", s.error().c_str());
     d.renderer.render(d.frame, {.framebuffer = d.fb.handle(), .drawOpaque = [&] { d.fb.clear({0.02f, 0.02f, 0.04f, 1.0f}); }});
     glFinish();
 }
@@ -68,7 +68,7 @@ double frameCost(splatfx::Scene& scene, splatfx::Materials& m, int frames, doubl
         if (d) {
             drawFrame(scene, m, *d, cam, t0 + f / 60.0);
         } else {
-            scene.update(t0 + f / 60.0, cam);
+            if (auto s = scene.update(t0 + f / 60.0, cam); !s) std::fprintf(stderr, "%s\n", s.error().c_str());
             builder.begin(cam);
             scene.emit(builder, m);
             builder.sort();

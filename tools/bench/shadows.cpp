@@ -330,7 +330,7 @@ int runShadows(int argc, char** argv) {
                 glFinish();
                 const auto a = Clock::now();
                 const std::clock_t c0 = std::clock();
-                scene.prepare(t, cam, m, frame);
+                if (auto s = scene.prepare(t, cam, m, frame); !s) return std::fprintf(stderr, "%s\n", s.error().c_str()), 1;
                 fr->render(frame, {.framebuffer = fb->handle(), .drawOpaque = [&] {
                                        bench::clearHost({0.1f, 0.1f, 0.12f, 1.0f});
                                        scenehost::GeometryLighting gl;

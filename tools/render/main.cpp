@@ -330,6 +330,14 @@ static int renderMain(int argc, char** argv) {
     const int frames = a.frames.value_or(file.output.frames);
     const float fps = a.fps.value_or(file.output.fps);
     const std::string name = file.output.name;
+    // Frame i shows time i / fps; the scene refuses times past kMaxTimeSec (the file's own frames and fps are checked when it is read).
+    if (const double last = (frames - 1) / double(fps); last > splatfx::kMaxTimeSec) {
+        char buf[256];
+        std::snprintf(buf, sizeof buf,
+                      "%d frames at %g fps end at %g s, later than %g s (splatfx::kMaxTimeSec, about 72.8 hours); fewer --frames or a higher --fps",
+                      frames, double(fps), last, splatfx::kMaxTimeSec);
+        return fail(buf);
+    }
     if (a.range)
         if (auto st = cli::checkFrameRange("--range", *a.range, frames); !st) return fail(st.error());
     const bool whole = !a.range;
@@ -393,7 +401,7 @@ static int renderMain(int argc, char** argv) {
             // Before or between this task's frames: the scene steps through
             // them as a full run does (same times, same cameras), undrawn.
             const auto r0 = Clock::now();
-            player->advance(t, player->cameraAt(t, size), {.traditional = a.traditional});
+            if (auto st = player->advance(t, player->cameraAt(t, size), {.traditional = a.traditional}); !st) return fail(st.error());
             replayMs += std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
             ++replayed;
             continue;
@@ -401,7 +409,7 @@ static int renderMain(int argc, char** argv) {
         if (written == 0) reachMs = replayMs;
         if (written == a.abortAfter) return fail("aborted on purpose after " + std::to_string(written) + " frames (--abort-after); no output kept");
         const auto f0 = Clock::now();
-        player->renderFrame(t, player->cameraAt(t, size), fb->handle(), {.traditional = a.traditional});
+        if (auto st = player->renderFrame(t, player->cameraAt(t, size), fb->handle(), {.traditional = a.traditional}); !st) return fail(st.error());
         splatfx::Image img = fb->read();
         // Every fallback of the frame renderer, said once, as it happens (FrameRenderStats::notes).
         for (const std::string& note : player->renderer().stats().notes)

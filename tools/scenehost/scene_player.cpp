@@ -113,21 +113,25 @@ GeometryRenderer& ScenePlayer::geometry() { return *mImpl->geometry; }
 
 splatfx::Camera ScenePlayer::cameraAt(double t, glm::ivec2 viewport) const { return evaluate(mImpl->file->camera, t, viewport); }
 
-void ScenePlayer::advance(double t, const splatfx::Camera& camera, const FrameOptions& options) {
+splatfx::Status ScenePlayer::advance(double t, const splatfx::Camera& camera, const FrameOptions& options) {
     Impl& p = *mImpl;
     splatfx::SceneFile& f = *p.file;
     FrameStats& s = p.stats;
     const auto t0 = Clock::now();
-    f.scene.prepare(t, camera, p.materials, p.frame, {.textured = !options.traditional, .opacityScale = options.opacityScale});
+    if (splatfx::Status st =
+            f.scene.prepare(t, camera, p.materials, p.frame, {.textured = !options.traditional, .opacityScale = options.opacityScale});
+        !st)
+        return st;
     s.prepareMs = msSince(t0);
     s.renderMs = 0.0;
     s.counters = p.frame.counters();
     s.splatsPerEffect.assign(f.effects.size(), 0);
     for (std::size_t i = 0; i < f.effects.size(); ++i) s.splatsPerEffect[i] = f.scene.status(f.effects[i].id).splatsDrawn;
+    return {};
 }
 
-void ScenePlayer::renderFrame(double t, const splatfx::Camera& camera, unsigned framebuffer, const FrameOptions& options) {
-    advance(t, camera, options);
+splatfx::Status ScenePlayer::renderFrame(double t, const splatfx::Camera& camera, unsigned framebuffer, const FrameOptions& options) {
+    if (splatfx::Status st = advance(t, camera, options); !st) return st;
     Impl& p = *mImpl;
     splatfx::SceneFile& f = *p.file;
     FrameStats& s = p.stats;
@@ -171,6 +175,7 @@ void ScenePlayer::renderFrame(double t, const splatfx::Camera& camera, unsigned 
     }
     p.renderer->render(p.frame, target);
     s.renderMs = msSince(t0);
+    return {};
 }
 
 } // namespace scenehost

@@ -61,15 +61,16 @@ public:
     // The scene file's camera path at t for a viewport.
     splatfx::Camera cameraAt(double timeSec, glm::ivec2 viewport) const;
     // Draws the frame at timeSec (>= the previous call's) into the host
-    // framebuffer (0: the default one) over camera.viewport.
-    void renderFrame(double timeSec, const splatfx::Camera& camera, unsigned framebuffer, const FrameOptions& options = {});
+    // framebuffer (0: the default one) over camera.viewport. Fails, drawing
+    // nothing, as Scene::prepare does (a time past splatfx::kMaxTimeSec).
+    splatfx::Status renderFrame(double timeSec, const splatfx::Camera& camera, unsigned framebuffer, const FrameOptions& options = {});
     // Everything renderFrame does except drawing: Scene::prepare (decide,
     // simulate, emit, sort) for this time and camera, stats() updated. A
     // render-farm task replays the frames before its range with it, so the
     // scene's state (solver effects, catch-ups, shadow tables) at its first
     // frame is the state a full run has there; the GL side caches only by
     // content version, so skipping its draws changes nothing drawn later.
-    void advance(double timeSec, const splatfx::Camera& camera, const FrameOptions& options = {});
+    splatfx::Status advance(double timeSec, const splatfx::Camera& camera, const FrameOptions& options = {});
 
     splatfx::SceneFile& file();
     const splatfx::SceneFile& file() const;

@@ -433,7 +433,9 @@ static int viewerMain(int argc, char** argv) {
                 }
                 v.target.emplace(std::move(*fb));
             }
-            v.player->renderFrame(v.time, cam, v.target->handle(), v.frame);
+            // Past kMaxTimeSec (about 72.8 hours of scene time) the scene refuses the time: restart the clock.
+            if (v.time > splatfx::kMaxTimeSec) v.time = 0.0;
+            if (auto st = v.player->renderFrame(v.time, cam, v.target->handle(), v.frame); !st) v.error = st.error();
             glBlitNamedFramebuffer(v.target->handle(), 0, 0, 0, fbSize.x, fbSize.y, 0, 0, fbSize.x, fbSize.y, GL_COLOR_BUFFER_BIT, GL_NEAREST);
             glBindFramebuffer(GL_FRAMEBUFFER, 0);
             glViewport(0, 0, fbSize.x, fbSize.y);

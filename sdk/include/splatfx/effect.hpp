@@ -136,7 +136,7 @@ public:
     ~Effect() override;
 
     bool isStateless() const;
-    // Stateless path: the effect at timeSec (>= 0), independent of earlier calls.
+    // Stateless path: the effect at timeSec (in [0, kMaxTimeSec]), independent of earlier calls.
     // Expects isStateless().
     void update(double timeSec);
     // Advances by dtSec (>= 0): simulates a solver effect, or update(time() + dtSec).

@@ -57,6 +57,18 @@ struct EmitOptions {
     float opacityScale = 1.0f; // multiplies each layer's style.opacityScale; default 1
 };
 
+// The latest time, in seconds, at which the effects' dynamics are held
+// exactly: 2^18 s, about 72.8 hours. The local dynamics' phase is
+// p = t * rate + start in double precision and its fraction is the splat's
+// cross-fade weight, a float; the fraction keeps all of a float's 24 bits
+// while p < 2^28, i.e. t < 2^18 s at rates up to 1024 a second (scene files
+// take at most 1000). Below it the propagation step floor(t * stepsPerSec)
+// is an exact integer, and the bob and spin phases (double) err by under
+// 1e-6 rad at the rates scene files take. Beyond it the cross-fades coarsen,
+// and past 2^63 steps the integer casts overflow: Scene::update and prepare
+// refuse such times, and a host restarts its scene clock before them.
+inline constexpr double kMaxTimeSec = 262144.0;
+
 // What alive() may use besides the time; filled by the Scene from EffectOptions.
 struct AliveHints {
     // A stateful kind with no source on and less total material than this is
@@ -113,7 +125,7 @@ public:
     // Called only for kinds in view; must be cheap and must not advance.
     virtual bool alive(double timeSec, const AliveHints& hints) const = 0;
     // Brings the kind to timeSec (>= time() for stateful kinds; stateless
-    // kinds accept any finite t >= 0).
+    // kinds accept any t in [0, kMaxTimeSec]).
     virtual AdvanceResult advanceTo(double timeSec, const AdvanceContext& context) = 0;
     // Adds what the kind draws in its current state for the camera of
     // context.splats. Not const: a view-dependent kind (LOD) keeps per-frame

@@ -206,8 +206,9 @@ public:
 
     // ---- Frames ------------------------------------------------------------
     // Decides what is needed for this camera at timeSec (non-decreasing
-    // across calls) and brings exactly those effects to timeSec.
-    void update(double timeSec, const Camera& camera);
+    // across calls) and brings exactly those effects to timeSec. Fails,
+    // changing nothing, unless timeSec is in [0, kMaxTimeSec] (effect_kind.hpp).
+    Status update(double timeSec, const Camera& camera);
     // Adds the splats of the effects the last update() found needed, each
     // drawn with its EffectOptions::draw combined with `options` (textured
     // only if both are; opacity scales multiply). Kinds drawn as tetrahedra
@@ -216,8 +217,8 @@ public:
     // One frame: update(timeSec, camera), then frame.begin, every needed
     // effect emitted into it in id order (splats, tetrahedra), the lit
     // effects' shadow, frame.end (one back-to-front sort), the fog, and the
-    // frame's counters.
-    void prepare(double timeSec, const Camera& camera, const Materials& materials, Frame& frame, const EmitOptions& options = {});
+    // frame's counters. Fails as update(), changing neither the scene nor the frame.
+    Status prepare(double timeSec, const Camera& camera, const Materials& materials, Frame& frame, const EmitOptions& options = {});
 
     // True when any part of the box may be inside the camera's frustum
     // (conservative: boxes near a frustum corner may pass).

@@ -363,7 +363,8 @@ typedef struct splatfx_frame_stats {
 } splatfx_frame_stats;
 SPLATFX_C_API splatfx_status splatfx_frame_get_stats(const splatfx_frame* frame, splatfx_frame_stats* out, splatfx_error* error);
 
-/* One frame at time_sec (finite, >= 0) for the camera: decides which effects
+/* One frame at time_sec (finite, in [0, 262144] seconds: kMaxTimeSec, the
+ * latest time the dynamics hold exactly; restart the clock before it) for the camera: decides which effects
  * are needed, brings exactly those to time_sec, builds and sorts their
  * splats into `frame` (Scene::prepare). GL-free: any thread that owns these
  * handles. Times should not decrease across calls (solver effects do not run

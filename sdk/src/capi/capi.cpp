@@ -1,5 +1,6 @@
 // splatfx_c.h, the GL-free half: errors, materials, texture sets, the scene and its presets, cameras, frames.
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <type_traits>
 #include <utility>
@@ -610,8 +611,15 @@ splatfx_status splatfx_scene_prepare(splatfx_scene* scene, double time_sec, cons
         if (!camera) return invalid("camera is NULL");
         if (!std::isfinite(time_sec)) return invalid("time_sec is " + str(float(time_sec)) + "; expected a finite number of seconds");
         if (time_sec < 0.0) return invalid("time_sec is " + str(float(time_sec)) + "; expected seconds >= 0");
+        if (time_sec > kMaxTimeSec) {
+            char buf[200];
+            std::snprintf(buf, sizeof buf,
+                          "time_sec is %g; expected seconds <= %g (kMaxTimeSec: later times lose the dynamics' precision; restart the clock)",
+                          time_sec, kMaxTimeSec);
+            return invalid(buf);
+        }
         if (auto bad = checkCamera(*camera, "camera")) return *bad;
-        scene->value.prepare(time_sec, toCamera(*camera), materials->value, frame->value);
+        if (Status s = scene->value.prepare(time_sec, toCamera(*camera), materials->value, frame->value); !s) return invalid(s.error());
         frame->prepared = true;
         frame->materials = materials->identity;
         return success();

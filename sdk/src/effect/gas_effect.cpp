@@ -32,7 +32,7 @@ public:
     }
 
     void update(double t) override {
-        assert(std::isfinite(t) && t >= 0.0 && "Effect::update: timeSec must be finite and >= 0");
+        assert(t >= 0.0 && t <= kMaxTimeSec && "Effect::update: timeSec must be in [0, kMaxTimeSec]");
         time = t;
         // Object dynamics move the lattice through the gas's world (the gas is
         // defined in world coordinates): what is sampled is what the pose covers.

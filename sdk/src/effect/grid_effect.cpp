@@ -49,7 +49,7 @@ public:
     std::uint64_t costCells() const override { return mBase.voxels.size(); }
 
     void update(double t) override {
-        assert(std::isfinite(t) && t >= 0.0 && "Effect::update: timeSec must be finite and >= 0");
+        assert(t >= 0.0 && t <= kMaxTimeSec && "Effect::update: timeSec must be in [0, kMaxTimeSec]");
         time = t;
         // Object dynamics (sec. 3.1): pose, fades and growth of the coarse grid.
         const Pose pose = desc.motion.sample(desc.enabled.object ? t : 0.0);

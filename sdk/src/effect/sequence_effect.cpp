@@ -39,7 +39,7 @@ public:
     std::uint64_t costCells() const override { return mSeq.cellCount(); }
 
     void update(double t) override {
-        assert(std::isfinite(t) && t >= 0.0 && "Effect::update: timeSec must be finite and >= 0");
+        assert(t >= 0.0 && t <= kMaxTimeSec && "Effect::update: timeSec must be in [0, kMaxTimeSec]");
         time = t;
         const double fieldsAt = desc.enabled.object ? t : 0.0;
         const Pose pose = desc.motion.sample(fieldsAt);

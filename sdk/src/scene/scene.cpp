@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstdio>
 
 #include "volume_kinds.hpp"
 
@@ -88,7 +89,23 @@ bool Scene::inFrustum(const Aabb& box, const Camera& camera) {
     return true;
 }
 
-void Scene::update(double timeSec, const Camera& camera) {
+namespace {
+
+// Times the dynamics hold exactly (kMaxTimeSec); NaN fails every comparison.
+Status checkTime(const char* function, double timeSec) {
+    if (timeSec >= 0.0 && timeSec <= kMaxTimeSec) return {};
+    char buf[320];
+    std::snprintf(buf, sizeof buf,
+                  "%s: timeSec is %g; expected a finite number of seconds in [0, %g] (kMaxTimeSec, about 72.8 hours: later times lose the "
+                  "dynamics' precision; restart the scene clock before then)",
+                  function, timeSec, kMaxTimeSec);
+    return makeError(buf);
+}
+
+} // namespace
+
+Status Scene::update(double timeSec, const Camera& camera) {
+    if (Status s = checkTime("Scene::update", timeSec); !s) return s;
     const double previous = mUpdated ? std::min(mTime, timeSec) : timeSec;
     mTime = timeSec;
     mUpdated = true;
@@ -123,6 +140,7 @@ void Scene::update(double timeSec, const Camera& camera) {
         ++mCounters.needed;
         ++mCounters.simulated;
     }
+    return {};
 }
 
 std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* volumes, const Materials& materials, const EmitOptions& options) {
@@ -160,8 +178,9 @@ std::size_t Scene::emit(SplatBuilder& builder, const Materials& materials, const
     return emitInto(builder, nullptr, materials, options);
 }
 
-void Scene::prepare(double timeSec, const Camera& camera, const Materials& materials, Frame& frame, const EmitOptions& options) {
-    update(timeSec, camera);
+Status Scene::prepare(double timeSec, const Camera& camera, const Materials& materials, Frame& frame, const EmitOptions& options) {
+    if (Status s = checkTime("Scene::prepare", timeSec); !s) return s;
+    if (Status s = update(timeSec, camera); !s) return s;
     frame.begin(timeSec, camera);
     emitInto(frame.builder(), &frame.volumes(), materials, options);
     shadeScene(frame); // the lit effects' shadow on the scene, into frame.shadow()
@@ -176,6 +195,7 @@ void Scene::prepare(double timeSec, const Camera& camera, const Materials& mater
     c.simulated = mCounters.simulated;
     c.drawn = 0;
     for (const Entry& e : mEntries) c.drawn += e.status.splatsDrawn > 0 || e.status.tetrahedraDrawn > 0 ? 1 : 0;
+    return {};
 }
 
 } // namespace splatfx

@@ -1,6 +1,7 @@
 // Scene files: the camera path and the output settings.
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 
 #include "scenefile/reader.hpp"
 
@@ -70,6 +71,15 @@ void readOutput(Context& c, const std::string& path, const Json& v, OutputSettin
     }
     o.integer("frames", out.frames, 1, 100000);
     o.number("fps", out.fps, 0.1, 240.0);
+    // Frame i shows time i / fps: the last one must be a time the scene can be prepared at.
+    if (const double last = (out.frames - 1) / double(out.fps); last > kMaxTimeSec) {
+        char buf[256];
+        std::snprintf(buf, sizeof buf,
+                      "%d frames at %g fps end at %g s, later than %g s (kMaxTimeSec, about 72.8 hours), the latest time the effects' "
+                      "dynamics hold exactly; fewer frames or a higher fps",
+                      out.frames, double(out.fps), last, kMaxTimeSec);
+        c.d.error(o.at("frames"), buf);
+    }
     o.color3("background", out.background);
     if (const Json* n = o.get("name"))
         if (auto s = readString(c.d, o.at("name"), *n)) {

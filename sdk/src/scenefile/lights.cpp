@@ -77,8 +77,17 @@ void readSceneShadow(Context& c, const std::string& path, const Json& v, SceneFi
     auto d = readObject<SceneShadowDesc>(c, path, v, [&](Context& cc, ObjectReader& o, SceneShadowDesc& s) {
         o.boolean("enabled", s.enabled);
         int light = int(s.light);
+        const bool lightGiven = o.has("light");
         o.integer("light", light, 0, 63);
         s.light = std::size_t(light);
+        // A shadow cast by a light the scene does not have would silently be
+        // no shadow at all (lights are read first; their own errors come first).
+        const std::size_t lights = out.scene.lights().size();
+        if ((s.enabled || lightGiven) && s.light >= lights && cc.d.ok())
+            cc.d.error(o.at("light"),
+                       lights == 0 ? "the scene has no \"lights\"; the scene shadow is cast by one of them (add one, or set \"enabled\": false)"
+                                   : "expected the index of one of the scene's " + std::to_string(lights) + " light(s), 0 to " +
+                                         std::to_string(lights - 1) + ", got " + std::to_string(s.light));
         readAxisCounts(cc, o, "dims", s.dims, 1, 1024);
         const std::uint64_t bytes = ShadowTable::memoryBytes(s.dims);
         if (bytes > s.memoryBudgetBytes)

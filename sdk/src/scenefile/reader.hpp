@@ -30,9 +30,11 @@ namespace splatfx::scenefile {
 
 // Larger than any sensible scene, small enough that a typo (an extra zero,
 // a unit mistake) is caught before it allocates gigabytes.
-inline constexpr double kMaxCoord = 1.0e6;   // world units for positions and offsets
-inline constexpr double kMaxSeconds = 1.0e6; // key times
-inline constexpr int kMaxAxis = 4096;        // cells per lattice axis
+inline constexpr double kMaxCoord = 1.0e6; // world units for positions and offsets
+// Key times (motion, camera): no later than the dynamics hold exactly
+// (kMaxTimeSec, effect_kind.hpp), since no frame may be prepared after it.
+inline constexpr double kMaxSeconds = kMaxTimeSec;
+inline constexpr int kMaxAxis = 4096; // cells per lattice axis
 inline constexpr std::size_t kMaxEffects = 4096;
 inline constexpr std::size_t kMaxGeometry = 4096;
 inline constexpr std::size_t kMaxKeys = 100000;

@@ -10,17 +10,21 @@
 //   lights.cpp         lights, the scene shadow, each effect's lighting
 //   fog_block.cpp      the "fog" block
 //
-// [SECTION] Text checks (size, nesting, syntax with line and column)
+// [SECTION] Text checks (size, nesting, syntax with line and column, duplicate keys)
 // [SECTION] Entry points
 #include "splatfx/scene_file.hpp"
 
 #include <algorithm>
 #include <cassert>
 #include <cctype>
+#include <deque>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
 
 #include "scenefile/reader.hpp"
 
@@ -65,6 +69,78 @@ std::optional<std::size_t> tooDeep(const std::string& text) {
     }
     return std::nullopt;
 }
+
+// Duplicate object keys. nlohmann::json keeps the last of them, so
+// `"density": 0.5, "density": 1e6` would silently become 1e6; its parser
+// callback gives no byte position, so this scans the text (already parsed,
+// hence valid JSON) once: a stack of open containers, each object holding
+// the keys it has seen with where. Linear in the text; what it keeps is at
+// most the text's keys, and the nesting is bounded by tooDeep.
+struct KeyScanner {
+    struct Place {
+        std::size_t line, column;
+    };
+    struct Open {
+        bool object = false;
+        std::string_view key;  // object: the key whose value is being read
+        std::size_t index = 0; // array: the element being read
+        std::unordered_map<std::string_view, Place> seen;
+    };
+    const std::string& text;
+    const std::string& file;
+    std::size_t maxReports;
+    std::vector<std::string> reports{};
+    std::deque<std::string> decoded{}; // keys written with escapes, decoded (the views point here or into text)
+
+    // The path of a key in the innermost open object, as messages write paths.
+    static std::string pathOf(const std::vector<Open>& stack, std::string_view key) {
+        std::string p;
+        for (std::size_t i = 0; i + 1 < stack.size(); ++i) p = stack[i].object ? join(p, std::string(stack[i].key)) : index(p, stack[i].index);
+        return join(p, std::string(key));
+    }
+
+    // The key as the JSON library reads it (escapes decoded: "\u0061" is "a").
+    std::string_view decode(std::size_t open, std::size_t close) {
+        const std::string_view raw = std::string_view(text).substr(open, close - open + 1);
+        if (raw.find('\\') == std::string_view::npos) return raw.substr(1, raw.size() - 2);
+        return decoded.emplace_back(Json::parse(raw).get<std::string>());
+    }
+
+    void run() {
+        std::vector<Open> stack;
+        std::size_t line = 1, lineStart = 0;
+        bool expectKey = false;
+        for (std::size_t i = 0; i < text.size() && reports.size() < maxReports; ++i) {
+            const char c = text[i];
+            if (c == '\n') {
+                ++line, lineStart = i + 1;
+            } else if (c == '{' || c == '[') {
+                stack.emplace_back().object = c == '{';
+                expectKey = c == '{';
+            } else if (c == '}' || c == ']') {
+                if (!stack.empty()) stack.pop_back();
+                expectKey = false;
+            } else if (c == ',') {
+                if (!stack.empty() && !stack.back().object) ++stack.back().index;
+                expectKey = !stack.empty() && stack.back().object;
+            } else if (c == '"') {
+                const std::size_t open = i;
+                for (++i; i < text.size() && text[i] != '"'; ++i)
+                    if (text[i] == '\\') ++i; // valid JSON: strings hold no raw newline
+                if (!expectKey || stack.empty()) continue;
+                expectKey = false;
+                Open& o = stack.back();
+                o.key = decode(open, i);
+                const Place here{line, open - lineStart + 1};
+                const auto [it, fresh] = o.seen.emplace(o.key, here);
+                if (fresh) continue;
+                const auto at = [&](const Place& p) { return file + ":" + std::to_string(p.line) + ":" + std::to_string(p.column); };
+                reports.push_back(at(here) + ": " + pathOf(stack, o.key) + ": duplicate key; it is also given at " + at(it->second) +
+                                  " (JSON keeps only one of them: remove the other)");
+            }
+        }
+    }
+};
 
 // nlohmann's messages start with "[json.exception.parse_error.101] parse
 // error at line L, column C: "; keep only the explanation after it.
@@ -113,6 +189,14 @@ Result<SceneFile> parse(const std::string& text, const std::string& path, Materi
                 where += ":" + std::to_string(lc.line) + ":" + std::to_string(lc.column);
             }
         return makeError(where + ": " + what + " (expected a finite number)");
+    }
+
+    KeyScanner keys{text, path, std::size_t(std::max(options.maxErrors, 1))};
+    keys.run();
+    if (!keys.reports.empty()) {
+        std::string m;
+        for (const std::string& r : keys.reports) m += (m.empty() ? "" : "\n") + r;
+        return makeError(m);
     }
 
     Diagnostics d(path, options.maxErrors);

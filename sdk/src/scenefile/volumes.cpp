@@ -4,6 +4,8 @@
 // and "groundFog" (GroundFog over a heightmap, sec. 6).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <string>
 #include <utility>
 
@@ -37,9 +39,76 @@ ScalarVolume yUp(const ScalarVolume& zUp) {
     return out;
 }
 
+std::string num(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+}
+
+std::string vec(glm::vec3 v) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "[%g, %g, %g]", double(v.x), double(v.y), double(v.z));
+    return buf;
+}
+
+// A "heightmap" geometry as a ground-fog layer's terrain ("terrainGeometry"):
+// the layer takes the geometry's heightmap, spacing, heightScale and position,
+// so the terrain the host draws from the layer is the geometry's own. Keys the
+// layer gives itself must agree exactly; a geometry the layer cannot follow
+// (rotated, scaled, moving: a layer is static and axis-aligned) is refused.
+struct TerrainSource {
+    std::string path; // resolved heightmap file
+    float spacing = 1.0f, heightScale = 1.0f;
+    glm::vec3 position{0.0f};
+};
+
+std::optional<TerrainSource> terrainFromGeometry(Context& c, ObjectReader& o, const std::string& name, const SceneFile& out) {
+    const auto g = std::find_if(out.geometry.begin(), out.geometry.end(), [&](const GeometryDesc& x) { return x.name == name; });
+    if (g == out.geometry.end() || g->type != GeometryType::Heightmap) {
+        c.d.error(o.at("terrainGeometry"), "names no heightmap geometry ('" + name + "')");
+        return std::nullopt;
+    }
+    const std::string gp = "geometry[" + std::to_string(g - out.geometry.begin()) + "]";
+    const glm::mat4 m = g->motion.matrix(0.0) * g->transform;
+    if (!g->motion.isStatic()) {
+        c.d.error(o.at("terrainGeometry"), "geometry '" + name + "' (" + gp +
+                                               ") moves (its own \"motion\" or what it is attached to); a ground-fog layer's terrain is static");
+        return std::nullopt;
+    }
+    if (glm::mat3(m) != glm::mat3(1.0f)) {
+        c.d.error(o.at("terrainGeometry"), "geometry '" + name + "' (" + gp +
+                                               ") is rotated or scaled (rotationDeg, scale, or what it is attached to); a ground-fog layer's "
+                                               "terrain is axis-aligned at scale 1: give the geometry only a \"position\"");
+        return std::nullopt;
+    }
+    TerrainSource t{g->heightmapPath, g->heightmapSpacing, g->heightmapScale, glm::vec3(m[3])};
+    const std::string why = "; leave it out to take the geometry's";
+    if (const Json* v = o.get("heightmap"))
+        if (auto file = readString(c.d, o.at("heightmap"), *v)) {
+            std::error_code ec; // a file that does not exist is not the geometry's
+            if (!std::filesystem::equivalent(resolvePath(c, *file), t.path, ec))
+                c.d.error(o.at("heightmap"),
+                          "'" + *file + "' is not the file of terrainGeometry '" + name + "' ('" + t.path + "', " + gp + ".heightmap)" + why);
+        }
+    auto agree = [&](const char* key, float theirs, const char* theirKey) {
+        if (const Json* v = o.get(key))
+            if (auto x = readNumber(c.d, o.at(key), *v, -1e9, 1e9); x && float(*x) != theirs)
+                c.d.error(o.at(key), num(*x) + " disagrees with terrainGeometry '" + name + "': its " + theirKey + " is " + num(theirs) + " (" + gp +
+                                         "." + theirKey + ")" + why);
+    };
+    agree("spacing", t.spacing, "spacing");
+    agree("heightScale", t.heightScale, "heightScale");
+    if (const Json* v = o.get("position"))
+        if (auto p = readVec3(c.d, o.at("position"), *v, -kMaxCoord, kMaxCoord); p && *p != t.position)
+            c.d.error(o.at("position"), vec(*p) + " disagrees with terrainGeometry '" + name + "': its position is " + vec(t.position) + " (" + gp +
+                                            ".position)" + why);
+    return t;
+}
+
 // (issue 17) kind "groundFog": prisms over a heightmap terrain
 // (Roettger & Ertl sec. 6), the terrain placed as a "heightmap" geometry with
-// the same heightmap, spacing, heightScale and position is (heightmapPoint).
+// the same heightmap, spacing, heightScale and position is (heightmapPoint);
+// with "terrainGeometry" those four come from the named geometry.
 void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std::string& name, SceneFile& out) {
     const std::size_t before = c.d.count();
     std::string file;
@@ -47,13 +116,26 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     glm::vec3 position{0.0f}, colour{0.85f, 0.87f, 0.9f};
     float spacing = 1.0f, heightScale = 1.0f, fogTop = 0.0f, density = 1.0f, extinction = 0.5f;
     int step = 1, scalarRes = 32, lengthRes = 128;
-    if (!o.has("heightmap")) c.d.error(p, "missing \"heightmap\" (an image file, e.g. a 16-bit PGM, relative to the scene file)");
+    std::string terrainGeometry;
+    o.string("terrainGeometry", terrainGeometry);
+    std::string path; // the heightmap, resolved
+    if (!terrainGeometry.empty()) {
+        // The geometry block is read before the volumes. Its four keys are compared there, or moot when it is refused.
+        for (const char* key : {"heightmap", "position", "spacing", "heightScale"}) o.touch(key);
+        if (auto t = terrainFromGeometry(c, o, terrainGeometry, out)) {
+            path = file = t->path;
+            spacing = t->spacing, heightScale = t->heightScale, position = t->position;
+        }
+    } else {
+        if (!o.has("heightmap")) c.d.error(p, "missing \"heightmap\" (an image file, e.g. a 16-bit PGM, relative to the scene file)");
+        o.string("heightmap", file);
+        o.vec3("position", position, -kMaxCoord, kMaxCoord);
+        o.number("spacing", spacing, 1e-4, 1e4);
+        o.number("heightScale", heightScale, -1e6, 1e6);
+        if (!file.empty()) path = resolvePath(c, file);
+    }
     if (!o.has("fogTop")) c.d.error(p, "missing \"fogTop\" (the world height of the fog's top)");
-    o.string("heightmap", file);
     o.boolean("enabled", enabled);
-    o.vec3("position", position, -kMaxCoord, kMaxCoord);
-    o.number("spacing", spacing, 1e-4, 1e4);
-    o.number("heightScale", heightScale, -1e6, 1e6);
     o.integer("step", step, 1, 64);
     o.number("fogTop", fogTop, -kMaxCoord, kMaxCoord);
     o.number("density", density, 0.0, 1.0);
@@ -72,33 +154,26 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     o.boolean("morph", morph);
     float densityDepth = 0.0f;
     o.number("densityDepthWorld", densityDepth, 0.0, 1e6);
-    std::string terrainGeometry;
-    o.string("terrainGeometry", terrainGeometry);
-    if (!terrainGeometry.empty()) { // the geometry block is read before the volumes
-        const auto g = std::find_if(out.geometry.begin(), out.geometry.end(), [&](const GeometryDesc& x) { return x.name == terrainGeometry; });
-        if (g == out.geometry.end() || g->type != GeometryType::Heightmap)
-            c.d.error(o.at("terrainGeometry"), "names no heightmap geometry ('" + terrainGeometry + "')");
-    }
     if (!lod)
         for (const char* key : {"detailC", "minAccuracyC", "morph", "terrainGeometry"})
             if (o.has(key)) c.d.error(o.at(key), std::string("only with \"lod\": true (the full-resolution layer has no LOD)"));
     o.finish();
-    if (c.d.count() != before || file.empty()) return;
-    const std::string path = resolvePath(c, file);
+    if (c.d.count() != before || path.empty()) return;
+    const char* imageKey = terrainGeometry.empty() ? "heightmap" : "terrainGeometry"; // where the image was named
     // The header first: a huge image is refused before anything is decoded.
     auto info = readImageInfo(path);
     if (!info) {
-        c.d.error(o.at("heightmap"), info.error());
+        c.d.error(o.at(imageKey), info.error());
         return;
     }
     if (double(info->width) * info->height > 16.0 * 1024 * 1024) {
-        c.d.error(o.at("heightmap"), "'" + file + "' is " + std::to_string(info->width) + "x" + std::to_string(info->height) +
-                                         ", more than the 16 Mi samples a ground-fog heightmap may have");
+        c.d.error(o.at(imageKey), "'" + file + "' is " + std::to_string(info->width) + "x" + std::to_string(info->height) +
+                                      ", more than the 16 Mi samples a ground-fog heightmap may have");
         return;
     }
     auto img = readImage(path, Alpha::Straight);
     if (!img) {
-        c.d.error(o.at("heightmap"), img.error());
+        c.d.error(o.at(imageKey), img.error());
         return;
     }
     const int w = img->width, h = img->height;
@@ -108,7 +183,7 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     GroundFogDesc gd;
     gd.dims = {samples(w), samples(h)};
     if (gd.dims.x < 2 || gd.dims.y < 2) {
-        c.d.error(o.at("heightmap"), "needs at least 2x2 samples after \"step\", got " + std::to_string(gd.dims.x) + "x" + std::to_string(gd.dims.y));
+        c.d.error(o.at(imageKey), "needs at least 2x2 samples after \"step\", got " + std::to_string(gd.dims.x) + "x" + std::to_string(gd.dims.y));
         return;
     }
     if (double(gd.dims.x) * gd.dims.y > 4.0 * 1024 * 1024) {

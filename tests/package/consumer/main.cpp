@@ -38,7 +38,7 @@ int main() {
     if (!frameRenderer || !frameRenderer->upload(materials)) return std::fprintf(stderr, "consumer: frame renderer setup failed\n"), 1;
     splatfx::Frame frame;
     bool opaqueDrawn = false;
-    scene.prepare(0.5, camera, materials, frame);
+    if (auto s = scene.prepare(0.5, camera, materials, frame); !s) return std::fprintf(stderr, "consumer: %s\n", s.error().c_str()), 1;
     frameRenderer->render(frame, {.framebuffer = fb->handle(), .drawOpaque = [&] {
                                       fb->clear({0, 0, 0, 1});
                                       opaqueDrawn = true;
