@@ -572,6 +572,49 @@ static void test_gl_errors(splatfx_error* err) {
     free_drawn(&d);
 }
 
+/* The frame's notes: with a multisampled host depth the depth cut is off, and the renderer says so. */
+static void test_notes(splatfx_error* err) {
+    Drawn d = make_drawn(err);
+    Target t = make_clear_target();
+    splatfx_host_target target;
+    splatfx_host_target_init(&target);
+    target.framebuffer = t.fbo;
+    target.depth_texture = t.depth;
+    CHECK_OK(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err);
+    CHECK(splatfx_renderer_note_count(d.r) == 0, "a single-sampled depth texture gave %u notes, the first: %s", splatfx_renderer_note_count(d.r),
+          splatfx_renderer_note(d.r, 0));
+    CHECK(splatfx_renderer_note(d.r, 0) == NULL, "note 0 of none");
+    GLuint ms_color = 0, ms_depth = 0, ms_fbo = 0;
+    glCreateTextures(GL_TEXTURE_2D_MULTISAMPLE, 1, &ms_color);
+    glTextureStorage2DMultisample(ms_color, 4, GL_RGBA8, W, H, GL_TRUE);
+    glCreateTextures(GL_TEXTURE_2D_MULTISAMPLE, 1, &ms_depth);
+    glTextureStorage2DMultisample(ms_depth, 4, GL_DEPTH_COMPONENT32F, W, H, GL_TRUE);
+    glCreateFramebuffers(1, &ms_fbo);
+    glNamedFramebufferTexture(ms_fbo, GL_COLOR_ATTACHMENT0, ms_color, 0);
+    glNamedFramebufferTexture(ms_fbo, GL_DEPTH_ATTACHMENT, ms_depth, 0);
+    CHECK(glCheckNamedFramebufferStatus(ms_fbo, GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE, "incomplete multisampled framebuffer");
+    const float far_depth = 1.0f;
+    glClearNamedFramebufferfv(ms_fbo, GL_DEPTH, 0, &far_depth);
+    target.framebuffer = ms_fbo;
+    target.depth_texture = ms_depth;
+    CHECK_OK(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err);
+    CHECK(splatfx_renderer_note_count(d.r) == 1, "a multisampled depth texture gave %u notes", splatfx_renderer_note_count(d.r));
+    const char* note = splatfx_renderer_note(d.r, 0);
+    CHECK(note && strstr(note, "depth cut off") && strstr(note, "multisampled (4 samples)"), "note: %s", note ? note : "(NULL)");
+    CHECK(splatfx_renderer_note(d.r, 1) == NULL, "note 1 of 1");
+    printf("multisampled host depth: %s\n", note ? note : "(no note)");
+    CHECK(splatfx_renderer_note_count(NULL) == 0 && splatfx_renderer_note(NULL, 0) == NULL, "notes of NULL");
+    CHECK(splatfx_renderer_note_count((const splatfx_renderer*)d.frame) == 0, "notes of a frame");
+    CHECK(glGetError() == GL_NO_ERROR, "a GL error was raised");
+    glDeleteFramebuffers(1, &ms_fbo);
+    glDeleteTextures(1, &ms_color);
+    glDeleteTextures(1, &ms_depth);
+    glDeleteFramebuffers(1, &t.fbo);
+    glDeleteTextures(1, &t.color);
+    glDeleteTextures(1, &t.depth);
+    free_drawn(&d);
+}
+
 int main(void) {
     splatfx_error* err = splatfx_error_create();
     splatfx_headless_context* ctx = NULL;
@@ -588,6 +631,7 @@ int main(void) {
     test_hooks_that_destroy(err);
     test_wrong_context(err, ctx);
     test_gl_errors(err);
+    test_notes(err);
     test_hook_destroys_its_context(err, ctx);
     CHECK(glGetError() == GL_NO_ERROR, "a GL error was raised");
     /* A renderer outliving its context: destroying it then must not abort in the GL loader, and

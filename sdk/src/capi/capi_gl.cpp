@@ -386,4 +386,14 @@ splatfx_status splatfx_renderer_get_stats(const splatfx_renderer* renderer, spla
     });
 }
 
+uint32_t splatfx_renderer_note_count(const splatfx_renderer* renderer) {
+    return isLive(renderer, Magic::Renderer) ? std::uint32_t(renderer->value->stats().notes.size()) : 0;
+}
+
+const char* splatfx_renderer_note(const splatfx_renderer* renderer, uint32_t index) {
+    if (!isLive(renderer, Magic::Renderer)) return nullptr;
+    const std::vector<std::string>& notes = renderer->value->stats().notes;
+    return index < notes.size() ? notes[index].c_str() : nullptr;
+}
+
 } // extern "C"
