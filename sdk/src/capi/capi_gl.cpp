@@ -156,7 +156,7 @@ namespace {
 // renderer while its context lives).
 class HeldHandles {
 public:
-    void hold(const void* h, const char* param, const char* type) {
+    void hold(const void* h, const char* param, Magic type) {
         capi::hold(h);
         mHeld[mCount++] = {h, param, type};
     }
@@ -165,7 +165,7 @@ public:
         for (std::size_t i = 0; i < mCount; ++i) {
             bool gone = false;
             liveType(mHeld[i].handle, &gone);
-            if (gone) return std::string(mHeld[i].param) + " (a " + mHeld[i].type + ")";
+            if (gone) return std::string(mHeld[i].param) + " (a " + typeName(mHeld[i].type) + ")";
         }
         return {};
     }
@@ -176,12 +176,15 @@ public:
                 if (!capi::release(h.handle)) continue;
             } catch (...) { continue; }
             // Handles are const in render's signature; the caller asked for them to be destroyed.
-            if (h.type == std::string("splatfx_renderer")) deleteHandle(static_cast<splatfx_renderer*>(const_cast<void*>(h.handle)));
-            else if (h.type == std::string("splatfx_frame")) deleteHandle(static_cast<splatfx_frame*>(const_cast<void*>(h.handle)));
-            else if (h.type == std::string("splatfx_materials")) deleteHandle(static_cast<splatfx_materials*>(const_cast<void*>(h.handle)));
-            else if (h.type == std::string("splatfx_headless_context"))
-                deleteHandle(static_cast<splatfx_headless_context*>(const_cast<void*>(h.handle)));
-            else if (h.type == std::string("splatfx_error")) deleteHandle(static_cast<splatfx_error*>(const_cast<void*>(h.handle)));
+            void* p = const_cast<void*>(h.handle);
+            switch (h.type) {
+            case Magic::Renderer: deleteHandle(static_cast<splatfx_renderer*>(p)); break;
+            case Magic::Frame: deleteHandle(static_cast<splatfx_frame*>(p)); break;
+            case Magic::Materials: deleteHandle(static_cast<splatfx_materials*>(p)); break;
+            case Magic::Context: deleteHandle(static_cast<splatfx_headless_context*>(p)); break;
+            case Magic::Error: deleteHandle(static_cast<splatfx_error*>(p)); break;
+            default: break; // a render holds no other type
+            }
         }
         mCount = 0;
     }
@@ -191,7 +194,7 @@ private:
     struct Held {
         const void* handle = nullptr;
         const char* param = "";
-        const char* type = "";
+        Magic type = Magic::Dead;
     };
     std::array<Held, 5> mHeld{};
     std::size_t mCount = 0;
@@ -319,12 +322,12 @@ splatfx_status splatfx_renderer_render(splatfx_renderer* renderer, const splatfx
         if (Outcome o = upload(*renderer, *materials); !o.ok()) return o;
 
         // From here to the end the handles are held: a hook may destroy them, and they are deleted after the render.
-        held.hold(renderer, "renderer", "splatfx_renderer");
-        held.hold(frame, "frame", "splatfx_frame");
-        held.hold(materials, "materials", "splatfx_materials");
+        held.hold(renderer, "renderer", Magic::Renderer);
+        held.hold(frame, "frame", Magic::Frame);
+        held.hold(materials, "materials", Magic::Materials);
         if (const void* ctx = findHandle(Magic::Context, gl::detail::currentContext()))
-            held.hold(ctx, "the current headless context", "splatfx_headless_context");
-        if (isLive(error, Magic::Error)) held.hold(error, "error", "splatfx_error");
+            held.hold(ctx, "the current headless context", Magic::Context);
+        if (isLive(error, Magic::Error)) held.hold(error, "error", Magic::Error);
 
         // GL errors are split at the hooks: raised before or after one, splatfx's; inside one, the host's.
         GlErrors ours;
