@@ -487,6 +487,10 @@ static void test_hook_destroys_its_context(splatfx_error* err, splatfx_headless_
     free_drawn(&d);
 }
 
+static void switch_context(void* user) {
+    splatfx_headless_context_make_current((splatfx_headless_context*)user, NULL);
+}
+
 /* A renderer used while another context is current: SPLATFX_ERROR_GL, no GL call in that context;
  * destroyed there, it deletes nothing of that context (the same names are that context's objects). */
 static void test_wrong_context(splatfx_error* err, splatfx_headless_context* main_ctx) {
@@ -508,6 +512,29 @@ static void test_wrong_context(splatfx_error* err, splatfx_headless_context* mai
     CHECK_FAILS(splatfx_renderer_upload(d.r, d.m, err), err, SPLATFX_ERROR_GL, "is not the one it was created in");
     CHECK(glGetError() == GL_INVALID_ENUM, "the host's own pending error was consumed by a refused call");
     CHECK(glGetError() == GL_NO_ERROR, "a refused render raised a GL error in the other context");
+    /* Back in its own context, a hook that makes the other one current: the frame ends after it. */
+    CHECK_OK(splatfx_headless_context_make_current(main_ctx, err), err);
+    {
+        Target own = make_clear_target();
+        splatfx_host_target in_own;
+        splatfx_host_target_init(&in_own);
+        in_own.framebuffer = own.fbo;
+        in_own.depth_texture = own.depth;
+        in_own.draw_opaque = switch_context;
+        in_own.user_data = other;
+        CHECK_FAILS(splatfx_renderer_render(d.r, d.m, d.frame, &in_own, err), err, SPLATFX_ERROR_GL,
+                    "the draw_opaque hook left another OpenGL context current (or none); the rest of the frame was not drawn");
+        const uint32_t n = splatfx_renderer_note_count(d.r);
+        const char* last = n ? splatfx_renderer_note(d.r, n - 1) : NULL;
+        CHECK(last && strstr(last, "frame cut short after the host's opaque hook"), "the renderer's last note: %s", last ? last : "(none)");
+        CHECK(glGetError() == GL_NO_ERROR, "the cut-short render raised a GL error in the other context");
+        CHECK_OK(splatfx_headless_context_make_current(main_ctx, err), err);
+        glDeleteFramebuffers(1, &own.fbo);
+        glDeleteTextures(1, &own.color);
+        glDeleteTextures(1, &own.depth);
+        CHECK(glGetError() == GL_NO_ERROR, "the cut-short render left a GL error in its own context");
+        CHECK_OK(splatfx_headless_context_make_current(other, err), err);
+    }
     splatfx_renderer_destroy(d.r); /* here: its GL objects are left to its own context */
     int kept = 1;
     for (int i = 0; i < 64; ++i) kept = kept && glIsTexture(textures[i]) && glIsBuffer(buffers[i]);
