@@ -337,9 +337,9 @@ enum { KILL_NOTHING, KILL_FRAME, KILL_MATERIALS, KILL_RENDERER, KILL_SCENE, KILL
 typedef struct Killer {
     int what;
     Drawn* d;
-    splatfx_error* error;               /* the render's own error object (KILL_ERROR) */
-    splatfx_headless_context* context;  /* the current context (KILL_CONTEXT) */
-    const splatfx_host_target* target;  /* for REENTER */
+    splatfx_error* error;              /* the render's own error object (KILL_ERROR) */
+    splatfx_headless_context* context; /* the current context (KILL_CONTEXT) */
+    const splatfx_host_target* target; /* for REENTER */
     splatfx_status nested_render, nested_prepare, nested_upload;
     char nested_message[3][512];
 } Killer;
@@ -444,9 +444,11 @@ static void test_hooks_that_destroy(splatfx_error* err) {
         Killer k = {REENTER, &d, NULL, NULL, &target, SPLATFX_OK, SPLATFX_OK, SPLATFX_OK, {{0}}};
         target.user_data = &k;
         CHECK_OK(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err);
-        CHECK(k.nested_render == SPLATFX_ERROR_INVALID_STATE && strstr(k.nested_message[0], "renderer is drawing a frame (this call came from one of its hooks)"),
+        CHECK(k.nested_render == SPLATFX_ERROR_INVALID_STATE &&
+                  strstr(k.nested_message[0], "renderer is drawing a frame (this call came from one of its hooks)"),
               "render from its own hook: %s: %s", splatfx_status_name(k.nested_render), k.nested_message[0]);
-        CHECK(k.nested_prepare == SPLATFX_ERROR_INVALID_STATE && strstr(k.nested_message[1], "frame is being drawn by the render that called this hook"),
+        CHECK(k.nested_prepare == SPLATFX_ERROR_INVALID_STATE &&
+                  strstr(k.nested_message[1], "frame is being drawn by the render that called this hook"),
               "prepare of the frame being drawn: %s: %s", splatfx_status_name(k.nested_prepare), k.nested_message[1]);
         CHECK(k.nested_upload == SPLATFX_ERROR_INVALID_STATE && strstr(k.nested_message[2], "renderer is drawing a frame"),
               "upload from its own hook: %s: %s", splatfx_status_name(k.nested_upload), k.nested_message[2]);
@@ -487,9 +489,7 @@ static void test_hook_destroys_its_context(splatfx_error* err, splatfx_headless_
     free_drawn(&d);
 }
 
-static void switch_context(void* user) {
-    splatfx_headless_context_make_current((splatfx_headless_context*)user, NULL);
-}
+static void switch_context(void* user) { splatfx_headless_context_make_current((splatfx_headless_context*)user, NULL); }
 
 /* A renderer used while another context is current: SPLATFX_ERROR_GL, no GL call in that context;
  * destroyed there, it deletes nothing of that context (the same names are that context's objects). */
