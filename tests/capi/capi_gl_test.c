@@ -285,6 +285,363 @@ static void test_render_errors(splatfx_error* err) {
     splatfx_materials_destroy(m);
 }
 
+/* ---- handles destroyed during a render, misused contexts, GL errors ---- */
+
+/* One fire, prepared, and a renderer, in the current context: what the tests below draw. */
+typedef struct Drawn {
+    splatfx_materials* m;
+    splatfx_scene* scene;
+    splatfx_frame* frame;
+    splatfx_renderer* r;
+    uint64_t splats;
+} Drawn;
+
+static Drawn make_drawn(splatfx_error* err) {
+    Drawn d = {NULL, NULL, NULL, NULL, 0};
+    CHECK_OK(splatfx_materials_create(NULL, &d.m, err), err);
+    CHECK_OK(splatfx_scene_create(&d.scene, err), err);
+    CHECK_OK(splatfx_frame_create(&d.frame, err), err);
+    CHECK_OK(splatfx_renderer_create(NULL, &d.r, err), err);
+    CHECK_OK(splatfx_scene_add_fire(d.scene, d.m, NULL, NULL, NULL, err), err);
+    const float eye[3] = {0.0f, 5.0f, 20.0f}, at[3] = {0.0f, 5.0f, 0.0f}, up[3] = {0.0f, 1.0f, 0.0f};
+    splatfx_camera cam;
+    CHECK_OK(splatfx_camera_look_at(eye, at, up, 0.8f, W, H, 0.1f, 100.0f, &cam, err), err);
+    CHECK_OK(splatfx_scene_prepare(d.scene, 0.25, &cam, d.m, d.frame, err), err);
+    splatfx_frame_stats fs;
+    CHECK_OK(splatfx_frame_get_stats(d.frame, &fs, err), err);
+    d.splats = fs.splats;
+    CHECK(d.splats > 0, "the fire has no splats");
+    return d;
+}
+
+/* A target with nothing drawn in it yet: the background, and depth 1 (nothing hides the fire). */
+static Target make_clear_target(void) {
+    Target t = make_target();
+    const float far_depth = 1.0f;
+    glClearNamedFramebufferfv(t.fbo, GL_COLOR, 0, kBackground);
+    glClearNamedFramebufferfv(t.fbo, GL_DEPTH, 0, &far_depth);
+    return t;
+}
+
+/* Destroying what is left (each destroy ignores what a hook destroyed already). */
+static void free_drawn(Drawn* d) {
+    splatfx_renderer_destroy(d->r);
+    splatfx_frame_destroy(d->frame);
+    splatfx_scene_destroy(d->scene);
+    splatfx_materials_destroy(d->m);
+}
+
+enum { KILL_NOTHING, KILL_FRAME, KILL_MATERIALS, KILL_RENDERER, KILL_SCENE, KILL_ERROR, KILL_CONTEXT, REENTER };
+
+/* A host hook that destroys a handle of the render that called it (or calls back into it). */
+typedef struct Killer {
+    int what;
+    Drawn* d;
+    splatfx_error* error;              /* the render's own error object (KILL_ERROR) */
+    splatfx_headless_context* context; /* the current context (KILL_CONTEXT) */
+    const splatfx_host_target* target; /* for REENTER */
+    splatfx_status nested_render, nested_prepare, nested_upload;
+    char nested_message[3][512];
+} Killer;
+
+static void killing_hook(void* user) {
+    Killer* k = (Killer*)user;
+    switch (k->what) {
+    case KILL_FRAME: splatfx_frame_destroy(k->d->frame); break;
+    case KILL_MATERIALS: splatfx_materials_destroy(k->d->m); break;
+    case KILL_RENDERER: splatfx_renderer_destroy(k->d->r); break;
+    case KILL_SCENE: splatfx_scene_destroy(k->d->scene); break;
+    case KILL_ERROR: splatfx_error_destroy(k->error); break;
+    case KILL_CONTEXT:
+        splatfx_renderer_destroy(k->d->r); /* the renderer first, as a host must; both deferred */
+        splatfx_headless_context_destroy(k->context);
+        break;
+    case REENTER: {
+        splatfx_error* e = splatfx_error_create();
+        k->nested_render = splatfx_renderer_render(k->d->r, k->d->m, k->d->frame, k->target, e);
+        snprintf(k->nested_message[0], sizeof k->nested_message[0], "%s", splatfx_error_message(e));
+        splatfx_camera cam;
+        const float eye[3] = {0.0f, 5.0f, 20.0f}, at[3] = {0.0f, 5.0f, 0.0f}, up[3] = {0.0f, 1.0f, 0.0f};
+        splatfx_camera_look_at(eye, at, up, 0.8f, W, H, 0.1f, 100.0f, &cam, e);
+        k->nested_prepare = splatfx_scene_prepare(k->d->scene, 0.5, &cam, k->d->m, k->d->frame, e);
+        snprintf(k->nested_message[1], sizeof k->nested_message[1], "%s", splatfx_error_message(e));
+        k->nested_upload = splatfx_renderer_upload(k->d->r, k->d->m, e);
+        snprintf(k->nested_message[2], sizeof k->nested_message[2], "%s", splatfx_error_message(e));
+        splatfx_error_destroy(e);
+        break;
+    }
+    }
+}
+
+/* A hook that destroys the frame, materials, renderer or the render's error object: the destroy is
+ * deferred to the end of the render (which finishes drawing with them), the render says so, and the
+ * handle is gone after it. The scene is not drawn with: destroying it is fine. A hook calling back
+ * into its own renderer, or preparing the frame being drawn, is refused. */
+static void test_hooks_that_destroy(splatfx_error* err) {
+    Target t = make_clear_target();
+    splatfx_host_target target;
+    splatfx_host_target_init(&target);
+    target.framebuffer = t.fbo;
+    target.depth_texture = t.depth;
+    const char* names[] = {"frame (a splatfx_frame)", "materials (a splatfx_materials)", "renderer (a splatfx_renderer)"};
+    for (int kill = KILL_FRAME; kill <= KILL_RENDERER; ++kill)
+        for (int transparent = 0; transparent < 2; ++transparent) {
+            Drawn d = make_drawn(err);
+            Killer k = {kill, &d, NULL, NULL, NULL, SPLATFX_OK, SPLATFX_OK, SPLATFX_OK, {{0}}};
+            target.draw_opaque = transparent ? NULL : killing_hook;
+            target.draw_transparent = transparent ? killing_hook : NULL;
+            target.user_data = &k;
+            char want[256];
+            snprintf(want, sizeof want, "splatfx_renderer_render: the %s hook destroyed %s while it was being drawn",
+                     transparent ? "draw_transparent" : "draw_opaque", names[kill - KILL_FRAME]);
+            if (kill == KILL_FRAME) {
+                /* The renderer's stats show the frame was drawn in full after its destroy. */
+                CHECK_FAILS(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err, SPLATFX_ERROR_INVALID_STATE, want);
+                splatfx_render_stats rs;
+                CHECK_OK(splatfx_renderer_get_stats(d.r, &rs, err), err);
+                CHECK(rs.splats == d.splats && rs.draw_calls > 0, "the frame destroyed by a hook was not drawn in full: %llu of %llu splats",
+                      (unsigned long long)rs.splats, (unsigned long long)d.splats);
+                splatfx_frame_stats fs;
+                CHECK_FAILS(splatfx_frame_get_stats(d.frame, &fs, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                            "frame is not a splatfx_frame (it was destroyed");
+            } else if (kill == KILL_MATERIALS) {
+                CHECK_FAILS(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err, SPLATFX_ERROR_INVALID_STATE, want);
+                CHECK(splatfx_materials_layer_count(d.m) == 0, "materials destroyed by a hook are still there");
+            } else {
+                CHECK_FAILS(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err, SPLATFX_ERROR_INVALID_STATE, want);
+                splatfx_render_stats rs;
+                CHECK_FAILS(splatfx_renderer_get_stats(d.r, &rs, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                            "renderer is not a splatfx_renderer (it was destroyed");
+            }
+            free_drawn(&d);
+        }
+    target.draw_transparent = NULL;
+    target.draw_opaque = killing_hook;
+
+    /* The scene: the frame holds its splats, so the render is unaffected. */
+    {
+        Drawn d = make_drawn(err);
+        Killer k = {KILL_SCENE, &d, NULL, NULL, NULL, SPLATFX_OK, SPLATFX_OK, SPLATFX_OK, {{0}}};
+        target.user_data = &k;
+        CHECK_OK(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err);
+        CHECK(splatfx_scene_effect_count(d.scene) == 0, "a scene destroyed by a hook is still there");
+        free_drawn(&d);
+    }
+    /* The render's own error object: the status still comes back; the object is gone after. */
+    {
+        Drawn d = make_drawn(err);
+        splatfx_error* own = splatfx_error_create();
+        Killer k = {KILL_ERROR, &d, own, NULL, NULL, SPLATFX_OK, SPLATFX_OK, SPLATFX_OK, {{0}}};
+        target.user_data = &k;
+        const splatfx_status s = splatfx_renderer_render(d.r, d.m, d.frame, &target, own);
+        CHECK(s == SPLATFX_ERROR_INVALID_STATE, "a hook destroying the render's error object: %s", splatfx_status_name(s));
+        CHECK(splatfx_error_status(own) == SPLATFX_ERROR_INVALID_ARGUMENT, "the error object destroyed by a hook is still there");
+        free_drawn(&d);
+    }
+    /* Calls back into the render from its hook. */
+    {
+        Drawn d = make_drawn(err);
+        Killer k = {REENTER, &d, NULL, NULL, &target, SPLATFX_OK, SPLATFX_OK, SPLATFX_OK, {{0}}};
+        target.user_data = &k;
+        CHECK_OK(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err);
+        CHECK(k.nested_render == SPLATFX_ERROR_INVALID_STATE &&
+                  strstr(k.nested_message[0], "renderer is drawing a frame (this call came from one of its hooks)"),
+              "render from its own hook: %s: %s", splatfx_status_name(k.nested_render), k.nested_message[0]);
+        CHECK(k.nested_prepare == SPLATFX_ERROR_INVALID_STATE &&
+                  strstr(k.nested_message[1], "frame is being drawn by the render that called this hook"),
+              "prepare of the frame being drawn: %s: %s", splatfx_status_name(k.nested_prepare), k.nested_message[1]);
+        CHECK(k.nested_upload == SPLATFX_ERROR_INVALID_STATE && strstr(k.nested_message[2], "renderer is drawing a frame"),
+              "upload from its own hook: %s: %s", splatfx_status_name(k.nested_upload), k.nested_message[2]);
+        splatfx_render_stats rs;
+        CHECK_OK(splatfx_renderer_get_stats(d.r, &rs, err), err);
+        CHECK(rs.splats == d.splats, "the outer render drew %llu of %llu splats", (unsigned long long)rs.splats, (unsigned long long)d.splats);
+        free_drawn(&d);
+    }
+    CHECK(glGetError() == GL_NO_ERROR, "a GL error was raised");
+    glDeleteFramebuffers(1, &t.fbo);
+    glDeleteTextures(1, &t.color);
+    glDeleteTextures(1, &t.depth);
+}
+
+/* A hook that destroys the headless context being drawn in (and its renderer): both deferred, the
+ * renderer deleted first while its context is still current. Another context (`main_ctx`) made
+ * before is unaffected by that one's destruction. */
+static void test_hook_destroys_its_context(splatfx_error* err, splatfx_headless_context* main_ctx) {
+    splatfx_headless_context* ctx = NULL;
+    CHECK_OK(splatfx_headless_context_create(&ctx, err), err); /* current now */
+    Drawn d = make_drawn(err);
+    Target t = make_clear_target();
+    splatfx_host_target target;
+    splatfx_host_target_init(&target);
+    target.framebuffer = t.fbo;
+    target.depth_texture = t.depth;
+    Killer k = {KILL_CONTEXT, &d, NULL, ctx, NULL, SPLATFX_OK, SPLATFX_OK, SPLATFX_OK, {{0}}};
+    target.draw_opaque = killing_hook;
+    target.user_data = &k;
+    CHECK_FAILS(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err, SPLATFX_ERROR_INVALID_STATE,
+                "the draw_opaque hook destroyed renderer (a splatfx_renderer) while it was being drawn");
+    CHECK(splatfx_headless_context_renderer(ctx) == NULL, "the context destroyed by a hook is still there");
+    /* Its framebuffer and textures went with it. */
+    CHECK_OK(splatfx_headless_context_make_current(main_ctx, err), err);
+    CHECK(glGetError() == GL_NO_ERROR, "the first context was disturbed by the second's destruction");
+    splatfx_render_stats rs;
+    CHECK_FAILS(splatfx_renderer_get_stats(d.r, &rs, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "it was destroyed");
+    free_drawn(&d);
+}
+
+static void switch_context(void* user) { splatfx_headless_context_make_current((splatfx_headless_context*)user, NULL); }
+
+/* A renderer used while another context is current: SPLATFX_ERROR_GL, no GL call in that context;
+ * destroyed there, it deletes nothing of that context (the same names are that context's objects). */
+static void test_wrong_context(splatfx_error* err, splatfx_headless_context* main_ctx) {
+    Drawn d = make_drawn(err); /* in main_ctx */
+    splatfx_headless_context* other = NULL;
+    CHECK_OK(splatfx_headless_context_create(&other, err), err); /* current now */
+    Target t = make_clear_target();
+    splatfx_host_target target;
+    splatfx_host_target_init(&target);
+    target.framebuffer = t.fbo;
+    target.depth_texture = t.depth;
+    /* Objects of this context whose names the renderer's objects also have in its own. */
+    GLuint textures[64], buffers[64];
+    glCreateTextures(GL_TEXTURE_2D, 64, textures);
+    glCreateBuffers(64, buffers);
+    glEnable(0x7fff); /* a GL error the host left pending (GL_INVALID_ENUM): not blamed on the renderer */
+    CHECK_FAILS(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err, SPLATFX_ERROR_GL,
+                "splatfx_renderer_render: splatfx::gl::FrameRenderer: the OpenGL context current on this thread is not the one it was created in");
+    CHECK_FAILS(splatfx_renderer_upload(d.r, d.m, err), err, SPLATFX_ERROR_GL, "is not the one it was created in");
+    CHECK(glGetError() == GL_INVALID_ENUM, "the host's own pending error was consumed by a refused call");
+    CHECK(glGetError() == GL_NO_ERROR, "a refused render raised a GL error in the other context");
+    /* Back in its own context, a hook that makes the other one current: the frame ends after it. */
+    CHECK_OK(splatfx_headless_context_make_current(main_ctx, err), err);
+    {
+        Target own = make_clear_target();
+        splatfx_host_target in_own;
+        splatfx_host_target_init(&in_own);
+        in_own.framebuffer = own.fbo;
+        in_own.depth_texture = own.depth;
+        in_own.draw_opaque = switch_context;
+        in_own.user_data = other;
+        CHECK_FAILS(splatfx_renderer_render(d.r, d.m, d.frame, &in_own, err), err, SPLATFX_ERROR_GL,
+                    "the draw_opaque hook left another OpenGL context current (or none); the rest of the frame was not drawn");
+        const uint32_t n = splatfx_renderer_note_count(d.r);
+        const char* last = n ? splatfx_renderer_note(d.r, n - 1) : NULL;
+        CHECK(last && strstr(last, "frame cut short after the host's opaque hook"), "the renderer's last note: %s", last ? last : "(none)");
+        CHECK(glGetError() == GL_NO_ERROR, "the cut-short render raised a GL error in the other context");
+        CHECK_OK(splatfx_headless_context_make_current(main_ctx, err), err);
+        glDeleteFramebuffers(1, &own.fbo);
+        glDeleteTextures(1, &own.color);
+        glDeleteTextures(1, &own.depth);
+        CHECK(glGetError() == GL_NO_ERROR, "the cut-short render left a GL error in its own context");
+        CHECK_OK(splatfx_headless_context_make_current(other, err), err);
+    }
+    splatfx_renderer_destroy(d.r); /* here: its GL objects are left to its own context */
+    int kept = 1;
+    for (int i = 0; i < 64; ++i) kept = kept && glIsTexture(textures[i]) && glIsBuffer(buffers[i]);
+    CHECK(kept, "destroying a renderer in another context deleted that context's objects");
+    glDeleteTextures(64, textures);
+    glDeleteBuffers(64, buffers);
+    glDeleteFramebuffers(1, &t.fbo);
+    glDeleteTextures(1, &t.color);
+    glDeleteTextures(1, &t.depth);
+    /* The other context destroyed while main_ctx is current: main_ctx stays current and usable. */
+    CHECK_OK(splatfx_headless_context_make_current(main_ctx, err), err);
+    splatfx_headless_context_destroy(other);
+    splatfx_headless_context_destroy(other); /* twice: ignored */
+    splatfx_renderer* r = NULL;
+    CHECK_OK(splatfx_renderer_create(NULL, &r, err), err);
+    splatfx_renderer_destroy(r);
+    splatfx_renderer_destroy(r); /* twice: ignored */
+    free_drawn(&d);
+}
+
+static void make_gl_error(void* user) {
+    (void)user;
+    glEnable(0x7fff); /* GL_INVALID_ENUM */
+}
+
+/* GL errors during a render: the host's pending ones are dropped (not splatfx's), the hooks' are
+ * named as the host's, splatfx's own (here: an incomplete target framebuffer) are SPLATFX_ERROR_GL. */
+static void test_gl_errors(splatfx_error* err) {
+    Drawn d = make_drawn(err);
+    Target t = make_clear_target();
+    splatfx_host_target target;
+    splatfx_host_target_init(&target);
+    target.framebuffer = t.fbo;
+    target.depth_texture = t.depth;
+    glEnable(0x7fff);
+    CHECK_OK(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err);
+    CHECK(glGetError() == GL_NO_ERROR, "an error left after a render");
+    target.draw_opaque = make_gl_error;
+    CHECK_FAILS(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err, SPLATFX_ERROR_GL,
+                "splatfx_renderer_render: the draw_opaque hook raised GL_INVALID_ENUM (the host's own GL calls; splatfx's raised none and the frame "
+                "was drawn)");
+    splatfx_render_stats rs;
+    CHECK_OK(splatfx_renderer_get_stats(d.r, &rs, err), err);
+    CHECK(rs.splats == d.splats, "a hook's error stopped the frame: %llu of %llu splats", (unsigned long long)rs.splats,
+          (unsigned long long)d.splats);
+    target.draw_opaque = NULL;
+    GLuint empty = 0;
+    glCreateFramebuffers(1, &empty); /* exists, no attachment: incomplete */
+    target.framebuffer = empty;
+    target.depth_texture = 0;
+    char want[256];
+    snprintf(want, sizeof want,
+             "GL_INVALID_FRAMEBUFFER_OPERATION raised by splatfx's own GL calls during the render (target->framebuffer %u is incomplete: "
+             "GL_FRAMEBUFFER_INCOMPLETE_MISSING_ATTACHMENT)",
+             empty);
+    CHECK_FAILS(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err, SPLATFX_ERROR_GL, want);
+    CHECK(glGetError() == GL_NO_ERROR, "an error left after a render");
+    glDeleteFramebuffers(1, &empty);
+    glDeleteFramebuffers(1, &t.fbo);
+    glDeleteTextures(1, &t.color);
+    glDeleteTextures(1, &t.depth);
+    free_drawn(&d);
+}
+
+/* The frame's notes: with a multisampled host depth the depth cut is off, and the renderer says so. */
+static void test_notes(splatfx_error* err) {
+    Drawn d = make_drawn(err);
+    Target t = make_clear_target();
+    splatfx_host_target target;
+    splatfx_host_target_init(&target);
+    target.framebuffer = t.fbo;
+    target.depth_texture = t.depth;
+    CHECK_OK(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err);
+    CHECK(splatfx_renderer_note_count(d.r) == 0, "a single-sampled depth texture gave %u notes, the first: %s", splatfx_renderer_note_count(d.r),
+          splatfx_renderer_note(d.r, 0));
+    CHECK(splatfx_renderer_note(d.r, 0) == NULL, "note 0 of none");
+    GLuint ms_color = 0, ms_depth = 0, ms_fbo = 0;
+    glCreateTextures(GL_TEXTURE_2D_MULTISAMPLE, 1, &ms_color);
+    glTextureStorage2DMultisample(ms_color, 4, GL_RGBA8, W, H, GL_TRUE);
+    glCreateTextures(GL_TEXTURE_2D_MULTISAMPLE, 1, &ms_depth);
+    glTextureStorage2DMultisample(ms_depth, 4, GL_DEPTH_COMPONENT32F, W, H, GL_TRUE);
+    glCreateFramebuffers(1, &ms_fbo);
+    glNamedFramebufferTexture(ms_fbo, GL_COLOR_ATTACHMENT0, ms_color, 0);
+    glNamedFramebufferTexture(ms_fbo, GL_DEPTH_ATTACHMENT, ms_depth, 0);
+    CHECK(glCheckNamedFramebufferStatus(ms_fbo, GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE, "incomplete multisampled framebuffer");
+    const float far_depth = 1.0f;
+    glClearNamedFramebufferfv(ms_fbo, GL_DEPTH, 0, &far_depth);
+    target.framebuffer = ms_fbo;
+    target.depth_texture = ms_depth;
+    CHECK_OK(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err);
+    CHECK(splatfx_renderer_note_count(d.r) == 1, "a multisampled depth texture gave %u notes", splatfx_renderer_note_count(d.r));
+    const char* note = splatfx_renderer_note(d.r, 0);
+    CHECK(note && strstr(note, "depth cut off") && strstr(note, "multisampled (4 samples)"), "note: %s", note ? note : "(NULL)");
+    CHECK(splatfx_renderer_note(d.r, 1) == NULL, "note 1 of 1");
+    printf("multisampled host depth: %s\n", note ? note : "(no note)");
+    CHECK(splatfx_renderer_note_count(NULL) == 0 && splatfx_renderer_note(NULL, 0) == NULL, "notes of NULL");
+    CHECK(splatfx_renderer_note_count((const splatfx_renderer*)d.frame) == 0, "notes of a frame");
+    CHECK(glGetError() == GL_NO_ERROR, "a GL error was raised");
+    glDeleteFramebuffers(1, &ms_fbo);
+    glDeleteTextures(1, &ms_color);
+    glDeleteTextures(1, &ms_depth);
+    glDeleteFramebuffers(1, &t.fbo);
+    glDeleteTextures(1, &t.color);
+    glDeleteTextures(1, &t.depth);
+    free_drawn(&d);
+}
+
 int main(void) {
     splatfx_error* err = splatfx_error_create();
     splatfx_headless_context* ctx = NULL;
@@ -298,6 +655,11 @@ int main(void) {
     test_fire_against_host_depth(err, 1);
     test_fire_against_host_depth(err, 2);
     test_render_errors(err);
+    test_hooks_that_destroy(err);
+    test_wrong_context(err, ctx);
+    test_gl_errors(err);
+    test_notes(err);
+    test_hook_destroys_its_context(err, ctx);
     CHECK(glGetError() == GL_NO_ERROR, "a GL error was raised");
     /* A renderer outliving its context: destroying it then must not abort in the GL loader, and
      * GL calls through the API are refused with a message. */

@@ -466,6 +466,70 @@ static void test_bad_input(void) {
     splatfx_error_destroy(err);
 }
 
+/* Every handle type destroyed twice, destroyed through a pointer of another handle type, and
+ * destroyed as a stray pointer: each ignored, never read through (a double free before, for the
+ * error object); a destroyed handle passed to a call is an error naming it, not a read of freed
+ * memory. Under ASan any read of a freed handle fails this test. */
+static void test_destroy_twice(void) {
+    splatfx_error* err = splatfx_error_create();
+    splatfx_materials* m = NULL;
+    splatfx_scene* scene = NULL;
+    splatfx_frame* frame = NULL;
+    splatfx_texture_set* set = NULL;
+    CHECK_OK(splatfx_materials_create(NULL, &m, err), err);
+    CHECK_OK(splatfx_scene_create(&scene, err), err);
+    CHECK_OK(splatfx_frame_create(&frame, err), err);
+    CHECK_OK(splatfx_texture_set_load(SPLATFX_SOURCE_DIR "/textures/photo-fire-8x32", &set, err), err);
+
+    /* A destroy through the wrong type leaves the handle alive and usable. */
+    splatfx_scene_destroy((splatfx_scene*)m);
+    splatfx_materials_destroy((splatfx_materials*)err);
+    splatfx_error_destroy((splatfx_error*)frame);
+    splatfx_frame_destroy((splatfx_frame*)set);
+    splatfx_texture_set_destroy((splatfx_texture_set*)scene);
+    CHECK(splatfx_materials_layer_count(m) == 1, "materials destroyed as a scene: %u layers", splatfx_materials_layer_count(m));
+    CHECK(splatfx_texture_set_count(set) == 8, "a texture set destroyed as a frame: %u textures", splatfx_texture_set_count(set));
+    CHECK_OK(splatfx_scene_add_fire(scene, m, NULL, NULL, NULL, err), err); /* the scene, materials and error object still work */
+    splatfx_camera cam = front_camera(err);
+    CHECK_OK(splatfx_scene_prepare(scene, 0.5, &cam, m, frame, err), err);
+    /* A stray pointer (not a handle the library returned) is ignored too, as is NULL. */
+    uint64_t stray[8] = {0};
+    splatfx_scene_destroy((splatfx_scene*)stray);
+    splatfx_error_destroy((splatfx_error*)stray);
+    splatfx_error_destroy(NULL);
+
+    /* Each type destroyed twice; then used: an error that says it was destroyed. */
+    splatfx_texture_set_destroy(set);
+    splatfx_texture_set_destroy(set);
+    CHECK(splatfx_texture_set_count(set) == 0, "a destroyed texture set counts %u textures", splatfx_texture_set_count(set));
+    splatfx_fire_desc fd;
+    splatfx_fire_desc_init(&fd);
+    fd.texture_set = set;
+    CHECK_FAILS(splatfx_scene_add_fire(scene, m, &fd, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                "desc.texture_set is not a splatfx_texture_set (it was destroyed, or is not a handle this library returned)");
+    splatfx_frame_destroy(frame);
+    splatfx_frame_destroy(frame);
+    CHECK_FAILS(splatfx_scene_prepare(scene, 0.5, &cam, m, frame, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                "splatfx_scene_prepare: frame is not a splatfx_frame (it was destroyed");
+    splatfx_scene_destroy(scene);
+    splatfx_scene_destroy(scene);
+    CHECK(splatfx_scene_effect_count(scene) == 0, "a destroyed scene has %u effects", splatfx_scene_effect_count(scene));
+    CHECK_FAILS(splatfx_scene_set_effect_enabled(scene, 0, 0, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                "scene is not a splatfx_scene (it was destroyed");
+    splatfx_materials_destroy(m);
+    splatfx_materials_destroy(m);
+    CHECK(splatfx_materials_layer_count(m) == 0, "destroyed materials have %u layers", splatfx_materials_layer_count(m));
+
+    /* The error object: destroyed twice, then read and passed to a call (which must not write into it). */
+    splatfx_error_destroy(err);
+    splatfx_error_destroy(err);
+    CHECK(splatfx_error_status(err) == SPLATFX_ERROR_INVALID_ARGUMENT, "status of a destroyed error object: %s",
+          splatfx_status_name(splatfx_error_status(err)));
+    CHECK(strstr(splatfx_error_message(err), "error is not a splatfx_error (it was destroyed") != NULL, "message of a destroyed error object: %s",
+          splatfx_error_message(err));
+    CHECK(splatfx_scene_create(NULL, err) == SPLATFX_ERROR_INVALID_ARGUMENT, "a call given a destroyed error object still returns its status");
+}
+
 int main(void) {
     test_version_and_error_object();
     test_fire_prepares();
@@ -473,6 +537,7 @@ int main(void) {
     test_motion();
     test_files();
     test_bad_input();
+    test_destroy_twice();
     if (g_failures) {
         fprintf(stderr, "capi_test: %d check(s) failed\n", g_failures);
         return 1;

@@ -40,6 +40,7 @@ fx.splatfx_c_api_version.restype = C.c_uint32
 fx.splatfx_error_create.restype = P
 fx.splatfx_error_message.restype = C.c_char_p
 fx.splatfx_error_message.argtypes = [P]
+fx.splatfx_error_status.argtypes = [P]
 fx.splatfx_error_destroy.argtypes = [P]
 for name in ("materials", "scene", "frame"):
     getattr(fx, f"splatfx_{name}_destroy").argtypes = [P]
@@ -54,7 +55,7 @@ fx.splatfx_scene_prepare.argtypes = [P, C.c_double, C.POINTER(Camera), P, P, P]
 fx.splatfx_frame_get_stats.argtypes = [P, C.POINTER(FrameStats), P]
 
 SPLATFX_OK, INVALID_ARGUMENT = 0, 1
-check(fx.splatfx_c_api_version() == 1, "API version")
+check(fx.splatfx_c_api_version() == 2, "API version")
 err = fx.splatfx_error_create()
 m, scene, frame = P(), P(), P()
 check(fx.splatfx_materials_create(None, C.byref(m), err) == SPLATFX_OK, "materials")
@@ -91,11 +92,15 @@ msg = fx.splatfx_error_message(err).decode()
 check(rc == INVALID_ARGUMENT and "scene is NULL" in msg, f"NULL scene: {rc} {msg}")
 rc = fx.splatfx_scene_prepare(m, 0.0, C.byref(cam), m, frame, err)  # materials passed as the scene
 msg = fx.splatfx_error_message(err).decode()
-check(rc == INVALID_ARGUMENT and "scene is not a splatfx_scene" in msg, f"wrong handle: {rc} {msg}")
+check(rc == INVALID_ARGUMENT and "scene is not a splatfx_scene (it is a splatfx_materials)" in msg, f"wrong handle: {rc} {msg}")
 
+# Handles destroyed twice (a binding's finalizer and an explicit close both running): ignored.
 for name, h in (("frame", frame), ("scene", scene), ("materials", m)):
     getattr(fx, f"splatfx_{name}_destroy")(h)
+    getattr(fx, f"splatfx_{name}_destroy")(h)
 fx.splatfx_error_destroy(err)
+fx.splatfx_error_destroy(err)
+check(fx.splatfx_error_status(err) == INVALID_ARGUMENT, "a destroyed error object's status")
 if failures:
     sys.exit(f"ctypes_test: {len(failures)} check(s) failed")
 print(f"ctypes_test: all checks passed ({st.splats} splats; NaN time -> an error message)")

@@ -163,3 +163,41 @@ TEST_F(FrameRendererGL, SceneFrameDrawsEachEffectItsOwnWay) {
     fr->render(frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground, 1.0)});
     EXPECT_EQ(fr->stats().splats, frame.splats().size());
 }
+
+// Its GL objects are names in the context it was created in: with another
+// context current it makes no GL call (upload fails, render draws nothing and
+// says why in stats().notes), and a hook that makes another context current
+// ends the frame there instead of drawing into that context's objects.
+TEST_F(FrameRendererGL, AnotherContextCurrentIsRefusedAndNoted) {
+    Fire f;
+    auto fr = gl::FrameRenderer::create();
+    ASSERT_TRUE(fr && fr->upload(f.materials));
+    ASSERT_TRUE(fr->checkContext());
+    auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y});
+    ASSERT_TRUE(fb);
+    {
+        auto other = HeadlessContext::create(); // current from here
+        ASSERT_TRUE(other) << other.error();
+        const Status wrong = fr->checkContext();
+        ASSERT_FALSE(wrong);
+        EXPECT_NE(wrong.error().find("is not the one it was created in"), std::string::npos) << wrong.error();
+        const Status upload = fr->upload(f.materials);
+        EXPECT_FALSE(upload);
+        fr->render(f.frame, {.framebuffer = fb->handle()});
+        ASSERT_EQ(fr->stats().notes.size(), 1u);
+        EXPECT_EQ(fr->stats().notes[0], "frame not drawn: " + wrong.error());
+        EXPECT_EQ(fr->stats().drawCalls, 0u);
+        EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR)); // nothing reached this context
+        // Back in its own context, a hook that switches to the other one: the frame stops after the hook.
+        SetUp();
+        fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = [&] { other->makeCurrent(); }});
+        ASSERT_FALSE(fr->stats().notes.empty());
+        EXPECT_NE(fr->stats().notes.back().find("frame cut short after the host's opaque hook"), std::string::npos) << fr->stats().notes.back();
+        EXPECT_EQ(fr->stats().drawCalls, 0u);
+        EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+    } // `other` destroyed while current: none is current after it
+    SetUp();
+    fr->render(f.frame, {.framebuffer = fb->handle(), .drawOpaque = clearTo(kBackground, 1.0)});
+    EXPECT_TRUE(fr->stats().notes.empty());
+    EXPECT_GT(fr->stats().drawCalls, 0u);
+}

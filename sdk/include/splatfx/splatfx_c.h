@@ -34,7 +34,13 @@
  * never a crash.
  *
  * Ownership: each *_create returns a handle the caller frees with the
- * matching *_destroy (NULL is accepted and ignored). Handles are
+ * matching *_destroy. A destroy ignores NULL, a handle destroyed already (a
+ * double destroy), a handle of another type and any pointer the library did
+ * not return: it looks the pointer up among the live handles and never reads
+ * through it; such a pointer passed to another call is an
+ * SPLATFX_ERROR_INVALID_ARGUMENT ("... it was destroyed ..."). (A new handle
+ * may reuse a destroyed one's address; from then on the old pointer is the
+ * new handle.) Handles are
  * independent: a scene does not keep its materials, a frame does not keep
  * its scene (though a scene is tied to the materials its effects were built
  * with, and a frame to those it was prepared with: others are refused); a
@@ -87,8 +93,10 @@ extern "C" {
 #endif
 
 /* The version of this header's API; splatfx_c_api_version() returns the
- * library's, so a binding can refuse a library it was not written for. */
-#define SPLATFX_C_API_VERSION 1
+ * library's, so a binding can refuse a library it was not written for.
+ * Versions only add: a program written for 1 runs unchanged on 2
+ * (2 added splatfx_renderer_note_count and splatfx_renderer_note). */
+#define SPLATFX_C_API_VERSION 2
 SPLATFX_C_API uint32_t splatfx_c_api_version(void);
 
 /* ---- [errors] ------------------------------------------------------------ */
@@ -98,7 +106,8 @@ typedef SPLATFX_C_ENUM(splatfx_status){SPLATFX_OK = 0,
                                        SPLATFX_ERROR_INVALID_STATE = 2,    /* e.g. rendering a frame that was never prepared */
                                        SPLATFX_ERROR_NOT_FOUND = 3,        /* an effect id the scene does not have */
                                        SPLATFX_ERROR_FILE = 4,             /* a scene file or texture-set folder could not be read or is invalid */
-                                       SPLATFX_ERROR_GL = 5, /* no OpenGL 4.5 context, no EGL display, a GL name that is not what was asked */
+                                       SPLATFX_ERROR_GL = 5, /* no OpenGL 4.5 context, the wrong one current, no EGL display, a GL name that is not
+                                                                what was asked, a GL error raised during the call */
                                        SPLATFX_ERROR_OUT_OF_MEMORY = 6,
                                        SPLATFX_ERROR_INTERNAL = 7, /* an unexpected C++ exception, caught at the boundary */
                                        SPLATFX_STATUS_MAX_ENUM = 0x7fffffff} splatfx_status;
@@ -389,7 +398,11 @@ typedef struct splatfx_host_target {
     /* Called with the host framebuffer bound and the viewport set, before the
      * volumes (opaque geometry, depth writes on) and after them (transparent
      * surfaces). NULL: none. They must return normally (no longjmp, no
-     * exception through the C frames). */
+     * exception through the C frames) with the same context current. A
+     * renderer, frame, materials, error object or headless context the hook
+     * destroys is deleted when the render returns (which then fails with
+     * SPLATFX_ERROR_INVALID_STATE naming it); calling the same renderer, or
+     * preparing the frame being drawn, from a hook is refused. */
     void (*draw_opaque)(void* user_data);      /* default NULL */
     void (*draw_transparent)(void* user_data); /* default NULL */
     void* user_data;                           /* passed to both; default NULL */
@@ -403,11 +416,20 @@ typedef struct splatfx_render_stats {
 } splatfx_render_stats;
 
 /* gl::FrameRenderer: owns the order of the frame's passes. Needs a current
- * OpenGL 4.5 context at create, render and destroy. */
+ * OpenGL 4.5 context at create, render and destroy: at upload, render and
+ * destroy the one it was created in (its GL objects are names in that
+ * context). Another one current is SPLATFX_ERROR_GL and no GL call is made.
+ * GL errors: those the host left pending before create, upload or render
+ * are taken and dropped (read glGetError first to keep them); errors raised
+ * inside a hook are reported as the hook's (SPLATFX_ERROR_GL, "the
+ * draw_opaque hook raised ..."); errors raised by splatfx's own calls are
+ * SPLATFX_ERROR_GL ("... raised by splatfx's own GL calls during the
+ * render"). A call refused before its GL work leaves pending errors alone. */
 typedef struct splatfx_renderer splatfx_renderer;
 SPLATFX_C_API splatfx_status splatfx_renderer_create(const splatfx_renderer_desc* desc, splatfx_renderer** out, splatfx_error* error);
-/* Call with its context current. Without one its GL objects cannot be
- * deleted (GL would abort): they are left to the context's own destruction
+/* Call with its context current. Without it (none, or another one) its GL
+ * objects cannot be deleted (GL would abort, or delete the other context's
+ * objects of the same names): they are left to the context's own destruction
  * (and its CPU-side memory is not freed) rather than crash. */
 SPLATFX_C_API void splatfx_renderer_destroy(splatfx_renderer* renderer);
 /* Uploads the materials' texture layers (only when they changed since the
@@ -421,6 +443,14 @@ SPLATFX_C_API splatfx_status splatfx_renderer_upload(splatfx_renderer* renderer,
 SPLATFX_C_API splatfx_status splatfx_renderer_render(splatfx_renderer* renderer, const splatfx_materials* materials, const splatfx_frame* frame,
                                                      const splatfx_host_target* target, splatfx_error* error);
 SPLATFX_C_API splatfx_status splatfx_renderer_get_stats(const splatfx_renderer* renderer, splatfx_render_stats* out, splatfx_error* error);
+/* The last render's notes: one line for each pass that could not run as
+ * asked and what it did instead (e.g. "depth cut off ... the host depth is
+ * multisampled (4 samples) ..."). 0 when every pass ran as asked, or for a
+ * NULL or destroyed renderer. */
+SPLATFX_C_API uint32_t splatfx_renderer_note_count(const splatfx_renderer* renderer);
+/* Note `index` (< note_count), UTF-8, valid until the renderer's next render
+ * or destroy; NULL for an index out of range or a NULL or destroyed renderer. */
+SPLATFX_C_API const char* splatfx_renderer_note(const splatfx_renderer* renderer, uint32_t index);
 
 #ifdef __cplusplus
 } /* extern "C" */

@@ -323,11 +323,25 @@ const char* splatfx_status_name(splatfx_status status) {
     return "SPLATFX_ERROR_UNKNOWN_STATUS";
 }
 
-splatfx_error* splatfx_error_create(void) { return new (std::nothrow) splatfx_error(); }
-void splatfx_error_destroy(splatfx_error* error) { delete error; }
-splatfx_status splatfx_error_status(const splatfx_error* error) { return error ? error->status : SPLATFX_ERROR_INVALID_ARGUMENT; }
+splatfx_error* splatfx_error_create(void) {
+    auto* error = new (std::nothrow) splatfx_error();
+    if (!error) return nullptr;
+    try {
+        registerHandle(error, Magic::Error);
+    } catch (...) {
+        delete error;
+        return nullptr;
+    }
+    return error;
+}
+void splatfx_error_destroy(splatfx_error* error) { destroyHandle(error, Magic::Error); }
+splatfx_status splatfx_error_status(const splatfx_error* error) {
+    return isLive(error, Magic::Error) ? error->status : SPLATFX_ERROR_INVALID_ARGUMENT;
+}
 const char* splatfx_error_message(const splatfx_error* error) {
     if (!error) return "splatfx_error_message: error is NULL";
+    if (!isLive(error, Magic::Error))
+        return "splatfx_error_message: error is not a splatfx_error (it was destroyed, or is another handle or a stray pointer)";
     if (error->status != SPLATFX_OK && error->message.empty()) return "out of memory while writing the error message";
     return error->message.c_str();
 }
@@ -353,19 +367,16 @@ splatfx_status splatfx_materials_create(const splatfx_materials_desc* desc, spla
             return invalid("desc.layer_size is " + std::to_string(d.layer_size) + "; expected texels in [4, 1024]");
         if (d.color_table_size < 2 || d.color_table_size > 65536)
             return invalid("desc.color_table_size is " + std::to_string(d.color_table_size) + "; expected entries in [2, 65536]");
-        *out = new splatfx_materials(MaterialsDesc{.layerSize = d.layer_size, .colorTableSize = d.color_table_size});
+        *out = listed(std::make_unique<splatfx_materials>(MaterialsDesc{.layerSize = d.layer_size, .colorTableSize = d.color_table_size}),
+                      Magic::Materials);
         return success();
     });
 }
 
-void splatfx_materials_destroy(splatfx_materials* materials) {
-    if (!materials || materials->magic != Magic::Materials) return;
-    materials->magic = Magic::Dead;
-    delete materials;
-}
+void splatfx_materials_destroy(splatfx_materials* materials) { destroyHandle(materials, Magic::Materials); }
 
 uint32_t splatfx_materials_layer_count(const splatfx_materials* materials) {
-    return materials && materials->magic == Magic::Materials ? materials->value.layerCount() : 0;
+    return isLive(materials, Magic::Materials) ? materials->value.layerCount() : 0;
 }
 
 splatfx_status splatfx_texture_set_load(const char* folder, splatfx_texture_set** out, splatfx_error* error) {
@@ -375,36 +386,26 @@ splatfx_status splatfx_texture_set_load(const char* folder, splatfx_texture_set*
         if (!folder) return invalid("folder is NULL");
         Result<TextureSet> set = loadTextureSet(folder);
         if (!set) return failure(SPLATFX_ERROR_FILE, set.error());
-        *out = new splatfx_texture_set{Magic::TextureSet, std::move(*set)};
+        *out = listed(std::make_unique<splatfx_texture_set>(splatfx_texture_set{Magic::TextureSet, std::move(*set)}), Magic::TextureSet);
         return success();
     });
 }
 
-void splatfx_texture_set_destroy(splatfx_texture_set* set) {
-    if (!set || set->magic != Magic::TextureSet) return;
-    set->magic = Magic::Dead;
-    delete set;
-}
+void splatfx_texture_set_destroy(splatfx_texture_set* set) { destroyHandle(set, Magic::TextureSet); }
 
-uint32_t splatfx_texture_set_count(const splatfx_texture_set* set) {
-    return set && set->magic == Magic::TextureSet ? std::uint32_t(set->value.count()) : 0;
-}
+uint32_t splatfx_texture_set_count(const splatfx_texture_set* set) { return isLive(set, Magic::TextureSet) ? std::uint32_t(set->value.count()) : 0; }
 
 // ---- [scene and presets]
 
 splatfx_status splatfx_scene_create(splatfx_scene** out, splatfx_error* error) {
     return guard("splatfx_scene_create", error, [&] {
         if (!out) return invalid("out is NULL");
-        *out = new splatfx_scene();
+        *out = listed(std::make_unique<splatfx_scene>(), Magic::Scene);
         return success();
     });
 }
 
-void splatfx_scene_destroy(splatfx_scene* scene) {
-    if (!scene || scene->magic != Magic::Scene) return;
-    scene->magic = Magic::Dead;
-    delete scene;
-}
+void splatfx_scene_destroy(splatfx_scene* scene) { destroyHandle(scene, Magic::Scene); }
 
 void splatfx_effect_options_init(splatfx_effect_options* options) {
     if (!options) return;
@@ -498,14 +499,12 @@ splatfx_status splatfx_scene_load_file(const char* path, splatfx_materials* mate
         for (const SceneEffectInfo& e : file->effects) scene->effects.push_back(e.id);
         scene->materials = materials->identity;
         scene->hasMaterials = true;
-        *out = scene.release();
+        *out = listed(std::move(scene), Magic::Scene);
         return success();
     });
 }
 
-uint32_t splatfx_scene_effect_count(const splatfx_scene* scene) {
-    return scene && scene->magic == Magic::Scene ? std::uint32_t(scene->effects.size()) : 0;
-}
+uint32_t splatfx_scene_effect_count(const splatfx_scene* scene) { return isLive(scene, Magic::Scene) ? std::uint32_t(scene->effects.size()) : 0; }
 
 splatfx_status splatfx_scene_set_effect_enabled(splatfx_scene* scene, uint32_t id, int enabled, splatfx_error* error) {
     return guard("splatfx_scene_set_effect_enabled", error, [&] {
@@ -580,16 +579,12 @@ splatfx_status splatfx_camera_look_at(const float eye[3], const float target[3],
 splatfx_status splatfx_frame_create(splatfx_frame** out, splatfx_error* error) {
     return guard("splatfx_frame_create", error, [&] {
         if (!out) return invalid("out is NULL");
-        *out = new splatfx_frame();
+        *out = listed(std::make_unique<splatfx_frame>(), Magic::Frame);
         return success();
     });
 }
 
-void splatfx_frame_destroy(splatfx_frame* frame) {
-    if (!frame || frame->magic != Magic::Frame) return;
-    frame->magic = Magic::Dead;
-    delete frame;
-}
+void splatfx_frame_destroy(splatfx_frame* frame) { destroyHandle(frame, Magic::Frame); }
 
 splatfx_status splatfx_frame_get_stats(const splatfx_frame* frame, splatfx_frame_stats* out, splatfx_error* error) {
     return guard("splatfx_frame_get_stats", error, [&] {
@@ -608,6 +603,9 @@ splatfx_status splatfx_scene_prepare(splatfx_scene* scene, double time_sec, cons
         if (auto bad = checkHandle(materials, Magic::Materials, "materials", "splatfx_materials")) return *bad;
         if (auto bad = checkHandle(frame, Magic::Frame, "frame", "splatfx_frame")) return *bad;
         if (auto bad = checkSceneMaterials(*scene, *materials)) return *bad;
+        // Only a hook can get here: the render reads the frame's splats after the hook returns.
+        if (isHeld(frame))
+            return failure(SPLATFX_ERROR_INVALID_STATE, "frame is being drawn by the render that called this hook; prepare another frame");
         if (!camera) return invalid("camera is NULL");
         if (!std::isfinite(time_sec)) return invalid("time_sec is " + str(float(time_sec)) + "; expected a finite number of seconds");
         if (time_sec < 0.0) return invalid("time_sec is " + str(float(time_sec)) + "; expected seconds >= 0");

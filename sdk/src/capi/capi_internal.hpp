@@ -3,9 +3,16 @@
 // Each public function is `return capi::guard("name", error, [&] { ... });`:
 // the body returns an Outcome (ok, or a status and a message), guard()
 // writes it into the caller's error object and turns any C++ exception into
-// a status, so none crosses the C boundary. Handles carry a magic number so
-// a handle of the wrong type (an easy mistake through a foreign-function
-// interface, where they are all void*) is an error, not a crash.
+// a status, so none crosses the C boundary.
+//
+// Every handle the library returns is listed, with its type, in one registry
+// (handles.cpp) until it is destroyed. A handle is checked against that list,
+// never by reading through the pointer, so a handle of the wrong type (an
+// easy mistake through a foreign-function interface, where they are all
+// void*), one destroyed already (a double destroy) or a stray pointer is an
+// error or an ignored destroy, not a read of freed memory. A render holds the
+// handles it draws with: a hook that destroys one of them only marks it, and
+// the render deletes it when it returns, with an error saying so.
 #pragma once
 
 #include <cstdint>
@@ -25,14 +32,9 @@
 #include "splatfx/scene.hpp"
 #include "splatfx/texture_set.hpp"
 
-struct splatfx_error {
-    splatfx_status status = SPLATFX_OK;
-    std::string message;
-};
-
 namespace splatfx::capi {
 
-// One per handle type ('S','F','X', type letter): a wrong-type or zeroed handle fails the check.
+// One per handle type ('S','F','X', type letter): the registry's type of a handle, also kept in it (for debuggers).
 enum class Magic : std::uint32_t {
     Materials = 0x53465801,
     TextureSet = 0x53465802,
@@ -40,8 +42,47 @@ enum class Magic : std::uint32_t {
     Frame = 0x53465804,
     Renderer = 0x53465805,
     Context = 0x53465806,
+    Error = 0x53465807,
     Dead = 0,
 };
+
+} // namespace splatfx::capi
+
+struct splatfx_error {
+    splatfx::capi::Magic magic = splatfx::capi::Magic::Error;
+    splatfx_status status = SPLATFX_OK;
+    std::string message;
+};
+
+namespace splatfx::capi {
+
+// "splatfx_scene" for Magic::Scene.
+const char* typeName(Magic type);
+
+// ---- the registry of live handles (handles.cpp; thread-safe) ----
+
+// Lists a new handle; throws std::bad_alloc (the caller deletes it then).
+// `tag`: an identity to find it by (findHandle); a headless context's GL context.
+void registerHandle(const void* handle, Magic type, const void* tag = nullptr);
+// The live handle of `type` listed with `tag`, or null.
+const void* findHandle(Magic type, const void* tag);
+// What `handle` is: its type when it is live (listed, and not destroyed by a
+// hook during a render), Magic::Dead otherwise. `destroyed`, when given, is
+// set when it was destroyed by a hook and awaits the end of the render.
+Magic liveType(const void* handle, bool* destroyed = nullptr);
+inline bool isLive(const void* handle, Magic type) { return handle && liveType(handle) == type; }
+// True while a render holds it (see hold()).
+bool isHeld(const void* handle);
+// A *_destroy's first step. Delete: unlisted, the caller deletes it now.
+// Deferred: a render holds it; it is marked and release() hands it back.
+// Ignore: NULL, not listed, another type, or marked already (a double destroy).
+enum class DestroyStep { Delete, Deferred, Ignore };
+DestroyStep beginDestroy(const void* handle, Magic type);
+// A render holds the handles it draws with (a count, for nested renders).
+void hold(const void* handle);
+// Ends one hold(); true when that was the last and a destroy was deferred:
+// the handle is unlisted and the caller deletes it.
+bool release(const void* handle);
 
 // What a body returns.
 struct Outcome {
@@ -55,7 +96,7 @@ inline Outcome invalid(std::string message) { return failure(SPLATFX_ERROR_INVAL
 
 // Writes the outcome into `error` (when given); never throws.
 inline splatfx_status report(splatfx_error* error, const char* function, splatfx_status status, const std::string& message) {
-    if (error) {
+    if (error && isLive(error, Magic::Error)) { // a destroyed error object is not written to
         error->status = status;
         try {
             if (status == SPLATFX_OK) error->message.clear();
@@ -80,12 +121,34 @@ splatfx_status guard(const char* function, splatfx_error* error, Body&& body) no
     } catch (...) { return report(error, function, SPLATFX_ERROR_INTERNAL, "unexpected C++ exception of unknown type"); }
 }
 
-// "materials is NULL" / "materials is not a splatfx_materials (wrong handle type, or destroyed)".
+// "materials is NULL" / "materials is not a splatfx_materials (it is a splatfx_scene)" / "... (it was destroyed ...)".
+std::string notLive(const void* h, Magic magic, const char* param);
 template <class Handle>
 std::optional<Outcome> checkHandle(const Handle* h, Magic magic, const char* param, const char* type) {
+    (void)type;
     if (!h) return invalid(std::string(param) + " is NULL");
-    if (h->magic != magic) return invalid(std::string(param) + " is not a " + type + " (a handle of another type, or one already destroyed)");
+    if (!isLive(h, magic)) return invalid(notLive(h, magic, param));
     return std::nullopt;
+}
+
+// A new handle, listed: what every *_create hands out.
+template <class Handle>
+Handle* listed(std::unique_ptr<Handle> h, Magic type, const void* tag = nullptr) {
+    registerHandle(h.get(), type, tag);
+    return h.release();
+}
+
+// Every *_destroy: deletes a live handle of its type now, or after the render
+// drawing with it returns; ignores anything else (NULL, a double destroy, a
+// handle of another type, a stray pointer), never reading through it.
+template <class Handle>
+void deleteHandle(Handle* h) noexcept;
+template <class Handle>
+void destroyHandle(Handle* h, Magic type) noexcept {
+    try {
+        if (beginDestroy(h, type) == DestroyStep::Delete) deleteHandle(h);
+    } catch (...) { // a lock that failed: the handle stays listed and alive rather than an exception crossing into C
+    }
 }
 
 } // namespace splatfx::capi
@@ -138,6 +201,20 @@ struct splatfx_headless_context {
     std::optional<splatfx::HeadlessContext> value;
     std::string renderer;
 };
+
+namespace splatfx::capi {
+template <class Handle>
+void deleteHandle(Handle* h) noexcept {
+    h->magic = Magic::Dead;
+    try {
+        delete h;
+    } catch (...) { // a destructor that throws must not cross into C
+    }
+}
+// Deletes its GL objects only in its own context (capi_gl.cpp).
+template <>
+void deleteHandle(splatfx_renderer* h) noexcept;
+} // namespace splatfx::capi
 
 // The C side sees int-sized enums (splatfx_c.h, SPLATFX_C_ENUM).
 static_assert(sizeof(splatfx_status) == 4 && sizeof(splatfx_easing) == 4, "splatfx_c.h enums must be 32-bit");

@@ -2,6 +2,8 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <map>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -10,14 +12,43 @@
 
 namespace splatfx {
 
+namespace {
+
+// An EGLDisplay is one per device and process, shared by every context made
+// on it, and eglTerminate ends all of them: each context counts its display
+// in, and only the last one out terminates it.
+struct DisplayUsers {
+    std::mutex mutex;
+    std::map<EGLDisplay, int> count;
+};
+DisplayUsers& displayUsers() {
+    static auto* users = new DisplayUsers(); // never freed: contexts may outlive static destruction
+    return *users;
+}
+void enterDisplay(EGLDisplay display) {
+    std::lock_guard lock(displayUsers().mutex);
+    ++displayUsers().count[display];
+}
+bool leaveDisplay(EGLDisplay display) { // true: the last user left
+    std::lock_guard lock(displayUsers().mutex);
+    auto& count = displayUsers().count;
+    if (--count[display] > 0) return false;
+    count.erase(display);
+    return true;
+}
+
+} // namespace
+
 struct HeadlessContext::Impl {
     EGLDisplay display = EGL_NO_DISPLAY;
     EGLContext context = EGL_NO_CONTEXT;
     ~Impl() {
         if (display != EGL_NO_DISPLAY) {
-            eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+            // Only this context is released: another one current on this thread stays current.
+            if (context != EGL_NO_CONTEXT && eglGetCurrentContext() == context)
+                eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
             if (context != EGL_NO_CONTEXT) eglDestroyContext(display, context);
-            eglTerminate(display);
+            if (leaveDisplay(display)) eglTerminate(display);
         }
     }
 };
@@ -80,6 +111,7 @@ Result<HeadlessContext> HeadlessContext::create(const HeadlessDesc& desc) {
         }
         auto impl = std::make_unique<Impl>();
         impl->display = display;
+        enterDisplay(display);
         if (!hasExtension(eglQueryString(display, EGL_EXTENSIONS), "EGL_KHR_surfaceless_context")) {
             why = "display lacks EGL_KHR_surfaceless_context";
             continue;

@@ -202,11 +202,17 @@ public:
     FrameRenderer& operator=(FrameRenderer&&) noexcept;
     ~FrameRenderer();
 
-    // Uploads texture layers and colour rows when materials changed (cheap otherwise).
+    // Uploads texture layers and colour rows when materials changed (cheap
+    // otherwise). Fails, uploading nothing, when checkContext() does.
     Status upload(const Materials& materials);
     // Runs the frame's passes into the host target. Expects upload() first and
-    // a frame camera with a positive viewport.
+    // a frame camera with a positive viewport. When checkContext() fails it
+    // makes no GL call and draws nothing; stats().notes says so.
     void render(const Frame& frame, const HostTarget& target);
+    // OK when the context current on this thread is the one create() ran in
+    // (its GL objects are names in that context only); otherwise an error
+    // saying whether none or another one is current.
+    Status checkContext() const;
 
     const FrameRendererDesc& desc() const;
     const FrameRenderStats& stats() const;

@@ -8,7 +8,7 @@
 
 namespace splatfx::gl::detail {
 
-bool contextIsCurrent() {
+const void* currentContext() {
     using GetCurrent = void* (*)();
     const char* libs[][2] = {
         {"libEGL.so.1", "eglGetCurrentContext"}, {"libGLX.so.0", "glXGetCurrentContext"}, {"libGL.so.1", "glXGetCurrentContext"}};
@@ -16,12 +16,14 @@ bool contextIsCurrent() {
         void* handle = dlopen(lib[0], RTLD_LAZY | RTLD_NOLOAD);
         if (!handle) continue;
         auto fn = reinterpret_cast<GetCurrent>(dlsym(handle, lib[1]));
-        const bool current = fn && fn() != nullptr;
+        const void* current = fn ? fn() : nullptr;
         dlclose(handle);
-        if (current) return true;
+        if (current) return current;
     }
-    return false;
+    return nullptr;
 }
+
+bool contextIsCurrent() { return currentContext() != nullptr; }
 
 bool softwareRasterizer() {
     const auto* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));

@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 
+#include "context_check.hpp"
 #include "passes/fog_pass.hpp"
 #include "passes/fragment_list_pass.hpp"
 #include "host_depth.hpp"
@@ -27,6 +28,7 @@ struct FrameRenderer::Impl {
           lists(std::move(l)) {}
 
     FrameRendererDesc desc;
+    const void* context = nullptr; // the context create() ran in: its GL objects are names in that context only
     FramePlan plan;
     FrameRenderStats stats;
     detail::ShadowPass shadow;
@@ -82,6 +84,7 @@ Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
     if (!lists) return makeError(lists.error());
     auto impl = std::make_unique<Impl>(desc, programs, std::move(*splats), std::move(*tetra), std::move(*lists));
     impl->stats.resolutionScale = desc.resolutionScale;
+    impl->context = detail::currentContext();
     return FrameRenderer(std::move(impl));
 }
 
@@ -90,7 +93,16 @@ FrameRenderer::FrameRenderer(FrameRenderer&&) noexcept = default;
 FrameRenderer& FrameRenderer::operator=(FrameRenderer&&) noexcept = default;
 FrameRenderer::~FrameRenderer() = default;
 
+Status FrameRenderer::checkContext() const {
+    const void* current = detail::currentContext();
+    if (current == mImpl->context) return {};
+    return makeError(current ? "splatfx::gl::FrameRenderer: the OpenGL context current on this thread is not the one it was created in "
+                               "(its GL objects are names in that context only); make that context current"
+                             : "splatfx::gl::FrameRenderer: no OpenGL context is current on this thread; make the one it was created in current");
+}
+
 Status FrameRenderer::upload(const Materials& materials) {
+    if (Status s = checkContext(); !s) return s;
     for (detail::Pass* p : mImpl->passes())
         if (Status s = p->upload(materials); !s) return s;
     return {};
@@ -104,10 +116,28 @@ const Renderer& FrameRenderer::splatRenderer() const { return mImpl->splats.rend
 
 void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
     Impl& r = *mImpl;
+    if (Status s = checkContext(); !s) {
+        // Any GL call here would reach another context's objects (or abort in the loader): nothing is drawn, and the stats say why.
+        r.plan = {};
+        r.stats = {};
+        r.stats.resolutionScale = r.desc.resolutionScale;
+        r.stats.notes.push_back("frame not drawn: " + s.error());
+        return;
+    }
     r.plan = planFrame(frame, target, r.desc, detail::queryHostDepth(target.framebuffer, target.depthTexture));
     for (detail::Pass* p : r.passes()) p->prepare(r.plan, frame);
     detail::StepContext context{.frame = frame, .host = target, .plan = r.plan, .splatLayers = r.splats.renderer().layerTexture()};
-    for (const PlanStep& step : r.plan.steps) r.passFor(step.kind).execute(step, context);
+    for (const PlanStep& step : r.plan.steps) {
+        r.passFor(step.kind).execute(step, context);
+        // A hook that made another context current (or none): the next GL call would reach that one's objects, or abort.
+        if (step.kind == StepKind::HostOpaque || step.kind == StepKind::HostTransparent)
+            if (Status s = checkContext(); !s) {
+                r.report(frame, context);
+                r.stats.notes.push_back("frame cut short after the host's " +
+                                        std::string(step.kind == StepKind::HostOpaque ? "opaque" : "transparent") + " hook: " + s.error());
+                return;
+            }
+    }
     r.report(frame, context);
 }
 
