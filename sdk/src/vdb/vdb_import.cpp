@@ -159,7 +159,14 @@ struct Lattice {
     }
 };
 
-Result<GridSequence> load(const std::vector<std::string>& paths, const std::vector<int>& frameNumbers, const VdbImportDesc& desc) {
+// The frame being checked or read, for a message when OpenVDB throws where it was not expected to.
+struct Current {
+    std::string path;
+    int frame = 0;
+};
+
+Result<GridSequence> loadFrames(const std::vector<std::string>& paths, const std::vector<int>& frameNumbers, const VdbImportDesc& desc,
+                                Current& cur) {
     if (desc.densityGrid.empty()) return makeError("VdbImportDesc::densityGrid is empty; name the density grid (e.g. \"density\")");
     if (desc.voxelsPerCell < 0) return makeError("VdbImportDesc::voxelsPerCell is " + std::to_string(desc.voxelsPerCell) + "; expected >= 0");
     if (desc.voxelsPerCell == 0 && desc.maxCellsPerAxis < 1)
@@ -197,6 +204,7 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
         FrameInfo fi;
         fi.path = paths[i];
         fi.frame = frameNumbers[i];
+        cur = {fi.path, fi.frame};
         const std::string fileAt = "OpenVDB file '" + fi.path + "' (frame " + std::to_string(fi.frame) + "): ";
         std::error_code ec;
         if (!std::filesystem::is_regular_file(fi.path, ec)) return makeError(fileAt + "no such file");
@@ -322,6 +330,7 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
 
     for (std::size_t i = 0; i < infos.size(); ++i) {
         const FrameInfo& fi = infos[i];
+        cur = {fi.path, fi.frame};
         Loaded g;
         if (Status s = readFrame(fi, g); !s) return makeError(s.error());
         GridSequenceFrame frame;
@@ -428,6 +437,15 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
     }
     if (Status s = seq.validate(); !s) return makeError("OpenVDB import of '" + infos[0].path + "': " + s.error());
     return seq;
+}
+
+// OpenVDB throws from more places than its readers (a transform whose matrix is singular
+// throws when its affine map is asked for): no exception leaves the importer.
+Result<GridSequence> load(const std::vector<std::string>& paths, const std::vector<int>& frameNumbers, const VdbImportDesc& desc) {
+    Current cur;
+    try {
+        return loadFrames(paths, frameNumbers, desc, cur);
+    } catch (const std::exception& e) { return makeError("OpenVDB file '" + cur.path + "' (frame " + std::to_string(cur.frame) + "): " + e.what()); }
 }
 
 } // namespace
