@@ -19,7 +19,7 @@ cd "$(dirname "$0")/.."
 BUILD_DIR="${BUILD_DIR:-build-asan}"
 export BUILD_DIR
 FUZZ_SECONDS="${FUZZ_SECONDS:-60}"
-FUZZ_TARGETS="${FUZZ_TARGETS:-scene_file texture_set image mesh}"
+FUZZ_TARGETS="${FUZZ_TARGETS:-scene_file texture_set image mesh vdb}"
 targets=()
 for t in $FUZZ_TARGETS; do targets+=("fuzz_$t"); done
 tools/instrumented-build.sh "${targets[@]}"
