@@ -4,6 +4,11 @@
 // says what it lacks instead of "unknown kind".
 #include <gtest/gtest.h>
 
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
 #include "splatfx/scene_file.hpp"
 
 namespace {
@@ -47,6 +52,31 @@ TEST(SceneFileVdb, KeysAreChecked) {
     auto m = parse(R"({"kind": "vdb"})");
     ASSERT_FALSE(m);
     EXPECT_NE(m.error().find("missing \"files\""), std::string::npos) << m.error();
+}
+
+// A real frame with four bytes of its density grid's metadata changed (the
+// delayed-load entry count, which OpenVDB allocates as given): the scene file
+// is refused at the effect's "files", naming the file, before OpenVDB reads it.
+TEST(SceneFileVdb, CorruptedFileRefusedAtFiles) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / "splatfx-scenefile-vdb-corrupt";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    std::ifstream in(std::string(SPLATFX_SOURCE_DIR) + "/samples/20-vdb-smoke/data/fluid_data_0010.vdb", std::ios::binary);
+    std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+    const std::size_t type = bytes.find("__delayedload", bytes.find("density"));
+    ASSERT_NE(type, std::string::npos);
+    const std::uint32_t huge = 0x7fffffff;
+    std::memcpy(&bytes[type + 13 + 4], &huge, 4);
+    std::ofstream(dir / "smoke.vdb", std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+    auto r = parse(R"({"kind": "vdb", "files": ")" + (dir / "smoke.vdb").string() + R"(", "grids": {"temperature": "flame"}})");
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().find("effects[0].files"), std::string::npos) << r.error();
+    EXPECT_NE(r.error().find("smoke.vdb' (frame 0): refused before OpenVDB reads it: grid 'density''s metadata 'file_delayed_load' claims "
+                             "2147483647 leaves"),
+              std::string::npos)
+        << r.error();
+    fs::remove_all(dir);
 }
 
 #else

@@ -6,11 +6,15 @@
 // bad input fails with a message naming the file, the frame and the grid.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
+
+#include <sys/resource.h>
 
 #include <openvdb/openvdb.h>
 
@@ -58,6 +62,38 @@ openvdb::FloatGrid::Ptr randomDensity(openvdb::Coord lo, openvdb::Coord hi, doub
                 if (v > 0.3f) acc.setValue({x, y, z}, 2.0f * v);
             }
     return g;
+}
+
+std::string readBytes(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void writeBytes(const fs::path& p, const std::string& bytes) {
+    std::ofstream(p, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+// Peak resident memory of this process so far, in bytes.
+std::uint64_t peakBytes() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return std::uint64_t(u.ru_maxrss) * 1024;
+}
+
+// A small smoke frame as OpenVDB writes it: density, temperature, velocity.
+void writeSmoke(const fs::path& p) {
+    auto d = randomDensity({0, 0, 0}, {11, 11, 11}, 0.1, 3);
+    auto t = openvdb::FloatGrid::create(0.0f);
+    t->setName("temperature");
+    t->setTransform(d->transform().copy());
+    auto v = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+    v->setName("velocity");
+    v->setTransform(d->transform().copy());
+    for (auto it = d->cbeginValueOn(); it; ++it) {
+        t->tree().setValue(it.getCoord(), 300.0f + float(it.getCoord().y()));
+        v->tree().setValue(it.getCoord(), openvdb::Vec3s(0.0f, 1.0f, 0.0f));
+    }
+    write(p, {d, t, v});
 }
 
 } // namespace
@@ -296,10 +332,9 @@ TEST(VdbImport, RotatedOrMismatchedGridTransformsRefused) {
     EXPECT_NE(w.error().find("grid 'velocity': has a transform different from grid 'density' in the same file"), std::string::npos) << w.error();
 }
 
-// A 1024^3 (about 1.07e9 voxels) active region, stored as tiles (a small
-// file), is refused from the file's metadata. The proof that no voxel data
-// is read: the same file cut short after its header and metadata, whose
-// tree cannot be read, fails with the same voxel-count message, not a read error.
+// A grid over maxFileVoxels (here 1024^3 in tiles: a 9 KB file) is refused
+// from the walk of the file's tree, tiles counted at their extent cubed; the
+// message says how many voxels were in tiles and that no value was read.
 TEST(VdbImport, BillionVoxelGridRefusedBeforeReading) {
     const fs::path dir = tempDir();
     auto g = openvdb::FloatGrid::create(0.0f);
@@ -309,33 +344,10 @@ TEST(VdbImport, BillionVoxelGridRefusedBeforeReading) {
     write(dir / "big.vdb", {g});
     auto r = loadVdb((dir / "big.vdb").string(), {.temperatureGrid = "", .velocityGrid = ""});
     ASSERT_FALSE(r);
-    EXPECT_NE(r.error().find("big.vdb' (frame 0), grid 'density': has 1073741824 active voxels (from the file's metadata; nothing was read)"),
+    EXPECT_NE(r.error().find("big.vdb' (frame 0), grid 'density': has 1073741824 active voxels (1073741824 of them in tiles; counted from the "
+                             "file's tree, no voxel value read); the limit is 268435456 (VdbImportDesc::maxFileVoxels)"),
               std::string::npos)
         << r.error();
-
-    // Cut the file where the tree starts: readAllGridMetadata still works, readGrid cannot.
-    const auto size = fs::file_size(dir / "big.vdb");
-    std::ifstream in(dir / "big.vdb", std::ios::binary);
-    std::string bytes(size, '\0');
-    in.read(bytes.data(), std::streamsize(size));
-    openvdb::io::File probe((dir / "big.vdb").string());
-    probe.open(false);
-    auto meta = probe.readAllGridMetadata();
-    probe.close();
-    // Keep everything except the tree's last bytes (the tile values).
-    const std::size_t keep = size - 64;
-    std::ofstream((dir / "cut.vdb"), std::ios::binary).write(bytes.data(), std::streamsize(keep));
-    bool treeUnreadable = false;
-    try {
-        openvdb::io::File cut((dir / "cut.vdb").string());
-        cut.open(false);
-        auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(cut.readGrid("density"));
-        treeUnreadable = !grid || grid->activeVoxelCount() != (openvdb::Index64(1) << 30);
-    } catch (const std::exception&) { treeUnreadable = true; }
-    ASSERT_TRUE(treeUnreadable) << "the cut file must not hold a readable tree for this proof";
-    auto c = loadVdb((dir / "cut.vdb").string(), {.temperatureGrid = "", .velocityGrid = ""});
-    ASSERT_FALSE(c);
-    EXPECT_NE(c.error().find("has 1073741824 active voxels (from the file's metadata; nothing was read)"), std::string::npos) << c.error();
 }
 
 // Two voxels far apart make a tiny file but a huge lattice: refused from
@@ -366,7 +378,7 @@ TEST(VdbImport, BadFileAndDescriptor) {
     std::ofstream(dir / "junk.vdb") << "not a vdb file";
     auto r = loadVdb((dir / "junk.vdb").string());
     ASSERT_FALSE(r);
-    EXPECT_NE(r.error().find("junk.vdb' (frame 0): cannot be read as OpenVDB"), std::string::npos) << r.error();
+    EXPECT_NE(r.error().find("junk.vdb' (frame 0): refused before OpenVDB reads it: not a VDB file"), std::string::npos) << r.error();
     auto n = loadVdb((dir / "nothing.vdb").string());
     ASSERT_FALSE(n);
     EXPECT_NE(n.error().find("nothing.vdb' (frame 0): no such file"), std::string::npos) << n.error();
@@ -422,4 +434,169 @@ TEST(VdbImport, SequenceEffectFromFile) {
         EXPECT_EQ(fx->grid().voxels[i].texture, direct.voxels[i].texture);
         EXPECT_EQ(fx->grid().voxels[i].opacity, direct.voxels[i].opacity);
     }
+}
+
+// A 4-byte change in a file's grid metadata: the entry count of OpenVDB's
+// delayed-load metadata (written into every grid), set to 2^31 - 1. OpenVDB
+// allocated what it claimed (2 GB resident, then std::bad_alloc, 8 s); the
+// walk refuses it before OpenVDB reads the file, naming the file, the entry
+// and the bound, with no memory to speak of. Likewise a string's length.
+TEST(VdbImport, CorruptedMetadataRefusedBeforeOpenVdbAllocates) {
+    const fs::path dir = tempDir();
+    writeSmoke(dir / "ok.vdb");
+    const std::string ok = readBytes(dir / "ok.vdb");
+    ASSERT_TRUE(loadVdb((dir / "ok.vdb").string()));
+    // "__delayedload" (the type name), then the value's size, then its leaf count.
+    const std::size_t type = ok.find("__delayedload", ok.find("density"));
+    ASSERT_NE(type, std::string::npos);
+    std::string bad = ok;
+    const std::uint32_t huge = 0x7fffffff;
+    std::memcpy(&bad[type + 13 + 4], &huge, 4);
+    writeBytes(dir / "count.vdb", bad);
+    // The string metadata "class" holds "fog volume": its value's size, 4 bytes before it.
+    const std::size_t fog = ok.find("fog volume");
+    ASSERT_NE(fog, std::string::npos);
+    bad = ok;
+    std::memcpy(&bad[fog - 4], &huge, 4);
+    writeBytes(dir / "string.vdb", bad);
+
+    const std::uint64_t before = peakBytes();
+    const auto t0 = std::chrono::steady_clock::now();
+    auto count = loadVdb((dir / "count.vdb").string());
+    auto string = loadVdb((dir / "string.vdb").string());
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ASSERT_FALSE(count);
+    EXPECT_NE(count.error().find("count.vdb' (frame 0): refused before OpenVDB reads it: grid 'density''s metadata 'file_delayed_load' claims "
+                                 "2147483647 leaves; its grid's"),
+              std::string::npos)
+        << count.error();
+    ASSERT_FALSE(string);
+    EXPECT_NE(string.error().find("string.vdb' (frame 0): refused before OpenVDB reads it: grid 'density''s metadata 'class' needs 2147483647 "
+                                  "bytes, but only"),
+              std::string::npos)
+        << string.error();
+    EXPECT_LT(peakBytes() - before, std::uint64_t(64) << 20) << "the refusals raised the peak memory";
+    EXPECT_LT(seconds, 1.0);
+}
+
+// 4-byte windows all over a real file (every 23rd offset: each field is hit
+// by some) set to 2^31 - 1, one at a time: each load ends with a sequence or
+// a message naming the file, and none costs memory to speak of.
+TEST(VdbImport, EveryFourByteChangeEndsQuicklyWithBoundedMemory) {
+    const fs::path dir = tempDir();
+    writeSmoke(dir / "ok.vdb");
+    const std::string ok = readBytes(dir / "ok.vdb");
+    const std::uint64_t before = peakBytes();
+    int refused = 0, loaded = 0;
+    for (std::size_t at = 0; at + 4 <= ok.size(); at += 23) {
+        std::string bad = ok;
+        const std::uint32_t huge = 0x7fffffff;
+        std::memcpy(&bad[at], &huge, 4);
+        writeBytes(dir / "bad.vdb", bad);
+        auto r = loadVdb((dir / "bad.vdb").string());
+        if (r) {
+            ++loaded;
+        } else {
+            ++refused;
+            EXPECT_NE(r.error().find("bad.vdb'"), std::string::npos) << r.error();
+        }
+    }
+    EXPECT_GT(refused, 100);
+    EXPECT_LT(peakBytes() - before, std::uint64_t(256) << 20) << "a corrupted file raised the peak memory";
+    std::printf("%d changes refused, %d loaded (changed values)\n", refused, loaded);
+}
+
+// A tile-filled 640^3 grid (125 tiles of 128^3, a few KB of file; 262 million voxels, under
+// maxFileVoxels) a frame: tiles are filled by region, so a frame takes milliseconds (voxel by
+// voxel it took 2 s a grid a frame), and the density is conserved.
+TEST(VdbImport, TiledGridsFillByRegion) {
+    const fs::path dir = tempDir();
+    auto g = openvdb::FloatGrid::create(0.0f);
+    g->setName("density");
+    g->setTransform(xform(0.01));
+    g->fill(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(639)), 0.5f, true);
+    write(dir / "tiles.vdb", {g});
+    const int frames = 10;
+    for (int f = 1; f <= frames; ++f) fs::copy_file(dir / "tiles.vdb", dir / vdbFramePath("t_##.vdb", f));
+    const auto t0 = std::chrono::steady_clock::now();
+    auto seq = loadVdbSequence((dir / "t_##.vdb").string(), 1, frames, {.temperatureGrid = "", .velocityGrid = ""});
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ASSERT_TRUE(seq) << seq.error();
+    ASSERT_EQ(seq->frames.size(), std::size_t(frames));
+    EXPECT_LT(seconds, 5.0) << "tiles expanded voxel by voxel?";
+    const double edge = seq->spacing.x, want = 0.5 * std::pow(640 * 0.01, 3);
+    for (const GridSequenceFrame& fr : seq->frames) {
+        double got = 0.0;
+        for (float d : fr.opticalDepth) got += double(d) * edge * edge;
+        EXPECT_NEAR(got, want, want * 1e-6);
+    }
+}
+
+// Tiles against a temperature that varies inside them (leaves) and one that does not
+// (a tile): the density-weighted temperature and the depth of every cell equal a
+// voxel-by-voxel sum over the tiles.
+TEST(VdbImport, TiledDensityWeightsTemperatureVoxelByVoxel) {
+    const fs::path dir = tempDir();
+    auto d = openvdb::FloatGrid::create(0.0f);
+    d->setName("density");
+    d->setTransform(xform(0.1));
+    d->tree().addTile(1, openvdb::Coord(0), 0.5f, true);          // 8^3
+    d->tree().addTile(2, openvdb::Coord(128, 0, 0), 0.25f, true); // 128^3
+    d->tree().setValue({3, 20, 5}, 2.0f);                         // a voxel
+    auto t = openvdb::FloatGrid::create(0.0f);
+    t->setName("temperature");
+    t->setTransform(xform(0.1));
+    t->tree().addTile(2, openvdb::Coord(128, 0, 0), 500.0f, true);
+    for (int z = 0; z < 8; ++z)
+        for (int y = 0; y < 8; ++y)
+            for (int x = 0; x < 8; ++x) t->tree().setValue({x, y, z}, 100.0f + 10.0f * float(x + y));
+    for (int x = 140; x < 150; ++x) t->tree().setValue({x, 3, 7}, 900.0f); // a leaf inside the tile
+    write(dir / "tt.vdb", {d, t});
+    const int N = 16;
+    auto seq = loadVdb((dir / "tt.vdb").string(), {.velocityGrid = "", .voxelsPerCell = N, .temperatureHot = 1000.0f, .temperatureCold = 0.0f});
+    ASSERT_TRUE(seq) << seq.error();
+    ASSERT_EQ(seq->dims, glm::ivec3(16, 8, 8));
+    std::vector<double> sum(seq->cellCount(), 0.0), sumT(seq->cellCount(), 0.0);
+    auto tAcc = t->getConstAccessor();
+    auto add = [&](const openvdb::Coord& c, float v) {
+        const std::size_t k = (std::size_t(c.z() / N) * 8 + std::size_t(c.y() / N)) * 16 + std::size_t(c.x() / N);
+        sum[k] += v, sumT[k] += double(v) * tAcc.getValue(c);
+    };
+    for (auto it = d->cbeginValueOn(); it; ++it) {
+        openvdb::CoordBBox b;
+        it.getBoundingBox(b);
+        for (auto c = b.begin(); c; ++c) add(*c, *it);
+    }
+    const double depthPerSum = 1.0 * (N * 0.1) / double(N * N * N);
+    for (std::size_t k = 0; k < sum.size(); ++k) {
+        EXPECT_NEAR(seq->frames[0].opticalDepth[k], sum[k] * depthPerSum, 1e-6 * (1.0 + sum[k] * depthPerSum)) << "cell " << k;
+        if (sum[k] > 0.0) { EXPECT_NEAR(seq->frames[0].colorCoord[k], 1.0 - sumT[k] / sum[k] / 1000.0, 1e-5) << "cell " << k; }
+    }
+}
+
+// The sequence's voxels (tiles included, every imported grid of every frame) against
+// maxSequenceVoxels, and a frame's tiles against maxFileVoxels: refused before any
+// voxel is read, naming the file, the count and the budget.
+TEST(VdbImport, TiledVoxelsCountAgainstTheBudgets) {
+    const fs::path dir = tempDir();
+    auto g = openvdb::FloatGrid::create(0.0f);
+    g->setName("density");
+    g->setTransform(xform(0.01));
+    g->fill(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(639)), 0.5f, true);
+    for (int f = 1; f <= 3; ++f) write(dir / vdbFramePath("t_##.vdb", f), {g});
+    const std::uint64_t frameVoxels = 640ull * 640 * 640;
+    auto seq = loadVdbSequence((dir / "t_##.vdb").string(), 1, 3, {.temperatureGrid = "", .velocityGrid = "", .maxSequenceVoxels = 2 * frameVoxels});
+    ASSERT_FALSE(seq);
+    EXPECT_NE(seq.error().find("t_03.vdb' (frame 3), grid 'density': brings the voxels to expand to 786432000 (tiles included, over the imported "
+                               "grids of frames up to this one); the limit is 524288000 (VdbImportDesc::maxSequenceVoxels)"),
+              std::string::npos)
+        << seq.error();
+    auto one = loadVdb((dir / "t_01.vdb").string(), {.temperatureGrid = "", .velocityGrid = "", .maxFileVoxels = frameVoxels - 1});
+    ASSERT_FALSE(one);
+    EXPECT_NE(one.error().find("t_01.vdb' (frame 0), grid 'density': has 262144000 active voxels (262144000 of them in tiles"), std::string::npos)
+        << one.error();
+    auto tree = loadVdb((dir / "t_01.vdb").string(), {.temperatureGrid = "", .velocityGrid = "", .maxTreeBytes = 1000});
+    ASSERT_FALSE(tree);
+    EXPECT_NE(tree.error().find("t_01.vdb' (frame 0), grid 'density': would take about "), std::string::npos) << tree.error();
+    EXPECT_NE(tree.error().find("the limit is 1000 (VdbImportDesc::maxTreeBytes)"), std::string::npos) << tree.error();
 }

@@ -18,11 +18,21 @@
 //   velocity     box average over the block, times velocityScale, in lattice
 //                cells per second (a staggered velocity grid is averaged as if
 //                cell-centred: half a file voxel, well inside one coarse cell).
-// Before any voxel data is read, every file's grid metadata is checked (grid
-// present, float or vec3s type, a fog volume with background 0, an active
-// voxel count above 0 and below maxFileVoxels, a transform that is a uniform
-// scale plus translation and equal in every grid and frame); each error names
-// the file, the frame and the grid.
+// Before OpenVDB reads a file, splatfx walks its structure (header, metadata,
+// grid descriptors, transforms, trees; and before each frame's voxels are
+// read, their buffers) and checks every count, length and offset against the
+// bytes present: OpenVDB allocates whatever a file claims, so a corrupted
+// file is refused ("refused before OpenVDB reads it: ...", naming what is
+// wrong and where) instead of exhausting memory. Formats 222 to 224 (OpenVDB
+// 3.0 onwards) with grid offsets are read; instanced grids are not.
+// Before any voxel data is read, every frame is checked (grid present, float
+// or vec3s type, a fog volume, active voxels counted from the tree with tiles
+// included, above 0 and within maxFileVoxels, the tree's memory within
+// maxTreeBytes, the sequence's voxels within maxSequenceVoxels, a transform
+// that is a uniform scale plus translation and equal in every grid and
+// frame); each error names the file, the frame and the grid. Frames are then
+// read one at a time (each released before the next); tiles are filled by
+// region, not voxel by voxel.
 // It does not write VDB files, render, or keep files open, and it reads no
 // grid other than the three named.
 //
@@ -74,9 +84,20 @@ struct VdbImportDesc {
     float velocityScale = 1.0f;                            // multiplies the file's velocity (after the unit); default 1
     double framesPerSec = 24.0;                            // playback rate of the sequence, > 0; default 24
     SequenceEnd end = SequenceEnd::Loop;                   // default Loop
-    // A grid whose metadata reports more active voxels than this is refused
-    // before its voxels are read. Default 2^28 (1 GiB of floats).
+    // A grid with more active voxels than this, tiles included (a tile counts
+    // its node's extent cubed: 512, 2^21 or 2^36 voxels), is refused; counted
+    // from the file's tree before any voxel value is read. Default 2^28 (1 GiB
+    // of floats).
     std::uint64_t maxFileVoxels = std::uint64_t(1) << 28;
+    // A grid whose tree would take OpenVDB more memory than this (its nodes and
+    // voxel buffers, estimated from the file's tree before OpenVDB reads it) is
+    // refused. Default 2^32 (4 GiB).
+    std::uint64_t maxTreeBytes = std::uint64_t(1) << 32;
+    // The active voxels of all imported grids of all frames, tiles included,
+    // may not exceed this; checked frame by frame before any voxel value is
+    // read. Tiles are filled by region, so a tiled voxel costs far less than a
+    // leaf's; this bounds the work of long sequences. Default 2^36.
+    std::uint64_t maxSequenceVoxels = std::uint64_t(1) << 36;
 };
 
 // One file as a one-frame sequence (frame number 0 in messages).

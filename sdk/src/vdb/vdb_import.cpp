@@ -1,8 +1,10 @@
-// OpenVDB import (splatfx::vdb): grid metadata checked for every frame first,
-// then each frame's density, temperature and velocity box-filtered onto one
-// coarse lattice (see splatfx/vdb.hpp for the filters and why the density
-// filter preserves each coarse cell's optical depth). OpenVDB throws; no
-// exception leaves this file.
+// OpenVDB import (splatfx::vdb): every frame's file walked (vdb_file_check:
+// its structure checked against its bytes, each grid's voxels counted, tiles
+// included) and its grid metadata checked first; then frame by frame the file
+// walked again down to its voxel buffers, read by OpenVDB, and its density,
+// temperature and velocity box-filtered onto one coarse lattice (see
+// splatfx/vdb.hpp for the filters and why the density filter preserves each
+// coarse cell's optical depth). OpenVDB throws; no exception leaves this file.
 #include "splatfx/vdb.hpp"
 
 #include <algorithm>
@@ -14,6 +16,8 @@
 #include <vector>
 
 #include <openvdb/openvdb.h>
+
+#include "vdb_file_check.hpp"
 
 namespace splatfx {
 namespace {
@@ -38,15 +42,13 @@ struct FrameInfo {
     std::string path;
     int frame = 0;
     openvdb::math::Transform::Ptr transform;
-    openvdb::CoordBBox densityBox;
-    bool hasMetaBox = false; // false: the file lacks OpenVDB's statistics metadata
+    openvdb::CoordBBox densityBox; // of the active voxels, tiles included (from the walk)
 };
 
-// Checks one grid's metadata: present, of the expected type, a fog volume,
-// within the voxel budget, not empty. `box` gets the file's bounding box.
+// Checks one grid's metadata: present, of the expected type, a fog volume.
 template <class GridT>
 Status checkGrid(const openvdb::GridPtrVec& grids, const std::string& path, int frame, const std::string& name, const char* typeWanted,
-                 const VdbImportDesc& desc, openvdb::GridBase::ConstPtr& found, openvdb::CoordBBox& box, bool& hasBox) {
+                 openvdb::GridBase::ConstPtr& found) {
     const std::string at = where(path, frame, name);
     std::string names;
     for (const auto& g : grids) {
@@ -57,18 +59,31 @@ Status checkGrid(const openvdb::GridPtrVec& grids, const std::string& path, int 
     if (!found) return makeError(at + "no such grid in the file (it has " + (names.empty() ? std::string("no grids") : names) + ")");
     if (!found->isType<GridT>()) return makeError(at + "holds " + found->valueType() + " values; expected a " + typeWanted + " grid");
     if (found->getGridClass() == openvdb::GRID_LEVEL_SET) return makeError(at + "is a level set (signed distances), not a density/fog volume");
-    const auto countMeta = found->getMetadata<openvdb::Int64Metadata>(openvdb::GridBase::META_FILE_VOXEL_COUNT);
-    const auto lo = found->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MIN);
-    const auto hi = found->getMetadata<openvdb::Vec3IMetadata>(openvdb::GridBase::META_FILE_BBOX_MAX);
-    hasBox = countMeta && lo && hi;
-    if (countMeta) {
-        const std::int64_t count = countMeta->value();
-        if (count <= 0) return makeError(at + "is empty (no active voxels)");
-        if (std::uint64_t(count) > desc.maxFileVoxels)
-            return makeError(at + "has " + std::to_string(count) + " active voxels (from the file's metadata; nothing was read); the limit is " +
-                             std::to_string(desc.maxFileVoxels) + " (VdbImportDesc::maxFileVoxels)");
-    }
-    if (hasBox) box = openvdb::CoordBBox(openvdb::Coord(lo->value()), openvdb::Coord(hi->value()));
+    return {};
+}
+
+// The walk's counts for one grid against the budgets; `total` adds up the
+// sequence's voxels so far.
+Status checkLayout(const vdbfile::GridLayout& g, const std::string& path, int frame, const VdbImportDesc& desc, std::uint64_t& total) {
+    const std::string at = where(path, frame, g.name);
+    // The metadata named the grid but its descriptor does not: OpenVDB would read another grid.
+    if (!g.found) return makeError(at + "is named in the grids' metadata but no grid descriptor has that name; the file is inconsistent");
+    if (!g.instanceOf.empty())
+        return makeError(at + "is an instance of grid '" + g.instanceOf + "' (it shares that grid's tree); instanced grids are not supported");
+    if (!g.supported) return makeError(at + "has tree type " + g.type + "; expected Tree_float_5_4_3 or Tree_vec3s_5_4_3");
+    if (g.activeVoxels == 0) return makeError(at + "is empty (no active voxels)");
+    if (g.activeVoxels > desc.maxFileVoxels)
+        return makeError(at + "has " + std::to_string(g.activeVoxels) + " active voxels (" + std::to_string(g.tileVoxels) +
+                         " of them in tiles; counted from the file's tree, no voxel value read); the limit is " + std::to_string(desc.maxFileVoxels) +
+                         " (VdbImportDesc::maxFileVoxels)");
+    if (g.treeBytes > desc.maxTreeBytes)
+        return makeError(at + "would take about " + std::to_string(g.treeBytes) +
+                         " bytes of memory in OpenVDB (estimated from the nodes of the file's tree before OpenVDB reads it); the limit is " +
+                         std::to_string(desc.maxTreeBytes) + " (VdbImportDesc::maxTreeBytes)");
+    total = g.activeVoxels > std::numeric_limits<std::uint64_t>::max() - total ? std::numeric_limits<std::uint64_t>::max() : total + g.activeVoxels;
+    if (total > desc.maxSequenceVoxels)
+        return makeError(at + "brings the voxels to expand to " + std::to_string(total) + " (tiles included, over the imported grids of frames " +
+                         "up to this one); the limit is " + std::to_string(desc.maxSequenceVoxels) + " (VdbImportDesc::maxSequenceVoxels)");
     return {};
 }
 
@@ -92,17 +107,18 @@ Status checkTransform(const openvdb::math::Transform& xf, const std::string& at,
     return {};
 }
 
-// Calls f(coord, value) for every active voxel of the grid, tiles expanded.
-template <class GridT, class F>
-void forEachActive(const GridT& grid, F&& f) {
+// Calls voxel(coord, value) for every active voxel of the grid and
+// tile(box, value) for every active tile: a tile is filled by region, never
+// voxel by voxel (a 128^3 tile is 2 million voxels).
+template <class GridT, class V, class T>
+void forEachActive(const GridT& grid, V&& voxel, T&& tile) {
     for (auto it = grid.cbeginValueOn(); it; ++it) {
         if (it.isVoxelValue()) {
-            f(it.getCoord(), *it);
+            voxel(it.getCoord(), *it);
         } else {
             openvdb::CoordBBox b;
             it.getBoundingBox(b);
-            const auto v = *it;
-            for (auto c = b.begin(); c; ++c) f(*c, v);
+            tile(b, *it);
         }
     }
 }
@@ -120,9 +136,37 @@ struct Lattice {
         if (x < 0 || y < 0 || z < 0 || x >= dims.x || y >= dims.y || z >= dims.z) return -1;
         return (std::int64_t(z) * dims.y + y) * dims.x + x;
     }
+
+    // Calls f(cell, voxels) for every cell the box of file voxels overlaps,
+    // with the number of the box's voxels inside that cell.
+    template <class F>
+    void forEachCell(const openvdb::CoordBBox& box, F&& f) const {
+        int from[3], to[3];
+        for (int a = 0; a < 3; ++a) {
+            from[a] = std::max(floorDiv(box.min()[a], factor) - lo[a], 0);
+            to[a] = std::min(floorDiv(box.max()[a], factor) - lo[a], (a == 0 ? dims.x : a == 1 ? dims.y : dims.z) - 1);
+            if (from[a] > to[a]) return;
+        }
+        auto overlap = [&](int a, int cell) {
+            const std::int64_t c0 = std::int64_t(cell + lo[a]) * factor, c1 = c0 + factor - 1;
+            return std::min<std::int64_t>(box.max()[a], c1) - std::max<std::int64_t>(box.min()[a], c0) + 1;
+        };
+        for (int z = from[2]; z <= to[2]; ++z)
+            for (int y = from[1]; y <= to[1]; ++y) {
+                const std::int64_t yz = overlap(1, y) * overlap(2, z);
+                for (int x = from[0]; x <= to[0]; ++x) f((std::int64_t(z) * dims.y + y) * dims.x + x, double(overlap(0, x) * yz));
+            }
+    }
 };
 
-Result<GridSequence> load(const std::vector<std::string>& paths, const std::vector<int>& frameNumbers, const VdbImportDesc& desc) {
+// The frame being checked or read, for a message when OpenVDB throws where it was not expected to.
+struct Current {
+    std::string path;
+    int frame = 0;
+};
+
+Result<GridSequence> loadFrames(const std::vector<std::string>& paths, const std::vector<int>& frameNumbers, const VdbImportDesc& desc,
+                                Current& cur) {
     if (desc.densityGrid.empty()) return makeError("VdbImportDesc::densityGrid is empty; name the density grid (e.g. \"density\")");
     if (desc.voxelsPerCell < 0) return makeError("VdbImportDesc::voxelsPerCell is " + std::to_string(desc.voxelsPerCell) + "; expected >= 0");
     if (desc.voxelsPerCell == 0 && desc.maxCellsPerAxis < 1)
@@ -138,15 +182,35 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
                          num(desc.temperatureHot) + " and " + num(desc.temperatureCold));
 
     openvdb::initialize();
+    std::vector<std::string> gridNames{desc.densityGrid};
+    if (!desc.temperatureGrid.empty()) gridNames.push_back(desc.temperatureGrid);
+    if (!desc.velocityGrid.empty()) gridNames.push_back(desc.velocityGrid);
+    std::uint64_t sequenceVoxels = 0;
+    // Pass 2's walk of one frame's file, down to the voxel buffers, with its counts checked again.
+    auto walkFrame = [&](const std::string& path, int frame, bool buffers) -> Status {
+        auto walked = vdbfile::walk(path, gridNames, buffers);
+        if (!walked)
+            return makeError("OpenVDB file '" + path + "' (frame " + std::to_string(frame) + "): refused before OpenVDB reads it: " + walked.error());
+        std::uint64_t total = 0;
+        for (const vdbfile::GridLayout& g : *walked)
+            if (Status s = checkLayout(g, path, frame, desc, total); !s) return s;
+        return {};
+    };
+
     std::vector<FrameInfo> infos;
-    // Pass 1: metadata only, every frame, so a bad frame 200 fails before frame 1's voxels are read.
+    // Pass 1: every frame's structure, voxel counts and metadata, so a bad frame 200 fails
+    // before frame 1's voxels are read. Only what is needed for the lattice is kept.
     for (std::size_t i = 0; i < paths.size(); ++i) {
         FrameInfo fi;
         fi.path = paths[i];
         fi.frame = frameNumbers[i];
+        cur = {fi.path, fi.frame};
         const std::string fileAt = "OpenVDB file '" + fi.path + "' (frame " + std::to_string(fi.frame) + "): ";
         std::error_code ec;
         if (!std::filesystem::is_regular_file(fi.path, ec)) return makeError(fileAt + "no such file");
+        auto walked = vdbfile::walk(fi.path, gridNames, false);
+        if (!walked) return makeError(fileAt + "refused before OpenVDB reads it: " + walked.error());
+        const std::vector<vdbfile::GridLayout> layouts = std::move(*walked);
         openvdb::GridPtrVecPtr grids;
         try {
             openvdb::io::File file(fi.path);
@@ -155,22 +219,16 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
             file.close();
         } catch (const std::exception& e) { return makeError(fileAt + "cannot be read as OpenVDB: " + e.what()); }
         openvdb::GridBase::ConstPtr density, temperature, velocity;
-        openvdb::CoordBBox unusedBox;
-        bool unusedHas = false;
-        if (Status s =
-                checkGrid<openvdb::FloatGrid>(*grids, fi.path, fi.frame, desc.densityGrid, "float", desc, density, fi.densityBox, fi.hasMetaBox);
-            !s)
-            return makeError(s.error());
+        if (Status s = checkGrid<openvdb::FloatGrid>(*grids, fi.path, fi.frame, desc.densityGrid, "float", density); !s) return makeError(s.error());
         if (!desc.temperatureGrid.empty())
-            if (Status s =
-                    checkGrid<openvdb::FloatGrid>(*grids, fi.path, fi.frame, desc.temperatureGrid, "float", desc, temperature, unusedBox, unusedHas);
-                !s)
+            if (Status s = checkGrid<openvdb::FloatGrid>(*grids, fi.path, fi.frame, desc.temperatureGrid, "float", temperature); !s)
                 return makeError(s.error());
         if (!desc.velocityGrid.empty())
-            if (Status s = checkGrid<openvdb::Vec3SGrid>(*grids, fi.path, fi.frame, desc.velocityGrid, "vec3s (float vector)", desc, velocity,
-                                                         unusedBox, unusedHas);
-                !s)
+            if (Status s = checkGrid<openvdb::Vec3SGrid>(*grids, fi.path, fi.frame, desc.velocityGrid, "vec3s (float vector)", velocity); !s)
                 return makeError(s.error());
+        for (const vdbfile::GridLayout& g : layouts)
+            if (Status s = checkLayout(g, fi.path, fi.frame, desc, sequenceVoxels); !s) return makeError(s.error());
+        fi.densityBox = layouts[0].activeBox;
         fi.transform = density->transform().copy();
         double vs = 0.0;
         openvdb::Vec3d origin;
@@ -190,13 +248,15 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
         infos.push_back(std::move(fi));
     }
 
-    // Pass 2: read each frame, then resample. Files without statistics
-    // metadata have their boxes and voxel counts checked right after reading.
+    // Pass 2, frame by frame: the file walked again, down to the voxel buffers OpenVDB is
+    // about to read (the checks of pass 1 repeated, in case the file changed), then read,
+    // resampled, and let go before the next frame.
     struct Loaded {
         openvdb::FloatGrid::ConstPtr density, temperature;
         openvdb::Vec3SGrid::ConstPtr velocity;
     };
     auto readFrame = [&](const FrameInfo& fi, Loaded& out) -> Status {
+        if (Status s = walkFrame(fi.path, fi.frame, true); !s) return s;
         try {
             openvdb::io::File file(fi.path);
             file.open(false);
@@ -211,27 +271,12 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
         if (!out.density) return makeError(at + "could not be read as a float grid");
         if (out.density->background() != 0.0f)
             return makeError(at + "has background " + num(out.density->background()) + "; a density grid's empty space must be 0");
-        if (!fi.hasMetaBox) {
-            const openvdb::Index64 count = out.density->activeVoxelCount();
-            if (count == 0) return makeError(at + "is empty (no active voxels)");
-            if (count > desc.maxFileVoxels)
-                return makeError(at + "has " + std::to_string(count) + " active voxels; the limit is " + std::to_string(desc.maxFileVoxels) +
-                                 " (VdbImportDesc::maxFileVoxels; the file had no voxel-count metadata, so this was found after reading)");
-        }
         return {};
     };
 
     // The lattice: the union of the frames' density boxes, in blocks of `factor` voxels.
-    std::vector<Loaded> early(infos.size());
     openvdb::CoordBBox unionBox;
-    for (std::size_t i = 0; i < infos.size(); ++i) {
-        FrameInfo& fi = infos[i];
-        if (!fi.hasMetaBox) {
-            if (Status s = readFrame(fi, early[i]); !s) return makeError(s.error());
-            fi.densityBox = early[i].density->evalActiveVoxelBoundingBox();
-        }
-        unionBox.expand(fi.densityBox);
-    }
+    for (const FrameInfo& fi : infos) unionBox.expand(fi.densityBox);
     Lattice lat;
     {
         openvdb::Vec3d origin;
@@ -285,23 +330,49 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
 
     for (std::size_t i = 0; i < infos.size(); ++i) {
         const FrameInfo& fi = infos[i];
-        Loaded g = std::move(early[i]);
-        if (!g.density)
-            if (Status s = readFrame(fi, g); !s) return makeError(s.error());
+        cur = {fi.path, fi.frame};
+        Loaded g;
+        if (Status s = readFrame(fi, g); !s) return makeError(s.error());
         GridSequenceFrame frame;
         std::vector<double> sum(n, 0.0), sumT(n, 0.0);
         auto tAcc = g.temperature ? std::make_unique<openvdb::FloatGrid::ConstAccessor>(g.temperature->getConstAccessor()) : nullptr;
         bool negative = false;
-        forEachActive(*g.density, [&](const openvdb::Coord& c, float d) {
-            const std::int64_t k = lat.cellOf(c);
-            if (k < 0 || d == 0.0f) return;
-            if (!(d >= 0.0f) || !std::isfinite(d)) {
-                negative = true;
-                return;
-            }
-            sum[std::size_t(k)] += d;
-            if (tAcc) sumT[std::size_t(k)] += double(d) * double(tAcc->getValue(c));
-        });
+        auto bad = [&](float d) { return !(d >= 0.0f) || !std::isfinite(d); };
+        forEachActive(
+            *g.density,
+            [&](const openvdb::Coord& c, float d) {
+                const std::int64_t k = lat.cellOf(c);
+                if (k < 0 || d == 0.0f) return;
+                if (bad(d)) return void(negative = true);
+                sum[std::size_t(k)] += d;
+                if (tAcc) sumT[std::size_t(k)] += double(d) * double(tAcc->getValue(c));
+            },
+            [&](const openvdb::CoordBBox& box, float d) {
+                if (d == 0.0f) return;
+                if (bad(d)) return void(negative = true);
+                if (!tAcc) return lat.forEachCell(box, [&](std::int64_t k, double count) { sum[std::size_t(k)] += d * count; });
+                // The temperature varies inside the tile only where it has leaves (8^3 voxels,
+                // aligned to 8 as every tile is): per voxel there, per 8^3 block elsewhere.
+                for (int z = box.min().z(); z <= box.max().z(); z += 8)
+                    for (int y = box.min().y(); y <= box.max().y(); y += 8)
+                        for (int x = box.min().x(); x <= box.max().x(); x += 8) {
+                            const openvdb::Coord o(x, y, z);
+                            if (const auto* leaf = tAcc->probeConstLeaf(o)) {
+                                for (auto c = leaf->getNodeBoundingBox().begin(); c; ++c) {
+                                    const std::int64_t k = lat.cellOf(*c);
+                                    if (k < 0) continue;
+                                    sum[std::size_t(k)] += d;
+                                    sumT[std::size_t(k)] += double(d) * double(leaf->getValue(*c));
+                                }
+                            } else {
+                                const double t = tAcc->getValue(o);
+                                lat.forEachCell(openvdb::CoordBBox(o, o.offsetBy(7)), [&](std::int64_t k, double count) {
+                                    sum[std::size_t(k)] += d * count;
+                                    sumT[std::size_t(k)] += double(d) * t * count;
+                                });
+                            }
+                        }
+            });
         if (negative)
             return makeError(where(fi.path, fi.frame, desc.densityGrid) + "holds negative, NaN or infinite densities; expected finite values >= 0");
         frame.opticalDepth.resize(n);
@@ -322,14 +393,20 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
         if (g.velocity) {
             const openvdb::Vec3s bg = g.velocity->background();
             std::vector<glm::dvec3> v(n, glm::dvec3(0.0));
-            bool bad = false;
-            forEachActive(*g.velocity, [&](const openvdb::Coord& c, const openvdb::Vec3s& u) {
-                const std::int64_t k = lat.cellOf(c);
-                if (k < 0) return;
-                if (!std::isfinite(u[0]) || !std::isfinite(u[1]) || !std::isfinite(u[2])) bad = true;
-                v[std::size_t(k)] += glm::dvec3(u[0] - bg[0], u[1] - bg[1], u[2] - bg[2]);
-            });
-            if (bad) return makeError(where(fi.path, fi.frame, desc.velocityGrid) + "holds NaN or infinite velocities");
+            bool nonFinite = false;
+            auto add = [&](std::int64_t k, const openvdb::Vec3s& u, double count) {
+                if (!std::isfinite(u[0]) || !std::isfinite(u[1]) || !std::isfinite(u[2])) nonFinite = true;
+                v[std::size_t(k)] += count * glm::dvec3(u[0] - bg[0], u[1] - bg[1], u[2] - bg[2]);
+            };
+            forEachActive(
+                *g.velocity,
+                [&](const openvdb::Coord& c, const openvdb::Vec3s& u) {
+                    if (const std::int64_t k = lat.cellOf(c); k >= 0) add(k, u, 1.0);
+                },
+                [&](const openvdb::CoordBBox& box, const openvdb::Vec3s& u) {
+                    lat.forEachCell(box, [&](std::int64_t k, double count) { add(k, u, count); });
+                });
+            if (nonFinite) return makeError(where(fi.path, fi.frame, desc.velocityGrid) + "holds NaN or infinite velocities");
             // World units (or file voxels) per second to lattice cells per second.
             const double unit = desc.velocityUnit == VdbImportDesc::VelocityUnit::VoxelsPerSec ? lat.voxelSize : 1.0;
             const double toCells = double(desc.velocityScale) * unit / cellWorld;
@@ -360,6 +437,15 @@ Result<GridSequence> load(const std::vector<std::string>& paths, const std::vect
     }
     if (Status s = seq.validate(); !s) return makeError("OpenVDB import of '" + infos[0].path + "': " + s.error());
     return seq;
+}
+
+// OpenVDB throws from more places than its readers (a transform whose matrix is singular
+// throws when its affine map is asked for): no exception leaves the importer.
+Result<GridSequence> load(const std::vector<std::string>& paths, const std::vector<int>& frameNumbers, const VdbImportDesc& desc) {
+    Current cur;
+    try {
+        return loadFrames(paths, frameNumbers, desc, cur);
+    } catch (const std::exception& e) { return makeError("OpenVDB file '" + cur.path + "' (frame " + std::to_string(cur.frame) + "): " + e.what()); }
 }
 
 } // namespace
