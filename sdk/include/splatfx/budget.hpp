@@ -52,6 +52,27 @@ struct Budgets {
     // hang or allocate without bound is an error. Defaults 4 GiB and 60 s.
     std::uint64_t meshImportBytes = 4ull << 30;
     std::uint64_t meshImportSeconds = 60;
+    // Bytes of GLSL a scene's fog terms generate (fogGlsl's source less the
+    // closed forms every fog shares). Every pass that fogs compiles it, and
+    // the compile time grows faster than the size (docs/fog.md, "What a fog
+    // costs"): the default keeps the first frame's compile within seconds on
+    // a software GL. Default 2^16 (64 KiB).
+    std::uint64_t fogShaderBytes = 1ull << 16;
+    // Vertices of one heightmap geometry's mesh (the image's width x height,
+    // read from its header before it is decoded); a host's mesh costs about
+    // 100 bytes a vertex (positions, normals, indices, the GL's copy).
+    // Default 2 * 10^7 (a 4097^2 heightmap fits).
+    std::uint64_t heightmapVertices = 20'000'000;
+    // Bytes of a scene's shadow tables: every light x every table-lit
+    // effect's self-shadowing table, plus the scene shadow, each at
+    // ShadowTable::memoryBytes (17 bytes an entry). Default 1 GiB.
+    std::uint64_t lightingBytes = 1ull << 30;
+    // Bytes of a scene's volumes (clouds and ground fog), summed: what each
+    // keeps (LodVolume::bytesFor, GroundFog::bytesFor, its pre-integration
+    // table) plus the tetrahedra one frame emits when fully refined (the
+    // worst a camera can ask for), at what the frame and the GL pass hold
+    // for each. Default 2 GiB.
+    std::uint64_t volumeBytes = 2ull << 30;
 };
 
 // The fields by name, in declaration order, for messages and command lines.
