@@ -53,11 +53,12 @@ struct Budgets {
     std::uint64_t meshImportBytes = 4ull << 30;
     std::uint64_t meshImportSeconds = 60;
     // Bytes of GLSL a scene's fog terms generate (fogGlsl's source less the
-    // closed forms every fog shares). Every pass that fogs compiles it, and
-    // the compile time grows faster than the size (docs/fog.md, "What a fog
-    // costs"): the default keeps the first frame's compile within seconds on
-    // a software GL. Default 2^16 (64 KiB).
-    std::uint64_t fogShaderBytes = 1ull << 16;
+    // closed forms every fog shares): polynomials are generated code (about
+    // 1.7 KB a degree-9 term), cosines and potentials one loop each whatever
+    // their count. Every pass that fogs compiles it, in time growing faster
+    // than its size (docs/fog.md, "What a fog's shader costs"). Default 2^15
+    // (32 KiB, about 18 degree-9 polynomial terms).
+    std::uint64_t fogShaderBytes = 1ull << 15;
     // Vertices of one heightmap geometry's mesh (the image's width x height,
     // read from its header before it is decoded); a host's mesh costs about
     // 100 bytes a vertex (positions, normals, indices, the GL's copy).
