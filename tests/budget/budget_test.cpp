@@ -37,5 +37,5 @@ TEST(Budget, EveryNamedFieldCanBeSet) {
         Budgets b;
         EXPECT_TRUE(setBudget(b, name + "=1")) << name;
     }
-    EXPECT_EQ(budgetNames().size(), 8u);
+    EXPECT_EQ(budgetNames().size(), 12u);
 }

@@ -179,3 +179,21 @@ TEST(SceneHostHeightmap, SamplesBecomeGridPointsFacingUp) {
     ASSERT_FALSE(thin);
     EXPECT_NE(thin.error().find("at least 2x2"), std::string::npos) << thin.error();
 }
+
+// A heightmap's mesh is budgeted from the image header before it is decoded:
+// a few bytes claiming 8192^2 samples (6.5-8 GB as a mesh) are refused, and
+// a lowered budget refuses a real image by the same rule.
+TEST(SceneHostHeightmap, AHeightmapOverItsVertexBudgetIsRefusedFromItsHeader) {
+    auto huge = scenehost::heightmapMesh(writeFile("heightmap_huge.pgm", "P5\n8192 8192\n255\n" + std::string(8192, '\1')), 1.0f, 1.0f);
+    ASSERT_FALSE(huge);
+    EXPECT_NE(huge.error().find("(8192x8192) as a mesh needs 67108864 vertices, over the budget of 20000000 (raise Budgets::heightmapVertices)"),
+              std::string::npos)
+        << huge.error();
+    const std::string small = writeFile("heightmap_3x2.pgm", "P5\n3 2\n255\n" + std::string(6, '\7'));
+    ASSERT_TRUE(scenehost::heightmapMesh(small, 1.0f, 1.0f));
+    splatfx::Budgets low;
+    low.heightmapVertices = 5;
+    auto refused = scenehost::heightmapMesh(small, 1.0f, 1.0f, low);
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().find("needs 6 vertices, over the budget of 5"), std::string::npos) << refused.error();
+}

@@ -172,3 +172,24 @@ TEST_F(SamplesGL, LodGroundFogTerrainIsTheHostsTerrain) {
     EXPECT_EQ(player->file().scene.groundFogTerrain(id), tris);
     EXPECT_LT(tris.size() / 3, 2u * 200u * 170u) << "the 201x171 heightmap at full resolution";
 }
+
+// A lighting failure while rendering (here a table no Scene can build, set
+// through the API after loading) is the player's problem(), which
+// splatfx-render turns into exit 1 and the viewer shows: never a frame
+// passed off as lit.
+TEST_F(SamplesGL, ALightingFailureIsThePlayersProblemNotASilentlyUnlitFrame) {
+    const std::string text = R"({"format": "splatfx-scene", "version": 1,
+      "camera": {"position": [0, 2, 8], "target": [0, 1, 0]},
+      "lights": [{"type": "directional"}],
+      "effects": [{"kind": "fire", "name": "lit", "dims": [7, 12, 5], "spacing": 0.3, "lighting": {"tableDims": 16}}]})";
+    auto player = scenehost::ScenePlayer::fromText(text, "lit-test.json");
+    ASSERT_TRUE(player.ok()) << player.error();
+    player->advance(1.0, player->cameraAt(1.0, {64, 48}));
+    EXPECT_EQ(player->problem(), "") << "a lit effect within its budgets";
+    splatfx::EffectLighting l = player->file().scene.options(player->file().effects[0].id).lighting;
+    l.tableDims = glm::ivec3(256);
+    player->file().scene.setLighting(player->file().effects[0].id, l);
+    player->advance(1.1, player->cameraAt(1.1, {64, 48}));
+    EXPECT_NE(player->problem().find("effect 'lit': lighting.tableDims: "), std::string::npos) << player->problem();
+    EXPECT_NE(player->problem().find("over ShadowTableDesc.memoryBudgetBytes"), std::string::npos) << player->problem();
+}

@@ -152,7 +152,8 @@ int parse(int argc, char** argv, Args& a) {
                    if (auto st = splatfx::setBudget(a.budgets, text); !st) throw CLI::ValidationError("--budget: " + st.error());
            },
            "raise (or lower) one of the loader's budgets (splatfx/budget.hpp; repeatable): effectCells, solverCells, sampledTexels, "
-           "textureLayers, meshElements, meshFileBytes, meshImportBytes, meshImportSeconds")
+           "textureLayers, meshElements, meshFileBytes, meshImportBytes, meshImportSeconds, fogShaderBytes, heightmapVertices, "
+           "lightingBytes, volumeBytes")
         ->type_name("NAME=N")
         ->expected(1)
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
@@ -402,6 +403,7 @@ static int renderMain(int argc, char** argv) {
             // them as a full run does (same times, same cameras), undrawn.
             const auto r0 = Clock::now();
             if (auto st = player->advance(t, player->cameraAt(t, size), {.traditional = a.traditional}); !st) return fail(st.error());
+            if (!player->problem().empty()) return fail("frame " + std::to_string(i) + ": " + player->problem() + "; no output kept");
             replayMs += std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
             ++replayed;
             continue;
@@ -410,6 +412,8 @@ static int renderMain(int argc, char** argv) {
         if (written == a.abortAfter) return fail("aborted on purpose after " + std::to_string(written) + " frames (--abort-after); no output kept");
         const auto f0 = Clock::now();
         if (auto st = player->renderFrame(t, player->cameraAt(t, size), fb->handle(), {.traditional = a.traditional}); !st) return fail(st.error());
+        // Lighting, shadows or a terrain the frame lost: never published as if complete.
+        if (!player->problem().empty()) return fail("frame " + std::to_string(i) + ": " + player->problem() + "; no output kept");
         splatfx::Image img = fb->read();
         // Every fallback of the frame renderer, said once, as it happens (FrameRenderStats::notes).
         for (const std::string& note : player->renderer().stats().notes)

@@ -109,7 +109,10 @@ struct GeometryRenderer::Impl {
         if (transparentProgram) glDeleteProgram(transparentProgram);
     }
     // (Re)places an object's buffers: interleaved position + normal, triangle indices.
-    static void upload(Object& o, const std::vector<float>& interleaved, const std::vector<std::uint32_t>& indices) {
+    // Fails when the GL cannot store the buffers (GL_OUT_OF_MEMORY): the
+    // object would otherwise vanish from every frame without a word.
+    static splatfx::Status upload(Object& o, const std::vector<float>& interleaved, const std::vector<std::uint32_t>& indices) {
+        while (glGetError() != GL_NO_ERROR) {}
         glDeleteBuffers(1, &o.vbo);
         glDeleteBuffers(1, &o.ibo);
         if (!o.vao) glCreateVertexArrays(1, &o.vao);
@@ -125,6 +128,13 @@ struct GeometryRenderer::Impl {
             glVertexArrayAttribBinding(o.vao, a, 0);
         }
         o.indexCount = GLsizei(indices.size());
+        if (const GLenum e = glGetError(); e != GL_NO_ERROR) {
+            o.indexCount = 0;
+            return splatfx::makeError("the GL could not store its mesh of " + std::to_string(interleaved.size() / 6) + " vertices and " +
+                                      std::to_string(indices.size() / 3) + " triangles (" +
+                                      (e == GL_OUT_OF_MEMORY ? std::string("GL_OUT_OF_MEMORY") : "GL error " + std::to_string(e)) + ")");
+        }
+        return {};
     }
 };
 
@@ -167,7 +177,7 @@ splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<spl
             break;
         }
         case splatfx::GeometryType::Heightmap: {
-            splatfx::Result<Mesh> m = heightmapMesh(g.heightmapPath, g.heightmapSpacing, g.heightmapScale);
+            splatfx::Result<Mesh> m = heightmapMesh(g.heightmapPath, g.heightmapSpacing, g.heightmapScale, budgets);
             if (!m) return splatfx::makeError("geometry '" + g.name + "': " + m.error());
             mesh = std::move(*m);
             break;
@@ -180,7 +190,7 @@ splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<spl
             const glm::vec3 p = mesh.positions[i], n = mesh.normals[i];
             interleaved.insert(interleaved.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
         }
-        Impl::upload(o, interleaved, mesh.indices);
+        if (auto s = Impl::upload(o, interleaved, mesh.indices); !s) return splatfx::makeError("geometry '" + g.name + "': " + s.error());
         impl->objects.push_back(std::move(o));
     }
     return GeometryRenderer(std::move(impl));
@@ -200,7 +210,7 @@ long GeometryRenderer::find(const std::string& name) const {
     return -1;
 }
 
-void GeometryRenderer::setWorldTriangles(std::size_t i, const std::vector<glm::vec3>& triangles) {
+splatfx::Status GeometryRenderer::setWorldTriangles(std::size_t i, const std::vector<glm::vec3>& triangles) {
     Impl::Object& o = mImpl->objects.at(i);
     // Corners are welded by exact position so triangles that meet share a smooth normal, as on
     // the heightmap mesh this replaces (the LOD terrain is conforming: corners that meet are
@@ -235,8 +245,9 @@ void GeometryRenderer::setWorldTriangles(std::size_t i, const std::vector<glm::v
         interleaved.insert(interleaved.end(), {p.x, p.y, p.z, n.x, n.y, n.z});
         o.localBounds.extend(p);
     }
-    Impl::upload(o, interleaved, welded.indices);
     o.worldSpace = true;
+    if (auto s = Impl::upload(o, interleaved, welded.indices); !s) return splatfx::makeError("geometry '" + o.desc.name + "': " + s.error());
+    return {};
 }
 
 splatfx::Aabb GeometryRenderer::worldBounds(std::size_t i, double t) const {

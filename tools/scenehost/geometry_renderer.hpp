@@ -66,8 +66,9 @@ public:
     // [issue 17] Replaces object i's mesh by world-space triangles (3 points
     // each, e.g. a LOD ground fog's terrain: GroundFog::update), drawn with
     // smooth normals (corners welded by position) and no placement or motion
-    // from then on. Expects i < the object count.
-    void setWorldTriangles(std::size_t i, const std::vector<glm::vec3>& triangles);
+    // from then on. Expects i < the object count. Fails when the GL cannot
+    // store the mesh (the object then draws nothing).
+    splatfx::Status setWorldTriangles(std::size_t i, const std::vector<glm::vec3>& triangles);
     // Index of the object named `name`, or -1.
     long find(const std::string& name) const;
 

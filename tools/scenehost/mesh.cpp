@@ -370,7 +370,14 @@ splatfx::Result<Mesh> loadMesh(const std::string& path, const splatfx::Budgets& 
     return out;
 }
 
-splatfx::Result<Mesh> heightmapMesh(const std::string& path, float spacing, float heightScale) {
+splatfx::Result<Mesh> heightmapMesh(const std::string& path, float spacing, float heightScale, const splatfx::Budgets& budgets) {
+    auto info = splatfx::readImageInfo(path);
+    if (!info) return splatfx::makeError(info.error());
+    const std::uint64_t vertices = std::uint64_t(info->width) * std::uint64_t(info->height);
+    if (auto s = splatfx::checkBudget(path + " (" + std::to_string(info->width) + "x" + std::to_string(info->height) + ") as a mesh", vertices,
+                                      "vertices", budgets.heightmapVertices, "heightmapVertices");
+        !s)
+        return splatfx::makeError(s.error());
     auto img = splatfx::readImage(path, splatfx::Alpha::Straight);
     if (!img) return splatfx::makeError(img.error());
     const int w = img->width, h = img->height;

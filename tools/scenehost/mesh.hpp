@@ -39,7 +39,9 @@ struct Mesh {
 splatfx::Result<Mesh> loadMesh(const std::string& path, const splatfx::Budgets& budgets = {});
 // A terrain grid from an image's channel 0 (splatfx::heightmapPoint
 // for each sample, two triangles a cell, facing +y). Errors name the file.
-splatfx::Result<Mesh> heightmapMesh(const std::string& path, float spacing, float heightScale);
+// An image of more samples than budgets.heightmapVertices is refused from its
+// header, before it is decoded.
+splatfx::Result<Mesh> heightmapMesh(const std::string& path, float spacing, float heightScale, const splatfx::Budgets& budgets = {});
 // Scaled so the largest bounding-box side is `size`, centred on x and z, resting on y = 0.
 Mesh fitted(const Mesh& mesh, float size);
 // Area-weighted vertex normals from the triangles.

@@ -25,6 +25,7 @@ struct ScenePlayer::Impl {
     std::vector<LodTerrain> lodTerrain;
     splatfx::LodFrame scratch;
     std::vector<glm::vec3> terrain;
+    std::string problem; // problem()
 };
 
 namespace {
@@ -109,6 +110,7 @@ splatfx::SceneFile& ScenePlayer::file() { return *mImpl->file; }
 const splatfx::SceneFile& ScenePlayer::file() const { return *mImpl->file; }
 const splatfx::Materials& ScenePlayer::materials() const { return mImpl->materials; }
 const FrameStats& ScenePlayer::stats() const { return mImpl->stats; }
+const std::string& ScenePlayer::problem() const { return mImpl->problem; }
 GeometryRenderer& ScenePlayer::geometry() { return *mImpl->geometry; }
 
 splatfx::Camera ScenePlayer::cameraAt(double t, glm::ivec2 viewport) const { return evaluate(mImpl->file->camera, t, viewport); }
@@ -123,6 +125,7 @@ splatfx::Status ScenePlayer::advance(double t, const splatfx::Camera& camera, co
         !st)
         return st;
     s.prepareMs = msSince(t0);
+    p.problem = f.scene.lightingError();
     s.renderMs = 0.0;
     s.counters = p.frame.counters();
     s.splatsPerEffect.assign(f.effects.size(), 0);
@@ -146,14 +149,16 @@ splatfx::Status ScenePlayer::renderFrame(double t, const splatfx::Camera& camera
         if (!options.drawGeometry) continue;
         const splatfx::GroundFog* layer = f.scene.findGroundFog(t.fog);
         const std::vector<glm::vec3>& kept = f.scene.groundFogTerrain(t.fog);
+        splatfx::Status set;
         if (f.scene.options(t.fog).enabled && !kept.empty()) {
-            p.geometry->setWorldTriangles(t.object, kept);
+            set = p.geometry->setWorldTriangles(t.object, kept);
             t.meshSet = true;
         } else if ((!f.scene.options(t.fog).enabled || !t.meshSet) && layer &&
                    layer->update(camera, f.scene.options(t.fog).refine, p.scratch, &p.terrain)) {
-            p.geometry->setWorldTriangles(t.object, p.terrain);
+            set = p.geometry->setWorldTriangles(t.object, p.terrain);
             t.meshSet = true;
         }
+        if (!set && p.problem.empty()) p.problem = set.error();
     }
 
     // This host's opaque pass: background, then geometry with depth writes.

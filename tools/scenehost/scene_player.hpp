@@ -71,6 +71,11 @@ public:
     // frame is the state a full run has there; the GL side caches only by
     // content version, so skipping its draws changes nothing drawn later.
     splatfx::Status advance(double timeSec, const splatfx::Camera& camera, const FrameOptions& options = {});
+    // What the last advance() or renderFrame() could not do, or empty: a
+    // lighting or shadow failure (Scene::lightingError: effects drawn unlit,
+    // no scene shadow), or a terrain mesh the GL could not store. The frame
+    // was drawn without it; a tool must not pass it off as complete.
+    const std::string& problem() const;
 
     splatfx::SceneFile& file();
     const splatfx::SceneFile& file() const;

@@ -242,6 +242,12 @@ struct Viewer {
         ImGui::Text("voxels: %llu   splats: %llu", (unsigned long long)s.voxels, (unsigned long long)s.splats);
         ImGui::Text("prepare %.2f ms  render %.2f ms", fs.prepareMs, fs.renderMs);
         if (!error.empty()) ImGui::TextColored(ImVec4(1, 0.4f, 0.3f, 1), "%s", error.c_str());
+        // Lighting, shadows or a terrain this frame is drawn without (ScenePlayer::problem).
+        if (player && !player->problem().empty()) {
+            ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.4f, 0.3f, 1));
+            ImGui::TextWrapped("drawn without: %s", player->problem().c_str());
+            ImGui::PopStyleColor();
+        }
         // What the frame renderer could not do as asked (FrameRenderStats::notes): said where the user looks.
         if (player)
             for (const std::string& note : player->renderer().stats().notes) {

@@ -52,6 +52,28 @@ struct Budgets {
     // hang or allocate without bound is an error. Defaults 4 GiB and 60 s.
     std::uint64_t meshImportBytes = 4ull << 30;
     std::uint64_t meshImportSeconds = 60;
+    // Bytes of GLSL a scene's fog terms generate (fogGlsl's source less the
+    // closed forms every fog shares): polynomials are generated code (about
+    // 1.7 KB a degree-9 term), cosines and potentials one loop each whatever
+    // their count. Every pass that fogs compiles it, in time growing faster
+    // than its size (docs/fog.md, "What a fog's shader costs"). Default 2^15
+    // (32 KiB, about 18 degree-9 polynomial terms).
+    std::uint64_t fogShaderBytes = 1ull << 15;
+    // Vertices of one heightmap geometry's mesh (the image's width x height,
+    // read from its header before it is decoded); a host's mesh costs about
+    // 100 bytes a vertex (positions, normals, indices, the GL's copy).
+    // Default 2 * 10^7 (a 4097^2 heightmap fits).
+    std::uint64_t heightmapVertices = 20'000'000;
+    // Bytes of a scene's shadow tables: every light x every table-lit
+    // effect's self-shadowing table, plus the scene shadow, each at
+    // ShadowTable::memoryBytes (17 bytes an entry). Default 1 GiB.
+    std::uint64_t lightingBytes = 1ull << 30;
+    // Bytes of a scene's volumes (clouds and ground fog), summed: what each
+    // keeps (LodVolume::bytesFor, GroundFog::bytesFor, its pre-integration
+    // table) plus the tetrahedra one frame emits when fully refined (the
+    // worst a camera can ask for), at what the frame and the GL pass hold
+    // for each. Default 2 GiB.
+    std::uint64_t volumeBytes = 2ull << 30;
 };
 
 // The fields by name, in declaration order, for messages and command lines.

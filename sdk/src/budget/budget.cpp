@@ -14,6 +14,8 @@ constexpr Field kFields[] = {
     {"sampledTexels", &Budgets::sampledTexels},     {"textureLayers", &Budgets::textureLayers},
     {"meshElements", &Budgets::meshElements},       {"meshFileBytes", &Budgets::meshFileBytes},
     {"meshImportBytes", &Budgets::meshImportBytes}, {"meshImportSeconds", &Budgets::meshImportSeconds},
+    {"fogShaderBytes", &Budgets::fogShaderBytes},   {"heightmapVertices", &Budgets::heightmapVertices},
+    {"lightingBytes", &Budgets::lightingBytes},     {"volumeBytes", &Budgets::volumeBytes},
 };
 
 } // namespace

@@ -189,7 +189,9 @@ std::vector<glm::vec4> Fog::glslParameters(double tSec, glm::dvec3 reference) co
     for (const auto& p : fr.pots) {
         out.push_back({glm::vec3(p.qRel), float(p.c)});
         out.push_back({glm::vec3(p.axis), float(p.d)});
-        out.push_back({float(p.weight), float(p.radius2), 0.0f, 0.0f});
+        // z: the kind the shader's loop branches on (0 point, 1 line, 2 sphere).
+        const float kind = p.kind == FogTermKind::Line ? 1.0f : p.kind == FogTermKind::Sphere ? 2.0f : 0.0f;
+        out.push_back({float(p.weight), float(p.radius2), kind, 0.0f});
     }
     return out;
 }
@@ -304,28 +306,24 @@ Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& opt) {
          "    vec3 e = seg / L;\n"
          "    float total = " +
          P + "_params[0].x * L;\n";
-    for (size_t j = 0; j < fr.waves.size(); ++j) {
-        const std::string w = P + "_params[" + std::to_string(1 + 2 * j) + "]";
-        const std::string a = P + "_params[" + std::to_string(2 + 2 * j) + "].x";
-        s += "    total += " + a + " * L * cos(dot(" + w + ".xyz, 0.5 * (oRel + pRel)) + " + w + ".w) * " + P + "_sinc(0.5 * dot(" + w +
-             ".xyz, seg));\n";
-    }
+    // Cosines and potentials are one loop each over their parameters (the
+    // kind of a potential is a parameter too), so the shader does not grow
+    // with their count: only polynomials are generated code.
+    if (!fr.waves.empty())
+        s += "    for (int j = 0; j < " + std::to_string(fr.waves.size()) + "; ++j) {\n        vec4 w = " + P +
+             "_params[1 + 2 * j];\n        total += " + P + "_params[2 + 2 * j].x * L * cos(dot(w.xyz, 0.5 * (oRel + pRel)) + w.w) * " + P +
+             "_sinc(0.5 * dot(w.xyz, seg));\n    }\n";
     for (size_t j = 0; j < fr.polys.size(); ++j) s += "    total += " + P + "_poly" + std::to_string(j) + "_integral(oRel, pRel, L);\n";
-    for (size_t j = 0; j < fr.pots.size(); ++j) {
-        const auto& p = fr.pots[j];
-        const std::string q = P + "_params[" + std::to_string(base) + "]";
-        const std::string ax = P + "_params[" + std::to_string(base + 1) + "]";
-        const std::string wr = P + "_params[" + std::to_string(base + 2) + "]";
-        s += "    { vec3 v = oRel - " + q + ".xyz;\n";
-        if (p.kind == FogTermKind::Point) s += "      total += " + wr + ".x * " + P + "_inv_quadratic(v, e, L, " + q + ".w, " + ax + ".w); }\n";
-        else if (p.kind == FogTermKind::Line)
-            s += "      vec3 a = " + ax +
-                 ".xyz;\n"
-                 "      total += " +
-                 wr + ".x * " + P + "_inv_quadratic(v - dot(v, a) * a, e - dot(e, a) * a, L, " + q + ".w, " + ax + ".w); }\n";
-        else s += "      total += " + wr + ".x * " + P + "_sphere(v, e, L, " + q + ".w, " + ax + ".w, " + wr + ".y); }\n";
-        base += 3;
-    }
+    if (!fr.pots.empty())
+        s += "    for (int j = 0; j < " + std::to_string(fr.pots.size()) + "; ++j) {\n        int b = " + std::to_string(base) +
+             " + 3 * j;\n        vec4 q = " + P + "_params[b], ax = " + P + "_params[b + 1], wr = " + P +
+             "_params[b + 2];\n"
+             "        vec3 v = oRel - q.xyz;\n"
+             "        if (wr.z == 1.0) total += wr.x * " +
+             P +
+             "_inv_quadratic(v - dot(v, ax.xyz) * ax.xyz, e - dot(e, ax.xyz) * ax.xyz, L, q.w, ax.w);\n        else if (wr.z == 2.0) total += wr.x "
+             "* " +
+             P + "_sphere(v, e, L, q.w, ax.w, wr.y);\n        else total += wr.x * " + P + "_inv_quadratic(v, e, L, q.w, ax.w);\n    }\n";
     s += "    return max(total, 0.0);\n}\n";
     g.source = std::move(s);
     return g;

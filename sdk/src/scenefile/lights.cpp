@@ -59,6 +59,8 @@ std::optional<Light> readLight(Context& c, const std::string& path, const Json& 
     });
 }
 
+std::string dimsText(glm::ivec3 d) { return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z); }
+
 } // namespace
 
 void readLights(Context& c, const std::string& path, const Json& v, SceneFile& out) {
@@ -97,6 +99,30 @@ void readSceneShadow(Context& c, const std::string& path, const Json& v, SceneFi
     if (d) out.scene.setSceneShadow(*d);
 }
 
+void checkLightingBudget(Context& c, const SceneFile& out) {
+    const Scene& scene = out.scene;
+    const std::size_t lights = scene.lights().size();
+    if (lights == 0) return;
+    std::uint64_t total = 0, largest = 0;
+    std::size_t tableLit = 0;
+    std::string largestAt;
+    for (std::size_t i = 0; i < out.effects.size(); ++i) {
+        const EffectLighting& L = scene.options(out.effects[i].id).lighting;
+        if (!L.enabled || L.selfShadow != SelfShadow::Table) continue;
+        const std::uint64_t bytes = ShadowTable::memoryBytes(L.tableDims) * lights; // one table per light
+        ++tableLit;
+        total += bytes;
+        if (bytes > largest) largest = bytes, largestAt = "effects[" + std::to_string(i) + "].lighting.tableDims " + dimsText(L.tableDims);
+    }
+    const SceneShadowDesc& sd = scene.sceneShadow();
+    if (sd.enabled) total += ShadowTable::memoryBytes(sd.dims);
+    std::string what = std::to_string(lights) + " light(s) x " + std::to_string(tableLit) + " table-lit effect(s)";
+    if (!largestAt.empty()) what += " (the largest " + largestAt + ")";
+    if (sd.enabled) what += " and sceneShadow.dims " + dimsText(sd.dims);
+    if (Status s = checkBudget("the shadow tables of " + what, total, "bytes", c.budgets.lightingBytes, "lightingBytes"); !s)
+        c.d.error("lights", s.error());
+}
+
 void readEffectLighting(Context& c, const std::string& path, const Json& v, EffectLighting& out) {
     auto l = readObject<EffectLighting>(c, path, v, [&](Context& cc, ObjectReader& o, EffectLighting& e) {
         e.enabled = true; // giving the block asks for lighting
@@ -129,6 +155,14 @@ void readEffectLighting(Context& c, const std::string& path, const Json& v, Effe
             if (auto ch = readChoice(cc.d, o.at("selfShadow"), *s, {"off", "traced", "table"}))
                 e.selfShadow = *ch == "off" ? SelfShadow::Off : *ch == "traced" ? SelfShadow::Traced : SelfShadow::Table;
         readAxisCounts(cc, o, "tableDims", e.tableDims, 1, 256);
+        // A lit effect's tables are built with ShadowTableDesc's default budget
+        // (the Scene gives them no other): a table over it would leave the
+        // effect unlit at every frame, so it is refused here.
+        if (e.selfShadow == SelfShadow::Table && o.has("tableDims"))
+            if (const std::uint64_t bytes = ShadowTable::memoryBytes(e.tableDims), budget = ShadowTableDesc{}.memoryBudgetBytes; bytes > budget)
+                cc.d.error(o.at("tableDims"), dimsText(e.tableDims) + " needs " + std::to_string(bytes) +
+                                                  " bytes a table (17 an entry), over the budget of " + std::to_string(budget) +
+                                                  " bytes of each shadow table (ShadowTableDesc::memoryBudgetBytes); 158x158x158 fits");
         o.boolean("castsShadow", e.castsShadow);
     });
     if (l) out = *l;

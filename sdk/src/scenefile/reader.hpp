@@ -52,7 +52,8 @@ struct Context {
     std::filesystem::path baseDir;
     Materials& materials;
     std::uint32_t sceneSeed = 1;
-    Budgets budgets{}; // SceneFileOptions::budgets
+    Budgets budgets{};             // SceneFileOptions::budgets
+    std::uint64_t volumeBytes = 0; // the estimates of the volumes read so far (Budgets::volumeBytes)
     // Texture-set folders already read for this file, by canonical path: a
     // level naming one folder for a thousand effects reads it once.
     std::map<std::string, TextureSet> folders{};
@@ -174,6 +175,9 @@ void readLights(Context& c, const std::string& path, const Json& v, SceneFile& o
 void readSceneShadow(Context& c, const std::string& path, const Json& v, SceneFile& out);
 // An effect's "lighting" object.
 void readEffectLighting(Context& c, const std::string& path, const Json& v, EffectLighting& out);
+// Every light x every table-lit effect's shadow table, plus the scene shadow,
+// against Budgets::lightingBytes (after the effects, lights and sceneShadow).
+void checkLightingBudget(Context& c, const SceneFile& out);
 // [clouds, issue 17] The top-level "volumes" block (volumes.cpp).
 void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& out);
 

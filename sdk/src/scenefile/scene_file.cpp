@@ -252,6 +252,7 @@ Result<SceneFile> parse(const std::string& text, const std::string& path, Materi
     if (const Json* v = o.get("effects")) readEffects(c, "effects", *v, geo, geoByName, out);
     if (const Json* v = o.get("lights")) readLights(c, "lights", *v, out); // issue 16
     if (const Json* v = o.get("sceneShadow")) readSceneShadow(c, "sceneShadow", *v, out);
+    if (d.ok()) checkLightingBudget(c, out);                                  // tables are built at the first frame: estimated now
     if (const Json* v = o.get("fog")) readFog(c, "fog", *v, out.scene);       // fog_block.cpp (issue 14)
     if (const Json* v = o.get("volumes")) readVolumes(c, "volumes", *v, out); // [clouds]
     o.finish();

@@ -20,6 +20,24 @@ namespace {
 // keeps a typo from building a field for minutes first.
 constexpr double kMaxVolumePoints = 64.0 * 1024 * 1024;
 
+// What one tetrahedron a volume emits costs a frame: 80 bytes in
+// LodFrame::tets, 160 in the tetrahedron pass's records and 160 in the GL's
+// copy of them (tetra_pass.cpp: ten vec4 a tetrahedron).
+constexpr std::uint64_t kFrameBytesPerTetrahedron = 80 + 160 + 160;
+
+std::string dimsText(glm::ivec3 d) { return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z); }
+
+// Adds a volume's estimate to the scene's and checks the sum against
+// Budgets::volumeBytes; false (reported at `where`) when it is over.
+bool addVolumeBytes(Context& c, const std::string& where, const std::string& what, std::uint64_t bytes) {
+    c.volumeBytes += bytes;
+    if (Status s = checkBudget("the scene's volumes with " + what, c.volumeBytes, "bytes", c.budgets.volumeBytes, "volumeBytes"); !s) {
+        c.d.error(where, s.error());
+        return false;
+    }
+    return true;
+}
+
 // The cloud generator's vertical axis is grid z; scenes are y-up. The field is
 // generated with (x, z, y) dims and re-indexed so grid y is world up.
 ScalarVolume yUp(const ScalarVolume& zUp) {
@@ -171,6 +189,28 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
                                       ", more than the 16 Mi samples a ground-fog heightmap may have");
         return;
     }
+    {
+        // Before the image is decoded: the decoded image (float RGBA), the
+        // desc's two arrays, what the layer keeps, its table, and the
+        // tetrahedra of its full resolution (what a fully refined LOD emits
+        // too), three a triangle, two triangles a cell.
+        const std::uint64_t sx = std::uint64_t((info->width - 1) / step + 1), sz = std::uint64_t((info->height - 1) / step + 1);
+        std::uint64_t cells = (sx - 1) * (sz - 1);
+        if (lod) {
+            std::uint64_t n = 2;
+            while (n < std::max(sx, sz)) n = 2 * (n - 1) + 1;
+            cells = (n - 1) * (n - 1);
+        }
+        const std::uint64_t tets = 6 * cells;
+        const std::uint64_t bytes = 16 * std::uint64_t(info->width) * std::uint64_t(info->height) + 8 * sx * sz +
+                                    GroundFog::bytesFor(glm::ivec2(int(sx), int(sz)), lod) + 16ull * scalarRes * scalarRes * lengthRes +
+                                    kFrameBytesPerTetrahedron * tets;
+        if (!addVolumeBytes(c, p,
+                            "groundFog '" + name + "' (" + std::to_string(sx) + "x" + std::to_string(sz) + " points, up to " + std::to_string(tets) +
+                                " tetrahedra a frame, a " + dimsText({scalarRes, scalarRes, lengthRes}) + " table)",
+                            bytes))
+            return;
+    }
     auto img = readImage(path, Alpha::Straight);
     if (!img) {
         c.d.error(o.at(imageKey), img.error());
@@ -303,6 +343,20 @@ void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& 
         if (!(glm::length(sun) > 0.0f)) {
             c.d.error(o.at("sunDirection"), "must not be zero");
             continue;
+        }
+        {
+            // Before the field is generated: the generated field and its y-up
+            // copy (two floats a point each), what the volume keeps, its
+            // table, and the tetrahedra of a full refinement (five a cell).
+            const std::uint64_t points = std::uint64_t(dims.x) * std::uint64_t(dims.y) * std::uint64_t(dims.z);
+            const std::uint64_t tets = 5 * std::uint64_t(dims.x - 1) * std::uint64_t(dims.y - 1) * std::uint64_t(dims.z - 1);
+            const std::uint64_t bytes =
+                16 * points + LodVolume::bytesFor(dims, true) + 16ull * scalarRes * scalarRes * lengthRes + kFrameBytesPerTetrahedron * tets;
+            if (!addVolumeBytes(c, p,
+                                "clouds '" + name + "' (" + dimsText(dims) + " points, up to " + std::to_string(tets) + " tetrahedra a frame, a " +
+                                    dimsText({scalarRes, scalarRes, lengthRes}) + " table)",
+                                bytes))
+                continue;
         }
         cd.dims = {dims.x, dims.z, dims.y}; // generator: z up
         cd.sunDirection = {sun.x, sun.z, sun.y};
