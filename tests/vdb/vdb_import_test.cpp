@@ -74,6 +74,18 @@ void writeBytes(const fs::path& p, const std::string& bytes) {
 }
 
 // Peak resident memory of this process so far, in bytes.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kAddressSanitizer = true;
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+
 std::uint64_t peakBytes() {
     rusage u{};
     getrusage(RUSAGE_SELF, &u);
@@ -502,7 +514,12 @@ TEST(VdbImport, EveryFourByteChangeEndsQuicklyWithBoundedMemory) {
         }
     }
     EXPECT_GT(refused, 100);
-    EXPECT_LT(peakBytes() - before, std::uint64_t(256) << 20) << "a corrupted file raised the peak memory";
+    // Under AddressSanitizer freed memory stays in its quarantine (256 MB by
+    // default) and counts in the peak: 1700 loads there reach it whatever
+    // the loader does, so the bound holds only for an uninstrumented build
+    // (the single bombs above stay far below it either way).
+    if (!kAddressSanitizer)
+        EXPECT_LT(peakBytes() - before, std::uint64_t(256) << 20) << "a corrupted file raised the peak memory";
     std::printf("%d changes refused, %d loaded (changed values)\n", refused, loaded);
 }
 
