@@ -289,7 +289,8 @@ void Renderer::draw(std::span<const Splat> splats, const Camera& camera, const P
 
 void Renderer::drawResolved(std::span<const Splat> splats, const Camera& camera, const PassTarget& target) {
     Impl& r = *mImpl;
-    assert(r.layers && "splatfx::gl::Renderer::draw: call upload(materials) first");
+    // No splats need no materials (a frame of only a shadow, fog or volumes).
+    assert((splats.empty() || r.layers) && "splatfx::gl::Renderer::draw: call upload(materials) first");
     r.stats.splats = splats.size();
     r.stats.drawCalls = 0;
     r.stats.cutNear = r.stats.cutGeneral = r.stats.cutHost = r.stats.cutHidden = 0;
