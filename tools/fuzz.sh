@@ -66,4 +66,4 @@ if ((${#failed[@]})); then
   echo "fuzz: findings in: ${failed[*]}" >&2
   exit 1
 fi
-echo "fuzz: all targets ran $what each with no finding"
+echo "fuzz: all targets ran with no finding (${FUZZ_TARGETS})"
