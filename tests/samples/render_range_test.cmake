@@ -7,12 +7,7 @@
 file(REMOVE_RECURSE ${OUT})
 set(common ${SCENE} --frames 24 --size 96x64 --quiet)
 
-function(render)
-  execute_process(COMMAND ${RENDER} ${common} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "splatfx-render ${ARGN} failed (${rc}):\n${out}\n${err}")
-  endif()
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/render_functions.cmake)
 
 function(frame_file var dir i)
   string(LENGTH "${i}" n)
@@ -22,13 +17,6 @@ function(frame_file var dir i)
     math(EXPR n "${n} + 1")
   endwhile()
   set(${var} ${dir}/${NAME}_${pad}.png PARENT_SCOPE)
-endfunction()
-
-function(expect_same a b what)
-  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${a} ${b} RESULT_VARIABLE differ)
-  if(differ)
-    message(FATAL_ERROR "${what}: '${a}' and '${b}' differ")
-  endif()
 endfunction()
 
 render(--out ${OUT}/full)

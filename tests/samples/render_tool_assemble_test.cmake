@@ -6,19 +6,7 @@
 file(REMOVE_RECURSE ${OUT})
 set(common ${SCENE} --frames 4 --size 48x32 --quiet)
 
-function(render)
-  execute_process(COMMAND ${RENDER} ${common} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "splatfx-render ${ARGN} failed (${rc}):\n${out}\n${err}")
-  endif()
-endfunction()
-
-function(expect_same a b what)
-  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${a} ${b} RESULT_VARIABLE differ)
-  if(differ)
-    message(FATAL_ERROR "${what}: '${a}' and '${b}' differ")
-  endif()
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/render_functions.cmake)
 
 # --assemble in DIR must fail matching REGEX and leave DIR/figure1.gif as it was (or absent).
 function(assemble_refused dir regex)
