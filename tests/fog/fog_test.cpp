@@ -337,6 +337,29 @@ TEST(FogValidation, BadFieldsAreNamed) {
     expectError(d, "FogDesc.farDistanceWorld");
 }
 
+TEST(FogValidation, TheShaderTheTermsGenerateIsBudgetedNotTheirCount) {
+    // 64 degree-9 polynomials on X: ~110 KB of generated GLSL (docs/fog.md,
+    // "What a fog's shader costs": 35 s of compile here), over the 32 KiB default.
+    FogDesc d;
+    d.terms.push_back(FogTerm::constant(2.0));
+    for (int i = 0; i < 64; ++i) d.terms.push_back(FogTerm::polynomial1D(0.01, 0, std::vector<double>(10, 0.1), 1.0 + 0.01 * i));
+    auto f = Fog::create(d);
+    ASSERT_FALSE(f.ok());
+    EXPECT_NE(f.error().find("FogDesc.terms: the shader of its 65 terms needs "), std::string::npos) << f.error();
+    EXPECT_NE(f.error().find("over FogDesc.shaderBudgetBytes = 32768"), std::string::npos) << f.error();
+    // Raised knowingly, the same fog is made, and its measure is what was refused.
+    d.shaderBudgetBytes = 1ull << 20;
+    auto raised = Fog::create(d);
+    ASSERT_TRUE(raised.ok()) << raised.error();
+    EXPECT_GT(fogGlsl(*raised)->termBytes, 32768u);
+    // 256 point potentials are one loop: their count costs no generated code.
+    FogDesc points;
+    for (int i = 0; i < 256; ++i) points.terms.push_back(FogTerm::point(0.01, {double(i), 0.0, 0.0}, 1.0, 1.0));
+    auto p = Fog::create(points);
+    ASSERT_TRUE(p.ok()) << p.error();
+    EXPECT_LT(fogGlsl(*p)->termBytes, 2048u);
+}
+
 TEST(FogPaper, Figure6FormulaAndValidity) {
     const Fog fog = make(paperFig6Fog());
     auto K = [](double x, double y, double z) {

@@ -190,6 +190,47 @@ TEST(SceneLighting, BadOptionsNameTheFieldAndLeaveTheEffectUnlit) {
     EXPECT_FALSE(s.scene.setLight(7, Light{}));
 }
 
+TEST(SceneLighting, TablesOverTheLightingBudgetAreNeverBuiltAndTheErrorNamesTheField) {
+    // Four lights x a 128^3 table (17 bytes an entry: 34 MiB each, under the
+    // 64 MiB a table may take) plus the default 64^3 scene shadow: 147 MiB,
+    // over a 100 MiB lightingBytes. Checked before any table is built.
+    LitScene s({.enabled = true, .selfShadow = SelfShadow::Table, .tableDims = glm::ivec3(128)});
+    for (int i = 0; i < 4; ++i) ASSERT_TRUE(s.scene.addLight(Light::directional({0.1f * float(i), -1.0f, 0.0f})));
+    Budgets b;
+    b.lightingBytes = 100ull << 20;
+    s.scene.setBudgets(b);
+    s.prepare(0.0);
+    const std::string& e = s.scene.lightingError();
+    EXPECT_NE(e.find("lighting: the shadow tables of 4 light(s) x 1 table-lit effect(s) and the scene shadow needs 147062784 bytes"),
+              std::string::npos)
+        << e;
+    EXPECT_NE(e.find("(raise Budgets::lightingBytes)"), std::string::npos) << e;
+    EXPECT_EQ(s.frame.counters().litEffects, 0u);
+    EXPECT_EQ(s.frame.counters().shadowTableBuilds, 0u);
+    EXPECT_FALSE(s.frame.shadow().valid);
+    // Within the budget the same scene is lit and shadows.
+    b.lightingBytes = 200ull << 20;
+    s.scene.setBudgets(b);
+    s.prepare(0.1);
+    EXPECT_EQ(s.scene.lightingError(), "");
+    EXPECT_EQ(s.frame.counters().litEffects, 1u);
+    EXPECT_TRUE(s.frame.shadow().valid);
+}
+
+TEST(SceneLighting, ASceneShadowLightPastTheLightsIsAnErrorNotNoShadow) {
+    LitScene s({.enabled = true, .selfShadow = SelfShadow::Table, .tableDims = glm::ivec3(16)});
+    ASSERT_TRUE(s.scene.addLight(Light::directional({0, -1, 0})));
+    s.scene.setSceneShadow({.light = 63});
+    s.prepare(0.0);
+    EXPECT_EQ(s.scene.lightingError(), "sceneShadow.light: expected the index of one of the scene's 1 light(s), 0 to 0, got 63");
+    EXPECT_FALSE(s.frame.shadow().valid);
+    EXPECT_EQ(s.frame.counters().litEffects, 1u) << "the effect itself is still lit";
+    // No lights at all: a scene without lights has nothing to shadow, and that is not an error.
+    s.scene.clearLights();
+    s.prepare(0.1);
+    EXPECT_EQ(s.scene.lightingError(), "");
+}
+
 TEST(SceneLighting, OneCasterWithTheSceneShadowsDimsSharesItsTable) {
     LitScene s({.enabled = true, .selfShadow = SelfShadow::Table, .tableDims = glm::ivec3(40)});
     const Light sun = Light::directional({0.4f, -1.0f, 0.1f});

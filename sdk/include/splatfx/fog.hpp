@@ -145,6 +145,13 @@ struct FogDesc {
     glm::dvec3 colour{0.8, 0.8, 0.85}; // C_fog of eq. 5, linear RGB; default (0.8, 0.8, 0.85)
     double farDistanceWorld = 0.0;     // beyond it fully fogged (sec. 4.2); default 0 = no cut-off
     FogWind wind;                      // default: calm
+    // Bytes of GLSL the terms may generate beyond the closed forms every fog
+    // shares (fogGlsl): polynomials are generated code, about 1.7 KB a
+    // degree-9 term, and every pass that fogs compiles it in time growing
+    // faster than its size (docs/fog.md, "What a fog's shader costs").
+    // Checked by Fog::create. Default 2^15 (32 KiB, about 18 degree-9
+    // polynomial terms; cosines and potentials cost nothing here).
+    std::uint64_t shaderBudgetBytes = 1ull << 15;
 };
 
 // A quadrature result (integrateFogNumerically).
@@ -223,6 +230,9 @@ struct FogGlsl {
     std::string source;
     std::string uniformName; // "<prefix>_params"
     int vec4Count = 0;       // N (at least 1)
+    // Bytes of `source` generated for this fog's terms (all but the shared
+    // fog.glsl): what FogDesc::shaderBudgetBytes bounds.
+    std::uint64_t termBytes = 0;
 };
 // Fails only for invalid options.
 Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& options = {});

@@ -45,6 +45,7 @@
 #include <string>
 #include <vector>
 
+#include "splatfx/budget.hpp"
 #include "splatfx/camera.hpp"
 #include "splatfx/effect.hpp"
 #include "splatfx/effect_kind.hpp"
@@ -235,9 +236,18 @@ public:
     void setLighting(EffectId id, const EffectLighting& lighting) { mEntries.at(id).options.lighting = lighting; }
     void setSceneShadow(const SceneShadowDesc& desc) { mSceneShadowDesc = desc; }
     const SceneShadowDesc& sceneShadow() const { return mSceneShadowDesc; }
-    // The last lighting failure (a bad EffectLighting or SceneShadowDesc: the
-    // effect is drawn unlit, or no scene shadow); empty when the last emit() had none.
+    // The last lighting failure (a bad EffectLighting or SceneShadowDesc, a
+    // sceneShadow.light past the lights, the shadow tables over
+    // Budgets::lightingBytes: the effect is drawn unlit, or no scene shadow);
+    // empty when the last emit() had none. Hosts must show it: the render
+    // tool fails the frame, the C API's prepare returns it.
     const std::string& lightingError() const { return mLightingError; }
+    // What the scene may spend; only lightingBytes is read here (every light
+    // x every table-lit effect's table, plus the scene shadow, checked
+    // before any table is built). Default Budgets{}; loadSceneFile sets the
+    // file's budgets.
+    void setBudgets(const Budgets& budgets) { mBudgets = budgets; }
+    const Budgets& budgets() const { return mBudgets; }
 
     // ---- Fog (docs/fog.md) -------------------------------------------------
     // The scene's fog, handed to every Frame prepare() fills (Frame::setFog).
@@ -267,6 +277,8 @@ private:
     // Lights the splats [first, end) the entry just emitted.
     void lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first, const EmitOptions& draw);
     void shadeScene(Frame& frame); // fills frame.shadow()
+    // The shadow tables' bytes against mBudgets.lightingBytes; the error when over.
+    Status checkLightingBudget() const;
 
     std::vector<Entry> mEntries;
     SceneCounters mCounters;
@@ -280,6 +292,8 @@ private:
     std::uint64_t mSceneShadowLastBuilds = 0;
     const ShadowTable* mSceneShadowSource = nullptr; // mSceneShadow, or a lit effect's own table it shares
     std::string mLightingError;
+    Budgets mBudgets;
+    bool mTablesFit = true; // checkLightingBudget() at the last emit
     std::shared_ptr<const Fog> mFog; // default none
 };
 

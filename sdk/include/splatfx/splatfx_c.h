@@ -377,7 +377,12 @@ SPLATFX_C_API splatfx_status splatfx_frame_get_stats(const splatfx_frame* frame,
  * are needed, brings exactly those to time_sec, builds and sorts their
  * splats into `frame` (Scene::prepare). GL-free: any thread that owns these
  * handles. Times should not decrease across calls (solver effects do not run
- * backwards; stateless effects may be scrubbed freely). */
+ * backwards; stateless effects may be scrubbed freely). A lighting or shadow
+ * failure of a loaded scene (a shadow table over Budgets::lightingBytes, a
+ * sceneShadow light it does not have: Scene::lightingError) is
+ * SPLATFX_ERROR_INVALID_ARGUMENT naming it, with the frame still prepared
+ * (those effects unlit, no scene shadow): render it or not, but it is not
+ * what the file asked for. */
 SPLATFX_C_API splatfx_status splatfx_scene_prepare(splatfx_scene* scene, double time_sec, const splatfx_camera* camera,
                                                    const splatfx_materials* materials, splatfx_frame* frame, splatfx_error* error);
 

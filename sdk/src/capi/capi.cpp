@@ -620,6 +620,9 @@ splatfx_status splatfx_scene_prepare(splatfx_scene* scene, double time_sec, cons
         if (Status s = scene->value.prepare(time_sec, toCamera(*camera), materials->value, frame->value); !s) return invalid(s.error());
         frame->prepared = true;
         frame->materials = materials->identity;
+        // Drawn without what was asked for: the host hears it, and may still render the frame.
+        if (const std::string& lit = scene->value.lightingError(); !lit.empty())
+            return invalid(lit + " (the frame is prepared without it and can be rendered)");
         return success();
     });
 }

@@ -364,6 +364,13 @@ Result<Fog> Fog::create(FogDesc desc) {
     // options, made once here so that a pass compares two integers per frame.
     auto glsl = fogGlsl(fog);
     if (!glsl) return makeError(glsl.error());
+    // The generated code is the fog's compile time (term count alone does not
+    // bound it: degree and variables multiply it), refused before any GL sees it.
+    if (const std::uint64_t bytes = glsl->termBytes; bytes > fog.mDesc.shaderBudgetBytes)
+        return makeError("FogDesc.terms: the shader of its " + std::to_string(fog.mDesc.terms.size()) + " terms needs " +
+                         std::to_string(bytes) + " bytes of GLSL, over FogDesc.shaderBudgetBytes = " +
+                         std::to_string(fog.mDesc.shaderBudgetBytes) +
+                         " (fewer or lower-degree polynomial terms, or raise the budget knowingly: docs/fog.md, \"What a fog's shader costs\")");
     std::uint64_t h = 1469598103934665603ull; // FNV-1a
     for (unsigned char c : glsl->source) h = (h ^ c) * 1099511628211ull;
     fog.mGlslKey = h | 1u; // never 0 (0: no fog)

@@ -228,6 +228,7 @@ Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& opt) {
         }
         s = std::move(renamed);
     }
+    const std::size_t sharedBytes = s.size();
     s += "// The terms of this fog (splatfx::fogGlsl).\n";
     if (opt.uniformLocation >= 0) s += "layout(location = " + std::to_string(opt.uniformLocation) + ") ";
     s += "uniform vec4 " + P + "_params[" + std::to_string(count) + "];\n";
@@ -325,6 +326,7 @@ Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& opt) {
              "* " +
              P + "_sphere(v, e, L, q.w, ax.w, wr.y);\n        else total += wr.x * " + P + "_inv_quadratic(v, e, L, q.w, ax.w);\n    }\n";
     s += "    return max(total, 0.0);\n}\n";
+    g.termBytes = s.size() - sharedBytes;
     g.source = std::move(s);
     return g;
 }

@@ -149,6 +149,11 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
     mLightingError.clear();
     mCounters.litEffects = 0;
     mCounters.shadowTableBuilds = mCounters.shadowTableReuses = 0;
+    mTablesFit = true;
+    if (Status s = checkLightingBudget(); !s) {
+        mLightingError = s.error();
+        mTablesFit = false;
+    }
     for (Entry& e : mEntries) {
         const EmitOptions draw{.textured = e.options.draw.textured && options.textured,
                                .opacityScale = e.options.draw.opacityScale * options.opacityScale};
@@ -167,7 +172,10 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
         tetrahedra += r.tetrahedra;
         // Colour the splats just emitted; unlit effects skip this.
         e.status.lit = false;
-        if (e.status.needed && e.options.lighting.enabled && !mLights.empty()) lightEmitted(e, builder, materials, first, draw);
+        // Tables over the budget are never built: those effects stay unlit (the error says why).
+        const bool tableLit = e.options.lighting.selfShadow == SelfShadow::Table;
+        if (e.status.needed && e.options.lighting.enabled && !mLights.empty() && (mTablesFit || !tableLit))
+            lightEmitted(e, builder, materials, first, draw);
     }
     mCounters.splats = splats;
     mCounters.tetrahedra = tetrahedra;

@@ -42,6 +42,22 @@ Status Scene::setLight(std::size_t i, const Light& light) {
     return {};
 }
 
+Status Scene::checkLightingBudget() const {
+    if (mLights.empty()) return {};
+    std::uint64_t total = 0;
+    std::size_t tableLit = 0;
+    for (const Entry& e : mEntries) {
+        const EffectLighting& L = e.options.lighting;
+        if (!e.options.enabled || !L.enabled || L.selfShadow != SelfShadow::Table) continue;
+        total += ShadowTable::memoryBytes(L.tableDims) * mLights.size(); // one table per light
+        ++tableLit;
+    }
+    if (mSceneShadowDesc.enabled) total += ShadowTable::memoryBytes(mSceneShadowDesc.dims);
+    return checkBudget("lighting: the shadow tables of " + std::to_string(mLights.size()) + " light(s) x " + std::to_string(tableLit) +
+                           " table-lit effect(s)" + (mSceneShadowDesc.enabled ? " and the scene shadow" : ""),
+                       total, "bytes", mBudgets.lightingBytes, "lightingBytes");
+}
+
 void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first, const EmitOptions& draw) {
     const EffectLighting& L = e.options.lighting;
     const std::string at = "effect '" + e.options.name + "': lighting.";
@@ -110,7 +126,11 @@ void Scene::shadeScene(Frame& frame) {
     const SceneShadowDesc& d = mSceneShadowDesc;
     std::vector<const DensityField*> fields;
     const Entry* only = nullptr; // the one casting effect, when there is one
-    if (d.enabled && d.light < mLights.size())
+    // A shadow cast by a light the scene does not have would silently be no shadow.
+    if (d.enabled && !mLights.empty() && d.light >= mLights.size() && mLightingError.empty())
+        mLightingError = "sceneShadow.light: expected the index of one of the scene's " + std::to_string(mLights.size()) +
+                         " light(s), 0 to " + std::to_string(mLights.size() - 1) + ", got " + std::to_string(d.light);
+    if (d.enabled && d.light < mLights.size() && mTablesFit)
         for (const Entry& e : mEntries)
             if (e.status.lit && e.options.lighting.castsShadow && e.lit && !e.lit->field.empty()) {
                 fields.push_back(&e.lit->field);

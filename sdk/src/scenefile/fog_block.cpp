@@ -3,6 +3,7 @@
 // the term) after the keys are checked here (each error names the field).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 #include <vector>
@@ -167,18 +168,19 @@ void readFog(Context& c, const std::string& path, const Json& v, Scene& scene) {
     desc.farDistanceWorld = far;
     if (wind) desc.wind = *wind;
     const std::size_t terms = desc.terms.size();
+    // The GLSL the terms generate is compiled into every pass that fogs, in
+    // time growing faster than its size: it is the fog's cost, budgeted
+    // before any GL sees it, here against Budgets (the field a scene file's
+    // user raises) instead of FogDesc::shaderBudgetBytes.
+    desc.shaderBudgetBytes = std::numeric_limits<std::uint64_t>::max();
     auto fog = Fog::create(std::move(desc));
     if (!fog) {
         c.d.error(path, fog.error());
         return;
     }
-    // The GLSL the terms generate is compiled into every pass that fogs, in
-    // time growing faster than its size: it is the fog's cost, budgeted
-    // before any GL sees it.
-    if (auto glsl = fogGlsl(*fog), none = fogGlsl(*Fog::create({})); glsl && none) {
-        const std::uint64_t bytes = glsl->source.size() > none->source.size() ? glsl->source.size() - none->source.size() : 0;
-        if (Status s = checkBudget("the shader of its " + std::to_string(terms) + " terms", bytes, "bytes of GLSL", c.budgets.fogShaderBytes,
-                                   "fogShaderBytes");
+    if (auto glsl = fogGlsl(*fog)) {
+        if (Status s = checkBudget("the shader of its " + std::to_string(terms) + " terms", glsl->termBytes, "bytes of GLSL",
+                                   c.budgets.fogShaderBytes, "fogShaderBytes");
             !s) {
             c.d.error(o.has("terms") ? o.at("terms") : path, s.error());
             return;

@@ -204,6 +204,7 @@ Result<SceneFile> parse(const std::string& text, const std::string& path, Materi
     out.path = path;
     Context c{d, fs::path(path).parent_path(), materials};
     c.budgets = options.budgets;
+    out.scene.setBudgets(options.budgets); // the same lightingBytes holds while it plays
     ObjectReader o(d, "", root);
     if (!o.valid()) return makeError(path + ": expected a JSON object {\"format\": \"splatfx-scene\", \"version\": 1, ...}");
 
