@@ -289,7 +289,7 @@ int runShadows(int argc, char** argv) {
     desc.layers = {splatfx::EffectLayer{.style = {.textureSet = set, .colorTable = table}}};
     const splatfx::ProceduralGasDesc gas = steamDesc();
     const splatfx::Grid lattice = steamLattice();
-    auto gasAt = [&](double t) { return *splatfx::sampleProceduralGas(gas, lattice, float(t)); };
+    auto gasAt = [&](double t) { return *splatfx::sampleProceduralGas(gas, lattice, t); };
 
     std::printf("steam from a glass: %zu of %d lattice cells hold steam at t = 2 s; %s; on %s\n", gasAt(2.0).voxels.size(), 16 * 24 * 16,
                 animated ? "the steam evolves (tables rebuilt every frame)" : "static steam (tables reused)", ctx->renderer().c_str());

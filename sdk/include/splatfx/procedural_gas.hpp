@@ -14,7 +14,7 @@
 //
 //   auto lattice = splatfx::Grid::box({24, 32, 24}, glm::vec3(0.125f));   // cells to sample
 //   splatfx::ProceduralGasDesc steam{.kind = splatfx::GasKind::Steam};
-//   auto grid = splatfx::sampleProceduralGas(steam, *lattice, 2.5f);     // Result<Grid>
+//   auto grid = splatfx::sampleProceduralGas(steam, *lattice, 2.5);      // Result<Grid>
 //
 // Threading: pure functions; call from any thread.
 #pragma once
@@ -101,14 +101,16 @@ Status validateProceduralGas(const ProceduralGasDesc& desc);
 float gasTurbulence(const GasTurbulenceDesc& desc, glm::vec3 p);
 
 // Density in [0, 1] at a world point and time, the gas's opacity there.
-// Expects a valid desc; non-finite input gives 0.
-float proceduralGasDensity(const ProceduralGasDesc& desc, glm::vec3 world, float timeSec);
+// Expects a valid desc; non-finite input gives 0. Evaluated in double, with
+// travel through turbulent space and swirl angles reduced by their periods,
+// so the motion is as smooth at 10^6 s as at 0 (docs/STABILITY.md, gases).
+float proceduralGasDensity(const ProceduralGasDesc& desc, glm::vec3 world, double timeSec);
 
 // Samples the density at every cell of `lattice`'s dims (its spacing and
 // transform give the world positions, as Grid::worldPosition) and returns a
 // grid with the same lattice holding the cells above desc.threshold, with
 // opacity = density, colour coordinate = normalized height, texture 0.
 // Fails on a bad desc, a non-finite time, or a lattice with no dims.
-Result<Grid> sampleProceduralGas(const ProceduralGasDesc& desc, const Grid& lattice, float timeSec);
+Result<Grid> sampleProceduralGas(const ProceduralGasDesc& desc, const Grid& lattice, double timeSec);
 
 } // namespace splatfx

@@ -40,7 +40,7 @@ public:
         Grid placed = mLattice;
         placed.transform = pose.matrix() * mLattice.transform;
         // The gas's own motion is object dynamics too: switched off, it freezes at t = 0.
-        Result<Grid> g = sampleProceduralGas(mGas, placed, float(desc.enabled.object ? t : 0.0));
+        Result<Grid> g = sampleProceduralGas(mGas, placed, desc.enabled.object ? t : 0.0);
         grid = g ? std::move(*g) : placed; // the desc was validated at creation: only a non-finite t fails
         const bool local = desc.enabled.local;
         for (Voxel& v : grid.voxels) {

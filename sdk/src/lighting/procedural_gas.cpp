@@ -12,8 +12,6 @@
 namespace splatfx {
 namespace {
 
-constexpr float kTwoPi = 6.283185307179586f;
-
 bool finite3(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 Status positive(float v, const std::string& field) {
@@ -29,85 +27,108 @@ Status finite(float v, const std::string& field) {
     return {};
 }
 
+// The noise repeats every 256 lattice units on each axis (its permutation),
+// so each octave is taken modulo 256 in double: a point 10^12 world units out,
+// or moved through turbulent space for 10^6 s, keeps full precision and never
+// overflows the lattice index.
+double wrapNoise(double s) { return s - 256.0 * std::floor(s / 256.0); }
+
 // Perlin 1985: turbulence(p) = sum_i |noise(2^i p)| / 2^i.
-float turb(const detail::Noise4& noise, const GasTurbulenceDesc& d, glm::vec3 p) {
+double turb(const detail::Noise4& noise, const GasTurbulenceDesc& d, glm::dvec3 p) {
     double sum = 0.0, scale = 1.0;
-    const glm::dvec3 q = glm::dvec3(p) * double(d.frequency);
+    const glm::dvec3 q = p * double(d.frequency);
     for (int i = 0; i < d.octaves; ++i) {
         const glm::dvec3 s = q / scale;
-        sum += std::abs(noise(s.x, s.y, s.z, 0.0)) * scale;
+        sum += std::abs(noise(wrapNoise(s.x), wrapNoise(s.y), wrapNoise(s.z), 0.0)) * scale;
         scale *= 0.5;
     }
-    return float(sum);
+    return sum;
 }
 
-float steam(const detail::Noise4& noise, const ProceduralGasDesc& g, glm::vec3 p, float t) {
+// A distance travelled through turbulent space, reduced modulo the
+// turbulence's period (256 / frequency world units: every octave repeats
+// within it), so the motion stays smooth at any time.
+double travelled(double speed, double t, const GasTurbulenceDesc& d) {
+    const double period = 256.0 / double(d.frequency);
+    const double x = speed * t;
+    return x - period * std::floor(x / period);
+}
+
+// 2 pi t / period, reduced to one turn in double first.
+double turnAngle(double t, double periodSec) {
+    const double p = double(periodSec);
+    return 6.283185307179586 * ((t - p * std::floor(t / p)) / p);
+}
+
+double steam(const detail::Noise4& noise, const ProceduralGasDesc& g, glm::dvec3 p, double t) {
     const GasSteamDesc& s = g.steam;
-    const float h = p.y - s.source.y;
-    if (!(h >= 0.0f) || h >= s.height) return 0.0f;
-    const float hn = h / s.height;
-    const float radius = s.sourceRadius * (1.0f + s.spread * hn);
-    const glm::vec2 r(p.x - s.source.x, p.z - s.source.z);
-    const float radial = 1.0f - glm::dot(r, r) / (radius * radius);
-    if (radial <= 0.0f) return 0.0f;
+    const double h = p.y - double(s.source.y);
+    if (!(h >= 0.0) || h >= double(s.height)) return 0.0;
+    const double hn = h / double(s.height);
+    const double radius = double(s.sourceRadius) * (1.0 + double(s.spread) * hn);
+    const glm::dvec2 r(p.x - double(s.source.x), p.z - double(s.source.z));
+    const double radial = 1.0 - glm::dot(r, r) / (radius * radius);
+    if (radial <= 0.0) return 0.0;
     // The steam's points rise through turbulent space along a helix.
-    const float theta = kTwoPi * t / s.swirlPeriodSec;
-    const glm::vec3 q = p - glm::vec3(0.0f, s.riseSpeed * t, 0.0f) + s.swirlRadius * glm::vec3(std::cos(theta), 0.0f, std::sin(theta));
+    const double theta = turnAngle(t, s.swirlPeriodSec);
+    const glm::dvec3 q =
+        p - glm::dvec3(0.0, travelled(double(s.riseSpeed), t, g.turbulence), 0.0) + double(s.swirlRadius) * glm::dvec3(std::cos(theta), 0.0, std::sin(theta));
     // Dissipates with distance from the source (the paper: "decreasing the
     // opacity as a function of the distance from the glass"): linearly to 0 at height.
-    const float d = s.opaque * turb(noise, g.turbulence, q) * radial * (1.0f - hn);
-    return std::pow(std::clamp(d, 0.0f, 1.0f), s.power);
+    const double d = double(s.opaque) * turb(noise, g.turbulence, q) * radial * (1.0 - hn);
+    return std::pow(std::clamp(d, 0.0, 1.0), double(s.power));
 }
 
-float fog(const detail::Noise4& noise, const ProceduralGasDesc& g, glm::vec3 p, float t) {
+double fog(const detail::Noise4& noise, const ProceduralGasDesc& g, glm::dvec3 p, double t) {
     const GasFogDesc& f = g.fog;
     // chess_fog (1): turbulence applied to the point "so that it appears more random".
-    const float tmp = turb(noise, g.turbulence, p);
+    const double tmp = turb(noise, g.turbulence, p);
     // The front: a plane x = f advancing with time, deformed by the point's
     // turbulence so that it "does not appear as a plane".
-    const float front = f.frontStart + f.frontSpeed * t + f.frontTurbulence * (tmp - 0.5f);
-    if (p.x > front) return 0.0f;
-    const float thicken = std::min((front - p.x) / f.thickenDistance, 1.0f);
-    const glm::vec3 pnt = p + glm::vec3(2.0f + tmp, 0.5f + tmp, -2.0f - tmp);
+    const double front = double(f.frontStart) + double(f.frontSpeed) * t + double(f.frontTurbulence) * (tmp - 0.5);
+    if (p.x > front) return 0.0;
+    const double thicken = std::min((front - p.x) / double(f.thickenDistance), 1.0);
+    const glm::dvec3 pnt = p + glm::dvec3(2.0 + tmp, 0.5 + tmp, -2.0 - tmp);
     // Helical path: an ellipse in the y-z plane while drifting along x. The
     // paper's listing reads "direction.y = pnt.x + cyl.y"; pnt.y is meant (the
     // ellipse lies in the y-z plane).
-    const float theta = kTwoPi * t / f.swirlPeriodSec;
-    const glm::vec3 direction(pnt.x - t * f.driftPerSec, pnt.y + f.ellipse1 * std::cos(theta), pnt.z + f.ellipse2 * std::sin(theta));
+    const double theta = turnAngle(t, f.swirlPeriodSec);
+    const glm::dvec3 direction(pnt.x - travelled(double(f.driftPerSec), t, g.turbulence), pnt.y + double(f.ellipse1) * std::cos(theta),
+                               pnt.z + double(f.ellipse2) * std::sin(theta));
     // (2), (3): grow to full density over fullDensitySec, then opaque and power.
-    const float factor = std::clamp(t / f.fullDensitySec, 0.0f, 1.0f);
-    const float d = turb(noise, g.turbulence, direction) * f.opaque * factor * thicken;
-    return std::pow(std::clamp(d, 0.0f, 1.0f), f.power);
+    const double factor = std::clamp(t / double(f.fullDensitySec), 0.0, 1.0);
+    const double d = turb(noise, g.turbulence, direction) * double(f.opaque) * factor * thicken;
+    return std::pow(std::clamp(d, 0.0, 1.0), double(f.power));
 }
 
-float cloud(const detail::Noise4& noise, const ProceduralGasDesc& g, glm::vec3 p, float t) {
+double cloud(const detail::Noise4& noise, const ProceduralGasDesc& g, glm::dvec3 p, double t) {
     const GasCloudDesc& c = g.cloud;
     // The ellipsoid drifts with the wind; density falls to 0 at its surface so
     // the defining solid is not seen (the paper: "decreasing the density
     // based on the location within the volume").
-    const glm::vec3 e = (p - c.center - c.windPerSec * t) / c.radii;
-    const float falloff = 1.0f - glm::dot(e, e);
-    if (falloff <= 0.0f) return 0.0f;
+    const glm::dvec3 e = (p - glm::dvec3(c.center) - glm::dvec3(c.windPerSec) * t) / glm::dvec3(c.radii);
+    const double falloff = 1.0 - glm::dot(e, e);
+    if (!(falloff > 0.0)) return 0.0;
     // The paper's clouds(): perturb the point by noise, a sine of the
     // turbulence, then 1 - (s + 1)^power / 2.
-    glm::vec3 q = p;
-    const float n = float(noise(q.x, q.y, q.z, 0.0));
+    glm::dvec3 q = p;
+    const double n = noise(wrapNoise(q.x), wrapNoise(q.y), wrapNoise(q.z), 0.0);
     q.x += n;
     q.y += n;
-    const float s = std::sin(turb(noise, g.turbulence, q) * c.frequency);
-    const float v = 1.0f - std::pow(s + 1.0f, c.power) * 0.5f;
-    return std::clamp(c.opaque * v * falloff, 0.0f, 1.0f);
+    const double s = std::sin(turb(noise, g.turbulence, q) * double(c.frequency));
+    const double v = 1.0 - std::pow(s + 1.0, double(c.power)) * 0.5;
+    return std::clamp(double(c.opaque) * v * falloff, 0.0, 1.0);
 }
 
-float density(const detail::Noise4& noise, const ProceduralGasDesc& g, glm::vec3 p, float t) {
+float density(const detail::Noise4& noise, const ProceduralGasDesc& g, glm::vec3 p, double t) {
     if (!finite3(p) || !std::isfinite(t)) return 0.0f;
-    float d = 0.0f;
+    double d = 0.0;
     switch (g.kind) {
-    case GasKind::Steam: d = steam(noise, g, p, t); break;
-    case GasKind::Fog: d = fog(noise, g, p, t); break;
-    case GasKind::Cloud: d = cloud(noise, g, p, t); break;
+    case GasKind::Steam: d = steam(noise, g, glm::dvec3(p), t); break;
+    case GasKind::Fog: d = fog(noise, g, glm::dvec3(p), t); break;
+    case GasKind::Cloud: d = cloud(noise, g, glm::dvec3(p), t); break;
     }
-    return std::isfinite(d) ? std::clamp(d, 0.0f, 1.0f) : 0.0f;
+    return std::isfinite(d) ? float(std::clamp(d, 0.0, 1.0)) : 0.0f;
 }
 
 } // namespace
@@ -155,15 +176,15 @@ Status validateProceduralGas(const ProceduralGasDesc& g) {
 
 float gasTurbulence(const GasTurbulenceDesc& desc, glm::vec3 p) {
     const detail::Noise4 noise(desc.seed);
-    return finite3(p) ? turb(noise, desc, p) : 0.0f;
+    return finite3(p) ? float(turb(noise, desc, glm::dvec3(p))) : 0.0f;
 }
 
-float proceduralGasDensity(const ProceduralGasDesc& desc, glm::vec3 world, float timeSec) {
+float proceduralGasDensity(const ProceduralGasDesc& desc, glm::vec3 world, double timeSec) {
     const detail::Noise4 noise(desc.turbulence.seed);
     return density(noise, desc, world, timeSec);
 }
 
-Result<Grid> sampleProceduralGas(const ProceduralGasDesc& desc, const Grid& lattice, float timeSec) {
+Result<Grid> sampleProceduralGas(const ProceduralGasDesc& desc, const Grid& lattice, double timeSec) {
     if (Status s = validateProceduralGas(desc); !s) return makeError(s.error());
     if (!std::isfinite(timeSec)) return makeError("timeSec must be finite");
     for (int a = 0; a < 3; ++a)
