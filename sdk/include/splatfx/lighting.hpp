@@ -63,7 +63,8 @@ struct Light {
     float outerConeRad = 0.6f;              // spot: no light beyond this half-angle, (0, pi); default 0.6
     // Point and spot: the irradiance of a voxel closer than this (or than half
     // its voxel's size, whichever is larger) is that at this distance, so a
-    // light inside the gas stays finite. >= 0, world units; default 0.
+    // light inside the gas stays finite (with both 0, a point exactly at the
+    // light takes it at 10^-12 units: huge, finite). >= 0, world units; default 0.
     float radiusWorld = 0.0f;
 
     static Light directional(glm::vec3 direction, glm::vec3 color = glm::vec3(1.0f), float intensity = 1.0f);

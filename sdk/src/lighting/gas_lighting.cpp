@@ -49,6 +49,9 @@ Status checkInputs(glm::vec3 eyeWorld, std::span<const Light> lights, const GasL
     return {};
 }
 
+// (10^-12 world units)^2: the closest a point light is taken to be.
+constexpr float kMinDist2 = 1e-24f;
+
 // The model for `count` points: point(v) gives the world position (and
 // false for data that is not finite), base(v) the base colour.
 template <class PointFn, class BaseFn>
@@ -93,7 +96,9 @@ void lightImpl(std::size_t count, PointFn point, BaseFn base, float voxelSize, g
             } else {
                 const glm::vec3 fromLight = x - l.position;
                 const float d2 = glm::dot(fromLight, fromLight);
-                irradiance = 1.0f / std::max(d2, l.minDist2);
+                // kMinDist2: a light exactly on a zero-size point with
+                // radiusWorld 0 gets a huge but finite irradiance, not inf.
+                irradiance = 1.0f / std::max({d2, l.minDist2, kMinDist2});
                 const float d = std::sqrt(d2);
                 const glm::vec3 travel = d > 0.0f ? fromLight / d : l.travel;
                 // Within minDist the light is among the voxel's material and
