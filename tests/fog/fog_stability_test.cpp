@@ -197,5 +197,125 @@ TEST(FogStability, ZeroLengthSegment) {
     EXPECT_EQ(fog.transmittance({15, 2, 15}, {15, 2, 15}, 0.0), 1.0);
 }
 
+// ---- More edges (issue 24, item 3) ----------------------------------------------
+
+// Adaptive quadrature of the density (the fog's own reference, validated
+// against closed forms in fog_test.cpp) along [o, p].
+double quadrature(const Fog& fog, glm::dvec3 o, glm::dvec3 p, double t = 0.0) {
+    const FogQuadrature q = integrateFogNumerically(fog, o, p, t, 1e-11);
+    EXPECT_TRUE(q.converged);
+    return q.value;
+}
+
+TEST(FogStability, CosineOfAMillionCyclesPerUnitAveragesOut) {
+    // k = 10^6 over L = 10: the cosine's integral is (sin(kL + phi) - sin(phi)) / k,
+    // at most 2e-6; in long double the argument 10^7 keeps 1e-12 of the phase.
+    const double L = 10.0, phi = 0.3, k = 1e6;
+    FogDesc d;
+    d.terms.push_back(FogTerm::constant(0.5));
+    d.terms.push_back(FogTerm::cosine(0.5, k, {1, 0, 0}, phi));
+    const Fog fog = make(d);
+    const long double kl = k;
+    const double expected = 0.5 * L + 0.5 * double((std::sin(kl * L + (long double)phi) - std::sin((long double)phi)) / kl);
+    // The closed form's phase k x in double: 10^7 x 2^-53 = 1e-9 rad, over k: 1e-15 absolute.
+    EXPECT_NEAR(fog.opticalDepth({0, 0, 0}, {L, 0, 0}, 0.0), expected, 1e-12);
+}
+
+TEST(FogStability, WindAfterAMillionSecondsSlidesTheFogExactly) {
+    // Wind moves every term: the fog at t over [o, p] is the calm fog over [o - w t, p - w t].
+    // After 10^6 s the displacement is 3 x 10^5: phases reduced in double keep 1e-10 rad.
+    FogDesc windy;
+    windy.terms.push_back(FogTerm::constant(0.4));
+    windy.terms.push_back(FogTerm::cosine(0.3, 2.0, {1, 0, 0}, 0.1));
+    windy.wind = FogWind::constant({0.3, 0.0, 0.0});
+    FogDesc calm = windy;
+    calm.wind = {};
+    const Fog a = make(windy), b = make(calm);
+    const double t = 1e6;
+    const glm::dvec3 o(1.0, 0.5, 2.0), p(7.5, 1.0, -3.0), w(0.3 * t, 0.0, 0.0);
+    EXPECT_NEAR(a.opticalDepth(o, p, t), b.opticalDepth(o - w, p - w, t), 1e-9);
+}
+
+TEST(FogStability, ZeroOutsidePolynomialRayStartingExactlyOnItsCellFace) {
+    // The ray starts on the face x = centre + halfSize (where the cell's polynomial
+    // ends) and runs back through the cell: the piece boundaries coincide with the end.
+    FogDesc d;
+    d.terms.push_back(FogTerm::constant(0.1));
+    d.terms.push_back(FogTerm::polynomial1D(1.0, 0, {0.5, 0.0, -0.25, 0.0, 0.1}, 1.5, FogCellMode::ZeroOutside));
+    const Fog fog = make(d);
+    const glm::dvec3 face(1.5, 0.2, 0.0);
+    for (glm::dvec3 to : {glm::dvec3(-4.0, 0.2, 0.0), glm::dvec3(1.5, 3.0, 1.0), glm::dvec3(3.0, 0.2, 0.0)})
+        EXPECT_NEAR(fog.opticalDepth(face, to, 0.0), quadrature(fog, face, to), 1e-9) << to.x << " " << to.y;
+}
+
+TEST(FogStability, RayTangentToASpherePotential) {
+    // The sphere potential is constant inside and falls outside: a ray touching the
+    // sphere at one point (the regimes meet there) integrates as the quadrature does.
+    FogDesc d;
+    d.terms.push_back(FogTerm::sphere(1.0, {0.0, 0.0, 0.0}, 2.0, 1.0, 0.5));
+    const Fog fog = make(d);
+    const glm::dvec3 o(-10.0, 2.0, 0.0), p(10.0, 2.0, 0.0); // tangent at (0, 2, 0)
+    EXPECT_NEAR(fog.opticalDepth(o, p, 0.0), quadrature(fog, o, p), 1e-9);
+    const glm::dvec3 o2(-10.0, 2.0 - 1e-12, 0.0), p2(10.0, 2.0 - 1e-12, 0.0); // a hair inside: continuous
+    EXPECT_NEAR(fog.opticalDepth(o2, p2, 0.0), fog.opticalDepth(o, p, 0.0), 1e-9);
+}
+
+TEST(FogStability, RayThroughALineEquipotentialsAxis) {
+    // r = 0 where the ray crosses the line: the integrand peaks at 1 / c there.
+    FogDesc d;
+    d.terms.push_back(FogTerm::line(1.0, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 0.01, 4.0));
+    const Fog fog = make(d);
+    const glm::dvec3 o(-5.0, 1.0, 0.0), p(5.0, -2.0, 0.0);
+    // Closed form: the ray's distance to the axis is |x| (z = 0), x = -5 + 10 s:
+    // integral of 1 / (c + d x^2) over x, times |p - o| / 10.
+    const double c = 0.01, dd = 4.0, scale = glm::length(p - o) / 10.0;
+    const double exact = scale * (2.0 / std::sqrt(c * dd)) * std::atan(5.0 * std::sqrt(dd / c));
+    EXPECT_NEAR(fog.opticalDepth(o, p, 0.0), exact, 1e-12 * exact);
+}
+
+TEST(FogStability, PotentialWithZeroFalloffIsAConstant) {
+    // d = 0: 1 / (c + 0 r^2) = 1 / c everywhere, including at the centre.
+    FogDesc d;
+    d.terms.push_back(FogTerm::point(0.5, {1.0, 1.0, 1.0}, 2.0, 0.0));
+    const Fog fog = make(d);
+    const glm::dvec3 o(1.0, 1.0, 1.0), p(4.0, 5.0, 1.0);
+    EXPECT_NEAR(fog.opticalDepth(o, p, 0.0), 0.5 * 5.0 / 2.0, 1e-15);
+}
+
+TEST(FogStability, CosineProductOfOppositeDirectionsHasAZeroFrequencyPart) {
+    // cos(k x) cos(-k x + phi): the difference frequency is 2k, the sum frequency 0
+    // (the sinc at 0): the product's constant part cos(phi) / 2 must integrate as L cos(phi) / 2.
+    FogDesc d;
+    d.terms.push_back(FogTerm::constant(1.0));
+    d.terms.push_back(FogTerm::cosineProduct(0.5, 1.7, {1, 0, 0}, 0.0, 1.7, {-1, 0, 0}, 0.4));
+    const Fog fog = make(d);
+    const glm::dvec3 o(0.0, 0.0, 0.0), p(9.0, 0.0, 0.0);
+    EXPECT_NEAR(fog.opticalDepth(o, p, 0.0), quadrature(fog, o, p), 1e-9);
+}
+
+TEST(FogStability, FarCutOffExactlyAtTheSegmentsEnd) {
+    // A point exactly at farDistanceWorld is not beyond it (transmittance exp(-depth));
+    // one ulp further is (0).
+    FogDesc d;
+    d.terms.push_back(FogTerm::constant(0.1));
+    d.farDistanceWorld = 10.0;
+    const Fog fog = make(d);
+    EXPECT_NEAR(fog.transmittance({0, 0, 0}, {10.0, 0, 0}, 0.0), std::exp(-1.0), 1e-15);
+    EXPECT_EQ(fog.transmittance({0, 0, 0}, {std::nextafter(10.0, 11.0), 0, 0}, 0.0), 0.0);
+}
+
+TEST(FogStability, PolynomialCellsOfAMillionthAlongAThousandUnits) {
+    // 10^9 cells crossed: counted in O(1), whole cells at the cell integral. The
+    // reference: the mean over a cell times the length, off by at most the two
+    // partial cells (2 x 2h x max |P| = 4e-6 x 1.35).
+    const double h = 1e-6, L = 1000.0;
+    FogDesc d;
+    d.terms.push_back(FogTerm::constant(1.0));
+    d.terms.push_back(FogTerm::polynomial1D(1.0, 0, {0.2, 0.0, 1.0}, h)); // P(u) = 0.2 + u^2, mean 0.2 + 1/3
+    const Fog fog = make(d);
+    const double got = fog.opticalDepth({0.3, 0, 0}, {0.3 + L, 0, 0}, 0.0);
+    EXPECT_NEAR(got, L * (1.0 + 0.2 + 1.0 / 3.0), 4e-6 * 1.35 + 1e-9 * L);
+}
+
 } // namespace
 } // namespace splatfx
