@@ -581,3 +581,163 @@ TEST(LodVolumeHardCases, NonFiniteRaysAndPointsGiveZero) {
     const glm::dvec4 r = v->integrateRay(*tf, {-1, 1.5, 1.5}, {1, 0, 0}, 0.0, inf); // to infinity: the grid ends it
     EXPECT_TRUE(std::isfinite(r.a));
 }
+
+// ---- More edges (issue 24, item 3; docs/STABILITY.md, "LOD clouds") -------------------
+
+// A node of zero deviation beside one of huge deviation: a constant field
+// with a single spike. Propagation must refine the spike's ancestors and
+// their neighbours enough to stay conforming, and the flat part stays coarse.
+TEST(LodVolumeHardCases, AFlatNodeBesideASpikeStaysConforming) {
+    ScalarVolume field = voltest::constantField({33, 33, 33}, 0.3f);
+    field.scalar[std::size_t(20 + 33 * (16 + 33 * 16))] = 1.0f;
+    auto v = LodVolume::create(field, {});
+    ASSERT_TRUE(v) << v.error();
+    LodFrame f;
+    ASSERT_TRUE(v->update(cameraAt({-20, 16, 16}, {16, 16, 16}), allOff(30.0f), nullptr, f));
+    int tChecks = 0, levels = 0;
+    expectConforming(*v, f.tets, tChecks, levels);
+    EXPECT_GE(levels, 3) << "fine at the spike, coarse in the flat field";
+    EXPECT_LT(f.tets.size(), v->fullResolutionTets() / 4);
+    double at = -1.0;
+    ASSERT_TRUE(meshValue(f.tets, {20.0, 16.0, 16.0}, at));
+    EXPECT_NEAR(at, 1.0, 1.0 / 255.0) << "the spike itself is drawn at full resolution";
+}
+
+// Dims far from 2^n + 1 on each axis (17 x 5 x 33): padded with padValue;
+// the mesh tiles the padded box and carries the pad value outside the data.
+TEST(LodVolumeHardCases, UnevenDimsArePaddedAndTiled) {
+    for (float pad : {0.0f, 1.0f}) {
+        auto v = LodVolume::create(voltest::randomField({17, 5, 33}, 31), {.padValue = pad});
+        ASSERT_TRUE(v) << v.error();
+        LodFrame f;
+        ASSERT_TRUE(v->update(cameraAt({-20, 10, 10}, {8, 2, 16}), allOff(1e9f), nullptr, f));
+        int tChecks = 0, levels = 0;
+        expectConforming(*v, f.tets, tChecks, levels);
+        const glm::ivec3 dims = v->pointDims();
+        if (dims.y > 5) { EXPECT_EQ(v->scalarAt({0, dims.y - 1, 0}), pad); }
+    }
+}
+
+// C at the smallest float above sqrt(3), eq. 4's limit: K_max is eq. 4's
+// value there, the mesh is conforming; sqrt(3) itself (as a float, just
+// under it) is refused naming the field.
+TEST(LodVolumeHardCases, MinAccuracyCJustAboveItsLimitGivesEquationFour) {
+    const float c = 1.7320509f;
+    ASSERT_GT(double(c), std::sqrt(3.0));
+    auto v = LodVolume::create(voltest::randomField({17, 17, 17}, 32), {.minAccuracyC = c});
+    ASSERT_TRUE(v) << v.error();
+    EXPECT_NEAR(v->kMax(), double(c) / (2.0 * double(c) - 0.5 * std::sqrt(3.0)), 1e-12);
+    auto under = LodVolume::create(voltest::randomField({5, 5, 5}, 32), {.minAccuracyC = std::nextafter(c, 0.0f)});
+    ASSERT_FALSE(under);
+    EXPECT_NE(under.error().find("minAccuracyC"), std::string::npos) << under.error();
+    LodFrame f;
+    ASSERT_TRUE(v->update(cameraAt({-10, 8, 8}, {8, 8, 8}), allOff(10.0f), nullptr, f));
+    int tChecks = 0, levels = 0;
+    expectConforming(*v, f.tets, tChecks, levels);
+}
+
+// An eye 10^6 units away: every error metric is tiny, the roots alone are
+// drawn; at 10^-6 from a grid point (inside r of every node) everything is fine.
+TEST(LodVolumeHardCases, EyeAMillionUnitsAwayDrawsTheRootsAndAMicronAwayTheFinest) {
+    auto v = LodVolume::create(voltest::randomField({17, 17, 17}, 33), {});
+    ASSERT_TRUE(v) << v.error();
+    LodFrame far, near;
+    ASSERT_TRUE(v->update(cameraAt({-1e6f, 8, 8}, {8, 8, 8}), allOff(10.0f), nullptr, far));
+    EXPECT_EQ(far.tets.size(), 5u * std::size_t(v->roots().x * v->roots().y * v->roots().z));
+    ASSERT_TRUE(v->update(cameraAt({8.000001f, 8, 8}, {16, 8, 8}), allOff(10.0f), nullptr, near));
+    int tChecks = 0, levels = 0;
+    expectConforming(*v, near.tets, tChecks, levels);
+    EXPECT_GT(near.tets.size(), far.tets.size());
+}
+
+// The near plane coplanar with a face of the box (the eye on the face,
+// looking along its normal): the clipped volume is the box beyond the plane.
+TEST(LodVolumeHardCases, NearPlaneCoplanarWithTheBoxFace) {
+    auto v = LodVolume::create(voltest::randomField({17, 17, 17}, 34), {});
+    ASSERT_TRUE(v) << v.error();
+    const float nearPlane = 0.1f;
+    const Camera cam = Camera::lookAt({-0.1f, 8, 8}, {16, 8, 8}, {0, 0, 1}, glm::radians(60.0f), {64, 48}, nearPlane, 1000.0f);
+    LodRefineDesc r = allOff(10.0f);
+    r.clipNear = true;
+    LodFrame f;
+    ASSERT_TRUE(v->update(cam, r, nullptr, f));
+    double volume = 0.0;
+    for (const Tetrahedron& t : f.tets) {
+        EXPECT_GT(tetVolume(t), 0.0);
+        volume += tetVolume(t);
+    }
+    EXPECT_NEAR(volume, 16.0 * 16.0 * 16.0, 1e-5 * 4096.0) << "the plane is the face: nothing is cut away";
+}
+
+// A ray exactly in a plane of shared faces (x = 8, a lattice plane) and one
+// 10^-9 beside it: the integral is continuous (no face counted twice or skipped).
+TEST(LodVolumeHardCases, ARayInAPlaneOfSharedFacesIntegratesContinuously) {
+    auto v = LodVolume::create(voltest::randomField({17, 17, 17}, 35), {});
+    ASSERT_TRUE(v) << v.error();
+    auto tf = TransferFunction::create({{0.0f, {1, 0.2f, 0.1f}, 0.1f}, {1.0f, {0.1f, 0.3f, 1}, 0.6f}});
+    ASSERT_TRUE(tf);
+    const glm::dvec3 d = glm::normalize(glm::dvec3(0.0, 1.0, 0.37));
+    const glm::dvec4 on = v->integrateRay(*tf, {8.0, -1.0, 2.0}, d, 0.0, 40.0);
+    const glm::dvec4 beside = v->integrateRay(*tf, {8.0 + 1e-9, -1.0, 2.0}, d, 0.0, 40.0);
+    for (int ch = 0; ch < 4; ++ch) EXPECT_NEAR(on[ch], beside[ch], 1e-6) << ch;
+    EXPECT_GT(on.a, 0.1);
+}
+
+// A ray through a grid point shared by 24 tetrahedra and along a lattice
+// edge: as continuous as one 10^-9 off it.
+TEST(LodVolumeHardCases, ARayThroughAGridPointAndAlongAnEdge) {
+    auto v = LodVolume::create(voltest::randomField({17, 17, 17}, 36), {});
+    ASSERT_TRUE(v) << v.error();
+    auto tf = TransferFunction::create({{0.0f, {1, 0.2f, 0.1f}, 0.1f}, {1.0f, {0.1f, 0.3f, 1}, 0.6f}});
+    ASSERT_TRUE(tf);
+    for (const glm::dvec3 d : {glm::normalize(glm::dvec3(1.0, 1.0, 1.0)), glm::dvec3(1.0, 0.0, 0.0)}) {
+        const glm::dvec3 through(8.0, 8.0, 8.0);
+        const glm::dvec4 on = v->integrateRay(*tf, through - 20.0 * d, d, 0.0, 60.0);
+        const glm::dvec4 off = v->integrateRay(*tf, through - 20.0 * d + glm::dvec3(0.0, 1e-9, -1e-9), d, 0.0, 60.0);
+        for (int ch = 0; ch < 4; ++ch) EXPECT_NEAR(on[ch], off[ch], 1e-6) << ch;
+    }
+}
+
+// Length scales of 0 everywhere (no extinction length at all): finite
+// tetrahedra and a finite, transparent-or-not but never NaN ray integral.
+TEST(LodVolumeHardCases, ZeroLengthScalesEverywhereStayFinite) {
+    ScalarVolume field = voltest::randomField({9, 9, 9}, 37, true);
+    std::fill(field.lengthScale.begin(), field.lengthScale.end(), 0.0f);
+    auto v = LodVolume::create(field, {});
+    ASSERT_TRUE(v) << v.error();
+    auto tf = makeCloudTransfer({});
+    ASSERT_TRUE(tf);
+    LodFrame f;
+    ASSERT_TRUE(v->update(cameraAt({-10, 4, 4}, {4, 4, 4}), allOff(10.0f), nullptr, f));
+    for (const Tetrahedron& t : f.tets)
+        for (float l : t.lengthScale) ASSERT_EQ(l, 0.0f);
+    const glm::dvec4 r = v->integrateRay(*tf, {-1, 4.2, 3.9}, {1, 0, 0}, 0.0, 20.0);
+    for (int ch = 0; ch < 4; ++ch) EXPECT_TRUE(std::isfinite(r[ch]));
+}
+
+// Grid spacings of 10^-4 and 10^4: the mesh scales, no tetrahedron degenerates.
+TEST(LodVolumeHardCases, SpacingsFromATenthOfAMillimetreToTenKilometres) {
+    for (float s : {1e-4f, 1e4f}) {
+        auto v = LodVolume::create(voltest::randomField({9, 9, 9}, 38), {.originWorld = glm::vec3(3.0f * s), .spacingWorld = s});
+        ASSERT_TRUE(v) << v.error();
+        const glm::vec3 c = v->originWorld() + glm::vec3(4.0f * s);
+        LodFrame f;
+        ASSERT_TRUE(v->update(cameraAt(c - glm::vec3(10.0f * s, 0, 0), c), allOff(1e9f), nullptr, f));
+        int tChecks = 0, levels = 0;
+        expectConforming(*v, f.tets, tChecks, levels);
+    }
+}
+
+// An explicit root level equal to the grid's own (one root for the whole
+// volume) and the smallest (roots of 2 cells: a forest of 4^3 roots).
+TEST(LodVolumeHardCases, OneRootOrAForestOfTheSmallestRoots) {
+    for (int root : {4, 1}) {
+        auto v = LodVolume::create(voltest::randomField({17, 17, 17}, 39), {.rootLevel = root});
+        ASSERT_TRUE(v) << v.error();
+        EXPECT_EQ(v->rootLevel(), root);
+        LodFrame f;
+        ASSERT_TRUE(v->update(cameraAt({-10, 8, 8}, {8, 8, 8}), allOff(10.0f), nullptr, f));
+        int tChecks = 0, levels = 0;
+        expectConforming(*v, f.tets, tChecks, levels);
+    }
+}

@@ -153,7 +153,7 @@ struct LodVolumeDesc {
     glm::vec3 originWorld{0.0f};                          // default (0,0,0): world position of grid point (0,0,0)
     float spacingWorld = 1.0f;                            // default 1: world distance between grid points
     int rootLevel = 0;                                    // default 0 = auto: roots are cubes of 2^rootLevel cells (see LodVolume)
-    float minAccuracyC = 4.0f;                            // default 4: C of eq. 1 (> sqrt(3)/2); fixes K_max of eq. 4 at build time
+    float minAccuracyC = 4.0f;                            // default 4: C of eq. 1 (> sqrt(3), as eq. 4 needs); fixes K_max of eq. 4 at build time
     DeltaMode delta = DeltaMode::Max;                     // default Max
     float padValue = 0.0f;                                // default 0: value of the points added by padding (both fields)
     std::size_t memoryBudgetBytes = std::size_t(1) << 30; // default 1 GiB: create() fails beyond it

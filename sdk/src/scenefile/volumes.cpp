@@ -330,7 +330,7 @@ void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& 
         o.color3("bright", td.bright);
         o.color3("dark", td.dark);
         o.number("detailC", detailC, 1e-3, 1e9);
-        o.number("minAccuracyC", minC, 0.9, 1e4);
+        o.number("minAccuracyC", minC, 1.7320509, 1e4); // eq. 4 holds for C > sqrt(3)
         o.boolean("morph", morph);
         o.integer("tableScalars", scalarRes, 2, 256);
         o.integer("tableLengths", lengthRes, 2, 512);
