@@ -133,8 +133,15 @@ struct EffectStatus {
     bool inView = false;                 // in range and inside the frustum
     bool alive = false;                  // in view and with material present (only tested when in view)
     bool needed = false;                 // enabled && inRange && inView && alive
+    // Not needed (out of view), but lit, shadow-casting, in range and alive,
+    // and its shadow towards the scene-shadow light can reach the view
+    // (Scene::shadowReachesView): advanced to the time and put into the scene
+    // shadow, not emitted (docs/lighting.md, "Scheduled by light influence").
+    bool castsIntoView = false;
+    bool inSceneShadow = false;          // its density was in the frame's scene shadow at the last prepare()
     std::uint64_t framesNeeded = 0;      // updates where it was needed
-    std::uint64_t framesSkipped = 0;     // updates where it was not (no work done)
+    std::uint64_t framesCastOnly = 0;    // updates where it was advanced only to cast into the view (castsIntoView)
+    std::uint64_t framesSkipped = 0;     // updates where it was neither (no work done)
     std::uint64_t catchUps = 0;          // returns of a stateful kind after being skipped (AdvanceResult::caughtUp)
     std::uint64_t splatsDrawn = 0;       // splats emitted at the last emit()
     std::uint64_t tetrahedraDrawn = 0;   // tetrahedra emitted at the last prepare() (emit() takes none)
@@ -142,19 +149,26 @@ struct EffectStatus {
     bool lit = false;                    // lit at the last emit()
     std::uint64_t shadowTableBuilds = 0; // self-shadowing tables built (cumulative)
     std::uint64_t shadowTableReuses = 0; // ... and reused unchanged (cumulative)
+    std::uint64_t shadowTableSkips = 0;  // self-shadowing tables not updated: the light cannot reach the effect (cumulative)
 };
 
 // Every count covers effects of every kind.
 struct SceneCounters {
     std::size_t declared = 0;            // effects in the scene
     std::size_t needed = 0;              // needed at the last update (= advanced and emitted)
-    std::size_t simulated = 0;           // effects advanced to the time at the last update
+    std::size_t simulated = 0;           // effects advanced to the time at the last update (needed + castOnly)
+    std::size_t castOnly = 0;            // of those, advanced only to cast into the view (EffectStatus::castsIntoView)
+    std::size_t castersCulled = 0;       // lit casters out of view whose shadow cannot reach it: not advanced
     std::uint64_t splats = 0;            // splats emitted at the last emit()
     std::uint64_t tetrahedra = 0;        // tetrahedra emitted at the last prepare()
     std::size_t litEffects = 0;          // effects lit at the last emit()
     std::uint64_t shadowTableBuilds = 0; // self-shadowing and scene-shadow tables built at the last emit()
     std::uint64_t shadowTableReuses = 0; // ... reused unchanged at the last emit()
     std::uint64_t sceneShadowBuilds = 0; // scene-shadow table builds (cumulative)
+    std::size_t sceneShadowCasters = 0;  // effects in the scene shadow at the last prepare()
+    // Self-shadowing tables not updated at the last emit() because their
+    // light cannot reach the effect (a spot light's cone misses its bounds).
+    std::uint64_t shadowTableSkips = 0;
 };
 
 class Scene {
@@ -223,6 +237,18 @@ public:
     // True when any part of the box may be inside the camera's frustum
     // (conservative: boxes near a frustum corner may pass).
     static bool inFrustum(const Aabb& box, const Camera& camera);
+    // True when the light may reach some point of the box (conservative).
+    // Directional and point lights reach everything (splatfx's lights have
+    // no range); a spot light misses a box whose bounding sphere lies
+    // outside its outer cone (where its irradiance is exactly 0).
+    static bool lightReaches(const Light& light, const Aabb& box);
+    // True when the shadow of a caster within `caster`, cast by `light`, may
+    // fall inside the camera's frustum (conservative): the caster's box
+    // extruded away from the light (along a directional light's travel, away
+    // from a point or spot light's position, without end) is tested against
+    // the frustum's planes, and a light that cannot reach the box casts no
+    // shadow. Used to schedule casters by light influence (docs/lighting.md).
+    static bool shadowReachesView(const Aabb& caster, const Light& light, const Camera& camera);
 
     // ---- Lights (docs/lighting.md, "In a Scene") ---------------------------
     // Adds a light; fails on an invalid light (the message names the field).
@@ -254,6 +280,7 @@ private:
         ShadowTables tables;                    // self-shadowing, one per light
         glm::ivec3 tableDims{0};                // what `tables` was made with
         std::vector<glm::vec3> points, factors; // scratch: splat centres and their light factors
+        std::vector<bool> reaches;              // scratch: which lights reach the effect (Scene::lightReaches)
     };
     struct Entry {
         std::unique_ptr<EffectKind> kind; // never null; on the heap, so what a Frame points at stays put
@@ -266,6 +293,9 @@ private:
     std::size_t emitInto(SplatBuilder& builder, std::vector<FrameVolume>* volumes, const Materials& materials, const EmitOptions& options);
     // Lights the splats [first, end) the entry just emitted.
     void lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first, const EmitOptions& draw);
+    // Refreshes e.lit->field from the kind's lighting density; false when the
+    // kind has none or it is bad (then mLightingError says why).
+    bool updateLitField(Entry& e, const Materials& materials, const EmitOptions& draw);
     void shadeScene(Frame& frame); // fills frame.shadow()
 
     std::vector<Entry> mEntries;
