@@ -97,6 +97,20 @@ struct SceneShadowDesc {
     std::uint64_t memoryBudgetBytes = 64ull << 20; // as ShadowTableDesc; default 64 MiB
 };
 
+// Which of the scene's fog terms a frame draws (docs/fog.md, "Terms out of
+// view"). Terms whose optical depth along every view ray is provably small
+// (Fog::termDepthBound over the view frustum's box) are dropped, smallest
+// first, while the dropped bounds sum to at most maxSkippedDepth; so no
+// pixel's fog transmittance, hence no fogged colour channel in [0, 1], moves
+// by more than 1 - exp(-maxSkippedDepth) <= maxSkippedDepth. With every term
+// dropped (and no far cut-off within the view) the frame has no fog and the
+// fog pass is skipped.
+struct FogCullDesc {
+    bool enabled = true; // default true
+    // >= 0, optical depth (natural log units); default 1/512: under half an 8-bit level.
+    double maxSkippedDepth = 1.0 / 512.0;
+};
+
 // How the Scene treats one effect. Every field applies to every kind; a
 // field a kind has no use for (catch-up for a stateless kind, refine for a
 // splat effect) is ignored by it.
@@ -169,6 +183,14 @@ struct SceneCounters {
     // Self-shadowing tables not updated at the last emit() because their
     // light cannot reach the effect (a spot light's cone misses its bounds).
     std::uint64_t shadowTableSkips = 0;
+    // The scene's fog at the last prepare() (FogCullDesc): terms drawn and
+    // dropped, and whether the frame got no fog at all because none is in view.
+    std::size_t fogTermsDrawn = 0;
+    std::size_t fogTermsSkipped = 0;
+    bool fogSkipped = false;
+    // Frames whose dropped terms left a fog that failed validation (a dropped
+    // term held the rest non-negative): the full fog was drawn (cumulative).
+    std::uint64_t fogCullFallbacks = 0;
 };
 
 class Scene {
@@ -268,9 +290,12 @@ public:
     // ---- Fog (docs/fog.md) -------------------------------------------------
     // The scene's fog, handed to every Frame prepare() fills (Frame::setFog).
     // A Fog is a pure function of time: it costs nothing while out of view.
-    void setFog(Fog fog) { mFog = std::make_shared<const Fog>(std::move(fog)); }
-    void clearFog() { mFog.reset(); }
+    void setFog(Fog fog) { mFog = std::make_shared<const Fog>(std::move(fog)), mFogView.reset(), mFogKeep.clear(); }
+    void clearFog() { mFog.reset(), mFogView.reset(), mFogKeep.clear(); }
     const Fog* fog() const { return mFog.get(); }
+    // Which terms each frame draws; a bad desc (negative or NaN depth) disables culling.
+    void setFogCulling(const FogCullDesc& desc) { mFogCull = desc; }
+    const FogCullDesc& fogCulling() const { return mFogCull; }
 
 private:
     // What a lit effect keeps between frames (scene_lighting.cpp).
@@ -297,6 +322,8 @@ private:
     // kind has none or it is bad (then mLightingError says why).
     bool updateLitField(Entry& e, const Materials& materials, const EmitOptions& draw);
     void shadeScene(Frame& frame); // fills frame.shadow()
+    // The fog this camera's frame draws: mFog without the terms it cannot see (scene_fog.cpp).
+    std::shared_ptr<const Fog> fogForView(const Camera& camera, double timeSec);
 
     std::vector<Entry> mEntries;
     SceneCounters mCounters;
@@ -311,6 +338,9 @@ private:
     const ShadowTable* mSceneShadowSource = nullptr; // mSceneShadow, or a lit effect's own table it shares
     std::string mLightingError;
     std::shared_ptr<const Fog> mFog; // default none
+    FogCullDesc mFogCull;
+    std::shared_ptr<const Fog> mFogView; // mFog with the terms of mFogKeep (rebuilt when the kept set changes)
+    std::vector<bool> mFogKeep;
 };
 
 } // namespace splatfx

@@ -202,7 +202,7 @@ Status Scene::prepare(double timeSec, const Camera& camera, const Materials& mat
     emitInto(frame.builder(), &frame.volumes(), materials, options);
     shadeScene(frame); // the lit effects' shadow on the scene, into frame.shadow()
     frame.end();
-    frame.setFog(mFog);
+    frame.setFog(fogForView(camera, timeSec)); // only the terms this view can see
     FrameCounters& c = frame.counters();
     c.litEffects = mCounters.litEffects;
     c.shadowTableBuilds = mCounters.shadowTableBuilds;
