@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <functional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -20,6 +21,7 @@
 #include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/gl/framebuffer.hpp"
 #include "splatfx/gl/renderer.hpp"
+#include "splatfx/image_io.hpp"
 #include "splatfx/presets.hpp"
 #include "splatfx/scene.hpp"
 
@@ -86,7 +88,7 @@ double frameCost(splatfx::Scene& scene, splatfx::Materials& m, int frames, doubl
 // view, against a scene holding only what that view needs (the items the
 // level drew or advanced to cast into it, and the fog terms it kept), drawn
 // alternately; then one frame of each read back and compared pixel by pixel.
-int runMixed(int count, int frames, glm::ivec2 size) {
+int runMixed(int count, int frames, glm::ivec2 size, const std::string& imagePath) {
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) return std::fprintf(stderr, "scheduling: %s\n", ctx.error().c_str()), 1;
     splatfx::Materials m{splatfx::Footprint{}};
@@ -131,12 +133,24 @@ int runMixed(int count, int frames, glm::ivec2 size) {
         tLevel.push_back(frameCost(level, m, 1, (11 + f) / 60.0, fixed, nullptr, &drawLevel));
         tNeeded.push_back(frameCost(needed, m, 1, (11 + f) / 60.0, fixed, nullptr, &drawNeeded));
     }
+    // The CPU part alone: Scene::prepare (schedule, advance, emit, light, shadow, sort, fog), alternately.
+    std::vector<double> cLevel, cNeeded;
+    for (int f = 0; f < frames; ++f) {
+        const double t = (11 + frames + f) / 60.0;
+        for (auto [scene, frame, out] : {std::tuple{&level, &drawLevel.frame, &cLevel}, std::tuple{&needed, &drawNeeded.frame, &cNeeded}}) {
+            const auto a = Clock::now();
+            if (splatfx::Status s = scene->prepare(t, fixed(0), m, *frame); !s) return std::fprintf(stderr, "%s\n", s.error().c_str()), 1;
+            out->push_back(std::chrono::duration<double>(Clock::now() - a).count());
+        }
+    }
     // One more frame each at the same time, read back.
-    const double tLast = (11 + frames) / 60.0;
+    const double tLast = (11 + 2 * frames) / 60.0;
     drawFrame(level, m, drawLevel, fixed(0), tLast);
     const splatfx::Image a = fb->read();
     drawFrame(needed, m, drawNeeded, fixed(0), tLast);
     const splatfx::Image b = fb->read();
+    if (!imagePath.empty())
+        if (splatfx::Status s = splatfx::writeImage(imagePath, a); !s) return std::fprintf(stderr, "scheduling: %s\n", s.error().c_str()), 1;
     float worst = 0.0f;
     std::size_t differing = 0;
     for (int y = 0; y < size.y; ++y)
@@ -158,6 +172,8 @@ int runMixed(int count, int frames, glm::ivec2 size) {
     row((std::to_string(count) + " items declared").c_str(), cl, median(tLevel));
     row("only what the view needs", cn, median(tNeeded));
     std::printf("  ratio %.2fx (target: at most 1.3x)\n", median(tLevel) / median(tNeeded));
+    std::printf("  CPU part alone (Scene::prepare, median of %d, alternately): %.3f vs %.3f ms/frame, ratio %.2fx\n", frames, 1e3 * median(cLevel),
+                1e3 * median(cNeeded), median(cLevel) / median(cNeeded));
     std::printf("  level: %zu lit casters culled (shadow cannot reach the view), %zu in the scene shadow\n", cl.castersCulled, cl.sceneShadowCasters);
     std::printf("  in-view image, level vs only-needed: %zu pixels differ, largest difference %.3g (expected 0: out-of-view content changes nothing)\n",
                 differing, double(worst));
@@ -182,9 +198,11 @@ int runScheduling(int argc, char** argv) {
     app.add_flag("--mixed", mixed,
                  "the mixed level instead: every kind (effects, gases, clouds, ground fog, fog terms; lit and shadow-casting), a few in view, "
                  "against only what the view needs; and the in-view pixels compared");
+    std::string imagePath;
+    app.add_option("--image", imagePath, "with --mixed: write the level's last frame here (PNG)")->type_name("FILE");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     if (quick && framesOption->count() == 0) frames = 15;
-    if (mixed) return runMixed(count, frames, size);
+    if (mixed) return runMixed(count, frames, size, imagePath);
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) {
         std::fprintf(stderr, "scheduling: %s\n", ctx.error().c_str());

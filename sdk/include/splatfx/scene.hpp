@@ -21,7 +21,12 @@
 // do not, their light is part of their data): their splat colours follow Ebert & Parent's low-albedo model with
 // self-shadowing, and prepare() puts their shadow on the scene into
 // Frame::shadow() (docs/lighting.md, "In a Scene"). And the scene's fog
-// (setFog), handed to every Frame.
+// (setFog), handed to every Frame without the terms the view cannot see
+// (FogCullDesc). Shadows are scheduled by light influence, not visibility: a
+// lit caster out of view whose shadow can fall into the view
+// (shadowReachesView) is advanced and put into the scene shadow, not drawn
+// (EffectStatus::castsIntoView); a light that cannot reach an effect builds
+// no table for it (lightReaches).
 // It does not render, load files, or own GL resources. Its frustum test is
 // per effect; a LOD volume's refinement culls its own nodes inside
 // (LodRefineDesc::frustumCull).
