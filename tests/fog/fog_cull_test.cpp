@@ -135,7 +135,11 @@ TEST(FogCull, NoFogInViewMeansNoFogInTheFrame) {
     // Culling off: every term, always.
     d.farDistanceWorld = 0.0;
     scene.setFog(*Fog::create(d));
-    scene.setFogCulling({.enabled = false});
+    const Status bad = scene.setFogCulling({.maxSkippedDepth = -1.0});
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error(), "FogCullDesc.maxSkippedDepth must be finite and >= 0 (an optical depth; 0 drops only terms that add nothing), got -1.000000");
+    EXPECT_EQ(scene.fogCulling().maxSkippedDepth, 1.0 / 512.0) << "the previous desc is kept";
+    ASSERT_TRUE(scene.setFogCulling({.enabled = false}));
     ASSERT_TRUE(scene.prepare(0.2, cam, mat, frame));
     ASSERT_NE(frame.fog(), nullptr);
     EXPECT_EQ(frame.fog(), scene.fog());

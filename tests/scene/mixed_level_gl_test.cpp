@@ -46,7 +46,7 @@ TEST_F(MixedLevelGL, OutOfViewContentChangesNoPixelInView) {
     ASSERT_TRUE(bench::buildMixedLevel(needed, m, kCount, [&](int i) { return bool(keep[std::size_t(i)]); }));
     ASSERT_NE(frameLevel.fog(), nullptr);
     needed.setFog(*Fog::create(frameLevel.fog()->desc()));
-    needed.setFogCulling({.enabled = false}); // already the kept terms
+    ASSERT_TRUE(needed.setFogCulling({.enabled = false})); // already the kept terms
     ASSERT_TRUE(needed.prepare(0.0, cam, m, frameNeeded));
 
     auto fb = gl::Framebuffer::create({.width = 160, .height = 120, .color = gl::Precision::F32});

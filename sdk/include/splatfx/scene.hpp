@@ -150,7 +150,7 @@ struct EffectStatus {
     bool enabled = true;
     bool inRange = false;
     bool inView = false;                 // in range and inside the frustum
-    bool alive = false;                  // in view and with material present (only tested when in view)
+    bool alive = false;                  // with material present (only tested when in view, or out of view but casting into it)
     bool needed = false;                 // enabled && inRange && inView && alive
     // Not needed (out of view), but lit, shadow-casting, in range and alive,
     // and its shadow towards the scene-shadow light can reach the view
@@ -298,8 +298,9 @@ public:
     void setFog(Fog fog) { mFog = std::make_shared<const Fog>(std::move(fog)), mFogView.reset(), mFogKeep.clear(); }
     void clearFog() { mFog.reset(), mFogView.reset(), mFogKeep.clear(); }
     const Fog* fog() const { return mFog.get(); }
-    // Which terms each frame draws; a bad desc (negative or NaN depth) disables culling.
-    void setFogCulling(const FogCullDesc& desc) { mFogCull = desc; }
+    // Which terms each frame draws. Fails on a maxSkippedDepth that is
+    // negative or not finite (the message names it), keeping the previous desc.
+    Status setFogCulling(const FogCullDesc& desc);
     const FogCullDesc& fogCulling() const { return mFogCull; }
 
 private:

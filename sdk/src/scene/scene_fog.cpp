@@ -5,10 +5,19 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <string>
 
 #include "splatfx/scene.hpp"
 
 namespace splatfx {
+
+Status Scene::setFogCulling(const FogCullDesc& desc) {
+    if (!(std::isfinite(desc.maxSkippedDepth) && desc.maxSkippedDepth >= 0.0))
+        return makeError("FogCullDesc.maxSkippedDepth must be finite and >= 0 (an optical depth; 0 drops only terms that add nothing), got " +
+                         std::to_string(desc.maxSkippedDepth));
+    mFogCull = desc;
+    return {};
+}
 
 std::shared_ptr<const Fog> Scene::fogForView(const Camera& camera, double timeSec) {
     mCounters.fogTermsDrawn = mCounters.fogTermsSkipped = 0;
@@ -17,7 +26,7 @@ std::shared_ptr<const Fog> Scene::fogForView(const Camera& camera, double timeSe
     const std::size_t n = mFog->desc().terms.size();
     mCounters.fogTermsDrawn = n;
     const FogCullDesc& cull = mFogCull;
-    if (!cull.enabled || !(cull.maxSkippedDepth >= 0.0) || n == 0) return mFog;
+    if (!cull.enabled || n == 0) return mFog;
     // The frustum's world box, from the 8 corners of clip space, and the
     // longest segment inside it (its diagonal).
     const glm::mat4 inv = glm::inverse(camera.proj * camera.view);
