@@ -182,6 +182,7 @@ int runMixed(int count, int frames, glm::ivec2 size, const std::string& imagePat
     std::printf("  level: %zu lit casters culled (shadow cannot reach the view); in the scene shadow: %zu drawn + %zu cast-only "
                 "(a cast-only caster with no density yet casts nothing)\n",
                 cl.castersCulled, drawnShadowing, castShadowing);
+    if (!level.lightingError().empty()) std::printf("  level: lighting: %s\n", level.lightingError().c_str());
     std::printf("  in-view image, level vs only-needed: %zu pixels differ, largest difference %.3g (expected 0: out-of-view content changes nothing)\n",
                 differing, double(worst));
     return differing == 0 ? 0 : 1;
