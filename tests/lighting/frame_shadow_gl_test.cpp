@@ -12,6 +12,7 @@
 #include "gl_fixture.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/lighting.hpp"
+#include "splatfx/scene.hpp"
 #include "test_scenes.hpp"
 
 using namespace splatfx;
@@ -88,10 +89,9 @@ struct Drawn {
     gl::ShadowBinding binding;
 };
 
-Drawn draw(gl::FrameRenderer& fr, const Frame& frame, GLuint prog) {
+Drawn draw(gl::FrameRenderer& fr, const Frame& frame, GLuint prog, const Camera& cam = topDown(), float half = kHalf) {
     auto fb = gl::Framebuffer::create({.width = kSize, .height = kSize, .color = gl::Precision::F32});
     EXPECT_TRUE(fb);
-    const Camera cam = topDown();
     const glm::mat4 vp = cam.proj * cam.view;
     GLuint vao = 0;
     glCreateVertexArrays(1, &vao);
@@ -104,7 +104,7 @@ Drawn draw(gl::FrameRenderer& fr, const Frame& frame, GLuint prog) {
                           glUseProgram(prog);
                           gl::setShadowUniforms(prog, fr.shadowBinding());
                           glUniformMatrix4fv(glGetUniformLocation(prog, "uViewProj"), 1, GL_FALSE, glm::value_ptr(vp));
-                          glUniform1f(glGetUniformLocation(prog, "uHalf"), kHalf);
+                          glUniform1f(glGetUniformLocation(prog, "uHalf"), half);
                           glUniform3fv(glGetUniformLocation(prog, "uAlbedo"), 1, glm::value_ptr(kAlbedo));
                           glBindVertexArray(vao);
                           glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
@@ -178,4 +178,55 @@ TEST_F(FrameShadowGL, BadShadowUnitIsRefusedByName) {
     auto fr = gl::FrameRenderer::create({.shadowTextureUnit = 16});
     ASSERT_FALSE(fr);
     EXPECT_NE(fr.error().find("shadowTextureUnit"), std::string::npos) << fr.error();
+}
+
+TEST_F(FrameShadowGL, TurningTheCameraOffACasterLeavesTheGroundsShadowInViewUnchanged) {
+    // Issue 24 item 4 / issue 27: shadows are scheduled by light influence. A lit plume at height 3 to
+    // 5.2 with the sun travelling along +x and down shadows the ground 3 to 5 units to its right.
+    // Camera A sees the plume; camera B, turned right from the same eye, sees only its shadow.
+    std::string log;
+    const GLuint prog = groundProgram(log);
+    ASSERT_NE(prog, 0u) << log;
+    Materials materials{Footprint{}};
+    const std::uint32_t row = materials.addColorTable(ColorTable::constant({0.8f, 0.8f, 0.8f, 1.0f}));
+    Scene scene;
+    const Light sun = Light::directional({1.0f, -1.0f, 0.0f});
+    ASSERT_TRUE(scene.addLight(sun));
+    Grid g = test::gaussianBlob(12, 0.2f, 0.9f);
+    g.transform = glm::translate(glm::mat4(1.0f), glm::vec3(-4.0f, 3.0f, -1.1f));
+    EffectDesc desc;
+    desc.layers = {EffectLayer{.style = {.colorTable = row, .textured = false}}};
+    const EffectId plume =
+        scene.add(*Effect::fromGrid(g, desc), {.name = "plume", .lighting = {.enabled = true, .selfShadow = SelfShadow::Off}});
+    const glm::vec3 eye(1.0f, 9.0f, 6.0f);
+    const Camera a = Camera::lookAt(eye, {-1.5f, 2.0f, 0.0f}, {0, 1, 0}, glm::radians(36.0f), {kSize, kSize}, 0.1f, 100.0f);
+    const Camera b = Camera::lookAt(eye, {1.5f, 0.0f, 0.0f}, {0, 1, 0}, glm::radians(36.0f), {kSize, kSize}, 0.1f, 100.0f);
+    Frame frameA, frameB;
+    ASSERT_TRUE(scene.prepare(0.0, a, materials, frameA));
+    ASSERT_TRUE(scene.status(plume).inView);
+    ASSERT_TRUE(scene.prepare(1 / 30.0, b, materials, frameB));
+    ASSERT_FALSE(scene.status(plume).inView) << "camera B must not see the plume";
+    ASSERT_TRUE(scene.status(plume).castsIntoView);
+    ASSERT_EQ(frameB.splats().size(), 0u);
+    // What camera B would see with the plume's shadow as the frame that drew the plume had it.
+    Frame withCasterDrawn;
+    withCasterDrawn.begin(1 / 30.0, b);
+    withCasterDrawn.end();
+    withCasterDrawn.shadow() = frameA.shadow();
+    auto fr = gl::FrameRenderer::create();
+    ASSERT_TRUE(fr);
+    const Drawn turned = draw(*fr, frameB, prog, b, 20.0f);
+    const Drawn reference = draw(*fr, withCasterDrawn, prog, b, 20.0f);
+    ASSERT_TRUE(turned.binding.valid);
+    // The same table, camera and shader: the same pixels, bit for bit (tolerance 0).
+    float darkest = 1.0f;
+    for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x) {
+            for (int c = 0; c < 3; ++c) ASSERT_EQ(turned.image.at(x, y, c), reference.image.at(x, y, c)) << x << "," << y;
+            if (turned.image.at(x, y, 0) > 0.0f) darkest = std::min(darkest, turned.image.at(x, y, 0) / kAlbedo.r);
+        }
+    // The shadow is there in view (0.2 sky + 0.8 T; T < 0.6 under the plume's shadow): the test would
+    // fail if the caster were dropped from the table when it left the view.
+    EXPECT_LT(darkest, 0.2f + 0.8f * 0.6f);
+    glDeleteProgram(prog);
 }

@@ -116,3 +116,66 @@ TEST(Clouds, BadDescIsRejected) {
     ASSERT_FALSE(b);
     EXPECT_NE(b.error().find("ambient"), std::string::npos);
 }
+
+// Per-node frustum culling of a LOD cloud (Roettger & Ertl sec. 4.2;
+// issue 24 item 4): nodes outside the frustum emit no tetrahedra, and what is
+// in view is unchanged. The culled list is the full list less tetrahedra that
+// each lie wholly behind one frustum plane, in the same order, so every pixel
+// ray integrates the same pieces: the reference image in view is the same to
+// the bit.
+TEST(Clouds, FrustumCullingDropsOnlyNodesOutOfView) {
+    CloudDesc d;
+    d.dims = {33, 33, 17};
+    auto field = makeCloudVolume(d);
+    ASSERT_TRUE(field);
+    auto vol = LodVolume::create(*field, {});
+    ASSERT_TRUE(vol) << vol.error();
+    auto tf = makeCloudTransfer({});
+    ASSERT_TRUE(tf);
+    // Above the deck (z up), looking down on a corner of it: most nodes are beside the view.
+    const Camera cam = Camera::lookAt({22, 22, 40}, {26, 26, 8}, {0, 1, 0}, glm::radians(30.0f), {48, 36}, 0.1f, 200.0f);
+    LodRefineDesc on;
+    on.detailC = 50.0f;
+    LodRefineDesc off = on;
+    off.frustumCull = false;
+    LodFrame culled, all;
+    ASSERT_TRUE(vol->update(cam, on, &*tf, culled));
+    ASSERT_TRUE(vol->update(cam, off, &*tf, all));
+    EXPECT_GT(culled.stats.nodesCulled, 0u);
+    EXPECT_EQ(all.stats.nodesCulled, 0u);
+    EXPECT_LT(culled.tets.size() * 2, all.tets.size()) << "most of the deck is out of this view";
+    const glm::mat4 vp = cam.proj * cam.view;
+    auto behindOnePlane = [&](const Tetrahedron& t) {
+        for (int i = 0; i < 3; ++i)
+            for (float sign : {-1.0f, 1.0f}) {
+                const glm::vec4 pl = glm::vec4(vp[0][3], vp[1][3], vp[2][3], vp[3][3]) + sign * glm::vec4(vp[0][i], vp[1][i], vp[2][i], vp[3][i]);
+                bool every = true;
+                for (const glm::vec3& p : t.position) every = every && glm::dot(glm::vec3(pl), p) + pl.w < 0.0f;
+                if (every) return true;
+            }
+        return false;
+    };
+    std::size_t k = 0;
+    for (const Tetrahedron& t : all.tets) {
+        if (k < culled.tets.size() && culled.tets[k].position == t.position && culled.tets[k].scalar == t.scalar) {
+            ++k;
+            continue;
+        }
+        ASSERT_TRUE(behindOnePlane(t)) << "a dropped tetrahedron reaches into the view";
+    }
+    ASSERT_EQ(k, culled.tets.size()) << "the kept tetrahedra are a subsequence of the full list";
+    // The reference image in view: every pixel centre's ray through both lists.
+    const glm::mat4 inv = glm::inverse(vp);
+    const glm::dvec3 eye(cam.eye());
+    int cloudy = 0;
+    for (int y = 0; y < 36; ++y)
+        for (int x = 0; x < 48; ++x) {
+            const glm::vec4 f = inv * glm::vec4((x + 0.5f) / 48.0f * 2 - 1, (y + 0.5f) / 36.0f * 2 - 1, 1.0f, 1.0f);
+            const glm::dvec3 dir = glm::normalize(glm::dvec3(glm::vec3(f) / f.w) - eye);
+            const glm::dvec4 a = integrateRay(culled.tets, *tf, eye, dir, 0.0, 1e4);
+            const glm::dvec4 b = integrateRay(all.tets, *tf, eye, dir, 0.0, 1e4);
+            cloudy += b.a > 1e-3;
+            ASSERT_EQ(a, b) << "pixel " << x << "," << y;
+        }
+    EXPECT_GT(cloudy, 48 * 36 / 10) << "the view should hold cloud for this test to mean anything";
+}

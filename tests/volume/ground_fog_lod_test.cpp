@@ -92,7 +92,8 @@ TEST(GroundFogLod, FullRefinementEqualsTheFullResolutionLayer) {
         for (const Camera& cam : {farCamera(), insideCamera()}) {
             LodFrame a, b;
             std::vector<glm::vec3> ta, tb;
-            ASSERT_TRUE(full->update(cam, LodRefineDesc{}, a, &ta));
+            // Neither culls (the full-resolution layer's culling is tested below).
+            ASSERT_TRUE(full->update(cam, LodRefineDesc{.frustumCull = false}, a, &ta));
             ASSERT_TRUE(lod->update(cam, kFull, b, &tb));
             ASSERT_GT(a.tets.size(), 0u);
             EXPECT_EQ(a.tets.size(), b.tets.size()) << dims.x << "x" << dims.y;
@@ -493,6 +494,65 @@ TEST(GroundFogLod, FrustumCullingDropsOnlyWhatIsOutOfView) {
         EXPECT_EQ(a, b) << "ray " << r;
     }
     EXPECT_GT(hits, 30);
+}
+
+// The full-resolution layer is culled too (issue 24 item 4): BSP nodes (sort
+// free: rows, then cells) whose box is outside the frustum emit no prisms.
+// Every dropped tetrahedron lies behind one frustum plane, rays inside the
+// frustum integrate the same fog, and the host's terrain is the whole grid.
+TEST(GroundFogLod, FullResolutionFrustumCullingDropsOnlyWhatIsOutOfView) {
+    const Camera cam = Camera::lookAt({-6.0f, 3.0f, -6.0f}, {4.0f, 0.0f, 0.0f}, {0, 1, 0}, glm::radians(40.0f), {64, 48}, 0.1f, 500.0f);
+    const glm::mat4 vp = cam.proj * cam.view;
+    auto behindOnePlane = [&](const Tetrahedron& t) {
+        for (int i = 0; i < 3; ++i)
+            for (float sign : {-1.0f, 1.0f}) {
+                const glm::vec4 pl = glm::vec4(vp[0][3], vp[1][3], vp[2][3], vp[3][3]) + sign * glm::vec4(vp[0][i], vp[1][i], vp[2][i], vp[3][i]);
+                bool all = true;
+                for (const glm::vec3& p : t.position) all = all && glm::dot(glm::vec3(pl), p) + pl.w < 0.0f;
+                if (all) return true;
+            }
+        return false;
+    };
+    for (bool sortFree : {false, true}) {
+        GroundFogDesc d = valleys({33, 33}, 0.8f, false);
+        d.sortFree = sortFree;
+        auto fog = GroundFog::create(d);
+        auto tf = makeGroundFogTransfer({1, 1, 1}, 0.8f);
+        ASSERT_TRUE(fog && tf);
+        LodFrame culled, all;
+        std::vector<glm::vec3> tc, ta;
+        ASSERT_TRUE(fog->update(cam, LodRefineDesc{.frustumCull = true}, culled, &tc));
+        ASSERT_TRUE(fog->update(cam, LodRefineDesc{.frustumCull = false}, all, &ta));
+        EXPECT_GT(culled.stats.nodesCulled, 0u) << sortFree;
+        EXPECT_EQ(all.stats.nodesCulled, 0u);
+        EXPECT_LT(culled.tets.size() * 3, all.tets.size() * 2) << "a third or more of the grid is out of this view";
+        EXPECT_EQ(culled.stats.fullResolution, all.stats.fullResolution);
+        EXPECT_EQ(sortedTriangles(tc), sortedTriangles(ta));
+        // What was dropped is out of view: the kept tetrahedra are the full list's, in its order, less
+        // only tetrahedra wholly behind one plane.
+        std::size_t k = 0, dropped = 0;
+        for (const Tetrahedron& t : all.tets) {
+            if (k < culled.tets.size() && culled.tets[k].position == t.position && culled.tets[k].scalar == t.scalar) {
+                ++k;
+                continue;
+            }
+            ++dropped;
+            ASSERT_TRUE(behindOnePlane(t)) << "a dropped tetrahedron reaches into the view";
+        }
+        EXPECT_EQ(k, culled.tets.size()) << "the kept ones are a subsequence of the full list";
+        EXPECT_EQ(dropped, all.tets.size() - culled.tets.size());
+        std::mt19937 rng(9);
+        std::uniform_real_distribution<double> u(-0.3, 0.3); // tan(20 deg) = 0.36 vertically: inside the frustum
+        int hits = 0;
+        for (int r = 0; r < 120; ++r) {
+            const glm::dvec3 dir = glm::dvec3(cam.forward()) + u(rng) * glm::dvec3(cam.right()) + u(rng) * glm::dvec3(cam.up());
+            const glm::dvec4 a = integrateRay(culled.tets, *tf, glm::dvec3(cam.eye()), dir, 0.0, 1e4);
+            const glm::dvec4 b = integrateRay(all.tets, *tf, glm::dvec3(cam.eye()), dir, 0.0, 1e4);
+            hits += b.a > 1e-3;
+            EXPECT_EQ(a, b) << "ray " << r;
+        }
+        EXPECT_GT(hits, 30);
+    }
 }
 
 // The sort-free model (eq. 10) on the LOD terrain: the same tetrahedra as

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <functional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -14,11 +15,13 @@
 #include <epoxy/gl.h>
 
 #include "bench_stats.hpp"
+#include "mixed_level.hpp"
 #include "options.hpp"
 #include "splatfx/context.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/gl/framebuffer.hpp"
 #include "splatfx/gl/renderer.hpp"
+#include "splatfx/image_io.hpp"
 #include "splatfx/presets.hpp"
 #include "splatfx/scene.hpp"
 
@@ -81,6 +84,110 @@ double frameCost(splatfx::Scene& scene, splatfx::Materials& m, int frames, doubl
     return t[t.size() / 2];
 }
 
+// The mixed level (mixed_level.hpp): every kind, lit and shadowing, a few in
+// view, against a scene holding only what that view needs (the items the
+// level drew or advanced to cast into it, and the fog terms it kept), drawn
+// alternately; then one frame of each read back and compared pixel by pixel.
+int runMixed(int count, int frames, glm::ivec2 size, const std::string& imagePath) {
+    auto ctx = splatfx::HeadlessContext::create();
+    if (!ctx) return std::fprintf(stderr, "scheduling: %s\n", ctx.error().c_str()), 1;
+    splatfx::Materials m{splatfx::Footprint{}};
+    splatfx::Scene level, needed;
+    std::printf("building the mixed level of %d items (effects, gases, clouds, ground fog; fog terms; lit and casting) ...\n", count);
+    const auto buildStart = Clock::now();
+    if (splatfx::Status s = bench::buildMixedLevel(level, m, count, [](int) { return true; }); !s)
+        return std::fprintf(stderr, "scheduling: %s\n", s.error().c_str()), 1;
+    auto fog = splatfx::Fog::create(bench::mixedFog(count));
+    if (!fog) return std::fprintf(stderr, "scheduling: %s\n", fog.error().c_str()), 1;
+    level.setFog(*fog);
+    int kinds[7] = {};
+    for (int i = 0; i < count; ++i) ++kinds[bench::mixedItem(i, count).kind];
+    std::printf("built in %.1f s: %d fire, %d steam, %d smoke solvers (lit), %d fire-to-smoke, %d procedural gases (lit), %d cloud decks,\n"
+                "  %d ground fog layers, %zu fog terms; %u texture sets\n",
+                std::chrono::duration<double>(Clock::now() - buildStart).count(), kinds[0], kinds[1], kinds[2], kinds[3], kinds[4], kinds[5], kinds[6],
+                fog->desc().terms.size(), m.setCount());
+    auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
+    auto renderer = splatfx::gl::FrameRenderer::create();
+    auto renderer2 = splatfx::gl::FrameRenderer::create();
+    if (!fb || !renderer || !renderer2) return std::fprintf(stderr, "scheduling: framebuffer or renderer failed\n"), 1;
+    FrameDraw drawLevel{*fb, *renderer, splatfx::Frame{}}, drawNeeded{*fb, *renderer2, splatfx::Frame{}};
+    const auto fixed = [&](int) { return bench::mixedCamera(size); };
+    // What this view needs, as the level decides it at t = 0.
+    if (splatfx::Status s = level.prepare(0.0, fixed(0), m, drawLevel.frame); !s) return std::fprintf(stderr, "%s\n", s.error().c_str()), 1;
+    std::vector<bool> keep(std::size_t(count), false);
+    for (int i = 0; i < count; ++i) keep[std::size_t(i)] = level.status(splatfx::EffectId(i)).needed || level.status(splatfx::EffectId(i)).castsIntoView;
+    if (splatfx::Status s = bench::buildMixedLevel(needed, m, count, [&](int i) { return bool(keep[std::size_t(i)]); }); !s)
+        return std::fprintf(stderr, "scheduling: %s\n", s.error().c_str()), 1;
+    if (drawLevel.frame.fog()) {
+        needed.setFog(*splatfx::Fog::create(drawLevel.frame.fog()->desc()));
+        (void)needed.setFogCulling({.enabled = false}); // already only the kept terms (a valid desc)
+    }
+    if (splatfx::Status s = needed.prepare(0.0, fixed(0), m, drawNeeded.frame); !s) return std::fprintf(stderr, "%s\n", s.error().c_str()), 1;
+    for (auto* r : {&*renderer, &*renderer2})
+        if (splatfx::Status s = r->upload(m); !s) return std::fprintf(stderr, "scheduling: %s\n", s.error().c_str()), 1;
+    std::printf("drawing at %dx%d on %s\n\n", size.x, size.y, ctx->renderer().c_str());
+    frameCost(level, m, 10, 1 / 60.0, fixed, nullptr, &drawLevel);
+    frameCost(needed, m, 10, 1 / 60.0, fixed, nullptr, &drawNeeded);
+    std::vector<double> tLevel, tNeeded;
+    for (int f = 0; f < frames; ++f) {
+        tLevel.push_back(frameCost(level, m, 1, (11 + f) / 60.0, fixed, nullptr, &drawLevel));
+        tNeeded.push_back(frameCost(needed, m, 1, (11 + f) / 60.0, fixed, nullptr, &drawNeeded));
+    }
+    // The CPU part alone: Scene::prepare (schedule, advance, emit, light, shadow, sort, fog), alternately.
+    std::vector<double> cLevel, cNeeded;
+    for (int f = 0; f < frames; ++f) {
+        const double t = (11 + frames + f) / 60.0;
+        for (auto [scene, frame, out] : {std::tuple{&level, &drawLevel.frame, &cLevel}, std::tuple{&needed, &drawNeeded.frame, &cNeeded}}) {
+            const auto a = Clock::now();
+            if (splatfx::Status s = scene->prepare(t, fixed(0), m, *frame); !s) return std::fprintf(stderr, "%s\n", s.error().c_str()), 1;
+            out->push_back(std::chrono::duration<double>(Clock::now() - a).count());
+        }
+    }
+    // One more frame each at the same time, read back.
+    const double tLast = (11 + 2 * frames) / 60.0;
+    drawFrame(level, m, drawLevel, fixed(0), tLast);
+    const splatfx::Image a = fb->read();
+    drawFrame(needed, m, drawNeeded, fixed(0), tLast);
+    const splatfx::Image b = fb->read();
+    if (!imagePath.empty())
+        if (splatfx::Status s = splatfx::writeImage(imagePath, a); !s) return std::fprintf(stderr, "scheduling: %s\n", s.error().c_str()), 1;
+    float worst = 0.0f;
+    std::size_t differing = 0;
+    for (int y = 0; y < size.y; ++y)
+        for (int x = 0; x < size.x; ++x) {
+            float d = 0.0f;
+            for (int c = 0; c < 4; ++c) d = std::max(d, std::abs(a.at(x, y, c) - b.at(x, y, c)));
+            worst = std::max(worst, d);
+            differing += d > 0.0f;
+        }
+    const splatfx::SceneCounters& cl = level.counters();
+    const splatfx::SceneCounters& cn = needed.counters();
+    std::printf("Mixed level, fixed camera, %d frames drawn at %dx%d (update + emit + light + sort + draw + glFinish, median, alternately)\n",
+                frames, size.x, size.y);
+    std::printf("  %-26s %8s %8s %9s %9s %11s %11s %10s\n", "scene", "declared", "drawn", "cast-only", "splats", "tetrahedra", "fog terms", "ms/frame");
+    auto row = [&](const char* name, const splatfx::SceneCounters& c, double t) {
+        std::printf("  %-26s %8zu %8zu %9zu %9llu %11llu %5zu (-%zu) %10.3f\n", name, c.declared, c.needed, c.castOnly, (unsigned long long)c.splats,
+                    (unsigned long long)c.tetrahedra, c.fogTermsDrawn, c.fogTermsSkipped, 1e3 * t);
+    };
+    row((std::to_string(count) + " items declared").c_str(), cl, median(tLevel));
+    row("only what the view needs", cn, median(tNeeded));
+    std::printf("  ratio %.2fx (target: at most 1.3x)\n", median(tLevel) / median(tNeeded));
+    std::printf("  CPU part alone (Scene::prepare, median of %d, alternately): %.3f vs %.3f ms/frame, ratio %.2fx\n", frames, 1e3 * median(cLevel),
+                1e3 * median(cNeeded), median(cLevel) / median(cNeeded));
+    std::size_t castShadowing = 0, drawnShadowing = 0;
+    for (splatfx::EffectId id = 0; id < level.size(); ++id) {
+        castShadowing += level.status(id).castsIntoView && level.status(id).inSceneShadow;
+        drawnShadowing += level.status(id).needed && level.status(id).inSceneShadow;
+    }
+    std::printf("  level: %zu lit casters culled (shadow cannot reach the view); in the scene shadow: %zu drawn + %zu cast-only "
+                "(a cast-only caster with no density yet casts nothing)\n",
+                cl.castersCulled, drawnShadowing, castShadowing);
+    if (!level.lightingError().empty()) std::printf("  level: lighting: %s\n", level.lightingError().c_str());
+    std::printf("  in-view image, level vs only-needed: %zu pixels differ, largest difference %.3g (expected 0: out-of-view content changes nothing)\n",
+                differing, double(worst));
+    return differing == 0 ? 0 : 1;
+}
+
 } // namespace
 
 int runScheduling(int argc, char** argv) {
@@ -95,8 +202,15 @@ int runScheduling(int argc, char** argv) {
     CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 5, 100000, "timed frames per run");
     cli::addSize(app, "--size", size.x, size.y, 16, 8192, "frame size");
     app.add_flag("--quick", quick, "15 frames (unless --frames is given)");
+    bool mixed = false;
+    app.add_flag("--mixed", mixed,
+                 "the mixed level instead: every kind (effects, gases, clouds, ground fog, fog terms; lit and shadow-casting), a few in view, "
+                 "against only what the view needs; and the in-view pixels compared");
+    std::string imagePath;
+    app.add_option("--image", imagePath, "with --mixed: write the level's last frame here (PNG)")->type_name("FILE");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     if (quick && framesOption->count() == 0) frames = 15;
+    if (mixed) return runMixed(count, frames, size, imagePath);
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) {
         std::fprintf(stderr, "scheduling: %s\n", ctx.error().c_str());

@@ -188,6 +188,23 @@ public:
 
     glm::dvec3 windDisplacement(double tSec) const { return mDesc.wind.displacement(tSec); }
 
+    // An upper bound on the optical depth term `term` adds along any segment
+    // of length at most maxLengthWorld inside the box [lo, hi], at tSec
+    // (docs/fog.md, "Terms out of view"), or +infinity where there is none:
+    // constants, cosines and periodic polynomials fill space, as does a
+    // zero-outside polynomial whose cell meets the box. Potentials are bounded
+    // by their density at the box's nearest point times the length, and
+    // points and spheres also by their integral along a whole line. A term a
+    // Scene drops is one whose bounds, summed with the others it drops, stay
+    // under a stated depth: no pixel's fog transmittance moves by more.
+    // Expects term < desc().terms.size().
+    double termDepthBound(std::size_t term, double tSec, glm::dvec3 lo, glm::dvec3 hi, double maxLengthWorld) const;
+    // This fog with only the terms where keep[i] is true (colour, far
+    // cut-off and wind kept), validated again by create(): it fails when the
+    // remaining terms can go negative (a dropped term held them up). Expects
+    // keep.size() == desc().terms.size().
+    Result<Fog> withTerms(const std::vector<bool>& keep) const;
+
     // Parameters of the GLSL from fogGlsl(*this) at time tSec, as vec4s for
     // glUniform4fv(location of FogGlsl::uniformName, count, data). Computed
     // in double relative to `reference` (world): the shader's positions are

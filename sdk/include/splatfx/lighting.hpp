@@ -289,6 +289,11 @@ public:
     // Updates table i for lights[i] (each rebuilt only on change); tables
     // beyond lights.size() are dropped. The message names the light.
     Status update(const DensityField& field, std::span<const Light> lights);
+    // The same, but table i is left as it was (not built, not counted) where
+    // reaches[i] is false: a light that cannot reach the field (a spot whose
+    // cone misses it) gives it no irradiance, so its transmittance is never
+    // used. Expects reaches.size() == lights.size().
+    Status update(const DensityField& field, std::span<const Light> lights, const std::vector<bool>& reaches);
     float transmittance(std::size_t light, glm::vec3 world) const override;
     const std::vector<ShadowTable>& tables() const { return mTables; }
 

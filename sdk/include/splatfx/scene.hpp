@@ -21,7 +21,12 @@
 // do not, their light is part of their data): their splat colours follow Ebert & Parent's low-albedo model with
 // self-shadowing, and prepare() puts their shadow on the scene into
 // Frame::shadow() (docs/lighting.md, "In a Scene"). And the scene's fog
-// (setFog), handed to every Frame.
+// (setFog), handed to every Frame without the terms the view cannot see
+// (FogCullDesc). Shadows are scheduled by light influence, not visibility: a
+// lit caster out of view whose shadow can fall into the view
+// (shadowReachesView) is advanced and put into the scene shadow, not drawn
+// (EffectStatus::castsIntoView); a light that cannot reach an effect builds
+// no table for it (lightReaches).
 // It does not render, load files, or own GL resources. Its frustum test is
 // per effect; a LOD volume's refinement culls its own nodes inside
 // (LodRefineDesc::frustumCull).
@@ -98,6 +103,20 @@ struct SceneShadowDesc {
     std::uint64_t memoryBudgetBytes = 64ull << 20; // as ShadowTableDesc; default 64 MiB
 };
 
+// Which of the scene's fog terms a frame draws (docs/fog.md, "Terms out of
+// view"). Terms whose optical depth along every view ray is provably small
+// (Fog::termDepthBound over the view frustum's box) are dropped, smallest
+// first, while the dropped bounds sum to at most maxSkippedDepth; so no
+// pixel's fog transmittance, hence no fogged colour channel in [0, 1], moves
+// by more than 1 - exp(-maxSkippedDepth) <= maxSkippedDepth. With every term
+// dropped (and no far cut-off within the view) the frame has no fog and the
+// fog pass is skipped.
+struct FogCullDesc {
+    bool enabled = true; // default true
+    // >= 0, optical depth (natural log units); default 1/512: under half an 8-bit level.
+    double maxSkippedDepth = 1.0 / 512.0;
+};
+
 // How the Scene treats one effect. Every field applies to every kind; a
 // field a kind has no use for (catch-up for a stateless kind, refine for a
 // splat effect) is ignored by it.
@@ -132,10 +151,17 @@ struct EffectStatus {
     bool enabled = true;
     bool inRange = false;
     bool inView = false;                 // in range and inside the frustum
-    bool alive = false;                  // in view and with material present (only tested when in view)
+    bool alive = false;                  // with material present (only tested when in view, or out of view but casting into it)
     bool needed = false;                 // enabled && inRange && inView && alive
+    // Not needed (out of view), but lit, shadow-casting, in range and alive,
+    // and its shadow towards the scene-shadow light can reach the view
+    // (Scene::shadowReachesView): advanced to the time and put into the scene
+    // shadow, not emitted (docs/lighting.md, "Scheduled by light influence").
+    bool castsIntoView = false;
+    bool inSceneShadow = false;          // its density was in the frame's scene shadow at the last prepare()
     std::uint64_t framesNeeded = 0;      // updates where it was needed
-    std::uint64_t framesSkipped = 0;     // updates where it was not (no work done)
+    std::uint64_t framesCastOnly = 0;    // updates where it was advanced only to cast into the view (castsIntoView)
+    std::uint64_t framesSkipped = 0;     // updates where it was neither (no work done)
     std::uint64_t catchUps = 0;          // returns of a stateful kind after being skipped (AdvanceResult::caughtUp)
     std::uint64_t splatsDrawn = 0;       // splats emitted at the last emit()
     std::uint64_t tetrahedraDrawn = 0;   // tetrahedra emitted at the last prepare() (emit() takes none)
@@ -143,19 +169,34 @@ struct EffectStatus {
     bool lit = false;                    // lit at the last emit()
     std::uint64_t shadowTableBuilds = 0; // self-shadowing tables built (cumulative)
     std::uint64_t shadowTableReuses = 0; // ... and reused unchanged (cumulative)
+    std::uint64_t shadowTableSkips = 0;  // self-shadowing tables not updated: the light cannot reach the effect (cumulative)
 };
 
 // Every count covers effects of every kind.
 struct SceneCounters {
     std::size_t declared = 0;            // effects in the scene
     std::size_t needed = 0;              // needed at the last update (= advanced and emitted)
-    std::size_t simulated = 0;           // effects advanced to the time at the last update
+    std::size_t simulated = 0;           // effects advanced to the time at the last update (needed + castOnly)
+    std::size_t castOnly = 0;            // of those, advanced only to cast into the view (EffectStatus::castsIntoView)
+    std::size_t castersCulled = 0;       // lit casters out of view whose shadow cannot reach it: not advanced
     std::uint64_t splats = 0;            // splats emitted at the last emit()
     std::uint64_t tetrahedra = 0;        // tetrahedra emitted at the last prepare()
     std::size_t litEffects = 0;          // effects lit at the last emit()
     std::uint64_t shadowTableBuilds = 0; // self-shadowing and scene-shadow tables built at the last emit()
     std::uint64_t shadowTableReuses = 0; // ... reused unchanged at the last emit()
     std::uint64_t sceneShadowBuilds = 0; // scene-shadow table builds (cumulative)
+    std::size_t sceneShadowCasters = 0;  // effects in the scene shadow at the last prepare()
+    // Self-shadowing tables not updated at the last emit() because their
+    // light cannot reach the effect (a spot light's cone misses its bounds).
+    std::uint64_t shadowTableSkips = 0;
+    // The scene's fog at the last prepare() (FogCullDesc): terms drawn and
+    // dropped, and whether the frame got no fog at all because none is in view.
+    std::size_t fogTermsDrawn = 0;
+    std::size_t fogTermsSkipped = 0;
+    bool fogSkipped = false;
+    // Frames whose dropped terms left a fog that failed validation (a dropped
+    // term held the rest non-negative): the full fog was drawn (cumulative).
+    std::uint64_t fogCullFallbacks = 0;
 };
 
 class Scene {
@@ -224,6 +265,18 @@ public:
     // True when any part of the box may be inside the camera's frustum
     // (conservative: boxes near a frustum corner may pass).
     static bool inFrustum(const Aabb& box, const Camera& camera);
+    // True when the light may reach some point of the box (conservative).
+    // Directional and point lights reach everything (splatfx's lights have
+    // no range); a spot light misses a box whose bounding sphere lies
+    // outside its outer cone (where its irradiance is exactly 0).
+    static bool lightReaches(const Light& light, const Aabb& box);
+    // True when the shadow of a caster within `caster`, cast by `light`, may
+    // fall inside the camera's frustum (conservative): the caster's box
+    // extruded away from the light (along a directional light's travel, away
+    // from a point or spot light's position, without end) is tested against
+    // the frustum's planes, and a light that cannot reach the box casts no
+    // shadow. Used to schedule casters by light influence (docs/lighting.md).
+    static bool shadowReachesView(const Aabb& caster, const Light& light, const Camera& camera);
 
     // ---- Lights (docs/lighting.md, "In a Scene") ---------------------------
     // Adds a light; fails on an invalid light (the message names the field).
@@ -252,9 +305,13 @@ public:
     // ---- Fog (docs/fog.md) -------------------------------------------------
     // The scene's fog, handed to every Frame prepare() fills (Frame::setFog).
     // A Fog is a pure function of time: it costs nothing while out of view.
-    void setFog(Fog fog) { mFog = std::make_shared<const Fog>(std::move(fog)); }
-    void clearFog() { mFog.reset(); }
+    void setFog(Fog fog) { mFog = std::make_shared<const Fog>(std::move(fog)), mFogView.reset(), mFogKeep.clear(); }
+    void clearFog() { mFog.reset(), mFogView.reset(), mFogKeep.clear(); }
     const Fog* fog() const { return mFog.get(); }
+    // Which terms each frame draws. Fails on a maxSkippedDepth that is
+    // negative or not finite (the message names it), keeping the previous desc.
+    Status setFogCulling(const FogCullDesc& desc);
+    const FogCullDesc& fogCulling() const { return mFogCull; }
 
 private:
     // What a lit effect keeps between frames (scene_lighting.cpp).
@@ -264,6 +321,7 @@ private:
         ShadowTables tables;                    // self-shadowing, one per light
         glm::ivec3 tableDims{0};                // what `tables` was made with
         std::vector<glm::vec3> points, factors; // scratch: splat centres and their light factors
+        std::vector<bool> reaches;              // scratch: which lights reach the effect (Scene::lightReaches)
     };
     struct Entry {
         std::unique_ptr<EffectKind> kind; // never null; on the heap, so what a Frame points at stays put
@@ -276,9 +334,14 @@ private:
     std::size_t emitInto(SplatBuilder& builder, std::vector<FrameVolume>* volumes, const Materials& materials, const EmitOptions& options);
     // Lights the splats [first, end) the entry just emitted.
     void lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first, const EmitOptions& draw);
+    // Refreshes e.lit->field from the kind's lighting density; false when the
+    // kind has none or it is bad (then mLightingError says why).
+    bool updateLitField(Entry& e, const Materials& materials, const EmitOptions& draw);
     void shadeScene(Frame& frame); // fills frame.shadow()
     // The shadow tables' bytes against mBudgets.lightingBytes; the error when over.
     Status checkLightingBudget() const;
+    // The fog this camera's frame draws: mFog without the terms it cannot see (scene_fog.cpp).
+    std::shared_ptr<const Fog> fogForView(const Camera& camera, double timeSec);
 
     std::vector<Entry> mEntries;
     SceneCounters mCounters;
@@ -295,6 +358,9 @@ private:
     Budgets mBudgets;
     bool mTablesFit = true; // checkLightingBudget() at the last emit
     std::shared_ptr<const Fog> mFog; // default none
+    FogCullDesc mFogCull;
+    std::shared_ptr<const Fog> mFogView; // mFog with the terms of mFogKeep (rebuilt when the kept set changes)
+    std::vector<bool> mFogKeep;
 };
 
 } // namespace splatfx

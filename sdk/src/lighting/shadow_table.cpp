@@ -2,6 +2,7 @@
 // depth towards a light at reduced resolution, filled in order of distance
 // from the light; and the GLSL that samples it for host geometry.
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -356,10 +357,16 @@ float ShadowTable::opticalDepth(glm::vec3 world) const {
 }
 
 Status ShadowTables::update(const DensityField& field, std::span<const Light> lights) {
+    return update(field, lights, std::vector<bool>(lights.size(), true));
+}
+
+Status ShadowTables::update(const DensityField& field, std::span<const Light> lights, const std::vector<bool>& reaches) {
+    assert(reaches.size() == lights.size() && "ShadowTables::update: reaches needs one entry per light");
     if (mTables.size() > lights.size()) mTables.erase(mTables.begin() + std::ptrdiff_t(lights.size()), mTables.end());
     while (mTables.size() < lights.size()) mTables.emplace_back(mDesc);
     for (std::size_t i = 0; i < lights.size(); ++i) {
         if (Status s = validateLight(lights[i], "lights[" + std::to_string(i) + "]"); !s) return s;
+        if (i < reaches.size() && !reaches[i]) continue;
         if (Status s = mTables[i].update(field, lights[i]); !s) return makeError("lights[" + std::to_string(i) + "]: " + s.error());
     }
     return {};

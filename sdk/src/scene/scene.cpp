@@ -109,13 +109,16 @@ Status Scene::update(double timeSec, const Camera& camera) {
     const double previous = mUpdated ? std::min(mTime, timeSec) : timeSec;
     mTime = timeSec;
     mUpdated = true;
-    mCounters.needed = mCounters.simulated = 0;
+    mCounters.needed = mCounters.simulated = mCounters.castOnly = mCounters.castersCulled = 0;
     const glm::vec3 eye = camera.eye();
+    // The light whose shadow on the scene goes into the frame: casters out of
+    // view are scheduled by where their shadow falls towards it.
+    const Light* shadowLight = mSceneShadowDesc.enabled && mSceneShadowDesc.light < mLights.size() ? &mLights[mSceneShadowDesc.light] : nullptr;
     for (Entry& e : mEntries) {
         EffectStatus& s = e.status;
-        const bool wasNeeded = s.needed;
+        const bool wasAdvanced = s.needed || s.castsIntoView;
         s.enabled = e.options.enabled;
-        s.needed = false;
+        s.needed = s.castsIntoView = false;
         if (!s.enabled) {
             ++s.framesSkipped;
             continue;
@@ -126,19 +129,31 @@ Status Scene::update(double timeSec, const Camera& camera) {
         s.inRange = !s.bounds.empty() && glm::length(eye - nearest) <= e.options.rangeWorld;
         // Cheapest tests first: a hidden effect costs one bounds query and a frustum test.
         s.inView = s.inRange && inFrustum(s.bounds, camera);
-        s.alive = s.inView && e.kind->alive(timeSec, AliveHints{.deadDensity = e.options.deadDensity});
+        // Out of view, a lit caster still matters where its shadow reaches the
+        // view (light influence, not visibility): it is advanced, not drawn.
+        const bool caster = shadowLight && s.inRange && !s.inView && e.options.lighting.enabled && e.options.lighting.castsShadow;
+        const bool casts = caster && shadowReachesView(s.bounds, *shadowLight, camera);
+        if (caster && !casts) ++mCounters.castersCulled;
+        s.alive = (s.inView || casts) && e.kind->alive(timeSec, AliveHints{.deadDensity = e.options.deadDensity});
         if (!s.alive) {
             ++s.framesSkipped;
             continue;
         }
         // Resumed: advanced before, skipped since; the kind decides what catching up costs.
-        const AdvanceContext context{
-            .catchUpStepSec = e.options.catchUpStepSec, .maxCatchUpSteps = e.options.maxCatchUpSteps, .resumed = !wasNeeded && s.framesNeeded > 0};
+        const AdvanceContext context{.catchUpStepSec = e.options.catchUpStepSec,
+                                     .maxCatchUpSteps = e.options.maxCatchUpSteps,
+                                     .resumed = !wasAdvanced && s.framesNeeded + s.framesCastOnly > 0};
         if (e.kind->advanceTo(timeSec, context).caughtUp) ++s.catchUps;
-        s.needed = true;
-        ++s.framesNeeded;
-        ++mCounters.needed;
         ++mCounters.simulated;
+        if (s.inView) {
+            s.needed = true;
+            ++s.framesNeeded;
+            ++mCounters.needed;
+        } else {
+            s.castsIntoView = true;
+            ++s.framesCastOnly;
+            ++mCounters.castOnly;
+        }
     }
     return {};
 }
@@ -148,7 +163,7 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
     // Per-emit lighting counters (scene_lighting.cpp).
     mLightingError.clear();
     mCounters.litEffects = 0;
-    mCounters.shadowTableBuilds = mCounters.shadowTableReuses = 0;
+    mCounters.shadowTableBuilds = mCounters.shadowTableReuses = mCounters.shadowTableSkips = 0;
     mTablesFit = true;
     if (Status s = checkLightingBudget(); !s) {
         mLightingError = s.error();
@@ -176,6 +191,8 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
         const bool tableLit = e.options.lighting.selfShadow == SelfShadow::Table;
         if (e.status.needed && e.options.lighting.enabled && !mLights.empty() && (mTablesFit || !tableLit))
             lightEmitted(e, builder, materials, first, draw);
+        // Not drawn but casting into the view: only the density the light sees.
+        if (e.status.castsIntoView && !updateLitField(e, materials, draw)) e.status.castsIntoView = false;
     }
     mCounters.splats = splats;
     mCounters.tetrahedra = tetrahedra;
@@ -193,7 +210,7 @@ Status Scene::prepare(double timeSec, const Camera& camera, const Materials& mat
     emitInto(frame.builder(), &frame.volumes(), materials, options);
     shadeScene(frame); // the lit effects' shadow on the scene, into frame.shadow()
     frame.end();
-    frame.setFog(mFog);
+    frame.setFog(fogForView(camera, timeSec)); // only the terms this view can see
     FrameCounters& c = frame.counters();
     c.litEffects = mCounters.litEffects;
     c.shadowTableBuilds = mCounters.shadowTableBuilds;

@@ -58,22 +58,27 @@ Status Scene::checkLightingBudget() const {
                        total, "bytes", mBudgets.lightingBytes, "lightingBytes");
 }
 
+bool Scene::updateLitField(Entry& e, const Materials& materials, const EmitOptions& draw) {
+    if (!e.lit) e.lit = std::make_unique<LitState>();
+    LitState& lit = *e.lit;
+    // The density the light sees, as the kind draws it; kinds the lights
+    // cannot see stay unlit.
+    if (!e.kind->lightingDensity(materials, draw, lit.densityGrid)) return false;
+    auto field = DensityField::fromGrid(lit.densityGrid);
+    if (!field) {
+        mLightingError = "effect '" + e.options.name + "': lighting.density: " + field.error();
+        return false;
+    }
+    lit.field = std::move(*field);
+    return true;
+}
+
 void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first, const EmitOptions& draw) {
     const EffectLighting& L = e.options.lighting;
     const std::string at = "effect '" + e.options.name + "': lighting.";
-    if (!e.lit) e.lit = std::make_unique<LitState>();
+    if (!updateLitField(e, materials, draw)) return;
     LitState& lit = *e.lit;
-
-    // The density the light sees, as the kind draws it; kinds the lights
-    // cannot see stay unlit.
-    Grid& dg = lit.densityGrid;
-    if (!e.kind->lightingDensity(materials, draw, dg)) return;
-    auto field = DensityField::fromGrid(dg);
-    if (!field) {
-        mLightingError = at + "density: " + field.error();
-        return;
-    }
-    lit.field = std::move(*field);
+    const Grid& dg = lit.densityGrid;
 
     const ShadowProvider* shadows = nullptr;
     ShadowTracer tracer(lit.field, mLights);
@@ -86,7 +91,16 @@ void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& mater
         }
         std::uint64_t b0 = 0, r0 = 0, b1 = 0, r1 = 0;
         for (const ShadowTable& t : lit.tables.tables()) b0 += t.builds(), r0 += t.reuses();
-        if (Status s = lit.tables.update(lit.field, mLights); !s) {
+        // A light that cannot reach the effect lights none of its splats
+        // (irradiance 0): its table is not worth building.
+        const Aabb box{lit.field.boundsMin(), lit.field.boundsMax()};
+        lit.reaches.assign(mLights.size(), true);
+        std::uint64_t skips = 0;
+        for (std::size_t i = 0; i < mLights.size(); ++i)
+            if (!lightReaches(mLights[i], box)) lit.reaches[i] = false, ++skips;
+        e.status.shadowTableSkips += skips;
+        mCounters.shadowTableSkips += skips;
+        if (Status s = lit.tables.update(lit.field, mLights, lit.reaches); !s) {
             mLightingError = at + "tableDims: " + s.error();
             return;
         }
@@ -130,13 +144,20 @@ void Scene::shadeScene(Frame& frame) {
     if (d.enabled && !mLights.empty() && d.light >= mLights.size() && mLightingError.empty())
         mLightingError = "sceneShadow.light: expected the index of one of the scene's " + std::to_string(mLights.size()) +
                          " light(s), 0 to " + std::to_string(mLights.size() - 1) + ", got " + std::to_string(d.light);
+    // Casters: the drawn lit effects, and those out of view whose shadow
+    // reaches it (castsIntoView); each only where the light reaches it.
+    for (Entry& e : mEntries) e.status.inSceneShadow = false;
     if (d.enabled && d.light < mLights.size() && mTablesFit)
-        for (const Entry& e : mEntries)
-            if (e.status.lit && e.options.lighting.castsShadow && e.lit && !e.lit->field.empty()) {
+        for (Entry& e : mEntries)
+            if ((e.status.lit || e.status.castsIntoView) && e.options.lighting.castsShadow && e.lit && !e.lit->field.empty() &&
+                lightReaches(mLights[d.light], Aabb{e.lit->field.boundsMin(), e.lit->field.boundsMax()})) {
                 fields.push_back(&e.lit->field);
+                e.status.inSceneShadow = true;
                 only = &e;
             }
-    if (fields.size() != 1) only = nullptr;
+    mCounters.sceneShadowCasters = fields.size();
+    // Only a drawn effect's self-shadowing tables are current.
+    if (fields.size() != 1 || !only->status.lit) only = nullptr;
     // One casting effect whose self-shadowing table for this light has the
     // scene shadow's dims: that table is the scene shadow (the paper's one
     // table serves both), so nothing more is built.

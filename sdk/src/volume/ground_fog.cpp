@@ -32,6 +32,35 @@ struct Emitter {
     std::vector<Tetrahedron> pieces;
     bool clip = true;                          // LodRefineDesc::clipNear
     std::vector<glm::vec3>* terrain = nullptr; // the host's terrain triangles, or null
+    // Full resolution: per-node frustum culling of the BSP (LodRefineDesc::frustumCull).
+    bool cull = false;
+    glm::dvec4 planes[6]{};     // the view frustum, normalized, inside >= 0
+    double yLo = 0.0, yHi = 0.0; // the layer's lowest terrain and highest fog top
+    bool prisms = true;          // false below a culled node: terrain only
+
+    // Cells [x0, x1) x [z0, z1) (every prism over them within yLo..yHi) outside the frustum?
+    bool outside(int x0, int x1, int z0, int z1) const {
+        const double s = d.spacingWorld;
+        const glm::dvec3 lo(d.originWorld.x + x0 * s, yLo, d.originWorld.z + z0 * s), hi(d.originWorld.x + x1 * s, yHi, d.originWorld.z + z1 * s);
+        for (const glm::dvec4& pl : planes) {
+            const glm::dvec3 p(pl.x >= 0 ? hi.x : lo.x, pl.y >= 0 ? hi.y : lo.y, pl.z >= 0 ? hi.z : lo.z);
+            // A margin of 1e-6 of the box's size: float heights rounded the other way are kept.
+            if (glm::dot(glm::dvec3(pl), p) + pl.w < -1e-6 * (1.0 + glm::length(hi - lo))) return true;
+        }
+        return false;
+    }
+    // Culls cells [x0, x1) x [z0, z1) when outside; true when nothing more is to be emitted for them.
+    template <class Visit>
+    bool culled(int x0, int x1, int z0, int z1, Visit&& visit) {
+        if (!cull || !prisms || !outside(x0, x1, z0, z1)) return false;
+        ++out.stats.nodesCulled;
+        if (terrain) { // the host's terrain still wants the whole mesh
+            prisms = false;
+            visit();
+            prisms = true;
+        }
+        return true;
+    }
 
     // A terrain triangle, counter-clockwise seen from above (+y).
     void terrainTri(glm::vec3 a, glm::vec3 b, glm::vec3 c) {
@@ -195,6 +224,7 @@ struct Emitter {
             terrainTri(bottom(first[0].x, first[0].y), bottom(first[1].x, first[1].y), bottom(first[2].x, first[2].y));
             terrainTri(bottom(second[0].x, second[0].y), bottom(second[1].x, second[1].y), bottom(second[2].x, second[2].y));
         }
+        if (!prisms) return;
         if (firstNear && !d.sortFree) {
             prism(second[0], second[1], second[2]);
             prism(first[0], first[1], first[2]);
@@ -207,6 +237,7 @@ struct Emitter {
     // BSP over cells [x0, x1) x [z0, z1): split the longer side at its middle
     // vertical plane, far half first (exact: the plane separates the halves).
     void range(int x0, int x1, int z0, int z1) {
+        if (culled(x0, x1, z0, z1, [&] { range(x0, x1, z0, z1); })) return;
         if (x1 - x0 == 1 && z1 - z0 == 1) return cell(x0, z0);
         const bool alongX = (x1 - x0) >= (z1 - z0);
         const int m = alongX ? (x0 + x1) / 2 : (z0 + z1) / 2;
@@ -592,6 +623,14 @@ Status GroundFog::update(const Camera& camera, const LodRefineDesc& refine, LodF
     Emitter em{mDesc, camera, out, {}, 0.0f, {}, refine.clipNear, terrainTriangles};
     em.nearNormal = f;
     em.nearOffset = glm::dot(f, e) + camera.nearPlane();
+    glm::dvec4 planes[6];
+    const glm::dmat4 vp = glm::dmat4(camera.proj) * glm::dmat4(camera.view);
+    for (int i = 0; i < 3; ++i)
+        for (int sign = 0; sign < 2; ++sign) {
+            glm::dvec4 pl = glm::dvec4(vp[0][3], vp[1][3], vp[2][3], vp[3][3]) + (sign ? -1.0 : 1.0) * glm::dvec4(vp[0][i], vp[1][i], vp[2][i], vp[3][i]);
+            const double len = glm::length(glm::dvec3(pl));
+            planes[2 * i + sign] = len > 0.0 ? pl / len : glm::dvec4(0.0, 0.0, 0.0, 1.0); // degenerate: never culls
+        }
     if (mDesc.lod) {
         LodGrid g;
         g.n = mN, g.maxDepth = mMaxDepth, g.dims = mDesc.dims, g.origin = mDesc.originWorld, g.spacing = mDesc.spacingWorld;
@@ -599,14 +638,7 @@ Status GroundFog::update(const Camera& camera, const LodRefineDesc& refine, LodF
         LodRefiner r{g, em, glm::dvec3(e), double(mDesc.minAccuracyC), double(refine.detailC), refine.morph};
         r.cull = refine.frustumCull;
         r.maxThickness = mMaxThickness;
-        const glm::dmat4 vp = glm::dmat4(camera.proj) * glm::dmat4(camera.view);
-        for (int i = 0; i < 3; ++i)
-            for (int sign = 0; sign < 2; ++sign) {
-                glm::dvec4 pl =
-                    glm::dvec4(vp[0][3], vp[1][3], vp[2][3], vp[3][3]) + (sign ? -1.0 : 1.0) * glm::dvec4(vp[0][i], vp[1][i], vp[2][i], vp[3][i]);
-                const double len = glm::length(glm::dvec3(pl));
-                r.planes[2 * i + sign] = len > 0.0 ? pl / len : glm::dvec4(0.0, 0.0, 0.0, 1.0); // degenerate: never culls
-            }
+        for (int i = 0; i < 6; ++i) r.planes[i] = planes[i];
         const int s = mN - 1;
         const Tri roots[2] = {{{s, 0}, {0, 0}, {s, s}}, {{0, s}, {s, s}, {0, 0}}};
         auto shown = [&](glm::ivec2 p) { return Shown{mHeight[g.at(p)], mThickness[g.at(p)]}; };
@@ -623,13 +655,23 @@ Status GroundFog::update(const Camera& camera, const LodRefineDesc& refine, LodF
         out.stats.emitted = out.tets.size();
         return {};
     }
+    // Full resolution: the BSP's nodes (sortFree: rows, then cells) outside the frustum emit no prisms.
+    em.cull = refine.frustumCull;
+    for (int i = 0; i < 6; ++i) em.planes[i] = planes[i];
+    em.yLo = double(mBounds.lo.y), em.yHi = double(mBounds.hi.y);
     if (mDesc.sortFree) { // eq. 10: grid order, no BSP
-        for (int j = 0; j + 1 < mDesc.dims.y; ++j)
-            for (int i = 0; i + 1 < mDesc.dims.x; ++i) em.cell(i, j);
+        const int cx = mDesc.dims.x - 1;
+        for (int j = 0; j + 1 < mDesc.dims.y; ++j) {
+            auto row = [&] {
+                for (int i = 0; i < cx; ++i)
+                    if (!em.culled(i, i + 1, j, j + 1, [&] { em.cell(i, j); })) em.cell(i, j);
+            };
+            if (!em.culled(0, cx, j, j + 1, row)) row();
+        }
     } else {
         em.range(0, mDesc.dims.x - 1, 0, mDesc.dims.y - 1);
     }
-    out.stats.fullResolution *= 3; // counted per prism above
+    out.stats.fullResolution = 3 * mPrisms; // every prism with fog, culled or not
     out.stats.emitted = out.tets.size();
     return {};
 }
