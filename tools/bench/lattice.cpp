@@ -253,16 +253,17 @@ int runLattice(int argc, char** argv) {
             if (!basis) basis = b;
             const std::vector<float> lum = luminance(fb->read());
             const float period = b->shortestPeriodPx();
-            const std::vector<float> mask = lattice::flameMask(lum, width, height, 2.0f * period);
-            measured.add(lum, mask, *b);
-            // The control: the frame's own large-scale brightness (its blur at
-            // twice the lattice period) modulated by lattice-free turbulence.
+            // The frame's large-scale brightness (its blur at twice the lattice
+            // period) gives the mask; the control is that brightness modulated
+            // by lattice-free turbulence, in the same mask.
             const std::vector<float> mean = lattice::blur(lum, width, height, 2.0f * period);
+            const std::vector<float> mask = lattice::maskOfBlurred(mean);
+            measured.add(lum, mask, *b);
             for (int c = 0; c < controls; ++c) {
                 const std::vector<float> n = noise[std::size_t(c)].frame(t);
                 std::vector<float> img(mean.size());
                 for (std::size_t i = 0; i < img.size(); ++i) img[i] = mean[i] * (1.0f + 0.4f * n[i]);
-                control[std::size_t(c)].add(img, lattice::flameMask(img, width, height, 2.0f * period), *b);
+                control[std::size_t(c)].add(img, mask, *b);
             }
             ++used;
         }
@@ -293,8 +294,8 @@ int runLattice(int argc, char** argv) {
     for (const Row& r : rows)
         std::printf("%-17s %8.2f %7.2f-%-7.2f %10.1f %7d  %s\n", r.name.c_str(), r.measure, r.controlLo, r.controlHi, double(r.periodPx), r.frames,
                     r.measure <= r.controlHi ? "invisible (within the control)" : "VISIBLE (above the control)");
-    std::printf("\nmeasure: the largest, over the lattice's frequencies (fundamentals, diagonals, second harmonics), of the peak\n"
-                "power within 8 %% of the frequency over the median power of the ring at that frequency (spectra of the\n"
+    std::printf("\nmeasure: the largest, over the lattice's frequencies (fundamentals, diagonals, second harmonics), of the mean\n"
+                "power within 8 %% of the frequency over the mean power of the ring at that frequency (spectra of the\n"
                 "high-passed, flame-masked luminance averaged over the frames); control: the same for animated turbulence.\n");
     return failed ? 1 : 0;
 }

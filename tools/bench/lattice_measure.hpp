@@ -39,8 +39,9 @@ struct Basis {
     glm::vec3 viewCells{0.0f, 0.0f, 1.0f};
     // The frequencies (cycles per pixel) at which a lattice with these
     // vectors shows: integer cell frequencies q (fundamentals, diagonals,
-    // second harmonics) nearly perpendicular to the view (|q . v| <= 0.15
-    // cycles per cell, v the unit view direction in cells), mapped to the
+    // second harmonics) nearly perpendicular to the view (|q . v| <= 0.3
+    // cycles per cell, v the unit view direction in cells: an effect a few
+    // cells deep seen in perspective still shows those), mapped to the
     // screen by f = (J J^T)^-1 J q with J the 2x3 matrix of the axes.
     struct Probe {
         glm::ivec3 q{0};
@@ -68,6 +69,8 @@ struct Score {
 // `hi` times the frame's largest blurred luminance, 0 below `lo` times it,
 // smooth between (so the mask's own edge adds little high frequency).
 std::vector<float> flameMask(const std::vector<float>& luminance, int width, int height, float blurSigmaPx, float lo = 0.1f, float hi = 0.3f);
+// The same from a luminance already blurred.
+std::vector<float> maskOfBlurred(const std::vector<float>& blurred, float lo = 0.1f, float hi = 0.3f);
 
 class Accumulator {
 public:
@@ -99,7 +102,8 @@ private:
     std::vector<float> mAmplitude, mPhase, mSpeed;
 };
 
-// Gaussian blur (separable, clamped edges) of a single-channel image.
+// Gaussian blur (separable, clamped edges) of a single-channel image;
+// above 8 pixels three box passes of the same variance (for masks).
 std::vector<float> blur(const std::vector<float>& image, int width, int height, float sigmaPx);
 
 } // namespace lattice
