@@ -392,3 +392,20 @@ TEST(SplatVariation, OutOfRangeFieldsAreNamed) {
     EXPECT_EQ(checkSplatVariation({.scaleLog2 = std::nanf("")}), "variation.scaleLog2 must be in [0, 1], got nan");
     EXPECT_EQ(checkSplatVariation(SplatVariation::recommended(1)), "");
 }
+
+TEST(SplatVariation, PlainFootprintsStayOnTheLattice) {
+    // Fig. 1a's traditional splats: no stamp to hide, and the lattice reconstructs the field best.
+    const Materials m = plainMaterials();
+    Grid g = *Grid::box({4, 4, 4}, glm::vec3(0.5f));
+    const Camera cam = Camera::lookAt({0, 1, 6}, {0, 1, 0}, {0, 1, 0}, glm::radians(50.0f), {320, 240}, 0.1f, 100.0f);
+    SplatBuilder a, b;
+    a.begin(cam);
+    b.begin(cam);
+    a.add(g, m, {.textured = false});
+    b.add(g, m, {.textured = false, .variation = SplatVariation::recommended(9)});
+    ASSERT_EQ(a.splats().size(), b.splats().size());
+    for (std::size_t i = 0; i < a.splats().size(); ++i) {
+        EXPECT_EQ(a.splats()[i].center, b.splats()[i].center);
+        EXPECT_EQ(a.splats()[i].axisU, b.splats()[i].axisU);
+    }
+}

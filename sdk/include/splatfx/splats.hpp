@@ -76,6 +76,8 @@ float splatRayScale(const Splat& splat, float footprintRadius);
 // regular weave. Each option is a pure function of (voxel cell, seed), so it
 // is stable over time (the three scales of motion still read) and is the
 // same for the GL renderer and the reference, which both draw the Splat list.
+// Untextured splats (SplatStyle::textured false, Fig. 1a) ignore it: plain
+// footprints on the lattice reconstruct the field best and show no stamp.
 // The zero value is the paper's lattice; presets use recommended().
 struct SplatVariation {
     // The splat centre moves by up to +-jitter cells along each lattice axis
