@@ -306,7 +306,10 @@ TEST_F(Stability, VariedSplatsMatchTheReference) {
     const Result lattice = run(texturedBox(), kTexCam, mat, {.textureSet = set, .crossfade = true});
     double moved = 0.0;
     for (size_t i = 0; i < r.gl.pixels.size(); ++i) moved = std::max(moved, double(std::abs(r.gl.pixels[i] - lattice.gl.pixels[i])));
-    EXPECT_GT(moved, 10.0 * r.bound) << "the variation must change the picture well beyond the GL-vs-reference bound";
+    // The derived bound is loose (it adds every overlapping splat's worst case); against the
+    // two paths' actual disagreement the variation's change must stand an order of magnitude out.
+    std::printf("  the variation changes a pixel by up to %.3f\n", moved);
+    EXPECT_GT(moved, 10.0 * r.worst) << "the variation must change the picture well beyond the GL-vs-reference difference";
 }
 
 } // namespace
