@@ -26,13 +26,19 @@ struct Campfire {
     bool figureWritten = false;
 
     bool setup() {
+        // --extra paper-lattice: every splat on its voxel with its texture upright, as in
+        // the paper (the before of docs/samples.md); default the preset's SplatVariation.
+        if (!options.extra.empty() && options.extra != "paper-lattice")
+            return fail("--extra expects paper-lattice (splats on the voxel lattice, as in the paper), got '" + options.extra + "'");
+        splatfx::presets::FireDesc desc{.dims = {7, 20, 5},
+                                        .spacing = glm::vec3(0.5f),
+                                        .propagationStepsPerSec = 8.0f,
+                                        .texturesPerSec = 6.0f,
+                                        .crossfade = true,
+                                        .seed = options.seed};
+        if (options.extra == "paper-lattice") desc.variation = {};
         // The preset registers its turbulence set and fire colour table in materials.
-        auto f = splatfx::presets::fire(materials, {.dims = {7, 20, 5},
-                                                    .spacing = glm::vec3(0.5f),
-                                                    .propagationStepsPerSec = 8.0f,
-                                                    .texturesPerSec = 6.0f,
-                                                    .crossfade = true,
-                                                    .seed = options.seed});
+        auto f = splatfx::presets::fire(materials, desc);
         if (!f) return fail(f.error());
         scene.add(std::move(*f), {.name = "campfire"});
         auto r = splatfx::gl::FrameRenderer::create();

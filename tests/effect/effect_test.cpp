@@ -1,5 +1,7 @@
 // Effects and presets: stateless frames, layers, counters, toggles, and
 // conservative bounds that contain every splat of a long animation.
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include <map>
@@ -263,9 +265,16 @@ TEST(Effect, BoundsAreNotWildlyLoose) {
     auto fire = presets::fire(m, {});
     const Aabb b = fire->bounds(0.0, 100.0);
     // 7x20x5 cells at 0.5: lattice 3 x 9.5 x 2; splat reach R * spacing = 1.6 * 0.5 = 0.8
-    // (the exact largest axis of a round kernel); 1e-3 covers the 1e-4 relative slack.
-    EXPECT_NEAR(b.hi.x - b.lo.x, 3.0f + 2.0f * 0.8f, 1e-3f);
-    EXPECT_NEAR(b.hi.y - b.lo.y, 9.5f + 2.0f * 0.8f, 1e-3f);
+    // (the exact largest axis of a round kernel), plus the preset's centre jitter of 0.5 cells
+    // per axis, bounded by its length 0.5 * sqrt(3) cells = 0.433; 1e-3 covers the 1e-4 relative slack.
+    const float jitterReach = 0.5f * std::sqrt(3.0f) * 0.5f;
+    EXPECT_NEAR(b.hi.x - b.lo.x, 3.0f + 2.0f * (0.8f + jitterReach), 1e-3f);
+    EXPECT_NEAR(b.hi.y - b.lo.y, 9.5f + 2.0f * (0.8f + jitterReach), 1e-3f);
+    // The paper's lattice (no variation): the kernel's reach alone.
+    auto plain = presets::fire(m, {.variation = {}});
+    const Aabb p = plain->bounds(0.0, 100.0);
+    EXPECT_NEAR(p.hi.x - p.lo.x, 3.0f + 2.0f * 0.8f, 1e-3f);
+    EXPECT_NEAR(p.hi.y - p.lo.y, 9.5f + 2.0f * 0.8f, 1e-3f);
 }
 
 TEST(Presets, ReportBadInputByField) {
@@ -306,4 +315,18 @@ TEST(Presets, GhostsUseFaces) {
     for (std::size_t i = 3; i < f.size(); i += 4) minA = std::min(minA, f[i]), maxA = std::max(maxA, f[i]);
     EXPECT_GT(maxA, 0.9f);
     EXPECT_LT(minA, 0.1f);
+}
+
+TEST(Presets, BadVariationIsNamed) {
+    Materials m(Footprint{});
+    auto bad = presets::fire(m, {.variation = {.jitter = 0.7f}});
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error(), "FireDesc.variation.jitter must be in [0, 0.5], got 0.700000");
+    auto ghosts = presets::ghosts(m, {.variation = {.scaleLog2 = 2.0f}});
+    ASSERT_FALSE(ghosts);
+    EXPECT_EQ(ghosts.error(), "GhostsDesc.variation.scaleLog2 must be in [0, 1], got 2.000000");
+    auto fire = presets::fire(m, {});
+    EXPECT_FALSE(fire->setSplatVariation({.rotationRad = 4.0f}));
+    EXPECT_TRUE(fire->setSplatVariation({}));
+    EXPECT_FALSE(fire->layer(0).style.variation.any());
 }

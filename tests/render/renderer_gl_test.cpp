@@ -26,7 +26,7 @@ struct FireMaterials {
     }
 };
 
-Image renderCampfire(std::uint32_t seed, glm::ivec2 size, const gl::RendererDesc& desc = {}) {
+Image renderCampfire(std::uint32_t seed, glm::ivec2 size, const gl::RendererDesc& desc = {}, const SplatVariation& variation = {}) {
     FireMaterials f(seed);
     auto fb = gl::Framebuffer::create({.width = size.x, .height = size.y});
     EXPECT_TRUE(fb) << fb.error();
@@ -38,7 +38,7 @@ Image renderCampfire(std::uint32_t seed, glm::ivec2 size, const gl::RendererDesc
     const Camera cam = test::campfireCamera(size);
     SplatBuilder b;
     b.begin(cam);
-    b.add(test::campfireGrid(seed), f.materials, {.textureSet = f.set, .colorTable = f.table});
+    b.add(test::campfireGrid(seed), f.materials, {.textureSet = f.set, .colorTable = f.table, .variation = variation});
     b.sort();
     r->draw(b.splats(), cam, {.framebuffer = fb->handle(), .width = size.x, .height = size.y});
     return fb->read();
@@ -80,15 +80,13 @@ public:
 
 class RendererGL : public test::GLTest {};
 
-TEST_F(RendererGL, CampfireMatchesGoldenImage) {
-    // Bilinear sampling, named: the default (Auto) depends on the GL.
-    const Image actual = renderCampfire(1, {160, 120}, {.sampling = gl::TextureSampling::Bilinear});
-    const std::string goldenPath = test::sourcePath("tests/golden/campfire_160x120.png");
+void expectGolden(const Image& actual, const std::string& name) {
+    const std::string goldenPath = test::sourcePath("tests/golden/" + name);
     if (std::getenv("SPLATFX_UPDATE_GOLDEN")) { ASSERT_TRUE(writeImage(goldenPath, actual)); }
     auto golden = readImage(goldenPath);
     ASSERT_TRUE(golden) << golden.error();
     // The tolerances live beside the golden, each explained there.
-    auto limits = test::loadGoldenThresholds(test::sourcePath("tests/golden/campfire_160x120.json"));
+    auto limits = test::loadGoldenThresholds(test::sourcePath("tests/golden/campfire_160x120.json")); // shared by both goldens
     ASSERT_TRUE(limits) << limits.error();
     const test::ImageDiff d = test::compareImages(actual, *golden, limits->pixelThreshold);
     ASSERT_TRUE(d.sameSize);
@@ -96,6 +94,19 @@ TEST_F(RendererGL, CampfireMatchesGoldenImage) {
     const bool ok = test::withinThresholds(d, *limits);
     EXPECT_TRUE(ok) << "mean " << d.meanAbs * 255 << "/255, max " << d.maxAbs * 255 << "/255, over " << d.fractionOver * 100 << "% -- "
                     << test::writeFailureImages(actual, d);
+}
+
+// The paper's lattice: every splat on its voxel, textures upright.
+TEST_F(RendererGL, CampfireMatchesGoldenImage) {
+    // Bilinear sampling, named: the default (Auto) depends on the GL.
+    expectGolden(renderCampfire(1, {160, 120}, {.sampling = gl::TextureSampling::Bilinear}), "campfire_160x120.png");
+}
+
+// The presets' default SplatVariation (jittered, turned and mirrored splats),
+// with the same tolerances (the same kinds of splats on the same pixels).
+TEST_F(RendererGL, VariedCampfireMatchesGoldenImage) {
+    expectGolden(renderCampfire(1, {160, 120}, {.sampling = gl::TextureSampling::Bilinear}, SplatVariation::recommended(1)),
+                 "campfire_varied_160x120.png");
 }
 
 // Upsampled layers sampled nearest stand in for bilinear sampling: the same

@@ -128,3 +128,38 @@ TEST(SceneFileKinds, AGasTakesOnlyItsTypesKeysAndNamesBadValues) {
     ASSERT_FALSE(octaves);
     EXPECT_NE(octaves.error().find("effects[0].gas.turbulence.octaves"), std::string::npos) << octaves.error();
 }
+
+// "variation" (issue 25): every kind takes it; omitted, presets and the
+// other kinds alike get the recommended variation (ghosts a smaller turn).
+TEST(SceneFileKinds, EveryKindTakesAVariationAndDefaultsToTheRecommendedOne) {
+    for (const std::string& kind : splatfx::scenefile::effectKindNames()) {
+        std::string entry = minimalEffect(kind);
+        auto r = parse(R"("effects": [)" + entry + "]");
+        ASSERT_TRUE(r) << kind << ": " << r.error();
+        const splatfx::Effect* e = r->scene.findEffect(r->effects[0].id);
+        ASSERT_NE(e, nullptr) << kind;
+        const splatfx::SplatVariation& v = e->layer(0).style.variation;
+        EXPECT_EQ(v.jitter, 0.5f) << kind;
+        EXPECT_TRUE(v.mirror) << kind;
+        EXPECT_EQ(v.rotationRad, kind == "ghosts" ? 0.35f : splatfx::SplatVariation::recommended(0).rotationRad) << kind;
+        entry.insert(entry.size() - 1, R"(, "variation": {"jitter": 0.25, "rotationDeg": 90, "mirror": false, "scaleLog2": 0.5})");
+        auto given = parse(R"("effects": [)" + entry + "]");
+        ASSERT_TRUE(given) << kind << ": " << given.error();
+        const splatfx::SplatVariation& g = given->scene.findEffect(given->effects[0].id)->layer(0).style.variation;
+        EXPECT_EQ(g.jitter, 0.25f);
+        EXPECT_NEAR(g.rotationRad, 1.5707963f, 1e-6f);
+        EXPECT_FALSE(g.mirror);
+        EXPECT_EQ(g.scaleLog2, 0.5f);
+    }
+    auto plain = parse(R"("effects": [{"kind": "fire", "variation": {"jitter": 0, "rotationDeg": 0, "mirror": false}}])");
+    ASSERT_TRUE(plain) << plain.error();
+    EXPECT_FALSE(plain->scene.findEffect(plain->effects[0].id)->layer(0).style.variation.any()); // the paper's lattice
+}
+
+TEST(SceneFileKinds, ABadVariationIsNamed) {
+    auto r = parse(R"("effects": [{"kind": "fire", "variation": {"jitter": 0.8, "rotationDeg": -5, "wobble": 1}}])");
+    ASSERT_FALSE(r);
+    EXPECT_NE(r.error().find("effects[0].variation.jitter"), std::string::npos) << r.error();
+    EXPECT_NE(r.error().find("effects[0].variation.rotationDeg"), std::string::npos) << r.error();
+    EXPECT_NE(r.error().find("effects[0].variation.wobble: unknown key"), std::string::npos) << r.error();
+}

@@ -321,3 +321,91 @@ TEST(SplatBuilder, RayScaleIsTheKernelsLengthAlongTheRay) {
     EXPECT_EQ(rayScaleCode(std::nanf("")), 0);
     EXPECT_GT(rayScaleRho(rayScaleCode(1e9f)), 10.0f);
 }
+
+// SplatVariation (issue 25): each option changes only what it says, the
+// same way on every build of the same cells and seed.
+namespace {
+std::vector<Splat> buildVaried(const Grid& g, const Materials& m, const Camera& cam, const SplatVariation& v) {
+    SplatBuilder b;
+    b.begin(cam);
+    b.add(g, m, {.textureSet = 0, .colorTable = 0, .variation = v});
+    return b.splats(); // grid order: splat i is voxel i
+}
+} // namespace
+
+TEST(SplatVariation, RotationAndMirrorTurnOnlyTheTexture) {
+    const Materials m = plainMaterials();
+    Grid g = *Grid::box({5, 6, 4}, glm::vec3(0.5f, 0.4f, 0.7f)); // non-cubic: anisotropic ellipses
+    const Camera cam = Camera::lookAt({3, 4, 6}, {0, 1, 0}, {0, 1, 0}, glm::radians(50.0f), {320, 240}, 0.1f, 100.0f);
+    const std::vector<Splat> plain = buildVaried(g, m, cam, {});
+    const std::vector<Splat> turned = buildVaried(g, m, cam, {.rotationRad = 3.14159265f, .mirror = true, .seed = 7});
+    ASSERT_EQ(plain.size(), turned.size());
+    int mirrored = 0, turnedFar = 0;
+    for (std::size_t i = 0; i < plain.size(); ++i) {
+        const Splat &a = plain[i], &b = turned[i];
+        EXPECT_EQ(a.center, b.center);
+        EXPECT_EQ(a.density, b.density);
+        EXPECT_EQ(a.layer, b.layer);
+        // The footprint is F(|(u, v)|) over the ellipse: the same ellipse iff
+        // U U^T + V V^T is unchanged (an orthogonal change of (u, v) keeps it).
+        const glm::mat3 qa = glm::outerProduct(a.axisU, a.axisU) + glm::outerProduct(a.axisV, a.axisV);
+        const glm::mat3 qb = glm::outerProduct(b.axisU, b.axisU) + glm::outerProduct(b.axisV, b.axisV);
+        const float scale = glm::length(a.axisU) * glm::length(a.axisU);
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) EXPECT_NEAR(qa[r][c], qb[r][c], 1e-5f * scale); // float rounding of a 2x2 rotation
+        mirrored += glm::dot(glm::cross(a.axisU, a.axisV), glm::cross(b.axisU, b.axisV)) < 0.0f;
+        turnedFar += glm::dot(glm::normalize(a.axisV), glm::normalize(b.axisV)) < 0.0f;
+    }
+    // About half mirrored and half turned by more than 90 degrees (120 voxels: 3 sigma is +-16).
+    EXPECT_NEAR(mirrored, 60, 17);
+    EXPECT_NEAR(turnedFar, 60, 17);
+    EXPECT_EQ(buildVaried(g, m, cam, {.rotationRad = 3.14159265f, .mirror = true, .seed = 7})[5].axisU, turned[5].axisU); // deterministic
+}
+
+TEST(SplatVariation, JitterStaysInTheCellAndScaleKeepsTheMaterial) {
+    const Materials m = plainMaterials();
+    Grid g = *Grid::box({6, 6, 6}, glm::vec3(0.5f));
+    const Camera cam = Camera::lookAt({0, 1.5f, 9}, {0, 1.5f, 0}, {0, 1, 0}, glm::radians(50.0f), {320, 240}, 0.1f, 100.0f);
+    const std::vector<Splat> plain = buildVaried(g, m, cam, {});
+    const std::vector<Splat> moved = buildVaried(g, m, cam, {.jitter = 0.5f, .seed = 3});
+    const std::vector<Splat> sized = buildVaried(g, m, cam, {.scaleLog2 = 0.5f, .seed = 3});
+    ASSERT_EQ(plain.size(), moved.size());
+    float largest = 0.0f;
+    for (std::size_t i = 0; i < plain.size(); ++i) {
+        const glm::vec3 d = moved[i].center - plain[i].center;
+        largest = std::max({largest, std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+        EXPECT_LE(std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)}), 0.25f + 1e-5f); // half a cell of 0.5
+        const float s = glm::length(sized[i].axisU) / glm::length(plain[i].axisU);
+        EXPECT_GE(s, std::exp2(-0.5f) * (1.0f - 1e-5f));
+        EXPECT_LE(s, std::exp2(0.5f) * (1.0f + 1e-5f));
+        // Material = density x ellipse area: kept (float rounding).
+        EXPECT_NEAR(sized[i].density * s * s, plain[i].density, 1e-5f * plain[i].density);
+    }
+    EXPECT_GT(largest, 0.2f); // 216 voxels x 3 axes: some offset reaches past 0.2 of the 0.25
+    const std::vector<Splat> other = buildVaried(g, m, cam, {.jitter = 0.5f, .seed = 4});
+    EXPECT_NE(other[0].center, moved[0].center); // the seed matters
+}
+
+TEST(SplatVariation, OutOfRangeFieldsAreNamed) {
+    EXPECT_EQ(checkSplatVariation({.jitter = 0.7f}), "variation.jitter must be in [0, 0.5], got 0.700000");
+    EXPECT_EQ(checkSplatVariation({.rotationRad = -1.0f}, "style."), "style.rotationRad must be in [0, 3.14159], got -1.000000");
+    EXPECT_EQ(checkSplatVariation({.scaleLog2 = std::nanf("")}), "variation.scaleLog2 must be in [0, 1], got nan");
+    EXPECT_EQ(checkSplatVariation(SplatVariation::recommended(1)), "");
+}
+
+TEST(SplatVariation, PlainFootprintsStayOnTheLattice) {
+    // Fig. 1a's traditional splats: no stamp to hide, and the lattice reconstructs the field best.
+    const Materials m = plainMaterials();
+    Grid g = *Grid::box({4, 4, 4}, glm::vec3(0.5f));
+    const Camera cam = Camera::lookAt({0, 1, 6}, {0, 1, 0}, {0, 1, 0}, glm::radians(50.0f), {320, 240}, 0.1f, 100.0f);
+    SplatBuilder a, b;
+    a.begin(cam);
+    b.begin(cam);
+    a.add(g, m, {.textured = false});
+    b.add(g, m, {.textured = false, .variation = SplatVariation::recommended(9)});
+    ASSERT_EQ(a.splats().size(), b.splats().size());
+    for (std::size_t i = 0; i < a.splats().size(); ++i) {
+        EXPECT_EQ(a.splats()[i].center, b.splats()[i].center);
+        EXPECT_EQ(a.splats()[i].axisU, b.splats()[i].axisU);
+    }
+}

@@ -293,5 +293,24 @@ TEST_F(Stability, TextureSetAllOneEqualsPlainSplatting) {
     EXPECT_LE(tex.worst, tex.bound);
 }
 
+// SplatVariation (issue 25) lives in the Splat list both paths read: jittered,
+// turned, mirrored and scaled splats agree with the reference within the
+// same derived bound, and the variation visibly changes the image.
+TEST_F(Stability, VariedSplatsMatchTheReference) {
+    Materials mat = plain();
+    const std::uint32_t set = mat.addTextureSet(TextureSet::turbulence({.count = 4, .size = 32}));
+    const SplatVariation varied{.jitter = 0.5f, .rotationRad = 3.14159265f, .mirror = true, .scaleLog2 = 0.3f, .seed = 5};
+    const Result r = run(texturedBox(), kTexCam, mat, {.textureSet = set, .crossfade = true, .variation = varied});
+    EXPECT_LE(r.worst, r.bound);
+    EXPECT_GT(visible(r.ref), 0.2);
+    const Result lattice = run(texturedBox(), kTexCam, mat, {.textureSet = set, .crossfade = true});
+    double moved = 0.0;
+    for (size_t i = 0; i < r.gl.pixels.size(); ++i) moved = std::max(moved, double(std::abs(r.gl.pixels[i] - lattice.gl.pixels[i])));
+    // The derived bound is loose (it adds every overlapping splat's worst case); against the
+    // two paths' actual disagreement the variation's change must stand an order of magnitude out.
+    std::printf("  the variation changes a pixel by up to %.3f\n", moved);
+    EXPECT_GT(moved, 10.0 * r.worst) << "the variation must change the picture well beyond the GL-vs-reference difference";
+}
+
 } // namespace
 } // namespace splatfx

@@ -81,6 +81,10 @@ constexpr int kTruthCount = 32;
 constexpr int kTruthLayer = 128;
 constexpr std::uint32_t kSeed = 1;
 
+// The splats' variation in every setting and its truth (--paper-lattice:
+// none): the presets' default, so the figures are those of what is drawn.
+splatfx::SplatVariation gVariation = splatfx::SplatVariation::recommended(1);
+
 struct Config {
     int tableSize = 256; // FootprintDesc::tableSize
     int layerSize = 32;  // MaterialsDesc::layerSize
@@ -286,7 +290,7 @@ struct Bench {
         const splatfx::Frame& prepare(const splatfx::Camera& cam) {
             frame->begin(0.0, cam);
             frame->setFog(fog);
-            frame->builder().add(grid, *mat, {.textureSet = setId, .colorTable = 0, .textured = config.textured, .crossfade = true});
+            frame->builder().add(grid, *mat, {.textureSet = setId, .colorTable = 0, .textured = config.textured, .crossfade = true, .variation = gVariation});
             frame->end(config.sort);
             return *frame;
         }
@@ -382,7 +386,7 @@ struct Bench {
         const splatfx::Materials mat = materials(tc, truthSet, setId);
         splatfx::SplatBuilder builder;
         builder.begin(cam);
-        builder.add(grid, mat, {.textureSet = setId, .colorTable = 0, .textured = c.textured, .crossfade = true});
+        builder.add(grid, mat, {.textureSet = setId, .colorTable = 0, .textured = c.textured, .crossfade = true, .variation = gVariation});
         auto img = splatfx::renderSplatExact(builder.splats(), cam, mat, {.host = refHost(), .fog = fog});
         return img ? *img : splatfx::Image{};
     }
@@ -411,7 +415,10 @@ int parse(int argc, char** argv, Options& o) {
     app.add_flag("--replot", o.replotOnly, "only run gnuplot again on DIR/accuracy.gp (after editing it)");
     app.add_flag("--fog-only", o.fogOnly, "only the fog knobs (host fog texture, per-splat fog, fog terms) and their reference");
     app.add_flag("--clouds-only", o.cloudsOnly, "only the LOD clouds' knobs (table size, c, C, max vs average Delta) against the finest level");
+    bool paperLattice = false;
+    app.add_flag("--paper-lattice", paperLattice, "splats on the voxel lattice as in the paper (no SplatVariation; default: the presets' recommended one)");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+    if (paperLattice) gVariation = {};
     if (noPlots || o.cloudsOnly) o.plots = false; // the clouds' table is printed, not plotted
     return -1;
 }

@@ -301,6 +301,8 @@ struct Settings {
     int frames = 30;
     splatfx::gl::RendererDesc renderer; // the SDK defaults unless an option says otherwise
     bool crossfade = false;
+    // The presets' default; --paper-lattice: none (splats on the lattice, as in the paper).
+    splatfx::SplatVariation variation = splatfx::SplatVariation::recommended(1);
 };
 
 RowResult measureRow(const Row& row, const Settings& settings) {
@@ -320,7 +322,7 @@ RowResult measureRow(const Row& row, const Settings& settings) {
     const splatfx::Camera cam = fireCamera(row.window);
     splatfx::Frame frame;
     const splatfx::gl::HostTarget target{.framebuffer = fb->handle()};
-    const splatfx::SplatStyle style{.textureSet = set, .colorTable = lut, .crossfade = settings.crossfade};
+    const splatfx::SplatStyle style{.textureSet = set, .colorTable = lut, .crossfade = settings.crossfade, .variation = settings.variation};
 
     // Full frame as an application runs it: dynamics, build, sort, upload,
     // draw, and wait for the pixels (glFinish), at 60 simulated frames/s.
@@ -457,7 +459,7 @@ void fragmentCosts(std::FILE* csv) {
 
 // CPU work per frame (dynamics + build + sort + copy into the instance
 // stream) at growing voxel counts.
-void cpuScaling(std::FILE* csv) {
+void cpuScaling(std::FILE* csv, const splatfx::SplatVariation& variation) {
     const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
     std::printf("\nCPU work per frame (texture cycling + splat build + radix sort + copy to the instance stream),\n"
                 "SplatBuilderDesc::threads = 1 (default) and = %u (this machine's hardware threads):\n",
@@ -490,7 +492,7 @@ void cpuScaling(std::FILE* csv) {
                     cycle(base, grid, i / 60.0);
                     const auto t1 = Clock::now();
                     builder.begin(cam);
-                    builder.add(grid, materials, {.textureSet = set, .colorTable = lut, .crossfade = true});
+                    builder.add(grid, materials, {.textureSet = set, .colorTable = lut, .crossfade = true, .variation = variation});
                     const auto t2 = Clock::now();
                     builder.sort();
                     const auto t3 = Clock::now();
@@ -552,6 +554,8 @@ int runTable1(int argc, char** argv) {
         },
         "texture sampling: auto, bilinear, nearest, upsampled or upsampledN (N in [2, 16])", "MODE");
     app.add_flag("--crossfade", settings.crossfade, "blend towards the next texture by the voxel's phase");
+    app.add_flag_callback("--paper-lattice", [&] { settings.variation = {}; },
+                          "splats on the voxel lattice as in the paper (no SplatVariation; default: the presets' recommended one)");
     CLI::Option* squares = app.add_flag_callback(
         "--squares", [&settings] { settings.renderer.trimCorners = false; }, "draw square splats");
     app.add_flag_callback(
@@ -596,7 +600,7 @@ int runTable1(int argc, char** argv) {
                 "side = the splats' mean size in pixels (sqrt of fragments per splat); vs sized = splat-pass fragments/s as a\n"
                 "  fraction of screen-aligned squares of that size doing the same work (the rasterizer's limit at that size)\n"
                 "ratio = splatfx full frame (dynamics, sort, upload, draw) vs the naive baseline's frame (no sort, no footprint math)\n");
-    cpuScaling(csv);
+    cpuScaling(csv, settings.variation);
     if (csv) {
         const bool ok = std::ferror(csv) == 0;
         if (std::fclose(csv) != 0 || !ok) {

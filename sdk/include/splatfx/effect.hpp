@@ -181,6 +181,10 @@ public:
     const EffectDesc& desc() const;
     // Switches scales of motion on or off; takes effect at the next update/step.
     void setToggles(const DynamicsToggles& toggles);
+    // Gives every layer this per-splat variation (splats.hpp; presets use
+    // SplatVariation::recommended); bounds() follow. Fails, changing nothing,
+    // on an out-of-range field (the message names it).
+    Status setSplatVariation(const SplatVariation& variation);
     // The solver of a solver effect, for emitters and inspection (nullptr otherwise).
     FluidSolver* solver();
     const FluidSolver* solver() const;

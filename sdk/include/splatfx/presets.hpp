@@ -63,6 +63,9 @@ struct FireDesc {
     bool crossfade = true;                  // cross-fade consecutive textures; default true
     Motion motion{};                        // object dynamics (keyframes, procedure); default at rest
     std::uint32_t seed = 1;                 // texture dynamics (which texture each voxel shows when); default 1
+    // Per-splat variation hiding the voxel lattice (splats.hpp); its seed is combined with `seed`;
+    // default SplatVariation::recommended (jitter 0.5, any rotation, mirrored). {} gives the paper's lattice.
+    SplatVariation variation = SplatVariation::recommended(0);
     std::uint32_t textureSeed = 1;          // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> fire(Materials& materials, const FireDesc& desc = {});
@@ -81,6 +84,9 @@ struct SmokeDesc {
     float texturesPerSec = 3.0f;              // local dynamics rate; default 3
     int substeps = 1;                         // solver substeps per step; default 1
     std::uint32_t seed = 1;                   // texture dynamics (which texture each voxel shows when); default 1
+    // Per-splat variation hiding the voxel lattice (splats.hpp); its seed is combined with `seed`;
+    // default SplatVariation::recommended (jitter 0.5, any rotation, mirrored). {} gives the paper's lattice.
+    SplatVariation variation = SplatVariation::recommended(0);
     std::uint32_t textureSeed = 1;            // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> smoke(Materials& materials, const SmokeDesc& desc = {});
@@ -96,6 +102,9 @@ struct SteamDesc {
     float texturesPerSec = 4.0f;            // default 4
     Motion motion{};                        // default at rest
     std::uint32_t seed = 1;                 // texture dynamics (which texture each voxel shows when); default 1
+    // Per-splat variation hiding the voxel lattice (splats.hpp); its seed is combined with `seed`;
+    // default SplatVariation::recommended (jitter 0.5, any rotation, mirrored). {} gives the paper's lattice.
+    SplatVariation variation = SplatVariation::recommended(0);
     std::uint32_t textureSeed = 1;          // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> steam(Materials& materials, const SteamDesc& desc = {});
@@ -115,6 +124,9 @@ struct GasDesc {
     float texturesPerSec = 3.0f;            // local dynamics' cycling rate; default 3
     Motion motion{};                        // moves the lattice; default at rest
     std::uint32_t seed = 1;                 // texture cycling; default 1
+    // Per-splat variation hiding the voxel lattice (splats.hpp); its seed is combined with `seed`;
+    // default SplatVariation::recommended (jitter 0.5, any rotation, mirrored). {} gives the paper's lattice.
+    SplatVariation variation = SplatVariation::recommended(0);
     std::uint32_t textureSeed = 1;          // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> gas(Materials& materials, const GasDesc& desc = {});
@@ -132,6 +144,9 @@ struct DustDesc {
     std::optional<TextureSet> textureSet{};    // default none (procedural turbulence)
     int textureCount = 8;                      // default 8
     std::uint32_t seed = 1;                    // texture dynamics (which texture each voxel shows when); default 1
+    // Per-splat variation hiding the voxel lattice (splats.hpp); its seed is combined with `seed`;
+    // default SplatVariation::recommended (jitter 0.5, any rotation, mirrored). {} gives the paper's lattice.
+    SplatVariation variation = SplatVariation::recommended(0);
     std::uint32_t textureSeed = 1;             // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> dust(Materials& materials, const DustDesc& desc = {});
@@ -148,6 +163,9 @@ struct FireToSmokeDesc {
     float texturesPerSec = 5.0f;                 // default 5
     Motion motion{};                             // default at rest
     std::uint32_t seed = 1;                      // texture dynamics (which texture each voxel shows when); default 1
+    // Per-splat variation hiding the voxel lattice (splats.hpp); its seed is combined with `seed`;
+    // default SplatVariation::recommended (jitter 0.5, any rotation, mirrored). {} gives the paper's lattice.
+    SplatVariation variation = SplatVariation::recommended(0);
     std::uint32_t textureSeed = 1;               // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> fireToSmoke(Materials& materials, const FireToSmokeDesc& desc = {});
@@ -163,6 +181,9 @@ struct GhostsDesc {
     float texturesPerSec = 5.0f;            // random selection rate; default 5
     float propagationStepsPerSec = 4.0f;    // faces drifting upwards; default 4
     std::uint32_t seed = 1;                 // texture dynamics (which texture each voxel shows when); default 1
+    // Per-splat variation hiding the voxel lattice (splats.hpp); its seed is combined with `seed`. Faces keep
+    // roughly upright: default jitter 0.5, rotation +-0.35 rad, mirrored.
+    SplatVariation variation{.jitter = 0.5f, .rotationRad = 0.35f, .mirror = true};
     std::uint32_t textureSeed = 1;          // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> ghosts(Materials& materials, const GhostsDesc& desc = {});

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "splatfx/camera.hpp"
@@ -69,6 +70,42 @@ float rayScaleRho(std::uint8_t code);
 // 0 for a degenerate ellipse.
 float splatRayScale(const Splat& splat, float footprintRadius);
 
+// Per-splat variation that hides the voxel lattice. King et al. 1999 (sec. 2)
+// stamp every voxel's texture at the same orientation and scale at a
+// position fixed to the grid, and the overlapping stamps then read as a
+// regular weave. Each option is a pure function of (voxel cell, seed), so it
+// is stable over time (the three scales of motion still read) and is the
+// same for the GL renderer and the reference, which both draw the Splat list.
+// Untextured splats (SplatStyle::textured false, Fig. 1a) ignore it: plain
+// footprints on the lattice reconstruct the field best and show no stamp.
+// The zero value is the paper's lattice; presets use recommended().
+struct SplatVariation {
+    // The splat centre moves by up to +-jitter cells along each lattice axis
+    // (uniform, per voxel). [0, 0.5]; default 0. At 0.5 the centres are
+    // uniform over their cells, and the expected lattice sum has no
+    // component at the lattice's frequencies.
+    float jitter = 0.0f;
+    // The texture turns about the splat's centre by an angle uniform in
+    // +-rotationRad (the footprint is radial, so only the texture turns).
+    // [0, pi]; default 0. pi: any orientation (isotropic turbulence); small
+    // angles for textures with an up (flames photographed, faces).
+    float rotationRad = 0.0f;
+    // Half of the splats show their texture mirrored left-right (up stays
+    // up). Default false.
+    bool mirror = false;
+    // The splat's size is multiplied by 2^u, u uniform in +-scaleLog2, with
+    // its optical depth divided by the square of that factor so each splat
+    // carries the same material. [0, 1]; default 0.
+    float scaleLog2 = 0.0f;
+    std::uint32_t seed = 0; // hashed with the voxel's cell; default 0
+
+    bool any() const { return jitter > 0.0f || rotationRad > 0.0f || mirror || scaleLog2 > 0.0f; }
+    // What the presets and scene files use (docs/BENCHMARKS.md, "The voxel
+    // lattice"): centres uniform over their cells, any orientation, mirrored
+    // half the time, no scale variation.
+    static SplatVariation recommended(std::uint32_t seed) { return {.jitter = 0.5f, .rotationRad = 3.14159265f, .mirror = true, .scaleLog2 = 0.0f, .seed = seed}; }
+};
+
 // How a grid's voxels become splats.
 struct SplatStyle {
     std::uint32_t textureSet = 0; // id from Materials::addTextureSet; default 0
@@ -76,7 +113,11 @@ struct SplatStyle {
     bool textured = true;         // false: traditional splatting with the plain footprint (Fig. 1a); default true
     bool crossfade = false;       // blend towards the next texture by the voxel's phase; default false
     float opacityScale = 1.0f;    // multiplies every voxel's opacity; default 1
+    SplatVariation variation{};   // per-splat jitter, rotation, mirroring, scale; default none (the paper's lattice)
 };
+// The message naming the first out-of-range field of v ("jitter must be in
+// [0, 0.5], got 0.7"), or empty when v is valid. `field` prefixes the name.
+std::string checkSplatVariation(const SplatVariation& v, const std::string& field = "variation.");
 
 enum class SortMode {
     Exact,    // radix sort on the exact depth key (default)

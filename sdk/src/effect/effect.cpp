@@ -97,6 +97,12 @@ void Effect::setToggles(const DynamicsToggles& toggles) {
     mBody->desc.enabled = toggles;
     mBody->togglesChanged();
 }
+Status Effect::setSplatVariation(const SplatVariation& variation) {
+    if (std::string e = checkSplatVariation(variation, "effect '" + mBody->desc.name + "': variation."); !e.empty()) return makeError(e);
+    for (EffectLayer& l : mBody->layers) l.style.variation = variation;
+    for (EffectLayer& l : mBody->desc.layers) l.style.variation = variation;
+    return {};
+}
 FluidSolver* Effect::solver() { return mBody->solver(); }
 const FluidSolver* Effect::solver() const { return mBody->solver(); }
 const TextureDynamics& Effect::textureDynamics() const { return mBody->textureDynamics(); }

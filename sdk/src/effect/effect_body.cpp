@@ -51,6 +51,7 @@ Status EffectBody::checkDesc(const EffectDesc& d) {
         if (!(l.heightFrom >= 0.0f && l.heightFrom <= 1.0f)) return makeError(li + "heightFrom must be in [0, 1]");
         if (!(l.heightTo >= l.heightFrom && l.heightTo <= 1.0f)) return makeError(li + "heightTo must be in [heightFrom, 1]");
         if (!(l.blend >= 0.0f && l.blend <= 1.0f)) return makeError(li + "blend must be in [0, 1]");
+        if (std::string e = checkSplatVariation(l.style.variation, li + "style.variation."); !e.empty()) return makeError(e);
     }
     const PropagationDesc& p = d.textures.propagation;
     if (p.mode != Propagation::None && !(p.stepsPerSec > 0.0f && std::isfinite(p.stepsPerSec)))
@@ -129,8 +130,16 @@ Aabb EffectBody::transformBox(const Aabb& box, const glm::mat4& m) {
 }
 
 Aabb EffectBody::withSplatExtent(const Aabb& world, float motionScale, const glm::mat4& transform, glm::vec3 spacing, float maxStretch) const {
-    // Splat extent: the builder's R times the kernel's largest axis.
-    const float extent = desc.footprintRadius * motionScale * kernelNormBound(transform, spacing, maxStretch);
+    // Splat extent: the builder's R times the kernel's largest axis, times the
+    // largest SplatVariation scale, plus the jitter's reach (at most
+    // jitter * sqrt(3) cells, each at most the kernel's largest axis long).
+    float maxScale = 1.0f, jitter = 0.0f;
+    for (const EffectLayer& l : layers) {
+        maxScale = std::max(maxScale, std::exp2(std::clamp(l.style.variation.scaleLog2, 0.0f, 1.0f)));
+        jitter = std::max(jitter, std::clamp(l.style.variation.jitter, 0.0f, 0.5f));
+    }
+    const float extent = motionScale * (desc.footprintRadius * maxScale * kernelNormBound(transform, spacing, maxStretch) +
+                                        jitter * 1.7320508f * kernelNormBound(transform, spacing, 0.0f));
     // A little slack for float rounding in the builder's matrix products.
     return world.expanded(extent * (1.0f + 1e-4f) + 1e-5f);
 }

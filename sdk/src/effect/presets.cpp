@@ -78,6 +78,14 @@ Status checkRate(const char* field, float v) {
     return {};
 }
 
+// The desc's variation with its seed tied to the effect's seed, so effects
+// with different seeds vary differently; fails naming the field.
+Result<SplatVariation> seededVariation(const char* desc, SplatVariation v, std::uint32_t seed) {
+    if (std::string e = checkSplatVariation(v, std::string(desc) + ".variation."); !e.empty()) return makeError(e);
+    v.seed = hash32(v.seed ^ hash32(seed + 0x51a7u));
+    return v;
+}
+
 EffectDesc gridDesc(const char* name, const Materials& m, const Motion& motion, std::uint32_t seed) {
     EffectDesc d;
     d.name = name;
@@ -97,6 +105,8 @@ Motion restingAt(const Motion& m, glm::vec3 position) {
 } // namespace
 
 Result<Effect> fire(Materials& materials, const FireDesc& d) {
+    const Result<SplatVariation> variation = seededVariation("FireDesc", d.variation, d.seed);
+    if (!variation) return makeError(variation.error());
     if (Status s = checkCount("FireDesc.textureCount", d.textureCount); !s) return makeError(s.error());
     if (Status s = checkUnit("FireDesc.opacity", d.opacity); !s) return makeError(s.error());
     if (Status s = checkRate("FireDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
@@ -117,11 +127,13 @@ Result<Effect> fire(Materials& materials, const FireDesc& d) {
     const Result<std::uint32_t> setId = registerSet(materials, *set);
     if (!setId) return makeError("FireDesc.textureSet: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::fire());
-    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = d.crossfade}}};
+    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = d.crossfade, .variation = *variation}}};
     return Effect::fromGrid(std::move(*grid), std::move(e));
 }
 
 Result<Effect> smoke(Materials& materials, const SmokeDesc& d) {
+    const Result<SplatVariation> variation = seededVariation("SmokeDesc", d.variation, d.seed);
+    if (!variation) return makeError(variation.error());
     if (Status s = checkCount("SmokeDesc.textureCount", d.textureCount); !s) return makeError(s.error());
     if (Status s = checkRate("SmokeDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
     if (!(d.sourceRadius > 0.0f)) return makeError("SmokeDesc.sourceRadius must be > 0");
@@ -150,11 +162,13 @@ Result<Effect> smoke(Materials& materials, const SmokeDesc& d) {
     const Result<std::uint32_t> setId = registerSet(materials, *set);
     if (!setId) return makeError("SmokeDesc.textureSet: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::smoke());
-    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true}}};
+    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true, .variation = *variation}}};
     return Effect::fromSolver(std::move(*solver), std::move(e));
 }
 
 Result<Effect> steam(Materials& materials, const SteamDesc& d) {
+    const Result<SplatVariation> variation = seededVariation("SteamDesc", d.variation, d.seed);
+    if (!variation) return makeError(variation.error());
     if (Status s = checkCount("SteamDesc.textureCount", d.textureCount); !s) return makeError(s.error());
     if (Status s = checkUnit("SteamDesc.opacity", d.opacity); !s) return makeError(s.error());
     if (Status s = checkRate("SteamDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
@@ -174,11 +188,13 @@ Result<Effect> steam(Materials& materials, const SteamDesc& d) {
     const Result<std::uint32_t> setId = registerSet(materials, *set);
     if (!setId) return makeError("SteamDesc.textureSet: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::steam());
-    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true}}};
+    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true, .variation = *variation}}};
     return Effect::fromGrid(std::move(*grid), std::move(e));
 }
 
 Result<Effect> gas(Materials& materials, const GasDesc& d) {
+    const Result<SplatVariation> variation = seededVariation("GasDesc", d.variation, d.seed);
+    if (!variation) return makeError(variation.error());
     if (Status s = checkCount("GasDesc.textureCount", d.textureCount); !s) return makeError(s.error());
     if (!(d.opacity > 0.0f && d.opacity <= 1.0f)) return makeError("GasDesc.opacity must be in (0, 1]");
     if (Status s = checkRate("GasDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
@@ -196,11 +212,13 @@ Result<Effect> gas(Materials& materials, const GasDesc& d) {
     const Result<std::uint32_t> setId = registerSet(materials, *set);
     if (!setId) return makeError("GasDesc.textureSet: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::steam());
-    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true, .opacityScale = d.opacity}}};
+    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true, .opacityScale = d.opacity, .variation = *variation}}};
     return Effect::fromProceduralGas(d.gas, std::move(*lattice), std::move(e));
 }
 
 Result<Effect> dust(Materials& materials, const DustDesc& d) {
+    const Result<SplatVariation> variation = seededVariation("DustDesc", d.variation, d.seed);
+    if (!variation) return makeError(variation.error());
     if (Status s = checkCount("DustDesc.textureCount", d.textureCount); !s) return makeError(s.error());
     if (!(d.sourceRadius > 0.0f)) return makeError("DustDesc.sourceRadius must be > 0");
     if (Status s = checkRate("DustDesc.settle", d.settle); !s) return makeError(s.error());
@@ -229,11 +247,13 @@ Result<Effect> dust(Materials& materials, const DustDesc& d) {
     const Result<std::uint32_t> setId = registerSet(materials, *set);
     if (!setId) return makeError("DustDesc.textureSet: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(ColorTable::dust());
-    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true}}};
+    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true, .variation = *variation}}};
     return Effect::fromSolver(std::move(*solver), std::move(e));
 }
 
 Result<Effect> fireToSmoke(Materials& materials, const FireToSmokeDesc& d) {
+    const Result<SplatVariation> variation = seededVariation("FireToSmokeDesc", d.variation, d.seed);
+    if (!variation) return makeError(variation.error());
     if (!(d.split > 0.0f && d.split < 1.0f)) return makeError("FireToSmokeDesc.split must be in (0, 1), got " + std::to_string(d.split));
     if (!(d.blend >= 0.0f && d.blend < 1.0f)) return makeError("FireToSmokeDesc.blend must be in [0, 1), got " + std::to_string(d.blend));
     if (Status s = checkRate("FireToSmokeDesc.texturesPerSec", d.texturesPerSec); !s) return makeError(s.error());
@@ -273,12 +293,12 @@ Result<Effect> fireToSmoke(Materials& materials, const FireToSmokeDesc& d) {
     const std::uint32_t fireLut = materials.addColorTable(ColorTable::fire());
     const std::uint32_t smokeLut = materials.addColorTable(ColorTable::smoke());
     e.layers = {
-        {.style = {.textureSet = *fireId, .colorTable = fireLut, .textured = true, .crossfade = true},
+        {.style = {.textureSet = *fireId, .colorTable = fireLut, .textured = true, .crossfade = true, .variation = *variation},
          .heightFrom = 0.0f,
          .heightTo = d.split,
          .blend = d.blend,
          .remapColor = true},
-        {.style = {.textureSet = *smokeId, .colorTable = smokeLut, .textured = true, .crossfade = true},
+        {.style = {.textureSet = *smokeId, .colorTable = smokeLut, .textured = true, .crossfade = true, .variation = *variation},
          .heightFrom = d.split,
          .heightTo = 1.0f,
          .blend = d.blend,
@@ -321,6 +341,8 @@ TextureSet proceduralFaces(int count, int size, std::uint32_t seed) {
 }
 
 Result<Effect> ghosts(Materials& materials, const GhostsDesc& d) {
+    const Result<SplatVariation> variation = seededVariation("GhostsDesc", d.variation, d.seed);
+    if (!variation) return makeError(variation.error());
     if (!(d.headRadiusCells >= 1.0f && d.headRadiusCells <= 64.0f))
         return makeError("GhostsDesc.headRadiusCells must be in [1, 64], got " + std::to_string(d.headRadiusCells));
     if (d.plumeCells < 0 || d.plumeCells > 256) return makeError("GhostsDesc.plumeCells must be in [0, 256], got " + std::to_string(d.plumeCells));
@@ -368,7 +390,7 @@ Result<Effect> ghosts(Materials& materials, const GhostsDesc& d) {
     if (!setId) return makeError("GhostsDesc.textureSet: " + setId.error());
     const std::uint32_t tableId = materials.addColorTable(
         ColorTable::gradient({{0.0f, {0.75f, 0.85f, 1.0f, 1.0f}}, {0.6f, {0.7f, 0.8f, 1.0f, 0.8f}}, {1.0f, {0.6f, 0.7f, 0.9f, 0.0f}}}));
-    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = false}}};
+    e.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = false, .variation = *variation}}};
     return Effect::fromGrid(std::move(*grid), std::move(e));
 }
 

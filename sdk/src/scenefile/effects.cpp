@@ -3,6 +3,10 @@
 #include "scenefile/kinds.hpp"
 #include "scenefile/reader.hpp"
 
+#include <algorithm>
+
+#include "splatfx/presets.hpp"
+
 namespace splatfx::scenefile {
 
 void readEffects(Context& c, const std::string& path, const Json& v, const std::vector<RawGeometry>& geo,
@@ -41,6 +45,19 @@ void readEffects(Context& c, const std::string& path, const Json& v, const std::
         o.boolean("enabled", e.options.enabled);
         o.number("rangeWorld", e.options.rangeWorld, 0.0, 1e9);
         o.boolean("traditional", e.traditional);
+        // Per-splat variation hiding the lattice (splats.hpp): the presets' default, keys override it.
+        SplatVariation variation = e.kind == "ghosts" ? presets::GhostsDesc{}.variation : SplatVariation::recommended(0);
+        variation.seed = hash32(e.seed ^ 0x51a7u);
+        if (const Json* va = o.get("variation")) {
+            ObjectReader vo(c.d, o.at("variation"), *va);
+            vo.number("jitter", variation.jitter, 0.0, 0.5);
+            float rotationDeg = variation.rotationRad * 57.2957795f;
+            vo.number("rotationDeg", rotationDeg, 0.0, 180.0);
+            variation.rotationRad = std::min(rotationDeg * 0.0174532925f, 3.14159265f);
+            vo.boolean("mirror", variation.mirror);
+            vo.number("scaleLog2", variation.scaleLog2, 0.0, 1.0);
+            vo.finish();
+        }
         if (const Json* t = o.get("toggles")) {
             ObjectReader to(c.d, o.at("toggles"), *t);
             to.boolean("object", e.toggles.object);
@@ -80,6 +97,10 @@ void readEffects(Context& c, const std::string& path, const Json& v, const std::
             return;
         }
         effect->setToggles(e.toggles);
+        if (Status st = effect->setSplatVariation(variation); !st) { // ranges were checked above: a bug if it fails
+            c.d.error(o.at("variation"), st.error());
+            continue;
+        }
         e.options.name = e.name;
         e.options.draw.textured = !e.traditional; // the Scene owns how each effect is drawn
         SceneEffectInfo info;

@@ -1,7 +1,11 @@
 #include "splatfx/splats.hpp"
 
+#include "splatfx/dynamics.hpp" // hashCell
+
 #include <algorithm>
+#include <cassert>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <thread>
 #include <utility>
@@ -73,6 +77,60 @@ struct FastMod {
     }
 };
 
+// One voxel's SplatVariation draw: centre offset (cells), the texture's
+// rotation (cos, sin; mirrored: the u axis negated) and size factor. Pure
+// function of (cell, seed): stable over time, the same on every thread.
+struct VariationDraw {
+    float offset[3] = {0.0f, 0.0f, 0.0f};
+    float cosA = 1.0f, sinA = 0.0f, mirror = 1.0f, scale = 1.0f;
+};
+constexpr std::uint32_t kVariationSalt = 0x1a771ceu; // apart from the texture dynamics' hashes of the same cells
+
+// cos and sin of 4096 angles over [-pi, pi], cheaper than std::cos and
+// std::sin per voxel; a 0.09 degree step is invisible in a texture.
+struct TurnTable {
+    static constexpr int kSize = 4096;
+    float c[kSize + 1], s[kSize + 1];
+    TurnTable() {
+        for (int i = 0; i <= kSize; ++i) {
+            const double a = (double(i) / kSize * 2.0 - 1.0) * 3.14159265358979323846;
+            c[i] = float(std::cos(a)), s[i] = float(std::sin(a));
+        }
+    }
+};
+const TurnTable& turnTable() {
+    static const TurnTable table; // built once, thread-safe
+    return table;
+}
+
+VariationDraw drawVariation(const SplatVariation& var, glm::ivec3 cell) {
+    VariationDraw d;
+    std::uint32_t h = hashCell(cell, var.seed, kVariationSalt);
+    auto next = [&h] { // a uniform in [-1, 1) per call
+        h = hash32(h + 0x9e3779b9u);
+        return 2.0f * hashUnit(h) - 1.0f;
+    };
+    const float jx = next(), jy = next(), jz = next(), angle = next(), flip = next(), size = next();
+    if (var.jitter > 0.0f) d.offset[0] = var.jitter * jx, d.offset[1] = var.jitter * jy, d.offset[2] = var.jitter * jz;
+    if (var.rotationRad > 0.0f) {
+        const TurnTable& t = turnTable(); // nearest of the table's angles to rotationRad * angle, in [-pi, pi]
+        const int i = std::clamp(int(std::lround((var.rotationRad * angle / 3.14159265f + 1.0f) * 0.5f * TurnTable::kSize)), 0, TurnTable::kSize);
+        d.cosA = t.c[i], d.sinA = t.s[i];
+    }
+    if (var.mirror && flip < 0.0f) d.mirror = -1.0f;
+    if (var.scaleLog2 > 0.0f) d.scale = std::exp2(var.scaleLog2 * size);
+    return d;
+}
+
+SplatVariation sanitized(const SplatVariation& v) {
+    assert(checkSplatVariation(v).empty() && "SplatBuilder::add: style.variation out of range (checkSplatVariation)");
+    SplatVariation s = v;
+    s.jitter = std::isfinite(v.jitter) ? std::clamp(v.jitter, 0.0f, 0.5f) : 0.0f;
+    s.rotationRad = std::isfinite(v.rotationRad) ? std::clamp(v.rotationRad, 0.0f, 3.14159265f) : 0.0f;
+    s.scaleLog2 = std::isfinite(v.scaleLog2) ? std::clamp(v.scaleLog2, 0.0f, 1.0f) : 0.0f;
+    return s;
+}
+
 // What a splat's geometry depends on besides its voxel and kernel shape.
 struct Frame {
     glm::mat4 transform;
@@ -108,8 +166,10 @@ struct GeometryBatch {
 // of Sigma^-1 = (M M^T)^-1 in the frame (e1, e2, d); Q^-1 is simply the
 // (e1, e2) block of Sigma, so the ellipse's axes are that 2x2 block's square
 // root. Isotropic kernels see a circle of radius s and a chord of s.
+// `offset` (3 floats per voxel, in cells; nullptr for none) moves each centre
+// off its lattice point (SplatVariation::jitter).
 template <bool Isotropic>
-void computeGeometry(const Frame& f, const Shape& shape, const Voxel* voxels, int count, GeometryBatch& out) {
+void computeGeometry(const Frame& f, const Shape& shape, const Voxel* voxels, int count, GeometryBatch& out, const float* offset = nullptr) {
     // Plain floats rather than glm vectors: GCC vectorizes the loop only
     // when no 3-vector aggregates are copied inside it (and, for the
     // selects, with -fno-trapping-math; see sdk/CMakeLists.txt).
@@ -135,6 +195,12 @@ void computeGeometry(const Frame& f, const Shape& shape, const Voxel* voxels, in
         cellY[i] = float(voxels[i].cell.y);
         cellZ[i] = float(voxels[i].cell.z);
     }
+    if (offset)
+        for (int i = 0; i < count; ++i) {
+            cellX[i] += offset[3 * i];
+            cellY[i] += offset[3 * i + 1];
+            cellZ[i] += offset[3 * i + 2];
+        }
     for (int i = 0; i < count; ++i) {
         const float lx = (cellX[i] - hx) * sx, ly = (cellY[i] - hy) * sy, lz = (cellZ[i] - hz) * sz;
         // Eye-relative centre.
@@ -200,6 +266,17 @@ void SplatBuilder::begin(const Camera& camera) {
     mStats = {};
 }
 
+std::string checkSplatVariation(const SplatVariation& v, const std::string& field) {
+    auto range = [&](const char* name, float x, float hi) {
+        char bound[32];
+        std::snprintf(bound, sizeof bound, "%g", double(hi));
+        return x >= 0.0f && x <= hi ? std::string() : field + name + " must be in [0, " + bound + "], got " + std::to_string(x);
+    };
+    for (std::string e : {range("jitter", v.jitter, 0.5f), range("rotationRad", v.rotationRad, 3.14159265f), range("scaleLog2", v.scaleLog2, 1.0f)})
+        if (!e.empty()) return e;
+    return {};
+}
+
 void SplatBuilder::add(const Grid& grid, const Materials& materials, const SplatStyle& style) {
     mStats.voxelsIn += grid.voxels.size();
     const Camera& cam = mCamera;
@@ -228,6 +305,13 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
 
     const glm::mat3 gridShape = rot * glm::mat3(glm::vec3(grid.spacing.x, 0, 0), glm::vec3(0, grid.spacing.y, 0), glm::vec3(0, 0, grid.spacing.z));
     const Shape plain(gridShape, R);
+    // Plain footprints have no stamp to hide and reconstruct the field best on
+    // the lattice (Crawfis-Max: 0.57 % ripple): the variation is for textured splats.
+    const SplatVariation variation = hasSet ? sanitized(style.variation) : SplatVariation{};
+    const bool varied = variation.any();
+    // Culling bound: a jittered centre moves by at most jitter * sqrt(3)
+    // cells' largest axis, and a scaled splat reaches scale times as far.
+    const float maxScale = std::exp2(variation.scaleLog2), jitterReach = variation.jitter * 1.7320508f * (R > 0.0f ? plain.extent / R : 0.0f);
     const glm::vec3 half = glm::vec3(glm::max(grid.dims - 1, glm::ivec3(0))) * 0.5f;
     const glm::vec3 halfXZ(half.x, 0.0f, half.z);
 
@@ -255,7 +339,7 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         for (int k = 0; k < 8 && inside; ++k) {
             const glm::ivec3 cell((k & 1) ? grid.dims.x - 1 : 0, (k & 2) ? grid.dims.y - 1 : 0, (k & 4) ? grid.dims.z - 1 : 0);
             const glm::vec3 corner = glm::vec3(grid.transform * glm::vec4((glm::vec3(cell) - halfXZ) * grid.spacing, 1.0f));
-            for (const auto& p : planes) inside = inside && glm::dot(glm::vec3(p), corner) + p.w >= -plain.extent;
+            for (const auto& p : planes) inside = inside && glm::dot(glm::vec3(p), corner) + p.w >= -(plain.extent * maxScale + jitterReach);
         }
         cullEach = !inside;
     }
@@ -279,11 +363,19 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         // Geometry is computed kBatch voxels at a time by a branch-free loop
         // the compiler vectorizes; the per-voxel rest below is scalar.
         GeometryBatch batch;
+        VariationDraw draws[kBatch];
+        float offsets[3 * kBatch];
         for (const Voxel* first = begin; first < end; first += kBatch) {
             const int count = int(std::min<std::ptrdiff_t>(kBatch, end - first));
+            if (varied)
+                for (int i = 0; i < count; ++i) {
+                    draws[i] = drawVariation(variation, first[i].cell);
+                    std::copy(draws[i].offset, draws[i].offset + 3, offsets + 3 * i);
+                }
+            const float* off = varied && variation.jitter > 0.0f ? offsets : nullptr;
             if (plain.ok) {
-                if (plain.isotropic) computeGeometry<true>(frame, plain, first, count, batch);
-                else computeGeometry<false>(frame, plain, first, count, batch);
+                if (plain.isotropic) computeGeometry<true>(frame, plain, first, count, batch, off);
+                else computeGeometry<false>(frame, plain, first, count, batch, off);
             }
             for (int i = 0; i < count; ++i) {
                 const Voxel& v = first[i];
@@ -302,8 +394,8 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
                     isoKernel = shape.isotropic;
                     if (shapeOk) {
                         GeometryBatch one;
-                        if (shape.isotropic) computeGeometry<true>(frame, shape, &v, 1, one);
-                        else computeGeometry<false>(frame, shape, &v, 1, one);
+                        if (shape.isotropic) computeGeometry<true>(frame, shape, &v, 1, one, off ? off + 3 * i : nullptr);
+                        else computeGeometry<false>(frame, shape, &v, 1, one, off ? off + 3 * i : nullptr);
                         g = one.at(0);
                     }
                 } else if (shapeOk) {
@@ -316,8 +408,9 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
                 }
                 const float opacity = std::clamp(v.opacity * scaleL, 0.0f, 1.0f);
                 bool outside = opacity <= 0.0f;
+                const float scale = varied ? draws[i].scale : 1.0f;
                 if (cull)
-                    for (const auto& p : planes) outside = outside || glm::dot(glm::vec3(p), g.center) + p.w < -extent;
+                    for (const auto& p : planes) outside = outside || glm::dot(glm::vec3(p), g.center) + p.w < -extent * scale;
                 const float fadeFrom = nearZL + fadeStart * extent, fadeTo = nearZL + fadeEnd * extent;
                 const float fade = !nearFade || g.viewZ >= fadeTo ? 1.0f : smoothstep(fadeFrom, fadeTo, g.viewZ);
                 if (outside || fade <= 0.0f) {
@@ -332,6 +425,13 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
                 sp.center = g.center;
                 sp.axisU = g.axisU;
                 sp.axisV = g.axisV;
+                if (varied) {
+                    // Turning or mirroring the (u, v) frame keeps the ellipse and
+                    // |(u, v)|, so the footprint is unchanged: only the texture turns.
+                    const VariationDraw& d = draws[i];
+                    sp.axisU = d.mirror * d.scale * (d.cosA * g.axisU + d.sinA * g.axisV);
+                    sp.axisV = d.scale * (d.cosA * g.axisV - d.sinA * g.axisU);
+                }
                 // Neighbouring voxels usually share a colour coordinate (one layer of
                 // the lattice) and an opacity: reuse the last lookup and logarithm.
                 if (!haveEntry || v.colorCoord != lastCoord) {
@@ -351,7 +451,8 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
                         alpha >= 1.0f ? kMaxTau : std::min(alpha < 0x1p-10f ? -std::log1p(-alpha) * 1.44269504f : -std::log2(1.0f - alpha), kMaxTau);
                     lastAlpha = alpha;
                 }
-                sp.density = lastTau * std::min(g.chord, 64.0f) * fade * gain;
+                // A splat scaled by s keeps its material: its optical depth falls by s^2 (area grows by s^2).
+                sp.density = lastTau * std::min(g.chord, 64.0f) * fade * gain / (scale * scale);
                 sp.colorCoord = std::clamp(v.colorCoord, 0.0f, 1.0f);
                 sp.colorRow = colorRow;
                 const std::uint32_t index = setCount.mod(v.texture);
