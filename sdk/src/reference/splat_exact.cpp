@@ -342,8 +342,9 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                 if (desc.fogHost) {
                     const double d = reference::hostDepth(desc.host, x, y);
                     double fb = 0.0; // NaN or outside [0, 1]: fully fogged
-                    if (!desc.host.depth || d == 1.0) fb = transmittanceTo(ray.origin + ray.tFar * ray.dir);
-                    else if (d >= 0.0 && d < 1.0) fb = transmittanceTo(ray.origin + ray.tLimit * ray.dir);
+                    // The far plane's depth (1, or 0 reversed): its point (none without a far plane: fully fogged).
+                    if (!desc.host.depth || d == camera.depth.farWindow()) fb = transmittanceTo(ray.origin + ray.tFar * ray.dir);
+                    else if (d >= 0.0 && d <= 1.0) fb = transmittanceTo(ray.origin + ray.tLimit * ray.dir);
                     acc = glm::dvec4(fogColour * (1.0 - fb), 1.0 - fb) + fb * acc;
                 }
                 for (size_t k = 0; k < frags.size(); ++k) {

@@ -78,8 +78,10 @@ public:
     // The layer is a framebuffer of ceil(width / scale) x ceil(height / scale)
     // pixels, premultiplied RGBA cleared to 0, whose depth attachment
     // (depthTexture) holds the host depth downsampled (farthest of each
-    // block; 1.0 without a host depth).
-    PassTarget begin(const PassTarget& target, glm::ivec4 box);
+    // block; the far plane's depth without a host depth). `depth`: the
+    // frame camera's convention (Camera::depth), which the downsampling
+    // and the reduced image's depth follow.
+    PassTarget begin(const PassTarget& target, glm::ivec4 box, const DepthConvention& depth = {});
     void drawSplats(std::span<const Splat> splats, const Camera& camera);
     void composite(const Camera& camera);
 
@@ -93,7 +95,7 @@ private:
     static Result<ScaledRenderer> create(const ScaledRendererDesc& desc, std::shared_ptr<detail::ProgramLibrary> programs);
     // draw() and begin() with the host depth already resolved.
     void drawResolved(std::span<const Splat> splats, const Camera& camera, const PassTarget& target);
-    PassTarget beginResolved(const PassTarget& target, glm::ivec4 box);
+    PassTarget beginResolved(const PassTarget& target, glm::ivec4 box, const DepthConvention& depth);
     struct Impl;
     explicit ScaledRenderer(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> mImpl;

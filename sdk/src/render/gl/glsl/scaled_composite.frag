@@ -7,13 +7,8 @@ uniform ivec2 uViewportOrigin; // the host viewport's corner in window pixels
 uniform int uScale;
 uniform int uUseDepth;
 uniform float uThreshold;
-uniform vec4 uDepthToView; // (a, b, c, d): view depth = |(a n + b) / (c n + d)|, n = ndc z (inverse projection's z and w rows)
+#include "host_depth.glsl"
 layout(location = 0) out vec4 oColor;
-
-float viewDepth(float d) {
-    float n = 2.0 * d - 1.0;
-    return abs((uDepthToView.x * n + uDepthToView.y) / (uDepthToView.z * n + uDepthToView.w));
-}
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy) - uViewportOrigin;
@@ -36,11 +31,12 @@ void main() {
         oColor = bilinear;
         return;
     }
-    float z = viewDepth(texelFetch(uHostDepth, uHostRect.xy + p, 0).r);
+    float z = splatfx_host_view_depth(texelFetch(uHostDepth, uHostRect.xy + p, 0).r);
     float worst = 0.0, best = 1e30;
     int nearest = 0;
     for (int k = 0; k < 4; ++k) {
-        float dz = abs(viewDepth(texelFetch(uLowDepth, t[k], 0).r) - z);
+        float zk = splatfx_host_view_depth(texelFetch(uLowDepth, t[k], 0).r);
+        float dz = zk == z ? 0.0 : abs(zk - z); // the sky under an infinite far plane: inf on both
         worst = max(worst, dz);
         if (dz < best) { best = dz; nearest = k; }
     }
