@@ -183,4 +183,45 @@ TEST_F(DepthConventionGL, GoldenFramesAreTheSameInAllFourConventions) {
     }
 }
 
+// The helper reads glClipControl; a camera that disagrees with the context
+// (or with its own projection) is said in FrameRenderStats::notes.
+TEST_F(DepthConventionGL, ContextConventionIsReadAndAMismatchIsANote) {
+    const DepthConvention rz{.clip = ClipDepth::ZeroToOne, .reversed = true, .infiniteFar = true};
+    const Camera cam = Camera::lookAt({0, 0, 5}, {0, 0, 0}, {0, 1, 0}, 0.8f, {32, 24}, 0.1f, 100.0f, rz);
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    auto got = gl::depthConventionOfContext(cam.proj);
+    ASSERT_TRUE(got) << got.error();
+    EXPECT_EQ(*got, rz);
+    glClipControl(GL_UPPER_LEFT, GL_ZERO_TO_ONE);
+    got = gl::depthConventionOfContext(cam.proj);
+    ASSERT_FALSE(got);
+    EXPECT_NE(got.error().find("GL_UPPER_LEFT"), std::string::npos) << got.error();
+    glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+
+    Materials mat{Footprint{}};
+    mat.addColorTable(ColorTable::constant(glm::vec4(1.0f)));
+    auto fr = gl::FrameRenderer::create();
+    ASSERT_TRUE(fr) << fr.error();
+    ASSERT_TRUE(fr->upload(mat));
+    auto fb = gl::Framebuffer::create({.width = 32, .height = 24, .floatDepth = true});
+    ASSERT_TRUE(fb);
+    auto notesOf = [&](const Camera& c) {
+        Frame frame;
+        frame.begin(0.0, c);
+        frame.end();
+        fr->render(frame, {.framebuffer = fb->handle()});
+        std::string all;
+        for (const std::string& n : fr->stats().notes) all += n + "\n";
+        return all;
+    };
+    EXPECT_NE(notesOf(cam).find("glClipControl depth mode is GL_NEGATIVE_ONE_TO_ONE"), std::string::npos) << "[0,1] camera, [-1,1] context";
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    EXPECT_EQ(notesOf(cam), "") << "matching";
+    EXPECT_EQ(fr->stats().depthConvention, "[0,1] reversed infinite far");
+    Camera lying = cam;
+    lying.depth.reversed = false;
+    EXPECT_NE(notesOf(lying).find("projection is reversed"), std::string::npos);
+    glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+}
+
 } // namespace

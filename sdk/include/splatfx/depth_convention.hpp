@@ -9,7 +9,7 @@
 // depth goes through depthUnprojection() of that camera, and splatfx's own
 // geometry is drawn with the camera's projection and the depth test the
 // convention implies (GL_GEQUAL when reversed). It does not call
-// glClipControl: that state is the host's (gl::clipDepthOfContext() reads it).
+// glClipControl: that state is the host's (gl::depthConventionOfContext() reads it).
 //
 //   splatfx::DepthConvention dc{.clip = splatfx::ClipDepth::ZeroToOne, .reversed = true, .infiniteFar = true};
 //   auto cam = splatfx::Camera::lookAt(eye, target, up, fovY, size, 0.1f, 1000.0f, dc); // the host's own projection

@@ -1,6 +1,8 @@
 // The one lookup of the host's depth texture (frame_plan.hpp, HostDepth).
 #pragma once
 
+#include <string>
+
 #include <glm/glm.hpp>
 
 #include "splatfx/camera.hpp"
@@ -14,6 +16,11 @@ HostDepth queryHostDepth(unsigned framebuffer, unsigned texture);
 
 // A bare renderer's target with its depth looked up: single-sampled, or 0.
 PassTarget resolveTarget(const PassTarget& target);
+
+// Empty, or a line for FrameRenderStats::notes saying how the camera's depth
+// convention disagrees with the current context's glClipControl or with its
+// own projection (the host depth is then read other than it was written).
+std::string depthConventionNote(const Camera& camera);
 
 // host_depth.glsl's uHostDepthMap for `camera` (depthUnprojection rounded to
 // float once): every pass that reads the host depth sets it from here.
