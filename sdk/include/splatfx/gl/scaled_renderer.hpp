@@ -7,11 +7,12 @@
 // copy of the host depth downsampled by taking the farthest depth of each
 // scale x scale block (so thin foreground geometry cannot hide the effect
 // behind it), then composites that image over the host target with
-// premultiplied "over". Upsampling is nearest-depth: each full-resolution
-// pixel reads the four nearest low-resolution texels bilinearly when their
-// downsampled depths all lie within depthThreshold (relative, in view depth)
-// of its own host depth, and otherwise takes the single texel whose depth is
-// nearest its own (so effects do not bleed onto geometry edges).
+// premultiplied "over". Upsampling is depth-aware: each full-resolution
+// pixel interpolates those of the four nearest low-resolution texels whose
+// downsampled depths lie within depthThreshold (relative, in view depth) of
+// its own host depth, their bilinear weights renormalized (all four: plain
+// bilinear), and takes the single texel whose depth is nearest its own when
+// none does (so effects do not bleed onto geometry edges).
 // Without a host depth texture it upsamples bilinearly and tests no depth.
 // The full-resolution passes are scissored to the splats' screen rectangle,
 // and the host depth is copied once per draw (sampling the attached texture
