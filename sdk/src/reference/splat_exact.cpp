@@ -334,6 +334,11 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                     // Beyond the cut-off f = 0 by definition: no integral (the points come
                     // nearest first, so every later one is beyond it too).
                     if (fogFar > 0.0 && glm::length(p - eye) > fogFar) return 0.0;
+                    // No finite point (the sky under an infinite far plane): infinitely far,
+                    // fully fogged, as Fog::transmittance and the GL pass take it (exact for a fog
+                    // whose density has a positive floor; a fog of point terms alone would keep
+                    // some transmittance at infinity, which neither models).
+                    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return 0.0;
                     const double tp = tauTo(p);
                     if (std::isfinite(tp)) fogTauMax = std::max(fogTauMax, tp);
                     return std::exp(-tp);
