@@ -53,16 +53,19 @@ struct Campfire {
         return false;
     }
 
+    // The host's depth convention (--reverse-z, --clip-01, --infinite-far) shapes its projection.
     splatfx::Camera camera(glm::ivec2 size) const {
-        return splatfx::Camera::lookAt({0.0f, 4.8f, 15.0f}, {0.0f, 4.6f, 0.0f}, {0, 1, 0}, glm::radians(45.0f), size);
+        return splatfx::Camera::lookAt({0.0f, 4.8f, 15.0f}, {0.0f, 4.6f, 0.0f}, {0, 1, 0}, glm::radians(45.0f), size, 0.05f, 1000.0f,
+                                       options.depth);
     }
 
-    // The host's opaque pass: this sample has no geometry, only a background.
-    static void clearBackground() {
+    // The host's opaque pass: this sample has no geometry, only a background (depth: the far plane's value).
+    void clearBackground() const {
         glClearColor(0.02f, 0.02f, 0.04f, 1.0f);
-        glClearDepth(1.0);
+        glClearDepth(options.depth.farWindow());
         glDepthMask(GL_TRUE);
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        glClearDepth(1.0);
     }
 
     void draw(double timeSec, glm::ivec2 size, unsigned framebuffer, bool textured) {
@@ -70,7 +73,7 @@ struct Campfire {
             std::fprintf(stderr, "campfire: %s\n", s.error().c_str());
             return;
         }
-        renderer->render(splatFrame, {.framebuffer = framebuffer, .drawOpaque = clearBackground});
+        renderer->render(splatFrame, {.framebuffer = framebuffer, .drawOpaque = [this] { clearBackground(); }});
     }
 
     bool frame(const samples::FrameContext& fc) {
@@ -83,7 +86,7 @@ struct Campfire {
         figureWritten = true;
         splatfx::Image halves[2];
         for (int textured = 0; textured < 2; ++textured) {
-            auto fb = splatfx::gl::Framebuffer::create({.width = fc.size.x, .height = fc.size.y});
+            auto fb = splatfx::gl::Framebuffer::create({.width = fc.size.x, .height = fc.size.y, .floatDepth = options.depth.reversed});
             if (!fb) return fail(fb.error());
             draw(fc.timeSec, fc.size, fb->handle(), textured == 1);
             halves[textured] = fb->read();

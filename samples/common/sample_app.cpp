@@ -34,6 +34,12 @@ int parseOptions(int argc, char** argv, const char* name, const char* about, Opt
         ->type_name("F");
     app.add_flag("--traditional", o.traditional, "untextured splats (Fig. 1a)");
     app.add_option("--extra", o.extra, "a sample-specific value (see the sample)")->type_name("VALUE");
+    // The engines' depth conventions (docs/integration.md, "Depth conventions").
+    app.add_flag_callback(
+        "--reverse-z", [&o] { o.depth.reversed = true, o.depth.clip = splatfx::ClipDepth::ZeroToOne; },
+        "draw as a reverse-Z engine: glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), near at depth 1, far at 0, float depth");
+    app.add_flag_callback("--clip-01", [&o] { o.depth.clip = splatfx::ClipDepth::ZeroToOne; }, "clip depth [0, 1] without reversing");
+    app.add_flag_callback("--infinite-far", [&o] { o.depth.infiniteFar = true; }, "an infinite far plane");
     return parseCommandLine(app, argc, argv);
 }
 
@@ -46,7 +52,8 @@ int runHeadless(const Options& o, const char* name, const std::function<bool()>&
         return 1;
     }
     std::printf("%s: headless on %s, %d frames at %dx%d -> %s/\n", name, ctx->renderer().c_str(), o.frames, o.size.x, o.size.y, o.out.c_str());
-    auto fb = splatfx::gl::Framebuffer::create({.width = o.size.x, .height = o.size.y});
+    auto fb = splatfx::gl::Framebuffer::create({.width = o.size.x, .height = o.size.y, .floatDepth = o.depth.reversed});
+    glClipControl(GL_LOWER_LEFT, o.depth.clip == splatfx::ClipDepth::ZeroToOne ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
     if (!fb) {
         std::fprintf(stderr, "%s: %s\n", name, fb.error().c_str());
         return 1;
@@ -67,6 +74,7 @@ int runHeadless(const Options& o, const char* name, const std::function<bool()>&
         fc.size = o.size;
         fc.target = {.framebuffer = fb->handle(), .width = o.size.x, .height = o.size.y};
         fc.outputs = &*outputs;
+        fc.depth = o.depth;
         glBindFramebuffer(GL_FRAMEBUFFER, fb->handle());
         if (!frame(fc)) return 1;
         splatfx::Image img = fb->read();
@@ -106,6 +114,9 @@ int runWindowed(const Options& o, const char* name, const std::function<bool()>&
         return 1;
     }
     if (!setup()) return 1;
+    // A window's default framebuffer has the depth format it was created with (24-bit here):
+    // reverse-Z works there, with a fixed-point buffer's precision.
+    glClipControl(GL_LOWER_LEFT, o.depth.clip == splatfx::ClipDepth::ZeroToOne ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
     const auto start = std::chrono::steady_clock::now();
     for (int i = 0; !window->shouldClose(); ++i) {
         if (glfwGetKey(window->handle(), GLFW_KEY_ESCAPE) == GLFW_PRESS) break;
@@ -115,6 +126,7 @@ int runWindowed(const Options& o, const char* name, const std::function<bool()>&
         fc.timeSec = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         fc.size = window->framebufferSize();
         fc.target = {.framebuffer = 0, .width = fc.size.x, .height = fc.size.y};
+        fc.depth = o.depth;
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
         if (!frame(fc)) return 1;
         window->swapBuffers();

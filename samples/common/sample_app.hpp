@@ -2,7 +2,7 @@
 //
 // A sample supplies setup (materials, grids) and a per-frame callback that
 // draws into the given target; SampleApp handles the command line
-// (--frames N --out DIR --size WxH --seed S), the context (a GLFW window by
+// (--frames N --out DIR --size WxH --seed S, --reverse-z / --clip-01 / --infinite-far), the context (a GLFW window by
 // default, headless EGL when --frames is given), PNG frames, the animated
 // GIF, progress output and a summary. Public SDK API only.
 #pragma once
@@ -25,6 +25,10 @@ struct Options {
     float fps = 24.0f;
     bool traditional = false; // untextured splats (Fig. 1a)
     std::string extra;        // sample-specific flag value (see each sample's --help)
+    // --reverse-z, --clip-01, --infinite-far: the depth convention the sample's host draws with
+    // (the loop sets glClipControl and, reversed, a float depth buffer; the sample's camera and
+    // clear follow FrameContext::depth).
+    splatfx::DepthConvention depth{};
 };
 
 // Parses argv (samples/common/sample_options.hpp). Returns -1 when the sample
@@ -39,6 +43,7 @@ struct FrameContext {
     // Headless: the run's output set, for extra files beside the frames
     // (write at outputs->path(f), then outputs->add(f)); null when windowed.
     splatfx::OutputSet* outputs = nullptr;
+    splatfx::DepthConvention depth{}; // Options::depth: build the camera with it, clear depth to depth.farWindow()
 };
 
 // Runs the loop. frame() draws one frame (the host part: clear, geometry, then

@@ -159,25 +159,26 @@ struct HostFogRun {
 template <class DepthAt>
 HostFogRun renderHostFog(const Camera& camera, const Fog& fog, DepthAt depthAt) {
     HostFogRun run;
+    const glm::ivec2 size = camera.viewport; // the image: the camera's viewport
     GLuint fbo = 0, colour = 0, depthTex = 0;
     glCreateFramebuffers(1, &fbo);
     glCreateTextures(GL_TEXTURE_2D, 1, &colour);
-    glTextureStorage2D(colour, 1, GL_RGBA32F, kSize.x, kSize.y);
+    glTextureStorage2D(colour, 1, GL_RGBA32F, size.x, size.y);
     glCreateTextures(GL_TEXTURE_2D, 1, &depthTex);
-    glTextureStorage2D(depthTex, 1, GL_DEPTH_COMPONENT32F, kSize.x, kSize.y);
+    glTextureStorage2D(depthTex, 1, GL_DEPTH_COMPONENT32F, size.x, size.y);
     glNamedFramebufferTexture(fbo, GL_COLOR_ATTACHMENT0, colour, 0);
     glNamedFramebufferTexture(fbo, GL_DEPTH_ATTACHMENT, depthTex, 0);
     EXPECT_EQ(glCheckNamedFramebufferStatus(fbo, GL_FRAMEBUFFER), GLenum(GL_FRAMEBUFFER_COMPLETE));
-    std::vector<float> d(size_t(kSize.x) * kSize.y);
-    for (int y = 0; y < kSize.y; ++y)
-        for (int x = 0; x < kSize.x; ++x) d[size_t(y) * kSize.x + x] = depthAt(x, y);
-    glTextureSubImage2D(depthTex, 0, 0, 0, kSize.x, kSize.y, GL_DEPTH_COMPONENT, GL_FLOAT, d.data());
+    std::vector<float> d(size_t(size.x) * size.y);
+    for (int y = 0; y < size.y; ++y)
+        for (int x = 0; x < size.x; ++x) d[size_t(y) * size.x + x] = depthAt(x, y);
+    glTextureSubImage2D(depthTex, 0, 0, 0, size.x, size.y, GL_DEPTH_COMPONENT, GL_FLOAT, d.data());
     std::vector<float> held(d.size());
     glGetTextureImage(depthTex, 0, GL_DEPTH_COMPONENT, GL_FLOAT, GLsizei(held.size() * 4), held.data());
-    run.depth.width = kSize.x, run.depth.height = kSize.y, run.depth.channels = 1;
+    run.depth.width = size.x, run.depth.height = size.y, run.depth.channels = 1;
     run.depth.pixels.resize(held.size());
-    for (int y = 0; y < kSize.y; ++y)
-        for (int x = 0; x < kSize.x; ++x) run.depth.pixels[size_t(y) * kSize.x + x] = held[size_t(kSize.y - 1 - y) * kSize.x + x];
+    for (int y = 0; y < size.y; ++y)
+        for (int x = 0; x < size.x; ++x) run.depth.pixels[size_t(y) * size.x + x] = held[size_t(size.y - 1 - y) * size.x + x];
 
     Frame frame;
     frame.begin(0.0, camera);
@@ -191,15 +192,17 @@ HostFogRun renderHostFog(const Camera& camera, const Fog& fog, DepthAt depthAt) 
     EXPECT_TRUE(fr->upload(mat));
     const float clear[4] = {kBackground.r, kBackground.g, kBackground.b, kBackground.a};
     glClearNamedFramebufferfv(fbo, GL_COLOR, 0, clear);
+    glClipControl(GL_LOWER_LEFT, camera.depth.clip == ClipDepth::ZeroToOne ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE); // the host's state
     fr->render(frame, {.framebuffer = fbo, .depthTexture = depthTex});
+    glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
     EXPECT_TRUE(fr->stats().fog.host) << fr->stats().fog.error;
-    run.got.width = kSize.x, run.got.height = kSize.y, run.got.channels = 4;
-    std::vector<float> raw(size_t(kSize.x) * kSize.y * 4);
+    run.got.width = size.x, run.got.height = size.y, run.got.channels = 4;
+    std::vector<float> raw(size_t(size.x) * size.y * 4);
     glGetTextureImage(colour, 0, GL_RGBA, GL_FLOAT, GLsizei(raw.size() * 4), raw.data());
     run.got.pixels.resize(raw.size());
-    for (int y = 0; y < kSize.y; ++y)
-        std::copy_n(raw.begin() + std::ptrdiff_t(size_t(kSize.y - 1 - y) * kSize.x * 4), kSize.x * 4,
-                    run.got.pixels.begin() + std::ptrdiff_t(size_t(y) * kSize.x * 4));
+    for (int y = 0; y < size.y; ++y)
+        std::copy_n(raw.begin() + std::ptrdiff_t(size_t(size.y - 1 - y) * size.x * 4), size.x * 4,
+                    run.got.pixels.begin() + std::ptrdiff_t(size_t(y) * size.x * 4));
     glDeleteFramebuffers(1, &fbo);
     glDeleteTextures(1, &colour);
     glDeleteTextures(1, &depthTex);
@@ -238,31 +241,53 @@ TEST_F(FogFrameGL, HostFogHandlesSkyNaNAndOutOfRangeDepth) {
     for (float v : run.got.pixels) ASSERT_TRUE(std::isfinite(v));
 }
 
-// Engines' near / far ratios: the sky (depth 1) and surfaces close to the far
-// plane keep their fog distance. A float inverse projection loses it there
-// (its w at depth 1 is the difference of two terms of size 1 / (2 near) whose
-// sum is 1 / far: at near 0.01, far 1e5 the sky's fog distance was off by 22 %
-// against POV-Ray's media); the pass blends 1 / view depth between its values
-// at depth 0 and 1 instead, so its error stays a few roundings at any ratio.
-// The far plane is the one the (float) projection matrix itself implies, the
-// one the GPU's depth values follow.
+// Engines' near / far ratios, in every depth convention (issue 26): the sky
+// (the far plane's depth, or no point at all under an infinite far plane:
+// fully fogged) and surfaces out to the far plane keep their fog distance. A
+// float inverse projection loses it there (its w at the far plane is the
+// difference of two terms of size 1 / (2 near) whose sum is 1 / far: at near
+// 0.01, far 1e5 the sky's fog distance was off by 22 % against POV-Ray's
+// media); every pass blends 1 / view depth between its values at window
+// depth 0 and 1 instead (host_depth.glsl), so its error stays a few roundings
+// at any ratio, against the double-precision reference reading the same
+// stored depths. The far plane is the one the (float) projection matrix
+// itself implies, the one the GPU's depth values follow.
 TEST_F(FogFrameGL, HostFogKeepsTheSkyAtLargeFarOverNear) {
-    for (const glm::vec2 nearFar : {glm::vec2(0.05f, 1e4f), glm::vec2(0.01f, 1e5f), glm::vec2(0.1f, 3e5f)}) {
-        SCOPED_TRACE("near " + std::to_string(nearFar.x) + ", far " + std::to_string(nearFar.y));
-        // About one optical depth at the far plane: the fog there is neither clear nor saturated.
-        FogDesc fd;
-        fd.terms.push_back(FogTerm::constant(0.7 / nearFar.y));
-        fd.terms.push_back(FogTerm::cosine(0.3 / nearFar.y, 3.0 / nearFar.y, {1.0, 0.3, 0.0}, 0.4));
-        fd.colour = {0.7, 0.75, 0.8};
-        const Fog fog = *Fog::create(fd);
-        const Camera cam = Camera::lookAt({0.4f, 0.3f, 5.0f}, {0, 0, 0}, {0, 1, 0}, 0.9f, kSize, nearFar.x, nearFar.y);
-        // Sky on the right half; on the left, depths within 1e-4 of the far plane.
-        const HostFogRun run = renderHostFog(cam, fog, [&](int x, int y) { return x >= kSize.x / 2 ? 1.0f : 1.0f - 1e-4f * float(y + 1) / kSize.y; });
-        ASSERT_FALSE(run.want.pixels.empty());
-        const double densityMax = 1.0 / nearFar.y, lengthMax = 1.2 * nearFar.y;
-        const double bound = 2.0 * tauFloatBound(fog, lengthMax, densityMax, 8.0 * kEps) + 2.0 * run.reference.fogMaxErrorEstimate + 1e-6;
-        EXPECT_LE(maxDiff(run.got, run.want), bound);
-    }
+    const DepthConvention conventions[] = {{}, {.clip = ClipDepth::ZeroToOne}, {.reversed = true}, {.clip = ClipDepth::ZeroToOne, .reversed = true},
+                                           {.clip = ClipDepth::ZeroToOne, .reversed = true, .infiniteFar = true}};
+    for (const DepthConvention& dc : conventions)
+        for (const glm::vec2 nearFar : {glm::vec2(0.05f, 1e4f), glm::vec2(0.01f, 1e5f), glm::vec2(0.1f, 3e5f), glm::vec2(0.001f, 1e4f)}) {
+            const glm::ivec2 size = kSize;
+            SCOPED_TRACE(describe(dc) + ", near " + std::to_string(nearFar.x) + ", far " + std::to_string(nearFar.y));
+            // About one optical depth at the far plane (or the farthest surface): neither clear nor saturated.
+            FogDesc fd;
+            fd.terms.push_back(FogTerm::constant(0.7 / nearFar.y));
+            fd.terms.push_back(FogTerm::cosine(0.3 / nearFar.y, 3.0 / nearFar.y, {1.0, 0.3, 0.0}, 0.4));
+            fd.colour = {0.7, 0.75, 0.8};
+            const Fog fog = *Fog::create(fd);
+            const Camera cam = Camera::lookAt({0.4f, 0.3f, 5.0f}, {0, 0, 0}, {0, 1, 0}, 0.9f, size, nearFar.x, nearFar.y, dc);
+            // Window depth of view depth z under the camera's float matrix, rounded to float as a depth buffer holds it.
+            auto windowOf = [&](double z) {
+                const glm::dvec4 c = glm::dmat4(cam.proj) * glm::dvec4(0.0, 0.0, -z, 1.0);
+                const double ndc = c.z / c.w;
+                return float(dc.clip == ClipDepth::ZeroToOne ? ndc : 0.5 * ndc + 0.5);
+            };
+            // Sky on the right half; on the left, surfaces from 0.5 far to within 1e-4 of it.
+            const HostFogRun run = renderHostFog(cam, fog, [&](int x, int y) {
+                if (x >= size.x / 2) return float(dc.farWindow());
+                const double t = double(y + 1) / size.y;
+                return windowOf(double(nearFar.y) * (x % 2 ? 1.0 - 1e-4 * t : 1.0 - 0.5 * t));
+            });
+            ASSERT_FALSE(run.want.pixels.empty());
+            EXPECT_EQ(run.reference.fogUnconverged, 0u);
+            const double densityMax = 1.0 / nearFar.y, lengthMax = 1.2 * nearFar.y;
+            const double bound = 2.0 * tauFloatBound(fog, lengthMax, densityMax, 8.0 * kEps) + 2.0 * run.reference.fogMaxErrorEstimate + 1e-6;
+            const double err = maxDiff(run.got, run.want);
+            std::printf("%s, far/near %.0e: max |GL - reference| %.2e (bound %.2e)\n", describe(dc).c_str(), double(nearFar.y / nearFar.x), err, bound);
+            EXPECT_LE(err, bound);
+            // The sky: the far-plane point's fog, or full fog without a far plane; never the background.
+            if (dc.infiniteFar) { EXPECT_NEAR(run.got.at(size.x - 1, 0, 0), fog.desc().colour.x, 1e-6); }
+        }
 }
 
 // Reduced fog textures: each pixel's upsampled f is a convex combination of the

@@ -229,6 +229,63 @@ TEST_F(FragmentListsGL, PanesInFrontOfAndBehindTheFireSortLikeTheUnambiguousOrde
     }
 }
 
+// The engines' depth conventions (issue 26): the lists sort by a key that
+// grows with distance in every convention (1 - depth reversed), the sections
+// cut at it and the hook's test follows the convention. Three panes drawn out
+// of order around and through the fire: the same 8-bit image in all four
+// conventions (reversed ones with float depth) as in OpenGL's default. Each
+// channel is rounded to 1/255 on readback; the conventions differ only in the
+// depths' last bits, which can move a value across one rounding boundary:
+// one step, never two.
+TEST_F(FragmentListsGL, PanesAroundTheFireAreTheSameInAllFourConventions) {
+    const DepthConvention conventions[] = {
+        {}, {.clip = ClipDepth::ZeroToOne}, {.reversed = true}, {.clip = ClipDepth::ZeroToOne, .reversed = true}};
+    Glass glass;
+    ASSERT_TRUE(glass.error().empty()) << glass.error();
+    const std::vector<Pane> panes{{.z = Fire::kBack - 1.0f, .premultiplied = {0.02f, 0.1f, 0.05f, 0.3f}},
+                                  {.z = Fire::kFront + 1.5f, .premultiplied = {0.05f, 0.15f, 0.2f, 0.35f}},
+                                  {.z = 0.1f, .premultiplied = {0.1f, 0.05f, 0.02f, 0.25f}}};
+    Image base;
+    for (const DepthConvention& dc : conventions) {
+        Materials materials{Footprint{}};
+        const std::uint32_t set = materials.addTextureSet(TextureSet::turbulence({.count = 8, .size = 32, .seed = 3}));
+        const std::uint32_t table = materials.addColorTable(ColorTable::fire());
+        const Camera cam = Camera::lookAt({0.0f, 4.8f, 15.0f}, {0.0f, 4.6f, 0.0f}, {0, 1, 0}, 0.7853982f, kSize, 0.05f, 1000.0f, dc);
+        Frame frame;
+        frame.begin(0.0, cam);
+        frame.builder().add(test::campfireGrid(3), materials, {.textureSet = set, .colorTable = table});
+        frame.end();
+        auto fr = gl::FrameRenderer::create();
+        ASSERT_TRUE(fr && fr->upload(materials));
+        auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .floatDepth = dc.reversed});
+        ASSERT_TRUE(fb);
+        glClipControl(GL_LOWER_LEFT, dc.clip == ClipDepth::ZeroToOne ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
+        fr->render(frame, {.framebuffer = fb->handle(),
+                           .drawOpaque =
+                               [&] {
+                                   glClearColor(kBackground.r, kBackground.g, kBackground.b, kBackground.a);
+                                   glClearDepth(dc.farWindow());
+                                   glDepthMask(GL_TRUE);
+                                   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+                                   glClearDepth(1.0);
+                               },
+                           .drawTransparent = [&] { glass.draw(panes, cam); },
+                           .transparentToLists = true});
+        glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+        EXPECT_TRUE(fr->stats().notes.empty()) << fr->stats().notes.front();
+        EXPECT_TRUE(fr->stats().lists.used && fr->stats().lists.splats);
+        EXPECT_GT(fr->stats().lists.splatsSectioned, 0u) << "the middle pane must cut the fire into sections";
+        const Image got = fb->read();
+        if (base.pixels.empty()) {
+            base = got;
+            continue;
+        }
+        const test::ImageDiff d = test::compareImages(got, base, 0.5 / 255.0);
+        std::printf("%s: max %.1f/255, mean %.4f/255\n", describe(dc).c_str(), d.maxAbs * 255, d.meanAbs * 255);
+        EXPECT_LE(d.maxAbs, kEightBit + 1e-6) << describe(dc) << " -- " << test::writeFailureImages(got, d);
+    }
+}
+
 // Three panes at once, drawn out of depth order: one in front of the fire,
 // two behind it: each splat finds its section from the surfaces of its pixel
 // (two sections in use need the 4-target variant). Against the ordered blend

@@ -43,10 +43,10 @@ Grid block(int n, float spacing, float opacity) {
     return g;
 }
 
-// Window depth of view depth z for this camera's projection.
+// Window depth of view depth z for this camera's projection and depth convention.
 float windowDepth(const Camera& cam, float z) {
     const glm::vec4 c = cam.proj * glm::vec4(0.0f, 0.0f, -z, 1.0f);
-    return 0.5f * c.z / c.w + 0.5f;
+    return cam.depth.clip == ClipDepth::ZeroToOne ? c.z / c.w : 0.5f * c.z / c.w + 0.5f;
 }
 
 // Largest table error of fractionBefore, in share units (see the header).
@@ -88,12 +88,16 @@ protected:
         EXPECT_TRUE(r) << r.error();
         const Status up = r->upload(mat);
         EXPECT_TRUE(up) << up.error();
-        auto fb = gl::Framebuffer::create({.width = cam.viewport.x, .height = cam.viewport.y, .color = gl::Precision::F32});
+        // A reversed host draws into float depth (the engines' reverse-Z setup).
+        auto fb = gl::Framebuffer::create(
+            {.width = cam.viewport.x, .height = cam.viewport.y, .color = gl::Precision::F32, .floatDepth = cam.depth.reversed});
         EXPECT_TRUE(fb);
-        const float depth = depthOverride >= 0.0f ? depthOverride : zSurface > 0.0f ? windowDepth(cam, zSurface) : 1.0f;
+        const float depth = depthOverride >= 0.0f ? depthOverride : zSurface > 0.0f ? windowDepth(cam, zSurface) : float(cam.depth.farWindow());
         fb->clear(kBackground, depth);
         const Image depthImage = fb->readDepth();
+        glClipControl(GL_LOWER_LEFT, cam.depth.clip == ClipDepth::ZeroToOne ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
         r->draw(splats, cam, {.framebuffer = fb->handle(), .width = cam.viewport.x, .height = cam.viewport.y});
+        glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
         if (cut) { EXPECT_TRUE(r->stats().cutHostDepth) << "the framebuffer depth texture must be read"; }
         f.gl = fb->read();
         SplatExactDesc rd;
@@ -231,6 +235,41 @@ TEST_F(CutStability, CameraInsideAKernelWithASurfaceInsideItToo) {
     continuity(b.splats(), cam, mat, 0.2f, 0.003f, false);
     const Frame open = draw(b.splats(), cam, mat, -1.0f);
     EXPECT_LE(open.worst, open.bound) << "the camera inside a kernel, no surface";
+}
+
+// The engines' convention (issue 26): reverse-Z, [0, 1] clip depth, float
+// depth. The same coincidence cases: the cut must not pop, the plain test
+// (GEQUAL now) must, GL against the reference with the same bound.
+constexpr DepthConvention kReverseZ{.clip = ClipDepth::ZeroToOne, .reversed = true};
+
+TEST_F(CutStability, SurfaceExactlyThroughVoxelCentresReverseZ) {
+    const Materials mat = plain();
+    const Grid g = block(6, 0.3f, 0.35f);
+    const glm::vec3 centre = g.worldPosition({3, 3, 3});
+    const Camera cam = Camera::lookAt(centre + glm::vec3(0.0f, 0.0f, 4.0f), centre, {0, 1, 0}, 0.7f, {48, 40}, 0.5f, 50.0f, kReverseZ);
+    SplatBuilder b;
+    b.begin(cam);
+    b.add(g, mat, {.textured = false});
+    b.sort();
+    continuity(b.splats(), cam, mat, 4.0f, 0.003f);
+}
+
+TEST_F(CutStability, CameraInsideAKernelWithASurfaceInsideItTooReverseZInfiniteFar) {
+    const Materials mat = plain();
+    const Grid g = block(5, 0.3f, 0.4f);
+    const glm::vec3 c = g.worldPosition({2, 2, 2});
+    const glm::vec3 eye = c + glm::vec3(0.02f, -0.01f, 0.03f);
+    DepthConvention dc = kReverseZ;
+    dc.infiniteFar = true;
+    const Camera cam = Camera::lookAt(eye, eye + glm::vec3(0.15f, 0.1f, -1.0f), {0, 1, 0}, 1.2f, {40, 32}, 0.02f, 50.0f, dc);
+    SplatBuilder b;
+    b.begin(cam);
+    b.add(g, mat, {.textured = false});
+    b.sort();
+    ASSERT_GT(b.splats().size(), 10u);
+    continuity(b.splats(), cam, mat, 0.2f, 0.003f, false);
+    const Frame open = draw(b.splats(), cam, mat, -1.0f);
+    EXPECT_LE(open.worst, open.bound) << "the camera inside a kernel, no surface, sky at infinity";
 }
 
 } // namespace

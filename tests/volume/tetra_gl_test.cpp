@@ -318,6 +318,47 @@ TEST_F(TetraPassGL, HostDepthCutsSegmentsInsideTetrahedra) {
     EXPECT_GT(differs, kSize.x * kSize.y / 20) << "the plane should hide part of the cloud";
 }
 
+// The engines' depth conventions (issue 26): the ray end read from the host
+// depth (a plane through the cloud at view depth 22) in each of the four
+// conventions, reversed ones with float depth, gives OpenGL's default image
+// within one 8-bit step per channel (RGBA8 readback: the conventions differ
+// only in the depths' last bits, which can move a value across one rounding
+// boundary, never two).
+TEST_F(TetraPassGL, HostDepthCutIsTheSameInAllFourConventions) {
+    Cloud cl;
+    const DepthConvention conventions[] = {
+        {}, {.clip = ClipDepth::ZeroToOne}, {.reversed = true}, {.clip = ClipDepth::ZeroToOne, .reversed = true}};
+    Image base;
+    for (const DepthConvention& dc : conventions) {
+        const Camera cam =
+            Camera::lookAt({-14.0f, 6.0f, 10.0f}, {8.0f, 8.0f, 4.0f}, {0, 0, 1}, glm::radians(50.0f), kSize, 0.5f, 200.0f, dc);
+        Frame frame;
+        frame.begin(0.0, cam);
+        FrameVolume& fv = frame.volumes().emplace_back();
+        fv.table = &*cl.table;
+        ASSERT_TRUE(cl.volume->update(cam, {.detailC = 20.0f}, &*cl.transfer, fv.lod));
+        frame.end();
+        const glm::dvec4 c = glm::dmat4(cam.proj) * glm::dvec4(0.0, 0.0, -22.0, 1.0);
+        const double window = dc.clip == ClipDepth::ZeroToOne ? c.z / c.w : 0.5 * c.z / c.w + 0.5;
+        auto fr = gl::FrameRenderer::create();
+        auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .floatDepth = dc.reversed});
+        ASSERT_TRUE(fr && fb);
+        glClipControl(GL_LOWER_LEFT, dc.clip == ClipDepth::ZeroToOne ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
+        renderFrame(*fr, *fb, frame, window);
+        glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+        EXPECT_TRUE(fr->stats().notes.empty()) << fr->stats().notes.front();
+        EXPECT_GT(fr->stats().tetrahedra.drawn, 0u);
+        const Image got = fb->read();
+        if (base.pixels.empty()) {
+            base = got;
+            continue;
+        }
+        double worst = 0.0;
+        for (std::size_t i = 0; i < got.pixels.size(); ++i) worst = std::max(worst, double(std::abs(got.pixels[i] - base.pixels[i])));
+        EXPECT_LE(worst, 1.0 / 255.0 + 1e-6) << describe(dc);
+    }
+}
+
 // The camera inside the cloud: the emitted list (clipped at the near plane as
 // volumes) integrates to the finest mesh's integral from the near plane, and
 // the GL image matches the pass model within the bound at every pixel: no

@@ -32,6 +32,8 @@
 
 #include <unistd.h>
 
+#include <epoxy/gl.h>
+
 #include "options.hpp"
 #include "run_record.hpp"
 #include "scene_player.hpp"
@@ -58,6 +60,7 @@ struct Args {
     std::optional<cli::FrameRange> range;      // --range: only these frames, no GIF
     bool assemble = false;                     // --assemble: the GIF from the frames in --out
     splatfx::Budgets budgets{};                // --budget NAME=N
+    splatfx::DepthConvention depth{};          // --reverse-z, --clip-01, --infinite-far (the host's depth convention)
 };
 
 // Returns -1 to go on, else the exit code (0 after --help, 2 after a bad command line).
@@ -161,6 +164,15 @@ int parse(int argc, char** argv, Args& a) {
         "--no-depth-cut", [&a] { a.renderer.splats.depthCut = false; },
         "the plain depth test at each splat's plane instead of the exact cut (RendererDesc::depthCut)");
     app.add_flag("--quiet", a.quiet, "no per-frame progress");
+    // The engines' depth conventions (docs/integration.md, "Depth conventions"): the host
+    // draws with glClipControl and a reversed or infinite projection, splatfx follows.
+    app.add_flag_callback(
+        "--reverse-z", [&a] { a.depth.reversed = true, a.depth.clip = splatfx::ClipDepth::ZeroToOne; },
+        "draw as a reverse-Z engine: glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), near at depth 1, far at 0, 32-bit float depth");
+    app.add_flag_callback(
+        "--clip-01", [&a] { a.depth.clip = splatfx::ClipDepth::ZeroToOne; }, "clip depth [0, 1] (glClipControl GL_ZERO_TO_ONE) without reversing");
+    app.add_flag_callback(
+        "--infinite-far", [&a] { a.depth.infiniteFar = true; }, "an infinite far plane (the scene's camera farPlane unused)");
     cli::addNumber(app, "--abort-after", a.abortAfter, 0, 100000,
                    "testing aid: fail on purpose after N frames (checks that nothing partial is left)");
     // Unset, these come from the scene file: the help says so instead of showing the placeholder 0.
@@ -372,8 +384,10 @@ static int renderMain(int argc, char** argv) {
     if (!outputs) return fail(outputs.error());
     std::map<std::string, std::pair<int, std::string>> hashes; // the run record's frames
 
-    auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
+    auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y, .floatDepth = a.depth.reversed});
     if (!fb) return fail(fb.error());
+    // The host's clip convention: GL state of this context, read by nothing in splatfx but the rasterizer.
+    glClipControl(GL_LOWER_LEFT, a.depth.clip == splatfx::ClipDepth::ZeroToOne ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
     std::printf("splatfx-render: %s (%s) on %s\n", a.scene.c_str(), file.title.empty() ? name.c_str() : file.title.c_str(), ctx->renderer().c_str());
     if (whole)
         std::printf("splatfx-render: %d frames at %dx%d, %g fps, seed %u, %s splats -> %s/%s_NNNN.png + %s.gif\n", frames, size.x, size.y, fps,
@@ -384,6 +398,7 @@ static int renderMain(int argc, char** argv) {
                     a.range->first, a.range->last, a.range->step > 1 ? (":" + std::to_string(a.range->step)).c_str() : "", toWrite, frames, size.x,
                     size.y, fps, file.seed, a.traditional ? "traditional" : "textured", a.out.c_str(), name.c_str());
 
+    if (!(a.depth == splatfx::DepthConvention{})) std::printf("splatfx-render: depth convention %s\n", splatfx::describe(a.depth).c_str());
     std::optional<splatfx::AnimationWriter> gif;
     if (whole) gif.emplace(outputs->path(name + ".gif"), fps);
     using Clock = std::chrono::steady_clock;
@@ -402,7 +417,7 @@ static int renderMain(int argc, char** argv) {
             // Before or between this task's frames: the scene steps through
             // them as a full run does (same times, same cameras), undrawn.
             const auto r0 = Clock::now();
-            if (auto st = player->advance(t, player->cameraAt(t, size), {.traditional = a.traditional}); !st) return fail(st.error());
+            if (auto st = player->advance(t, player->cameraAt(t, size, a.depth), {.traditional = a.traditional}); !st) return fail(st.error());
             if (!player->problem().empty()) return fail("frame " + std::to_string(i) + ": " + player->problem() + "; no output kept");
             replayMs += std::chrono::duration<double, std::milli>(Clock::now() - r0).count();
             ++replayed;
@@ -411,7 +426,7 @@ static int renderMain(int argc, char** argv) {
         if (written == 0) reachMs = replayMs;
         if (written == a.abortAfter) return fail("aborted on purpose after " + std::to_string(written) + " frames (--abort-after); no output kept");
         const auto f0 = Clock::now();
-        if (auto st = player->renderFrame(t, player->cameraAt(t, size), fb->handle(), {.traditional = a.traditional}); !st) return fail(st.error());
+        if (auto st = player->renderFrame(t, player->cameraAt(t, size, a.depth), fb->handle(), {.traditional = a.traditional}); !st) return fail(st.error());
         // Lighting, shadows or a terrain the frame lost: never published as if complete.
         if (!player->problem().empty()) return fail("frame " + std::to_string(i) + ": " + player->problem() + "; no output kept");
         splatfx::Image img = fb->read();

@@ -23,12 +23,12 @@ splatfx::CameraKey sampleKey(const splatfx::CameraPath& path, double t) {
     return out;
 }
 
-splatfx::Camera evaluate(const splatfx::CameraPath& path, double t, glm::ivec2 viewport) {
+splatfx::Camera evaluate(const splatfx::CameraPath& path, double t, glm::ivec2 viewport, const splatfx::DepthConvention& depth) {
     const splatfx::CameraKey k = sampleKey(path, t);
     glm::vec3 up(0, 1, 0);
     // Looking straight up or down: any up that is not parallel will do.
     if (glm::length(glm::cross(glm::normalize(k.target - k.position), up)) < 1e-4f) up = {0, 0, -1};
-    return splatfx::Camera::lookAt(k.position, k.target, up, k.fovYRad, viewport, path.nearPlane, path.farPlane);
+    return splatfx::Camera::lookAt(k.position, k.target, up, k.fovYRad, viewport, path.nearPlane, path.farPlane, depth);
 }
 
 } // namespace scenehost

@@ -16,6 +16,7 @@ namespace scenehost {
 
 // Expects at least one key.
 splatfx::CameraKey sampleKey(const splatfx::CameraPath& path, double timeSec);
-splatfx::Camera evaluate(const splatfx::CameraPath& path, double timeSec, glm::ivec2 viewport);
+// `depth`: the host's depth convention, which the camera's projection follows.
+splatfx::Camera evaluate(const splatfx::CameraPath& path, double timeSec, glm::ivec2 viewport, const splatfx::DepthConvention& depth = {});
 
 } // namespace scenehost

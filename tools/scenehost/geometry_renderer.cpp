@@ -264,7 +264,7 @@ void GeometryRenderer::draw(double t, const splatfx::Camera& camera, const Geome
     Impl& r = *mImpl;
     r.stats = {};
     glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
+    glDepthFunc(camera.depth.reversed ? GL_GREATER : GL_LESS); // the camera's depth convention
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);

@@ -113,7 +113,9 @@ const FrameStats& ScenePlayer::stats() const { return mImpl->stats; }
 const std::string& ScenePlayer::problem() const { return mImpl->problem; }
 GeometryRenderer& ScenePlayer::geometry() { return *mImpl->geometry; }
 
-splatfx::Camera ScenePlayer::cameraAt(double t, glm::ivec2 viewport) const { return evaluate(mImpl->file->camera, t, viewport); }
+splatfx::Camera ScenePlayer::cameraAt(double t, glm::ivec2 viewport, const splatfx::DepthConvention& depth) const {
+    return evaluate(mImpl->file->camera, t, viewport, depth);
+}
 
 splatfx::Status ScenePlayer::advance(double t, const splatfx::Camera& camera, const FrameOptions& options) {
     Impl& p = *mImpl;
@@ -165,9 +167,10 @@ splatfx::Status ScenePlayer::renderFrame(double t, const splatfx::Camera& camera
     auto drawOpaque = [&] {
         if (options.clear) {
             glClearColor(f.output.background.r, f.output.background.g, f.output.background.b, 1.0f);
-            glClearDepth(1.0);
+            glClearDepth(camera.depth.farWindow()); // 0 under reverse-Z
             glDepthMask(GL_TRUE);
             glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+            glClearDepth(1.0);
         }
         if (options.drawGeometry) p.geometry->draw(t, camera, geometryLighting(f.scene, *p.renderer));
     };

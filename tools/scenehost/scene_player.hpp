@@ -59,7 +59,8 @@ public:
     ~ScenePlayer();
 
     // The scene file's camera path at t for a viewport.
-    splatfx::Camera cameraAt(double timeSec, glm::ivec2 viewport) const;
+    // `depth`: the host's depth convention (its clear value and depth test follow the camera's).
+    splatfx::Camera cameraAt(double timeSec, glm::ivec2 viewport, const splatfx::DepthConvention& depth = {}) const;
     // Draws the frame at timeSec (>= the previous call's) into the host
     // framebuffer (0: the default one) over camera.viewport. Fails, drawing
     // nothing, as Scene::prepare does (a time past splatfx::kMaxTimeSec).

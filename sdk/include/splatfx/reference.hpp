@@ -111,8 +111,10 @@ struct SplatExactDesc {
     // forms) along each pixel ray from the eye: every fragment at world
     // point X becomes f c + (1 - f) alpha C_fog (premultiplied), f = exp(-tau(eye, X))
     // (0 beyond farDistanceWorld), and the host background is fogged to the
-    // host depth's point as gl::FrameRenderer's fog pass does: depth 1 (sky,
-    // or no depth image) to the far plane, NaN or outside [0, 1] fully fogged.
+    // host depth's point as gl::FrameRenderer's fog pass does, in the camera's
+    // depth convention: the far plane's depth (sky: 1, 0 reversed; or no depth
+    // image) to the far plane (none under an infinite far plane: fully
+    // fogged), NaN or outside [0, 1] fully fogged.
     const Fog* fog = nullptr;   // default none
     double fogTimeSec = 0.0;    // the fog's time; default 0
     double fogTolerance = 1e-9; // absolute tolerance on each optical depth; default 1e-9

@@ -4,6 +4,7 @@
 
 #include "splatfx/budget.hpp"
 #include "splatfx/camera.hpp"
+#include "splatfx/depth_convention.hpp"
 #include "splatfx/color_table.hpp"
 #include "splatfx/dynamics.hpp"
 #include "splatfx/effect.hpp"

@@ -19,25 +19,26 @@ constexpr int kSections[] = {2, 4, 8}; // FragmentListPass: 2, 4 and kTransparen
 constexpr int kResolveK[] = {1, 2, 3, 4, 8, 16, 32, 64, 100, 127, 128};
 
 constexpr const char* kSplatUniforms[] = {"uViewProj", "uOctagon", "uCut",   "uFogEye", "splatfx_fog_params", "splatfx_fog_colour", "splatfx_fog_far",
-                                          "uEye",      "uForward", "uNearZ", "uPersp",  "uKernelRadius",      "uDepthToView",       "uInvViewProj",
-                                          "uViewport"};
+                                          "uEye",      "uForward", "uNearZ", "uPersp",  "uKernelRadius",      "uHostDepthMap",      "uInvViewProj",
+                                          "uViewport", "uNdcZ"};
 static_assert(std::size(kSplatUniforms) == splat::UniformCount);
-constexpr const char* kDepthTilesUniforms[] = {"uDepthToView", "uTarget"};
+constexpr const char* kDepthTilesUniforms[] = {"uHostDepthMap", "uTarget"};
 static_assert(std::size(kDepthTilesUniforms) == depth_tiles::UniformCount);
-constexpr const char* kDownsampleUniforms[] = {"uHostRect", "uScale"};
+constexpr const char* kDownsampleUniforms[] = {"uHostRect", "uScale", "uReversed"};
 static_assert(std::size(kDownsampleUniforms) == downsample::UniformCount);
-constexpr const char* kCompositeUniforms[] = {"uHostRect", "uViewportOrigin", "uScale", "uUseDepth", "uThreshold", "uDepthToView"};
+constexpr const char* kCompositeUniforms[] = {"uHostRect", "uViewportOrigin", "uScale", "uUseDepth", "uThreshold", "uHostDepthMap"};
 static_assert(std::size(kCompositeUniforms) == composite::UniformCount);
-constexpr const char* kFogPassUniforms[] = {"uRay",  "uDepthAxis", "uDepthMap", "uOrigin", "uSize", "splatfx_fog_params", "splatfx_fog_colour", "splatfx_fog_far",
+constexpr const char* kFogPassUniforms[] = {"uRay",  "uDepthAxis", "uHostDepthMap", "uOrigin", "uSize", "splatfx_fog_params", "splatfx_fog_colour", "splatfx_fog_far",
                                             "uFogSize", "uThreshold"};
 static_assert(std::size(kFogPassUniforms) == fog_pass::UniformCount);
-constexpr const char* kTetraUniforms[] = {"uViewProjRel", "uFirst",     "uForward",           "uDepthToView",       "uTexScale",
+constexpr const char* kTetraUniforms[] = {"uViewProjRel", "uFirst",     "uForward",           "uHostDepthMap",       "uTexScale",
                                           "uTexOffset",   "uMaxLength", "splatfx_fog_params", "splatfx_fog_colour", "splatfx_fog_far"};
 static_assert(std::size(kTetraUniforms) == tetra::UniformCount);
 constexpr const char* kSectionUniforms[] = {"uViewProj", "uOctagon", "uCut",          "uOrigin",      "uEye",         "uForward",
-                                            "uNearZ",    "uPersp",   "uKernelRadius", "uDepthToView", "uInvViewProj", "uViewport"};
+                                            "uNearZ",    "uPersp",   "uKernelRadius", "uHostDepthMap", "uInvViewProj", "uViewport",
+                                            "uNdcZ",     "uReversed"};
 static_assert(std::size(kSectionUniforms) == section::UniformCount);
-constexpr const char* kListUniforms[] = {"uSize", "uLayers", "uTiles", "uOrigin", "uSectionCount"};
+constexpr const char* kListUniforms[] = {"uSize", "uLayers", "uTiles", "uOrigin", "uSectionCount", "uReversed"};
 static_assert(std::size(kListUniforms) == lists::UniformCount);
 
 // Renderer::Impl::program: FOG_PER_SPLAT only with FOG; the cut's variants only with CUT; GENERAL implies NEAR_CUT.

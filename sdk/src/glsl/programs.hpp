@@ -106,36 +106,37 @@ enum Uniform {
     NearZ,
     Persp,
     KernelRadius,
-    DepthToView,
+    HostDepthMap,
     InvViewProj,
     Viewport,
+    NdcZ,
     UniformCount
 };
 } // namespace splat
 namespace depth_tiles {
-enum Uniform { DepthToView, Target, UniformCount };
+enum Uniform { HostDepthMap, Target, UniformCount };
 }
 namespace downsample {
-enum Uniform { HostRect, Scale, UniformCount };
+enum Uniform { HostRect, Scale, Reversed, UniformCount };
 }
 namespace composite {
-enum Uniform { HostRect, ViewportOrigin, Scale, UseDepth, Threshold, DepthToView, UniformCount };
+enum Uniform { HostRect, ViewportOrigin, Scale, UseDepth, Threshold, HostDepthMap, UniformCount };
 }
 namespace fog_pass {
 enum Define { MODE };
-enum Uniform { Ray, DepthAxis, DepthMap, Origin, Size, FogParams, FogColour, FogFar, FogSize, Threshold, UniformCount };
+enum Uniform { Ray, DepthAxis, HostDepthMap, Origin, Size, FogParams, FogColour, FogFar, FogSize, Threshold, UniformCount };
 } // namespace fog_pass
 namespace tetra {
 enum Define { PERSPECTIVE, HAS_DEPTH, FOG };
-enum Uniform { ViewProjRel, First, Forward, DepthToView, TexScale, TexOffset, MaxLength, FogParams, FogColour, FogFar, UniformCount };
+enum Uniform { ViewProjRel, First, Forward, HostDepthMap, TexScale, TexOffset, MaxLength, FogParams, FogColour, FogFar, UniformCount };
 } // namespace tetra
 namespace section {
 enum Define { FOG, FOG_PER_SPLAT, CUT, HOST_DEPTH, NEAR_CUT, GENERAL, CROSSFADE, SECTIONS };
-enum Uniform { ViewProj, Octagon, Cut, Origin, Eye, Forward, NearZ, Persp, KernelRadius, DepthToView, InvViewProj, Viewport, UniformCount };
+enum Uniform { ViewProj, Octagon, Cut, Origin, Eye, Forward, NearZ, Persp, KernelRadius, HostDepthMap, InvViewProj, Viewport, NdcZ, Reversed, UniformCount };
 } // namespace section
 namespace lists { // prepare, tile range, host tiles, resolve (both), composite
 enum Define { K };
-enum Uniform { Size, Layers, Tiles, Origin, SectionCount, UniformCount };
+enum Uniform { Size, Layers, Tiles, Origin, SectionCount, Reversed, UniformCount };
 } // namespace lists
 
 } // namespace splatfx::glsl

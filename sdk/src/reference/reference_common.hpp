@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <string>
 #include <thread>
 #include <vector>
@@ -20,35 +21,47 @@
 namespace splatfx::reference {
 
 // The segment of the line through a pixel centre between the near and far
-// planes, in world space, in double. Points along it all rasterize to that
-// pixel; t measures world distance from the near-plane point.
+// planes, in world space, in double, in the camera's depth convention
+// (Camera::depth). Points along it all rasterize to that pixel; t measures
+// world distance from the near-plane point.
 struct PixelRay {
-    glm::dvec3 origin{0.0}; // on the near plane (ndc z = -1)
+    glm::dvec3 origin{0.0}; // on the near plane
     glm::dvec3 dir{0.0};    // unit, towards the far plane
-    double tFar = 0.0;      // distance to the far plane (ndc z = +1)
+    double tFar = 0.0;      // distance to the far plane (+inf without one)
     double tLimit = 0.0;    // min(tFar, host depth): fragments beyond it are dropped
 };
 
 class RayMapper {
 public:
     explicit RayMapper(const Camera& camera)
-        : mInv(glm::inverse(glm::dmat4(camera.proj) * glm::dmat4(camera.view))), mW(camera.viewport.x), mH(camera.viewport.y) {}
+        : mInv(glm::inverse(glm::dmat4(camera.proj) * glm::dmat4(camera.view))), mW(camera.viewport.x), mH(camera.viewport.y),
+          mDepth(camera.depth), mUnproject(depthUnprojection(camera)), mForward(camera.forward()),
+          mNearDepth(mUnproject.viewDepth(camera.depth.nearWindow())) {
+        // Under an infinite far plane each ray's direction comes from a finite
+        // point beyond the near plane (at twice its view depth).
+        const glm::dmat4 P(camera.proj);
+        mInfinite = camera.perspective() && P[2][2] / P[2][3] == mDepth.farNdc();
+        mInnerNdc = mInfinite ? P[2][2] / P[2][3] - P[3][2] / (P[2][3] * 2.0 * mNearDepth) : mDepth.farNdc();
+    }
 
-    // (x, y): output pixel, top row first. hostDepth: window depth or > 1 for none.
+    // (x, y): output pixel, top row first. hostDepth: window depth or > 1 for
+    // none (any convention: the depth itself is read through depthUnprojection).
     PixelRay ray(int x, int y, double hostDepth) const {
         // GL: window x = x + 0.5; the output is flipped, so GL row = H - 1 - y.
         const double nx = (x + 0.5) / mW * 2.0 - 1.0;
         const double ny = (mH - 1 - y + 0.5) / mH * 2.0 - 1.0;
-        const glm::dvec3 p0 = unproject(nx, ny, -1.0), p1 = unproject(nx, ny, 1.0);
+        const glm::dvec3 p0 = unproject(nx, ny, mDepth.nearNdc()), p1 = unproject(nx, ny, mInnerNdc);
         PixelRay r;
         r.origin = p0;
         const glm::dvec3 d = p1 - p0;
-        r.tFar = glm::length(d);
-        r.dir = r.tFar > 0.0 ? d / r.tFar : glm::dvec3(0.0, 0.0, -1.0);
+        const double len = glm::length(d);
+        r.dir = len > 0.0 ? d / len : glm::dvec3(0.0, 0.0, -1.0);
+        r.tFar = mInfinite ? std::numeric_limits<double>::infinity() : len;
         r.tLimit = r.tFar;
         if (hostDepth <= 1.0) {
-            const glm::dvec3 pz = unproject(nx, ny, 2.0 * hostDepth - 1.0);
-            r.tLimit = std::min(r.tFar, glm::dot(pz - p0, r.dir));
+            // View depth grows by dot(dir, forward) per unit of t from the near plane.
+            const double t = (mUnproject.viewDepth(hostDepth) - mNearDepth) / glm::dot(r.dir, mForward);
+            r.tLimit = std::min(r.tFar, t);
         }
         return r;
     }
@@ -60,6 +73,12 @@ private:
     }
     glm::dmat4 mInv;
     int mW, mH;
+    DepthConvention mDepth;
+    DepthUnprojection mUnproject;
+    glm::dvec3 mForward;
+    double mNearDepth;
+    bool mInfinite = false;
+    double mInnerNdc = 1.0;
 };
 
 inline Status checkHost(const ReferenceHost& host, const Camera& camera, const char* who) {

@@ -334,6 +334,11 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                     // Beyond the cut-off f = 0 by definition: no integral (the points come
                     // nearest first, so every later one is beyond it too).
                     if (fogFar > 0.0 && glm::length(p - eye) > fogFar) return 0.0;
+                    // No finite point (the sky under an infinite far plane): infinitely far,
+                    // fully fogged, as Fog::transmittance and the GL pass take it (exact for a fog
+                    // whose density has a positive floor; a fog of point terms alone would keep
+                    // some transmittance at infinity, which neither models).
+                    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return 0.0;
                     const double tp = tauTo(p);
                     if (std::isfinite(tp)) fogTauMax = std::max(fogTauMax, tp);
                     return std::exp(-tp);
@@ -342,8 +347,9 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                 if (desc.fogHost) {
                     const double d = reference::hostDepth(desc.host, x, y);
                     double fb = 0.0; // NaN or outside [0, 1]: fully fogged
-                    if (!desc.host.depth || d == 1.0) fb = transmittanceTo(ray.origin + ray.tFar * ray.dir);
-                    else if (d >= 0.0 && d < 1.0) fb = transmittanceTo(ray.origin + ray.tLimit * ray.dir);
+                    // The far plane's depth (1, or 0 reversed): its point (none without a far plane: fully fogged).
+                    if (!desc.host.depth || d == camera.depth.farWindow()) fb = transmittanceTo(ray.origin + ray.tFar * ray.dir);
+                    else if (d >= 0.0 && d <= 1.0) fb = transmittanceTo(ray.origin + ray.tLimit * ray.dir);
                     acc = glm::dvec4(fogColour * (1.0 - fb), 1.0 - fb) + fb * acc;
                 }
                 for (size_t k = 0; k < frags.size(); ++k) {

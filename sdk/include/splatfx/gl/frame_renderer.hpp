@@ -32,6 +32,9 @@
 // Where a pass cannot run as asked (no host depth texture, a multisampled
 // one, a fog with splat sections, tetrahedra in a list frame) the frame says
 // so in stats().notes and the pass's own block; nothing falls back silently.
+// The host depth is read in the frame camera's depth convention
+// (Camera::depth, depth_convention.hpp); a context whose glClipControl or a
+// projection that disagrees with it is a note too.
 // It never creates a context, never clears, and writes no depth.
 //
 //   auto fr = splatfx::gl::FrameRenderer::create();       // a GL 4.5 context must be current
@@ -122,7 +125,8 @@ struct HostTarget {
     int x = 0, y = 0;         // viewport origin; its size is the frame camera's viewport; default 0, 0
     // The host's depth as a texture (GL name, single-sampled, the
     // framebuffer's size); 0: the framebuffer's depth attachment when it is a
-    // texture. Every pass that reads the host depth reads this one (the depth
+    // texture, in the frame camera's depth convention (Camera::depth). Every
+    // pass that reads the host depth reads this one (the depth
     // cut of the splats, the reduced-resolution upsampling, the host fog, the
     // tetrahedra's ray end, the list sections). Without one the splats and
     // tetrahedra are only depth-tested at their fragments (not exact inside
@@ -152,6 +156,7 @@ struct FrameRenderStats {
     std::uint64_t drawCalls = 0;    // draw calls of the volume passes
     int resolutionScale = 1;        // the scale the splats were drawn at
     std::vector<std::string> notes; // every fallback of the frame, one line each (the plan's and the passes'); empty: all ran as asked
+    std::string depthConvention;    // the frame camera's (describe(Camera::depth)): how the host depth was read
     struct Shadow {
         std::uint64_t uploads = 0; // shadow-table uploads (cumulative; only when the frame's changed)
     } shadow;
@@ -189,6 +194,13 @@ struct FrameRenderStats {
         std::size_t bytes = 0; // GPU bytes of the lists (pool, heads, counts, counters, section targets)
     } lists;
 };
+
+// Camera::depth for a host drawing with `proj` in the current context: the
+// clip range from glClipControl's depth mode (GL_CLIP_DEPTH_MODE), reversed
+// and infinite far from the projection (conventionOfProjection). Fails when
+// no context is current or the clip origin is GL_UPPER_LEFT (not supported:
+// flip y in the projection instead, docs/integration.md).
+Result<DepthConvention> depthConventionOfContext(const glm::mat4& proj);
 
 struct FramePlan; // frame_plan.hpp
 

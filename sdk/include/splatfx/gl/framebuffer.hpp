@@ -24,6 +24,7 @@ struct FramebufferDesc {
     int width = 640;                 // default 640
     int height = 480;                // default 480
     Precision color = Precision::U8; // colour attachment format; default RGBA8
+    bool floatDepth = false;         // depth attachment DEPTH_COMPONENT32F (reverse-Z hosts) instead of DEPTH_COMPONENT24; default false
 };
 
 class Framebuffer {
@@ -36,7 +37,7 @@ public:
     unsigned handle() const { return mFbo; }
     int width() const { return mDesc.width; }
     int height() const { return mDesc.height; }
-    // The depth attachment, a DEPTH_COMPONENT24 texture (HostTarget::depthTexture).
+    // The depth attachment, a DEPTH_COMPONENT24 (or 32F) texture (HostTarget::depthTexture).
     unsigned depthTexture() const { return mDepth; }
     void clear(glm::vec4 color, float depth = 1.0f);
     // RGBA float, top row first (flipped from GL's bottom-up order).

@@ -7,11 +7,12 @@
 // copy of the host depth downsampled by taking the farthest depth of each
 // scale x scale block (so thin foreground geometry cannot hide the effect
 // behind it), then composites that image over the host target with
-// premultiplied "over". Upsampling is nearest-depth: each full-resolution
-// pixel reads the four nearest low-resolution texels bilinearly when their
-// downsampled depths all lie within depthThreshold (relative, in view depth)
-// of its own host depth, and otherwise takes the single texel whose depth is
-// nearest its own (so effects do not bleed onto geometry edges).
+// premultiplied "over". Upsampling is depth-aware: each full-resolution
+// pixel interpolates those of the four nearest low-resolution texels whose
+// downsampled depths lie within depthThreshold (relative, in view depth) of
+// its own host depth, their bilinear weights renormalized (all four: plain
+// bilinear), and takes the single texel whose depth is nearest its own when
+// none does (so effects do not bleed onto geometry edges).
 // Without a host depth texture it upsamples bilinearly and tests no depth.
 // The full-resolution passes are scissored to the splats' screen rectangle,
 // and the host depth is copied once per draw (sampling the attached texture
@@ -78,8 +79,10 @@ public:
     // The layer is a framebuffer of ceil(width / scale) x ceil(height / scale)
     // pixels, premultiplied RGBA cleared to 0, whose depth attachment
     // (depthTexture) holds the host depth downsampled (farthest of each
-    // block; 1.0 without a host depth).
-    PassTarget begin(const PassTarget& target, glm::ivec4 box);
+    // block; the far plane's depth without a host depth). `depth`: the
+    // frame camera's convention (Camera::depth), which the downsampling
+    // and the reduced image's depth follow.
+    PassTarget begin(const PassTarget& target, glm::ivec4 box, const DepthConvention& depth = {});
     void drawSplats(std::span<const Splat> splats, const Camera& camera);
     void composite(const Camera& camera);
 
@@ -93,7 +96,7 @@ private:
     static Result<ScaledRenderer> create(const ScaledRendererDesc& desc, std::shared_ptr<detail::ProgramLibrary> programs);
     // draw() and begin() with the host depth already resolved.
     void drawResolved(std::span<const Splat> splats, const Camera& camera, const PassTarget& target);
-    PassTarget beginResolved(const PassTarget& target, glm::ivec4 box);
+    PassTarget beginResolved(const PassTarget& target, glm::ivec4 box, const DepthConvention& depth);
     struct Impl;
     explicit ScaledRenderer(std::unique_ptr<Impl> impl);
     std::unique_ptr<Impl> mImpl;

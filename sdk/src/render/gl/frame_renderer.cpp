@@ -31,6 +31,7 @@ struct FrameRenderer::Impl {
     const void* context = nullptr; // the context create() ran in: its GL objects are names in that context only
     FramePlan plan;
     FrameRenderStats stats;
+    std::string depthNote; // the camera's depth convention against the context and its projection
     detail::ShadowPass shadow;
     detail::HostPass host;
     detail::FogPass fog;
@@ -124,6 +125,7 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         r.stats.notes.push_back("frame not drawn: " + s.error());
         return;
     }
+    r.depthNote = detail::depthConventionNote(frame.camera());
     r.plan = planFrame(frame, target, r.desc, detail::queryHostDepth(target.framebuffer, target.depthTexture));
     for (detail::Pass* p : r.passes()) p->prepare(r.plan, frame);
     detail::StepContext context{.frame = frame, .host = target, .plan = r.plan, .splatLayers = r.splats.renderer().layerTexture()};
@@ -146,6 +148,7 @@ void FrameRenderer::Impl::report(const Frame& frame, const detail::StepContext& 
     s = {};
     s.splats = frame.splats().size();
     s.resolutionScale = desc.resolutionScale;
+    s.depthConvention = describe(frame.camera().depth);
     for (detail::Pass* p : passes()) p->report(s);
     if (plan.tetrahedra)
         s.tetrahedra.batches = std::uint64_t(std::count_if(plan.steps.begin(), plan.steps.end(), [](const PlanStep& step) {
@@ -160,6 +163,7 @@ void FrameRenderer::Impl::report(const Frame& frame, const detail::StepContext& 
     auto note = [&](const std::string& line) {
         if (!line.empty() && std::find(s.notes.begin(), s.notes.end(), line) == s.notes.end()) s.notes.push_back(line);
     };
+    note(depthNote);
     note(s.fog.error);
     for (const PlanStep& step : plan.steps)
         if (step.range != StepRange::ListsBehindAndBetween) note(step.note); // that one is noted with its count, when it applies

@@ -21,7 +21,7 @@ Result<Framebuffer> Framebuffer::create(const FramebufferDesc& desc) {
     glCreateTextures(GL_TEXTURE_2D, 1, &fb.mColor);
     glTextureStorage2D(fb.mColor, 1, format, desc.width, desc.height);
     glCreateTextures(GL_TEXTURE_2D, 1, &fb.mDepth);
-    glTextureStorage2D(fb.mDepth, 1, GL_DEPTH_COMPONENT24, desc.width, desc.height);
+    glTextureStorage2D(fb.mDepth, 1, desc.floatDepth ? GL_DEPTH_COMPONENT32F : GL_DEPTH_COMPONENT24, desc.width, desc.height);
     glCreateFramebuffers(1, &fb.mFbo);
     glNamedFramebufferTexture(fb.mFbo, GL_COLOR_ATTACHMENT0, fb.mColor, 0);
     glNamedFramebufferTexture(fb.mFbo, GL_DEPTH_ATTACHMENT, fb.mDepth, 0);

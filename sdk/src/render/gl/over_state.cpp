@@ -11,9 +11,9 @@ void setOverState(unsigned framebuffer, const PassTarget& target, DepthTest test
     glBlendFuncSeparate(GL_ONE, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
     glBlendEquationSeparate(GL_FUNC_ADD, GL_FUNC_ADD);
     glDepthMask(GL_FALSE);
-    if (test == DepthTest::LessEqual) {
+    if (test != DepthTest::Off) {
         glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_LEQUAL);
+        glDepthFunc(test == DepthTest::GreaterEqual ? GL_GEQUAL : GL_LEQUAL);
     } else {
         glDisable(GL_DEPTH_TEST);
     }

@@ -321,7 +321,8 @@ void Renderer::drawResolved(std::span<const Splat> splats, const Camera& camera,
     // (A multisampled host depth was resolved to none: the plain test at the splat plane.)
     const GLuint depthTex = cut && r.desc.depthTest && r.tilesProgram ? target.depthTexture : 0;
     r.stats.cutHostDepth = depthTex != 0;
-    const glm::mat4 invProj = glm::inverse(camera.proj);
+    const glm::vec3 depthMap = detail::hostDepthMap(camera);
+    const glm::vec2 ndcZ = detail::generalNdcZ(camera);
     const int tile = kCutTile;
     const int tilesX = (target.width + tile - 1) / tile, tilesY = (target.height + tile - 1) / tile;
     if (depthTex) {
@@ -342,7 +343,7 @@ void Renderer::drawResolved(std::span<const Splat> splats, const Camera& camera,
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, r.tilesFbo);
         glViewport(0, 0, tilesX, tilesY);
         glUseProgram(r.tilesProgram->id);
-        glUniform4f(r.tilesProgram->uniform(glsl::depth_tiles::DepthToView), invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+        glUniform3fv(r.tilesProgram->uniform(glsl::depth_tiles::HostDepthMap), 1, glm::value_ptr(depthMap));
         glUniform4i(r.tilesProgram->uniform(glsl::depth_tiles::Target), target.x, target.y, target.width, target.height);
         glBindTextureUnit(1, depthTex);
         glDrawArrays(GL_TRIANGLES, 0, 3);
@@ -414,7 +415,7 @@ void Renderer::drawResolved(std::span<const Splat> splats, const Camera& camera,
 
     // With the host depth read, the cut replaces the hardware test (the
     // depth texture is read, never written: the test and writes are off).
-    detail::setOverState(target.framebuffer, target, r.desc.depthTest && !depthTex ? detail::DepthTest::LessEqual : detail::DepthTest::Off);
+    detail::setOverState(target.framebuffer, target, r.desc.depthTest && !depthTex ? detail::nearerOrEqual(camera) : detail::DepthTest::Off);
     glDisable(GL_CULL_FACE);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 
@@ -455,7 +456,8 @@ void Renderer::drawResolved(std::span<const Splat> splats, const Camera& camera,
             glUniform1f(p->uniform(glsl::splat::NearZ), nearZ);
             glUniform1i(p->uniform(glsl::splat::Persp), persp ? 1 : 0);
             glUniform1f(p->uniform(glsl::splat::KernelRadius), r.kernelRadius);
-            glUniform4f(p->uniform(glsl::splat::DepthToView), invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+            glUniform3fv(p->uniform(glsl::splat::HostDepthMap), 1, glm::value_ptr(depthMap));
+            glUniform2fv(p->uniform(glsl::splat::NdcZ), 1, glm::value_ptr(ndcZ));
             glUniformMatrix4fv(p->uniform(glsl::splat::InvViewProj), 1, GL_FALSE, glm::value_ptr(invVp));
             glUniform4f(p->uniform(glsl::splat::Viewport), float(target.x), float(target.y), float(target.width), float(target.height));
         }

@@ -1,5 +1,7 @@
 #include "splatfx/gl/scaled_renderer.hpp"
 
+#include <glm/gtc/type_ptr.hpp>
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -129,7 +131,9 @@ void ScaledRenderer::draw(std::span<const Splat> splats, const Camera& camera, c
     drawResolved(splats, camera, detail::resolveTarget(target));
 }
 
-PassTarget ScaledRenderer::begin(const PassTarget& target, glm::ivec4 box) { return beginResolved(detail::resolveTarget(target), box); }
+PassTarget ScaledRenderer::begin(const PassTarget& target, glm::ivec4 box, const DepthConvention& depth) {
+    return beginResolved(detail::resolveTarget(target), box, depth);
+}
 
 void ScaledRenderer::drawResolved(std::span<const Splat> splats, const Camera& camera, const PassTarget& target) {
     Impl& r = *mImpl;
@@ -146,12 +150,12 @@ void ScaledRenderer::drawResolved(std::span<const Splat> splats, const Camera& c
     // rasterizer a full-screen pass costs as much as the effect itself.
     const glm::ivec4 box = splatBounds(splats, camera, target.width, target.height);
     if (box.z <= box.x || box.w <= box.y) return;
-    beginResolved(target, box);
+    beginResolved(target, box, camera.depth);
     drawSplats(splats, camera);
     composite(camera);
 }
 
-PassTarget ScaledRenderer::beginResolved(const PassTarget& target, glm::ivec4 box) {
+PassTarget ScaledRenderer::beginResolved(const PassTarget& target, glm::ivec4 box, const DepthConvention& depth) {
     Impl& r = *mImpl;
     assert(target.width > 0 && target.height > 0 && "PassTarget::width and height must be positive");
     assert(!r.open && "ScaledRenderer::begin: composite() the previous layer first");
@@ -190,7 +194,7 @@ PassTarget ScaledRenderer::beginResolved(const PassTarget& target, glm::ivec4 bo
     glDisable(GL_CULL_FACE);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDepthMask(GL_TRUE);
-    const float clear[4] = {0.0f, 0.0f, 0.0f, 0.0f}, farDepth = 1.0f;
+    const float clear[4] = {0.0f, 0.0f, 0.0f, 0.0f}, farDepth = float(depth.farWindow());
     glDisable(GL_SCISSOR_TEST);
     glClearNamedFramebufferfv(r.fbo, GL_COLOR, 0, clear);
     glClearNamedFramebufferfv(r.fbo, GL_DEPTH, 0, &farDepth);
@@ -204,6 +208,7 @@ PassTarget ScaledRenderer::beginResolved(const PassTarget& target, glm::ivec4 bo
         glUseProgram(r.downsample->id);
         glUniform4iv(r.downsample->uniform(glsl::downsample::HostRect), 1, hostRect);
         glUniform1i(r.downsample->uniform(glsl::downsample::Scale), s);
+        glUniform1i(r.downsample->uniform(glsl::downsample::Reversed), depth.reversed ? 1 : 0);
         glBindTextureUnit(2, r.hostCopy);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -235,8 +240,8 @@ void ScaledRenderer::composite(const Camera& camera) {
     glUniform1i(r.composite->uniform(glsl::composite::Scale), r.desc.scale);
     glUniform1i(r.composite->uniform(glsl::composite::UseDepth), r.useDepth ? 1 : 0);
     glUniform1f(r.composite->uniform(glsl::composite::Threshold), r.desc.depthThreshold);
-    const glm::mat4 invProj = glm::inverse(camera.proj);
-    glUniform4f(r.composite->uniform(glsl::composite::DepthToView), invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+    const glm::vec3 depthMap = detail::hostDepthMap(camera);
+    glUniform3fv(r.composite->uniform(glsl::composite::HostDepthMap), 1, glm::value_ptr(depthMap));
     glBindTextureUnit(0, r.color);
     glBindTextureUnit(1, r.depth);
     if (r.useDepth) glBindTextureUnit(2, r.hostCopy);

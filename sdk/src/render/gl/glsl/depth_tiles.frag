@@ -2,7 +2,7 @@
 // farthest host view depth (RG32F), read back so the CPU can give the cut
 // program only to the splats whose support meets the surface.
 layout(binding = 1) uniform sampler2D uHostDepth;
-uniform vec4 uDepthToView; // inverse projection's (z, w) rows at (z, w) columns
+#include "host_depth.glsl"
 uniform ivec4 uTarget;     // x, y, width, height of the target in the depth texture
 layout(location = 0) out vec2 oRange;
 void main() {
@@ -11,8 +11,7 @@ void main() {
     float lo = 3.4e38, hi = 0.0;
     for (int y = first.y; y < last.y; ++y)
         for (int x = first.x; x < last.x; ++x) {
-            float nz = texelFetch(uHostDepth, ivec2(x, y) + uTarget.xy, 0).r * 2.0 - 1.0;
-            float z = abs((uDepthToView.x * nz + uDepthToView.y) / (uDepthToView.z * nz + uDepthToView.w));
+            float z = splatfx_host_view_depth(texelFetch(uHostDepth, ivec2(x, y) + uTarget.xy, 0).r);
             lo = min(lo, z);
             hi = max(hi, z);
         }

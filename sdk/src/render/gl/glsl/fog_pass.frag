@@ -2,20 +2,20 @@
 // the host colour; 1: reduced (f, distance) texture; 2: its depth-aware
 // upsampling, blended into the host colour.
 #include "fog.glsl"
+#include "host_depth.glsl"
 layout(binding = 0) uniform sampler2D uDepth; // host depth, framebuffer-sized
 // Window position and depth -> world position relative to the eye, without a
-// 4x4 inverse projection: its w at depth 1 is the difference of two terms of
-// size 1 / (2 near) whose true value is 1 / far, which float cannot hold when
-// far / near is large. Instead (FogPass::draw, in double on the CPU):
-//  perspective: the view depth's inverse is affine in the window depth, so it
-//    is the blend (1 - d) a + d b of its values at d = 0 and d = 1 (1 / near
-//    and 1 / far: each term positive, nothing cancels, and d = 1 gives 1 / far
-//    exactly; 0 for an infinite far plane), and the point is the ray through
-//    the pixel at view depth 1 (uRay * (ndc, 1), rotated to world) over it;
+// 4x4 inverse projection: its w at the far plane is the difference of two
+// terms of size 1 / (2 near) whose true value is 1 / far, which float cannot
+// hold when far / near is large. Instead (FogPass::draw, in double on the CPU):
+//  perspective: 1 / view depth from host_depth.glsl (the blend of its values
+//    at d = 0 and d = 1, in any depth convention: nothing cancels, 1 / far
+//    exactly at the far plane, 0 under an infinite far plane), and the point
+//    is the ray through the pixel at view depth 1 (uRay * (ndc, 1), rotated
+//    to world) over it;
 //  orthographic: the point is affine in (ndc, d): uRay * (ndc, 1) + d uDepthAxis.
 uniform mat3 uRay;       // (ndc.x, ndc.y, 1) -> eye-relative world point (view depth 1, or d = 0 orthographic)
 uniform vec3 uDepthAxis; // orthographic: the world offset from d = 0 to d = 1
-uniform vec3 uDepthMap;  // (a, b, 1: perspective / 0: orthographic)
 uniform vec2 uOrigin;    // viewport origin, framebuffer pixels
 uniform vec2 uSize;      // viewport size, pixels
 
@@ -27,8 +27,8 @@ bool hostPoint(vec2 xy, float d, out vec3 rel) {
     if (isnan(d) || !(d >= 0.0 && d <= 1.0)) return false;
     vec2 ndc = (xy - uOrigin) / uSize * 2.0 - 1.0;
     vec3 ray = uRay * vec3(ndc, 1.0);
-    if (uDepthMap.z > 0.5)
-        rel = ray / ((1.0 - d) * uDepthMap.x + d * uDepthMap.y); // d = 1 (sky): the far-plane point
+    if (uHostDepthMap.z > 0.5)
+        rel = ray / splatfx_host_depth_blend(d); // the far plane: its point (inf beyond an infinite one: no point)
     else
         rel = ray + d * uDepthAxis;
     return !(any(isnan(rel)) || any(isinf(rel)));

@@ -6,8 +6,10 @@
 #endif
 #include "transparent.glsl"
 layout(binding = 0) uniform sampler2DArray uLayers;
-layout(binding = 2) uniform sampler2DArray uDepths; // the pixel's nearest SECTIONS - 1 surface depths, sorted; 2.0: none
+layout(binding = 2) uniform sampler2DArray uDepths; // the pixel's nearest SECTIONS - 1 surface depth keys, sorted; 2.0: none
 uniform ivec2 uOrigin; // the lists' viewport origin
+uniform int uReversed; // the keys are 1 - window depth (transparent_lists.glsl)
+float windowOfKey(float key) { return uReversed != 0 ? 1.0 - key : key; }
 in vec2 vTex;
 flat in float vDensity;
 flat in vec3 vLayers;
@@ -22,7 +24,7 @@ uniform float uNearZ;
 uniform int uPersp;
 uniform float uKernelRadius;
 layout(binding = 1) uniform sampler2D uHostDepth;
-uniform vec4 uDepthToView; // inverse projection's (z, w) rows at (z, w) columns
+#include "host_depth.glsl"
 flat in float vScale;
 in vec3 vRel;
 #if GENERAL
@@ -30,19 +32,16 @@ in vec3 vRel;
 #include "splat_plane.glsl"
 #endif
 float gR, gTP, gInvCos, gInvL, gLo, gHi;
-float viewDepth(float windowDepth) {
-    float nz = windowDepth * 2.0 - 1.0;
-    return abs((uDepthToView.x * nz + uDepthToView.y) / (uDepthToView.z * nz + uDepthToView.w));
-}
+float viewDepth(float key) { return splatfx_host_view_depth(windowOfKey(key)); }
 // Share of the kernel's line integral on this ray in front of view depth z.
 float beforeView(float z) { return splatfx_partial_before(gR, (z * gInvCos - gTP) * gInvL); }
 // The share of this fragment's optical depth (between the near plane and the
-// host's opaque surface) in front of window depth d: non-decreasing in d.
+// host's opaque surface) in front of the surface with key d: non-decreasing in d.
 float sectionFraction(float d) { return clamp(beforeView(viewDepth(d)), gLo, gHi) - gLo; }
 #else
 // Without the cut the kernel is concentrated on its plane: a step at the
-// plane's depth (LEQUAL, as the ordered blend's depth test).
-float sectionFraction(float d) { return gl_FragCoord.z <= d ? 1.0 : 0.0; }
+// plane's depth (LEQUAL on the keys, as the ordered blend's depth test).
+float sectionFraction(float d) { return (uReversed != 0 ? 1.0 - gl_FragCoord.z : gl_FragCoord.z) <= d ? 1.0 : 0.0; }
 #endif
 
 void main() {
@@ -79,7 +78,7 @@ void main() {
     gLo = 0.0;
 #endif
 #if HOST_DEPTH
-    gHi = max(beforeView(viewDepth(texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r)), gLo);
+    gHi = max(beforeView(splatfx_host_view_depth(texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r)), gLo);
 #else
     gHi = 1.0;
 #endif

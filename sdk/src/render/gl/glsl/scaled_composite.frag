@@ -1,4 +1,4 @@
-// Nearest-depth upsampling of the premultiplied low-resolution image (ScaledRenderer).
+// Depth-aware upsampling of the premultiplied low-resolution image (ScaledRenderer).
 layout(binding = 0) uniform sampler2D uLowColor;
 layout(binding = 1) uniform sampler2D uLowDepth;
 layout(binding = 2) uniform sampler2D uHostDepth;
@@ -7,13 +7,8 @@ uniform ivec2 uViewportOrigin; // the host viewport's corner in window pixels
 uniform int uScale;
 uniform int uUseDepth;
 uniform float uThreshold;
-uniform vec4 uDepthToView; // (a, b, c, d): view depth = |(a n + b) / (c n + d)|, n = ndc z (inverse projection's z and w rows)
+#include "host_depth.glsl"
 layout(location = 0) out vec4 oColor;
-
-float viewDepth(float d) {
-    float n = 2.0 * d - 1.0;
-    return abs((uDepthToView.x * n + uDepthToView.y) / (uDepthToView.z * n + uDepthToView.w));
-}
 
 void main() {
     ivec2 p = ivec2(gl_FragCoord.xy) - uViewportOrigin;
@@ -36,13 +31,25 @@ void main() {
         oColor = bilinear;
         return;
     }
-    float z = viewDepth(texelFetch(uHostDepth, uHostRect.xy + p, 0).r);
-    float worst = 0.0, best = 1e30;
-    int nearest = 0;
+    float z = splatfx_host_view_depth(texelFetch(uHostDepth, uHostRect.xy + p, 0).r);
+    // The taps on this pixel's surface (relative view depth within the
+    // threshold) are interpolated, their weights renormalized; all four: the
+    // plain bilinear. None: the one nearest in depth. Which taps count does
+    // not hinge on the depths' last bits (the surfaces differ by far more
+    // than the threshold), so the depth buffer's format and convention do
+    // not change the picture; a choice by smallest difference alone did.
+    vec4 acc = vec4(0.0);
+    float wsum = 0.0, best = 1e30;
+    int nearest = 0, same = 0;
     for (int k = 0; k < 4; ++k) {
-        float dz = abs(viewDepth(texelFetch(uLowDepth, t[k], 0).r) - z);
-        worst = max(worst, dz);
+        float zk = splatfx_host_view_depth(texelFetch(uLowDepth, t[k], 0).r);
+        float dz = zk == z ? 0.0 : abs(zk - z); // the sky under an infinite far plane: inf on both
+        if (dz <= uThreshold * z) {
+            acc += w[k] * c[k];
+            wsum += w[k];
+            ++same;
+        }
         if (dz < best) { best = dz; nearest = k; }
     }
-    oColor = worst <= uThreshold * z ? bilinear : c[nearest];
+    oColor = same == 4 ? bilinear : wsum > 0.0 ? acc / wsum : c[nearest];
 }

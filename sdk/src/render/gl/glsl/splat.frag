@@ -35,7 +35,7 @@ flat in float vScale;
 in vec3 vRel;
 #if HOST_DEPTH
 layout(binding = 1) uniform sampler2D uHostDepth; // the host's depth texture (read only; the depth test is off)
-uniform vec4 uDepthToView; // inverse projection's (z, w) rows at (z, w) columns
+#include "host_depth.glsl"
 #endif
 #if GENERAL
 #include "splat_plane.glsl"
@@ -73,8 +73,7 @@ void main() {
     share -= splatfx_partial_before(r, (uNearZ * invCos - tP) * invL);
 #endif
 #if HOST_DEPTH
-    float nz = texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r * 2.0 - 1.0;
-    float zD = abs((uDepthToView.x * nz + uDepthToView.y) / (uDepthToView.z * nz + uDepthToView.w));
+    float zD = splatfx_host_view_depth(texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r);
     share -= 1.0 - splatfx_partial_before(r, (zD * invCos - tP) * invL);
 #endif
     // Opacity from the optical depth in front: alpha = 1 - 2^(-density * detail * share).

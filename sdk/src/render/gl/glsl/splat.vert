@@ -30,6 +30,9 @@ uniform float uKernelRadius; // Footprint::radius(), kernel units
 flat out float vScale;      // world length of one kernel unit along the ray
 out vec3 vRel;              // the fragment's point on the splat plane, minus uEye
 #if GENERAL
+// x: clip z / w of the screen-covering polygon, just inside the near plane
+// (in the host's depth convention); y: splat_plane.glsl's.
+uniform vec2 uNdcZ;
 flat out vec3 vCenter;
 flat out vec3 vAxisU;
 flat out vec3 vAxisV;
@@ -73,7 +76,7 @@ void main() {
 #if GENERAL
     // The polygon crosses (or nearly) the eye plane: cover the screen at the
     // near plane; the fragment intersects its ray with the splat plane.
-    gl_Position = vec4(sign(corner), -1.0 + 1e-5, 1.0);
+    gl_Position = vec4(sign(corner), uNdcZ.x, 1.0);
     vCenter = c;
     vAxisU = au;
     vAxisV = av;

@@ -6,6 +6,7 @@
 uniform mat4 uInvViewProj;
 uniform vec4 uViewport; // x, y, width, height
 uniform vec3 uEye;
+uniform vec2 uNdcZ; // y: ndc z of a finite point beyond the near plane (the far plane's, when finite), giving each pixel's ray
 uniform float uCut;
 uniform int uOctagon;
 flat in vec3 vCenter;
@@ -17,7 +18,7 @@ flat in vec3 vAxisV;
 // outside the drawn polygon).
 bool splatfx_splat_plane(out vec3 dir, out float tP, out vec2 uvk) {
     vec2 ndc = (gl_FragCoord.xy - uViewport.xy) / uViewport.zw * 2.0 - 1.0;
-    vec4 farPoint = uInvViewProj * vec4(ndc, 1.0, 1.0);
+    vec4 farPoint = uInvViewProj * vec4(ndc, uNdcZ.y, 1.0);
     dir = normalize(farPoint.xyz / farPoint.w - uEye);
     vec3 n = cross(vAxisU, vAxisV);
     float dn = dot(dir, n);

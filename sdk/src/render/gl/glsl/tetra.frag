@@ -2,7 +2,7 @@
 layout(binding = 1) uniform sampler2D uHostDepth;
 layout(binding = 2) uniform sampler3D uTable;
 uniform vec3 uForward;      // unit view direction
-uniform vec4 uDepthToView;  // inverse projection's (z, w) rows at (z, w) columns
+#include "host_depth.glsl"
 uniform vec3 uTexScale;     // (n-1)/n, (n-1)/n, (m-1)/m: texel centres at the table's samples
 uniform vec3 uTexOffset;    // 0.5/n, 0.5/n, 0.5/m
 uniform float uMaxLength;   // the table's maxLengthWorld
@@ -63,10 +63,8 @@ void main() {
 #if HAS_DEPTH
     // The ray ends at the host's surface: the segment is cut there, and the
     // scalars below are interpolated at the cut (exact inside a tetrahedron).
-    // View depth from the stored depth: |(a n + b) / (c n + d)| with the
-    // inverse projection's z and w rows; along the ray t = depth / dot(d, forward).
-    float nz = texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r * 2.0 - 1.0;
-    float zView = abs((uDepthToView.x * nz + uDepthToView.y) / (uDepthToView.z * nz + uDepthToView.w));
+    // View depth from the stored depth (host_depth.glsl); along the ray t = depth / dot(d, forward).
+    float zView = splatfx_host_view_depth(texelFetch(uHostDepth, ivec2(gl_FragCoord.xy), 0).r);
 #if PERSPECTIVE
     tOut = min(tOut, zView / dot(d, uForward));
 #else

@@ -14,7 +14,7 @@ vec4 splatfx_emitTransparent(vec4 premultipliedColour, float windowDepth) {
             // One 16-byte store (a software rasterizer scatters each store per lane).
             uint next = imageAtomicExchange(splatfx_surfaceHeads, p, i);
             splatfx_nodes[i] = splatfx_Node(packHalf2x16(premultipliedColour.rg), packHalf2x16(premultipliedColour.ba),
-                                            floatBitsToUint(clamp(windowDepth, 0.0, 1.0)), next);
+                                            floatBitsToUint(clamp(splatfx_depthReversed != 0 ? 1.0 - windowDepth : windowDepth, 0.0, 1.0)), next);
         } else {
             atomicAdd(splatfx_fallback, 1u);
             result = premultipliedColour;

@@ -7,7 +7,7 @@
 #define SPLATFX_HEAD_UNIT 6
 struct splatfx_Node {
     uint rg, ba;   // premultiplied colour, packHalf2x16
-    uint depthBits; // window depth (floatBitsToUint)
+    uint depthBits; // depth key (floatBitsToUint): the window depth, 1 - window depth under a reversed convention (nearer: smaller)
     uint next;     // next node of this pixel (0xffffffff ends the list)
 };
 layout(std430, binding = SPLATFX_NODE_BINDING) coherent buffer splatfx_NodePool { splatfx_Node splatfx_nodes[]; };
@@ -17,6 +17,7 @@ layout(std430, binding = SPLATFX_COUNTER_BINDING) coherent buffer splatfx_Counte
     int splatfx_originX, splatfx_originY, splatfx_width, splatfx_height; // the lists' viewport
     uint splatfx_maxSurfaces;  // most surfaces stored on one pixel (counted after the hook, from the lists)
     uint splatfx_sectionOverflow, splatfx_overflowPixels, splatfx_mergedNodes;
+    int splatfx_depthReversed; // 1: the host's depth convention is reversed (window depth falls with distance)
 };
 layout(r32ui, binding = SPLATFX_HEAD_UNIT) coherent uniform uimage2D splatfx_surfaceHeads;
 const uint splatfx_kEnd = 0xffffffffu;

@@ -11,14 +11,17 @@
 
 #include "render/gl/context_check.hpp"
 #include "render/gl/fog_state.hpp"
+#include "render/gl/host_depth.hpp"
 #include "render/gl/over_state.hpp"
 #include "render/gl/saved_state.hpp"
 
 namespace splatfx::gl::detail {
 
 HostUnprojection hostUnprojection(const Camera& camera) {
-    // In double from the projection's own (float) entries. inverse(view) =
-    // [R^T | eye], so its rotation alone takes view space to eye-relative world.
+    // In double from the projection's own (float) entries, in the camera's
+    // depth convention. inverse(view) = [R^T | eye], so its rotation alone
+    // takes view space to eye-relative world.
+    const DepthConvention& dc = camera.depth;
     const glm::dmat4 invProj = glm::inverse(glm::dmat4(camera.proj));
     const glm::dmat3 rot(glm::inverse(glm::dmat4(camera.view)));
     auto viewPoint = [&](double x, double y, double z) {
@@ -29,20 +32,21 @@ HostUnprojection hostUnprojection(const Camera& camera) {
     if (camera.perspective()) {
         // The pixel's ray at view depth 1 is affine in ndc.xy; the inverse view
         // depth is affine in the window depth d (1/z = (P22 - P23 z_ndc) / P32).
+        // (The near plane's points: finite in every convention.)
+        const double zNear = dc.nearNdc();
         auto unitDepth = [&](double x, double y) {
-            const glm::dvec3 p = viewPoint(x, y, 0.0);
+            const glm::dvec3 p = viewPoint(x, y, zNear);
             return p / -p.z;
         };
         const glm::dvec3 o = unitDepth(0.0, 0.0);
         u.ray = glm::mat3(rot * glm::dmat3(unitDepth(1.0, 0.0) - o, unitDepth(0.0, 1.0) - o, o));
-        const glm::dmat4 P(camera.proj);
-        auto inverseDepth = [&](double ndcZ) { return (P[2][2] - P[2][3] * ndcZ) / P[3][2]; };
-        u.depthMap = glm::vec3(float(inverseDepth(-1.0)), float(inverseDepth(1.0)), 1.0f);
     } else {
-        const glm::dvec3 o = viewPoint(0.0, 0.0, -1.0);
-        u.ray = glm::mat3(rot * glm::dmat3(viewPoint(1.0, 0.0, -1.0) - o, viewPoint(0.0, 1.0, -1.0) - o, o));
-        u.depthAxis = glm::vec3(rot * (viewPoint(0.0, 0.0, 1.0) - o));
+        const double z0 = dc.ndcFromWindow(0.0), z1 = dc.ndcFromWindow(1.0);
+        const glm::dvec3 o = viewPoint(0.0, 0.0, z0);
+        u.ray = glm::mat3(rot * glm::dmat3(viewPoint(1.0, 0.0, z0) - o, viewPoint(0.0, 1.0, z0) - o, o));
+        u.depthAxis = glm::vec3(rot * (viewPoint(0.0, 0.0, z1) - o));
     }
+    u.depthMap = hostDepthMap(camera); // 1 / view depth (perspective): the one unprojection of every pass
     return u;
 }
 
@@ -119,7 +123,7 @@ Status FogPass::draw(const Fog& fog, double timeSec, const Camera& camera, const
         glUseProgram(p.id);
         glUniformMatrix3fv(p.uniform(Ray), 1, GL_FALSE, glm::value_ptr(unproject.ray));
         glUniform3fv(p.uniform(DepthAxis), 1, glm::value_ptr(unproject.depthAxis));
-        glUniform3fv(p.uniform(DepthMap), 1, glm::value_ptr(unproject.depthMap));
+        glUniform3fv(p.uniform(HostDepthMap), 1, glm::value_ptr(unproject.depthMap));
         glUniform2f(p.uniform(Origin), float(target.x), float(target.y));
         glUniform2f(p.uniform(Size), float(target.width), float(target.height));
         setFogUniforms(p.id, {.params = p.uniform(FogParams), .colour = p.uniform(FogColour), .far = p.uniform(FogFar)}, fog, params);

@@ -9,7 +9,8 @@
 // "over" layer ((1 - f) C_fog, 1 - f) with (ONE, ONE_MINUS_SRC_ALPHA): no copy
 // of the colour, no feedback loop. The depth texture is only sampled (no depth
 // test, no depth writes), as every engine's deferred fog does.
-//  * depth 1 (sky): the far-plane point (fully fogged beyond the cut-off);
+//  * the far plane's depth (sky; 1, or 0 reversed): the far-plane point (fully
+//    fogged beyond the cut-off, and always under an infinite far plane);
 //  * NaN or outside [0, 1]: fully fogged (as Fog::transmittance for invalid input);
 //  * beyond FogDesc::farDistanceWorld: fully fogged, no evaluation (sec. 4.2).
 // At full resolution (one evaluation per pixel) or into a reduced fog texture
@@ -35,7 +36,7 @@ namespace splatfx::gl::detail {
 struct HostUnprojection {
     glm::mat3 ray{0.0f};       // (ndc.x, ndc.y, 1) -> the point at view depth 1 (perspective) or at d = 0
     glm::vec3 depthAxis{0.0f}; // orthographic: from d = 0 to d = 1
-    glm::vec3 depthMap{0.0f};  // perspective: (1 / view depth at d = 0, at d = 1, 1); orthographic: 0
+    glm::vec3 depthMap{0.0f};  // host_depth.glsl's uHostDepthMap (hostDepthMap(camera))
 };
 HostUnprojection hostUnprojection(const Camera& camera);
 

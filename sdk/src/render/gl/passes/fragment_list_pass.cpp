@@ -16,6 +16,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "render/gl/context_check.hpp"
+#include "render/gl/host_depth.hpp"
 #include "render/gl/partial_texture.hpp"
 #include "render/gl/over_state.hpp"
 #include "render/gl/program_library.hpp"
@@ -268,7 +269,7 @@ Status FragmentListPass::upload(const Materials& materials) {
     return {};
 }
 
-Status FragmentListPass::collectSurfaces(const PassTarget& target, const std::function<void()>& drawSurfaces) {
+Status FragmentListPass::collectSurfaces(const PassTarget& target, const Camera& camera, const std::function<void()>& drawSurfaces) {
     Impl& r = *mImpl;
     if (target.width <= 0 || target.height <= 0) return makeError("fragment lists: the viewport must be positive");
     r.resize(target.width, target.height);
@@ -278,14 +279,15 @@ Status FragmentListPass::collectSurfaces(const PassTarget& target, const std::fu
     r.stats.splatsBehind = r.stats.splatsFront = r.stats.splatsSectioned = 0;
     const GLuint end = kEnd;
     glClearTexImage(r.heads, 0, GL_RED_INTEGER, GL_UNSIGNED_INT, &end);
-    const GLint header[kCounterWords] = {0, 0, target.x, target.y, target.width, target.height, 0, 0, 0, 0, 0, 0};
+    // Word 10: splatfx_depthReversed (transparent_lists.glsl: the nodes' depth key).
+    const GLint header[kCounterWords] = {0, 0, target.x, target.y, target.width, target.height, 0, 0, 0, 0, camera.depth.reversed ? 1 : 0, 0};
     glNamedBufferSubData(r.counters, 0, sizeof(header), header);
     glBindBufferRange(GL_SHADER_STORAGE_BUFFER, kTransparentNodeBinding, r.pool, 0, GLsizeiptr(r.poolNodes * kTransparentNodeBytes));
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kTransparentCounterBinding, r.counters);
     glBindImageTexture(kTransparentHeadImageUnit, r.heads, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     if (drawSurfaces) {
-        setOverState(target.framebuffer, target, DepthTest::LessEqual);
+        setOverState(target.framebuffer, target, nearerOrEqual(camera));
         drawSurfaces();
     }
     // The survey of the lists (kTileRangeCompute).
@@ -315,13 +317,13 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
     glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
     r.tileBits.resize(std::size_t(tilesX) * std::size_t(tilesY) * 4);
     glGetTextureImage(r.tileRange, 0, GL_RGBA_INTEGER, GL_UNSIGNED_INT, GLsizei(r.tileBits.size() * sizeof(GLuint)), r.tileBits.data());
-    // Window depth to view depth, as the shaders do (monotonic: the range maps to the range).
-    const glm::mat4 invProj = glm::inverse(camera.proj);
+    // A list key (window depth, or 1 - it reversed) to view depth, as the
+    // shaders do (monotonic: the range maps to the range).
+    const DepthUnprojection unproject = depthUnprojection(camera);
     auto viewDepth = [&](GLuint bits) {
-        float d;
-        std::memcpy(&d, &bits, 4);
-        const float nz = d * 2.0f - 1.0f;
-        return std::abs((invProj[2][2] * nz + invProj[3][2]) / (invProj[2][3] * nz + invProj[3][3]));
+        float key;
+        std::memcpy(&key, &bits, 4);
+        return float(unproject.viewDepth(camera.depth.reversed ? 1.0 - double(key) : double(key)));
     };
     std::vector<float>& range = r.tileView;
     const std::size_t tiles = std::size_t(tilesX) * std::size_t(tilesY);
@@ -400,6 +402,7 @@ FragmentListPass::Split FragmentListPass::split(const std::vector<Splat>& splats
         glUniform2i(r.hostTileProgram->uniform(glsl::lists::Size), target.width, target.height);
         glUniform2i(r.hostTileProgram->uniform(glsl::lists::Tiles), tilesX, tilesY);
         glUniform2i(r.hostTileProgram->uniform(glsl::lists::Origin), target.x, target.y);
+        glUniform1i(r.hostTileProgram->uniform(glsl::lists::Reversed), camera.depth.reversed ? 1 : 0);
         glBindTextureUnit(3, target.depthTexture);
         glBindImageTexture(5, r.hostTiles, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
         glDispatchCompute(GLuint((tilesX + 7) / 8), GLuint(tilesY), 1);
@@ -481,7 +484,7 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t b
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     const GLfloat clear[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     for (int k = 0; k < prog->sections; ++k) glClearNamedFramebufferfv(r.sectionFbo, GL_COLOR, k, clear);
-    setOverState(r.sectionFbo, target, DepthTest::LessEqual);
+    setOverState(r.sectionFbo, target, nearerOrEqual(camera));
     glDisable(GL_CULL_FACE);
     // Perspective with the cut: a polygon that crosses (or nearly) the eye
     // plane takes the general variant (screen-covering, each fragment meets
@@ -497,7 +500,9 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t b
     };
     const bool general = partial && camera.perspective();
     const glm::mat4 vp = camera.proj * camera.view;
-    const glm::mat4 invProj = glm::inverse(camera.proj), invVp = glm::inverse(vp);
+    const glm::mat4 invVp = glm::inverse(vp);
+    const glm::vec3 depthMap = hostDepthMap(camera);
+    const glm::vec2 ndcZ = generalNdcZ(camera);
     const std::size_t variant = std::size_t(prog - &r.sectionPrograms[partial][0]);
     const Impl::SectionProgram* generalProg = &r.sectionPrograms[2][variant];
     auto setUniforms = [&](const Impl::SectionProgram& p) {
@@ -506,13 +511,15 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t b
         glUniform1i(p.program->uniform(glsl::section::Octagon), trimCorners ? 1 : 0);
         glUniform1f(p.program->uniform(glsl::section::Cut), extent);
         glUniform2i(p.program->uniform(glsl::section::Origin), target.x, target.y);
+        glUniform1i(p.program->uniform(glsl::section::Reversed), camera.depth.reversed ? 1 : 0);
         if (!partial) return;
         glUniform3f(p.program->uniform(glsl::section::Eye), eye.x, eye.y, eye.z);
         glUniform3f(p.program->uniform(glsl::section::Forward), fwd.x, fwd.y, fwd.z);
         glUniform1f(p.program->uniform(glsl::section::NearZ), nearZ);
         glUniform1i(p.program->uniform(glsl::section::Persp), camera.perspective() ? 1 : 0);
         glUniform1f(p.program->uniform(glsl::section::KernelRadius), r.kernelRadius);
-        glUniform4f(p.program->uniform(glsl::section::DepthToView), invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+        glUniform3fv(p.program->uniform(glsl::section::HostDepthMap), 1, glm::value_ptr(depthMap));
+        glUniform2fv(p.program->uniform(glsl::section::NdcZ), 1, glm::value_ptr(ndcZ));
         glUniformMatrix4fv(p.program->uniform(glsl::section::InvViewProj), 1, GL_FALSE, glm::value_ptr(invVp));
         glUniform4f(p.program->uniform(glsl::section::Viewport), float(target.x), float(target.y), float(target.width), float(target.height));
     };
@@ -649,7 +656,7 @@ void FragmentListPass::execute(const PlanStep& step, StepContext& context) {
     switch (step.kind) {
     case StepKind::ListsCollect: {
         if (d.restoreState) mSaved.save({.texture2DUnits = 0, .scissor = false});
-        const Status s = collectSurfaces(target, context.host.drawTransparent);
+        const Status s = collectSurfaces(target, context.frame.camera(), context.host.drawTransparent);
         context.listsReady = bool(s);
         if (!s) context.listsNote = s.error();
         if (!s && d.restoreState) mSaved.restore();

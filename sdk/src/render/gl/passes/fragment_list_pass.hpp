@@ -93,7 +93,8 @@ public:
     // transparentGlsl() expects them; then runs drawSurfaces with the
     // target's framebuffer bound, premultiplied "over" blending, depth test
     // LEQUAL without writes.
-    Status collectSurfaces(const PassTarget& target, const std::function<void()>& drawSurfaces);
+    // `camera`: its depth convention (the lists' key and the hook's depth test).
+    Status collectSurfaces(const PassTarget& target, const Camera& camera, const std::function<void()>& drawSurfaces);
     // After collectSurfaces: the sorted splats (back to front) as three runs.
     // [0, behindEnd) lie behind every surface stored on every pixel they may
     // cover, [frontBegin, size) in front of every one, the rest between.

@@ -49,7 +49,7 @@ void SplatPass::execute(const PlanStep& step, StepContext& context) {
     }
     case StepKind::ReducedSplats: mReduced->drawResolved(all, camera, context.plan.target); break;
     case StepKind::ReducedBegin:
-        context.reduced = mReduced->beginResolved(context.plan.target, {0, 0, context.plan.target.width, context.plan.target.height});
+        context.reduced = mReduced->beginResolved(context.plan.target, {0, 0, context.plan.target.width, context.plan.target.height}, context.frame.camera().depth);
         return;
     case StepKind::ReducedComposite: mReduced->composite(camera); return;
     default: assert(false && "SplatPass: not a splat step"); return;

@@ -14,6 +14,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "render/gl/context_check.hpp"
+#include "render/gl/host_depth.hpp"
 #include "render/gl/fog_state.hpp"
 #include "render/gl/saved_state.hpp"
 #include "render/gl/over_state.hpp"
@@ -266,7 +267,7 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
 
     // With the host depth the shader cuts each segment there; without it
     // whole fragments behind the host are dropped.
-    setOverState(target.framebuffer, target, hostDepth ? DepthTest::Off : DepthTest::LessEqual);
+    setOverState(target.framebuffer, target, hostDepth ? DepthTest::Off : nearerOrEqual(camera));
     glEnable(GL_DEPTH_CLAMP); // the CPU clipped at the near plane; GL must not clip again by rounding
     glEnable(GL_CULL_FACE);
     glCullFace(GL_BACK);
@@ -291,8 +292,8 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     glUniform1i(p.uniform(glsl::tetra::First), GLint(r.recordBase[volume] + a));
     const glm::vec3 f = camera.forward();
     glUniform3f(p.uniform(glsl::tetra::Forward), f.x, f.y, f.z);
-    const glm::mat4 invProj = glm::inverse(camera.proj);
-    glUniform4f(p.uniform(glsl::tetra::DepthToView), invProj[2][2], invProj[3][2], invProj[2][3], invProj[3][3]);
+    const glm::vec3 depthMap = hostDepthMap(camera);
+    glUniform3fv(p.uniform(glsl::tetra::HostDepthMap), 1, glm::value_ptr(depthMap));
     const glm::vec3 n(table.dims());
     glUniform3f(p.uniform(glsl::tetra::TexScale), (n.x - 1.0f) / n.x, (n.y - 1.0f) / n.y, (n.z - 1.0f) / n.z);
     glUniform3f(p.uniform(glsl::tetra::TexOffset), 0.5f / n.x, 0.5f / n.y, 0.5f / n.z);
