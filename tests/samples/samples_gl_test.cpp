@@ -184,12 +184,13 @@ TEST_F(SamplesGL, ALightingFailureIsThePlayersProblemNotASilentlyUnlitFrame) {
       "effects": [{"kind": "fire", "name": "lit", "dims": [7, 12, 5], "spacing": 0.3, "lighting": {"tableDims": 16}}]})";
     auto player = scenehost::ScenePlayer::fromText(text, "lit-test.json");
     ASSERT_TRUE(player.ok()) << player.error();
-    player->advance(1.0, player->cameraAt(1.0, {64, 48}));
+    ASSERT_TRUE(player->advance(1.0, player->cameraAt(1.0, {64, 48})));
     EXPECT_EQ(player->problem(), "") << "a lit effect within its budgets";
     splatfx::EffectLighting l = player->file().scene.options(player->file().effects[0].id).lighting;
     l.tableDims = glm::ivec3(256);
     player->file().scene.setLighting(player->file().effects[0].id, l);
-    player->advance(1.1, player->cameraAt(1.1, {64, 48}));
+    // The frame itself is prepared (advance succeeds); what it lacks is the player's problem.
+    ASSERT_TRUE(player->advance(1.1, player->cameraAt(1.1, {64, 48})));
     EXPECT_NE(player->problem().find("effect 'lit': lighting.tableDims: "), std::string::npos) << player->problem();
     EXPECT_NE(player->problem().find("over ShadowTableDesc.memoryBudgetBytes"), std::string::npos) << player->problem();
 }

@@ -473,8 +473,9 @@ TEST(VdbImport, EveryFourByteChangeEndsQuicklyWithBoundedMemory) {
     // default) and counts in the peak: 1700 loads there reach it whatever
     // the loader does, so the bound holds only for an uninstrumented build
     // (the single bombs above stay far below it either way).
-    if (!kAddressSanitizer)
+    if (!kAddressSanitizer) {
         EXPECT_LT(peakBytes() - before, std::uint64_t(256) << 20) << "a corrupted file raised the peak memory";
+    }
     std::printf("%d changes refused, %d loaded (changed values)\n", refused, loaded);
 }
 
