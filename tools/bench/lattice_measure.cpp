@@ -6,6 +6,8 @@
 #include <complex>
 #include <cstdio>
 
+#include "splatfx/dynamics.hpp"
+
 namespace lattice {
 namespace {
 
@@ -53,14 +55,6 @@ glm::dvec2 binFrequency(int i, int j, glm::ivec2 n) {
     return {double(i <= n.x / 2 ? i : i - n.x) / n.x, double(j <= n.y / 2 ? j : j - n.y) / n.y};
 }
 
-std::uint32_t mix(std::uint32_t x) {
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
-}
 double unit(std::uint32_t h) { return double(h >> 8) / 16777216.0; }
 
 } // namespace
@@ -246,9 +240,9 @@ Turbulence::Turbulence(glm::ivec2 size, float beta, std::uint32_t seed) : mSize(
             const double k = glm::length(binFrequency(i, j, mFft));
             // Power ~ k^-beta; nothing below a 256-pixel period (the flame's shape, not its texture).
             mAmplitude[b] = k > 1.0 / 256.0 ? float(std::pow(k, -0.5 * beta)) : 0.0f;
-            const std::uint32_t h = mix(seed * 0x9e3779b9u ^ mix(std::uint32_t(b) + 1u));
+            const std::uint32_t h = splatfx::hash32(seed * 0x9e3779b9u ^ splatfx::hash32(std::uint32_t(b) + 1u));
             mPhase[b] = float(2.0 * kPi * unit(h));
-            mSpeed[b] = float(6.0 * (unit(mix(h)) - 0.5)); // rad / s: the field churns, it does not translate
+            mSpeed[b] = float(6.0 * (unit(splatfx::hash32(h)) - 0.5)); // rad / s: the field churns, it does not translate
         }
 }
 
