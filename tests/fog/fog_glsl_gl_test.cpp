@@ -155,6 +155,27 @@ double errorBound(const Fog& fog, const Seg& s, glm::dvec3 ref, double tSec, con
         case FogTermKind::Point:
         case FogTermKind::Line:
         case FogTermKind::Sphere: {
+            if (t.form == FogPotentialForm::Segment) {
+                // V = w / (c + d r^2) in float. The nearest point moves with the float
+                // positions (delta each, relative to the reference) and with L (eps L along
+                // the ray at a clamped end); |d r^2 / dx| <= 2 r, so r^2 is off by
+                // 4 r (delta + eps L) + delta^2 + 8 eps r^2 (its own rounding), and V by
+                // w d / (c + d r^2)^2 times that, plus 8 eps V for the division.
+                const glm::dvec3 q = t.centre + t.windFactor * D - ref;
+                const double delta = 4.0 * kEps * (glm::length(q) + glm::length(oR) + glm::length(pR) + 1.0);
+                FogDesc one;
+                one.terms.push_back(t);
+                one.terms.back().weight = 1.0;
+                one.terms.back().weightOverTime = {};
+                one.wind = fog.desc().wind;
+                auto single = Fog::create(one);
+                const double V = single ? single->opticalDepth(s.o, s.p, tSec) : 0.0; // 1 / (c + d r^2)
+                const double r2 = std::max(0.0, (1.0 / std::max(V, 1e-300) - t.c) / std::max(t.d, 1e-300));
+                const double r = std::sqrt(r2 + t.radius * t.radius);
+                const double r2Err = 4.0 * r * (delta + kEps * L) + delta * delta + 8.0 * kEps * (r2 + t.radius * t.radius);
+                bound += w * (t.d * V * V * r2Err + 8.0 * kEps * V);
+                break;
+            }
             FogDesc one;
             one.terms.push_back(t);
             one.terms.back().weight = 1.0;
@@ -251,6 +272,24 @@ TEST_F(FogGlslGL, EveryTermKindWithWind) {
     d.farDistanceWorld = 5e4;
     check(d, {0.0, 1.7, 0.0}, 0.0, "all kinds t=0");
     check(d, {0.0, 1.7, 0.0}, 37.5, "all kinds t=37.5 (wind)");
+}
+
+// Biri et al.'s eq. 9 as printed (FogPotentialForm::Segment) for each kind, beside a
+// density term of every potential kind, near the eye and far from the origin.
+TEST_F(FogGlslGL, PaperEquation9SegmentFormForEveryPotentialKind) {
+    FogDesc d;
+    d.terms.push_back(FogTerm::constant(0.01));
+    d.terms.push_back(FogTerm::point(0.8, {2, 1.5, 30}, 0.5, 0.02));
+    d.terms.push_back(FogTerm::line(0.6, {-5, 0, 12}, {0.2, 1, 0}, 1.0, 0.1));
+    d.terms.push_back(FogTerm::sphere(0.7, {6, 2, -40}, 8.0, 0.4, 0.01));
+    d.terms.push_back(FogTerm::point(0.3, {0, 1.7, 0}, 1.0, 1.0)); // at the eye: r = 0 on every ray
+    for (std::size_t i = 1; i < d.terms.size(); ++i) d.terms[i].form = FogPotentialForm::Segment;
+    d.terms.push_back(FogTerm::sphere(0.05, {-3, 1, 20}, 3.0, 0.5, 2.0)); // a density term beside them
+    d.wind = FogWind::constant({0.4, 0, -0.1});
+    check(d, {0.0, 1.7, 0.0}, 0.0, "eq. 9 segment form");
+    check(d, {0.0, 1.7, 0.0}, 25.0, "eq. 9 segment form, wind");
+    for (FogTerm& t : d.terms) t.centre += glm::dvec3(3e5, 0, -2e5);
+    check(d, {3e5, 1.7, -2e5}, 0.0, "eq. 9 segment form at 3e5");
 }
 
 TEST_F(FogGlslGL, ZeroTermsCompiles) { check(FogDesc{}, {1, 2, 3}, 0.0, "no terms"); }

@@ -54,6 +54,20 @@ TEST(FogBlock, ScaleKeepsTheOpticalDepthOfAScaledPath) {
     EXPECT_NEAR(scaled->scene.fog()->opticalDepth(50.0 * o, 50.0 * p, 0.0), 2.0 * paper->scene.fog()->opticalDepth(o, p, 0.0), 1e-9);
 }
 
+// Biri et al.'s eq. 9 as printed: "form": "segment" on a potential; its
+// weight is a depth, so "scale" leaves it alone ("density" still multiplies it).
+TEST(FogBlock, ThePapersSegmentFormIsReadAndScaledAsADepth) {
+    auto r = parseFog(R"({"scale": 10, "density": 2, "terms": [{"kind": "point", "weight": 0.5, "centre": [0, 1, 0], "c": 1, "d": 4, "form": "segment"}]})");
+    ASSERT_TRUE(r) << r.error();
+    const splatfx::FogTerm& t = r->scene.fog()->desc().terms.at(0);
+    EXPECT_EQ(t.form, splatfx::FogPotentialForm::Segment);
+    // The same path in the file's own units (scaled by 10): r = 1 there, 10 in the world.
+    EXPECT_NEAR(r->scene.fog()->opticalDepth({-30, 0, 0}, {30, 0, 0}, 0.0), 2.0 * 0.5 / (1.0 + 4.0 * 1.0), 1e-12);
+    EXPECT_NE(errorOf(R"({"terms": [{"kind": "point", "form": "sideways"}]})").find("fog.terms[0].form"), std::string::npos);
+    EXPECT_NE(errorOf(R"({"terms": [{"kind": "constant", "weight": 1}, {"kind": "point", "weight": -0.1, "form": "segment"}]})").find("terms[1].weight"),
+              std::string::npos);
+}
+
 TEST(FogBlock, ErrorsNameTheField) {
     EXPECT_NE(errorOf(R"({"terms": [{"kind": "fluffy"}]})").find("fog.terms[0].kind"), std::string::npos);
     EXPECT_NE(errorOf(R"({"terms": [{"weight": 1}]})").find("fog.terms[0].kind"), std::string::npos);

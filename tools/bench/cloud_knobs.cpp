@@ -37,6 +37,7 @@ struct Knobs {
     float minC = 4.0f;         // LodVolumeDesc::minAccuracyC default
     splatfx::DeltaMode delta = splatfx::DeltaMode::Max;
     int scale = 1; // FrameRendererDesc::resolutionScale, the tetrahedra reduced with it (reduceTetrahedra)
+    splatfx::CloudModel model = splatfx::CloudModel::DensityTableLightLength;
 };
 
 struct Row {
@@ -47,7 +48,7 @@ struct Row {
 struct View {
     const char* name;
     splatfx::Camera camera;
-    splatfx::Image exact; // the finest level, no table, RGBA premultiplied over black
+    splatfx::Image exact[2]; // per cloud model: the finest level, no table, RGBA premultiplied over black
 };
 
 // The ray through a pixel centre (x right, y top row first, as Framebuffer::read orders rows).
@@ -70,15 +71,26 @@ int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
     }
     auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y, .color = splatfx::gl::Precision::F32});
     if (!fb) return std::fprintf(stderr, "clouds knobs: %s\n", fb.error().c_str()), 1;
-    splatfx::CloudDesc cd;
-    cd.dims = dims;
-    auto field = splatfx::makeCloudVolume(cd);
-    auto tf = splatfx::makeCloudTransfer({});
-    if (!field || !tf) return std::fprintf(stderr, "clouds knobs: %s\n", field ? tf.error().c_str() : field.error().c_str()), 1;
+    // The two cloud models (Roettger & Ertl sec. 5.2, the default, and sec. 5.1 with eq. 9): the same cloud, its own field and transfer.
+    std::vector<splatfx::ScalarVolume> fields;
+    std::vector<splatfx::TransferFunction> transfers;
+    for (splatfx::CloudModel model : {splatfx::CloudModel::DensityTableLightLength, splatfx::CloudModel::LightTableDensityLength}) {
+        splatfx::CloudDesc cd;
+        cd.dims = dims;
+        cd.model = model;
+        auto field = splatfx::makeCloudVolume(cd);
+        auto tf = splatfx::makeCloudTransfer({}, model);
+        if (!field || !tf) return std::fprintf(stderr, "clouds knobs: %s\n", field ? tf.error().c_str() : field.error().c_str()), 1;
+        fields.push_back(std::move(*field));
+        transfers.push_back(std::move(*tf));
+    }
     splatfx::Materials materials{splatfx::Footprint{}};
 
     // A scene of the field with these knobs (the octree depends on C and Delta, the table on its size).
     auto makeScene = [&](const Knobs& k, splatfx::Scene& scene) -> bool {
+        const std::size_t m = k.model == splatfx::CloudModel::DensityTableLightLength ? 0 : 1;
+        const splatfx::ScalarVolume* field = &fields[m];
+        const splatfx::TransferFunction* tf = &transfers[m];
         auto vol = splatfx::LodVolume::create(*field, {.minAccuracyC = k.minC, .delta = k.delta});
         if (!vol) return std::fprintf(stderr, "clouds knobs: %s\n", vol.error().c_str()), false;
         const float longest = std::sqrt(3.0f) * float(1 << vol->rootLevel()) * vol->spacingWorld();
@@ -88,9 +100,9 @@ int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
         scene.add(std::move(*vol), *tf, std::move(*table), {.name = "clouds", .refine = {.detailC = k.detailC}});
         return true;
     };
-    splatfx::Scene finest;
-    if (!makeScene({}, finest)) return 1;
-    const splatfx::LodVolume& ref = *finest.findLodVolume(0);
+    splatfx::Scene finest[2];
+    if (!makeScene({}, finest[0]) || !makeScene({.model = splatfx::CloudModel::LightTableDensityLength}, finest[1])) return 1;
+    const splatfx::LodVolume& ref = *finest[0].findLodVolume(0);
     const glm::vec3 ext = glm::vec3(ref.pointDims() - 1) * ref.spacingWorld();
 
     std::vector<View> views;
@@ -102,18 +114,20 @@ int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
                                              size, 0.1f, 5000.0f),
                      {}});
     const auto e0 = Clock::now();
-    for (View& v : views) {
-        v.exact = {size.x, size.y, 4, std::vector<float>(std::size_t(size.x) * std::size_t(size.y) * 4, 0.0f)};
-        const glm::dvec3 eye(v.camera.eye()), fwd(v.camera.forward());
-        for (int y = 0; y < size.y; ++y)
-            for (int x = 0; x < size.x; ++x) {
-                const glm::dvec3 d = pixelRay(v.camera, x, y);
-                // GL starts every ray at the near plane (volumetric clipping, sec. 4.3).
-                const double tNear = double(v.camera.nearPlane()) / std::max(glm::dot(d, fwd), 1e-9);
-                const glm::dvec4 c = ref.integrateRay(*tf, eye, d, tNear, 1e30);
-                for (int k = 0; k < 4; ++k) v.exact.at(x, y, k) = float(c[k]);
-            }
-    }
+    for (View& v : views)
+        for (std::size_t m = 0; m < 2; ++m) {
+            const splatfx::LodVolume& vol = *finest[m].findLodVolume(0);
+            v.exact[m] = {size.x, size.y, 4, std::vector<float>(std::size_t(size.x) * std::size_t(size.y) * 4, 0.0f)};
+            const glm::dvec3 eye(v.camera.eye()), fwd(v.camera.forward());
+            for (int y = 0; y < size.y; ++y)
+                for (int x = 0; x < size.x; ++x) {
+                    const glm::dvec3 d = pixelRay(v.camera, x, y);
+                    // GL starts every ray at the near plane (volumetric clipping, sec. 4.3).
+                    const double tNear = double(v.camera.nearPlane()) / std::max(glm::dot(d, fwd), 1e-9);
+                    const glm::dvec4 c = vol.integrateRay(transfers[m], eye, d, tNear, 1e30);
+                    for (int k = 0; k < 4; ++k) v.exact[m].at(x, y, k) = float(c[k]);
+                }
+        }
     const double exactMs = std::chrono::duration<double, std::milli>(Clock::now() - e0).count();
 
     std::vector<Row> rows;
@@ -126,10 +140,12 @@ int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
     for (float C : {2.0f, 8.0f, 16.0f}) rows.push_back({"C", std::to_string(int(C)), {.minC = C}});
     rows.push_back({"delta", "average", {.delta = splatfx::DeltaMode::Average}});
     for (int scale : {2, 4}) rows.push_back({"resolution scale", std::to_string(scale), {.scale = scale}});
+    // Sec. 5.1 against its own finest level: what the paper's eq. 9 model costs and how well the table holds it.
+    rows.push_back({"model", "5.1 (eq. 9)", {.model = splatfx::CloudModel::LightTableDensityLength}});
 
     std::printf("LOD clouds knobs: field %dx%dx%d (full %llu tetrahedra), %dx%d RGBA32F, median of %d frames; defaults: "
-                "table 64x64x128, c = 10, C = 4, Delta max\n"
-                "error: GL vs the finest level integrated exactly (no table; %.0f ms for both views), per pixel the largest of "
+                "table 64x64x128, c = 10, C = 4, Delta max, model sec. 5.2\n"
+                "error: GL vs the finest level (of the row's model) integrated exactly (no table; %.0f ms for both views), per pixel the largest of "
                 "|dR|, |dG|, |dB|, |dA| (premultiplied)\n\n",
                 dims.x, dims.y, dims.z, static_cast<unsigned long long>(ref.fullResolutionTets()), size.x, size.y, reps, exactMs);
     std::printf("%-20s %-12s %-8s %10s %9s %9s %9s %9s\n", "knob", "value", "view", "tets", "ms/frame", "mean err", "p99 err", "max err");
@@ -154,7 +170,8 @@ int runCloudKnobs(glm::ivec3 dims, glm::ivec2 size, int reps) {
             for (int y = 0; y < size.y; ++y)
                 for (int x = 0; x < size.x; ++x) {
                     double e = 0.0;
-                    for (int k = 0; k < 4; ++k) e = std::max(e, std::abs(double(img.at(x, y, k)) - double(v.exact.at(x, y, k))));
+                    const splatfx::Image& exact = v.exact[r.k.model == splatfx::CloudModel::DensityTableLightLength ? 0 : 1];
+                    for (int k = 0; k < 4; ++k) e = std::max(e, std::abs(double(img.at(x, y, k)) - double(exact.at(x, y, k))));
                     err.push_back(e);
                     sum += e;
                 }

@@ -36,6 +36,21 @@ splatfx::FogDesc polynomialFog() {
     d.farDistanceWorld = 150.0;
     return d;
 }
+// Fig. 8's four point equipotentials, placed among the countryside's trees
+// (the sample's fog is centred near the origin), in the default form (a
+// density integrated along the ray) or in eq. 9's as printed (a depth from
+// the segment's distance; its weight a depth, chosen for a similar veil).
+splatfx::FogDesc equipotentialFog(splatfx::FogPotentialForm form) {
+    splatfx::FogDesc d = splatfx::paperFig8Fog();
+    for (splatfx::FogTerm& t : d.terms) {
+        if (t.kind != splatfx::FogTermKind::Point) continue;
+        t.centre = glm::dvec3(t.centre.x * 0.8, 1.0, t.centre.z * 0.8 - 20.0);
+        t.form = form;
+        if (form == splatfx::FogPotentialForm::Segment) t.weight = 1.5; // ~ 0.5 per unit through a tree's ~3-unit core
+    }
+    d.farDistanceWorld = 150.0;
+    return d;
+}
 splatfx::FogDesc constantFog() {
     splatfx::FogDesc d;
     d.terms.push_back(splatfx::FogTerm::constant(0.02));
@@ -54,7 +69,7 @@ int runFog(int argc, char** argv) {
     std::string scenePath = "samples/09-fog-countryside/scene.json";
     int frames = 30, rounds = 3;
     glm::ivec2 size{800, 600};
-    bool quick = false;
+    bool quick = false, forms = false;
     CLI::App app{"Frame time at 800x600 of the scene's geometry (its effects disabled) with no fog, per-pixel fog and the reduced fog\n"
                  "textures of Biri et al.'s Table 1, for three fogs; error of each against per-pixel.",
                  "splatfx-bench fog"};
@@ -62,6 +77,8 @@ int runFog(int argc, char** argv) {
     CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 3, 100000, "timed frames per mode");
     CLI::Option* roundsOption = cli::addNumber(app, "--rounds", rounds, 1, 1000, "rounds over the modes");
     app.add_flag("--quick", quick, "5 frames x 1 round (unless given)");
+    app.add_flag("--forms", forms,
+                 "instead of the paper's three fogs, Fig. 8's point equipotentials in the default density form and in eq. 9's segment form");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     if (quick && framesOption->count() == 0) frames = 5;
     if (quick && roundsOption->count() == 0) rounds = 1;
@@ -77,8 +94,15 @@ int runFog(int argc, char** argv) {
     }
     splatfx::SceneFile& file = player->file();
     for (const splatfx::SceneEffectInfo& e : file.effects) file.scene.setEnabled(e.id, false); // the paper's scene: terrain only
-    std::vector<FogCase> fogs{{"polynomial (Fig. 7)", polynomialFog()}, {"constant", constantFog()}};
-    if (const splatfx::Fog* own = file.scene.fog()) fogs.push_back({"cosines (Fig. 6)", own->desc()});
+    std::vector<FogCase> fogs;
+    if (forms) {
+        fogs.push_back({"points, density", equipotentialFog(splatfx::FogPotentialForm::Density)});
+        fogs.push_back({"points, eq. 9 segment", equipotentialFog(splatfx::FogPotentialForm::Segment)});
+    } else {
+        fogs.push_back({"polynomial (Fig. 7)", polynomialFog()});
+        fogs.push_back({"constant", constantFog()});
+        if (const splatfx::Fog* own = file.scene.fog()) fogs.push_back({"cosines (Fig. 6)", own->desc()});
+    }
     auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
     if (!fb) {
         std::fprintf(stderr, "fog: %s\n", fb.error().c_str());

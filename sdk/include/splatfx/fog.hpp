@@ -79,6 +79,21 @@ enum class FogTermKind {
     Sphere,        // weight / (c + d max(0, |x - centre|^2 - radius^2)): 1/c inside the ball (docs/fog.md)
 };
 
+// How a potential (Point, Line, Sphere) enters the optical depth.
+enum class FogPotentialForm {
+    // The default: 1 / (c + d r^2) is a density (per world unit), integrated
+    // along the ray in closed form. Physically consistent: a path split in two
+    // has the depth of the whole, so splats and the host fogged at different
+    // depths along one ray agree.
+    Density,
+    // Biri et al. eq. 9 as printed: the term adds weight / (c + d r^2) to the
+    // optical depth, r the distance between the segment OP and the object (a
+    // depth, not a density: weight is dimensionless). It grows as the segment
+    // reaches nearer the object and never with length, so it is not additive
+    // over split paths. Needs weight >= 0 (docs/fog.md, "The paper's eq. 9").
+    Segment,
+};
+
 enum class FogCellMode {
     Periodic,    // the reference cell repeats over all space (Biri et al. Fig. 3)
     ZeroOutside, // the polynomial is zero outside its cell (on the axes it depends on)
@@ -123,6 +138,7 @@ struct FogTerm {
     double radius = 0.0;            // Sphere radius, world units; default 0
     double c = 1.0;                 // > 0 (finite density at r = 0); default 1
     double d = 1.0;                 // >= 0, per world unit^2; default 1
+    FogPotentialForm form = FogPotentialForm::Density; // default Density (Segment: the paper's eq. 9 as printed)
     FogCurve cOverTime;             // replaces c when not empty (every key > 0); default empty
     FogCurve dOverTime;             // replaces d when not empty (every key >= 0); default empty
 

@@ -54,6 +54,8 @@ double Fog::termDepthBound(std::size_t term, double tSec, glm::dvec3 lo, glm::dv
             rho = distanceToBox(q, lo, hi);
         }
         const double r2 = t.kind == FogTermKind::Sphere ? std::max(0.0, rho * rho - t.radius * t.radius) : rho * rho;
+        // The paper's segment form adds at most its value at the box's nearest distance, whatever the length.
+        if (t.form == FogPotentialForm::Segment) return w / (c + d * r2);
         // The density never exceeds its value at the nearest distance: times the longest segment.
         double bound = L * w / (c + d * r2);
         if (d > 0.0) {

@@ -113,6 +113,17 @@ Status checkTerm(FogTerm& t, const std::string& n) {
             if (t.cOverTime.keys[i].y <= 0.0) return makeError(n + ".cOverTime.keys[" + std::to_string(i) + "] value must be > 0");
         for (size_t i = 0; i < t.dOverTime.keys.size(); ++i)
             if (t.dOverTime.keys[i].y < 0.0) return makeError(n + ".dOverTime.keys[" + std::to_string(i) + "] value must be >= 0");
+        if (t.form != FogPotentialForm::Density && t.form != FogPotentialForm::Segment) return makeError(n + ".form is not a FogPotentialForm");
+        if (t.form == FogPotentialForm::Segment) {
+            // The segment form adds a depth that only grows as the path reaches nearer the
+            // object; a negative weight would make the transmittance rise along the ray.
+            if (t.weight < 0.0)
+                return makeError(n + ".weight must be >= 0 with form Segment (Biri et al. eq. 9 adds a depth, not a density; got " +
+                                 fmt(t.weight) + ")");
+            for (size_t i = 0; i < t.weightOverTime.keys.size(); ++i)
+                if (t.weightOverTime.keys[i].y < 0.0)
+                    return makeError(n + ".weightOverTime.keys[" + std::to_string(i) + "] value must be >= 0 with form Segment");
+        }
         break;
     }
     return {};
@@ -212,7 +223,8 @@ Status checkNonNegative(const FogDesc& d) {
             case FogTermKind::Line:
             case FogTermKind::Sphere:
                 const double c = term.cOverTime.at(t, term.c), dd = term.dOverTime.at(t, term.d);
-                low = dd == 0.0 ? w / c : std::min(0.0, w / c);
+                // A segment-form term is no density (and is >= 0): it holds nothing up.
+                low = term.form == FogPotentialForm::Segment ? 0.0 : dd == 0.0 ? w / c : std::min(0.0, w / c);
                 where = "at its centre " + fmt(term.centre) + ", value " + fmt(w / c);
                 break;
             }

@@ -35,7 +35,14 @@ struct Potential {
     glm::dvec3 axis{0.0, 1.0, 0.0};
     double radius2 = 0.0;
     double c = 1.0, d = 1.0, weight = 0.0;
+    bool segment = false; // FogPotentialForm::Segment: weight / (c + d r^2) of the segment, not a density
 };
+
+// Squared distance r^2 of FogTermKind's measure between the segment
+// oRel + s e, s in [0, L] (e unit) and the potential's object: the nearest
+// point for a point, the nearest approach for a line, the power of the
+// nearest point with respect to a sphere (0 inside).
+double segmentDistance2(const Potential& p, glm::dvec3 oRel, glm::dvec3 e, double L);
 
 struct Frozen {
     double constant = 0.0;

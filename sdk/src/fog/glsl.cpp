@@ -189,9 +189,10 @@ std::vector<glm::vec4> Fog::glslParameters(double tSec, glm::dvec3 reference) co
     for (const auto& p : fr.pots) {
         out.push_back({glm::vec3(p.qRel), float(p.c)});
         out.push_back({glm::vec3(p.axis), float(p.d)});
-        // z: the kind the shader's loop branches on (0 point, 1 line, 2 sphere).
+        // z: the kind the shader's loop branches on (0 point, 1 line, 2 sphere);
+        // w: 1 for FogPotentialForm::Segment (a parameter, so the source does not change with it).
         const float kind = p.kind == FogTermKind::Line ? 1.0f : p.kind == FogTermKind::Sphere ? 2.0f : 0.0f;
-        out.push_back({float(p.weight), float(p.radius2), kind, 0.0f});
+        out.push_back({float(p.weight), float(p.radius2), kind, p.segment ? 1.0f : 0.0f});
     }
     return out;
 }
@@ -320,7 +321,10 @@ Result<FogGlsl> fogGlsl(const Fog& fog, const FogGlslOptions& opt) {
              " + 3 * j;\n        vec4 q = " + P + "_params[b], ax = " + P + "_params[b + 1], wr = " + P +
              "_params[b + 2];\n"
              "        vec3 v = oRel - q.xyz;\n"
-             "        if (wr.z == 1.0) total += wr.x * " +
+             "        if (wr.w == 1.0) total += wr.x / (q.w + ax.w * " +
+             P +
+             "_segment_r2(v, e, L, ax.xyz, wr.z, wr.y));\n"
+             "        else if (wr.z == 1.0) total += wr.x * " +
              P +
              "_inv_quadratic(v - dot(v, ax.xyz) * ax.xyz, e - dot(e, ax.xyz) * ax.xyz, L, q.w, ax.w);\n        else if (wr.z == 2.0) total += wr.x "
              "* " +

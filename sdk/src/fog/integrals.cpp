@@ -217,6 +217,7 @@ double integratePoly(const Poly& p, glm::dvec3 oRel, glm::dvec3 pRel, double L) 
 }
 
 double evalPotential(const Potential& p, glm::dvec3 x) {
+    if (p.segment) return 0.0; // a depth of the whole segment, not a density (integrate adds it)
     const glm::dvec3 v = x - p.qRel;
     double r2 = glm::dot(v, v);
     if (p.kind == FogTermKind::Line) {
@@ -230,6 +231,20 @@ double evalPotential(const Potential& p, glm::dvec3 x) {
 }
 
 } // namespace
+
+double segmentDistance2(const Potential& p, glm::dvec3 oRel, glm::dvec3 e, double L) {
+    glm::dvec3 v = oRel - p.qRel, dir = e;
+    if (p.kind == FogTermKind::Line) {
+        v -= glm::dot(v, p.axis) * p.axis;
+        dir -= glm::dot(dir, p.axis) * p.axis;
+    }
+    // |v + s dir|^2 is convex in s: its minimum over [0, L] is the clamped vertex.
+    const double m2 = glm::dot(dir, dir);
+    const double s = m2 > 0.0 ? std::clamp(-glm::dot(v, dir) / m2, 0.0, L) : 0.0;
+    const glm::dvec3 h = v + s * dir;
+    const double r2 = glm::dot(h, h);
+    return p.kind == FogTermKind::Sphere ? std::max(0.0, r2 - p.radius2) : r2;
+}
 
 double evalPoly(const Poly& p, glm::dvec3 u) {
     double pw[3][kFogMaxDegree + 1];
@@ -303,7 +318,7 @@ Frozen freeze(const FogDesc& desc, double tSec, glm::dvec3 ref) {
         case FogTermKind::Line:
         case FogTermKind::Sphere:
             fr.pots.push_back({term.kind, term.centre + Dt - ref, term.axis, term.radius * term.radius, term.cOverTime.at(tSec, term.c),
-                               term.dOverTime.at(tSec, term.d), w});
+                               term.dOverTime.at(tSec, term.d), w, term.form == FogPotentialForm::Segment});
             break;
         }
     }
@@ -341,6 +356,10 @@ double integrate(const Frozen& f, glm::dvec3 oRel, glm::dvec3 pRel) {
     }
     for (const Poly& p : f.polys) total += integratePoly(p, oRel, pRel, L);
     for (const Potential& p : f.pots) {
+        if (p.segment) {
+            total += p.weight / (p.c + p.d * segmentDistance2(p, oRel, e, L));
+            continue;
+        }
         const glm::dvec3 v = oRel - p.qRel;
         double I = 0.0;
         if (p.kind == FogTermKind::Point) I = inverseQuadratic(v, e, L, p.c, p.d);

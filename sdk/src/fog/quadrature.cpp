@@ -124,6 +124,32 @@ FogQuadrature integrateFogNumerically(const Fog& fog, glm::dvec3 o, glm::dvec3 p
         stack.push_back({s.a, c, s.depth + 1});
         stack.push_back({c, s.b, s.depth + 1});
     }
+    // Biri et al.'s eq. 9 as printed (FogPotentialForm::Segment) is no density: its
+    // depth is weight / (c + d r^2) with r the distance from the segment to the object,
+    // found here by search (the squared distance along the segment is convex: a sampled
+    // bracket, then golden sections), not by segmentDistance2's closed vertex.
+    for (const auto& pot : fr.pots) {
+        if (!pot.segment) continue;
+        auto r2At = [&](double s) {
+            glm::dvec3 v = s * e - pot.qRel;
+            if (pot.kind == FogTermKind::Line) v -= glm::dot(v, pot.axis) * pot.axis;
+            const double r2 = glm::dot(v, v);
+            return pot.kind == FogTermKind::Sphere ? std::max(0.0, r2 - pot.radius2) : r2;
+        };
+        constexpr int kSamples = 64;
+        int best = 0;
+        for (int i = 1; i <= kSamples; ++i)
+            if (r2At(L * i / kSamples) < r2At(L * best / kSamples)) best = i;
+        double a = L * std::max(best - 1, 0) / kSamples, b = L * std::min(best + 1, kSamples) / kSamples;
+        const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+        for (int it = 0; it < 200 && b - a > 1e-15 * L; ++it) {
+            const double x1 = b - g * (b - a), x2 = a + g * (b - a);
+            if (r2At(x1) <= r2At(x2)) b = x2;
+            else a = x1;
+        }
+        const double r2 = std::min({r2At(0.5 * (a + b)), r2At(0.0), r2At(L)});
+        q.value += pot.weight / (pot.c + pot.d * r2);
+    }
     return q;
 }
 

@@ -114,6 +114,9 @@ void readTerm(Context& c, ObjectReader& o, FogTerm& t) {
         if (t.kind == FogTermKind::Sphere) o.number("radius", t.radius, 0.0, kMaxCoord);
         o.number("c", t.c, 1e-12, 1e12);
         o.number("d", t.d, 0.0, 1e12);
+        if (const Json* f = o.get("form"))
+            if (auto s = readChoice(c.d, o.at("form"), *f, {"density", "segment"}))
+                t.form = *s == "segment" ? FogPotentialForm::Segment : FogPotentialForm::Density;
     }
 }
 
@@ -122,7 +125,8 @@ void readTerm(Context& c, ObjectReader& o, FogTerm& t) {
 // optical depth of a scaled path is unchanged; `density` multiplies every weight.
 void scaleFog(FogDesc& f, double s, double density) {
     for (FogTerm& t : f.terms) {
-        t.weight *= density / s;
+        // A density is per unit length; the paper's segment form is a depth already.
+        t.weight *= t.form == FogPotentialForm::Segment ? density : density / s;
         t.wave /= s, t.wave2 /= s;
         t.cellCentre *= s, t.cellHalfSize *= s;
         t.centre *= s, t.radius *= s;

@@ -51,6 +51,20 @@ float splatfx_fog_sphere(vec3 v, vec3 e, float L, float c, float d, float R2) {
     if (afterStart < L) total += splatfx_fog_inv_shifted(afterStart - s0, L - s0, kappa, d);
     return total;
 }
+// integrals.cpp: segmentDistance2 (Biri et al. eq. 9 as printed: r between
+// the segment and the object). kind: 0 point, 1 line (axis), 2 sphere (R2).
+float splatfx_fog_segment_r2(vec3 v, vec3 e, float L, vec3 axis, float kind, float R2) {
+    vec3 dir = e;
+    if (kind == 1.0) {
+        v -= dot(v, axis) * axis;
+        dir -= dot(dir, axis) * axis;
+    }
+    float m2 = dot(dir, dir);
+    float s = m2 > 0.0 ? clamp(-dot(v, dir) / m2, 0.0, L) : 0.0;
+    vec3 h = v + s * dir;
+    float r2 = dot(h, h);
+    return kind == 2.0 ? max(0.0, r2 - R2) : r2;
+}
 // The sum of the fog's terms along [oRel, pRel] (generated: it follows this text).
 float splatfx_fog_optical_depth(vec3 oRel, vec3 pRel);
 float splatfx_fog_transmittance(vec3 oRel, vec3 pRel) {
