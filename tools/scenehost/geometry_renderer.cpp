@@ -10,6 +10,8 @@
 #include "splatfx/transparency.hpp"
 #include <glm/gtc/type_ptr.hpp>
 
+#include "splatfx/fog.hpp"
+#include "splatfx/gl/fog_uniforms.hpp"
 #include "splatfx/gl/program.hpp"
 #include "splatfx/lighting.hpp"
 
@@ -65,6 +67,45 @@ void main() {
 }
 )";
 
+// Biri et al.'s buffer method (sec. 4.3): the fog include (fogGlsl) in the
+// vertex stage, one transmittance per vertex, interpolated across the
+// triangle; the fragment mixes with the fog colour as the per-pixel pass does.
+const char* kVertexFogBody = R"(
+layout(location = 0) in vec3 aPosition;
+layout(location = 1) in vec3 aNormal;
+uniform mat4 uModel;
+uniform mat4 uViewProj;
+uniform vec3 uEye;
+out vec3 vNormal;
+out vec3 vWorld;
+out float vFog;
+void main() {
+    vec4 world = uModel * vec4(aPosition, 1.0);
+    vWorld = world.xyz;
+    vNormal = transpose(inverse(mat3(uModel))) * aNormal;
+    vFog = splatfx_fog_transmittance(vec3(0.0), world.xyz - uEye);
+    gl_Position = uViewProj * world;
+}
+)";
+const char* kFragmentFogBody = R"(
+in vec3 vNormal;
+in vec3 vWorld;
+in float vFog;
+uniform vec3 uColor;
+uniform vec3 uEye;
+uniform vec4 uLight;
+uniform vec3 uLightColor;
+uniform vec3 splatfx_fog_colour;
+out vec4 fragColor;
+void main() {
+    vec3 n = twoSidedNormal(vNormal, vWorld, uEye);
+    vec3 toLight = normalize(uLight.w == 0.0 ? uLight.xyz : uLight.xyz - vWorld);
+    float diffuse = max(dot(n, toLight), 0.0) * splatfx_shadow(vWorld);
+    vec3 lit = uColor * (0.25 + 0.75 * diffuse * uLightColor);
+    fragColor = vec4(mix(splatfx_fog_colour, lit, vFog), 1.0);
+}
+)";
+
 // (issue 15) Transparent objects (GeometryDesc::opacity < 1): the same
 // shading, premultiplied, emitted into the frame's fragment lists through the
 // SDK's include (transparentGlsl(); docs/integration.md, "Transparent surfaces").
@@ -97,6 +138,9 @@ struct GeometryRenderer::Impl {
     };
     GLuint program = 0;
     GLuint transparentProgram = 0;
+    GLuint vertexFogProgram = 0;       // for GeometryLighting::vertexFog, built for the fog's structure
+    std::uint64_t vertexFogKey = 0;    // Fog::glslKey of vertexFogProgram
+    std::string vertexFogError;        // why it could not be built (draw then fogs nothing: problem() says so)
     std::vector<Object> objects;
     GeometryStats stats;
     ~Impl() {
@@ -107,6 +151,7 @@ struct GeometryRenderer::Impl {
         }
         if (program) glDeleteProgram(program);
         if (transparentProgram) glDeleteProgram(transparentProgram);
+        if (vertexFogProgram) glDeleteProgram(vertexFogProgram);
     }
     // (Re)places an object's buffers: interleaved position + normal, triangle indices.
     // Fails when the GL cannot store the buffers (GL_OUT_OF_MEMORY): the
@@ -202,6 +247,7 @@ GeometryRenderer& GeometryRenderer::operator=(GeometryRenderer&&) noexcept = def
 GeometryRenderer::~GeometryRenderer() = default;
 
 const GeometryStats& GeometryRenderer::stats() const { return mImpl->stats; }
+const std::string& GeometryRenderer::vertexFogError() const { return mImpl->vertexFogError; }
 
 // [issue 17]
 long GeometryRenderer::find(const std::string& name) const {
@@ -268,15 +314,37 @@ void GeometryRenderer::draw(double t, const splatfx::Camera& camera, const Geome
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE);
-    glUseProgram(r.program);
+    GLuint program = r.program;
+    if (lighting.vertexFog) {
+        if (r.vertexFogKey != lighting.vertexFog->glslKey()) {
+            if (r.vertexFogProgram) glDeleteProgram(r.vertexFogProgram);
+            r.vertexFogProgram = 0;
+            r.vertexFogKey = lighting.vertexFog->glslKey();
+            r.vertexFogError.clear();
+            auto glsl = splatfx::fogGlsl(*lighting.vertexFog);
+            const std::string shadow = splatfx::shadowGlsl();
+            auto linked = glsl ? splatfx::gl::linkProgram({"#version 450 core\n", glsl->source.c_str(), kVertexFogBody},
+                                                          {"#version 450 core\n", shadow.c_str(), kHostNormal, kFragmentFogBody},
+                                                          "GeometryRenderer (fog per vertex)")
+                               : splatfx::Result<GLuint>(splatfx::makeError(glsl.error()));
+            if (linked) r.vertexFogProgram = *linked;
+            else r.vertexFogError = "geometry fog per vertex: " + linked.error();
+        }
+        if (r.vertexFogProgram) {
+            program = r.vertexFogProgram;
+            if (auto s = splatfx::gl::setFogUniforms(program, *lighting.vertexFog, t, glm::dvec3(camera.eye())); !s)
+                r.vertexFogError = "geometry fog per vertex: " + s.error();
+        }
+    }
+    glUseProgram(program);
     const glm::mat4 viewProj = camera.proj * camera.view;
     const glm::vec3 eye = camera.eye();
-    glUniformMatrix4fv(glGetUniformLocation(r.program, "uViewProj"), 1, GL_FALSE, glm::value_ptr(viewProj));
-    glUniform3fv(glGetUniformLocation(r.program, "uEye"), 1, glm::value_ptr(eye));
-    glUniform4fv(glGetUniformLocation(r.program, "uLight"), 1, glm::value_ptr(lighting.light));
-    glUniform3fv(glGetUniformLocation(r.program, "uLightColor"), 1, glm::value_ptr(lighting.lightColor));
-    splatfx::gl::setShadowUniforms(r.program, lighting.shadow);
-    const GLint model = glGetUniformLocation(r.program, "uModel"), color = glGetUniformLocation(r.program, "uColor");
+    glUniformMatrix4fv(glGetUniformLocation(program, "uViewProj"), 1, GL_FALSE, glm::value_ptr(viewProj));
+    glUniform3fv(glGetUniformLocation(program, "uEye"), 1, glm::value_ptr(eye));
+    glUniform4fv(glGetUniformLocation(program, "uLight"), 1, glm::value_ptr(lighting.light));
+    glUniform3fv(glGetUniformLocation(program, "uLightColor"), 1, glm::value_ptr(lighting.lightColor));
+    splatfx::gl::setShadowUniforms(program, lighting.shadow);
+    const GLint model = glGetUniformLocation(program, "uModel"), color = glGetUniformLocation(program, "uColor");
     for (const Impl::Object& o : r.objects) {
         if (!o.vao || o.desc.opacity < 1.0f) continue; // transparent ones: drawTransparent
         // Object to world: its motion (own or shared) after its static placement.

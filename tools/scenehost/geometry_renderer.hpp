@@ -40,6 +40,11 @@ struct GeometryLighting {
     glm::vec4 light{0.4f, 1.0f, 0.6f, 0.0f}; // direction towards the light (w = 0) or position (w = 1); default a sun
     glm::vec3 lightColor{1.0f};              // default white
     splatfx::gl::ShadowBinding shadow{};     // FrameRenderer::shadowBinding(); default none (unshadowed)
+    // Biri et al.'s buffer method (sec. 4.3): the opaque objects fog themselves,
+    // the transmittance evaluated per vertex (at draw()'s time) and interpolated,
+    // instead of the frame renderer's per-pixel pass (turn that off: fogHost).
+    // Default none.
+    const splatfx::Fog* vertexFog = nullptr;
 };
 
 class GeometryRenderer {
@@ -61,6 +66,9 @@ public:
     bool hasTransparent() const;
     void drawTransparent(double timeSec, const splatfx::Camera& camera, const GeometryLighting& lighting = {});
     const GeometryStats& stats() const;
+    // Why the last draw() with GeometryLighting::vertexFog could not fog (its
+    // program failed to build or take the fog's uniforms); empty when it did.
+    const std::string& vertexFogError() const;
     // World-space box of object i at timeSec (empty for Empty objects).
     splatfx::Aabb worldBounds(std::size_t i, double timeSec) const;
     // [issue 17] Replaces object i's mesh by world-space triangles (3 points

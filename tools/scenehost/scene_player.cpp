@@ -172,8 +172,14 @@ splatfx::Status ScenePlayer::renderFrame(double t, const splatfx::Camera& camera
             glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
             glClearDepth(1.0);
         }
-        if (options.drawGeometry) p.geometry->draw(t, camera, geometryLighting(f.scene, *p.renderer));
+        if (options.drawGeometry) {
+            GeometryLighting g = geometryLighting(f.scene, *p.renderer);
+            if (options.fogPerVertex) g.vertexFog = f.scene.fog();
+            p.geometry->draw(t, camera, g);
+        }
     };
+    if (options.fogPerVertex && p.renderer->desc().fogHost)
+        return splatfx::makeError("fog per vertex needs a frame renderer with fogHost off (the host image would be fogged twice)");
     const auto t0 = Clock::now();
     splatfx::gl::HostTarget target{.framebuffer = framebuffer, .drawOpaque = drawOpaque};
     // (issue 15) Glass: sorted per pixel with the gas through the fragment lists.
@@ -183,6 +189,8 @@ splatfx::Status ScenePlayer::renderFrame(double t, const splatfx::Camera& camera
     }
     p.renderer->render(p.frame, target);
     s.renderMs = msSince(t0);
+    if (options.fogPerVertex && options.drawGeometry && !p.geometry->vertexFogError().empty())
+        return splatfx::makeError(p.geometry->vertexFogError());
     return {};
 }
 

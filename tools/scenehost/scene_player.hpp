@@ -39,6 +39,11 @@ struct FrameOptions {
     float opacityScale = 1.0f; // multiplies every splat's opacity; default 1
     bool drawGeometry = true;  // default true
     bool clear = true;         // clear colour (scene background) and depth first; default true
+    // Biri et al.'s buffer method (sec. 4.3): the geometry fogs itself per
+    // vertex (GeometryLighting::vertexFog) with the scene's fog. Needs a
+    // renderer with fogHost off (else the geometry would be fogged twice:
+    // renderFrame refuses). The background is not fogged. Default false.
+    bool fogPerVertex = false;
 };
 
 struct FrameStats {
