@@ -19,6 +19,7 @@ int runTransparency(int argc, char** argv); // transparency.cpp: glass panes amo
 int runShadowTables(int argc, char** argv); // shadow_tables.cpp: shadow-table build time and error against tracing, CPU only
 int runLodRefine(int argc, char** argv);    // lod_refine.cpp: LOD cloud refinement on the CPU: tetrahedra, update time, memory
 int runLattice(int argc, char** argv);      // lattice.cpp: how visible the voxel lattice is in the effect samples (issue 25)
+int runEbert(int argc, char** argv);        // ebert.cpp: Ebert & Parent 1990 Table 1, the paper's scenes with and without their volumes
 
 // cloud_knobs.cpp, run by accuracy (--clouds-only alone): the LOD clouds' table size, c, C and
 // max vs average Delta against the finest level integrated exactly (issue 17). Needs a current GL context.
@@ -38,6 +39,7 @@ inline constexpr BenchCommand kCommands[] = {
     {"groundfog", "LOD ground fog over the Jacksboro DEM: count vs full, ms/frame, error vs full, popping with/without morphing", runGroundFog},
     {"scheduling", "a level of 1000 effects with 10 in view vs those 10 alone; camera sweep; catch-up error", runScheduling},
     {"shadows", "Ebert & Parent 1990 Table 2: steam from a glass, no/geometry/traced/table shadowing, table error", runShadows},
+    {"ebert", "Ebert & Parent 1990 Table 1: the gallery, steam and chess-fog scenes at the paper's resolutions, with and without their volumes", runEbert},
     {"shadowtables", "shadow tables 16^3..128^3 vs tracing for a 1560-voxel effect: build and lookup time, error (CPU only)", runShadowTables},
     {"fog", "Biri et al. 2002 Table 1: no fog, per-pixel fog, reduced fog textures at 800x600; error vs per pixel", runFog},
     {"cut", "splats cut exactly by depth: cost vs plain on Table I rows, error per table size, popping of a moving wall and the cow", runCut},
