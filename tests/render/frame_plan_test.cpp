@@ -66,7 +66,7 @@ std::string show(const gl::FramePlan& plan) {
     return out;
 }
 
-const gl::HostDepth kDepth{.texture = 7, .samples = 1};
+const gl::HostDepth kDepth{.texture = 7, .samples = 1, .copied = false, .missing = {}};
 void opaque() {}
 void transparent() {}
 
@@ -153,22 +153,50 @@ TEST(FramePlan, AFogIsDrawnOverTheHostImageRightAfterTheOpaquePass) {
     EXPECT_NE(off.fog, nullptr);
 }
 
-// A window's default framebuffer has no depth texture: the host image cannot
-// be fogged, and the plan says so instead of skipping it silently.
+// No host depth to read (none handed over, none that could be copied): the
+// host image cannot be fogged, and the plan says so instead of skipping it silently.
 TEST(FramePlan, AFogWithoutAHostDepthTextureIsNotedNotSkippedSilently) {
     TestFrame f(false, true);
     const gl::FramePlan p = gl::planFrame(f.frame, {.framebuffer = 0, .drawOpaque = opaque}, {}, {});
     const std::vector<StepKind> k = kinds(p);
     EXPECT_EQ(std::count(k.begin(), k.end(), StepKind::HostFog), 0) << show(p);
     EXPECT_FALSE(p.fogHost);
-    EXPECT_NE(p.fogNote.find("no host depth texture"), std::string::npos) << p.fogNote;
+    EXPECT_NE(p.fogNote.find("no host depth to read"), std::string::npos) << p.fogNote;
+    // The frame renderer's reason, when it has one, is the note's.
+    const gl::FramePlan why =
+        gl::planFrame(f.frame, {.framebuffer = 0, .drawOpaque = opaque}, {}, {.texture = 0, .samples = 0, .copied = false, .missing = "no depth buffer"});
+    EXPECT_NE(why.fogNote.find("no depth buffer"), std::string::npos) << why.fogNote;
+}
+
+// A window's default framebuffer (or a renderbuffer) is copied into a texture:
+// the copy comes after the host has drawn its depth and before anything reads it.
+TEST(FramePlan, ACopiedHostDepthIsCopiedAfterTheOpaquePassAndBeforeItIsRead) {
+    TestFrame f(false, true);
+    const gl::HostDepth copied{.texture = 3, .samples = 0, .copied = true, .missing = {}};
+    const gl::FramePlan p = gl::planFrame(f.frame, {.framebuffer = 0, .drawOpaque = opaque}, {}, copied);
+    const std::vector<StepKind> k = kinds(p);
+    const auto opaqueAt = std::find(k.begin(), k.end(), StepKind::HostOpaque), copyAt = std::find(k.begin(), k.end(), StepKind::CopyHostDepth);
+    ASSERT_NE(copyAt, k.end()) << show(p);
+    EXPECT_EQ(copyAt, opaqueAt + 1) << show(p);
+    EXPECT_TRUE(p.fogHost);
+    EXPECT_EQ(p.target.depthTexture, 3u);
+    // Without an opaque hook (the host drew before render()) the copy comes before any pass.
+    const gl::FramePlan before = gl::planFrame(f.frame, {.framebuffer = 0}, {}, copied);
+    const std::vector<StepKind> kb = kinds(before);
+    const auto copyBefore = std::find(kb.begin(), kb.end(), StepKind::CopyHostDepth);
+    ASSERT_NE(copyBefore, kb.end()) << show(before);
+    EXPECT_LT(copyBefore - kb.begin(), std::find(kb.begin(), kb.end(), StepKind::HostFog) - kb.begin()) << show(before);
+    // A depth texture the host hands over is never copied.
+    EXPECT_EQ(std::count(kinds(gl::planFrame(f.frame, {.framebuffer = 0, .drawOpaque = opaque}, {}, kDepth)).begin(),
+                         kinds(gl::planFrame(f.frame, {.framebuffer = 0, .drawOpaque = opaque}, {}, kDepth)).end(), StepKind::CopyHostDepth),
+              0);
 }
 
 // A multisampled host depth cannot be sampled by the passes: the fog and the
 // depth cut say so, and no pass is handed the texture.
 TEST(FramePlan, AMultisampledHostDepthIsNeverHandedToAPassAndEveryFallbackIsNoted) {
     TestFrame f(false, true);
-    const gl::FramePlan p = gl::planFrame(f.frame, {.framebuffer = 5}, {}, {.texture = 9, .samples = 4});
+    const gl::FramePlan p = gl::planFrame(f.frame, {.framebuffer = 5}, {}, {.texture = 9, .samples = 4, .copied = false, .missing = {}});
     EXPECT_EQ(p.target.depthTexture, 0u);
     EXPECT_FALSE(p.fogHost);
     EXPECT_NE(p.fogNote.find("multisampled (4 samples)"), std::string::npos) << p.fogNote;
@@ -219,7 +247,7 @@ TEST(FramePlan, ListFramesTheSplatsCannotJoinNameTheReason) {
     const Case cases[] = {{plain.frame, {.resolutionScale = 2}, kDepth, "reduced resolution"},
                           {clouds.frame, {}, kDepth, "tetrahedra in the frame"},
                           {plain.frame, {}, {}, "no host depth texture"},
-                          {plain.frame, {}, {.texture = 9, .samples = 8}, "multisampled (8 samples)"}};
+                          {plain.frame, {}, {.texture = 9, .samples = 8, .copied = false, .missing = {}}, "multisampled (8 samples)"}};
     for (const Case& c : cases) {
         const gl::FramePlan p = gl::planFrame(c.frame, host, c.desc, c.depth);
         EXPECT_TRUE(p.lists && !p.splatsInLists) << c.reason;

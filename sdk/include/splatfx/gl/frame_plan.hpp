@@ -30,17 +30,22 @@ namespace splatfx::gl {
 
 // The host's depth as the passes can read it: the texture behind
 // HostTarget::depthTexture, or behind the framebuffer's depth attachment when
-// that is a texture (the default framebuffer's never is). Looked up once a
-// frame by the frame renderer.
+// that is a texture, or (copied) the frame renderer's own texture that the
+// framebuffer's depth buffer (the default framebuffer's, a renderbuffer) is
+// copied into after the host's opaque pass. Looked up once a frame by the
+// frame renderer.
 struct HostDepth {
     unsigned texture = 0; // GL name; 0: none that can be sampled
     int samples = 0;      // its sample count (0 or 1: single-sampled)
+    bool copied = false;  // `texture` is filled by the CopyHostDepth step
+    std::string missing;  // with no texture: why none could be read or copied (for the notes)
 };
 
 enum class StepKind : std::uint8_t {
     UploadShadow,      // the frame's shadow table (when it changed), bound for the hooks
     PrepareTetrahedra, // pre-integration tables that changed; per-tetrahedron data
     HostOpaque,        // HostTarget::drawOpaque
+    CopyHostDepth,     // the framebuffer's depth buffer into a texture the passes read (HostDepth::copied)
     HostFog,           // the fog of the host's opaque image
     Splats,            // splats of `range`, full resolution
     ReducedSplats,     // every splat, at reduced resolution, composited over the host

@@ -93,6 +93,12 @@ struct FrameRendererDesc {
     glm::ivec2 fogTextureSize{0, 0};
     float fogDepthThreshold = 0.05f; // fog texture: relative distance still one surface; default 0.05
     bool fogHost = true;             // fog the host's opaque image (false: only the splats); default true
+    // A host depth that is not a texture (the default framebuffer's, a
+    // renderbuffer) is copied, after the opaque pass, into a texture of the
+    // same format that every pass then reads (one depth blit a frame,
+    // FrameRenderStats::hostDepthCopied); false: those passes fall back
+    // (FrameRenderStats::notes says how). Default true.
+    bool copyHostDepth = true;
     // Order-exact transparency (HostTarget::transparentToLists).
     // The fragment budget for the host's transparent surfaces: the node pool
     // holds viewport pixels x this many nodes (16 bytes each, plus 8 bytes of
@@ -125,10 +131,12 @@ struct HostTarget {
     int x = 0, y = 0;         // viewport origin; its size is the frame camera's viewport; default 0, 0
     // The host's depth as a texture (GL name, single-sampled, the
     // framebuffer's size); 0: the framebuffer's depth attachment when it is a
-    // texture, in the frame camera's depth convention (Camera::depth). Every
+    // texture, else a copy of its depth buffer (FrameRendererDesc::copyHostDepth),
+    // in the frame camera's depth convention (Camera::depth). Every
     // pass that reads the host depth reads this one (the depth
     // cut of the splats, the reduced-resolution upsampling, the host fog, the
-    // tetrahedra's ray end, the list sections). Without one the splats and
+    // tetrahedra's ray end, the list sections). Without any (no depth buffer,
+    // a multisampled one, copyHostDepth off) the splats and
     // tetrahedra are only depth-tested at their fragments (not exact inside
     // a volume), the host image gets no fog and the splats take the ordered
     // blend in a list frame; FrameRenderStats::notes says so. Default 0.
@@ -157,6 +165,7 @@ struct FrameRenderStats {
     int resolutionScale = 1;        // the scale the splats were drawn at
     std::vector<std::string> notes; // every fallback of the frame, one line each (the plan's and the passes'); empty: all ran as asked
     std::string depthConvention;    // the frame camera's (describe(Camera::depth)): how the host depth was read
+    bool hostDepthCopied = false;   // the host depth was copied from a depth buffer that is not a texture (FrameRendererDesc::copyHostDepth)
     struct Shadow {
         std::uint64_t uploads = 0; // shadow-table uploads (cumulative; only when the frame's changed)
     } shadow;

@@ -75,6 +75,8 @@ FramePlan planFrame(const Frame& frame, const HostTarget& host, const FrameRende
 
     // 1. The host's opaque pass: its depth is what the volumes are tested against.
     if (host.drawOpaque) plan.steps.push_back(step(StepKind::HostOpaque));
+    // 1a. A depth buffer that cannot be sampled, copied once it is complete (before anything reads it).
+    if (depth.copied && hasDepth) plan.steps.push_back(step(StepKind::CopyHostDepth));
 
     // 1b. The fog of the host's opaque image, read from its depth.
     if (plan.fog && desc.fogHost) {
@@ -84,8 +86,9 @@ FramePlan planFrame(const Frame& frame, const HostTarget& host, const FrameRende
         } else if (multisampled) {
             plan.fogNote = multisampledNote("fog of the host image skipped", depth.samples);
         } else {
-            plan.fogNote = "fog of the host image skipped: no host depth texture (HostTarget::depthTexture, or a texture depth attachment; "
-                           "the default framebuffer's depth is never one)";
+            plan.fogNote = "fog of the host image skipped: no host depth to read (" +
+                           (depth.missing.empty() ? std::string("HostTarget::depthTexture, a texture depth attachment or a depth buffer to copy") : depth.missing) +
+                           ")";
         }
     }
 
@@ -99,8 +102,11 @@ FramePlan planFrame(const Frame& frame, const HostTarget& host, const FrameRende
         plan.listsNote = plan.reduced      ? "reduced resolution: the splats take the ordered blend under the surfaces"
                          : plan.tetrahedra ? "tetrahedra in the frame: the volumes take the ordered blend under the surfaces"
                          : multisampled    ? multisampledNote("the splats take the ordered blend under the surfaces", depth.samples)
-                                           : "no host depth texture (HostTarget::depthTexture or a texture depth attachment): "
-                                             "the splats take the ordered blend under the surfaces";
+                                           : "no host depth to read (" +
+                                                 (depth.missing.empty() ? std::string("HostTarget::depthTexture, a texture depth attachment or a "
+                                                                                      "depth buffer to copy")
+                                                                        : depth.missing) +
+                                                 "): the splats take the ordered blend under the surfaces";
 
     // 2. The volumes, back to front.
     const std::size_t splats = frame.splats().size();
@@ -150,6 +156,7 @@ const char* toString(StepKind kind) {
     case StepKind::UploadShadow: return "UploadShadow";
     case StepKind::PrepareTetrahedra: return "PrepareTetrahedra";
     case StepKind::HostOpaque: return "HostOpaque";
+    case StepKind::CopyHostDepth: return "CopyHostDepth";
     case StepKind::HostFog: return "HostFog";
     case StepKind::Splats: return "Splats";
     case StepKind::ReducedSplats: return "ReducedSplats";

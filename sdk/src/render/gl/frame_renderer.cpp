@@ -45,6 +45,7 @@ struct FrameRenderer::Impl {
         case StepKind::UploadShadow:
         case StepKind::UnbindShadow: return shadow;
         case StepKind::HostOpaque:
+        case StepKind::CopyHostDepth:
         case StepKind::HostTransparent: return host;
         case StepKind::HostFog: return fog;
         case StepKind::Splats:
@@ -126,7 +127,13 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
         return;
     }
     r.depthNote = detail::depthConventionNote(frame.camera());
-    r.plan = planFrame(frame, target, r.desc, detail::queryHostDepth(target.framebuffer, target.depthTexture));
+    HostDepth depth = detail::queryHostDepth(target.framebuffer, target.depthTexture);
+    if (!depth.texture)
+        depth = r.desc.copyHostDepth
+                    ? r.host.depthCopy(target.framebuffer, target.x + frame.camera().viewport.x, target.y + frame.camera().viewport.y)
+                    : HostDepth{.missing = "FrameRendererDesc::copyHostDepth is off and neither HostTarget::depthTexture nor a texture depth "
+                                           "attachment is given"};
+    r.plan = planFrame(frame, target, r.desc, depth);
     for (detail::Pass* p : r.passes()) p->prepare(r.plan, frame);
     detail::StepContext context{.frame = frame, .host = target, .plan = r.plan, .splatLayers = r.splats.renderer().layerTexture()};
     for (const PlanStep& step : r.plan.steps) {

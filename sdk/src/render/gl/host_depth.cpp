@@ -51,7 +51,7 @@ HostDepth queryHostDepth(unsigned framebuffer, unsigned texture) {
     if (!texture) return {};
     GLint samples = 0;
     glGetTextureLevelParameteriv(texture, 0, GL_TEXTURE_SAMPLES, &samples);
-    return {.texture = texture, .samples = samples};
+    return {.texture = texture, .samples = samples, .copied = false, .missing = {}};
 }
 
 glm::vec3 hostDepthMap(const Camera& camera) {
