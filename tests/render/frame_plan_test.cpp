@@ -245,7 +245,7 @@ TEST(FramePlan, ListFramesTheSplatsCannotJoinNameTheReason) {
     };
     const Case cases[] = {{plain.frame, {.resolutionScale = 2}, kDepth, "reduced resolution"},
                           {clouds.frame, {}, kDepth, "tetrahedra in the frame"},
-                          {plain.frame, {}, {}, "no host depth texture"},
+                          {plain.frame, {}, {}, "no host depth to read"},
                           {plain.frame, {}, {.texture = 9, .samples = 8, .copied = false, .missing = {}}, "multisampled (8 samples)"}};
     for (const Case& c : cases) {
         const gl::FramePlan p = gl::planFrame(c.frame, host, c.desc, c.depth);
