@@ -16,13 +16,17 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <vector>
 
 #include <epoxy/gl.h>
 #include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/type_ptr.hpp>
 #include <gtest/gtest.h>
 
 #include "../reference/gl_bounds.hpp"
 #include "gl_fixture.hpp"
+#include "splatfx/gl/program.hpp"
 #include "splatfx/reference.hpp"
 
 namespace splatfx {
@@ -71,39 +75,132 @@ double tableError(const Footprint& fp) {
     return worst + 2.0 * step / 256.0 + 1e-6;
 }
 
+// The host's opaque geometry: world-space triangles drawn into the bound
+// framebuffer's depth with the depth test of the camera's convention, in
+// the background colour (so only the depth changes).
+// The largest slope of the bilinear table in s (kernel units), times the
+// exact window F(r) / F(0): the most detail x d(share)/ds of a GL fragment.
+// The lookup is bilinear in (r, sigma), so its slope in s is largest on cell
+// edges; sampled 8x per cell in r and once per cell in sigma (linear there).
+double glTableSlope(const Footprint& fp) {
+    const double R = fp.radius(), F0 = fp.exact(0.0);
+    const int rows = fp.partialRows(), cols = fp.partialCols();
+    double worst = 0.0;
+    for (int i = 0; i <= (rows - 1) * 8; ++i) {
+        const double r = std::min(R * i / ((rows - 1) * 8.0), R * (1.0 - 1e-3)), chord = std::sqrt(R * R - r * r);
+        for (int j = 0; j + 1 < cols; ++j) {
+            const double s0 = chord * (-1.0 + 2.0 * (j + 0.25) / (cols - 1)), s1 = chord * (-1.0 + 2.0 * (j + 0.75) / (cols - 1));
+            const double slope = std::abs(double(fp.fractionBefore(float(r), float(s1))) - fp.fractionBefore(float(r), float(s0))) / (s1 - s0);
+            worst = std::max(worst, slope * fp.exact(r) / F0);
+        }
+    }
+    return worst;
+}
+
+class OpaqueTriangles {
+public:
+    OpaqueTriangles() {
+        const char* vs = "#version 450 core\nlayout(location = 0) in vec3 aPosition;\nuniform mat4 uViewProj;\n"
+                         "void main() { gl_Position = uViewProj * vec4(aPosition, 1.0); }\n";
+        const char* fs = "#version 450 core\nuniform vec4 uColour;\nout vec4 oColour;\nvoid main() { oColour = uColour; }\n";
+        auto prog = gl::linkProgram({vs}, {fs}, "opaque host triangles");
+        EXPECT_TRUE(prog) << prog.error();
+        if (prog) mProgram = *prog;
+        glCreateVertexArrays(1, &mVao);
+        glCreateBuffers(1, &mVbo);
+    }
+    ~OpaqueTriangles() {
+        if (mProgram) glDeleteProgram(mProgram);
+        glDeleteVertexArrays(1, &mVao);
+        glDeleteBuffers(1, &mVbo);
+    }
+    void draw(const std::vector<glm::vec3>& triangles, const Camera& cam) const {
+        glNamedBufferData(mVbo, GLsizeiptr(triangles.size() * sizeof(glm::vec3)), triangles.data(), GL_DYNAMIC_DRAW);
+        glVertexArrayVertexBuffer(mVao, 0, mVbo, 0, sizeof(glm::vec3));
+        glVertexArrayAttribFormat(mVao, 0, 3, GL_FLOAT, GL_FALSE, 0);
+        glVertexArrayAttribBinding(mVao, 0, 0);
+        glEnableVertexArrayAttrib(mVao, 0);
+        const glm::mat4 vp = cam.proj * cam.view;
+        glUseProgram(mProgram);
+        glUniformMatrix4fv(glGetUniformLocation(mProgram, "uViewProj"), 1, GL_FALSE, &vp[0][0]);
+        glUniform4f(glGetUniformLocation(mProgram, "uColour"), kBackground.r, kBackground.g, kBackground.b, kBackground.a);
+        glDisable(GL_BLEND);
+        glDisable(GL_CULL_FACE);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(cam.depth.reversed ? GL_GEQUAL : GL_LEQUAL);
+        glDepthMask(GL_TRUE);
+        glBindVertexArray(mVao);
+        glDrawArrays(GL_TRIANGLES, 0, GLsizei(triangles.size()));
+        glBindVertexArray(0);
+        glUseProgram(0);
+        glDisable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+    }
+
+private:
+    GLuint mProgram = 0, mVao = 0, mVbo = 0;
+};
+
+// The quad a, b, c, d as two triangles.
+std::vector<glm::vec3> quad(glm::vec3 a, glm::vec3 b, glm::vec3 c, glm::vec3 d) { return {a, b, c, a, c, d}; }
+
 class CutStability : public test::GLTest {
 protected:
     struct Frame {
-        Image gl, ref;
+        Image gl, ref, depth;
         double worst = 0.0, bound = 0.0;
+        double n = 0.0, density = 0.0, minScale = 0.0; // most fragments on a pixel, largest density, smallest ray scale
+        gl::DrawStats stats{};
     };
 
-    // Draws the splats over a host surface at view depth zSurface (a
-    // constant window depth: a plane facing the camera; < 0: none), GL and
-    // reference, and compares them.
-    Frame draw(const std::vector<Splat>& splats, const Camera& cam, const Materials& mat, float zSurface, bool cut = true,
-               float depthOverride = -1.0f) {
+    // The host under the splats: a plane facing the camera at view depth
+    // zSurface (a constant window depth; < 0: none), or the window depth
+    // `depth` when >= 0, then `opaque` drawn into the cleared depth (the
+    // host's geometry; colour kBackground, so the background stays constant).
+    struct Host {
+        float zSurface = -1.0f;
+        float depth = -1.0f;
+        std::function<void()> opaque{};
+        bool cut = true;
+        int floatDepth = -1; // -1: the convention's (float when reversed)
+        double zMax = 0.0;   // largest finite view depth of the host surface, for the bound; 0: from zSurface
+        gl::RendererDesc renderer{.sampling = gl::TextureSampling::Bilinear};
+    };
+
+    // Draws the splats over the host, GL and reference, and compares them.
+    Frame drawOver(const std::vector<Splat>& splats, const Camera& cam, const Materials& mat, const Host& host) {
         Frame f;
-        auto r = gl::Renderer::create({.sampling = gl::TextureSampling::Bilinear, .depthCut = cut});
+        gl::RendererDesc rdesc = host.renderer;
+        rdesc.depthCut = host.cut;
+        auto r = gl::Renderer::create(rdesc);
         EXPECT_TRUE(r) << r.error();
         const Status up = r->upload(mat);
         EXPECT_TRUE(up) << up.error();
         // A reversed host draws into float depth (the engines' reverse-Z setup).
-        auto fb = gl::Framebuffer::create(
-            {.width = cam.viewport.x, .height = cam.viewport.y, .color = gl::Precision::F32, .floatDepth = cam.depth.reversed});
+        const bool floatDepth = host.floatDepth < 0 ? cam.depth.reversed : host.floatDepth != 0;
+        auto fb = gl::Framebuffer::create({.width = cam.viewport.x, .height = cam.viewport.y, .color = gl::Precision::F32, .floatDepth = floatDepth});
         EXPECT_TRUE(fb);
-        const float depth = depthOverride >= 0.0f ? depthOverride : zSurface > 0.0f ? windowDepth(cam, zSurface) : float(cam.depth.farWindow());
+        const float depth = host.depth >= 0.0f ? host.depth : host.zSurface > 0.0f ? windowDepth(cam, host.zSurface) : float(cam.depth.farWindow());
         fb->clear(kBackground, depth);
-        const Image depthImage = fb->readDepth();
         glClipControl(GL_LOWER_LEFT, cam.depth.clip == ClipDepth::ZeroToOne ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
+        if (host.opaque) {
+            glBindFramebuffer(GL_FRAMEBUFFER, fb->handle());
+            glViewport(0, 0, cam.viewport.x, cam.viewport.y);
+            host.opaque();
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        }
+        const Image depthImage = fb->readDepth();
         r->draw(splats, cam, {.framebuffer = fb->handle(), .width = cam.viewport.x, .height = cam.viewport.y});
         glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
-        if (cut) { EXPECT_TRUE(r->stats().cutHostDepth) << "the framebuffer depth texture must be read"; }
+        if (host.cut && rdesc.depthTest) { EXPECT_TRUE(r->stats().cutHostDepth) << "the framebuffer depth texture must be read"; }
+        f.stats = r->stats();
         f.gl = fb->read();
+        f.depth = depthImage;
         SplatExactDesc rd;
         rd.host.background = kBackground;
-        rd.host.depth = &depthImage;
-        rd.depthCut = cut;
+        if (rdesc.depthTest) rd.host.depth = &depthImage;
+        rd.depthCut = host.cut;
+        rd.threads = 2;
         SplatExactStats stats;
         auto ref = renderSplatExact(splats, cam, mat, rd, &stats);
         EXPECT_TRUE(ref) << ref.error();
@@ -115,12 +212,14 @@ protected:
         }
         const Footprint& fp = mat.footprint();
         // Depth linearization in float (GLSL): view depth to ~2^-22 relative, twice (surface, fragment).
-        const double zMax = std::max(double(zSurface), 1.0) * 2.0;
+        const double zMax = std::max(host.zMax > 0.0 ? host.zMax : double(host.zSurface), 1.0) * 2.0;
         const double depthErr = 4.0 * std::ldexp(zMax, -22) / minScale;
         const double cutErr = 2.0 * tableError(fp) + fp.kernel(0.0) / fp.exact(0.0) * depthErr;
-        const double n = double(stats.maxOverlap);
-        f.bound = n * std::log(2.0) * maxDensity * (test::windowErrorBound(mat, 0) + (cut ? cutErr : 0.0)) + std::ldexp(1.0, -11) +
-                  n * std::ldexp(1.0, -24);
+        f.n = double(stats.maxOverlap);
+        f.density = maxDensity;
+        f.minScale = minScale;
+        f.bound = f.n * std::log(2.0) * maxDensity * (test::windowErrorBound(mat, 0) + (host.cut ? cutErr : 0.0)) + std::ldexp(1.0, -11) +
+                  f.n * std::ldexp(1.0, -24);
         for (size_t i = 0; i < f.gl.pixels.size(); ++i) {
             const float v = f.gl.pixels[i];
             EXPECT_TRUE(std::isfinite(v)) << "pixel value " << i;
@@ -129,6 +228,12 @@ protected:
             f.worst = std::max(f.worst, double(std::abs(v - f.ref.pixels[i])));
         }
         return f;
+    }
+
+    // Over a plane facing the camera at view depth zSurface (< 0: none), or the window depth depthOverride.
+    Frame draw(const std::vector<Splat>& splats, const Camera& cam, const Materials& mat, float zSurface, bool cut = true,
+               float depthOverride = -1.0f) {
+        return drawOver(splats, cam, mat, {.zSurface = zSurface, .depth = depthOverride, .cut = cut});
     }
 
     static double maxDiff(const Image& a, const Image& b) {
@@ -270,6 +375,239 @@ TEST_F(CutStability, CameraInsideAKernelWithASurfaceInsideItTooReverseZInfiniteF
     continuity(b.splats(), cam, mat, 0.2f, 0.003f, false);
     const Frame open = draw(b.splats(), cam, mat, -1.0f);
     EXPECT_LE(open.worst, open.bound) << "the camera inside a kernel, no surface, sky at infinity";
+}
+
+
+// ---- Issue 24: the depth cut's further edges ----
+
+std::vector<Splat> built(const Grid& g, const Camera& cam, const Materials& mat) {
+    SplatBuilder b;
+    b.begin(cam);
+    b.add(g, mat, {.textured = false});
+    b.sort();
+    return b.splats();
+}
+
+TEST_F(CutStability, SkyDepthWithTheFarPlaneThroughTheKernels) {
+    // The host's sky (window depth 1: the far plane) with the far plane
+    // through the block's middle layer: each kernel it crosses keeps its share
+    // in front of the far plane, including those whose splat plane lies beyond
+    // it (GL clipped their polygons whole until the vertex stage moved them in
+    // front of the far plane: 8x the error of the same cut by a surface).
+    // The far plane at view depth 4 is the same cut as a host surface at view
+    // depth 4 with the far plane beyond it, so GL's error against the
+    // reference must be that frame's (factor 2 for the depths' different
+    // rounding, as in continuity()), besides the per-fragment bound.
+    const Materials mat = plain();
+    const Grid g = block(5, 0.3f, 0.5f);
+    const glm::vec3 centre = g.worldPosition({2, 2, 2});
+    const glm::vec3 eye = centre + glm::vec3(0.05f, 0.03f, 4.0f);
+    const Camera cam = Camera::lookAt(eye, centre, {0, 1, 0}, 0.7f, {40, 32}, 0.5f, 4.0f);
+    const std::vector<Splat> splats = built(g, cam, mat);
+    ASSERT_GT(splats.size(), 50u);
+    const Frame f = drawOver(splats, cam, mat, {.zMax = 4.0});
+    EXPECT_LE(f.worst, f.bound) << "sky at the far plane, the cut on";
+    EXPECT_GT(f.stats.cutHost, 0u) << "the far plane meets the kernels: the host-depth variant must draw them";
+    const Camera open = Camera::lookAt(eye, centre, {0, 1, 0}, 0.7f, {40, 32}, 0.5f, 50.0f);
+    const std::vector<Splat> openSplats = built(g, open, mat);
+    const Frame surface = draw(openSplats, open, mat, 4.0f);
+    std::printf("  far plane at 4: error %.3e; a surface at 4, far 50: %.3e\n", f.worst, surface.worst);
+    EXPECT_LE(f.worst, 2.0 * surface.worst + std::ldexp(1.0, -11));
+    // The far plane does cut: the block seen with the far plane beyond it is denser.
+    const Frame whole = draw(openSplats, open, mat, -1.0f);
+    EXPECT_GT(maxDiff(whole.ref, f.ref), 0.05);
+}
+
+TEST_F(CutStability, SurfaceAMicronFromASplatPlane) {
+    // Orthographic, float depth: the surface 1e-6 in front of and behind a
+    // splat layer's plane (a few float steps of its window depth). The cut
+    // share is continuous in the surface depth, so the image moves by at most
+    // its slope times the move: per fragment ln2 density x detail x
+    // d(share)/ds x ds, with detail x d(share)/ds <= h(0)/F(0) for the exact
+    // fraction (the reference) and, for GL, the largest slope of the
+    // bilinear table (glTableSlope) times the window (plus its 8-bit error),
+    // over ds = (the depths' difference, read back, + GL's float rounding of
+    // both view depths) / l. The plain test pops by a whole layer there.
+    const Materials mat = plain();
+    const Grid g = block(6, 0.3f, 0.35f);
+    const glm::vec3 centre = g.worldPosition({3, 3, 3});
+    const glm::mat4 view = glm::lookAt(centre + glm::vec3(0.0f, 0.0f, 4.0f), centre, glm::vec3(0, 1, 0));
+    const Camera cam = Camera::fromMatrices(view, glm::ortho(-1.2f, 1.2f, -1.0f, 1.0f, 0.5f, 50.0f), {32, 28});
+    const std::vector<Splat> splats = built(g, cam, mat);
+    const float eps = 1e-6f;
+    const Frame below = drawOver(splats, cam, mat, {.zSurface = 4.0f - eps, .floatDepth = 1, .zMax = 4.0});
+    const Frame above = drawOver(splats, cam, mat, {.zSurface = 4.0f + eps, .floatDepth = 1, .zMax = 4.0});
+    EXPECT_LE(below.worst, below.bound);
+    EXPECT_LE(above.worst, above.bound);
+    const DepthUnprojection un = depthUnprojection(cam);
+    const double dz = std::abs(un.viewDepth(above.depth.at(0, 0, 0)) - un.viewDepth(below.depth.at(0, 0, 0)));
+    EXPECT_GT(dz, 0.0) << "float depth must resolve the move";
+    EXPECT_LE(dz, 4.0 * eps);
+    const Footprint& fp = mat.footprint();
+    const double perFragment = std::log(2.0) * below.density / below.minScale;
+    const double refBound = below.n * perFragment * fp.kernel(0.0) / fp.exact(0.0) * dz + 2.0 * std::ldexp(1.0, -24);
+    // GL: the table's slope; the two view depths rounded in float (2^-22 relative, each, twice);
+    // exp2 within (3 + 2|x|) ulps (GLSL 4.50), x <= density <= 1, and one F32 blend, per fragment and frame.
+    const double glBound = below.n * perFragment * (1.0 + test::windowErrorBound(mat, 0)) * glTableSlope(fp) * (dz + 4.0 * std::ldexp(8.0, -22)) +
+                           below.n * 2.0 * 6.0 * std::ldexp(1.0, -24);
+    const double across = maxDiff(below.gl, above.gl), acrossRef = maxDiff(below.ref, above.ref);
+    std::printf("  view depth moved %.3e: GL %.3e (bound %.3e), reference %.3e (bound %.3e)\n", dz, across, glBound, acrossRef, refBound);
+    EXPECT_LE(acrossRef, refBound);
+    EXPECT_LE(across, glBound);
+    const Frame plainBelow = drawOver(splats, cam, mat, {.zSurface = 4.0f - eps, .cut = false, .floatDepth = 1, .zMax = 4.0});
+    const Frame plainAbove = drawOver(splats, cam, mat, {.zSurface = 4.0f + eps, .cut = false, .floatDepth = 1, .zMax = 4.0});
+    EXPECT_GT(maxDiff(plainBelow.gl, plainAbove.gl), 0.02) << "the plain test pops a layer here (else the case proves nothing)";
+}
+
+TEST_F(CutStability, GrazingFloorThroughTheBlock) {
+    // A floor through the block seen 4 degrees above grazing: along a pixel
+    // column the host depth runs from the near plane to 20, so every 16 x 16
+    // tile's depth range (which decides which splats are cut, which skipped
+    // as hidden) spans many voxels; each pixel must still be cut at its own
+    // depth.
+    const Materials mat = plain();
+    const Grid g = block(5, 0.3f, 0.4f);
+    const glm::vec3 c = g.worldPosition({2, 2, 2});
+    const Camera cam = Camera::lookAt(c + glm::vec3(0.03f, 0.28f, 4.0f), c, {0, 1, 0}, 0.7f, {40, 32}, 0.5f, 20.0f);
+    const float y = c.y - 0.05f;
+    OpaqueTriangles floor;
+    const std::vector<glm::vec3> tris = quad({c.x - 30, y, c.z + 3.9f}, {c.x + 30, y, c.z + 3.9f}, {c.x + 30, y, c.z - 30}, {c.x - 30, y, c.z - 30});
+    const Frame f = drawOver(built(g, cam, mat), cam, mat, {.opaque = [&] { floor.draw(tris, cam); }, .zMax = 20.0});
+    EXPECT_LE(f.worst, f.bound);
+    double lo = 1.0, hi = 0.0;
+    for (float d : f.depth.pixels) lo = std::min(lo, double(d)), hi = std::max(hi, double(d));
+    EXPECT_LT(lo, hi) << "the floor must cover part of the image";
+    EXPECT_GT(f.stats.cutHost, 0u);
+    const Frame open = draw(built(g, cam, mat), cam, mat, -1.0f);
+    EXPECT_GT(maxDiff(open.ref, f.ref), 0.05) << "the floor must cut the block";
+}
+
+TEST_F(CutStability, SilhouetteEdgeAcrossTheSplats) {
+    // A depth discontinuity through the block: an opaque wall through the
+    // middle layer on the left of x = c.x + 0.07 (not on a pixel or voxel
+    // boundary), the sky on the right. Splats across the edge are cut on its
+    // left and whole on its right, pixel by pixel; the edge tiles' depth range
+    // spans the wall to the far plane.
+    const Materials mat = plain();
+    const Grid g = block(5, 0.3f, 0.45f);
+    const glm::vec3 c = g.worldPosition({2, 2, 2});
+    const Camera cam = Camera::lookAt(c + glm::vec3(0.0f, 0.0f, 4.0f), c, {0, 1, 0}, 0.7f, {40, 32}, 0.5f, 50.0f);
+    const float x = c.x + 0.07f;
+    OpaqueTriangles wall;
+    const std::vector<glm::vec3> tris = quad({x - 20, c.y - 20, c.z}, {x, c.y - 20, c.z}, {x, c.y + 20, c.z}, {x - 20, c.y + 20, c.z});
+    const Frame f = drawOver(built(g, cam, mat), cam, mat, {.opaque = [&] { wall.draw(tris, cam); }, .zMax = 4.0});
+    EXPECT_LE(f.worst, f.bound);
+    // Mirror pixels about the block's centre column: cut on the left, whole on the right.
+    const int row = f.ref.height / 2;
+    // (Red: the gas's colour over the dark background; alpha is 1 everywhere.)
+    EXPECT_GT(f.ref.at(f.ref.width / 2 + 6, row, 0) - f.ref.at(f.ref.width / 2 - 7, row, 0), 0.05f);
+}
+
+TEST_F(CutStability, SplatLargerThanTheScreenCutBySurface) {
+    // One kernel of support radius 3.2 seen from 6 units with a 0.3 rad field
+    // of view (0.9 units of half height): its polygon covers the screen many
+    // times over (the tiles it covers clamped to the screen), the texture
+    // magnified ~40x; a surface 0.4 in front of its centre cuts it everywhere.
+    const Materials mat = plain();
+    Grid g = *Grid::box({1, 1, 1}, glm::vec3(2.0f));
+    g.voxels[0].opacity = 0.6f;
+    const glm::vec3 c = g.worldPosition({0, 0, 0});
+    const Camera cam = Camera::lookAt(c + glm::vec3(0.1f, 0.05f, 6.0f), c + glm::vec3(0.1f, 0.05f, 0.0f), {0, 1, 0}, 0.3f, {40, 32}, 0.5f, 50.0f);
+    const std::vector<Splat> splats = built(g, cam, mat);
+    ASSERT_EQ(splats.size(), 1u);
+    const Frame f = draw(splats, cam, mat, 5.6f);
+    EXPECT_LE(f.worst, f.bound);
+    EXPECT_EQ(f.stats.cutHost, 1u);
+    EXPECT_EQ(f.stats.cutGeneral, 0u) << "the eye is outside the support";
+    const Frame open = draw(splats, cam, mat, -1.0f);
+    EXPECT_LE(open.worst, open.bound);
+    EXPECT_GT(std::abs(open.ref.at(0, 0, 0) - f.ref.at(0, 0, 0)), 0.02f) << "cut in the corner too";
+}
+
+TEST_F(CutStability, SplatCentreExactlyOnTheNearPlane) {
+    // One voxel whose centre is at view depth 1 = the near plane: the ray
+    // through the centre (pixel (16, 12) of 33 x 25) keeps exactly half of
+    // the kernel's line integral (the fraction before s = 0 is 1/2 by
+    // symmetry; the table's two columns around sigma = 0 average to 1/2):
+    // alpha = 1 - 2^(-density / 2), over the background.
+    const Materials mat = plain();
+    Grid g = *Grid::box({1, 1, 1}, glm::vec3(0.4f));
+    g.voxels[0].opacity = 0.7f;
+    const glm::vec3 c = g.worldPosition({0, 0, 0});
+    const Camera cam = Camera::lookAt(c + glm::vec3(0.0f, 0.0f, 1.0f), c, {0, 1, 0}, 1.0f, {33, 25}, 1.0f, 50.0f);
+    const std::vector<Splat> splats = built(g, cam, mat);
+    ASSERT_EQ(splats.size(), 1u);
+    const Frame f = draw(splats, cam, mat, -1.0f);
+    EXPECT_LE(f.worst, f.bound);
+    EXPECT_EQ(f.stats.cutNear + f.stats.cutGeneral, 1u) << "the near plane crosses the kernel";
+    const double a = 1.0 - std::exp2(-0.5 * double(splats[0].density));
+    for (int ch = 0; ch < 4; ++ch) {
+        const double want = double(kColour[ch]) * a + (1.0 - a) * double(kBackground[ch]); // kColour.a = 1
+        // The reference: exactFractionBefore(0, 0) = 1/2 exactly; the pixel ray meets the centre to float rounding of the camera.
+        EXPECT_NEAR(f.ref.at(16, 12, ch), want, 1e-5) << "reference, channel " << ch;
+        EXPECT_NEAR(f.gl.at(16, 12, ch), want, f.bound + 1e-5) << "GL, channel " << ch;
+    }
+}
+
+TEST_F(CutStability, FloatDepthWithNearOneThousandthAndFarOneHundredThousand) {
+    // OpenGL's default [-1, 1] convention, not reversed, into a 32-bit float
+    // depth buffer with far / near = 1e8: the surface at view depth 4 through
+    // the voxel centres has window depth 1 - 2.5e-4. A 4x4 inverse projection
+    // in float would lose ~1e-3 of view depth there (f + n - ndc (f - n)
+    // subtracts terms of 1e5); the cut's unprojection blends 1 / depth
+    // (depth_convention.hpp) and must agree with the reference to float
+    // rounding (the bound's 2^-22 relative).
+    const Materials mat = plain();
+    const Grid g = block(5, 0.3f, 0.35f);
+    const glm::vec3 c = g.worldPosition({2, 2, 2});
+    const Camera cam = Camera::lookAt(c + glm::vec3(0.02f, 0.01f, 4.0f), c, {0, 1, 0}, 0.7f, {40, 32}, 1e-3f, 1e5f);
+    const std::vector<Splat> splats = built(g, cam, mat);
+    const Frame f = drawOver(splats, cam, mat, {.zSurface = 4.0f, .floatDepth = 1, .zMax = 4.0});
+    EXPECT_LE(f.worst, f.bound);
+    EXPECT_GT(f.stats.cutHost, 0u);
+    EXPECT_NEAR(f.depth.at(20, 16, 0), 1.0 - 2.5e-4, 1e-6);
+}
+
+TEST_F(CutStability, D24DepthWhereOneCodeIsAFiftiethOfAVoxel) {
+    // A 24-bit fixed depth with near 0.01: at view depth 30 one depth code
+    // spans z^2 / near x 2^-24 = 5.4e-3 world units, 1/55 of the voxel
+    // spacing. GL reads the code from the depth texture, the reference the
+    // same code read back as float: they must agree to the bound (one code's
+    // difference would move the cut by 0.018 kernel units, 100x the bound's
+    // linearization term).
+    const Materials mat = plain();
+    const Grid g = block(5, 0.3f, 0.35f);
+    const glm::vec3 c = g.worldPosition({2, 2, 2});
+    const Camera cam = Camera::lookAt(c + glm::vec3(0.01f, 0.02f, 30.0f), c, {0, 1, 0}, 0.06f, {40, 32}, 0.01f, 1000.0f);
+    const std::vector<Splat> splats = built(g, cam, mat);
+    const Frame f = drawOver(splats, cam, mat, {.zSurface = 30.0f, .floatDepth = 0, .zMax = 30.0});
+    EXPECT_LE(f.worst, f.bound);
+    EXPECT_GT(f.stats.cutHost, 0u);
+    const DepthUnprojection un = depthUnprojection(cam);
+    const double d = f.depth.at(20, 16, 0), code = std::ldexp(1.0, -24);
+    const double step = un.viewDepth(d + code) - un.viewDepth(d);
+    EXPECT_GT(step, 3e-3);
+    EXPECT_LT(step, 8e-3);
+    const Frame open = draw(splats, cam, mat, -1.0f);
+    EXPECT_GT(maxDiff(open.ref, f.ref), 0.05) << "the surface must cut the block";
+}
+
+TEST_F(CutStability, StretchedKernelsReachInFrontOfTheSurface) {
+    // Voxels stretched 4x along the view (stretch 3): their centres 0.5
+    // behind the surface, their supports reaching 1.92 in front of it (an
+    // unstretched one reaches 0.48). The part in front is drawn; the splats
+    // must not be skipped as hidden behind the surface (the classifier's reach
+    // is the ray scale's, stretch included).
+    const Materials mat = plain();
+    Grid g = block(3, 0.3f, 0.6f);
+    for (Voxel& v : g.voxels) v.stretch = {0.0f, 0.0f, 3.0f};
+    const glm::vec3 c = g.worldPosition({1, 1, 1});
+    const Camera cam = Camera::lookAt(c + glm::vec3(0.02f, 0.01f, 4.0f), c, {0, 1, 0}, 0.7f, {40, 32}, 0.5f, 50.0f);
+    const std::vector<Splat> splats = built(g, cam, mat);
+    const Frame f = draw(splats, cam, mat, 3.5f - 0.3f); // in front of the front layer's centres by 0.5
+    EXPECT_LE(f.worst, f.bound);
+    EXPECT_EQ(f.stats.cutHidden, 0u);
+    EXPECT_GT(visible(f.ref), 0.05) << "the stretched kernels' front parts must show";
 }
 
 } // namespace
