@@ -418,6 +418,15 @@ TEST_F(CutStability, SkyDepthWithTheFarPlaneThroughTheKernels) {
     // The far plane does cut: the block seen with the far plane beyond it is denser.
     const Frame whole = draw(openSplats, open, mat, -1.0f);
     EXPECT_GT(maxDiff(whole.ref, f.ref), 0.05);
+    // Orthographic (the polygons are shifted along the view, not scaled about the eye).
+    const glm::mat4 view = glm::lookAt(eye, centre, glm::vec3(0, 1, 0));
+    const Camera ortho = Camera::fromMatrices(view, glm::ortho(-1.0f, 1.0f, -0.8f, 0.8f, 0.5f, 4.0f), {40, 32});
+    const Camera orthoOpen = Camera::fromMatrices(view, glm::ortho(-1.0f, 1.0f, -0.8f, 0.8f, 0.5f, 50.0f), {40, 32});
+    const Frame o = drawOver(built(g, ortho, mat), ortho, mat, {.zMax = 4.0});
+    const Frame oSurface = draw(built(g, orthoOpen, mat), orthoOpen, mat, 4.0f);
+    std::printf("  orthographic: far plane at 4: error %.3e; a surface at 4, far 50: %.3e\n", o.worst, oSurface.worst);
+    EXPECT_LE(o.worst, o.bound);
+    EXPECT_LE(o.worst, 2.0 * oSurface.worst + std::ldexp(1.0, -11));
 }
 
 TEST_F(CutStability, SurfaceAMicronFromASplatPlane) {
