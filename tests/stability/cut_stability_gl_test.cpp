@@ -1,5 +1,7 @@
-// The depth cut's hard cases (issue 15) through the GL renderer, each against
-// the splat-exact reference with the same cut, and for continuity: a surface
+// The depth cut's and the fragment lists' hard cases (issues 15, 24) through
+// the GL renderer, each against the splat-exact reference with the same cut
+// (and, for the lists, the same transparent surfaces; their bound is derived
+// above ListStability), and for continuity: a surface
 // moved by 2 eps across a coincidence (voxel centres, a splat plane) must
 // change the image no more than a move of 2 eps elsewhere does (the cut image
 // is a smooth function of the surface depth, so equal moves give equal
