@@ -406,13 +406,13 @@ TEST_F(CutStability, SkyDepthWithTheFarPlaneThroughTheKernels) {
     const Grid g = block(5, 0.3f, 0.5f);
     const glm::vec3 centre = g.worldPosition({2, 2, 2});
     const glm::vec3 eye = centre + glm::vec3(0.05f, 0.03f, 4.0f);
-    const Camera cam = Camera::lookAt(eye, centre, {0, 1, 0}, 0.7f, {40, 32}, 0.5f, 4.0f);
+    const Camera cam = Camera::lookAt(eye, centre, {0, 1, 0}, 0.7f, {32, 24}, 0.5f, 4.0f);
     const std::vector<Splat> splats = built(g, cam, mat);
     ASSERT_GT(splats.size(), 50u);
     const Frame f = drawOver(splats, cam, mat, {.zMax = 4.0});
     EXPECT_LE(f.worst, f.bound) << "sky at the far plane, the cut on";
     EXPECT_GT(f.stats.cutHost, 0u) << "the far plane meets the kernels: the host-depth variant must draw them";
-    const Camera open = Camera::lookAt(eye, centre, {0, 1, 0}, 0.7f, {40, 32}, 0.5f, 50.0f);
+    const Camera open = Camera::lookAt(eye, centre, {0, 1, 0}, 0.7f, {32, 24}, 0.5f, 50.0f);
     const std::vector<Splat> openSplats = built(g, open, mat);
     const Frame surface = draw(openSplats, open, mat, 4.0f);
     std::printf("  far plane at 4: error %.3e; a surface at 4, far 50: %.3e\n", f.worst, surface.worst);
@@ -422,8 +422,8 @@ TEST_F(CutStability, SkyDepthWithTheFarPlaneThroughTheKernels) {
     EXPECT_GT(maxDiff(whole.ref, f.ref), 0.05);
     // Orthographic (the polygons are shifted along the view, not scaled about the eye).
     const glm::mat4 view = glm::lookAt(eye, centre, glm::vec3(0, 1, 0));
-    const Camera ortho = Camera::fromMatrices(view, glm::ortho(-1.0f, 1.0f, -0.8f, 0.8f, 0.5f, 4.0f), {40, 32});
-    const Camera orthoOpen = Camera::fromMatrices(view, glm::ortho(-1.0f, 1.0f, -0.8f, 0.8f, 0.5f, 50.0f), {40, 32});
+    const Camera ortho = Camera::fromMatrices(view, glm::ortho(-1.0f, 1.0f, -0.8f, 0.8f, 0.5f, 4.0f), {32, 24});
+    const Camera orthoOpen = Camera::fromMatrices(view, glm::ortho(-1.0f, 1.0f, -0.8f, 0.8f, 0.5f, 50.0f), {32, 24});
     const Frame o = drawOver(built(g, ortho, mat), ortho, mat, {.zMax = 4.0});
     const Frame oSurface = draw(built(g, orthoOpen, mat), orthoOpen, mat, 4.0f);
     std::printf("  orthographic: far plane at 4: error %.3e; a surface at 4, far 50: %.3e\n", o.worst, oSurface.worst);
@@ -442,10 +442,10 @@ TEST_F(CutStability, SurfaceAMicronFromASplatPlane) {
     // over ds = (the depths' difference, read back, + GL's float rounding of
     // both view depths) / l. The plain test pops by a whole layer there.
     const Materials mat = plain();
-    const Grid g = block(6, 0.3f, 0.35f);
-    const glm::vec3 centre = g.worldPosition({3, 3, 3});
+    const Grid g = block(5, 0.3f, 0.35f);
+    const glm::vec3 centre = g.worldPosition({2, 2, 2});
     const glm::mat4 view = glm::lookAt(centre + glm::vec3(0.0f, 0.0f, 4.0f), centre, glm::vec3(0, 1, 0));
-    const Camera cam = Camera::fromMatrices(view, glm::ortho(-1.2f, 1.2f, -1.0f, 1.0f, 0.5f, 50.0f), {32, 28});
+    const Camera cam = Camera::fromMatrices(view, glm::ortho(-1.0f, 1.0f, -0.8f, 0.8f, 0.5f, 50.0f), {25, 20});
     const std::vector<Splat> splats = built(g, cam, mat);
     const float eps = 1e-6f;
     const Frame below = drawOver(splats, cam, mat, {.zSurface = 4.0f - eps, .floatDepth = 1, .zMax = 4.0});
