@@ -95,7 +95,7 @@ void main() {
     // surface (a fragment keeps its share in front of it: the sky's depth is
     // the far plane's), so a polygon reaching beyond it is moved in front of
     // it the same way (GL would clip the part beyond, whose kernels still
-    // reach in front of the far plane); the near plane takes precedence.
+    // reach in front of the far plane), never past the near plane.
 #if HOST_DEPTH
     float farZ = max(splatfx_host_view_depth(0.0), splatfx_host_view_depth(1.0)); // +inf without a far plane
     float maxZ = dot(c - uEye, uForward) + uCut * reach;
@@ -104,13 +104,13 @@ void main() {
     if (uPersp != 0) {
         float k = max(1.0, zDraw / max(minZ, 1e-30));
 #if HOST_DEPTH
-        if (k == 1.0 && maxZ > zFarDraw) k = zFarDraw / maxZ;
+        if (k == 1.0 && maxZ > zFarDraw) k = max(zFarDraw / maxZ, zDraw / max(minZ, 1e-30)); // never past the near plane
 #endif
         if (k != 1.0) p = uEye + k * (p - uEye); // k = 1: the plain path's position, bit for bit
     } else {
         float d = max(0.0, zDraw - minZ);
 #if HOST_DEPTH
-        if (d == 0.0 && maxZ > zFarDraw) d = zFarDraw - maxZ;
+        if (d == 0.0 && maxZ > zFarDraw) d = max(zFarDraw - maxZ, zDraw - minZ);
 #endif
         if (d != 0.0) p += d * uForward;
     }
