@@ -60,8 +60,8 @@ TEST(CutStabilityCpu, SectionsAtSevenSurfacesMultiplyBackToTheWholeFragment) {
     double keep = 1.0;
     for (int k = 0; k < 7; ++k) {
         const double a = 0.05 + 0.03 * k, h = 4.0;
-        panes.push_back(ReferenceSurface::quad({c.x - h, c.y - h, zs[k]}, {c.x + h, c.y - h, zs[k]}, {c.x + h, c.y + h, zs[k]}, {c.x - h, c.y + h, zs[k]},
-                                               {0.2 * a, 0.5 * a, 0.9 * a, a}));
+        panes.push_back(ReferenceSurface::quad({c.x - h, c.y - h, zs[k]}, {c.x + h, c.y - h, zs[k]}, {c.x + h, c.y + h, zs[k]},
+                                               {c.x - h, c.y + h, zs[k]}, {0.2 * a, 0.5 * a, 0.9 * a, a}));
         keep *= 1.0 - a;
     }
     SplatExactDesc without{.host = {.depth = &depth}, .threads = 2};

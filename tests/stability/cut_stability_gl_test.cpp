@@ -381,7 +381,6 @@ TEST_F(CutStability, CameraInsideAKernelWithASurfaceInsideItTooReverseZInfiniteF
     EXPECT_LE(open.worst, open.bound) << "the camera inside a kernel, no surface, sky at infinity";
 }
 
-
 // ---- Issue 24: the depth cut's further edges ----
 
 std::vector<Splat> built(const Grid& g, const Camera& cam, const Materials& mat) {
@@ -566,10 +565,10 @@ TEST_F(CutStability, FloatDepthWithNearOneThousandthAndFarOneHundredThousand) {
     // OpenGL's default [-1, 1] convention, not reversed, into a 32-bit float
     // depth buffer with far / near = 1e8: the surface at view depth 4 through
     // the voxel centres has window depth 1 - 2.5e-4. A 4x4 inverse projection
-    // in float would lose ~1e-3 of view depth there (f + n - ndc (f - n)
-    // subtracts terms of 1e5); the cut's unprojection blends 1 / depth
-    // (depth_convention.hpp) and must agree with the reference to float
-    // rounding (the bound's 2^-22 relative).
+    // in float would lose ~6e-4 of view depth there (f + n - ndc (f - n)
+    // subtracts terms of 1e5: 80x the bound's linearization term); the
+    // cut's unprojection blends 1 / depth (depth_convention.hpp) and must
+    // agree with the reference to float rounding (the bound's 2^-22 relative).
     const Materials mat = plain();
     const Grid g = block(5, 0.3f, 0.35f);
     const glm::vec3 c = g.worldPosition({2, 2, 2});
@@ -623,7 +622,6 @@ TEST_F(CutStability, StretchedKernelsReachInFrontOfTheSurface) {
     EXPECT_GT(visible(f.ref), 0.05) << "the stretched kernels' front parts must show";
 }
 
-
 // ---- Issue 24: the fragment lists' edges (transparent surfaces among the splats) ----
 //
 // The block (5^3, spacing 0.3, opacity 0.4, one colour) seen from 2.5 in
@@ -648,7 +646,7 @@ protected:
         double worst = 0.0;
     };
     struct Options {
-        std::vector<glm::vec3> opaque{};               // the host's opaque triangles (depth), drawn after the clear
+        std::vector<glm::vec3> opaque{}; // the host's opaque triangles (depth), drawn after the clear
         int fragmentsPerPixel = 8;
         const std::vector<ReferenceSurface>* reference = nullptr; // the reference's surfaces; default the panes
     };
@@ -843,7 +841,7 @@ TEST_F(ListStability, EightPanesThroughOneKernelOverflowTheSections) {
 
 TEST_F(ListStability, PixelsWithPanesButNoSplats) {
     // A block covering the left of the image, two panes over all of it: on
-    // pixels no splat reaches (tiles with no splat among them), the lists
+    // pixels no splat reaches, the lists
     // must still composite both panes in depth order over the background:
     // front over (back over background), closed form, to the panes' half
     // colours (2^-11 each) and the resolve's RGBA16F (2^-12). The background
