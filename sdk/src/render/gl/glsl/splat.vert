@@ -29,6 +29,9 @@ uniform int uPersp;         // 1: perspective, 0: orthographic
 uniform float uKernelRadius; // Footprint::radius(), kernel units
 flat out float vScale;      // world length of one kernel unit along the ray
 out vec3 vRel;              // the fragment's point on the splat plane, minus uEye
+#if HOST_DEPTH && !GENERAL
+#include "host_depth.glsl"
+#endif
 #if GENERAL
 // x: clip z / w of the screen-covering polygon, just inside the near plane
 // (in the host's depth convention); y: splat_plane.glsl's.
@@ -88,11 +91,27 @@ void main() {
     // vRel exactly (both are affine in position). With a host depth the
     // hardware depth test is off (the CPU drops splats wholly behind the
     // surface per tile; the shader cuts the rest), so nothing else moves.
+    // With the host depth read, the far plane is a cut like the host's
+    // surface (a fragment keeps its share in front of it: the sky's depth is
+    // the far plane's), so a polygon reaching beyond it is moved in front of
+    // it the same way (GL would clip the part beyond, whose kernels still
+    // reach in front of the far plane), never past the near plane.
+#if HOST_DEPTH
+    float farZ = max(splatfx_host_view_depth(0.0), splatfx_host_view_depth(1.0)); // +inf without a far plane
+    float maxZ = dot(c - uEye, uForward) + uCut * reach;
+    float zFarDraw = farZ * 0.9999;
+#endif
     if (uPersp != 0) {
         float k = max(1.0, zDraw / max(minZ, 1e-30));
+#if HOST_DEPTH
+        if (k == 1.0 && maxZ > zFarDraw) k = max(zFarDraw / maxZ, zDraw / max(minZ, 1e-30)); // never past the near plane
+#endif
         if (k != 1.0) p = uEye + k * (p - uEye); // k = 1: the plain path's position, bit for bit
     } else {
         float d = max(0.0, zDraw - minZ);
+#if HOST_DEPTH
+        if (d == 0.0 && maxZ > zFarDraw) d = max(zFarDraw - maxZ, zDraw - minZ);
+#endif
         if (d != 0.0) p += d * uForward;
     }
     gl_Position = uViewProj * vec4(p, 1.0);

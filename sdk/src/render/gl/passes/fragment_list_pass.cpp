@@ -484,7 +484,13 @@ void FragmentListPass::insertSplats(const std::vector<Splat>& all, std::size_t b
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     const GLfloat clear[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     for (int k = 0; k < prog->sections; ++k) glClearNamedFramebufferfv(r.sectionFbo, GL_COLOR, k, clear);
-    setOverState(r.sectionFbo, target, nearerOrEqual(camera));
+    // With the cut the shader keeps each fragment's share in front of the
+    // host depth it reads, so the hardware test is off (as in the splat
+    // pass): at the drawn polygon it would drop whole the splats whose plane
+    // lies behind the host surface (or was moved there past the near plane)
+    // but whose kernel reaches in front of it. Without the cut, the plain
+    // test at the splat plane is the model.
+    setOverState(r.sectionFbo, target, partial ? DepthTest::Off : nearerOrEqual(camera));
     glDisable(GL_CULL_FACE);
     // Perspective with the cut: a polygon that crosses (or nearly) the eye
     // plane takes the general variant (screen-covering, each fragment meets
