@@ -61,6 +61,7 @@ struct Setting {
     SelfShadow shadow = SelfShadow::Table;
     int tableN = 32, lobes = 2, samples = 1;
     bool eightBit = true;
+    bool kernelTrace = false; // trace the reference's continuous field (VolumeFieldShadows), not the DensityField
 };
 struct Row {
     Setting s;
@@ -80,6 +81,7 @@ std::vector<Setting> settings() {
     };
     add("self-shadow", "off", [](Setting& s) { s.shadow = SelfShadow::Off; });
     add("self-shadow", "traced", [](Setting& s) { s.shadow = SelfShadow::Traced; });
+    add("self-shadow", "kernel field traced (bench-side)", [](Setting& s) { s.shadow = SelfShadow::Traced, s.kernelTrace = true; });
     for (int n : {8, 16, 64, 128}) add("self-shadow", "table " + std::to_string(n) + "^3", [n](Setting& s) { s.tableN = n; });
     for (int n : {1, 3, 4}) add("phase lobes", std::to_string(n), [n](Setting& s) { s.lobes = n; });
     for (int n : {2, 3}) add("samples per voxel", std::to_string(n * n * n) + " (bench-side)", [n](Setting& s) { s.samples = n; });
@@ -201,7 +203,10 @@ int runLighting(int argc, char** argv) {
             ShadowTracer tracer(*density, lights);
             ShadowTables tables({.dims = glm::ivec3(s.tableN)});
             const ShadowProvider* shadows = nullptr;
-            if (s.shadow == SelfShadow::Traced) shadows = &tracer;
+            VolumeField kernels(m);
+            if (s.kernelTrace) kernels.add(grid, {.textured = false});
+            const VolumeFieldShadows kernelTracer(kernels, lights);
+            if (s.shadow == SelfShadow::Traced) shadows = s.kernelTrace ? static_cast<const ShadowProvider*>(&kernelTracer) : &tracer;
             if (s.shadow == SelfShadow::Table) {
                 if (Status st = tables.update(*density, lights); !st) return std::fprintf(stderr, "lighting: %s\n", st.error().c_str()), 1;
                 shadows = &tables;
