@@ -470,3 +470,19 @@ TEST(LitReferenceHardCases, ASingleVoxelLitFromInsideMatchesARadialQuadrature) {
     EXPECT_NEAR(img->at(2, 2, 3), 1.0 - std::exp(-tauView), 1e-7);
     EXPECT_GT(C, 0.05) << "the light inside must show";
 }
+
+TEST(LitReference, ABadLightOrGasDescIsNamedAndNothingIsRendered) {
+    LitBlob s;
+    const VolumeField f = s.field();
+    LitVolumeDesc bad = s.lit;
+    bad.lights.push_back(Light::point({0, 0, 0}));
+    bad.lights[1].intensity = -1.0f;
+    auto a = renderVolumeExact(f, s.camera, {.lighting = &bad});
+    ASSERT_FALSE(a);
+    EXPECT_NE(a.error().find("renderVolumeExact: desc.lighting: lights[1].intensity must be a finite number >= 0"), std::string::npos) << a.error();
+    bad = s.lit;
+    bad.gas.albedo = 1.5f;
+    auto b = renderVolumeExact(f, s.camera, {.lighting = &bad});
+    ASSERT_FALSE(b);
+    EXPECT_NE(b.error().find("renderVolumeExact: desc.lighting: GasLightingDesc.albedo must be in [0, 1]"), std::string::npos) << b.error();
+}
