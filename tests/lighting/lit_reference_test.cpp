@@ -92,9 +92,11 @@ double maxAlpha(const Image& img) {
 
 // sup over each kernel's support of |base (f(x) - f(c_j))|: what replacing the lit factor at
 // every sample point by its value at the voxel centre can change a colour by (the image changes by
-// at most (1 - T) times it; see maxAlpha). Sampled on a 7^3 lattice over each support's box; the
-// sup between samples exceeds the sampled max by at most the largest change between lattice
-// neighbours (a point is within one lattice cell of a sample and f is smooth on that scale).
+// at most (1 - T) times it; see maxAlpha). Sampled on a 7^3 lattice over each support's bounding
+// box (a superset of the support). A point of the box is within half a lattice step of a sample
+// along each axis, so where f is close to linear on a lattice cell (it is smooth on that scale)
+// it differs from that sample by at most half the three axis steps: 1.5 times the largest change
+// between lattice neighbours.
 double perVoxelBound(const LitBlob& s, const VolumeField& field, const LitVolumeDesc& lit, const std::vector<glm::vec3>& voxelColours) {
     const double R = s.materials.footprint().radius() * s.grid.spacing.x;
     const glm::dvec3 eye(s.camera.eye());
@@ -113,15 +115,13 @@ double perVoxelBound(const LitBlob& s, const VolumeField& field, const LitVolume
             for (int jj = 0; jj < n; ++jj)
                 for (int i = 0; i < n; ++i) {
                     const glm::dvec3 v = f[std::size_t(i + n * (jj + n * k))];
-                    const glm::dvec3 d = glm::dvec3(R * (glm::dvec3(i, jj, k) / double(n - 1) * 2.0 - 1.0));
-                    if (glm::length(d) <= R)
-                        for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(v[c] - double(voxelColours[j][c])));
+                    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(v[c] - double(voxelColours[j][c])));
                     if (i + 1 < n) step = std::max(step, glm::length(f[std::size_t(i + 1 + n * (jj + n * k))] - v));
                     if (jj + 1 < n) step = std::max(step, glm::length(f[std::size_t(i + n * (jj + 1 + n * k))] - v));
                     if (k + 1 < n) step = std::max(step, glm::length(f[std::size_t(i + n * (jj + n * (k + 1)))] - v));
                 }
     }
-    return worst + step;
+    return worst + 1.5 * step;
 }
 
 } // namespace
