@@ -49,6 +49,8 @@
 //   splatfx::VolumeField field(materials);
 //   field.add(grid, {.colorTable = lut});
 //   splatfx::Image vol = *splatfx::renderVolumeExact(field, camera, {.background = bg});
+//   splatfx::LitVolumeDesc lit{.lights = lights, .gas = gas};      // the lit volume: the model at every sample
+//   splatfx::Image litRef = *splatfx::renderVolumeExact(field, camera, {.lighting = &lit});
 //
 // Threading: the render functions split rows over `threads` worker threads
 // they own; inputs are read-only during the call. A VolumeField is a plain
