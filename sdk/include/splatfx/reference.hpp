@@ -25,6 +25,15 @@
 //    along every pixel ray with the emission-absorption model, halving the
 //    step until two successive results agree to VolumeExactDesc::tolerance.
 //    It measures what splatting itself costs against true volume rendering.
+//    With VolumeExactDesc::lighting (LitVolumeDesc) the field is lit as
+//    lighting.hpp's low-albedo model defines it, but at every sample point
+//    of the view ray rather than at voxel centres: the phase function in
+//    double (or an exact phase the HG lobes approximate), the transmittance
+//    to each light (directional, point, spot; inside the field too) through
+//    this continuous field. VolumeField::add can instead take each voxel's
+//    colour as lit per voxel (what a Scene puts in its splats), so the two
+//    differ by the per-voxel lighting alone (docs/lighting.md, "The lit
+//    reference").
 //
 //  * Tetrahedra with fog (renderTetraExact, integrateRayWithFog): a LOD
 //    volume's emitted tetrahedra and a Biri fog as one medium, integrated
@@ -40,6 +49,8 @@
 //   splatfx::VolumeField field(materials);
 //   field.add(grid, {.colorTable = lut});
 //   splatfx::Image vol = *splatfx::renderVolumeExact(field, camera, {.background = bg});
+//   splatfx::LitVolumeDesc lit{.lights = lights, .gas = gas};      // the lit volume: the model at every sample
+//   splatfx::Image litRef = *splatfx::renderVolumeExact(field, camera, {.lighting = &lit});
 //
 // Threading: the render functions split rows over `threads` worker threads
 // they own; inputs are read-only during the call. A VolumeField is a plain
@@ -47,6 +58,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <span>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -55,6 +68,7 @@
 #include "splatfx/fog.hpp"
 #include "splatfx/grid.hpp"
 #include "splatfx/image.hpp"
+#include "splatfx/lighting.hpp"
 #include "splatfx/materials.hpp"
 #include "splatfx/result.hpp"
 #include "splatfx/splats.hpp"
@@ -182,14 +196,28 @@ public:
     // Appends the grid's voxels with the splat builder's rules: opacities
     // clamped to [0, 1], non-finite voxels or singular kernels dropped and
     // counted in rejected(), zero-opacity voxels left out. style.textured is
-    // ignored (the field is the untextured one).
-    void add(const Grid& grid, const SplatStyle& style = {});
+    // ignored (the field is the untextured one). voxelColors, when not
+    // empty, gives voxel i's colour in place of the colour table's (a lit
+    // colour, as a Scene writes into the splat); the table's alpha still
+    // scales the opacity. Expects voxelColors empty or of grid.voxels.size().
+    void add(const Grid& grid, const SplatStyle& style = {}, std::span<const glm::vec3> voxelColors = {});
 
     Sample evaluate(glm::dvec3 worldPoint) const;
     // Exact optical depth (natural log) along the whole line origin + t dir,
     // t in (-inf, inf): the sum of each kernel's footprint (closed form up to
     // Footprint::exact's quadrature). For tests.
     double lineOpticalDepth(glm::dvec3 origin, glm::dvec3 dir) const;
+    // Optical depth (natural log) along the segment from `from` to `to`:
+    // each kernel integrated over its own chord of the segment by 6-point
+    // Gauss-Legendre on panels doubled until two results agree to
+    // `tolerance` (relative to the kernel's whole-line depth). Along a line
+    // the Crawfis-Max kernel is a polynomial of degree 10 in the line
+    // parameter, which 6 points integrate exactly, so it converges at once;
+    // the Gaussian kernel needs a few doublings.
+    double segmentOpticalDepth(glm::dvec3 from, glm::dvec3 to, double tolerance = 1e-10) const;
+    // From a world point to the light: to its position (point, spot), or out
+    // of the field against the direction a directional light travels.
+    double opticalDepthToLight(glm::dvec3 world, const Light& light, double tolerance = 1e-10) const;
 
     const Materials& materials() const { return *mMaterials; }
     const std::vector<VoxelKernel>& kernels() const { return mKernels; }
@@ -200,6 +228,50 @@ private:
     std::vector<VoxelKernel> mKernels;
     std::uint64_t mRejected = 0;
     double mCentreFootprint = 1.0; // F(0)
+    double mSupportRadius = 1.0;   // where the kernel ends, in double (Footprint::radius() is a float: 1.6 is not one)
+};
+
+// The lit volume (lighting.hpp's model, evaluated exactly): at a point x of
+// colour c(x) (the field's extinction-weighted colour) the source is
+//   c(x) * (emission + albedo * (ambient + sum_i color_i E_i(x) (4 pi p(cos theta_i) T_i(x) + multipleScattering)))
+// with E_i the irradiance (intensity; point and spot: intensity / d^2 with d
+// at least the light's radiusWorld, spot cone by the same smoothstep), T_i =
+// exp(-VolumeField::opticalDepthToLight) and theta_i between the light's
+// travel and the direction to the eye. Unlike lightVoxels there is no voxel
+// size: only the light's own radiusWorld (inside it the phase is isotropic,
+// as in the model).
+struct LitVolumeDesc {
+    std::vector<Light> lights{}; // default none (then emission and ambient only)
+    GasLightingDesc gas{};       // phase, albedo, emission, multipleScattering, ambient; colorTable ignored (the field's colour is the base)
+    // The phase function p(cos theta) per steradian, when it is not gas.phase:
+    // e.g. the exact phase a few HG lobes are fitted to. Empty: gas.phase's
+    // lobes evaluated in double. Default empty.
+    std::function<double(double)> phase{};
+    double shadowTolerance = 1e-10; // VolumeField::opticalDepthToLight's; default 1e-10
+};
+
+// The lit factor (the bracket above, without c(x)) at a world point seen from
+// eyeWorld, in double. Expects valid lights (validateLight).
+glm::dvec3 litFactor(const VolumeField& field, glm::dvec3 world, glm::dvec3 eyeWorld, const LitVolumeDesc& desc);
+// The phase the lit reference uses at cos theta (desc.phase, or the lobes in
+// double with 1 -+ cos theta as given, so a g near +-1 keeps its peak).
+double litPhase(const LitVolumeDesc& desc, double cosTheta, double oneMinusCos, double onePlusCos);
+
+// Transmittance towards each light through a VolumeField (opticalDepthToLight,
+// in double), as a ShadowProvider: lightVoxels / lightPoints with it light
+// each voxel at its centre with the reference's own shadows, which isolates
+// the per-voxel lighting from the shadow table and the light's field.
+// Keeps a pointer to the field and a copy of the lights.
+class VolumeFieldShadows final : public ShadowProvider {
+public:
+    VolumeFieldShadows(const VolumeField& field, std::span<const Light> lights, double tolerance = 1e-10)
+        : mField(&field), mLights(lights.begin(), lights.end()), mTolerance(tolerance) {}
+    float transmittance(std::size_t light, glm::vec3 world) const override;
+
+private:
+    const VolumeField* mField;
+    std::vector<Light> mLights;
+    double mTolerance;
 };
 
 struct VolumeExactDesc {
@@ -211,6 +283,9 @@ struct VolumeExactDesc {
     // Fixed step (no refinement) when > 0: for convergence studies. Default 0.
     double fixedStep = 0.0;
     int threads = 0; // 0 = std::thread::hardware_concurrency(); default 0
+    // Lit: the source at each sample point is c(x) times litFactor(x), the
+    // eye at camera.eye(). Default none (the field's colours as they are).
+    const LitVolumeDesc* lighting = nullptr;
 };
 
 struct VolumeExactStats {
@@ -226,6 +301,9 @@ struct VolumeExactStats {
 // inside each piece, steps of at most h each contribute
 // (1 - exp(-dtau)) * (extinction-weighted colour) with dtau by 4-point
 // Gauss-Legendre: exact for a constant colour, second order in h otherwise.
+// Lit (desc.lighting), each Gauss point's extinction-weighted source is the
+// lit one. Fails on a bad host image or tolerance, or (lit) a bad light or
+// gas desc, the message naming the field.
 Result<Image> renderVolumeExact(const VolumeField& field, const Camera& camera, const VolumeExactDesc& desc = {}, VolumeExactStats* stats = nullptr);
 
 // ---- Tetrahedra (LOD volumes) and fog in one medium ----

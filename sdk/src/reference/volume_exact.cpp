@@ -28,8 +28,16 @@ struct RayResult {
     double transmittance = 1.0;
 };
 
+// Lit: the field, the eye, the lighting and the ray in world space, so each
+// Gauss point's source can be lit where it is.
+struct LitRay {
+    const VolumeField* field = nullptr;
+    const LitVolumeDesc* desc = nullptr;
+    glm::dvec3 eye{0.0}, origin{0.0}, dir{0.0};
+};
+
 RayResult integrate(const std::vector<Crossing>& cs, const std::vector<double>& breaks, const Footprint& fp, double h, double cutoff,
-                    std::uint64_t& evals) {
+                    std::uint64_t& evals, const LitRay& lit) {
     RayResult r;
     std::vector<const Crossing*> active;
     for (size_t i = 0; i + 1 < breaks.size(); ++i) {
@@ -57,6 +65,7 @@ RayResult integrate(const std::vector<Crossing>& cs, const std::vector<double>& 
                     ec += k * c->color;
                 }
                 evals += active.size();
+                if (lit.desc && e > 0.0) ec *= litFactor(*lit.field, lit.origin + t * lit.dir, lit.eye, *lit.desc);
                 tau += kGw[g] * e;
                 tauColor += kGw[g] * ec;
             }
@@ -79,6 +88,12 @@ RayResult integrate(const std::vector<Crossing>& cs, const std::vector<double>& 
 Result<Image> renderVolumeExact(const VolumeField& field, const Camera& camera, const VolumeExactDesc& desc, VolumeExactStats* statsOut) {
     if (Status s = reference::checkHost(desc.host, camera, "renderVolumeExact"); !s) return makeError(s.error());
     if (!(desc.tolerance > 0.0)) return makeError("renderVolumeExact: desc.tolerance must be positive");
+    if (desc.lighting) {
+        // The SDK's own checks of the lights and the gas desc (no points: nothing is lit).
+        std::vector<glm::vec3> none;
+        if (Status s = lightPoints({}, 0.0f, camera.eye(), desc.lighting->lights, nullptr, desc.lighting->gas, none); !s)
+            return makeError("renderVolumeExact: desc.lighting: " + s.error());
+    }
     const int W = camera.viewport.x, H = camera.viewport.y;
     const Footprint& fp = field.materials().footprint();
     const double R = fp.radius();
@@ -124,22 +139,23 @@ Result<Image> renderVolumeExact(const VolumeField& field, const Camera& camera, 
                 breaks.push_back(t0);
                 breaks.push_back(t1);
             }
+            const LitRay lit{&field, desc.lighting, glm::dvec3(camera.eye()), ray.origin, ray.dir};
             std::sort(breaks.begin(), breaks.end());
             breaks.erase(std::unique(breaks.begin(), breaks.end()), breaks.end());
             // Stop once what is left behind cannot change the pixel by tolerance / 1000.
             const double cutoff = desc.tolerance * 1e-3;
             RayResult res;
             if (desc.fixedStep > 0.0) {
-                res = integrate(cs, breaks, fp, desc.fixedStep, cutoff, local.kernelEvaluations);
+                res = integrate(cs, breaks, fp, desc.fixedStep, cutoff, local.kernelEvaluations, lit);
             } else {
                 double h = h0;
-                RayResult prev = integrate(cs, breaks, fp, h, cutoff, local.kernelEvaluations);
+                RayResult prev = integrate(cs, breaks, fp, h, cutoff, local.kernelEvaluations, lit);
                 res = prev;
                 double err = 0.0;
                 int level = 0;
                 for (level = 1; level <= desc.maxHalvings; ++level) {
                     h *= 0.5;
-                    res = integrate(cs, breaks, fp, h, cutoff, local.kernelEvaluations);
+                    res = integrate(cs, breaks, fp, h, cutoff, local.kernelEvaluations, lit);
                     err = std::abs(res.transmittance - prev.transmittance);
                     for (int c = 0; c < 3; ++c) err = std::max(err, std::abs(res.color[c] - prev.color[c]));
                     if (level >= desc.minHalvings && err < desc.tolerance) break;

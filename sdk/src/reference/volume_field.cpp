@@ -14,16 +14,29 @@ constexpr double kMaxTau = 24.0;
 bool finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 } // namespace
 
-VolumeField::VolumeField(const Materials& materials) : mMaterials(&materials), mCentreFootprint(materials.footprint().exact(0.0)) {}
+VolumeField::VolumeField(const Materials& materials) : mMaterials(&materials), mCentreFootprint(materials.footprint().exact(0.0)) {
+    // The last radius where the kernel is non-zero, by bisection to double precision: a chord
+    // clipped there holds one polynomial piece of the kernel (see segmentOpticalDepth).
+    const Footprint& fp = materials.footprint();
+    double lo = 0.0, hi = double(fp.radius()) * (1.0 + 1e-6);
+    for (int i = 0; i < 200 && hi - lo > 0.0; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        if (mid <= lo || mid >= hi) break;
+        (fp.kernel(mid) > 0.0 ? lo : hi) = mid;
+    }
+    mSupportRadius = hi;
+}
 
-void VolumeField::add(const Grid& grid, const SplatStyle& style) {
+void VolumeField::add(const Grid& grid, const SplatStyle& style, std::span<const glm::vec3> voxelColors) {
     const Materials& mat = *mMaterials;
     const double R = mat.footprint().radius();
     const bool hasTable = style.colorTable < mat.colorTableCount();
     const double opacityScale = std::isfinite(style.opacityScale) ? std::max(double(style.opacityScale), 0.0) : 0.0;
     const glm::dmat3 rot(glm::dmat4(grid.transform));
     const glm::dmat3 space(glm::dvec3(grid.spacing.x, 0, 0), glm::dvec3(0, grid.spacing.y, 0), glm::dvec3(0, 0, grid.spacing.z));
-    for (const Voxel& v : grid.voxels) {
+    const bool override = voxelColors.size() == grid.voxels.size() && !voxelColors.empty();
+    for (std::size_t vi = 0; vi < grid.voxels.size(); ++vi) {
+        const Voxel& v = grid.voxels[vi];
         // The kernel matrix exactly as SplatBuilder::add forms it, in double.
         glm::dmat3 m = rot * space;
         const glm::dvec3 st(v.stretch);
@@ -51,6 +64,7 @@ void VolumeField::add(const Grid& grid, const SplatStyle& style) {
         k.boundRadius = R * std::sqrt(glm::dot(m[0], m[0]) + glm::dot(m[1], m[1]) + glm::dot(m[2], m[2]));
         const std::uint32_t row = hasTable ? style.colorTable : 0u;
         k.color = row < mat.colorTableCount() ? reference::rowColor(mat.colorRow(row), std::clamp(double(v.colorCoord), 0.0, 1.0)) : glm::dvec3(1.0);
+        if (override) k.color = glm::dvec3(voxelColors[vi]);
         mKernels.push_back(k);
     }
 }
