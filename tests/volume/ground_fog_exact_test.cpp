@@ -260,25 +260,46 @@ TEST(GroundFogExact, SortFreeWithAColourRampShowsItsOrderError) {
 }
 
 // The host's depth (the terrain drawn first) ends every ray where it says,
-// in the camera's convention, and the background shows through by T.
+// in the camera's convention, and the background shows through by T: the
+// same as renderTetraExact on the tetrahedra, with the cut inside the layer.
 TEST(GroundFogExact, HostDepthAndBackgroundFollowTheOtherReferences) {
-    const GroundFogDesc d = valleys({9, 9}, 0.8f, 3.0f);
-    const TransferFunction tf = fogTransfer(1.5f);
-    const Camera cam = Camera::lookAt({-22.0f, 16.0f, -18.0f}, {0.0f, 0.0f, 0.0f}, {0, 1, 0}, glm::radians(55.0f), {16, 12}, 0.1f, 200.0f);
+    // A flat layer 0..2, the eye inside it at y = 1 looking level: a ray is
+    // still in the fog at view depth z when |tan(pitch)| < 1 / z.
+    const GroundFogDesc d = slab({9, 9}, 4.0f, 0.0f, 2.0f);
+    const TransferFunction tf = fogTransfer(0.2f);
+    const Camera cam = Camera::lookAt({-4.0f, 1.0f, 16.0f}, {32.0f, 1.0f, 16.0f}, {0, 1, 0}, glm::radians(20.0f), {16, 12}, 0.1f, 200.0f);
     Image depth;
     depth.width = 16, depth.height = 12, depth.channels = 1;
     depth.pixels.assign(16 * 12, 0.0f);
     for (int y = 0; y < 12; ++y)
-        for (int x = 0; x < 16; ++x) depth.at(x, y, 0) = 0.985f + 0.001f * float(x); // window depths across the layer
+        for (int x = 0; x < 16; ++x) {
+            // View depths 8 to 23 across the view, as GL window depths (near 0.1, far 200).
+            const double z = 8.0 + double(x);
+            depth.at(x, y, 0) = float(200.0 / 199.9 * (1.0 - 0.1 / z));
+        }
     const ReferenceHost host{.background = {0.1f, 0.2f, 0.3f, 1.0f}, .depth = &depth};
-    auto field = renderGroundFogExact(d, tf, cam, {.host = host});
-    auto tets = renderTetraExact(emit(d, cam), tf, cam, {.host = host, .tolerance = 1e-7});
+    GroundFogExactStats fs;
+    TetraExactStats ts;
+    auto field = renderGroundFogExact(d, tf, cam, {.host = host}, &fs);
+    auto tets = renderTetraExact(emit(d, cam), tf, cam, {.host = host, .tolerance = 1e-7}, &ts);
     ASSERT_TRUE(field && tets);
-    EXPECT_LT(maxDiff(*field, *tets), 1e-4); // the float bound of the tests above (coordinates <= 10) with both estimates < 1e-6
-    // The depth does cut: without it the image differs.
+    // Flat layer, heights exact in float: the scalars' rounding (2^-24
+    // relative, a few times) on optical depths <= 0.2 * 40, and the clipped
+    // near faces (coordinates <= 32) at extinction <= 0.2.
+    EXPECT_LT(maxDiff(*field, *tets), fs.maxErrorEstimate + ts.maxErrorEstimate + 0.2 * 40.0 * 4.0 * kFloatEps + 0.2 * 32.0 * kFloatEps);
+    // The depth cuts inside the layer: fog in front of it, less than without it.
     auto whole = renderGroundFogExact(d, tf, cam, {.host = {.background = {0.1f, 0.2f, 0.3f, 1.0f}}});
     ASSERT_TRUE(whole);
-    EXPECT_GT(maxDiff(*field, *whole), 1e-2);
+    int cut = 0;
+    for (int y = 0; y < 12; ++y)
+        for (int x = 0; x < 16; ++x) {
+            const double with = field->at(x, y, 0) - 0.1, without = whole->at(x, y, 0) - 0.1; // the fog's red over the background's
+            cut += with > 1e-3 && without > with + 1e-3 ? 1 : 0;
+        }
+    // Column x cuts at z = 8 + x: the rows (1.67 degrees apart, 20 degrees
+    // in all) with |pitch| < atan(1 / z), 8 rows at x = 0 down to 2 at x = 15,
+    // about 75 pixels; rays that leave the layer before the cut are not cut.
+    EXPECT_GT(cut, 16 * 12 / 3);
 }
 
 TEST(GroundFogExact, BadInputNamesTheField) {
