@@ -19,6 +19,8 @@
 
 #include <gtest/gtest.h>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "splatfx/reference.hpp"
 #include "splatfx/volume.hpp"
 #include "volume_test_util.hpp"
@@ -300,6 +302,42 @@ TEST(GroundFogExact, HostDepthAndBackgroundFollowTheOtherReferences) {
     // in all) with |pitch| < atan(1 / z), 8 rows at x = 0 down to 2 at x = 15,
     // about 75 pixels; rays that leave the layer before the cut are not cut.
     EXPECT_GT(cut, 16 * 12 / 3);
+}
+
+// An orthographic camera looking straight down: every pixel ray is a
+// vertical, along which the paper's scalar falls linearly from `density` to 0
+// over the thickness h, so the optical depth is extinction * density * h / 2.
+// With h affine in (x, z) (terrain 0, top 1 + 0.25 i + 0.125 j) each pixel has
+// its closed form at its centre, which pins GL's pixel conventions (centres,
+// top row first) for the orthographic mapping.
+TEST(GroundFogExact, OrthographicStraightDownIsTheVerticalIntegralAtPixelCentres) {
+    GroundFogDesc d = slab({9, 9}, 1.0f, 0.0f, 0.0f);
+    d.density = 0.75f;
+    for (int j = 0; j < 9; ++j)
+        for (int i = 0; i < 9; ++i) d.fogTop[std::size_t(i) + 9u * std::size_t(j)] = 1.0f + 0.25f * float(i) + 0.125f * float(j);
+    const TransferFunction tf = fogTransfer(0.5f);
+    // Eye above (4, 4), up -z: screen right is +x, screen up is -z; the box is 8 x 6 world units.
+    const glm::ivec2 size{16, 12};
+    const Camera cam = Camera::fromMatrices(glm::lookAt(glm::vec3(4.0f, 10.0f, 4.0f), glm::vec3(4.0f, 0.0f, 4.0f), glm::vec3(0.0f, 0.0f, -1.0f)),
+                                            glm::ortho(-4.0f, 4.0f, -3.0f, 3.0f, 0.5f, 20.0f), size);
+    ASSERT_FALSE(cam.perspective());
+    GroundFogExactStats fs;
+    auto img = renderGroundFogExact(d, tf, cam, {}, &fs);
+    ASSERT_TRUE(img) << img.error();
+    double worst = 0.0;
+    for (int y = 0; y < size.y; ++y)
+        for (int x = 0; x < size.x; ++x) {
+            const double wx = (4.0 - 4.0) + (x + 0.5) * 0.5;         // pixel centre from the box's left edge, x = 0
+            const double wz = 4.0 - (3.0 - (y + 0.5) * 0.5);         // top row first: screen up is -z
+            const double h = 1.0 + 0.25 * wx + 0.125 * wz;           // the top (terrain 0), affine
+            const double alpha = -std::expm1(-0.5 * 0.75 * h / 2.0); // extinction 0.5 per unit scalar; density 0.75f is exact in float
+            worst = std::max(worst, std::abs(double(img->at(x, y, 3)) - alpha));
+        }
+    // The scalar is linear along each vertical, so 4-point Gauss-Legendre is
+    // exact up to rounding; the float image (2^-24) and the float camera's
+    // unprojected pixel centres (|x|, |z| <= 8, relative 2^-24, times dh/dx
+    // <= 0.25 and d alpha / dh <= 0.19) are what is left.
+    EXPECT_LT(worst, fs.maxErrorEstimate + 2.0 * kFloatEps + 8.0 * kFloatEps * 0.25 * 0.19 * 8.0);
 }
 
 TEST(GroundFogExact, BadInputNamesTheField) {
