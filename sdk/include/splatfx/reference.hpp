@@ -302,10 +302,10 @@ struct GroundFogRayStats {
 // triangulation (cell (i, j) split along (i, j)-(i+1, j+1) when i + j is even,
 // else along (i+1, j)-(i, j+1), as GroundFog builds it) the terrain and the
 // thickness max(fogTop - terrain, 0) are linear (in double from the desc's
-// floats); between them the scalar is density (fogTop - y) / thickness (the
-// paper's: density at the terrain, 0 at the top, linear along every vertical)
-// or, with densityDepthWorld D > 0, density (fogTop - y) / D; transfer's
-// extinction and colour of it. Outside the grid there is no fog. Each stretch
+// floats); between the terrain and top = terrain + thickness the scalar is
+// density (top - y) / thickness (the paper's: density at the terrain, 0 at
+// the top, linear along every vertical) or, with densityDepthWorld D > 0,
+// min(density (top - y) / D, 1); transfer's extinction and colour of it. Outside the grid there is no fog. Each stretch
 // (per triangle, cut where the scalar crosses a control point of `transfer`)
 // is integrated by 4-point Gauss-Legendre steps, halved until two results
 // differ by less than `tolerance` (at most maxHalvings times).
