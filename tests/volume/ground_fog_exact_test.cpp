@@ -340,6 +340,51 @@ TEST(GroundFogExact, OrthographicStraightDownIsTheVerticalIntegralAtPixelCentres
     EXPECT_LT(worst, fs.maxErrorEstimate + 2.0 * kFloatEps + 8.0 * kFloatEps * 0.25 * 0.19 * 8.0);
 }
 
+// The outside validation kept: tools/validate/ground_fog.py (standard library
+// only, written from the definition: point-wise field, midpoint rule with
+// 200,000 and 400,000 steps) printed these values for its case, the same as
+// `splatfx-bench groundfog --validate-case`. Each ray's tolerance is the
+// script's own step-doubling estimate (the midpoint rule is first order at
+// the layer's boundaries, so its 2N result is off by about the N-2N
+// difference) plus the 5e-8 of its 7 printed decimals.
+TEST(GroundFogExact, AgreesWithTheIndependentQuadrature) {
+    GroundFogDesc d;
+    d.dims = {3, 3};
+    d.originWorld = {-1.0f, 0.0f, 0.5f};
+    d.spacingWorld = 1.5f;
+    d.terrainHeight = {0.0f, 0.4f, 1.1f, 0.2f, -0.3f, 0.6f, 0.9f, 0.1f, -0.2f};
+    d.fogTop = {1.2f, 1.0f, 0.9f, 1.4f, 1.6f, 1.0f, 1.3f, 0.8f, 1.1f};
+    d.density = 0.8f;
+    auto tf = TransferFunction::create({{0.0f, {1.0f, 0.9f, 0.8f}, 0.0f}, {0.4f, {0.6f, 0.7f, 0.9f}, 1.2f}, {1.0f, {0.2f, 0.3f, 0.7f}, 2.0f}});
+    ASSERT_TRUE(tf);
+    const glm::dvec3 rays[4][2] = {{{-2.0, 2.5, 0.0}, {1.0, -0.6, 0.7}},
+                                   {{3.5, 0.8, 1.2}, {-1.0, 0.05, 0.3}},
+                                   {{0.1, 3.0, 2.0}, {0.05, -1.0, 0.02}},
+                                   {{-1.5, 0.7, 3.9}, {1.0, 0.0, -0.8}}};
+    struct Expected {
+        glm::dvec4 rgba;
+        double estimate;
+    };
+    const Expected paper[4] = {{{0.6346155, 0.6791503, 0.8050912, 0.9355138}, 2.8e-6},
+                               {{0.6513922, 0.6994947, 0.8183733, 0.9344965}, 1.5e-6},
+                               {{0.5128357, 0.5665983, 0.7135334, 0.8366037}, 7.1e-6},
+                               {{0.4746828, 0.5718185, 0.8262737, 0.9849529}, 6.1e-6}};
+    const Expected affine[4] = {{{0.6387196, 0.6394742, 0.6806205, 0.8002861}, 4.5e-6},
+                                {{0.6270608, 0.6078574, 0.6158432, 0.7358175}, 2.1e-6},
+                                {{0.5220036, 0.5570492, 0.6529528, 0.7541835}, 8.7e-6},
+                                {{0.6813281, 0.6894008, 0.7451020, 0.8718419}, 1.9e-6}};
+    for (float depth : {0.0f, 2.5f}) {
+        d.densityDepthWorld = depth;
+        for (int r = 0; r < 4; ++r) {
+            const Expected& e = depth == 0.0f ? paper[r] : affine[r];
+            GroundFogRayStats rs;
+            const glm::dvec4 c = integrateGroundFogRay(d, *tf, rays[r][0], glm::normalize(rays[r][1]), 0.0, 10.0, 1e-9, 14, &rs);
+            for (int ch = 0; ch < 4; ++ch)
+                EXPECT_NEAR(c[ch], e.rgba[ch], e.estimate + 5e-8 + rs.errorEstimate) << "depth " << depth << " ray " << r << " channel " << ch;
+        }
+    }
+}
+
 TEST(GroundFogExact, BadInputNamesTheField) {
     const GroundFogDesc d = valleys({5, 5}, 0.8f, 0.0f);
     const TransferFunction tf = fogTransfer(1.0f);
