@@ -20,6 +20,7 @@ Usage: python3 tools/validate/ground_fog.py [--steps N]
 """
 import argparse
 import math
+import struct
 
 # The case (the same numbers as splatfx-bench groundfog --validate-case).
 NX, NZ = 3, 3
@@ -45,7 +46,6 @@ RAYS = [((-2.0, 2.5, 0.0), (1.0, -0.6, 0.7), 10.0),
 
 def f32(x):
     """Round to IEEE single precision, as the desc's float heights are."""
-    import struct
     return struct.unpack('f', struct.pack('f', x))[0]
 
 
