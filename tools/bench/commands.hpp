@@ -12,7 +12,7 @@ int runScheduling(int argc, char** argv);   // scheduling.cpp: 1000 effects, 10 
 int runShadows(int argc, char** argv);      // shadows.cpp: Ebert & Parent 1990 Table 2, shadow tables vs tracing (issue 16)
 int runFog(int argc, char** argv);          // fog.cpp: Biri et al. 2002 Table 1, fog cost per pixel and per fog texture (issue 14)
 int runClouds(int argc, char** argv);       // clouds.cpp: LOD volumes as projected tetrahedra, flight, popping (issue 17)
-int runGroundFog(int argc, char** argv);    // groundfog.cpp: LOD ground fog over the Jacksboro DEM: count, time, error, popping (issue 17)
+int runGroundFog(int argc, char** argv);    // groundfog.cpp: LOD ground fog over the Jacksboro DEM: count, time, error, popping (issue 17); --knobs vs the exact field (issue 24)
 int runCut(int argc, char** argv);          // cut.cpp: splats cut by the host depth and the near plane: cost, accuracy, popping (issue 15)
 int runSoak(int argc, char** argv);         // soak.cpp: every preset for an hour of scene time; finite, flat bounds and memory (issue 13)
 int runTransparency(int argc, char** argv); // transparency.cpp: glass panes among the fire, fragment lists vs ordered blend (issue 15)
@@ -37,7 +37,7 @@ inline constexpr BenchCommand kCommands[] = {
     {"table1", "King et al. 1999 Table I on this machine, fill limit, naive baseline, CPU scaling", runTable1},
     {"clouds", "LOD cloud volumes as tetrahedra: count vs full, frame rate and memory outside/inside, popping", runClouds},
     {"lodrefine", "LOD cloud refinement on the CPU: tetrahedra per frame vs full, update() time, memory, error vs finest", runLodRefine},
-    {"groundfog", "LOD ground fog over the Jacksboro DEM: count vs full, ms/frame, error vs full, popping with/without morphing", runGroundFog},
+    {"groundfog", "LOD ground fog over the Jacksboro DEM: count vs full, ms/frame, error vs full, popping with/without morphing; --knobs: every knob vs the exact field, Pareto", runGroundFog},
     {"scheduling", "a level of 1000 effects with 10 in view vs those 10 alone; camera sweep; catch-up error", runScheduling},
     {"lighting", "every lighting knob (self-shadow, table size, lobes, samples per voxel, 8-bit) vs the lit volume reference, Pareto", runLighting},
     {"shadows", "Ebert & Parent 1990 Table 2: steam from a glass, no/geometry/traced/table shadowing, table error", runShadows},

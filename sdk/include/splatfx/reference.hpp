@@ -40,6 +40,11 @@
 //    numerically; what gl::FrameRenderer's tetrahedra pass with per-segment
 //    fog is measured against.
 //
+//  * Ground fog (renderGroundFogExact, integrateGroundFogRay): the layer of
+//    Roettger & Ertl sec. 6 between the terrain and the fog top as a
+//    continuous field, not its tetrahedra, so the prisms' split, the LOD and
+//    the sort-free mode each show their error against it.
+//
 // It does NOT: draw anything with GL, apply the splat builder's near-plane
 // fade in volume mode (rays simply start at the near plane), model textured
 // detail in volume mode (the field is the traditional, untextured one), or
@@ -359,5 +364,54 @@ struct TetraExactStats {
 // tolerance or maxHalvings, or an orthographic camera.
 Result<Image> renderTetraExact(const std::vector<Tetrahedron>& tets, const TransferFunction& transfer, const Camera& camera,
                                const TetraExactDesc& desc = {}, TetraExactStats* stats = nullptr);
+
+// ---- Ground fog (Roettger & Ertl 2002, sec. 6): the layer's continuous field ----
+
+struct GroundFogRayStats {
+    double errorEstimate = 0.0; // sum of the pieces' last step-halving differences
+    bool converged = true;      // every piece met the tolerance
+    std::uint64_t pieces = 0;   // stretches integrated (per triangle, cut at the transfer's control points)
+    double transmittance = 1.0; // through the whole ray
+};
+
+// The emission-absorption integral of a ground fog layer along origin + t dir,
+// t in [tNear, tFar] (multiples of |dir|), through the field the prisms stand
+// for, not through any tetrahedra: over each triangle of the full-resolution
+// triangulation (cell (i, j) split along (i, j)-(i+1, j+1) when i + j is even,
+// else along (i+1, j)-(i, j+1), as GroundFog builds it) the terrain and the
+// thickness max(fogTop - terrain, 0) are linear (in double from the desc's
+// floats); between the terrain and top = terrain + thickness the scalar is
+// density (top - y) / thickness (the paper's: density at the terrain, 0 at
+// the top, linear along every vertical) or, with densityDepthWorld D > 0,
+// min(density (top - y) / D, 1); transfer's extinction and colour of it. Outside the grid there is no fog. Each stretch
+// (per triangle, cut where the scalar crosses a control point of `transfer`)
+// is integrated by 4-point Gauss-Legendre steps, halved until two results
+// differ by less than `tolerance` (at most maxHalvings times).
+// Premultiplied RGBA, front to back. Expects a desc GroundFog::create accepts
+// (desc.lod and desc.sortFree are ignored: the field is the same); gives 0 for
+// a bad one or a non-finite ray.
+glm::dvec4 integrateGroundFogRay(const GroundFogDesc& desc, const TransferFunction& transfer, glm::dvec3 origin, glm::dvec3 dir, double tNear,
+                                 double tFar, double tolerance = 1e-7, int maxHalvings = 14, GroundFogRayStats* stats = nullptr);
+
+struct GroundFogExactDesc {
+    ReferenceHost host{};    // default: transparent black, no depth (a depth that is NaN or < 0 is ignored)
+    double tolerance = 1e-7; // per stretch, as integrateGroundFogRay; default 1e-7
+    int maxHalvings = 14;    // in [1, 20]; default 14
+    int threads = 0;         // 0 = std::thread::hardware_concurrency(); default 0
+};
+struct GroundFogExactStats {
+    double maxErrorEstimate = 0.0; // largest GroundFogRayStats::errorEstimate of a pixel
+    std::uint64_t unconverged = 0; // pixels whose integral missed the tolerance somewhere
+    std::uint64_t pieces = 0;      // stretches integrated over all pixels
+};
+
+// integrateGroundFogRay through every pixel centre (GL's conventions, as the
+// other modes) from the near plane to the far plane or the host depth, then
+// C + T * background: what GroundFog's tetrahedra, at full resolution or LOD,
+// sorted or sort-free, drawn by gl::FrameRenderer are measured against.
+// Perspective or orthographic. Fails on a bad host image, tolerance or
+// maxHalvings, or a fog desc GroundFog::create rejects (its message).
+Result<Image> renderGroundFogExact(const GroundFogDesc& fog, const TransferFunction& transfer, const Camera& camera,
+                                   const GroundFogExactDesc& desc = {}, GroundFogExactStats* stats = nullptr);
 
 } // namespace splatfx
