@@ -214,7 +214,9 @@ TEST(VdbStability, AUniformTemperatureWithAnAutomaticRangeIsHotNotNaN) {
     auto seq = loadVdb((dir / "u.vdb").string(), {.velocityGrid = "", .voxelsPerCell = 2});
     ASSERT_TRUE(seq) << seq.error();
     for (std::size_t i = 0; i < seq->cellCount(); ++i)
-        if (seq->frames[0].opticalDepth[i] > 0.0f) EXPECT_EQ(seq->frames[0].colorCoord[i], 0.0f);
+        if (seq->frames[0].opticalDepth[i] > 0.0f) {
+            EXPECT_EQ(seq->frames[0].colorCoord[i], 0.0f);
+        }
 }
 
 // Velocities of 10^20 voxels/s are finite and scaled (the playback clamps
