@@ -133,3 +133,19 @@ TEST(VdbReference, TrilinearAndNearestAgreeAlongAColumnOfConstantDensity) {
     EXPECT_NEAR(t[4], 1.5 * 6 * 0.2, depthTolerance(1.8));
     EXPECT_NEAR(t[0], 0.0, 1e-12) << "the trilinear reading is 0 along the neighbouring centres";
 }
+
+// The reference's dense copy is bounded: two voxels 1000 apart make a box of
+// 1001 voxels, refused under a budget of 1000 naming the grid and the budget
+// (a file whose active box is huge cannot make the reference allocate it).
+TEST(VdbReference, ADenseBoxOverTheBudgetIsRefusedNamingIt) {
+    const fs::path dir = tempDir();
+    auto g = densityGrid(0.1);
+    g->tree().setValue({0, 0, 0}, 1.0f);
+    g->tree().setValue({1000, 0, 0}, 1.0f);
+    write(dir / "far.vdb", {g});
+    auto v = readVdbDensity((dir / "far.vdb").string(), densityOnly(1), 1000);
+    ASSERT_FALSE(v);
+    EXPECT_NE(v.error().find("grid 'density'"), std::string::npos) << v.error();
+    EXPECT_NE(v.error().find("1001 voxels, more than 1000 (readVdbDensity's maxVoxels)"), std::string::npos) << v.error();
+    EXPECT_TRUE(readVdbDensity((dir / "far.vdb").string(), densityOnly(1), 1001)) << "at the budget it is read";
+}
