@@ -111,9 +111,7 @@ TEST(GasReference, LatticeSamplingErrorFallsAtFirstOrderWithTheSpacing) {
         f.addMedium(sampledMedium(*sampleProceduralGas(g0, lattice(h), 2.5)));
         const double err = maxAlphaDifference(*renderVolumeExact(f, kCamera, {.tolerance = 1e-4}), truth);
         std::printf("h %.4f: max alpha error %.4f\n", h, err);
-        if (prev > 0.0) {
-            EXPECT_LT(err, prev / std::sqrt(2.0)) << h;
-        }
+        if (prev > 0.0) { EXPECT_LT(err, prev / std::sqrt(2.0)) << h; }
         prev = err;
     }
     EXPECT_GT(prev, 1e-3);
@@ -134,7 +132,7 @@ TEST(GasReference, ThresholdErrorIsBoundedByWhatTheThresholdRemoves) {
     cut.addMedium(proceduralGasMedium(gas, lattice(0.125), 2.5, mat, {.cellLength = kCell, .threshold = theta}));
     const VolumeExactDesc rd{.tolerance = 1e-4, .initialStep = 1.0 / 64};
     const Image a = *renderVolumeExact(full, kCamera, rd), b = *renderVolumeExact(cut, kCamera, rd);
-    const double chord = std::sqrt(3.0) * (2.0 + 0.125); // the box's diagonal bounds every chord
+    const double chord = std::sqrt(3.0) * (2.0 + 0.125);                    // the box's diagonal bounds every chord
     const double bound = 1.0 - std::pow(1.0 - theta, chord / kCell) + 2e-4; // + both quadratures' tolerance
     double worst = 0.0;
     for (int y = 0; y < a.height; ++y)

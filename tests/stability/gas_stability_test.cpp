@@ -85,9 +85,9 @@ TEST(GasStability, SteamAtAMillionSecondsMovesAsSmoothlyAsAtTen) {
 // is the same gas. Checked for the steam's rise at the scene clock's limit.
 TEST(GasStability, RiseByOneTurbulencePeriodAtTheClockLimitGivesTheSameGas) {
     ProceduralGasDesc d = gas(GasKind::Steam);
-    d.steam.swirlRadius = 0.0f;     // no swirl: the rise alone moves the gas
-    d.turbulence.frequency = 2.0f;  // period 128 world units
-    d.steam.riseSpeed = 0.5f;       // 256 s per period
+    d.steam.swirlRadius = 0.0f;    // no swirl: the rise alone moves the gas
+    d.turbulence.frequency = 2.0f; // period 128 world units
+    d.steam.riseSpeed = 0.5f;      // 256 s per period
     const double t = kMaxTimeSec - 256.0;
     EXPECT_LE(change(d, t, t + 256.0).largest, 1e-5f) << "float rounding of the density only";
     EXPECT_GT(change(d, t, t + 1.0).present, 10);

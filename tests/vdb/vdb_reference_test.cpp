@@ -75,9 +75,7 @@ TEST(VdbReference, AConstantBlockAlignedFieldRendersIdenticallyBothWays) {
     for (std::size_t i = 0; i < a.size(); ++i) {
         EXPECT_NEAR(a[i], b[i], depthTolerance(a[i])) << i;
         inside += a[i] > 0.0;
-        if (a[i] > 0.0) {
-            EXPECT_NEAR(a[i], 0.8 * 16 * 0.1, depthTolerance(a[i])) << "tau = density * depth";
-        }
+        if (a[i] > 0.0) { EXPECT_NEAR(a[i], 0.8 * 16 * 0.1, depthTolerance(a[i])) << "tau = density * depth"; }
     }
     EXPECT_EQ(inside, 12 * 8);
 }

@@ -200,8 +200,7 @@ TEST(VdbStability, ActiveZeroDensityVoxelsAddNothingAndWeighNothing) {
     d->tree().setValue({1, 0, 0}, 0.0f), t->tree().setValue({1, 0, 0}, 5000.0f); // active, empty: its heat is not seen
     d->tree().setValue({4, 0, 0}, 0.0f), t->tree().setValue({4, 0, 0}, 900.0f);  // a block of nothing but empty air
     write(dir / "z.vdb", {d, t});
-    auto seq = loadVdb((dir / "z.vdb").string(),
-                       {.velocityGrid = "", .voxelsPerCell = 2, .temperatureHot = 500.0f, .temperatureCold = 300.0f});
+    auto seq = loadVdb((dir / "z.vdb").string(), {.velocityGrid = "", .voxelsPerCell = 2, .temperatureHot = 500.0f, .temperatureCold = 300.0f});
     ASSERT_TRUE(seq) << seq.error();
     ASSERT_EQ(seq->dims.x, 3);
     EXPECT_NEAR(seq->frames[0].colorCoord[0], 1.0 - (400.0 - 300.0) / 200.0, 1e-6);
@@ -236,9 +235,7 @@ TEST(VdbStability, AUniformTemperatureWithAnAutomaticRangeIsHotNotNaN) {
     auto seq = loadVdb((dir / "u.vdb").string(), {.velocityGrid = "", .voxelsPerCell = 2});
     ASSERT_TRUE(seq) << seq.error();
     for (std::size_t i = 0; i < seq->cellCount(); ++i)
-        if (seq->frames[0].opticalDepth[i] > 0.0f) {
-            EXPECT_EQ(seq->frames[0].colorCoord[i], 0.0f);
-        }
+        if (seq->frames[0].opticalDepth[i] > 0.0f) { EXPECT_EQ(seq->frames[0].colorCoord[i], 0.0f); }
 }
 
 // Velocities of 10^20 voxels/s are finite and scaled (the playback clamps
@@ -455,8 +452,8 @@ TEST(VdbStability, ALatticeOfOddAndEvenBlockCountsSitsOnTheFilesVoxels) {
     g->tree().fill(openvdb::CoordBBox({0, 0, 0}, {11, 7, 7}), 0.5f, true); // 3 x 2 x 2 blocks of 4
     write(dir / "place.vdb", {g});
     // Pixel size s, grid of pixel centres shifted to 0.05 voxel inside each voxel's upper edge.
-    const BothWays r = renderBothWays(dir / "place.vdb", 4, orthoAlongZ({0.37 - 0.5 * s + 0.45 * s - 2 * s, -1.13 - 0.5 * s + 0.45 * s - 2 * s},
-                                                                        {16, 12}, s, 3.0));
+    const BothWays r =
+        renderBothWays(dir / "place.vdb", 4, orthoAlongZ({0.37 - 0.5 * s + 0.45 * s - 2 * s, -1.13 - 0.5 * s + 0.45 * s - 2 * s}, {16, 12}, s, 3.0));
     ASSERT_EQ(r.file.size(), 192u);
     int inside = 0;
     for (std::size_t i = 0; i < r.file.size(); ++i) {

@@ -36,7 +36,7 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
-constexpr double kTime = 2.5;     // scene time of the measured frame
+constexpr double kTime = 2.5;      // scene time of the measured frame
 constexpr double kSpacing = 0.125; // the default lattice spacing, and the gas's cellLength
 
 // The steam's lattice over [-1, 1] x [0, 2] x [-1, 1] at spacing h.
@@ -75,7 +75,7 @@ int validation() {
     f.addMedium(splatfx::proceduralGasMedium(gas, lattice(kSpacing), kTime, mat, {.cellLength = kSpacing}));
     // 0.15 x 0.3 pixels over x in [-0.3, 0.3], y in [0.35, 1.25].
     const splatfx::Camera cam = splatfx::Camera::fromMatrices(glm::lookAt(glm::vec3(0.0f, 0.8f, 3.0f), glm::vec3(0.0f, 0.8f, 0.0f), {0, 1, 0}),
-                                                               glm::ortho(-0.3f, 0.3f, -0.45f, 0.45f, 0.01f, 6.0f), {4, 3});
+                                                              glm::ortho(-0.3f, 0.3f, -0.45f, 0.45f, 0.01f, 6.0f), {4, 3});
     splatfx::VolumeExactStats st;
     auto img = splatfx::renderVolumeExact(f, cam, {.tolerance = 1e-8, .initialStep = 1.0 / 256, .maxHalvings = 14, .threads = 0}, &st);
     if (!img) return std::fprintf(stderr, "gases: %s\n", img.error().c_str()), 1;
@@ -168,7 +168,10 @@ int runGases(int argc, char** argv) {
         f.add(g, {.colorTable = 0});
         auto img = splatfx::renderVolumeExact(f, cam, {.tolerance = 1e-4});
         if (!img) return std::fprintf(stderr, "gases: %s\n", img.error().c_str()), 1;
-        bench::KnobRow row{.knob = s.knob, .setting = s.setting, .ms = bench::median(ms)};
+        bench::KnobRow row;
+        row.knob = s.knob;
+        row.setting = s.setting;
+        row.ms = bench::median(ms);
         bench::imageError(*img, *truth, row.rmse, row.maxErr);
         // The same samples read trilinearly (no splat kernel): the lattice sampling's own share.
         splatfx::VolumeField tf(mat);
@@ -190,7 +193,8 @@ int runGases(int argc, char** argv) {
     if (noPlots) return 0;
     std::error_code ec;
     std::filesystem::create_directories(out, ec);
-    return bench::writePlot(rows, out, "gases", "procedural gas (steam): error vs the continuous gas per knob", "CPU ms per frame: sample + build splats (median)")
+    return bench::writePlot(rows, out, "gases", "procedural gas (steam): error vs the continuous gas per knob",
+                            "CPU ms per frame: sample + build splats (median)")
                ? 0
                : 1;
 }

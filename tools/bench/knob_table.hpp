@@ -18,10 +18,10 @@ namespace bench {
 
 struct KnobRow {
     std::string knob, setting;
-    double ms = 0.0;      // the setting's cost (what the command says it times)
-    double rmse = 0.0;    // premultiplied RGBA over black, against the reference
-    double maxErr = 0.0;  // largest channel difference of any pixel
-    std::string extra;    // one more column (cells, splats)
+    double ms = 0.0;     // the setting's cost (what the command says it times)
+    double rmse = 0.0;   // premultiplied RGBA over black, against the reference
+    double maxErr = 0.0; // largest channel difference of any pixel
+    std::string extra;   // one more column (cells, splats)
     bool isDefault = false;
     bool pareto = false;
 };

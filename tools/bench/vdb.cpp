@@ -80,16 +80,18 @@ int runVdb(int argc, char** argv) {
         const splatfx::Materials mat = whiteMaterials(splatfx::Kernel::CrawfisMax);
         splatfx::VolumeField f(mat);
         f.addMedium(splatfx::denseMedium(std::make_shared<splatfx::DenseVoxels>(*v), splatfx::DenseFilter::Trilinear, 1.0));
-        // Rays along -z through x = 0.3 + 0.4 i, y = -0.2 + 0.5 j (row 0 on top): the grid's voxels and its tile.
-        const splatfx::Camera cam = splatfx::Camera::fromMatrices(glm::lookAt(glm::vec3(1.1f, 0.55f, 8.0f), glm::vec3(1.1f, 0.55f, 0.0f), {0, 1, 0}),
-                                                                  glm::ortho(-1.0f, 1.0f, -1.0f, 1.0f, 0.01f, 16.0f), {5, 4});
+        // Rays along -z through x = (i + 1/2) 0.45, y = -0.45 + (4 - 1 - j + 1/2) 0.5 (row 0 on top):
+        // the grid's voxels (x < 1.25), the gap, and the tile (x in [1.875, 3.875]).
+        const splatfx::Camera cam = splatfx::Camera::fromMatrices(glm::lookAt(glm::vec3(1.8f, 0.55f, 8.0f), glm::vec3(1.8f, 0.55f, 0.0f), {0, 1, 0}),
+                                                                  glm::ortho(-1.8f, 1.8f, -1.0f, 1.0f, 0.01f, 16.0f), {8, 4});
         splatfx::VolumeExactStats st;
         auto img = splatfx::renderVolumeExact(f, cam, {.tolerance = 1e-9, .maxHalvings = 14}, &st);
         if (!img) return std::fprintf(stderr, "vdb: %s\n", img.error().c_str()), 1;
         std::printf("# %s/validation.vdb, trilinear, extinction 1, rays along -z; reference error estimate %.1e, unconverged %llu\nx,y,alpha\n",
                     out.c_str(), st.maxErrorEstimate, (unsigned long long)st.unconverged);
         for (int j = 0; j < 4; ++j)
-            for (int i = 0; i < 5; ++i) std::printf("%.17g,%.17g,%.9f\n", 0.1 + (i + 0.5) * 0.4, -0.45 + (4 - 1 - j + 0.5) * 0.5, double(img->at(i, j, 3)));
+            for (int i = 0; i < 8; ++i)
+                std::printf("%.17g,%.17g,%.9f\n", (i + 0.5) * 0.45, -0.45 + (4 - 1 - j + 0.5) * 0.5, double(img->at(i, j, 3)));
         return 0;
     }
 
@@ -100,8 +102,8 @@ int runVdb(int argc, char** argv) {
     const glm::dvec3 lo = voxels->origin, hi = voxels->origin + glm::dvec3(voxels->dims - 1) * voxels->voxelSize;
     const glm::dvec3 centre = 0.5 * (lo + hi);
     const double extent = glm::length(hi - lo);
-    const splatfx::Camera cam = splatfx::Camera::lookAt(glm::vec3(centre + glm::dvec3(0.35, 0.2, 1.0) * 1.6 * extent), glm::vec3(centre), {0, 1, 0},
-                                                        0.7f, size);
+    const splatfx::Camera cam =
+        splatfx::Camera::lookAt(glm::vec3(centre + glm::dvec3(0.35, 0.2, 1.0) * 1.6 * extent), glm::vec3(centre), {0, 1, 0}, 0.7f, size);
     const splatfx::Materials crawfis = whiteMaterials(splatfx::Kernel::CrawfisMax), gaussian = whiteMaterials(splatfx::Kernel::Gaussian);
     splatfx::VolumeField truthField(crawfis);
     truthField.addMedium(splatfx::denseMedium(voxels, splatfx::DenseFilter::Trilinear, 1.0));
@@ -151,7 +153,10 @@ int runVdb(int argc, char** argv) {
             c.addMedium(latticeCubes(*seq));
             auto cub = splatfx::renderVolumeExact(c, cam, {.tolerance = 1e-5});
             if (!img || !cub) return std::fprintf(stderr, "vdb: render failed\n"), 1;
-            bench::KnobRow row{.knob = gauss ? "splat filter" : "voxels per cell", .setting = gauss ? "Gaussian" : std::to_string(n), .ms = bench::median(frameMs)};
+            bench::KnobRow row;
+            row.knob = gauss ? "splat filter" : "voxels per cell";
+            row.setting = gauss ? "Gaussian" : std::to_string(n);
+            row.ms = bench::median(frameMs);
             bench::imageError(*img, *truth, row.rmse, row.maxErr);
             double cr = 0.0, cm = 0.0;
             bench::imageError(*cub, *truth, cr, cm);
@@ -173,7 +178,10 @@ int runVdb(int argc, char** argv) {
     bench::markPareto(rows);
     bench::printTable(rows, "CPU ms/frame (sample + splats)", "splats | RMSE as cubes | import ms");
     if (noPlots) return 0;
-    return bench::writePlot(rows, out, "vdb", "OpenVDB import: error vs the file at full resolution per knob", "CPU ms per frame: sample + build splats (median)") ? 0 : 1;
+    return bench::writePlot(rows, out, "vdb", "OpenVDB import: error vs the file at full resolution per knob",
+                            "CPU ms per frame: sample + build splats (median)")
+               ? 0
+               : 1;
 }
 
 #else

@@ -14,6 +14,7 @@ difference.
 """
 import csv
 import math
+import struct
 import sys
 
 M64 = (1 << 64) - 1
@@ -98,15 +99,14 @@ def steam(perm, p, t):
 
 
 def f32(v):
-    # The SDK evaluates the density at a float world point.
-    import struct
+    """The nearest float: the SDK takes the world point as floats and returns a float density."""
     return struct.unpack('f', struct.pack('f', v))[0]
 
 
 def optical_depth(perm, x, y, t, cell, z0, z1):
     def sigma(z):
         d = steam(perm, (f32(x), f32(y), f32(z)), t)
-        d = float(struct_f32(d))
+        d = f32(d)
         return 0.0 if d <= 0.0 else -math.log1p(-min(d, 1.0)) / cell if d < 1.0 else 24.0 * math.log(2.0) / cell
 
     def simpson(n):
@@ -124,10 +124,6 @@ def optical_depth(perm, x, y, t, cell, z0, z1):
         if n >= 1 << 16:
             return cur
         prev, n = cur, n * 2
-
-
-def struct_f32(v):
-    return f32(v)
 
 
 def main():

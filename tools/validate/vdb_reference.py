@@ -27,7 +27,7 @@ def write(folder):
         for y in range(4):
             for x in range(5):
                 acc.setValueOn((x, y, z), 0.2 + 0.1 * ((7 * x + 3 * y + 5 * z) % 11))
-    g.fill((8, 0, -4), (15, 7, 3), 0.6, True)  # one 8^3 constant region (OpenVDB stores it as a tile)
+    g.fill((8, 0, 0), (15, 7, 7), 0.6, True)  # one 8^3 node-aligned constant region: OpenVDB stores it as a tile
     os.makedirs(folder, exist_ok=True)
     vdb.write(os.path.join(folder, 'validation.vdb'), grids=[g])
 

@@ -188,9 +188,9 @@ enum class DenseFilter {
 
 // Axis-aligned cubic voxels (e.g. an OpenVDB grid at full resolution, tiles filled): value 0 outside.
 struct DenseVoxels {
-    glm::ivec3 dims{0};     // voxels along x, y, z
-    glm::dvec3 origin{0.0}; // world centre of voxel (0, 0, 0)
-    double voxelSize = 1.0; // world edge of a voxel, > 0
+    glm::ivec3 dims{0};          // voxels along x, y, z
+    glm::dvec3 origin{0.0};      // world centre of voxel (0, 0, 0)
+    double voxelSize = 1.0;      // world edge of a voxel, > 0
     std::vector<float> values{}; // x fastest, then y, then z; dims.x * dims.y * dims.z entries
 };
 

@@ -38,7 +38,9 @@ ContinuousMedium denseMedium(std::shared_ptr<const DenseVoxels> voxels, DenseFil
     m.boxMax = v.origin + (glm::dvec3(v.dims - 1) + reach) * s;
     m.featureSize = s;
     const glm::dvec3 first = filter == DenseFilter::Nearest ? v.origin - 0.5 * s : v.origin;
-    m.breaks = [first, s](glm::dvec3 o, glm::dvec3 d, double t0, double t1, std::vector<double>& out) { planeCrossings(o, d, t0, t1, first, s, out); };
+    m.breaks = [first, s](glm::dvec3 o, glm::dvec3 d, double t0, double t1, std::vector<double>& out) {
+        planeCrossings(o, d, t0, t1, first, s, out);
+    };
     m.sample = [voxels, filter, extinctionPerValue, color](glm::dvec3 p) {
         const DenseVoxels& g = *voxels;
         const glm::dvec3 u = (p - g.origin) / g.voxelSize; // in voxel units, centres on integers

@@ -509,7 +509,8 @@ Result<DenseVoxels> readVdbDensity(const std::string& path, const VdbImportDesc&
         const auto grid = openvdb::gridConstPtrCast<openvdb::FloatGrid>(file.readGrid(desc.densityGrid));
         file.close();
         if (!grid) return makeError(at + "could not be read as a float grid");
-        if (grid->background() != 0.0f) return makeError(at + "has background " + num(grid->background()) + "; a density grid's empty space must be 0");
+        if (grid->background() != 0.0f)
+            return makeError(at + "has background " + num(grid->background()) + "; a density grid's empty space must be 0");
         double vs = 0.0;
         openvdb::Vec3d origin;
         if (Status s = checkTransform(grid->transform(), at, vs, origin); !s) return makeError(s.error());
@@ -531,11 +532,10 @@ Result<DenseVoxels> readVdbDensity(const std::string& path, const VdbImportDesc&
             const openvdb::Coord r = c - box.min();
             out.values[(std::size_t(r.z()) * std::size_t(dim.y()) + std::size_t(r.y())) * std::size_t(dim.x()) + std::size_t(r.x())] = d;
         };
-        forEachActive(
-            *grid, set, [&](const openvdb::CoordBBox& tile, float d) {
-                const openvdb::CoordBBox b(openvdb::Coord::maxComponent(tile.min(), box.min()), openvdb::Coord::minComponent(tile.max(), box.max()));
-                for (auto c = b.begin(); c; ++c) set(*c, d);
-            });
+        forEachActive(*grid, set, [&](const openvdb::CoordBBox& tile, float d) {
+            const openvdb::CoordBBox b(openvdb::Coord::maxComponent(tile.min(), box.min()), openvdb::Coord::minComponent(tile.max(), box.max()));
+            for (auto c = b.begin(); c; ++c) set(*c, d);
+        });
         if (bad) return makeError(at + "holds negative, NaN or infinite densities; a density must be finite and >= 0");
         return out;
     } catch (const std::exception& e) { return makeError("OpenVDB file '" + path + "' (frame 0): " + e.what()); }
