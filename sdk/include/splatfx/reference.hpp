@@ -211,7 +211,9 @@ struct GasMediumDesc {
     // lattice's cell, cbrt of its spacings' product. Default 0.
     double cellLength = 0.0;
     // Densities at most this are empty (the sampler's threshold); the
-    // continuous gas has none, so its error is measured. Default 0.
+    // continuous gas has none, so its error is measured. Its jumps are not
+    // break points: there the quadrature converges at first order and may
+    // stop at up to about twice its tolerance. Default 0.
     double threshold = 0.0;
     // Lattice rows (cell y) mapped to colour coordinate 0 and 1, linear in
     // between and clamped, as Grid::colorByHeight does for the cells present.
