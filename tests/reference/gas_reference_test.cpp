@@ -3,6 +3,7 @@
 // lattice points, so the lattice sampling and the threshold show their error.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 
 #include <gtest/gtest.h>
@@ -88,8 +89,10 @@ TEST(GasReference, MediumAtTheLatticePointsIsTheSampledGrid) {
 // The lattice sampling's error: the gas read trilinearly from its lattice
 // samples against the continuous gas, both through the same integrator, at
 // h = 1/4, 1/8, 1/16 (nested lattices). The density is Lipschitz (|noise|,
-// min/max and a power >= 1 of it), so trilinear reconstruction errs by at
-// most L h sqrt(3) / 2 at a point: first order at least, each halving at
+// min/max and a power >= 1 of it) but for its jump at the source plane
+// y = 0, so trilinear reconstruction errs by at most L h sqrt(3) / 2 at a
+// point, and by O(1) only within one cell of that plane (O(h) of any ray's
+// depth): first order at least, each halving at
 // least halving the error once h is below the finest octave (1/8 here);
 // measured on this case: 0.137, 0.046, 0.021 of alpha (order 1.6, then 1.1).
 // Asserted: each halving divides the largest pixel error by more than
