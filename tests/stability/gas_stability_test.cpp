@@ -13,6 +13,7 @@
 #include "splatfx/effect.hpp"
 #include "splatfx/materials.hpp"
 #include "splatfx/procedural_gas.hpp"
+#include "splatfx/reference.hpp"
 #include "splatfx/splats.hpp"
 
 using namespace splatfx;
@@ -84,9 +85,9 @@ TEST(GasStability, SteamAtAMillionSecondsMovesAsSmoothlyAsAtTen) {
 // is the same gas. Checked for the steam's rise at the scene clock's limit.
 TEST(GasStability, RiseByOneTurbulencePeriodAtTheClockLimitGivesTheSameGas) {
     ProceduralGasDesc d = gas(GasKind::Steam);
-    d.steam.swirlRadius = 0.0f;     // no swirl: the rise alone moves the gas
-    d.turbulence.frequency = 2.0f;  // period 128 world units
-    d.steam.riseSpeed = 0.5f;       // 256 s per period
+    d.steam.swirlRadius = 0.0f;    // no swirl: the rise alone moves the gas
+    d.turbulence.frequency = 2.0f; // period 128 world units
+    d.steam.riseSpeed = 0.5f;      // 256 s per period
     const double t = kMaxTimeSec - 256.0;
     EXPECT_LE(change(d, t, t + 256.0).largest, 1e-5f) << "float rounding of the density only";
     EXPECT_GT(change(d, t, t + 1.0).present, 10);
@@ -360,4 +361,32 @@ TEST(GasStability, NegativeRiseSpeedMovesAsSmoothlyAsPositive) {
     ASSERT_GT(a, 0.0f);
     EXPECT_GT(b / a, 0.25f);
     EXPECT_LT(b / a, 4.0f);
+}
+
+// ---- The exact reference (proceduralGasMedium through renderVolumeExact) ----
+
+// A lattice rotated 30 degrees about y: its world box is wider than its
+// cells, and the reference must be empty in the corners between (where the
+// gas itself has density, but no cell of the lattice samples it), and equal
+// to the gas at a point inside the rotated cells.
+TEST(GasStability, ARotatedLatticesReferenceIsEmptyOutsideItsCellsInsideItsWorldBox) {
+    Materials mat{Footprint{}};
+    mat.addColorTable(ColorTable::constant({1.0f, 1.0f, 1.0f, 1.0f}));
+    ProceduralGasDesc d = gas(GasKind::Fog); // fog fills all space behind its front
+    d.fog.frontStart = 50.0f;
+    Grid l = lattice({9, 9, 9}, 0.25f); // x, z in [-1, 1], y in [0, 2]
+    l.transform = glm::rotate(glm::mat4(1.0f), glm::radians(30.0f), glm::vec3(0, 1, 0));
+    const ContinuousMedium m = proceduralGasMedium(d, l, 5.0, mat, {.cellLength = 0.25});
+    // (1.1, 1, 1.1) is inside the world box (its x, z reach 1.125 (cos 30 + sin 30) = 1.54)
+    // but outside the cells: rotated back it is at x' = 1.1 cos 30 - 1.1 sin 30 = 0.40,
+    // z' = 1.1 sin 30 + 1.1 cos 30 = 1.50 > 1.125.
+    const glm::dvec3 corner(1.1, 1.0, 1.1);
+    ASSERT_TRUE(glm::all(glm::lessThan(corner, m.boxMax)));
+    ASSERT_GT(proceduralGasDensity(d, glm::vec3(corner), 5.0), 0.0f);
+    EXPECT_EQ(m.sample(corner).extinction, 0.0);
+    // The centre is inside: the medium is the gas there.
+    const glm::dvec3 inside(0.1, 1.0, 0.2);
+    const double dens = double(proceduralGasDensity(d, glm::vec3(inside), 5.0));
+    ASSERT_GT(dens, 0.0);
+    EXPECT_NEAR(m.sample(inside).extinction * 0.25, -std::log1p(-dens), 1e-12);
 }

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "splatfx/vdb.hpp"
+#include "vdb_reference.hpp"
 #include "vdb_test_files.hpp"
 
 using namespace splatfx;
@@ -26,6 +27,27 @@ openvdb::FloatGrid::Ptr densityGrid(double voxelSize, openvdb::Vec3d origin = op
 }
 
 VdbImportDesc densityOnly(int voxelsPerCell = 0) { return {.temperatureGrid = "", .velocityGrid = "", .voxelsPerCell = voxelsPerCell}; }
+
+// The full-resolution reference (readVdbDensity, each voxel a cube) and the
+// coarse lattice (each cell a cube of its optical depth over its edge), each
+// pixel's optical depth along -z, one pixel per file voxel column.
+struct BothWays {
+    std::vector<double> file, lattice;
+};
+BothWays renderBothWays(const fs::path& file, int n, const Camera& cam) {
+    BothWays out;
+    auto seq = loadVdb(file.string(), densityOnly(n));
+    auto fine = readVdbDensity(file.string(), densityOnly(n));
+    EXPECT_TRUE(seq && fine);
+    if (!seq || !fine) return out;
+    out.file = pixelDepths(denseMedium(std::make_shared<DenseVoxels>(*fine), DenseFilter::Nearest, 1.0), cam);
+    out.lattice = pixelDepths(denseMedium(coarseVoxels(*seq), DenseFilter::Nearest, 1.0), cam);
+    return out;
+}
+
+// Float alpha (2^-24) read back as -ln(1 - alpha): at most 2^-24 e^tau, with
+// a factor 16 for the float camera's rounding of where each ray starts.
+double depthTolerance(double tau) { return 16.0 * 0x1p-24 * std::exp(tau); }
 
 // Sum over every cell of optical depth x face area, against extinction x the
 // file's integrated density: the filter conserves it exactly but for float
@@ -178,8 +200,7 @@ TEST(VdbStability, ActiveZeroDensityVoxelsAddNothingAndWeighNothing) {
     d->tree().setValue({1, 0, 0}, 0.0f), t->tree().setValue({1, 0, 0}, 5000.0f); // active, empty: its heat is not seen
     d->tree().setValue({4, 0, 0}, 0.0f), t->tree().setValue({4, 0, 0}, 900.0f);  // a block of nothing but empty air
     write(dir / "z.vdb", {d, t});
-    auto seq = loadVdb((dir / "z.vdb").string(),
-                       {.velocityGrid = "", .voxelsPerCell = 2, .temperatureHot = 500.0f, .temperatureCold = 300.0f});
+    auto seq = loadVdb((dir / "z.vdb").string(), {.velocityGrid = "", .voxelsPerCell = 2, .temperatureHot = 500.0f, .temperatureCold = 300.0f});
     ASSERT_TRUE(seq) << seq.error();
     ASSERT_EQ(seq->dims.x, 3);
     EXPECT_NEAR(seq->frames[0].colorCoord[0], 1.0 - (400.0 - 300.0) / 200.0, 1e-6);
@@ -214,7 +235,7 @@ TEST(VdbStability, AUniformTemperatureWithAnAutomaticRangeIsHotNotNaN) {
     auto seq = loadVdb((dir / "u.vdb").string(), {.velocityGrid = "", .voxelsPerCell = 2});
     ASSERT_TRUE(seq) << seq.error();
     for (std::size_t i = 0; i < seq->cellCount(); ++i)
-        if (seq->frames[0].opticalDepth[i] > 0.0f) EXPECT_EQ(seq->frames[0].colorCoord[i], 0.0f);
+        if (seq->frames[0].opticalDepth[i] > 0.0f) { EXPECT_EQ(seq->frames[0].colorCoord[i], 0.0f); }
 }
 
 // Velocities of 10^20 voxels/s are finite and scaled (the playback clamps
@@ -290,4 +311,154 @@ TEST(VdbStability, FramesWithDisjointBoxesShareOneLatticeWithoutLoss) {
     for (auto it = b->cbeginValueOn(); it; ++it) fileB += double(*it) * 1e-3;
     EXPECT_NEAR(sumA, fileA, fileA * 1e-6);
     EXPECT_NEAR(sumB, fileB, fileB * 1e-6);
+}
+
+// ---- Against the full-resolution reference (renderVolumeExact through the file's voxels) ----
+
+// Active voxels only on the first slice x = 4 of the block [4, 7] (N = 4),
+// seen edge-on along z: the file has tau = rho D s in that one column, the
+// lattice rho D s / N in each of the block's N columns. Per column the error
+// is that closed form (the largest, rho D s (1 - 1/N), on the face), summed
+// over the columns it is 0: the resampling moves depth sideways, never loses it.
+TEST(VdbStability, VoxelsAllOnOneCoarseCellFaceSpreadOverTheBlockButKeepTheirDepth) {
+    const fs::path dir = tempDir();
+    const double s = 0.1, rho = 1.0;
+    const int D = 8;
+    auto g = densityGrid(s);
+    for (int z = 0; z < D; ++z)
+        for (int y = 0; y < 8; ++y) g->tree().setValue({4, y, z}, float(rho));
+    write(dir / "face.vdb", {g});
+    const BothWays r = renderBothWays(dir / "face.vdb", 4, orthoAlongZ({-0.5 * s, -0.5 * s}, {12, 8}, s, 3.0));
+    ASSERT_EQ(r.file.size(), 96u);
+    double sumFile = 0.0, sumLattice = 0.0;
+    for (std::size_t i = 0; i < r.file.size(); ++i) {
+        const int col = int(i % 12);
+        EXPECT_NEAR(r.file[i], col == 4 ? rho * D * s : 0.0, depthTolerance(0.8)) << col;
+        EXPECT_NEAR(r.lattice[i], col >= 4 && col < 8 ? rho * D * s / 4.0 : 0.0, depthTolerance(0.2)) << col;
+        sumFile += r.file[i], sumLattice += r.lattice[i];
+    }
+    EXPECT_NEAR(sumLattice, sumFile, 96 * depthTolerance(0.8));
+}
+
+// Ten voxels along x with N = 3: blocks [0, 2], [3, 5], [6, 8] and a last
+// block [9, 11] holding one voxel. Columns 0..8 render exactly as the file
+// (a uniform density: each block mean is the value); the partial block
+// spreads its one column over three at a third of the depth, summed the same.
+TEST(VdbStability, ABlockSizeNotDividingTheGridKeepsThePartialBlocksDepth) {
+    const fs::path dir = tempDir();
+    const double s = 0.1;
+    auto g = densityGrid(s);
+    g->tree().fill(openvdb::CoordBBox({0, 0, 0}, {9, 5, 5}), 0.5f, true);
+    write(dir / "partial.vdb", {g});
+    const BothWays r = renderBothWays(dir / "partial.vdb", 3, orthoAlongZ({-0.5 * s, -0.5 * s}, {12, 6}, s, 3.0));
+    ASSERT_EQ(r.file.size(), 72u);
+    const double tau = 0.5 * 6 * s; // density x depth
+    for (std::size_t i = 0; i < r.file.size(); ++i) {
+        const int col = int(i % 12);
+        if (col < 9) {
+            EXPECT_NEAR(r.lattice[i], r.file[i], depthTolerance(tau)) << col;
+        } else {
+            EXPECT_NEAR(r.file[i], col == 9 ? tau : 0.0, depthTolerance(tau)) << col;
+            EXPECT_NEAR(r.lattice[i], tau / 3.0, depthTolerance(tau)) << col;
+        }
+    }
+}
+
+// The automatic block size at exactly the limit: a grid 24 voxels long with
+// maxCellsPerAxis 24 gets N = 1 (a rounding of 24 / 24 up to 2 would halve
+// the lattice), so the lattice's cells are the file's voxels and a random
+// density renders identically both ways, column by column.
+TEST(VdbStability, AGridExactlyMaxCellsLongIsImportedAtTheFilesOwnVoxelSize) {
+    const fs::path dir = tempDir();
+    auto g = randomDensity({0, 0, 0}, {23, 5, 3}, 0.1, 31);
+    g->setTransform(xform(0.1));
+    write(dir / "edge.vdb", {g});
+    auto seq = loadVdb((dir / "edge.vdb").string(), {.temperatureGrid = "", .velocityGrid = "", .maxCellsPerAxis = 24});
+    auto fine = readVdbDensity((dir / "edge.vdb").string(), densityOnly(0));
+    ASSERT_TRUE(seq && fine);
+    EXPECT_EQ(seq->spacing.x, 0.1f) << "one file voxel per cell";
+    const Camera cam = orthoAlongZ({-0.05, -0.05}, {24, 6}, 0.1, 3.0);
+    const auto a = pixelDepths(denseMedium(std::make_shared<DenseVoxels>(*fine), DenseFilter::Nearest, 1.0), cam);
+    const auto b = pixelDepths(denseMedium(coarseVoxels(*seq), DenseFilter::Nearest, 1.0), cam);
+    ASSERT_EQ(a.size(), b.size());
+    double largest = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        EXPECT_NEAR(b[i], a[i], depthTolerance(a[i])) << i;
+        largest = std::max(largest, a[i]);
+    }
+    EXPECT_GT(largest, 0.5);
+}
+
+// A sheet one voxel thin (z = 5, inside the block [4, 7]) seen head-on: the
+// block's mean rho / N over its N voxels of depth is rho s again, so every
+// ray keeps the sheet's depth exactly, though the lattice is four times thicker.
+TEST(VdbStability, AOneVoxelThinSheetSeenHeadOnKeepsItsDepthExactly) {
+    const fs::path dir = tempDir();
+    const double s = 0.1, rho = 2.0;
+    auto g = densityGrid(s);
+    g->tree().fill(openvdb::CoordBBox({0, 0, 5}, {15, 11, 5}), float(rho), true);
+    write(dir / "sheet.vdb", {g});
+    const BothWays r = renderBothWays(dir / "sheet.vdb", 4, orthoAlongZ({-0.5 * s, -0.5 * s}, {16, 12}, s, 3.0));
+    ASSERT_EQ(r.file.size(), 192u);
+    for (std::size_t i = 0; i < r.file.size(); ++i) {
+        EXPECT_NEAR(r.file[i], rho * s, depthTolerance(0.2)) << i;
+        EXPECT_NEAR(r.lattice[i], rho * s, depthTolerance(0.2)) << i;
+    }
+}
+
+// One voxel of 10^6 among voxels of 0.1: the reference's quadrature takes
+// a piece of extinction 10^6 (exp(-10^5) underflows to exactly 0, no NaN),
+// the spike's column is opaque and its neighbours keep tau = 0.1 D s; the
+// lattice makes the whole block column opaque (its depth, the block's sum
+// (10^6 + 63 x 0.1) s / N^2, is finite): the error of resampling a spike is
+// 1 - exp(-0.1 D s) of alpha on the block's other columns, and that is what
+// the reference shows.
+TEST(VdbStability, ADensitySpikeOfAMillionInOneVoxelIsOpaqueInTheReferenceAndFinite) {
+    const fs::path dir = tempDir();
+    const double s = 0.1;
+    auto g = densityGrid(s);
+    g->tree().fill(openvdb::CoordBBox({0, 0, 0}, {3, 3, 3}), 0.1f, true);
+    g->tree().setValue({1, 2, 3}, 1e6f);
+    write(dir / "spike.vdb", {g});
+    auto seq = loadVdb((dir / "spike.vdb").string(), densityOnly(4));
+    auto fine = readVdbDensity((dir / "spike.vdb").string(), densityOnly(4));
+    ASSERT_TRUE(seq && fine);
+    EXPECT_NEAR(seq->frames[0].opticalDepth[0], (1e6 + 63 * 0.1) * s / 16.0, 1e6 * s / 16.0 * 0x1p-22);
+    Materials mat{Footprint{}};
+    const Camera cam = orthoAlongZ({-0.5 * s, -0.5 * s}, {4, 4}, s, 3.0);
+    for (bool lattice : {false, true}) {
+        VolumeField f(mat);
+        f.addMedium(denseMedium(lattice ? coarseVoxels(*seq) : std::make_shared<DenseVoxels>(*fine), DenseFilter::Nearest, 1.0));
+        auto img = renderVolumeExact(f, cam, {.tolerance = 1e-9, .threads = 1});
+        ASSERT_TRUE(img);
+        for (int y = 0; y < 4; ++y)
+            for (int x = 0; x < 4; ++x) {
+                const bool spike = x == 1 && y == 4 - 1 - 2; // image rows top first
+                const double want = lattice || spike ? 1.0 : -std::expm1(-0.1 * 4 * s);
+                EXPECT_NEAR(img->at(x, y, 3), want, 1e-6) << lattice << " " << x << "," << y;
+            }
+    }
+}
+
+// A lattice of an odd number of blocks along x and an even one along z
+// (Grid::localPosition centres both axes differently) under a translation
+// that is no multiple of anything: the lattice must sit on the file's voxels.
+// Pixels sample 0.45 voxel from the block edges, so a misplacement of more
+// than 0.05 voxel moves a column of depth to the wrong pixel.
+TEST(VdbStability, ALatticeOfOddAndEvenBlockCountsSitsOnTheFilesVoxels) {
+    const fs::path dir = tempDir();
+    const double s = 0.1;
+    auto g = densityGrid(s, {0.37, -1.13, 0.051});
+    g->tree().fill(openvdb::CoordBBox({0, 0, 0}, {11, 7, 7}), 0.5f, true); // 3 x 2 x 2 blocks of 4
+    write(dir / "place.vdb", {g});
+    // Pixel size s, grid of pixel centres shifted to 0.05 voxel inside each voxel's upper edge.
+    const BothWays r =
+        renderBothWays(dir / "place.vdb", 4, orthoAlongZ({0.37 - 0.5 * s + 0.45 * s - 2 * s, -1.13 - 0.5 * s + 0.45 * s - 2 * s}, {16, 12}, s, 3.0));
+    ASSERT_EQ(r.file.size(), 192u);
+    int inside = 0;
+    for (std::size_t i = 0; i < r.file.size(); ++i) {
+        EXPECT_NEAR(r.lattice[i], r.file[i], depthTolerance(0.4)) << i;
+        inside += r.file[i] > 0.0;
+    }
+    EXPECT_EQ(inside, 12 * 8);
 }

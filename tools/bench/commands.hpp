@@ -19,6 +19,8 @@ int runTransparency(int argc, char** argv); // transparency.cpp: glass panes amo
 int runShadowTables(int argc, char** argv); // shadow_tables.cpp: shadow-table build time and error against tracing, CPU only
 int runLighting(int argc, char** argv);     // lighting.cpp: every lighting knob against the lit volume reference, Pareto (issue 24)
 int runLodRefine(int argc, char** argv);    // lod_refine.cpp: LOD cloud refinement on the CPU: tetrahedra, update time, memory
+int runGases(int argc, char** argv);        // gases.cpp: procedural gases' spacing, threshold, octaves vs the continuous gas (issue 24)
+int runVdb(int argc, char** argv);          // vdb.cpp: VDB resampling block size and splat filter vs the file at full resolution (issue 24)
 int runLattice(int argc, char** argv);      // lattice.cpp: how visible the voxel lattice is in the effect samples (issue 25)
 int runEbert(int argc, char** argv);        // ebert.cpp: Ebert & Parent 1990 Table 1, the paper's scenes with and without their volumes
 
@@ -47,5 +49,7 @@ inline constexpr BenchCommand kCommands[] = {
     {"cut", "splats cut exactly by depth: cost vs plain on Table I rows, error per table size, popping of a moving wall and the cow", runCut},
     {"transparency", "glass panes among the 1560-voxel fire: fragment lists vs ordered blend vs opaque only, budget, memory", runTransparency},
     {"lattice", "the voxel lattice's visibility per effect sample: spectral peaks at the voxel spacing vs a turbulence control", runLattice},
+    {"gases", "procedural gases: grid spacing, threshold, octaves against the continuous turbulence gas; Pareto plot", runGases},
+    {"vdb", "OpenVDB import: voxels per cell and splat filter against the file's voxels at full resolution; Pareto plot", runVdb},
     {"soak", "every preset stepped at 60 Hz for an hour of scene time: no NaN/Inf, bounds and memory flat", runSoak},
 };

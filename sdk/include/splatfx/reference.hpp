@@ -34,6 +34,10 @@
 //    colour as lit per voxel (what a Scene puts in its splats), so the two
 //    differ by the per-voxel lighting alone (docs/lighting.md, "The lit
 //    reference").
+//    A VolumeField can also hold continuous media (ContinuousMedium), through
+//    the same integrator: a procedural gas's turbulence density
+//    (proceduralGasMedium) or a VDB file's voxels at full resolution
+//    (denseMedium), the truths its sampled or resampled grid is measured against.
 //
 //  * Tetrahedra with fog (renderTetraExact, integrateRayWithFog): a LOD
 //    volume's emitted tetrahedra and a Biri fog as one medium, integrated
@@ -65,6 +69,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -75,6 +80,7 @@
 #include "splatfx/image.hpp"
 #include "splatfx/lighting.hpp"
 #include "splatfx/materials.hpp"
+#include "splatfx/procedural_gas.hpp"
 #include "splatfx/result.hpp"
 #include "splatfx/splats.hpp"
 #include "splatfx/volume.hpp"
@@ -171,6 +177,75 @@ struct SplatExactStats {
 Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& camera, const Materials& materials, const SplatExactDesc& desc = {},
                                SplatExactStats* stats = nullptr);
 
+// A continuous medium the volume-exact reference integrates beside (or
+// instead of) the voxel kernels: extinction and colour as a function of the
+// world point, through the same quadrature (so a gas's turbulence or a VDB
+// file's own voxels are the truth a sampled grid is measured against).
+struct ContinuousMedium {
+    struct Sample {
+        double extinction = 0.0; // natural log, per world unit, >= 0
+        glm::dvec3 color{0.0};   // emitted colour per unit extinction
+    };
+    // Called only inside the box, from several threads at once (const state only).
+    std::function<Sample(glm::dvec3 world)> sample{};
+    glm::dvec3 boxMin{0.0}, boxMax{0.0}; // world box outside which the medium is empty
+    // World length of its finest detail (a voxel, a noise octave): the first
+    // quadrature step is a quarter of it. > 0.
+    double featureSize = 1.0;
+    // Optional: appends the t in (t0, t1) where origin + t dir crosses a kink
+    // or jump of the medium (voxel faces or centre planes), so each quadrature
+    // piece is smooth. Default none.
+    std::function<void(glm::dvec3 origin, glm::dvec3 dir, double t0, double t1, std::vector<double>& out)> breaks{};
+};
+
+// How a dense voxel array is read between voxel centres.
+enum class DenseFilter {
+    Nearest,   // each voxel a cube of its value (a box-filtered grid's own meaning); jumps at voxel faces
+    Trilinear, // between the 8 nearest voxel centres (OpenVDB's BoxSampler); kinks at voxel-centre planes
+};
+
+// Axis-aligned cubic voxels (e.g. an OpenVDB grid at full resolution, tiles filled): value 0 outside.
+struct DenseVoxels {
+    glm::ivec3 dims{0};          // voxels along x, y, z
+    glm::dvec3 origin{0.0};      // world centre of voxel (0, 0, 0)
+    double voxelSize = 1.0;      // world edge of a voxel, > 0
+    std::vector<float> values{}; // x fastest, then y, then z; dims.x * dims.y * dims.z entries
+};
+
+// The voxels as a medium: extinction = extinctionPerValue * value(x) read
+// with `filter`, colour = color(world point) (default white). Breaks at every
+// voxel face (Nearest) or centre plane (Trilinear): between them the
+// extinction along a ray is a polynomial of degree <= 3, which the
+// reference's 4-point Gauss-Legendre integrates exactly. Shares the voxels.
+ContinuousMedium denseMedium(std::shared_ptr<const DenseVoxels> voxels, DenseFilter filter, double extinctionPerValue,
+                             std::function<glm::dvec3(glm::dvec3 world)> color = {});
+
+// What a procedural gas's sampled grid stands for, as a continuous medium.
+struct GasMediumDesc {
+    SplatStyle style{}; // the layer's colour table and opacityScale (as drawn); default as SplatStyle
+    // World length over which a density d has opacity d (a voxel's opacity is
+    // that of a ray through one cell): sigma(x) = -ln(1 - alpha(x)) / cellLength
+    // with alpha = clamp(d(x) * opacityScale, 0, 1) * table alpha. 0: the
+    // lattice's cell, cbrt of its spacings' product. Default 0.
+    double cellLength = 0.0;
+    // Densities at most this are empty (the sampler's threshold); the
+    // continuous gas has none, so its error is measured. Its jumps are not
+    // break points: there the quadrature converges at first order and may
+    // stop at up to about twice its tolerance. Default 0.
+    double threshold = 0.0;
+    // Lattice rows (cell y) mapped to colour coordinate 0 and 1, linear in
+    // between and clamped, as Grid::colorByHeight does for the cells present.
+    // Both 0: the lattice's full height, 0 to dims.y - 1. Default 0, 0.
+    double rowLow = 0.0, rowHigh = 0.0;
+};
+
+// proceduralGasDensity (in double, not the float sampled value) at every
+// point of the lattice's box (its cells' extent, half a cell beyond the
+// outer cell centres, under its transform) at timeSec. Expects a valid desc
+// and a lattice with dims >= 1.
+ContinuousMedium proceduralGasMedium(const ProceduralGasDesc& gas, const Grid& lattice, double timeSec, const Materials& materials,
+                                     const GasMediumDesc& desc = {});
+
 // The continuous field that untextured splatting reconstructs.
 //
 // Voxel j, with kernel matrix M_j (grid rotation and scale, lattice spacing,
@@ -197,6 +272,11 @@ public:
     };
 
     explicit VolumeField(const Materials& materials);
+
+    // Adds a continuous medium beside the kernels (evaluate() and
+    // renderVolumeExact include it; lineOpticalDepth does not).
+    void addMedium(ContinuousMedium medium) { mMedia.push_back(std::move(medium)); }
+    const std::vector<ContinuousMedium>& media() const { return mMedia; }
 
     // Appends the grid's voxels with the splat builder's rules: opacities
     // clamped to [0, 1], non-finite voxels or singular kernels dropped and
@@ -234,6 +314,7 @@ private:
     std::uint64_t mRejected = 0;
     double mCentreFootprint = 1.0; // F(0)
     double mSupportRadius = 1.0;   // where the kernel ends, in double (Footprint::radius() is a float: 1.6 is not one)
+    std::vector<ContinuousMedium> mMedia;
 };
 
 // The lit volume (lighting.hpp's model, evaluated exactly): at a point x of
@@ -309,6 +390,8 @@ struct VolumeExactStats {
 // Lit (desc.lighting), each Gauss point's extinction-weighted source is the
 // lit one. Fails on a bad host image or tolerance, or (lit) a bad light or
 // gas desc, the message naming the field.
+// A medium's box is a piece of its own, cut at its breaks, and sampled at the
+// same Gauss points.
 Result<Image> renderVolumeExact(const VolumeField& field, const Camera& camera, const VolumeExactDesc& desc = {}, VolumeExactStats* stats = nullptr);
 
 // ---- Tetrahedra (LOD volumes) and fog in one medium ----

@@ -49,6 +49,7 @@
 #include <string>
 
 #include "splatfx/grid_sequence.hpp"
+#include "splatfx/reference.hpp"
 #include "splatfx/result.hpp"
 
 namespace splatfx {
@@ -109,6 +110,15 @@ Result<GridSequence> loadVdb(const std::string& path, const VdbImportDesc& desc 
 // from firstFrame whose file exists (at least one). Sequence frame i is file
 // frame firstFrame + i.
 Result<GridSequence> loadVdbSequence(const std::string& pattern, int firstFrame, int lastFrame, const VdbImportDesc& desc = {});
+
+// One file's density grid at full resolution, for references (denseMedium:
+// what the coarse lattice is measured against): the box of its active voxels
+// (tiles included) as a dense array of the file's values, inactive voxels 0,
+// with the file's voxel size and the world centre of the box's first voxel.
+// Refused like loadVdb (the file walked before OpenVDB reads it, desc's grid
+// name and budgets, a float fog volume, a uniform scale plus translation,
+// finite densities >= 0), and when the box holds more than maxVoxels.
+Result<DenseVoxels> readVdbDensity(const std::string& path, const VdbImportDesc& desc = {}, std::uint64_t maxVoxels = std::uint64_t(1) << 26);
 
 // The file name for one frame of a pattern (see loadVdbSequence); the
 // pattern unchanged when it has no '#'.

@@ -21,6 +21,7 @@ struct Crossing {
     glm::dvec3 y, b;
     double scale;
     glm::dvec3 color;
+    const ContinuousMedium* medium = nullptr; // set: a medium's box (origin and dir in y, b), not a kernel
 };
 
 struct RayResult {
@@ -60,6 +61,12 @@ RayResult integrate(const std::vector<Crossing>& cs, const std::vector<double>& 
                 double e = 0.0;
                 glm::dvec3 ec(0.0);
                 for (const Crossing* c : active) {
+                    if (c->medium) {
+                        const ContinuousMedium::Sample ms = c->medium->sample(c->y + t * c->b);
+                        e += ms.extinction;
+                        ec += ms.extinction * ms.color;
+                        continue;
+                    }
                     const double k = c->scale * fp.kernel(glm::length(c->y + t * c->b));
                     e += k;
                     ec += k * c->color;
@@ -103,7 +110,8 @@ Result<Image> renderVolumeExact(const VolumeField& field, const Camera& camera, 
     if (!(h0 > 0.0)) {
         double smallest = 1e300;
         for (const auto& k : kernels) smallest = std::min(smallest, R * std::cbrt(1.0 / std::abs(glm::determinant(k.inverse))));
-        h0 = kernels.empty() ? 1.0 : 0.25 * smallest;
+        for (const ContinuousMedium& m : field.media()) smallest = std::min(smallest, m.featureSize);
+        h0 = smallest < 1e300 ? 0.25 * smallest : 1.0;
     }
 
     Image out;
@@ -135,9 +143,27 @@ Result<Image> renderVolumeExact(const VolumeField& field, const Camera& camera, 
                 const double sq = std::sqrt(disc);
                 const double t0 = std::max((-B - sq) / A, 0.0), t1 = std::min((-B + sq) / A, ray.tLimit);
                 if (!(t1 > t0)) continue;
-                cs.push_back({t0, t1, yy, b, k.scale, k.color});
+                cs.push_back({t0, t1, yy, b, k.scale, k.color, nullptr});
                 breaks.push_back(t0);
                 breaks.push_back(t1);
+            }
+            for (const ContinuousMedium& m : field.media()) {
+                // The ray's stretch inside the medium's box (slabs), cut at its kinks.
+                double t0 = 0.0, t1 = ray.tLimit;
+                for (int a = 0; a < 3; ++a) {
+                    if (ray.dir[a] == 0.0) {
+                        if (ray.origin[a] < m.boxMin[a] || ray.origin[a] > m.boxMax[a]) t1 = -1.0;
+                        continue;
+                    }
+                    const double ta = (m.boxMin[a] - ray.origin[a]) / ray.dir[a], tb = (m.boxMax[a] - ray.origin[a]) / ray.dir[a];
+                    t0 = std::max(t0, std::min(ta, tb));
+                    t1 = std::min(t1, std::max(ta, tb));
+                }
+                if (!(t1 > t0)) continue;
+                cs.push_back({t0, t1, ray.origin, ray.dir, 0.0, glm::dvec3(0.0), &m});
+                breaks.push_back(t0);
+                breaks.push_back(t1);
+                if (m.breaks) m.breaks(ray.origin, ray.dir, t0, t1, breaks);
             }
             const LitRay lit{&field, desc.lighting, glm::dvec3(camera.eye()), ray.origin, ray.dir};
             std::sort(breaks.begin(), breaks.end());

@@ -79,6 +79,12 @@ VolumeField::Sample VolumeField::evaluate(glm::dvec3 p) const {
         s.extinction += e;
         weighted += e * k.color;
     }
+    for (const ContinuousMedium& m : mMedia) {
+        if (glm::any(glm::lessThan(p, m.boxMin)) || glm::any(glm::greaterThan(p, m.boxMax))) continue;
+        const ContinuousMedium::Sample ms = m.sample(p);
+        s.extinction += ms.extinction;
+        weighted += ms.extinction * ms.color;
+    }
     if (s.extinction > 0.0) s.color = weighted / s.extinction;
     return s;
 }

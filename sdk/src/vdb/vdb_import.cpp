@@ -486,3 +486,59 @@ Result<GridSequence> loadVdbSequence(const std::string& pattern, int firstFrame,
 }
 
 } // namespace splatfx
+
+namespace splatfx {
+
+Result<DenseVoxels> readVdbDensity(const std::string& path, const VdbImportDesc& desc, std::uint64_t maxVoxels) {
+    const std::string at = where(path, 0, desc.densityGrid);
+    try {
+        openvdb::initialize();
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(path, ec)) return makeError("OpenVDB file '" + path + "' (frame 0): no such file");
+        // The same walk as the importer's, down to the voxel buffers, before OpenVDB reads anything.
+        auto walked = vdbfile::walk(path, {desc.densityGrid}, true);
+        if (!walked) return makeError("OpenVDB file '" + path + "' (frame 0): refused before OpenVDB reads it: " + walked.error());
+        std::uint64_t total = 0;
+        for (const vdbfile::GridLayout& g : *walked)
+            if (Status s = checkLayout(g, path, 0, desc, total); !s) return makeError(s.error());
+        openvdb::io::File file(path);
+        file.open(false);
+        openvdb::GridBase::ConstPtr found;
+        if (Status s = checkGrid<openvdb::FloatGrid>(*file.readAllGridMetadata(), path, 0, desc.densityGrid, "float", found); !s)
+            return makeError(s.error());
+        const auto grid = openvdb::gridConstPtrCast<openvdb::FloatGrid>(file.readGrid(desc.densityGrid));
+        file.close();
+        if (!grid) return makeError(at + "could not be read as a float grid");
+        if (grid->background() != 0.0f)
+            return makeError(at + "has background " + num(grid->background()) + "; a density grid's empty space must be 0");
+        double vs = 0.0;
+        openvdb::Vec3d origin;
+        if (Status s = checkTransform(grid->transform(), at, vs, origin); !s) return makeError(s.error());
+        const openvdb::CoordBBox box = (*walked)[0].activeBox;
+        const openvdb::Coord dim = box.dim();
+        const std::uint64_t count = std::uint64_t(dim.x()) * std::uint64_t(dim.y()) * std::uint64_t(dim.z());
+        if (count > maxVoxels)
+            return makeError(at + "its active box holds " + std::to_string(count) + " voxels, more than " + std::to_string(maxVoxels) +
+                             " (readVdbDensity's maxVoxels)");
+        DenseVoxels out;
+        out.dims = glm::ivec3(dim.x(), dim.y(), dim.z());
+        out.voxelSize = vs;
+        const openvdb::Vec3d o = grid->transform().indexToWorld(box.min());
+        out.origin = glm::dvec3(o[0], o[1], o[2]);
+        out.values.assign(count, 0.0f);
+        bool bad = false;
+        auto set = [&](const openvdb::Coord& c, float d) {
+            if (!(d >= 0.0f) || !std::isfinite(d)) return void(bad = true);
+            const openvdb::Coord r = c - box.min();
+            out.values[(std::size_t(r.z()) * std::size_t(dim.y()) + std::size_t(r.y())) * std::size_t(dim.x()) + std::size_t(r.x())] = d;
+        };
+        forEachActive(*grid, set, [&](const openvdb::CoordBBox& tile, float d) {
+            const openvdb::CoordBBox b(openvdb::Coord::maxComponent(tile.min(), box.min()), openvdb::Coord::minComponent(tile.max(), box.max()));
+            for (auto c = b.begin(); c; ++c) set(*c, d);
+        });
+        if (bad) return makeError(at + "holds negative, NaN or infinite densities; a density must be finite and >= 0");
+        return out;
+    } catch (const std::exception& e) { return makeError("OpenVDB file '" + path + "' (frame 0): " + e.what()); }
+}
+
+} // namespace splatfx
