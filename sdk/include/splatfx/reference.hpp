@@ -54,10 +54,10 @@
 // detail in volume mode (the field is the traditional, untextured one), or
 // run fast: it is for tests and benchmarks (seconds per frame).
 //
-//   splatfx::Image ref = *splatfx::renderSplatExact(builder.splats(), camera, materials, {.background = bg});
+//   splatfx::Image ref = *splatfx::renderSplatExact(builder.splats(), camera, materials, {.host = {.background = bg}});
 //   splatfx::VolumeField field(materials);
 //   field.add(grid, {.colorTable = lut});
-//   splatfx::Image vol = *splatfx::renderVolumeExact(field, camera, {.background = bg});
+//   splatfx::Image vol = *splatfx::renderVolumeExact(field, camera, {.host = {.background = bg}});
 //   splatfx::LitVolumeDesc lit{.lights = lights, .gas = gas};      // the lit volume: the model at every sample
 //   splatfx::Image litRef = *splatfx::renderVolumeExact(field, camera, {.lighting = &lit});
 //
