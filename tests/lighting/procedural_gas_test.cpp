@@ -135,3 +135,35 @@ TEST(ProceduralGas, BadDescNamesTheField) {
     EXPECT_FALSE(sampleProceduralGas(ProceduralGasDesc{}, lattice(), INFINITY));
     EXPECT_EQ(proceduralGasDensity(ProceduralGasDesc{}, {NAN, 0, 0}, 1.0f), 0.0f);
 }
+
+// ProceduralGasDesc::cellLength: the density is the opacity of a cell that
+// size; a lattice of half the spacing gets half the optical depth per cell
+// (-ln(1 - opacity) halved), so a column through the gas has the same depth at
+// both spacings up to the sampling. 0 keeps opacity = density.
+TEST(ProceduralGas, CellLengthKeepsTheOpticalDepthPerLengthAtAnySpacing) {
+    ProceduralGasDesc d = gas(GasKind::Steam);
+    d.threshold = 0.0f;
+    const Grid coarse = *Grid::box({16, 20, 16}, glm::vec3(0.125f)), fine = *Grid::box({32, 40, 32}, glm::vec3(0.0625f));
+    const Grid plain = *sampleProceduralGas(d, fine, 1.5);
+    d.cellLength = 0.125f;
+    const Grid same = *sampleProceduralGas(d, coarse, 1.5), scaled = *sampleProceduralGas(d, fine, 1.5);
+    ASSERT_FALSE(same.voxels.empty());
+    ASSERT_EQ(scaled.voxels.size(), plain.voxels.size());
+    // At its own spacing the density is the opacity, bit for bit.
+    for (const Voxel& v : same.voxels) EXPECT_EQ(v.opacity, proceduralGasDensity(d, same.worldPosition(v.cell), 1.5)) << v.cell.x;
+    double worst = 0.0;
+    for (std::size_t i = 0; i < scaled.voxels.size(); ++i) {
+        const double density = plain.voxels[i].opacity; // cellLength 0: the density itself
+        if (density >= 1.0) continue;                   // opaque stays opaque
+        const double depth = -std::log1p(-double(scaled.voxels[i].opacity)), want = -0.5 * std::log1p(-density);
+        // The opacity is stored in float: its rounding (2^-24 relative) moves the depth by
+        // 2^-24 o / (1 - o); the density's own float rounding by half that.
+        const double o = scaled.voxels[i].opacity, tol = std::ldexp(1.0, -23) * (o + density) / (1.0 - std::max(o, density)) + 1e-12;
+        worst = std::max(worst, std::abs(depth - want) / tol);
+        EXPECT_NEAR(depth, want, tol) << "cell " << i;
+    }
+    RecordProperty("worst_over_tolerance", std::to_string(worst));
+    ProceduralGasDesc bad;
+    bad.cellLength = -0.1f;
+    EXPECT_NE(validateProceduralGas(bad).error().find("cellLength"), std::string::npos);
+}

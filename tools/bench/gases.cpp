@@ -12,7 +12,8 @@
 // (GasMediumDesc::cellLength): a lattice of another spacing, sampled as the
 // SDK samples (opacity = density per cell), is thicker or thinner by their
 // ratio; the rows "spacing, depth-scaled" show what the spacing costs when
-// the opacity is scaled to the cell (1 - (1 - d)^(s / s0)).
+// the opacity is scaled to the cell (ProceduralGasDesc::cellLength = s0:
+// 1 - (1 - d)^(s / s0)).
 // --validation prints a 4 x 3 orthographic case (pixel centre, reference
 // alpha) for tools/validate/gas_reference.py.
 #include <chrono>
@@ -151,6 +152,7 @@ int runGases(int argc, char** argv) {
         splatfx::ProceduralGasDesc gas = base;
         gas.threshold = s.threshold;
         gas.turbulence.octaves = s.octaves;
+        if (s.depthScaled) gas.cellLength = float(kSpacing);
         const splatfx::Grid l = lattice(s.spacing);
         std::vector<double> ms;
         splatfx::Grid g;
@@ -158,8 +160,6 @@ int runGases(int argc, char** argv) {
         for (int r = 0; r < reps; ++r) {
             const auto a = Clock::now();
             g = *splatfx::sampleProceduralGas(gas, l, kTime);
-            if (s.depthScaled)
-                for (splatfx::Voxel& v : g.voxels) v.opacity = float(1.0 - std::pow(1.0 - double(v.opacity), s.spacing / kSpacing));
             builder.begin(cam);
             builder.add(g, mat, {.colorTable = 0});
             ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - a).count());

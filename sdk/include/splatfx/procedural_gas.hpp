@@ -91,6 +91,14 @@ struct ProceduralGasDesc {
     GasCloudDesc cloud{};
     // Cells whose density is at most this are left out of the grid (sparse). [0, 1); default 0.01.
     float threshold = 0.01f;
+    // The cell size the density is the opacity of, world units. 0: every
+    // cell's opacity is the density, whatever the lattice's spacing (the
+    // paper's per-sample density: halving the spacing doubles the optical
+    // depth). > 0: a lattice of spacing s (the cube root of its cell volume)
+    // gets 1 - (1 - density)^(s / cellLength), the same optical depth per
+    // unit length at any spacing, so the spacing is a pure quality knob
+    // (splatfx-bench gases). >= 0; default 0.
+    float cellLength = 0.0f;
 };
 
 // Fails on a desc field out of range; the message names it ("fog.power must be > 0").
@@ -109,7 +117,8 @@ float proceduralGasDensity(const ProceduralGasDesc& desc, glm::vec3 world, doubl
 // Samples the density at every cell of `lattice`'s dims (its spacing and
 // transform give the world positions, as Grid::worldPosition) and returns a
 // grid with the same lattice holding the cells above desc.threshold, with
-// opacity = density, colour coordinate = normalized height, texture 0.
+// opacity = density (scaled to the cell by desc.cellLength when it is set),
+// colour coordinate = normalized height, texture 0.
 // Fails on a bad desc, a non-finite time, or a lattice with no dims.
 Result<Grid> sampleProceduralGas(const ProceduralGasDesc& desc, const Grid& lattice, double timeSec);
 

@@ -139,6 +139,7 @@ Status validateProceduralGas(const ProceduralGasDesc& g) {
         return makeError("turbulence.octaves must be in [1, 12], got " + std::to_string(g.turbulence.octaves));
     if (Status s = positive(g.turbulence.frequency, "turbulence.frequency"); !s) return s;
     if (!(g.threshold >= 0.0f && g.threshold < 1.0f)) return makeError("threshold must be in [0, 1)");
+    if (!(g.cellLength >= 0.0f) || !std::isfinite(g.cellLength)) return makeError("cellLength must be finite and >= 0");
     const GasSteamDesc& st = g.steam;
     for (int a = 0; a < 3; ++a)
         if (Status s = finite(st.source[a], "steam.source"); !s) return s;
@@ -196,6 +197,10 @@ Result<Grid> sampleProceduralGas(const ProceduralGasDesc& desc, const Grid& latt
     g.dims = lattice.dims;
     g.spacing = lattice.spacing;
     g.transform = lattice.transform;
+    // The opacity of a cell of this lattice for a density given per cellLength (same depth per unit length).
+    const double perCell = desc.cellLength > 0.0f
+                               ? std::cbrt(double(lattice.spacing.x) * double(lattice.spacing.y) * double(lattice.spacing.z)) / double(desc.cellLength)
+                               : 1.0;
     for (int z = 0; z < g.dims.z; ++z)
         for (int y = 0; y < g.dims.y; ++y)
             for (int x = 0; x < g.dims.x; ++x) {
@@ -204,7 +209,7 @@ Result<Grid> sampleProceduralGas(const ProceduralGasDesc& desc, const Grid& latt
                 if (d <= desc.threshold) continue;
                 Voxel v;
                 v.cell = cell;
-                v.opacity = d;
+                v.opacity = perCell == 1.0 ? d : float(1.0 - std::pow(1.0 - double(d), perCell));
                 g.voxels.push_back(v);
             }
     g.colorByHeight();

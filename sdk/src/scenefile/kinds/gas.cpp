@@ -24,6 +24,7 @@ void readGas(Context& c, ObjectReader& g, ProceduralGasDesc& d) {
         if (auto s = readChoice(c.d, g.at("type"), *t, {"steam", "fog", "cloud"})) type = *s;
     readTurbulence(c, g, d.turbulence);
     g.number("threshold", d.threshold, 0.0, 0.999);
+    g.number("cellLength", d.cellLength, 0.0, 1e4);
     constexpr double kBig = 1e4;
     if (type == "steam") {
         GasSteamDesc& s = d.steam;
