@@ -34,6 +34,9 @@ HostDepth HostPass::depthCopy(unsigned framebuffer, int width, int height) {
     const GLenum stencilPoint = framebuffer == 0 ? GL_STENCIL : GL_STENCIL_ATTACHMENT;
     GLint type = GL_NONE;
     glGetNamedFramebufferAttachmentParameteriv(framebuffer, depthPoint, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &type);
+    // A context without a default framebuffer (surfaceless) answers with an error: no depth
+    // either way, and the error must not reach a later pass's own check.
+    while (glGetError() != GL_NO_ERROR) {}
     if (type == GL_NONE) return {.missing = "the host framebuffer has no depth buffer"};
     GLint samples = 0;
     glGetNamedFramebufferParameteriv(framebuffer, GL_SAMPLES, &samples);
