@@ -140,8 +140,9 @@ TEST_F(GroundFogGL, FullResolutionMatchesTheFieldWithinTheTablesBound) {
                 }
                 if (!hit) continue;
                 const double t0 = std::max(iv.x, 0.0), t1 = iv.y;
-                auto scalarAt = [&](double tt) {
-                    const glm::dvec4 l = voltest::barycentric(t, o + tt * dir);
+                // The ray copied in: a lambda cannot capture a structured binding (before C++23).
+                auto scalarAt = [&t, ro = o, rd = dir](double tt) {
+                    const glm::dvec4 l = voltest::barycentric(t, ro + tt * rd);
                     return l.x * t.scalar[0] + l.y * t.scalar[1] + l.z * t.scalar[2] + l.w * t.scalar[3];
                 };
                 const double l = t1 - t0 + hl, s = std::max(scalarAt(t0), scalarAt(t1)) + hs;
