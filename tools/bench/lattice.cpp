@@ -41,6 +41,7 @@ const Sample kSamples[] = {
     {"chess-fog", "samples/14-chess-fog/scene.json"},
     {"sunlit-smoke", "samples/15-campfire-sunlit-smoke/scene.json"},
     {"vdb-smoke", "samples/20-vdb-smoke/scene.json"},
+    {"photo-fire", "samples/25-photo-fire/scene.json"},
 };
 
 // "none", "default" or a list like "jitter=0.5,rotation=180,mirror,scale=0.3".
@@ -185,7 +186,7 @@ int runLattice(int argc, char** argv) {
                    "jitter=0.5,rotation=180,mirror,scale=0.3")
         ->capture_default_str();
     app.add_option("--sample", only, "only these samples (campfire, cow-through-fire, herd-dust, teapot-steam, locomotive-smoke, ghosts, "
-                                     "chess-fog, sunlit-smoke, vdb-smoke); default all");
+                                     "chess-fog, sunlit-smoke, vdb-smoke, photo-fire); default all");
     app.add_flag("--verbose", verbose, "every probe's ratio");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     std::optional<splatfx::SplatVariation> variation;
