@@ -107,6 +107,20 @@ TEST(ParticleEmitter, BirthAndDeathCountsFollowTheSlots) {
     EXPECT_EQ(e.maxAlive(), 10u);
 }
 
+TEST(ParticleEmitter, LateTimesKeepTheBirthSlotsExact) {
+    // Near kMaxTimeSec at 1000 births a second the slot index passes 2^28: the
+    // birth times (double) still fall 1 ms apart, so exactly rate * life are alive.
+    const ParticleEmitter e = *ParticleEmitter::create({.ratePerSec = 1000, .velocity = {0, 1, 0}, .lifetimeSec = 0.25f});
+    const double t = kMaxTimeSec - 0.1234;
+    const std::vector<Particle> ps = at(e, t);
+    EXPECT_EQ(ps.size(), 250u);
+    for (const Particle& p : ps) {
+        EXPECT_TRUE(std::isfinite(p.position.y));
+        EXPECT_GE(p.position.y, -1e-3f);
+        EXPECT_LE(p.position.y, 0.25f + 1e-3f); // |v| * lifetime, plus float rounding of the age (t ~ 2^18: 2^-34 s) and position
+    }
+}
+
 TEST(ParticleEmitter, BadFieldsAndTheParticleBudgetAreNamed) {
     auto err = [](const ParticleEmitterDesc& d) {
         auto r = ParticleEmitter::create(d);
@@ -177,7 +191,7 @@ TEST(ParticleSplats, AParticleBetweenTwoVoxelsInDepthIsSortedBetweenThem) {
     EXPECT_NEAR(depths[3], 2.0f, 1e-4f); // voxel
 }
 
-TEST(ParticleSplats, BehindTheEyeIsCulledAndNaNFromTheHostIsDroppedAlone) {
+TEST(ParticleSplats, BehindTheEyeIsCulledTheNearPlaneKeptAndABadHostParticleDroppedAlone) {
     Materials mat{Footprint{}};
     mat.addColorTable(ColorTable::constant({1, 1, 1, 1}));
     const Camera cam = Camera::lookAt({0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0.9f, {64, 48});
@@ -238,10 +252,9 @@ TEST(ParticleEffect, BoundsHoldEverySplatOverTheInterval) {
     EXPECT_TRUE(fx.bounds(10.0, 10.0).empty() == false); // the emitter never stops: material still there
 }
 
-TEST(ParticleEffect, ZeroLifetimeAndAStepLongerThanTheLifetime) {
+TEST(ParticleEffect, ZeroLifetimeIsNeverAliveAndNeverDividesByIt) {
     Materials mat{Footprint{}};
     mat.addColorTable(ColorTable::fire());
-    // Zero lifetime: nothing is ever alive, no division by it.
     Effect none = embers({.lifetimeSec = 0.0f});
     none.update(3.0);
     SplatBuilder b;
@@ -250,7 +263,11 @@ TEST(ParticleEffect, ZeroLifetimeAndAStepLongerThanTheLifetime) {
     EXPECT_FALSE(none.alive(3.0, {}));
     EXPECT_TRUE(none.bounds(0, 10).empty());
     EXPECT_EQ(none.costCells(), 0u);
-    // dt of 50 lifetimes in one step: the same frame as evaluating t directly.
+}
+
+TEST(ParticleEffect, AStepFiftyLifetimesLongIsTheFrameEvaluatedDirectly) {
+    Materials mat{Footprint{}};
+    mat.addColorTable(ColorTable::fire());
     Effect stepped = embers({.ratePerSec = 30, .velocitySpread = {0.3f, 0.3f, 0.3f}, .lifetimeSec = 0.2f, .texturesPerSec = 4});
     Effect direct = stepped;
     stepped.update(0.1);

@@ -11,7 +11,7 @@ std::optional<Effect> readParticlesKind(Context& c, ObjectReader& o, const Effec
     o.vec3("position", d.position, -L, L);
     o.vec3("halfExtent", d.halfExtent, 0.0, L, true);
     o.number("rate", d.ratePerSec, 0.0, 1e6);
-    o.number("startSec", d.startSec, 0.0, kMaxSeconds);
+    o.number("startSec", d.startSec, -kMaxSeconds, kMaxSeconds); // before 0: the emitter is warmed up at t = 0
     double stop = kMaxSeconds;
     o.number("stopSec", stop, 0.0, kMaxSeconds);
     d.stopSec = o.has("stopSec") ? stop : d.stopSec;
