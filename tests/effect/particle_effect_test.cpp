@@ -121,6 +121,27 @@ TEST(ParticleEmitter, LateTimesKeepTheBirthSlotsExact) {
     }
 }
 
+TEST(ParticleEmitter, TexturesCycleWithAgeAndColourAndSizeFollowTheLife) {
+    // Local dynamics (sec. 3.3) per particle: texture + phase advance by
+    // texturesPerSec * age, so 0.5 s later the same particle is 2 textures on.
+    const ParticleEmitterDesc d{.ratePerSec = 4, .lifetimeSec = 2, .sizeWorld = 0.1f, .sizeEndWorld = 0.3f, .colorFrom = 0.2f, .colorTo = 0.8f,
+                                .texturesPerSec = 4};
+    const ParticleEmitter e = *ParticleEmitter::create(d);
+    const std::vector<Particle> a = at(e, 3.0), b = at(e, 3.5);
+    int matched = 0;
+    for (const Particle& p : a)
+        for (const Particle& q : b)
+            if (p.id == q.id) {
+                ++matched;
+                EXPECT_EQ(q.texture - p.texture, 2u) << "particle " << p.id;
+                EXPECT_NEAR(q.phase, p.phase, 1e-5f);
+                const double age = 3.5 - (q.id + 0.5) / 4.0; // closed form of the life fraction
+                EXPECT_NEAR(q.colorCoord, 0.2 + 0.6 * age / 2.0, 1e-6);
+                EXPECT_NEAR(q.sizeWorld, 0.1 + 0.2 * age / 2.0, 1e-6);
+            }
+    EXPECT_GE(matched, 5);
+}
+
 TEST(ParticleEmitter, BadFieldsAndTheParticleBudgetAreNamed) {
     auto err = [](const ParticleEmitterDesc& d) {
         auto r = ParticleEmitter::create(d);
@@ -279,6 +300,22 @@ TEST(ParticleEffect, AStepFiftyLifetimesLongIsTheFrameEvaluatedDirectly) {
     ASSERT_EQ(stepped.emit(b1, mat), direct.emit(b2, mat));
     ASSERT_GT(b1.splats().size(), 3u);
     for (std::size_t i = 0; i < b1.splats().size(); ++i) EXPECT_EQ(b1.splats()[i].center, b2.splats()[i].center);
+}
+
+TEST(ParticleEffect, ObjectDynamicsOffFreezesTheParticlesAtTimeZero) {
+    Effect fx = embers({.ratePerSec = 10, .startSec = -3.0, .velocity = {0, 1, 0}, .lifetimeSec = 2, .texturesPerSec = 5});
+    Effect still = fx;
+    still.setToggles({.object = false});
+    fx.update(0.0);
+    still.update(7.0);
+    Materials mat{Footprint{}};
+    mat.addColorTable(ColorTable::fire());
+    const Camera cam = Camera::lookAt({0, 1, 5}, {0, 1, 0}, {0, 1, 0}, 0.9f, {64, 48});
+    SplatBuilder b0, b1;
+    b0.begin(cam), b1.begin(cam);
+    ASSERT_EQ(fx.emit(b0, mat), still.emit(b1, mat)) << "object dynamics off: the particles of t = 0";
+    ASSERT_GT(b0.splats().size(), 10u);
+    for (std::size_t i = 0; i < b0.splats().size(); ++i) EXPECT_EQ(b0.splats()[i].center, b1.splats()[i].center);
 }
 
 TEST(ParticleEffect, HostParticlesAreDrawnBoundedAndOnlyAParticleEffectTakesThem) {

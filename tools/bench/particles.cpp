@@ -50,6 +50,23 @@ std::vector<splatfx::Particle> scatter(const splatfx::Grid& g) {
     return out;
 }
 
+// The small case tools/validate/particle_flight.py integrates on its own: the
+// closed-form flight (ParticleEmitter::flightPosition) for a few drags, ages
+// and starts, as CSV.
+int validation() {
+    std::printf("k,ax,ay,az,wx,wy,wz,x0x,x0y,x0z,v0x,v0y,v0z,age,x,y,z\n");
+    for (float k : {0.0f, 1e-6f, 0.4f, 3.0f})
+        for (double age : {0.05, 0.7, 2.5, 9.0}) {
+            const splatfx::ParticleEmitterDesc d{.acceleration = {0.1f, 0.8f, -0.2f}, .dragPerSec = k, .wind = {1.1f, 0.0f, 0.3f}};
+            const glm::dvec3 x0(0.3, 3.2, -0.4), v0(-0.7, 2.6, 0.5);
+            const glm::dvec3 x = splatfx::ParticleEmitter::flightPosition(d, x0, v0, age);
+            std::printf("%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", double(k),
+                        double(d.acceleration.x), double(d.acceleration.y), double(d.acceleration.z), double(d.wind.x), double(d.wind.y),
+                        double(d.wind.z), x0.x, x0.y, x0.z, v0.x, v0.y, v0.z, age, x.x, x.y, x.z);
+        }
+    return 0;
+}
+
 } // namespace
 
 int runParticles(int argc, char** argv) {
@@ -58,13 +75,15 @@ int runParticles(int argc, char** argv) {
     std::string out = "bench-particles";
     glm::ivec2 size{640, 480}, refSize{80, 60};
     int frames = 15;
-    bool noPlots = false;
+    bool noPlots = false, valid = false;
+    app.add_flag("--validation", valid, "print the small case tools/validate/particle_flight.py checks, and stop");
     app.add_option("--out", out, "where particles.dat, particles.gp and the PNG plots go")->type_name("DIR")->capture_default_str();
     cli::addSize(app, "--size", size.x, size.y, 16, 4096, "window of the timed GL pass");
     cli::addSize(app, "--reference-size", refSize.x, refSize.y, 8, 512, "image size of the error against the exact reference");
     cli::addNumber(app, "--frames", frames, 1, 1000, "timed frames per row, median reported");
     app.add_flag("--no-plots", noPlots, "print the table only");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+    if (valid) return validation();
     auto ctx = splatfx::HeadlessContext::create();
     if (!ctx) return std::fprintf(stderr, "particles: %s\n", ctx.error().c_str()), 1;
 

@@ -130,6 +130,10 @@ void ParticleEmitter::particlesAt(double t, std::vector<Particle>& out) const {
     const double first = std::max(std::ceil((t - life - d.startSec) * rate - 0.5), 0.0);
     if (!(last >= first)) return;
     out.reserve(std::size_t(last - first + 1.0));
+    // A motion at rest places every birth alike: its matrix once, not per particle.
+    const bool still = mMotion.isStatic();
+    const Pose rest = still ? mMotion.sample(0.0) : Pose{};
+    const glm::mat4 restMatrix = rest.matrix();
     for (double nf = first; nf <= last; nf += 1.0) {
         const std::uint64_t n = std::uint64_t(nf);
         const double birth = d.startSec + (nf + 0.5) / rate;
@@ -138,9 +142,9 @@ void ParticleEmitter::particlesAt(double t, std::vector<Particle>& out) const {
         const double lifetime = life * (1.0 - double(d.lifetimeJitter) * r.u[0]);
         const double age = t - birth;
         if (!(age < lifetime)) continue;
-        const Pose pose = mMotion.sample(birth); // the emitter where the particle was born; it then flies free
+        const Pose pose = still ? rest : mMotion.sample(birth); // the emitter where the particle was born; it then flies free
         const glm::vec3 local = d.position + d.halfExtent * glm::vec3(2.0f * r.u[1] - 1.0f, 2.0f * r.u[2] - 1.0f, 2.0f * r.u[3] - 1.0f);
-        const glm::dvec3 x0 = glm::dvec3(pose.matrix() * glm::vec4(local, 1.0f));
+        const glm::dvec3 x0 = glm::dvec3((still ? restMatrix : pose.matrix()) * glm::vec4(local, 1.0f));
         const glm::dvec3 v0 =
             glm::dvec3(d.velocity + d.velocitySpread * glm::vec3(2.0f * r.u[4] - 1.0f, 2.0f * r.u[5] - 1.0f, 2.0f * r.u[6] - 1.0f));
         const double x = age / lifetime; // [0, 1)

@@ -533,6 +533,9 @@ void SplatBuilder::add(std::span<const Particle> particles, const Materials& mat
     const float maxStretch = std::isfinite(pstyle.maxStretch) ? std::max(pstyle.maxStretch, 0.0f) : 0.0f;
     const FastMod setCount(range.count);
     const Voxel origin{}; // each particle is the lone lattice point of its own frame
+    const glm::vec3 eye = cam.eye(), fwd = cam.forward(), camUp = cam.up(), camRight = cam.right();
+    const float nearZ = cam.nearPlane();
+    mSplats.reserve(mSplats.size() + particles.size());
     for (const Particle& p : particles) {
         const float size = p.sizeWorld;
         const float speed = glm::length(p.velocity);
@@ -563,13 +566,12 @@ void SplatBuilder::add(std::span<const Particle> particles, const Materials& mat
             ++mStats.culled;
             continue;
         }
-        const Frame frame{glm::translate(glm::mat4(1.0f), p.position), glm::vec3(1.0f), glm::vec3(0.0f), cam.eye(), cam.forward(), cam.up(),
-                          cam.right(), R, persp};
+        const Frame frame{glm::translate(glm::mat4(1.0f), p.position), glm::vec3(1.0f), glm::vec3(0.0f), eye, fwd, camUp, camRight, R, persp};
         GeometryBatch one;
         if (shape.isotropic) computeGeometry<true>(frame, shape, &origin, 1, one);
         else computeGeometry<false>(frame, shape, &origin, 1, one);
         const Geometry g = one.at(0);
-        const float fadeFrom = cam.nearPlane() + mDesc.nearFadeStart * shape.extent, fadeTo = cam.nearPlane() + mDesc.nearFadeEnd * shape.extent;
+        const float fadeFrom = nearZ + mDesc.nearFadeStart * shape.extent, fadeTo = nearZ + mDesc.nearFadeEnd * shape.extent;
         const float fade = !mDesc.nearFade || g.viewZ >= fadeTo ? 1.0f : smoothstep(fadeFrom, fadeTo, g.viewZ);
         if (fade <= 0.0f) {
             ++mStats.culled;
