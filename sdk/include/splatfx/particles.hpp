@@ -5,9 +5,10 @@
 // as a control for the object dynamics." A Particle is a splat centre off the
 // lattice: a world position, a kernel size, a velocity (which may stretch the
 // kernel along the flow), an opacity, a colour coordinate and a texture.
-// SplatBuilder::add(particles, ...) turns them into the same Splat list the
-// grid's voxels go to, so one exact back-to-front sort and the depth cut treat
-// both together; the GL renderer and the reference draw them unchanged.
+// SplatBuilder::add(particles, materials, ParticleStyle) (splats.hpp) turns
+// them into the same Splat list the grid's voxels go to, so one exact
+// back-to-front sort and the depth cut treat both together; the GL renderer
+// and the reference draw them unchanged.
 //
 // A ParticleEmitter is a particle system that is a pure function of time:
 // particle n is born at startSec + (n + 1/2) / ratePerSec at a point of the
@@ -18,7 +19,9 @@
 // step longer than the lifetime loses nothing. Effect::fromParticles
 // (effect.hpp) schedules one in a Scene; a host with its own particle system
 // hands its particles to SplatBuilder::add or Effect::setParticles instead.
-// It does not render, sort or read files.
+// It does not render, sort or read files, does not collide particles with
+// anything, and does not read a solver's velocity field (particles fly in
+// the closed-form field above).
 //
 //   auto em = splatfx::ParticleEmitter::create({.ratePerSec = 40, .lifetimeSec = 2});
 //   std::vector<splatfx::Particle> now;
