@@ -17,6 +17,9 @@ namespace {
 
 constexpr std::uint32_t kParticleSalt = 0x9a71c1e5u; // apart from the other hashes of the same seed
 
+// kMaxTimeSec (effect_kind.hpp): no later time is evaluated by a Scene.
+constexpr double kLatestSec = 262144.0;
+
 bool finite3(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 // The draws of particle n: seven uniforms in [0, 1) and a texture index.
@@ -67,8 +70,9 @@ std::string checkParticleEmitter(const ParticleEmitterDesc& d, const std::string
     if (!finite3(d.position)) return f + "position must be finite, got " + vec(d.position);
     if (!finite3(d.halfExtent) || glm::any(glm::lessThan(d.halfExtent, glm::vec3(0.0f))))
         return f + "halfExtent must be finite and >= 0, got " + vec(d.halfExtent);
-    if (!(d.ratePerSec >= 0.0f) || !std::isfinite(d.ratePerSec)) return f + "ratePerSec must be finite and >= 0, got " + num(d.ratePerSec);
-    if (!std::isfinite(d.startSec)) return f + "startSec must be finite, got " + num(d.startSec);
+    // Slot indices stay exact doubles (below 2^52) over [startSec, 2^18 s] at rates up to 10^9.
+    if (!(d.ratePerSec >= 0.0f && d.ratePerSec <= 1e9f)) return f + "ratePerSec must be in [0, 1e9], got " + num(d.ratePerSec);
+    if (!(std::abs(d.startSec) <= kLatestSec)) return f + "startSec must be in [-262144, 262144] s, got " + num(d.startSec);
     if (!(d.stopSec >= d.startSec)) return f + "stopSec must be >= startSec, got " + num(d.stopSec);
     if (!finite3(d.velocity)) return f + "velocity must be finite, got " + vec(d.velocity);
     if (!finite3(d.velocitySpread) || glm::any(glm::lessThan(d.velocitySpread, glm::vec3(0.0f))))
@@ -129,6 +133,8 @@ void ParticleEmitter::particlesAt(double t, std::vector<Particle>& out) const {
     const double last = std::min(std::floor((t - d.startSec) * rate - 0.5), std::ceil((d.stopSec - d.startSec) * rate - 0.5) - 1.0);
     const double first = std::max(std::ceil((t - life - d.startSec) * rate - 0.5), 0.0);
     if (!(last >= first)) return;
+    // Far past kLatestSec slot indices stop being exact doubles (and the loop would not advance).
+    if (!(last < 0x1p52)) return;
     out.reserve(std::size_t(last - first + 1.0));
     // A motion at rest places every birth alike: its matrix once, not per particle.
     const bool still = mMotion.isStatic();
