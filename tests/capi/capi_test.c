@@ -103,8 +103,8 @@ static void test_every_preset(void) {
     CHECK_OK(splatfx_materials_create(NULL, &m, err), err);
     CHECK_OK(splatfx_frame_create(&frame, err), err);
     splatfx_camera cam = front_camera(err);
-    const char* names[6] = {"fire", "smoke", "steam", "dust", "fire_to_smoke", "ghosts"};
-    for (int k = 0; k < 6; ++k) {
+    const char* names[7] = {"fire", "smoke", "steam", "dust", "fire_to_smoke", "ghosts", "embers"};
+    for (int k = 0; k < 7; ++k) {
         splatfx_scene* scene = NULL;
         CHECK_OK(splatfx_scene_create(&scene, err), err);
         splatfx_status s = SPLATFX_ERROR_INTERNAL;
@@ -143,6 +143,12 @@ static void test_every_preset(void) {
             splatfx_ghosts_desc d;
             splatfx_ghosts_desc_init(&d);
             s = splatfx_scene_add_ghosts(scene, m, &d, NULL, NULL, err);
+            break;
+        }
+        case 6: {
+            splatfx_embers_desc d;
+            splatfx_embers_desc_init(&d);
+            s = splatfx_scene_add_embers(scene, m, &d, NULL, NULL, err);
             break;
         }
         }
@@ -429,6 +435,17 @@ static void test_bad_input(void) {
     splatfx_effect_options_init(&o);
     o.opacity_scale = NAN;
     CHECK_FAILS(splatfx_scene_add_ghosts(scene, m, NULL, &o, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "options.opacity_scale is nan");
+    splatfx_embers_desc ed;
+    splatfx_embers_desc_init(&ed);
+    ed.rate_per_sec = -1.0f;
+    CHECK_FAILS(splatfx_scene_add_embers(scene, m, &ed, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                "EmbersDesc.ratePerSec must be in [0, 1e9], got -1");
+    splatfx_embers_desc_init(&ed);
+    ed.rate_per_sec = 1e9f; /* a particle memory bomb: refused against the particle budget */
+    CHECK_FAILS(splatfx_scene_add_embers(scene, m, &ed, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "exceeds maxParticles");
+    splatfx_embers_desc_init(&ed);
+    ed.velocity[1] = NAN;
+    CHECK_FAILS(splatfx_scene_add_embers(scene, m, &ed, NULL, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "desc.velocity[1] is nan");
     CHECK(splatfx_scene_effect_count(scene) == effectsBefore, "failed adds added %u effects", splatfx_scene_effect_count(scene) - effectsBefore);
 
     /* A scene's effects index the materials they were built with. */

@@ -55,7 +55,7 @@ fx.splatfx_scene_prepare.argtypes = [P, C.c_double, C.POINTER(Camera), P, P, P]
 fx.splatfx_frame_get_stats.argtypes = [P, C.POINTER(FrameStats), P]
 
 SPLATFX_OK, INVALID_ARGUMENT = 0, 1
-check(fx.splatfx_c_api_version() == 2, "API version")
+check(fx.splatfx_c_api_version() == 3, "API version")
 err = fx.splatfx_error_create()
 m, scene, frame = P(), P(), P()
 check(fx.splatfx_materials_create(None, C.byref(m), err) == SPLATFX_OK, "materials")

@@ -60,10 +60,10 @@ TEST(SceneFileKinds, AnUnknownKindNamesEveryKnownKind) {
     // "vdb" only in builds with OpenVDB (splatfx::vdb).
     const std::string vdb = SPLATFX_WITH_VDB ? ", vdb" : "";
     EXPECT_EQ(listed,
-              std::string(R"("fire", "smoke", "steam", "dust", "fireToSmoke", "ghosts", "grid", "gas")") + (SPLATFX_WITH_VDB ? R"(, "vdb")" : ""));
+              std::string(R"("fire", "smoke", "steam", "dust", "fireToSmoke", "ghosts", "grid", "gas", "particles")") + (SPLATFX_WITH_VDB ? R"(, "vdb")" : ""));
     auto missing = parse(R"("effects": [{"name": "a"}])");
     ASSERT_FALSE(missing);
-    EXPECT_NE(missing.error().find("missing \"kind\" (one of fire, smoke, steam, dust, fireToSmoke, ghosts, grid, gas" + vdb + ")"),
+    EXPECT_NE(missing.error().find("missing \"kind\" (one of fire, smoke, steam, dust, fireToSmoke, ghosts, grid, gas, particles" + vdb + ")"),
               std::string::npos)
         << missing.error();
 }
@@ -162,4 +162,30 @@ TEST(SceneFileKinds, ABadVariationIsNamed) {
     EXPECT_NE(r.error().find("effects[0].variation.jitter"), std::string::npos) << r.error();
     EXPECT_NE(r.error().find("effects[0].variation.rotationDeg"), std::string::npos) << r.error();
     EXPECT_NE(r.error().find("effects[0].variation.wobble: unknown key"), std::string::npos) << r.error();
+}
+
+TEST(SceneFileKinds, ParticlesBuildAndTheirBadInputIsNamed) {
+    auto ok = parse(R"("effects": [{"kind": "particles", "rate": 30, "lifetimeSec": 1.5, "velocity": [0, 1, 0], "size": 0.05}])");
+    ASSERT_TRUE(ok) << ok.error();
+    ASSERT_EQ(ok->effects.size(), 1u);
+    EXPECT_EQ(ok->effects[0].kind, "particles");
+    auto negative = parse(R"("effects": [{"kind": "particles", "rate": -5}])");
+    ASSERT_FALSE(negative);
+    EXPECT_NE(negative.error().find("effects[0].rate"), std::string::npos) << negative.error();
+    // A NaN is no JSON number: the file is refused where it is.
+    auto nan = parse(R"("effects": [{"kind": "particles", "lifetimeSec": NaN}])");
+    ASSERT_FALSE(nan);
+    // The memory bomb: a million a second living ten seconds.
+    auto bomb = parse(R"("effects": [{"kind": "particles", "rate": 1000000, "lifetimeSec": 10}])");
+    ASSERT_FALSE(bomb);
+    EXPECT_NE(bomb.error().find("effects[0].rate: rate * lifetimeSec = 10000000 particles alive at once exceeds maxParticles (65536)"),
+              std::string::npos)
+        << bomb.error();
+    // maxParticles raises the cap only to kMaxParticles (2^24).
+    auto raised = parse(R"("effects": [{"kind": "particles", "rate": 1000000, "lifetimeSec": 20, "maxParticles": 16777216}])");
+    ASSERT_FALSE(raised);
+    EXPECT_NE(raised.error().find("exceeds maxParticles (16777216)"), std::string::npos) << raised.error();
+    auto over = parse(R"("effects": [{"kind": "particles", "maxParticles": 16777217}])");
+    ASSERT_FALSE(over);
+    EXPECT_NE(over.error().find("effects[0].maxParticles"), std::string::npos) << over.error();
 }

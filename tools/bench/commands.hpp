@@ -22,6 +22,7 @@ int runLodRefine(int argc, char** argv);    // lod_refine.cpp: LOD cloud refinem
 int runGases(int argc, char** argv);        // gases.cpp: procedural gases' spacing, threshold, octaves vs the continuous gas (issue 24)
 int runVdb(int argc, char** argv);          // vdb.cpp: VDB resampling block size and splat filter vs the file at full resolution (issue 24)
 int runLattice(int argc, char** argv);      // lattice.cpp: how visible the voxel lattice is in the effect samples (issue 25)
+int runParticles(int argc, char** argv);    // particles.cpp: splats at particle positions vs the same number of grid splats (issue 25)
 int runEbert(int argc, char** argv);        // ebert.cpp: Ebert & Parent 1990 Table 1, the paper's scenes with and without their volumes
 
 // cloud_knobs.cpp, run by accuracy (--clouds-only alone): the LOD clouds' table size, c, C and
@@ -51,5 +52,6 @@ inline constexpr BenchCommand kCommands[] = {
     {"lattice", "the voxel lattice's visibility per effect sample: spectral peaks at the voxel spacing vs a turbulence control", runLattice},
     {"gases", "procedural gases: grid spacing, threshold, octaves against the continuous turbulence gas; Pareto plot", runGases},
     {"vdb", "OpenVDB import: voxels per cell and splat filter against the file's voxels at full resolution; Pareto plot", runVdb},
+    {"particles", "splats at particle positions (host, emitter) vs the same number of grid splats: CPU frame, GL pass, error vs the exact reference", runParticles},
     {"soak", "every preset stepped at 60 Hz for an hour of scene time: no NaN/Inf, bounds and memory flat", runSoak},
 };

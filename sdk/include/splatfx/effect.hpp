@@ -13,7 +13,7 @@
 // color tables and differing texture sets").
 //
 // An Effect is an EffectKind (effect_kind.hpp), the interface Scene schedules
-// by; it is a copyable value that owns one of the SDK's four kinds:
+// by; it is a copyable value that owns one of the SDK's five kinds:
 //   - grid effects (fromGrid) are stateless: update(t) computes frame t
 //     directly from (voxel, t, seed), in any order, at no cost for skipped
 //     frames. step(dt) is update(time() + dt); advanceTo(t) is update(t).
@@ -27,6 +27,9 @@
 //     frames; their texture propagation runs on a fixed clock and is replayed
 //     as needed, so update(t) depends on t alone: stateless, at a cost linear
 //     in the propagation steps replayed.
+//   - particle effects (fromParticles) put splats at particle positions
+//     (King et al. sec. 6, particles.hpp): a closed-form emitter evaluated at
+//     t (stateless), plus particles a host hands in (setParticles).
 // isStateless() tells which; bounds(t0, t1) is a conservative world box of
 // every splat the effect can produce in [t0, t1] (motion and splat extent
 // included), for culling by a scheduler. Other kinds implement EffectKind
@@ -43,6 +46,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -51,6 +55,7 @@
 #include "splatfx/grid.hpp"
 #include "splatfx/grid_sequence.hpp"
 #include "splatfx/motion.hpp"
+#include "splatfx/particles.hpp"
 #include "splatfx/procedural_gas.hpp"
 #include "splatfx/result.hpp"
 #include "splatfx/solver.hpp"
@@ -128,6 +133,16 @@ public:
     // t * stepsPerSec). isStateless() is true. Fails on an invalid sequence,
     // or Propagation::Velocity without velocity; the message names the field.
     static Result<Effect> fromSequence(GridSequence sequence, EffectDesc desc);
+    // Splats at particle positions (King et al. 1999, sec. 6; particles.hpp):
+    // the emitter's particles, born at desc.motion's pose at their birth and
+    // then flying free, drawn with desc.layers[0].style (at most one layer;
+    // its variation's rotation, mirroring and scale per particle, no jitter),
+    // plus any particles a host hands to setParticles. Stateless: update(t)
+    // evaluates the emitter at t. Drawn unlit (lightingDensity is false).
+    // Toggles: object off freezes the particles at t = 0, local off stops
+    // their texture cycling. Fails on a bad emitter (checkParticleEmitter, its
+    // particle budget included) or more than one layer; the message names the field.
+    static Result<Effect> fromParticles(ParticleEmitterDesc emitter, EffectDesc desc);
 
     Effect(const Effect& other);
     Effect& operator=(const Effect& other);
@@ -185,6 +200,12 @@ public:
     // SplatVariation::recommended); bounds() follow. Fails, changing nothing,
     // on an out-of-range field (the message names it).
     Status setSplatVariation(const SplatVariation& variation);
+    // A particle effect's host particles (an engine's own particle system),
+    // replacing the previous set: drawn with the emitter's at every emit and
+    // included in bounds() at any time, until replaced. Copied; positions in
+    // world units. Fails on a kind other than fromParticles, or more than
+    // kMaxParticles. Particles with non-finite fields are dropped when drawn.
+    Status setParticles(std::span<const Particle> particles);
     // The solver of a solver effect, for emitters and inspection (nullptr otherwise).
     FluidSolver* solver();
     const FluidSolver* solver() const;

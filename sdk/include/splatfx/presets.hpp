@@ -188,6 +188,36 @@ struct GhostsDesc {
 };
 Result<Effect> ghosts(Materials& materials, const GhostsDesc& desc = {});
 
+// Embers rising over a fire (King et al. 1999, sec. 6: splats at particle
+// positions, Effect::fromParticles): sparks born in a box over the fire,
+// lifted by buoyancy and drifting with a wind, fading through the fire colour
+// table from yellow to dark red. Warmed up: births start warmUpSec before t = 0.
+struct EmbersDesc {
+    glm::vec3 position{0.0f, 3.2f, 0.0f};        // emitter box centre, world; default 3.2 above the origin (inside FireDesc{}'s flame)
+    glm::vec3 halfExtent{1.0f, 1.6f, 0.7f};       // >= 0; default 1, 1.6, 0.7
+    float ratePerSec = 45.0f;                     // births per second, >= 0; default 45
+    float warmUpSec = 5.0f;                       // births start this long before t = 0, >= 0; default 5
+    float lifetimeSec = 4.2f;                     // >= 0; default 4.2
+    float lifetimeJitter = 0.5f;                  // [0, 1]; default 0.5
+    glm::vec3 velocity{0.0f, 2.6f, 0.0f};         // world units / s; default 2.6 up
+    glm::vec3 velocitySpread{1.6f, 1.4f, 1.6f};   // + - per axis, >= 0; default 1.6, 1.4, 1.6
+    glm::vec3 acceleration{0.0f, 0.8f, 0.0f};     // buoyancy, world units / s^2; default 0.8 up
+    float dragPerSec = 0.4f;                      // towards the wind, >= 0; default 0.4
+    glm::vec3 wind{1.1f, 0.0f, 0.3f};             // world units / s; default 1.1, 0, 0.3
+    float sizeWorld = 0.065f;                     // kernel unit at birth, > 0; default 0.065
+    float sizeEndWorld = 0.03f;                   // ... at death, > 0; default 0.03
+    float opacity = 1.0f;                         // [0, 1]; default 1
+    float stretchPerSpeed = 0.4f;                 // streaks along the flight, s, >= 0; default 0.4
+    float texturesPerSec = 8.0f;                  // local dynamics; default 8
+    std::optional<TextureSet> textureSet{};       // default none (procedural turbulence)
+    int textureCount = 8;                         // procedural textures; default 8
+    Motion motion{};                              // moves the emitter (particles trail); default at rest
+    std::uint32_t seed = 1;                       // default 1
+    std::uint32_t textureSeed = 1;                // procedural texture set; default 1
+    SplatVariation variation = SplatVariation::recommended(0); // rotation and mirroring per particle; default recommended
+};
+Result<Effect> embers(Materials& materials, const EmbersDesc& desc = {});
+
 // A set of simple procedural faces (pale oval, dark eyes and mouth), the
 // fallback texture set for ghosts.
 TextureSet proceduralFaces(int count, int size, std::uint32_t seed);

@@ -95,8 +95,9 @@ extern "C" {
 /* The version of this header's API; splatfx_c_api_version() returns the
  * library's, so a binding can refuse a library it was not written for.
  * Versions only add: a program written for 1 runs unchanged on 2
- * (2 added splatfx_renderer_note_count and splatfx_renderer_note). */
-#define SPLATFX_C_API_VERSION 2
+ * (2 added splatfx_renderer_note_count and splatfx_renderer_note; 3 added
+ * splatfx_embers_desc and splatfx_scene_add_embers). */
+#define SPLATFX_C_API_VERSION 3
 SPLATFX_C_API uint32_t splatfx_c_api_version(void);
 
 /* ---- [errors] ------------------------------------------------------------ */
@@ -306,6 +307,34 @@ typedef struct splatfx_ghosts_desc {
 } splatfx_ghosts_desc;
 SPLATFX_C_API void splatfx_ghosts_desc_init(splatfx_ghosts_desc* desc);
 
+/* Embers: splats at particle positions (King et al. 1999, sec. 6;
+ * presets::EmbersDesc, Effect::fromParticles): sparks rising over a fire. */
+typedef struct splatfx_embers_desc {
+    float position[3];                      /* emitter box centre, world; default 0, 3.2, 0 */
+    float half_extent[3];                   /* >= 0; default 1, 1.6, 0.7 */
+    float rate_per_sec;                     /* births per second, >= 0; default 45 */
+    float warm_up_sec;                      /* births start this long before t = 0, >= 0; default 5 */
+    float lifetime_sec;                     /* >= 0; default 4.2 */
+    float lifetime_jitter;                  /* [0, 1]; default 0.5 */
+    float velocity[3];                      /* world units per second; default 0, 2.6, 0 */
+    float velocity_spread[3];               /* + - per axis, >= 0; default 1.6, 1.4, 1.6 */
+    float acceleration[3];                  /* buoyancy, world units per second^2; default 0, 0.8, 0 */
+    float drag_per_sec;                     /* towards the wind, >= 0; default 0.4 */
+    float wind[3];                          /* world units per second; default 1.1, 0, 0.3 */
+    float size_world;                       /* kernel unit at birth, > 0; default 0.065 */
+    float size_end_world;                   /* ... at death, > 0; default 0.03 */
+    float opacity;                          /* [0, 1]; default 1 */
+    float stretch_per_speed;                /* streaks along the flight, seconds, >= 0; default 0.4 */
+    float textures_per_sec;                 /* texture cycling rate; default 8 */
+    const splatfx_texture_set* texture_set; /* default NULL (procedural) */
+    int32_t texture_count;                  /* procedural textures; default 8 */
+    const splatfx_keyframe* motion_keys;    /* moves the emitter (particles trail); default NULL (at rest) */
+    uint32_t motion_key_count;              /* keys at motion_keys; default 0 */
+    uint32_t seed;                          /* default 1 */
+    uint32_t texture_seed;                  /* procedural texture set; default 1 */
+} splatfx_embers_desc;
+SPLATFX_C_API void splatfx_embers_desc_init(splatfx_embers_desc* desc);
+
 /* Builds the preset (registering its texture sets and colour tables in
  * `materials`) and adds it to the scene; *out_id (may be NULL) receives its
  * id. desc and options may be NULL (defaults). On failure nothing is added.
@@ -323,6 +352,8 @@ SPLATFX_C_API splatfx_status splatfx_scene_add_fire_to_smoke(splatfx_scene* scen
                                                              const splatfx_fire_to_smoke_desc* desc, const splatfx_effect_options* options,
                                                              uint32_t* out_id, splatfx_error* error);
 SPLATFX_C_API splatfx_status splatfx_scene_add_ghosts(splatfx_scene* scene, splatfx_materials* materials, const splatfx_ghosts_desc* desc,
+                                                      const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error);
+SPLATFX_C_API splatfx_status splatfx_scene_add_embers(splatfx_scene* scene, splatfx_materials* materials, const splatfx_embers_desc* desc,
                                                       const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error);
 
 /* Reads a scene file (docs/scene-format.md) into a new scene, registering its

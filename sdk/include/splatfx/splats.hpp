@@ -19,12 +19,14 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "splatfx/camera.hpp"
 #include "splatfx/grid.hpp"
 #include "splatfx/materials.hpp"
+#include "splatfx/particles.hpp"
 
 namespace splatfx {
 
@@ -115,6 +117,17 @@ struct SplatStyle {
     float opacityScale = 1.0f;    // multiplies every voxel's opacity; default 1
     SplatVariation variation{};   // per-splat jitter, rotation, mirroring, scale; default none (the paper's lattice)
 };
+// How particles become splats: the grid's SplatStyle (texture set, colour
+// table, cross-fade, opacity scale; its variation's rotation, mirroring and
+// scale are drawn per particle id, its jitter is ignored) plus the stretch.
+struct ParticleStyle {
+    SplatStyle splat{};
+    // The kernel is stretched by 1 + min(|v| * stretchPerSpeed, maxStretch)
+    // along the velocity v (Voxel::stretch): sparks streak along their flight.
+    float stretchPerSpeed = 0.0f; // seconds, >= 0; default 0 (round)
+    float maxStretch = 4.0f;      // >= 0; default 4
+};
+
 // The message naming the first out-of-range field of v ("jitter must be in
 // [0, 0.5], got 0.7"), or empty when v is valid. `field` prefixes the name.
 std::string checkSplatVariation(const SplatVariation& v, const std::string& field = "variation.");
@@ -165,6 +178,11 @@ public:
     // Appends the grid's voxels. Opacities are clamped to [0, 1]; voxels with
     // non-finite data are dropped and counted in stats().rejected.
     void add(const Grid& grid, const Materials& materials, const SplatStyle& style = {});
+    // Appends particles (particles.hpp; King et al. 1999, sec. 6) to the same
+    // list, so they sort and cut with the grids' splats. A particle with a
+    // non-finite field or a size <= 0 is dropped and counted in
+    // stats().rejected; stats().voxelsIn counts the particles offered.
+    void add(std::span<const Particle> particles, const Materials& materials, const ParticleStyle& style = {});
     // Orders the list back to front (largest depth first).
     void sort(SortMode mode = SortMode::Exact);
 

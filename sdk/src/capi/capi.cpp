@@ -272,6 +272,22 @@ struct GhostsFields {
     }
 };
 
+struct EmbersFields {
+    template <class V, class C, class D>
+    void operator()(V& v, C& c, D& d) const {
+        v("position", c.position, d.position), v("half_extent", c.half_extent, d.halfExtent), v("rate_per_sec", c.rate_per_sec, d.ratePerSec);
+        v("warm_up_sec", c.warm_up_sec, d.warmUpSec), v("lifetime_sec", c.lifetime_sec, d.lifetimeSec);
+        v("lifetime_jitter", c.lifetime_jitter, d.lifetimeJitter), v("velocity", c.velocity, d.velocity);
+        v("velocity_spread", c.velocity_spread, d.velocitySpread), v("acceleration", c.acceleration, d.acceleration);
+        v("drag_per_sec", c.drag_per_sec, d.dragPerSec), v("wind", c.wind, d.wind), v("size_world", c.size_world, d.sizeWorld);
+        v("size_end_world", c.size_end_world, d.sizeEndWorld), v("opacity", c.opacity, d.opacity);
+        v("stretch_per_speed", c.stretch_per_speed, d.stretchPerSpeed), v("textures_per_sec", c.textures_per_sec, d.texturesPerSec);
+        v("texture_set", c.texture_set, d.textureSet), v("texture_count", c.texture_count, d.textureCount);
+        v.motion("motion", c.motion_keys, c.motion_key_count, d.motion);
+        v("seed", c.seed, d.seed), v("texture_seed", c.texture_seed, d.textureSeed);
+    }
+};
+
 template <class CDesc, class Desc, class Fields>
 void initPresetDesc(CDesc* desc, Fields fields) {
     if (!desc) return;
@@ -440,6 +456,7 @@ void splatfx_fire_to_smoke_desc_init(splatfx_fire_to_smoke_desc* desc) {
     initPresetDesc<splatfx_fire_to_smoke_desc, presets::FireToSmokeDesc>(desc, FireToSmokeFields{});
 }
 void splatfx_ghosts_desc_init(splatfx_ghosts_desc* desc) { initPresetDesc<splatfx_ghosts_desc, presets::GhostsDesc>(desc, GhostsFields{}); }
+void splatfx_embers_desc_init(splatfx_embers_desc* desc) { initPresetDesc<splatfx_embers_desc, presets::EmbersDesc>(desc, EmbersFields{}); }
 
 splatfx_status splatfx_scene_add_fire(splatfx_scene* scene, splatfx_materials* materials, const splatfx_fire_desc* desc,
                                       const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
@@ -481,6 +498,12 @@ splatfx_status splatfx_scene_add_ghosts(splatfx_scene* scene, splatfx_materials*
                                         const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
     return addPresetC<presets::GhostsDesc>("splatfx_scene_add_ghosts", error, scene, materials, desc, options, out_id, splatfx_ghosts_desc_init,
                                            GhostsFields{}, presets::ghosts, kNoExtraCheck);
+}
+
+splatfx_status splatfx_scene_add_embers(splatfx_scene* scene, splatfx_materials* materials, const splatfx_embers_desc* desc,
+                                        const splatfx_effect_options* options, uint32_t* out_id, splatfx_error* error) {
+    return addPresetC<presets::EmbersDesc>("splatfx_scene_add_embers", error, scene, materials, desc, options, out_id, splatfx_embers_desc_init,
+                                           EmbersFields{}, presets::embers, kNoExtraCheck);
 }
 
 splatfx_status splatfx_scene_load_file(const char* path, splatfx_materials* materials, const uint32_t* seed, splatfx_scene** out,

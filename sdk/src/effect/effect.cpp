@@ -49,6 +49,15 @@ Result<Effect> Effect::fromSequence(GridSequence sequence, EffectDesc desc) {
     return Effect(std::move(*body));
 }
 
+Result<Effect> Effect::fromParticles(ParticleEmitterDesc emitter, EffectDesc desc) {
+    if (Status s = detail::EffectBody::checkDesc(desc); !s) return makeError(s.error());
+    auto body = detail::makeParticleBody(std::move(emitter), std::move(desc));
+    if (!body) return makeError(body.error());
+    return Effect(std::move(*body));
+}
+
+Status Effect::setParticles(std::span<const Particle> particles) { return mBody->setParticles(particles); }
+
 bool Effect::isStateless() const { return mBody->stateless(); }
 void Effect::update(double timeSec) { mBody->update(timeSec); }
 void Effect::step(double dtSec) { mBody->step(dtSec); }
@@ -67,6 +76,7 @@ EmitResult Effect::emit(const EmitContext& context) { return {.splats = emit(con
 bool Effect::lightingDensity(const Materials& materials, const EmitOptions& draw, Grid& out) const {
     // The light sees the opacity the splats are drawn with (style and draw
     // scales, table alpha), so the self-shadow matches the splats' own optical depth.
+    if (!mBody->lit()) return false;
     const Grid& whole = grid();
     out.dims = whole.dims;
     out.spacing = whole.spacing;

@@ -122,6 +122,10 @@ std::size_t EffectBody::emit(SplatBuilder& builder, const Materials& materials, 
     return builder.splats().size() - before;
 }
 
+Status EffectBody::setParticles(std::span<const Particle>) {
+    return makeError("effect '" + desc.name + "': setParticles needs a particle effect (Effect::fromParticles)");
+}
+
 Aabb EffectBody::transformBox(const Aabb& box, const glm::mat4& m) {
     Aabb out;
     if (box.empty()) return out;

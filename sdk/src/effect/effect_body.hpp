@@ -7,9 +7,11 @@
 #pragma once
 
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "splatfx/effect.hpp"
+#include "splatfx/particles.hpp"
 #include "splatfx/procedural_gas.hpp"
 
 namespace splatfx::detail {
@@ -38,7 +40,12 @@ public:
     void init(EffectDesc d, int latticeLoY, int latticeHiY);
     // grid -> layerGrids by the layers' height bands (EffectLayer).
     void splitLayers();
-    std::size_t emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options) const;
+    // Every layer's grid through the builder; the particle kind draws its particles instead.
+    virtual std::size_t emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options) const;
+    // Whether the scene's lights see the kind (lightingDensity): particles are drawn unlit.
+    virtual bool lit() const { return true; }
+    // Host particles (Effect::setParticles): only the particle kind takes them.
+    virtual Status setParticles(std::span<const Particle> particles);
     // The world box `world` (lattice points, motion included) grown by the
     // largest splat: footprint radius times the kernel's largest axis for a
     // lattice with this transform and spacing, scaled by `motionScale`.
@@ -73,6 +80,7 @@ protected:
 std::unique_ptr<EffectBody> makeGridBody(Grid base, EffectDesc desc);
 Result<std::unique_ptr<EffectBody>> makeSolverBody(FluidSolver solver, EffectDesc desc);
 Result<std::unique_ptr<EffectBody>> makeGasBody(ProceduralGasDesc gas, Grid lattice, EffectDesc desc);
+Result<std::unique_ptr<EffectBody>> makeParticleBody(ParticleEmitterDesc emitter, EffectDesc desc); // particle_effect.cpp
 Result<std::unique_ptr<EffectBody>> makeSequenceBody(GridSequence sequence, EffectDesc desc); // sequence_effect.cpp
 
 } // namespace splatfx::detail

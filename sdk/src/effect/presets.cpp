@@ -394,4 +394,42 @@ Result<Effect> ghosts(Materials& materials, const GhostsDesc& d) {
     return Effect::fromGrid(std::move(*grid), std::move(e));
 }
 
+Result<Effect> embers(Materials& materials, const EmbersDesc& d) {
+    const Result<SplatVariation> variation = seededVariation("EmbersDesc", d.variation, d.seed);
+    if (!variation) return makeError(variation.error());
+    if (Status s = checkCount("EmbersDesc.textureCount", d.textureCount); !s) return makeError(s.error());
+    if (!(d.warmUpSec >= 0.0f) || !std::isfinite(d.warmUpSec)) return makeError("EmbersDesc.warmUpSec must be finite and >= 0");
+    const ParticleEmitterDesc e{.position = d.position,
+                                .halfExtent = d.halfExtent,
+                                .ratePerSec = d.ratePerSec,
+                                .startSec = -double(d.warmUpSec),
+                                .velocity = d.velocity,
+                                .velocitySpread = d.velocitySpread,
+                                .lifetimeSec = d.lifetimeSec,
+                                .lifetimeJitter = d.lifetimeJitter,
+                                .acceleration = d.acceleration,
+                                .dragPerSec = d.dragPerSec,
+                                .wind = d.wind,
+                                .sizeWorld = d.sizeWorld,
+                                .sizeEndWorld = d.sizeEndWorld,
+                                .opacity = d.opacity,
+                                .fadeIn = 0.05f,
+                                .fadeOut = 0.5f,
+                                .colorFrom = 0.15f, // past the table's white base: embers glow yellow-orange, then redden and darken
+                                .colorTo = 0.95f,
+                                .texturesPerSec = d.texturesPerSec,
+                                .stretchPerSpeed = d.stretchPerSpeed,
+                                .maxStretch = 3.0f,
+                                .seed = d.seed};
+    if (std::string err = checkParticleEmitter(e, "EmbersDesc."); !err.empty()) return makeError(err);
+    Result<PendingSet> set = resolveSet(materials, d.textureSet, {.count = d.textureCount, .size = 32, .seed = d.textureSeed, .contrast = 2.5f});
+    if (!set) return makeError("EmbersDesc.textureSet: " + set.error());
+    EffectDesc ed = gridDesc("embers", materials, d.motion, d.seed);
+    const Result<std::uint32_t> setId = registerSet(materials, *set);
+    if (!setId) return makeError("EmbersDesc.textureSet: " + setId.error());
+    const std::uint32_t tableId = materials.addColorTable(ColorTable::fire());
+    ed.layers = {{.style = {.textureSet = *setId, .colorTable = tableId, .textured = true, .crossfade = true, .variation = *variation}}};
+    return Effect::fromParticles(e, std::move(ed));
+}
+
 } // namespace splatfx::presets

@@ -5,7 +5,7 @@
 namespace splatfx::scenefile {
 
 // Effect readers, one a file in kinds/.
-EffectReaderFn readFire, readSmoke, readSteam, readDust, readFireToSmoke, readGhosts, readGridKind, readGasKind;
+EffectReaderFn readFire, readSmoke, readSteam, readDust, readFireToSmoke, readGhosts, readGridKind, readGasKind, readParticlesKind;
 #if SPLATFX_WITH_VDB
 EffectReaderFn readVdbKind; // only when splatfx::vdb is built (OpenVDB found)
 #endif
@@ -25,6 +25,7 @@ constexpr EffectKind kEffectKinds[] = {
     {"ghosts", &readGhosts},           // kinds/ghosts.cpp
     {"grid", &readGridKind},           // kinds/grid.cpp
     {"gas", &readGasKind},             // kinds/gas.cpp
+    {"particles", &readParticlesKind}, // kinds/particles.cpp
 #if SPLATFX_WITH_VDB
     {"vdb", &readVdbKind}, // kinds/vdb.cpp
 #endif

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <glm/gtc/matrix_transform.hpp>
 #include <thread>
 #include <utility>
 #include <vector>
@@ -503,6 +504,110 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
         mStats.culled += stats[t].culled;
     }
     mSplats.resize(std::size_t(write - mSplats.data()));
+}
+
+void SplatBuilder::add(std::span<const Particle> particles, const Materials& materials, const ParticleStyle& pstyle) {
+    mStats.voxelsIn += particles.size();
+    const SplatStyle& style = pstyle.splat;
+    const Camera& cam = mCamera;
+    const bool persp = cam.perspective();
+    const float R = materials.footprint().radius();
+    const glm::mat4 vp = cam.proj * cam.view;
+    glm::vec4 planes[6]; // as in add(Grid): Gribb & Hartmann, normalized
+    for (int i = 0; i < 3; ++i) {
+        const glm::vec4 row(vp[0][i], vp[1][i], vp[2][i], vp[3][i]);
+        const glm::vec4 w(vp[0][3], vp[1][3], vp[2][3], vp[3][3]);
+        planes[2 * i] = w + row;
+        planes[2 * i + 1] = w - row;
+    }
+    for (auto& p : planes) p /= std::max(glm::length(glm::vec3(p)), 1e-30f);
+    const bool hasSet = style.textured && style.textureSet < materials.setCount();
+    const Materials::SetRange range = hasSet ? materials.set(style.textureSet) : Materials::SetRange{0, 1, false, 1.0f};
+    const bool hasTable = style.colorTable < materials.colorTableCount();
+    const ColorTable* table = hasTable ? &materials.colorTable(style.colorTable) : nullptr;
+    const float opacityScale = std::isfinite(style.opacityScale) ? std::max(style.opacityScale, 0.0f) : 0.0f;
+    SplatVariation variation = hasSet ? sanitized(style.variation) : SplatVariation{};
+    variation.jitter = 0.0f; // a particle's centre is its own, not a lattice point's
+    const bool varied = variation.any();
+    const float stretchPerSpeed = std::isfinite(pstyle.stretchPerSpeed) ? std::max(pstyle.stretchPerSpeed, 0.0f) : 0.0f;
+    const float maxStretch = std::isfinite(pstyle.maxStretch) ? std::max(pstyle.maxStretch, 0.0f) : 0.0f;
+    const FastMod setCount(range.count);
+    const Voxel origin{}; // each particle is the lone lattice point of its own frame
+    const glm::vec3 eye = cam.eye(), fwd = cam.forward(), camUp = cam.up(), camRight = cam.right();
+    const float nearZ = cam.nearPlane();
+    mSplats.reserve(mSplats.size() + particles.size());
+    for (const Particle& p : particles) {
+        const float size = p.sizeWorld;
+        const float speed = glm::length(p.velocity);
+        if (!finite3(p.position) || !(size > 0.0f) || !std::isfinite(size) || !std::isfinite(p.opacity) || !std::isfinite(p.colorCoord) ||
+            !std::isfinite(p.phase) || !std::isfinite(speed)) {
+            ++mStats.rejected;
+            continue;
+        }
+        // The kernel of a voxel with spacing `size` and no rotation, stretched
+        // along the velocity (the grid path's Voxel::stretch, in world units here).
+        const float stretch = stretchPerSpeed > 0.0f && speed > 0.0f ? std::min(speed * stretchPerSpeed, maxStretch) : 0.0f;
+        glm::mat3 m(size);
+        if (stretch > 0.0f) {
+            const glm::vec3 sd = p.velocity / speed;
+            m = m * (glm::mat3(1.0f) + stretch * glm::outerProduct(sd, sd));
+        }
+        const Shape shape(m, R);
+        if (!shape.ok) {
+            ++mStats.rejected;
+            continue;
+        }
+        const VariationDraw d = varied ? drawVariation(variation, glm::ivec3(int(p.id & 0x7fffffffu), int(p.id >> 31), 0x5a17)) : VariationDraw{};
+        const float opacity = std::clamp(p.opacity * opacityScale, 0.0f, 1.0f);
+        bool outside = opacity <= 0.0f;
+        if (mDesc.frustumCull)
+            for (const auto& pl : planes) outside = outside || glm::dot(glm::vec3(pl), p.position) + pl.w < -shape.extent * d.scale;
+        if (outside) {
+            ++mStats.culled;
+            continue;
+        }
+        const Frame frame{glm::translate(glm::mat4(1.0f), p.position), glm::vec3(1.0f), glm::vec3(0.0f), eye, fwd, camUp, camRight, R, persp};
+        GeometryBatch one;
+        if (shape.isotropic) computeGeometry<true>(frame, shape, &origin, 1, one);
+        else computeGeometry<false>(frame, shape, &origin, 1, one);
+        const Geometry g = one.at(0);
+        const float fadeFrom = nearZ + mDesc.nearFadeStart * shape.extent, fadeTo = nearZ + mDesc.nearFadeEnd * shape.extent;
+        const float fade = !mDesc.nearFade || g.viewZ >= fadeTo ? 1.0f : smoothstep(fadeFrom, fadeTo, g.viewZ);
+        if (fade <= 0.0f) {
+            ++mStats.culled;
+            continue;
+        }
+        if (!finite3(g.center) || !finite3(g.axisU) || !finite3(g.axisV)) {
+            ++mStats.rejected;
+            continue;
+        }
+        Splat sp;
+        sp.center = g.center;
+        sp.axisU = d.mirror * d.scale * (d.cosA * g.axisU + d.sinA * g.axisV);
+        sp.axisV = d.scale * (d.cosA * g.axisV - d.sinA * g.axisU);
+        glm::vec4 entry(1.0f);
+        if (table) {
+            const std::vector<glm::vec4>& e = table->entries;
+            const float f = std::clamp(p.colorCoord, 0.0f, 1.0f) * float(e.size() - 1);
+            const size_t i = std::min(size_t(f), e.size() - 2);
+            entry = glm::clamp(glm::mix(e[i], e[i + 1], f - float(i)), glm::vec4(0.0f), glm::vec4(1.0f));
+        }
+        const std::uint32_t packed = std::uint32_t(entry.r * 255.0f + 0.5f) | std::uint32_t(entry.g * 255.0f + 0.5f) << 8 |
+                                     std::uint32_t(entry.b * 255.0f + 0.5f) << 16 | 0xff000000u;
+        const float alpha = opacity * entry.a;
+        // As add(Grid): -log2(1 - alpha), log1p for small alphas, capped at kMaxTau.
+        const float tau = alpha >= 1.0f ? kMaxTau : std::min(alpha < 0x1p-10f ? -std::log1p(-alpha) * 1.44269504f : -std::log2(1.0f - alpha), kMaxTau);
+        sp.density = tau * std::min(g.chord, 64.0f) * fade * range.gain / (d.scale * d.scale);
+        sp.colorCoord = std::clamp(p.colorCoord, 0.0f, 1.0f);
+        sp.colorRow = hasTable ? float(style.colorTable) : 0.0f;
+        const std::uint32_t index = setCount.mod(p.texture);
+        sp.layer = std::uint16_t(range.first + index);
+        sp.nextLayer = std::uint16_t(range.first + (index + 1 == setCount.d ? 0 : index + 1));
+        sp.color = shape.isotropic ? packed : (packed & 0x00ffffffu) | std::uint32_t(rayScaleCode(std::pow(g.chord, 1.5f))) << 24;
+        sp.blend = style.crossfade ? std::clamp(p.phase - std::floor(p.phase), 0.0f, 1.0f) : 0.0f;
+        sp.depth = persp ? g.dist : g.viewZ;
+        mSplats.push_back(sp);
+    }
 }
 
 void SplatBuilder::sort(SortMode mode) { sortBackToFront(mSplats, mScratch, mode, mDesc.buckets); }
