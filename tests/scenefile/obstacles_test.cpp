@@ -86,5 +86,5 @@ TEST(SceneFileObstacles, BadEntriesNameTheField) {
     expectError(with(R"([{"type": "box", "attachTo": "deck", "motion": {"velocity": [1, 0, 0]}}])"),
                 "effects[0].obstacles[0].motion: an obstacle either has its own \"motion\" or is attached to geometry; not both");
     expectError(with(R"({"type": "box"})"), "effects[0].obstacles: expected an array of at most 4096 obstacles");
-    expectError(with(R"([{"type": "box", "colour": 1}])"), "effects[0].obstacles[0]: unknown key \"colour\"");
+    expectError(with(R"([{"type": "box", "colour": 1}])"), "effects[0].obstacles[0].colour: unknown key; keys allowed here: attachTo, geometry, motion");
 }

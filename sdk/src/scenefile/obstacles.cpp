@@ -60,6 +60,7 @@ std::optional<Obstacle> readObstacle(Context& c, const std::string& path, const 
         ob.desc.transform = a->transform;
         ob.motion = a->motion;
     } else {
+        o.touch("geometry"); // listed among the keys allowed when one is unknown
         if (!o.has("type")) c.d.error(path, "missing \"type\" (\"box\", \"plane\", \"sphere\", \"cylinder\" or \"mesh\") or \"geometry\" (a name)");
         if (const Json* t = o.get("type")) {
             if (auto s = readChoice(c.d, o.at("type"), *t, {"box", "plane", "sphere", "cylinder", "mesh"})) {
