@@ -1,5 +1,5 @@
 // splatfx-bench obstacles: what solids cost the gas solver. The smoke of
-// samples/26-locomotive-bridge (a 46x18x14 domain, the emitter riding the
+// samples/26-locomotive-bridge (a 46x18x22 domain, the emitter riding the
 // locomotive) stepped for the sample's 4 s at 24 Hz with no obstacle, with
 // the bridge (boxes), the bridge and the moving locomotive (a box and a
 // cylinder), the same as triangle meshes (winding-number voxelization), and
@@ -62,7 +62,7 @@ struct Config {
 
 int runObstacles(int argc, char** argv) {
     int steps = 96;
-    CLI::App app{"Solver step cost with obstacles against none: the smoke of samples/26-locomotive-bridge (46x18x14 cells) stepped at 24 Hz",
+    CLI::App app{"Solver step cost with obstacles against none: the smoke of samples/26-locomotive-bridge (46x18x22 cells) stepped at 24 Hz",
                  "splatfx-bench obstacles"};
     cli::addNumber(app, "--steps", steps, 1, 100000, "steps per configuration (96: the sample's 4 s)");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
@@ -79,7 +79,7 @@ int runObstacles(int argc, char** argv) {
     std::printf("\n| obstacles | solid cells (last step) | ms/step | vs none | CG iterations/step |\n| --- | ---: | ---: | ---: | ---: |\n");
     double noneMs = 0.0;
     for (const Config& c : configs) {
-        auto solver = FluidSolver::create({.dims = {46, 18, 14},
+        auto solver = FluidSolver::create({.dims = {46, 18, 22},
                                            .spacing = glm::vec3(0.3f),
                                            .transform = glm::translate(glm::mat4(1.0f), {0, 0.2f, 0}),
                                            .buoyancy = 3.0f,

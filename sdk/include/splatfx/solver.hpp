@@ -215,6 +215,7 @@ private:
     std::vector<std::uint8_t> mFixed[3];    // per face: velocity prescribed by an obstacle
     std::vector<float> mFixedVelocity[3];   // per face: that velocity, local units/s
     std::vector<int> mComponent;            // projection: connected fluid region of each cell
+    std::vector<std::uint8_t> mWallBits;    // projection: which of a cell's six faces are walls
     glm::vec3 mUpLocal{0, 1, 0};
     glm::vec3 mWindLocal{0.0f};
     double mTime = 0.0;

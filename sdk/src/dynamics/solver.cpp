@@ -626,6 +626,27 @@ void FluidSolver::project() {
             if (mComponent[i] >= 0 && !open[std::size_t(mComponent[i])]) mRhs[i] -= sum[std::size_t(mComponent[i])] / double(size[std::size_t(mComponent[i])]);
     }
 
+    // With obstacles, which of each fluid cell's six faces are walls (bit 2a
+    // for the low face on axis a, 2a + 1 for the high one), looked up once
+    // per projection instead of once per CG iteration.
+    if (withObstacles) {
+        mWallBits.assign(n, 0);
+        for (int k = 0; k < mDims.z; ++k)
+            for (int j = 0; j < mDims.y; ++j)
+                for (int i = 0; i < mDims.x; ++i) {
+                    const glm::ivec3 cell{i, j, k};
+                    std::uint8_t bits = 0;
+                    for (int a = 0; a < 3; ++a) {
+                        glm::ivec3 hiF = cell;
+                        hiF[a] += 1;
+                        const glm::ivec3 fd = faceDims(mDims, a);
+                        if (fixedFace(a, lin(cell, fd))) bits |= std::uint8_t(1u << (2 * a));
+                        if (fixedFace(a, lin(hiF, fd))) bits |= std::uint8_t(1u << (2 * a + 1));
+                    }
+                    mWallBits[lin(cell, mDims)] = bits;
+                }
+    }
+
     auto applyA = [&](const std::vector<double>& x, std::vector<double>& out) {
         for (int k = 0; k < mDims.z; ++k)
             for (int j = 0; j < mDims.y; ++j)
@@ -637,16 +658,13 @@ void FluidSolver::project() {
                         continue;
                     }
                     const double xc = x[ci];
+                    const std::uint8_t walls = withObstacles ? mWallBits[ci] : std::uint8_t(0);
                     double acc = 0.0;
                     for (int a = 0; a < 3; ++a)
                         for (int side = -1; side <= 1; side += 2) {
+                            if (walls & (1u << (2 * a + (side > 0 ? 1 : 0)))) continue; // a wall: no flux term
                             glm::ivec3 nb = cell;
                             nb[a] += side;
-                            if (withObstacles) {
-                                glm::ivec3 f = cell;
-                                if (side > 0) f[a] += 1;
-                                if (fixedFace(a, lin(f, faceDims(mDims, a)))) continue; // a wall: no flux term
-                            }
                             if (nb[a] < 0 || nb[a] >= mDims[a]) {
                                 if (!(side < 0 ? closedLo[a] : closedHi[a])) acc += c[a] * xc; // phi = 0 outside
                                 continue;
