@@ -8,7 +8,7 @@
 // cells and the mean conjugate-gradient iterations (obstacles change the
 // pressure system, so the iteration count is part of the cost).
 //
-//   splatfx-bench obstacles [--steps N]
+//   splatfx-bench obstacles [--steps N] [--validation]
 #include <chrono>
 #include <cstdio>
 #include <ctime>
@@ -60,12 +60,48 @@ struct Config {
 
 } // namespace
 
+// The channel case of Obstacles.ChannelFlowAroundABox... projected once
+// (step(0)), every face velocity as CSV (axis, i, j, k, u) for
+// tools/validate/obstacle_projection.py.
+int validation() {
+    auto s = FluidSolver::create({.dims = {8, 14, 6},
+                                  .spacing = glm::vec3(0.5f),
+                                  .buoyancy = 0.0f,
+                                  .pressureIterations = 2000,
+                                  .pressureTolerance = 1e-10f,
+                                  .closedFloor = false,
+                                  .closedWalls = true,
+                                  .closedCeiling = false});
+    if (!s) return std::fprintf(stderr, "obstacles: %s\n", s.error().c_str()), 1;
+    // Cells x 2..5, y 5..7, z 1..4: local centres (x - 3.5, y, z - 2.5) * 0.5.
+    Obstacle o;
+    o.desc.size = {2.0f, 1.5f, 2.0f};
+    o.desc.transform = glm::translate(glm::mat4(1.0f), {0.0f, 3.0f, 0.0f});
+    if (Status st = s->addObstacle(o); !st) return std::fprintf(stderr, "obstacles: %s\n", st.error().c_str()), 1;
+    s->setUniformVelocity({0, 1, 0});
+    s->step(0.0);
+    std::printf("axis,i,j,k,u\n");
+    for (int a = 0; a < 3; ++a) {
+        glm::ivec3 fd = s->dims();
+        fd[a] += 1;
+        for (int k = 0; k < fd.z; ++k)
+            for (int j = 0; j < fd.y; ++j)
+                for (int i = 0; i < fd.x; ++i) std::printf("%d,%d,%d,%d,%.9g\n", a, i, j, k, s->faceVelocity(a, {i, j, k}));
+    }
+    std::fprintf(stderr, "solid cells %llu, CG %d iterations, relative residual %.3g\n", static_cast<unsigned long long>(s->stats().solidCells),
+                 s->stats().lastPressureIterations, double(s->stats().lastResidual));
+    return 0;
+}
+
 int runObstacles(int argc, char** argv) {
     int steps = 96;
     CLI::App app{"Solver step cost with obstacles against none: the smoke of samples/26-locomotive-bridge (46x18x22 cells) stepped at 24 Hz",
                  "splatfx-bench obstacles"};
+    bool validate = false;
     cli::addNumber(app, "--steps", steps, 1, 100000, "steps per configuration (96: the sample's 4 s)");
+    app.add_flag("--validation", validate, "print the projected face velocities of a small channel case as CSV for tools/validate/obstacle_projection.py");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+    if (validate) return validation();
 
     const Motion train({{.timeSec = 0, .pose = {.position = {-8, 0.22f, 0}}}, {.timeSec = 4, .pose = {.position = {6, 0.22f, 0}}}});
     const Config configs[] = {
