@@ -252,6 +252,67 @@ static void test_motion(void) {
     splatfx_error_destroy(err);
 }
 
+/* Obstacles in a smoke solver (splatfx_scene_add_obstacle): a box and a
+ * mesh are taken, a grid effect or a bad desc are refused by field. */
+static void test_obstacles(void) {
+    splatfx_error* err = splatfx_error_create();
+    splatfx_materials* m = NULL;
+    splatfx_scene* scene = NULL;
+    CHECK_OK(splatfx_materials_create(NULL, &m, err), err);
+    CHECK_OK(splatfx_scene_create(&scene, err), err);
+    splatfx_smoke_desc sd;
+    splatfx_smoke_desc_init(&sd);
+    sd.dims[0] = sd.dims[1] = sd.dims[2] = 6;
+    uint32_t smoke = 99, fire = 99;
+    CHECK_OK(splatfx_scene_add_smoke(scene, m, &sd, NULL, &smoke, err), err);
+    CHECK_OK(splatfx_scene_add_fire(scene, m, NULL, NULL, &fire, err), err);
+    splatfx_obstacle_desc od;
+    splatfx_obstacle_desc_init(&od);
+    CHECK(od.shape == SPLATFX_OBSTACLE_BOX && od.size[1] == 1.0f && od.transform[0] == 1.0f && od.transform[1] == 0.0f && od.transform[15] == 1.0f &&
+              od.no_slip == 0 && od.triangles == NULL,
+          "obstacle desc defaults");
+    od.transform[13] = 2.0f; /* a deck 2 units up */
+    od.size[0] = 3.0f;
+    od.no_slip = 1;
+    CHECK_OK(splatfx_scene_add_obstacle(scene, smoke, &od, err), err);
+    /* A tetrahedron as a mesh, moving. */
+    const float tet[36] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 1, 0, 0, 0, 0, 1, 0, 1, 0};
+    splatfx_keyframe keys[2];
+    splatfx_keyframe_init(&keys[0]);
+    splatfx_keyframe_init(&keys[1]);
+    keys[1].time_sec = 2.0;
+    keys[1].position[0] = 1.0f;
+    splatfx_obstacle_desc_init(&od);
+    od.shape = SPLATFX_OBSTACLE_MESH;
+    od.triangles = tet;
+    od.triangle_count = 4;
+    od.motion_keys = keys;
+    od.motion_key_count = 2;
+    CHECK_OK(splatfx_scene_add_obstacle(scene, smoke, &od, err), err);
+    CHECK_FAILS(splatfx_scene_add_obstacle(scene, fire, &od, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "effect 1 has no solver");
+    CHECK_FAILS(splatfx_scene_add_obstacle(scene, 7, &od, err), err, SPLATFX_ERROR_NOT_FOUND, "id 7 is not an effect of this scene");
+    CHECK_FAILS(splatfx_scene_add_obstacle(scene, smoke, NULL, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "desc is NULL");
+    float bad[36];
+    memcpy(bad, tet, sizeof bad);
+    bad[13] = NAN;
+    od.triangles = bad;
+    CHECK_FAILS(splatfx_scene_add_obstacle(scene, smoke, &od, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "desc.triangles[4] is not finite");
+    od.triangles = NULL;
+    CHECK_FAILS(splatfx_scene_add_obstacle(scene, smoke, &od, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                "desc.triangles is NULL but desc.triangle_count is 4");
+    od.triangle_count = 0;
+    CHECK_FAILS(splatfx_scene_add_obstacle(scene, smoke, &od, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                "desc.triangles must hold three vertices per triangle");
+    od.shape = (splatfx_obstacle_shape)9;
+    CHECK_FAILS(splatfx_scene_add_obstacle(scene, smoke, &od, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "desc.shape is 9");
+    splatfx_obstacle_desc_init(&od);
+    od.size[2] = -1.0f;
+    CHECK_FAILS(splatfx_scene_add_obstacle(scene, smoke, &od, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "desc.size must be positive and finite");
+    splatfx_scene_destroy(scene);
+    splatfx_materials_destroy(m);
+    splatfx_error_destroy(err);
+}
+
 /* A texture-set folder and a scene file, and their missing counterparts. */
 static void test_files(void) {
     splatfx_error* err = splatfx_error_create();
@@ -552,6 +613,7 @@ int main(void) {
     test_fire_prepares();
     test_every_preset();
     test_motion();
+    test_obstacles();
     test_files();
     test_bad_input();
     test_destroy_twice();

@@ -43,6 +43,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -83,6 +84,8 @@ struct SmokeDesc {
     int textureCount = 8;                     // default 8
     float texturesPerSec = 3.0f;              // local dynamics rate; default 3
     int substeps = 1;                         // solver substeps per step; default 1
+    // Solids the smoke flows around (a bridge deck, a roof), world placement (obstacle.hpp); default none
+    std::vector<Obstacle> obstacles{};
     std::uint32_t seed = 1;                   // texture dynamics (which texture each voxel shows when); default 1
     // Per-splat variation hiding the voxel lattice (splats.hpp); its seed is combined with `seed`;
     // default SplatVariation::recommended (jitter 0.5, any rotation, mirrored). {} gives the paper's lattice.
@@ -143,6 +146,7 @@ struct DustDesc {
     float dissipation = 0.3f;                  // 1/s; default 0.3
     std::optional<TextureSet> textureSet{};    // default none (procedural turbulence)
     int textureCount = 8;                      // default 8
+    std::vector<Obstacle> obstacles{};         // solids the dust flows around, world placement (obstacle.hpp); default none
     std::uint32_t seed = 1;                    // texture dynamics (which texture each voxel shows when); default 1
     // Per-splat variation hiding the voxel lattice (splats.hpp); its seed is combined with `seed`;
     // default SplatVariation::recommended (jitter 0.5, any rotation, mirrored). {} gives the paper's lattice.

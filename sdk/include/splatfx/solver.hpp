@@ -17,6 +17,13 @@
 //   4. semi-Lagrangian advection (RK2 backtrace, clamped to the domain,
 //      trilinear interpolation) of density, temperature, then velocity;
 //   5. dissipation (implicit decay); optional global mass correction.
+// Obstacles (obstacle.hpp) are voxelized at the start of each substep: a
+// cell whose centre is inside one is solid. Faces touching a solid cell carry
+// the obstacle's velocity (its motion over the substep) and are walls to the
+// projection, so no gas flows into it relative to its motion; Slip::None also
+// pins the fluid faces beside it. Density never sits in a solid cell: what a
+// moving obstacle covers is handed to the nearest fluid cell, emitters skip
+// solid cells, and backtraces stop before they cross one.
 // Every update is a convex combination or an implicit relaxation, so fields
 // stay finite and density stays non-negative for any time step and any speed.
 // toGrid() turns the dense fields into a sparse splatfx::Grid: voxels appear
@@ -38,6 +45,7 @@
 
 #include "splatfx/grid.hpp"
 #include "splatfx/motion.hpp"
+#include "splatfx/obstacle.hpp"
 #include "splatfx/result.hpp"
 
 namespace splatfx {
@@ -110,6 +118,8 @@ struct SolverStats {
     std::uint64_t cellsUpdated = 0; // cells times substeps
     int lastPressureIterations = 0; // CG iterations of the last projection
     float lastResidual = 0.0f;      // relative residual after it
+    std::uint64_t solidCells = 0;   // cells inside obstacles at the last voxelization
+    double displacedDensity = 0.0;  // density moved out of cells an obstacle covered (total over all substeps)
 };
 
 class FluidSolver {
@@ -120,6 +130,20 @@ public:
     void addEmitter(const Emitter& emitter) { mEmitters.push_back(emitter); }
     std::vector<Emitter>& emitters() { return mEmitters; }
     const std::vector<Emitter>& emitters() const { return mEmitters; }
+
+    // Adds a solid the gas flows around (obstacle.hpp) and voxelizes the
+    // obstacles at the current time. On failure (validateObstacle's message,
+    // or more than kMaxObstacles) nothing is added.
+    static constexpr std::size_t kMaxObstacles = 4096;
+    Status addObstacle(const Obstacle& obstacle);
+    const std::vector<Obstacle>& obstacles() const { return mObstacles; }
+    void clearObstacles();
+    // Whether a cell is inside an obstacle (as of the last voxelization).
+    bool solid(glm::ivec3 cell) const { return !mSolidOwner.empty() && mSolidOwner[cellIndex(cell)] >= 0; }
+    // Largest |divergence| of the face velocities over fluid cells, 1/s
+    // (grid-local units): what the last projection left, when called right
+    // after it (step(0) projects and does nothing else).
+    float maxFluidDivergence() const;
 
     // Advances by dtSec (>= 0, finite) in desc.substeps equal substeps.
     void step(double dtSec);
@@ -136,6 +160,9 @@ public:
     const std::vector<float>& temperature() const { return mTemp; }
     std::vector<float>& temperature() { return mTemp; }
     glm::vec3 velocityAt(glm::ivec3 cell) const;
+    // The staggered velocity component `axis` on face `face` (face i along
+    // the axis lies between cells i-1 and i; 0..dims[axis]), local units/s.
+    float faceVelocity(int axis, glm::ivec3 face) const;
     // Sets every face velocity to v (grid-local units/s), e.g. for tests or a
     // prescribed flow.
     void setUniformVelocity(glm::vec3 v);
@@ -163,6 +190,13 @@ private:
     void advectScalars(float dt);
     void advectVelocity(float dt);
     void dissipate(float dt);
+    // Voxelizes the obstacles at mTime (velocities from their motion over the
+    // last dt), hands covered density to fluid cells, fixes the wall faces.
+    void updateObstacles(float dt);
+    void enforceObstacleFaces();
+    bool fixedFace(int axis, std::size_t faceIndex) const { return !mFixed[axis].empty() && mFixed[axis][faceIndex] != 0; }
+    // The last point of the straight path from -> to before it enters a solid cell.
+    glm::vec3 stopAtSolid(glm::vec3 from, glm::vec3 to) const;
 
     float sampleScalar(const std::vector<float>& f, glm::vec3 p, float outside) const;
     float sampleFace(int axis, const std::vector<float>& f, glm::vec3 p) const;
@@ -175,6 +209,13 @@ private:
     std::vector<float> mU[3], mUScratch[3];   // face velocities, local units/s
     std::vector<double> mP, mR, mD, mQ, mRhs; // CG workspace
     std::vector<Emitter> mEmitters;
+    std::vector<Obstacle> mObstacles;
+    std::vector<std::int16_t> mSolidOwner;  // per cell: obstacle index, -1 fluid; empty without obstacles
+    std::vector<glm::vec3> mSolidVelocity;  // per cell: the obstacle's velocity there, local units/s
+    std::vector<std::uint8_t> mFixed[3];    // per face: velocity prescribed by an obstacle
+    std::vector<float> mFixedVelocity[3];   // per face: that velocity, local units/s
+    std::vector<int> mComponent;            // projection: connected fluid region of each cell
+    std::vector<std::uint8_t> mWallBits;    // projection: which of a cell's six faces are walls
     glm::vec3 mUpLocal{0, 1, 0};
     glm::vec3 mWindLocal{0.0f};
     double mTime = 0.0;

@@ -25,6 +25,7 @@
 #include "splatfx/lighting.hpp"
 #include "splatfx/materials.hpp"
 #include "splatfx/motion.hpp"
+#include "splatfx/obstacle.hpp"
 #include "splatfx/presets.hpp"
 #include "splatfx/procedural_gas.hpp"
 #include "splatfx/reference.hpp"

@@ -334,6 +334,34 @@ typedef struct splatfx_embers_desc {
     uint32_t texture_seed;                  /* procedural texture set; default 1 */
 } splatfx_embers_desc;
 SPLATFX_C_API void splatfx_embers_desc_init(splatfx_embers_desc* desc);
+/* Solids a solver effect's gas flows around (obstacle.hpp; King et al.
+ * 1999 Fig. 9: smoke under a bridge). The shape is in its object's frame,
+ * placed in the world by motion(t) * transform like the scene file's
+ * geometry; the solver voxelizes it every substep. */
+typedef SPLATFX_C_ENUM(splatfx_obstacle_shape){SPLATFX_OBSTACLE_BOX = 0,      /* centred on the origin, size = full extents */
+                                               SPLATFX_OBSTACLE_PLANE = 1,    /* the xz square (size x by z) and all below it */
+                                               SPLATFX_OBSTACLE_SPHERE = 2,   /* radius size[0] / 2 */
+                                               SPLATFX_OBSTACLE_CYLINDER = 3, /* along +y from 0 to size[1], radius size[0] / 2 */
+                                               SPLATFX_OBSTACLE_MESH = 4,     /* a closed triangle list */
+                                               SPLATFX_OBSTACLE_MAX_ENUM = 0x7fffffff} splatfx_obstacle_shape;
+
+typedef struct splatfx_obstacle_desc {
+    splatfx_obstacle_shape shape;        /* default SPLATFX_OBSTACLE_BOX */
+    float size[3];                       /* object units, > 0; default 1, 1, 1 */
+    float transform[16];                 /* static placement in the object, column-major; default identity */
+    const float* triangles;              /* MESH: 9 floats a triangle (three x, y, z vertices), copied; default NULL */
+    uint32_t triangle_count;             /* default 0 */
+    int no_slip;                         /* 1: the gas beside it moves with it; 0: it slides along (free slip); default 0 */
+    const splatfx_keyframe* motion_keys; /* the object it belongs to; default NULL (at rest) */
+    uint32_t motion_key_count;           /* default 0 */
+} splatfx_obstacle_desc;
+SPLATFX_C_API void splatfx_obstacle_desc_init(splatfx_obstacle_desc* desc);
+
+/* Adds an obstacle to the solver of effect `id` (smoke or dust). Fails,
+ * adding nothing, when the effect has no solver or the desc is bad (the
+ * message names the field: "desc.triangles[4] is not finite" for the
+ * fifth vertex, floats 12..14). */
+SPLATFX_C_API splatfx_status splatfx_scene_add_obstacle(splatfx_scene* scene, uint32_t id, const splatfx_obstacle_desc* desc, splatfx_error* error);
 
 /* Builds the preset (registering its texture sets and colour tables in
  * `materials`) and adds it to the scene; *out_id (may be NULL) receives its

@@ -540,6 +540,47 @@ splatfx_status splatfx_scene_set_effect_enabled(splatfx_scene* scene, uint32_t i
     });
 }
 
+void splatfx_obstacle_desc_init(splatfx_obstacle_desc* desc) {
+    if (!desc) return;
+    *desc = {};
+    desc->shape = SPLATFX_OBSTACLE_BOX;
+    for (float& v : desc->size) v = 1.0f;
+    for (int i = 0; i < 16; ++i) desc->transform[i] = i % 5 == 0 ? 1.0f : 0.0f;
+}
+
+splatfx_status splatfx_scene_add_obstacle(splatfx_scene* scene, uint32_t id, const splatfx_obstacle_desc* desc, splatfx_error* error) {
+    return guard("splatfx_scene_add_obstacle", error, [&] {
+        if (auto bad = checkHandle(scene, Magic::Scene, "scene", "splatfx_scene")) return *bad;
+        if (!desc) return invalid("desc is NULL");
+        if (id >= scene->effects.size())
+            return failure(SPLATFX_ERROR_NOT_FOUND,
+                           "id " + std::to_string(id) + " is not an effect of this scene (it has " + std::to_string(scene->effects.size()) + ")");
+        FluidSolver* solver = scene->value.effect(scene->effects[id]).solver();
+        if (!solver) return invalid("effect " + std::to_string(id) + " has no solver (obstacles belong to smoke and dust effects)");
+        if (desc->shape < SPLATFX_OBSTACLE_BOX || desc->shape > SPLATFX_OBSTACLE_MESH)
+            return invalid("desc.shape is " + std::to_string(int(desc->shape)) + "; expected a splatfx_obstacle_shape value");
+        constexpr std::uint32_t kMaxTriangles = 1u << 20;
+        if (desc->triangle_count > kMaxTriangles)
+            return invalid("desc.triangle_count is " + std::to_string(desc->triangle_count) + "; expected at most " + std::to_string(kMaxTriangles));
+        if (desc->triangle_count > 0 && !desc->triangles)
+            return invalid("desc.triangles is NULL but desc.triangle_count is " + std::to_string(desc->triangle_count));
+        Obstacle o;
+        o.desc.shape = ObstacleShape(int(desc->shape));
+        o.desc.size = vec3Of(desc->size);
+        for (int c = 0; c < 4; ++c)
+            for (int r = 0; r < 4; ++r) o.desc.transform[c][r] = desc->transform[c * 4 + r];
+        for (std::uint32_t i = 0; i < desc->triangle_count * 3; ++i) o.desc.triangles.push_back(vec3Of(desc->triangles + 3 * i));
+        o.desc.slip = desc->no_slip ? Slip::None : Slip::Free;
+        if (auto bad = toMotion("desc.motion", desc->motion_keys, desc->motion_key_count, o.motion)) return *bad;
+        if (Status st = solver->addObstacle(o); !st) {
+            std::string msg = st.error();
+            if (msg.rfind("ObstacleDesc.", 0) == 0) msg = "desc." + msg.substr(13);
+            return invalid(msg);
+        }
+        return success();
+    });
+}
+
 // ---- [camera]
 
 splatfx_status splatfx_camera_from_matrices(const float view[16], const float proj[16], int32_t width, int32_t height, splatfx_camera* out,

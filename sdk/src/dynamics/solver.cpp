@@ -4,12 +4,15 @@
 // forces relaxed implicitly, semi-Lagrangian transport, pressure projection.
 //
 // [SECTION] layout and sampling   [SECTION] create   [SECTION] substep stages
-// [SECTION] projection            [SECTION] output
+// [SECTION] obstacles             [SECTION] projection
+// [SECTION] output
 #include "splatfx/solver.hpp"
 
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <deque>
+#include <limits>
 #include <string>
 
 namespace splatfx {
@@ -68,10 +71,28 @@ float FluidSolver::sampleScalar(const std::vector<float>& f, glm::vec3 p, float 
     const bool closedLo[3] = {mDesc.closedWalls, mDesc.closedFloor, mDesc.closedWalls};
     const bool closedHi[3] = {mDesc.closedWalls, mDesc.closedCeiling, mDesc.closedWalls};
     for (int a = 0; a < 3; ++a) p[a] = std::clamp(p[a], closedLo[a] ? 0.0f : -1.0f, closedHi[a] ? float(mDims[a] - 1) : float(mDims[a]));
-    return trilinear(p, [&](glm::ivec3 i) {
-        if (glm::any(glm::lessThan(i, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(i, mDims))) return outside;
-        return f[lin(i, mDims)];
-    });
+    auto inside = [&](glm::ivec3 i) { return glm::all(glm::greaterThanEqual(i, glm::ivec3(0))) && glm::all(glm::lessThan(i, mDims)); };
+    if (mStats.solidCells == 0)
+        return trilinear(p, [&](glm::ivec3 i) { return inside(i) ? f[lin(i, mDims)] : outside; });
+    // Solid corners hold no material: the weights of the fluid corners are
+    // renormalized, so nothing is read through a wall. stopAtSolid leaves p
+    // nearest a fluid cell, whose weight is at least 1/8.
+    const glm::vec3 fl = glm::floor(p);
+    const glm::ivec3 i0(fl);
+    const glm::vec3 t = p - fl;
+    float acc = 0.0f, wsum = 0.0f;
+    for (int c = 0; c < 8; ++c) {
+        const glm::ivec3 o((c & 1), (c >> 1) & 1, (c >> 2) & 1);
+        const float w = (o.x ? t.x : 1.0f - t.x) * (o.y ? t.y : 1.0f - t.y) * (o.z ? t.z : 1.0f - t.z);
+        if (w == 0.0f) continue;
+        const glm::ivec3 i = i0 + o;
+        if (!inside(i)) {
+            acc += w * outside, wsum += w;
+        } else if (mSolidOwner[lin(i, mDims)] < 0) {
+            acc += w * f[lin(i, mDims)], wsum += w;
+        }
+    }
+    return wsum > 0.0f ? acc / wsum : outside;
 }
 
 float FluidSolver::sampleFace(int axis, const std::vector<float>& f, glm::vec3 p) const {
@@ -94,7 +115,27 @@ glm::vec3 FluidSolver::backtrace(glm::vec3 p, float dt) const {
                        mDesc.closedWalls ? mDims.z - 1.0f : float(mDims.z));
     auto clampIn = [&](glm::vec3 q) { return finite3(q) ? glm::clamp(q, lo, hi) : glm::clamp(p, lo, hi); };
     const glm::vec3 mid = clampIn(p - 0.5f * dt * velocityCells(p));
-    return clampIn(p - dt * velocityCells(mid));
+    return stopAtSolid(p, clampIn(p - dt * velocityCells(mid)));
+}
+
+glm::vec3 FluidSolver::stopAtSolid(glm::vec3 from, glm::vec3 to) const {
+    if (mStats.solidCells == 0) return to;
+    auto solidAt = [&](glm::vec3 q) {
+        const glm::ivec3 c(glm::round(q));
+        if (glm::any(glm::lessThan(c, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(c, mDims))) return false;
+        return mSolidOwner[lin(c, mDims)] >= 0;
+    };
+    if (solidAt(from)) return to; // a wall face's own point: its velocity is re-imposed after advection
+    // Half-cell steps: a one-cell wall cannot be stepped over.
+    const float len = glm::length(to - from);
+    const int n = std::max(1, int(std::ceil(2.0f * len)));
+    glm::vec3 last = from;
+    for (int s = 1; s <= n; ++s) {
+        const glm::vec3 q = from + (to - from) * (float(s) / float(n));
+        if (solidAt(q)) return last;
+        last = q;
+    }
+    return to;
 }
 
 // [SECTION] create
@@ -166,11 +207,14 @@ void FluidSolver::step(double dtSec) {
 }
 
 void FluidSolver::substep(float dt) {
+    updateObstacles(dt);
     applyEmitters(dt);
     applyForces(dt);
+    enforceObstacleFaces();
     project();
     advectScalars(dt);
     advectVelocity(dt);
+    enforceObstacleFaces();
     dissipate(dt);
 }
 
@@ -194,6 +238,7 @@ void FluidSolver::applyEmitters(float dt) {
             for (int j = 0; j < mDims.y; ++j)
                 for (int i = 0; i < mDims.x; ++i) {
                     const glm::ivec3 c{i, j, k};
+                    if (solid(c)) continue; // no material inside an obstacle
                     const float w = weightAt(glm::vec3(mDesc.transform * glm::vec4(localPosition(c), 1.0f)));
                     if (w <= 0.0f) continue;
                     // Implicit relaxation towards the target: bounded by it for any
@@ -211,6 +256,7 @@ void FluidSolver::applyEmitters(float dt) {
             for (int k = 0; k < fd.z; ++k)
                 for (int j = 0; j < fd.y; ++j)
                     for (int i = 0; i < fd.x; ++i) {
+                        if (fixedFace(a, lin({i, j, k}, fd))) continue; // an obstacle sets it
                         glm::vec3 p(i, j, k);
                         p[a] -= 0.5f;
                         const glm::vec3 local = (p - glm::vec3(0.5f * (mDims.x - 1), 0.0f, 0.5f * (mDims.z - 1))) * mDesc.spacing;
@@ -269,7 +315,7 @@ void FluidSolver::advectScalars(float dt) {
             for (int j = 0; j < mDims.y; ++j)
                 for (int i = 0; i < mDims.x; ++i) {
                     const glm::ivec3 c{i, j, k};
-                    mScratch[lin(c, mDims)] = sampleScalar(f, backtrace(glm::vec3(c), dt), outside);
+                    mScratch[lin(c, mDims)] = solid(c) ? outside : sampleScalar(f, backtrace(glm::vec3(c), dt), outside);
                 }
         f.swap(mScratch);
     }
@@ -319,6 +365,180 @@ void FluidSolver::dissipate(float dt) {
         for (float& v : mTemp) v = mDesc.ambientTemperature + (v - mDesc.ambientTemperature) * kt;
 }
 
+// [SECTION] obstacles
+
+Status FluidSolver::addObstacle(const Obstacle& o) {
+    if (mObstacles.size() >= kMaxObstacles) return makeError("FluidSolver::addObstacle: at most " + std::to_string(kMaxObstacles) + " obstacles");
+    if (Status st = validateObstacle(o.desc); !st) return st;
+    mObstacles.push_back(o);
+    updateObstacles(0.0f);
+    return {};
+}
+
+void FluidSolver::clearObstacles() {
+    mObstacles.clear();
+    updateObstacles(0.0f);
+}
+
+void FluidSolver::updateObstacles(float dt) {
+    const std::size_t n = mDensity.size();
+    if (mObstacles.empty()) {
+        mSolidOwner.clear(), mSolidVelocity.clear();
+        for (int a = 0; a < 3; ++a) mFixed[a].clear(), mFixedVelocity[a].clear();
+        mStats.solidCells = 0;
+        return;
+    }
+    mSolidOwner.assign(n, -1);
+    mSolidVelocity.assign(n, glm::vec3(0.0f));
+    const glm::mat4& toWorld = mDesc.transform;
+    const glm::mat3 velToLocal = glm::inverse(glm::mat3(toWorld));
+    const glm::vec3 half(0.5f * float(mDims.x - 1), 0.0f, 0.5f * float(mDims.z - 1));
+    std::uint64_t solidCount = 0;
+    for (std::size_t oi = 0; oi < mObstacles.size(); ++oi) {
+        const Obstacle& ob = mObstacles[oi];
+        const glm::mat4 now = ob.objectToWorld(mTime);
+        const glm::mat4 objectFromLocal = glm::inverse(now) * toWorld;
+        // Where each material point of the object was at the substep's start:
+        // its velocity is the displacement over the substep (rotation included).
+        const glm::mat4 before = dt > 0.0f ? ob.objectToWorld(mTime - double(dt)) * glm::inverse(now) : glm::mat4(1.0f);
+        // Cells to test: the object's bounds in lattice coordinates.
+        glm::ivec3 lo(0), hi = mDims - 1;
+        const Aabb ob3 = obstacleBounds(ob.desc);
+        if (std::isfinite(ob3.lo.y)) {
+            Aabb lattice;
+            const glm::mat4 latticeFromObject = glm::inverse(objectFromLocal);
+            for (int c = 0; c < 8; ++c) lattice.extend(glm::vec3(latticeFromObject * glm::vec4(ob3.corner(c), 1.0f)) / mDesc.spacing + half);
+            lo = glm::max(lo, glm::ivec3(glm::floor(lattice.lo)));
+            hi = glm::min(hi, glm::ivec3(glm::ceil(lattice.hi)));
+        }
+        for (int k = lo.z; k <= hi.z; ++k)
+            for (int j = lo.y; j <= hi.y; ++j)
+                for (int i = lo.x; i <= hi.x; ++i) {
+                    const std::size_t idx = lin({i, j, k}, mDims);
+                    if (mSolidOwner[idx] >= 0) continue; // the first obstacle listed owns shared cells
+                    const glm::vec4 local(localPosition({i, j, k}), 1.0f);
+                    if (!obstacleContains(ob.desc, glm::vec3(objectFromLocal * local))) continue;
+                    mSolidOwner[idx] = std::int16_t(oi);
+                    ++solidCount;
+                    if (dt > 0.0f) {
+                        const glm::vec3 x(toWorld * local);
+                        const glm::vec3 x0(before * glm::vec4(x, 1.0f));
+                        mSolidVelocity[idx] = velToLocal * ((x - x0) / dt);
+                    }
+                }
+    }
+    mStats.solidCells = solidCount;
+
+    // Material an obstacle now covers goes to the nearest fluid cell
+    // (breadth-first from every fluid cell at once, ties in index order), so a
+    // moving obstacle pushes smoke instead of deleting it.
+    bool covered = false;
+    for (std::size_t i = 0; i < n && !covered; ++i) covered = mSolidOwner[i] >= 0 && mDensity[i] > 0.0f;
+    if (covered) {
+        std::vector<std::int64_t> nearest(n, -1);
+        std::deque<std::size_t> queue;
+        for (std::size_t i = 0; i < n; ++i)
+            if (mSolidOwner[i] < 0) nearest[i] = std::int64_t(i), queue.push_back(i);
+        while (!queue.empty()) {
+            const std::size_t i = queue.front();
+            queue.pop_front();
+            const glm::ivec3 c(int(i % std::size_t(mDims.x)), int((i / std::size_t(mDims.x)) % std::size_t(mDims.y)),
+                               int(i / (std::size_t(mDims.x) * std::size_t(mDims.y))));
+            for (int a = 0; a < 3; ++a)
+                for (int side = -1; side <= 1; side += 2) {
+                    glm::ivec3 nb = c;
+                    nb[a] += side;
+                    if (nb[a] < 0 || nb[a] >= mDims[a]) continue;
+                    const std::size_t j = lin(nb, mDims);
+                    if (nearest[j] >= 0) continue;
+                    nearest[j] = nearest[i];
+                    queue.push_back(j);
+                }
+        }
+        for (std::size_t i = 0; i < n; ++i) {
+            if (mSolidOwner[i] < 0 || mDensity[i] <= 0.0f) continue;
+            if (nearest[i] >= 0) mDensity[std::size_t(nearest[i])] += mDensity[i];
+            mStats.displacedDensity += mDensity[i];
+            mDensity[i] = 0.0f;
+        }
+    }
+    for (std::size_t i = 0; i < n; ++i)
+        if (mSolidOwner[i] >= 0) mTemp[i] = mDesc.ambientTemperature;
+
+    // Faces: a face with a solid cell on either side moves with the
+    // obstacle (the mean of the two when both are solid); with Slip::None a
+    // fluid face with a solid cell beside it (across a tangential axis) does too.
+    auto owner = [&](glm::ivec3 c) -> int {
+        if (glm::any(glm::lessThan(c, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(c, mDims))) return -1;
+        return mSolidOwner[lin(c, mDims)];
+    };
+    for (int a = 0; a < 3; ++a) {
+        const glm::ivec3 fd = faceDims(mDims, a);
+        mFixed[a].assign(mU[a].size(), 0);
+        mFixedVelocity[a].assign(mU[a].size(), 0.0f);
+        for (int k = 0; k < fd.z; ++k)
+            for (int j = 0; j < fd.y; ++j)
+                for (int i = 0; i < fd.x; ++i) {
+                    const glm::ivec3 f{i, j, k};
+                    glm::ivec3 c0 = f;
+                    c0[a] -= 1;
+                    const glm::ivec3 cells[2] = {c0, f};
+                    float sum = 0.0f;
+                    int count = 0;
+                    for (glm::ivec3 c : cells)
+                        if (owner(c) >= 0) sum += mSolidVelocity[lin(c, mDims)][a], ++count;
+                    if (count == 0)
+                        for (glm::ivec3 c : cells)
+                            for (int b = 0; b < 3; ++b)
+                                for (int side = -1; side <= 1 && b != a; side += 2) {
+                                    if (c[a] < 0 || c[a] >= mDims[a]) continue; // only cells of the grid have sideways neighbours
+                                    glm::ivec3 nb = c;
+                                    nb[b] += side;
+                                    const int o = owner(nb);
+                                    if (o < 0 || mObstacles[std::size_t(o)].desc.slip != Slip::None) continue;
+                                    sum += mSolidVelocity[lin(nb, mDims)][a], ++count;
+                                }
+                    if (count == 0) continue;
+                    const std::size_t fi = lin(f, fd);
+                    mFixed[a][fi] = 1;
+                    mFixedVelocity[a][fi] = sum / float(count);
+                }
+    }
+}
+
+void FluidSolver::enforceObstacleFaces() {
+    if (mObstacles.empty()) return;
+    for (int a = 0; a < 3; ++a) {
+        const glm::ivec3 fd = faceDims(mDims, a);
+        for (int k = 0; k < fd.z; ++k)
+            for (int j = 0; j < fd.y; ++j)
+                for (int i = 0; i < fd.x; ++i) {
+                    const std::size_t fi = lin({i, j, k}, fd);
+                    if (!mFixed[a][fi]) continue;
+                    mU[a][fi] = closedFace(a, {i, j, k}) ? 0.0f : mFixedVelocity[a][fi];
+                }
+    }
+}
+
+float FluidSolver::maxFluidDivergence() const {
+    float m = 0.0f;
+    for (int k = 0; k < mDims.z; ++k)
+        for (int j = 0; j < mDims.y; ++j)
+            for (int i = 0; i < mDims.x; ++i) {
+                const glm::ivec3 cell{i, j, k};
+                if (solid(cell)) continue;
+                double div = 0.0;
+                for (int a = 0; a < 3; ++a) {
+                    const glm::ivec3 fd = faceDims(mDims, a);
+                    glm::ivec3 hiF = cell;
+                    hiF[a] += 1;
+                    div += (double(mU[a][lin(hiF, fd)]) - double(mU[a][lin(cell, fd)])) / double(mDesc.spacing[a]);
+                }
+                m = std::max(m, float(std::abs(div)));
+            }
+    return m;
+}
+
 // [SECTION] projection
 //
 // Solve A phi = -div u with A = -Laplacian (closed faces: no term; open
@@ -335,6 +555,9 @@ void FluidSolver::project() {
     const bool closedLo[3] = {mDesc.closedWalls, mDesc.closedFloor, mDesc.closedWalls};
     const bool closedHi[3] = {mDesc.closedWalls, mDesc.closedCeiling, mDesc.closedWalls};
     const bool anyOpen = !(closedLo[0] && closedLo[1] && closedHi[0] && closedHi[1]);
+    const bool withObstacles = !mObstacles.empty();
+    // A face the projection may not change: a closed side, or one an obstacle sets.
+    auto wall = [&](int a, glm::ivec3 f) { return closedFace(a, f) || fixedFace(a, lin(f, faceDims(mDims, a))); };
 
     mRhs.assign(n, 0.0);
     double mean = 0.0;
@@ -342,6 +565,7 @@ void FluidSolver::project() {
         for (int j = 0; j < mDims.y; ++j)
             for (int i = 0; i < mDims.x; ++i) {
                 const glm::ivec3 cell{i, j, k};
+                if (withObstacles && solid(cell)) continue; // not an unknown: phi stays 0 there
                 double div = 0.0;
                 for (int a = 0; a < 3; ++a) {
                     const glm::ivec3 fd = faceDims(mDims, a);
@@ -352,10 +576,75 @@ void FluidSolver::project() {
                 mRhs[lin(cell, mDims)] = -div;
                 mean += -div;
             }
-    if (!anyOpen) {
-        // Closed domain: A is singular (constants); make the right side consistent.
-        mean /= double(n);
-        for (double& v : mRhs) v -= mean;
+    if (!withObstacles) {
+        if (!anyOpen) {
+            // Closed domain: A is singular (constants); make the right side consistent.
+            mean /= double(n);
+            for (double& v : mRhs) v -= mean;
+        }
+    } else {
+        // Obstacles can cut the fluid into regions; each region with no open
+        // side has a singular block (constants), made consistent by removing
+        // its mean. (Gas squeezed by an obstacle moving into a closed pocket
+        // cannot leave: that pocket keeps the mean divergence.)
+        mComponent.assign(n, -1);
+        std::vector<std::size_t> stack;
+        std::vector<double> sum;
+        std::vector<std::size_t> size;
+        std::vector<char> open;
+        for (std::size_t seed = 0; seed < n; ++seed) {
+            if (mComponent[seed] >= 0 || mSolidOwner[seed] >= 0) continue;
+            const int id = int(sum.size());
+            sum.push_back(0.0), size.push_back(0), open.push_back(0);
+            mComponent[seed] = id;
+            stack.assign(1, seed);
+            while (!stack.empty()) {
+                const std::size_t i = stack.back();
+                stack.pop_back();
+                sum[id] += mRhs[i], ++size[id];
+                const glm::ivec3 cell(int(i % std::size_t(mDims.x)), int((i / std::size_t(mDims.x)) % std::size_t(mDims.y)),
+                                      int(i / (std::size_t(mDims.x) * std::size_t(mDims.y))));
+                for (int a = 0; a < 3; ++a)
+                    for (int side = -1; side <= 1; side += 2) {
+                        glm::ivec3 f = cell;
+                        if (side > 0) f[a] += 1;
+                        if (wall(a, f)) continue;
+                        glm::ivec3 nb = cell;
+                        nb[a] += side;
+                        if (nb[a] < 0 || nb[a] >= mDims[a]) {
+                            open[id] = 1;
+                            continue;
+                        }
+                        const std::size_t j = lin(nb, mDims);
+                        if (mComponent[j] >= 0 || mSolidOwner[j] >= 0) continue;
+                        mComponent[j] = id;
+                        stack.push_back(j);
+                    }
+            }
+        }
+        for (std::size_t i = 0; i < n; ++i)
+            if (mComponent[i] >= 0 && !open[std::size_t(mComponent[i])]) mRhs[i] -= sum[std::size_t(mComponent[i])] / double(size[std::size_t(mComponent[i])]);
+    }
+
+    // With obstacles, which of each fluid cell's six faces are walls (bit 2a
+    // for the low face on axis a, 2a + 1 for the high one), looked up once
+    // per projection instead of once per CG iteration.
+    if (withObstacles) {
+        mWallBits.assign(n, 0);
+        for (int k = 0; k < mDims.z; ++k)
+            for (int j = 0; j < mDims.y; ++j)
+                for (int i = 0; i < mDims.x; ++i) {
+                    const glm::ivec3 cell{i, j, k};
+                    std::uint8_t bits = 0;
+                    for (int a = 0; a < 3; ++a) {
+                        glm::ivec3 hiF = cell;
+                        hiF[a] += 1;
+                        const glm::ivec3 fd = faceDims(mDims, a);
+                        if (fixedFace(a, lin(cell, fd))) bits |= std::uint8_t(1u << (2 * a));
+                        if (fixedFace(a, lin(hiF, fd))) bits |= std::uint8_t(1u << (2 * a + 1));
+                    }
+                    mWallBits[lin(cell, mDims)] = bits;
+                }
     }
 
     auto applyA = [&](const std::vector<double>& x, std::vector<double>& out) {
@@ -363,10 +652,17 @@ void FluidSolver::project() {
             for (int j = 0; j < mDims.y; ++j)
                 for (int i = 0; i < mDims.x; ++i) {
                     const glm::ivec3 cell{i, j, k};
-                    const double xc = x[lin(cell, mDims)];
+                    const std::size_t ci = lin(cell, mDims);
+                    if (withObstacles && mSolidOwner[ci] >= 0) {
+                        out[ci] = 0.0;
+                        continue;
+                    }
+                    const double xc = x[ci];
+                    const std::uint8_t walls = withObstacles ? mWallBits[ci] : std::uint8_t(0);
                     double acc = 0.0;
                     for (int a = 0; a < 3; ++a)
                         for (int side = -1; side <= 1; side += 2) {
+                            if (walls & (1u << (2 * a + (side > 0 ? 1 : 0)))) continue; // a wall: no flux term
                             glm::ivec3 nb = cell;
                             nb[a] += side;
                             if (nb[a] < 0 || nb[a] >= mDims[a]) {
@@ -375,7 +671,7 @@ void FluidSolver::project() {
                             }
                             acc += c[a] * (xc - x[lin(nb, mDims)]);
                         }
-                    out[lin(cell, mDims)] = acc;
+                    out[ci] = acc;
                 }
     };
 
@@ -410,14 +706,14 @@ void FluidSolver::project() {
     mStats.lastPressureIterations = it;
     mStats.lastResidual = rr0 > 0.0 ? float(std::sqrt(rr / rr0)) : 0.0f;
 
-    // u -= grad phi on every face that is not closed.
+    // u -= grad phi on every face that is not a wall.
     for (int a = 0; a < 3; ++a) {
         const glm::ivec3 fd = faceDims(mDims, a);
         for (int k = 0; k < fd.z; ++k)
             for (int j = 0; j < fd.y; ++j)
                 for (int i = 0; i < fd.x; ++i) {
                     const glm::ivec3 f{i, j, k};
-                    if (closedFace(a, f)) continue;
+                    if (wall(a, f)) continue;
                     glm::ivec3 lo = f;
                     lo[a] -= 1;
                     const double pHi = f[a] < mDims[a] ? mP[lin(f, mDims)] : 0.0;
@@ -439,6 +735,12 @@ glm::vec3 FluidSolver::velocityAt(glm::ivec3 c) const {
         v[a] = 0.5f * (mU[a][lin(c, fd)] + mU[a][lin(hi, fd)]);
     }
     return v;
+}
+
+float FluidSolver::faceVelocity(int axis, glm::ivec3 f) const {
+    assert(axis >= 0 && axis < 3 && glm::all(glm::greaterThanEqual(f, glm::ivec3(0))) &&
+           glm::all(glm::lessThan(f, faceDims(mDims, axis))) && "FluidSolver::faceVelocity: axis or face out of range");
+    return mU[axis][lin(f, faceDims(mDims, axis))];
 }
 
 std::vector<glm::vec3> FluidSolver::cellVelocities() const {

@@ -131,6 +131,19 @@ Result<Effect> fire(Materials& materials, const FireDesc& d) {
     return Effect::fromGrid(std::move(*grid), std::move(e));
 }
 
+namespace {
+
+// Obstacles are given in world placement, like the host's geometry; the
+// message names the entry ("SmokeDesc.obstacles[2]: ObstacleDesc.size ...").
+Status addObstacles(FluidSolver& solver, const std::vector<Obstacle>& obstacles, const char* descName) {
+    for (std::size_t i = 0; i < obstacles.size(); ++i)
+        if (Status st = solver.addObstacle(obstacles[i]); !st)
+            return makeError(std::string(descName) + ".obstacles[" + std::to_string(i) + "]: " + st.error());
+    return {};
+}
+
+} // namespace
+
 Result<Effect> smoke(Materials& materials, const SmokeDesc& d) {
     const Result<SplatVariation> variation = seededVariation("SmokeDesc", d.variation, d.seed);
     if (!variation) return makeError(variation.error());
@@ -154,6 +167,7 @@ Result<Effect> smoke(Materials& materials, const SmokeDesc& d) {
     if (!set) return makeError("SmokeDesc.textureSet: " + set.error());
     solver->addEmitter({.desc = {.offset = d.sourceOffset, .radius = d.sourceRadius, .density = 1.0f, .temperature = 1.0f, .rate = 6.0f},
                         .motion = restingAt(d.sourceMotion, d.position)});
+    if (Status st = addObstacles(*solver, d.obstacles, "SmokeDesc"); !st) return makeError(st.error());
 
     EffectDesc e = gridDesc("smoke", materials, Motion{}, d.seed);
     e.textures.propagation = {.mode = Propagation::Velocity, .offset = 1};
@@ -239,6 +253,7 @@ Result<Effect> dust(Materials& materials, const DustDesc& d) {
     if (!set) return makeError("DustDesc.textureSet: " + set.error());
     solver->addEmitter({.desc = {.offset = d.sourceOffset, .radius = d.sourceRadius, .density = 1.0f, .temperature = 0.6f, .rate = 5.0f},
                         .motion = restingAt(d.sourceMotion, d.position)});
+    if (Status st = addObstacles(*solver, d.obstacles, "DustDesc"); !st) return makeError(st.error());
 
     EffectDesc e = gridDesc("dust", materials, Motion{}, d.seed);
     e.textures.propagation = {.mode = Propagation::Velocity, .offset = 1};

@@ -21,6 +21,7 @@
 
 #include "scenefile/json_reader.hpp"
 #include "splatfx/color_table.hpp"
+#include "splatfx/obstacle.hpp"
 #include "splatfx/scene_file.hpp"
 #include "splatfx/texture_set.hpp"
 
@@ -44,6 +45,8 @@ inline constexpr int kMaxAttachDepth = 16;
 
 // [SECTION] Context
 
+struct RawGeometry;
+
 // Sizes that cost memory or time in proportion (cells, texels, texture
 // layers) are budgets the user can raise: Context::budgets (budget.hpp).
 
@@ -57,6 +60,10 @@ struct Context {
     // Texture-set folders already read for this file, by canonical path: a
     // level naming one folder for a thousand effects reads it once.
     std::map<std::string, TextureSet> folders{};
+    // The file's geometry, for effects that refer to it by name (a solver
+    // effect's "obstacles"); set once the geometry list is read.
+    const std::vector<RawGeometry>* geometry = nullptr;
+    const std::map<std::string, std::size_t>* geometryByName = nullptr;
 };
 
 // [SECTION] Shared pieces
@@ -180,6 +187,10 @@ void readEffectLighting(Context& c, const std::string& path, const Json& v, Effe
 void checkLightingBudget(Context& c, const SceneFile& out);
 // [clouds, issue 17] The top-level "volumes" block (volumes.cpp).
 void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& out);
+
+// [SECTION] Obstacles (obstacles.cpp): a solver effect's "obstacles" list,
+// entries naming geometry or giving their own shape; nullopt after reporting.
+std::optional<std::vector<Obstacle>> readObstacles(Context& c, const std::string& path, const Json& v);
 
 // [SECTION] Camera and output
 

@@ -250,6 +250,7 @@ Result<SceneFile> parse(const std::string& text, const std::string& path, Materi
             out.geometry.push_back(std::move(desc));
         }
     }
+    c.geometry = &geo, c.geometryByName = &geoByName;
     if (const Json* v = o.get("effects")) readEffects(c, "effects", *v, geo, geoByName, out);
     if (const Json* v = o.get("lights")) readLights(c, "lights", *v, out); // issue 16
     if (const Json* v = o.get("sceneShadow")) readSceneShadow(c, "sceneShadow", *v, out);

@@ -2,7 +2,8 @@
 // kinds/dust.cpp), parameterized by the preset's descriptor: an emitter in
 // a simulated domain (presets::SmokeDesc, presets::DustDesc). The keys a
 // descriptor lacks (dust has no "substeps", smoke no "settle") are not read,
-// so the file gets "unknown key" for them.
+// so the file gets "unknown key" for them. "obstacles" (obstacles.cpp) are
+// placed in the world as they are, not by the effect's anchor.
 #pragma once
 
 #include "scenefile/kinds.hpp"
@@ -34,6 +35,8 @@ std::optional<Effect> readSolverEffect(Context& c, ObjectReader& o, const Effect
     const std::optional<TextureSpec> tex = readPresetTextureSet(c, o, e.seed, d.textureCount);
     if constexpr (requires { d.texturesPerSec; }) o.number("texturesPerSec", d.texturesPerSec, 0.0, 1e3);
     if constexpr (requires { d.substeps; }) o.integer("substeps", d.substeps, 1, 16);
+    if (const Json* ob = o.get("obstacles"))
+        if (auto obstacles = readObstacles(c, o.at("obstacles"), *ob)) d.obstacles = std::move(*obstacles);
     if (!c.d.ok()) return std::nullopt;
     d.textureSet = presetSet(c, e.path, tex);
     if (!c.d.ok()) return std::nullopt;
