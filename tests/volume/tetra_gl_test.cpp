@@ -447,7 +447,11 @@ TEST_F(TetraPassGL, VolumeLayerRoundsAnEightBitHostOnceInsideTheCloud) {
     };
     renderFrame(*layered, *fb32, frame, 1.0);
     const Image ref = fb32->read();
-    EXPECT_FALSE(usesLayer(*layered)) << "a float host is drawn into straight";
+    EXPECT_FALSE(usesLayer(*layered)) << "an RGBA32F host is drawn into straight";
+    auto fb16 = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F16});
+    ASSERT_TRUE(fb16);
+    renderFrame(*layered, *fb16, frame, 1.0);
+    EXPECT_TRUE(usesLayer(*layered)) << "RGBA16F rounds every blend: it takes the layer";
     renderFrame(*layered, *fb8, frame, 1.0);
     const Image once = fb8->read();
     EXPECT_TRUE(usesLayer(*layered));

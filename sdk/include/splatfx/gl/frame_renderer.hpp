@@ -19,7 +19,8 @@
 //      interleaved (Frame::drawOrder) with the LOD volumes' pre-integrated
 //      projected tetrahedra (Frame::volumes; at reduced resolution either all
 //      tetrahedra then the splats, or both in one order in the reduced image:
-//      FrameRendererDesc::reduceTetrahedra); with a fog, every splat fragment
+//      FrameRendererDesc::reduceTetrahedra; at full resolution both in one
+//      float layer composited once: FrameRendererDesc::volumeLayer); with a fog, every splat fragment
 //      and every tetrahedron segment is fogged by the medium in front of it
 //   3. the host's transparent pass (HostTarget::drawTransparent), blended
 //      over; or, with HostTarget::transparentToLists, the order-exact path:
@@ -86,8 +87,8 @@ struct FrameRendererDesc {
     // over the host, so an 8-bit host target rounds the volumes once instead
     // of once per tetrahedron (which leaves faint straight steps along the
     // tetrahedra's faces inside a cloud); false: straight into the host
-    // target. A host colour buffer of floats (RGBA16F, RGBA32F) is drawn into
-    // straight (it rounds no more than the layer). Where the layer cannot be
+    // target. A host colour buffer of 32-bit floats is drawn into straight
+    // (it rounds no more than the layer; RGBA16F does). Where the layer cannot be
     // made, FrameRenderStats::notes says so and the volumes go straight into
     // the host target. Default true.
     bool volumeLayer = true;

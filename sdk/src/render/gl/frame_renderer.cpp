@@ -22,9 +22,10 @@ namespace splatfx::gl {
 
 namespace {
 
-// Whether the host's colour buffer (its draw buffer 0) stores floats: blending
-// into it rounds no more than the volume layer would, so the layer is not used.
-bool hostColorIsFloat(unsigned framebuffer) {
+// Whether the host's colour buffer (its draw buffer 0) stores 32-bit floats:
+// blending into it rounds no more than the volume layer would, so the layer is
+// not used. RGBA16F rounds each blend to 11 bits: that one takes the layer.
+bool hostColorIsFloat32(unsigned framebuffer) {
     GLint bound = 0, buffer = GL_NONE;
     glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
     if (GLuint(bound) != framebuffer) glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer);
@@ -35,8 +36,10 @@ bool hostColorIsFloat(unsigned framebuffer) {
     GLint object = GL_NONE, type = GL_NONE;
     glGetNamedFramebufferAttachmentParameteriv(framebuffer, GLenum(buffer), GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &object);
     if (object == GL_NONE) return false; // asking more of an empty attachment is an error
+    GLint red = 0;
     glGetNamedFramebufferAttachmentParameteriv(framebuffer, GLenum(buffer), GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE, &type);
-    return type == GL_FLOAT;
+    glGetNamedFramebufferAttachmentParameteriv(framebuffer, GLenum(buffer), GL_FRAMEBUFFER_ATTACHMENT_RED_SIZE, &red);
+    return type == GL_FLOAT && red >= 32;
 }
 
 } // namespace
@@ -158,7 +161,7 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
                                            "attachment is given"};
     FrameRendererDesc planDesc = r.desc;
     if (!r.splats.layerError().empty()) planDesc.volumeLayer = false; // noted in report()
-    else if (planDesc.volumeLayer && planDesc.resolutionScale == 1 && hostColorIsFloat(target.framebuffer)) planDesc.volumeLayer = false;
+    else if (planDesc.volumeLayer && planDesc.resolutionScale == 1 && hostColorIsFloat32(target.framebuffer)) planDesc.volumeLayer = false;
     r.plan = planFrame(frame, target, planDesc, depth);
     for (detail::Pass* p : r.passes()) p->prepare(r.plan, frame);
     detail::StepContext context{.frame = frame, .host = target, .plan = r.plan, .splatLayers = r.splats.renderer().layerTexture()};
