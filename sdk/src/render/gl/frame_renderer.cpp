@@ -35,6 +35,10 @@ bool hostColorIsFloat32(unsigned framebuffer) {
     if (buffer == GL_NONE) return false;
     GLint object = GL_NONE, type = GL_NONE;
     glGetNamedFramebufferAttachmentParameteriv(framebuffer, GLenum(buffer), GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &object);
+    // A context without a default framebuffer (surfaceless) answers with an
+    // error: the layer is used, and the error must not reach a later pass's own check.
+    if (framebuffer == 0)
+        while (glGetError() != GL_NO_ERROR) {}
     if (object == GL_NONE) return false; // asking more of an empty attachment is an error
     GLint red = 0;
     glGetNamedFramebufferAttachmentParameteriv(framebuffer, GLenum(buffer), GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE, &type);
