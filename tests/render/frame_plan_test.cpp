@@ -104,7 +104,7 @@ TEST(FramePlan, ReducedResolutionDrawsEverySplatInOneReducedPass) {
 TEST(FramePlan, TetrahedraInterleaveWithTheSplatsInTheFramesDrawOrder) {
     TestFrame f(true);
     ASSERT_GE(f.frame.drawOrder().size(), 3u) << "the test frame must interleave";
-    const gl::FramePlan p = gl::planFrame(f.frame, {}, {}, kDepth);
+    const gl::FramePlan p = gl::planFrame(f.frame, {}, {.volumeLayer = false}, kDepth);
     ASSERT_GE(p.steps.size(), 2u + f.frame.drawOrder().size());
     EXPECT_EQ(p.steps[1].kind, StepKind::PrepareTetrahedra) << show(p);
     std::size_t splats = 0, tets = 0;
@@ -119,6 +119,29 @@ TEST(FramePlan, TetrahedraInterleaveWithTheSplatsInTheFramesDrawOrder) {
     }
     EXPECT_EQ(splats, f.frame.splats().size());
     EXPECT_EQ(tets, 2u);
+}
+
+// FrameRendererDesc::volumeLayer (the default): at full resolution the same
+// batches in the same order, all into the layer, composited once.
+TEST(FramePlan, TetrahedraAtFullResolutionGoIntoTheVolumeLayerInTheSameOrder) {
+    TestFrame f(true);
+    const gl::FramePlan p = gl::planFrame(f.frame, {}, {}, kDepth);
+    const std::size_t n = f.frame.drawOrder().size();
+    ASSERT_GE(p.steps.size(), 4u + n) << show(p);
+    EXPECT_EQ(p.steps[2].kind, StepKind::ReducedBegin) << show(p);
+    EXPECT_EQ(p.steps[3 + n].kind, StepKind::ReducedComposite) << show(p);
+    EXPECT_FALSE(p.reduced);
+    for (std::size_t i = 0; i < n; ++i) {
+        const DrawBatch& b = f.frame.drawOrder()[i];
+        const gl::PlanStep& s = p.steps[3 + i];
+        EXPECT_EQ(s.kind, b.kind == DrawBatch::Kind::Tetrahedra ? StepKind::Tetrahedra : StepKind::Splats) << show(p);
+        EXPECT_EQ(s.begin, b.begin);
+        EXPECT_EQ(s.end, b.end);
+        EXPECT_EQ(s.target, StepTarget::Reduced) << show(p);
+    }
+    // Without tetrahedra the splats go straight into the host, as before.
+    TestFrame splatsOnly(false);
+    for (const gl::PlanStep& s : gl::planFrame(splatsOnly.frame, {}, {}, kDepth).steps) EXPECT_NE(s.kind, StepKind::ReducedBegin);
 }
 
 // At reduced resolution the splats are composited in one pass: every

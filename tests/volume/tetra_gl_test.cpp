@@ -11,6 +11,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "gl_fixture.hpp"
+#include "splatfx/gl/frame_plan.hpp"
 #include "scenes.hpp"
 
 using namespace splatfx;
@@ -414,6 +415,91 @@ TEST_F(TetraPassGL, CameraInsideTheCloudRendersWithoutHoles) {
         }
     EXPECT_GT(dense, kSize.x * kSize.y / 4) << "inside a cloud most pixels see cloud";
     EXPECT_EQ(over, 0) << "worst |GL - model| / bound " << worst;
+}
+
+// Inside the cloud into an 8-bit host (FrameRendererDesc::volumeLayer): drawn
+// straight, every tetrahedron's blend is rounded to 8 bits, and the dozens a
+// pixel sees add up to steps along their projected faces (the faint straight
+// streaks of samples/17-into-the-cloud); through the layer the frame is the
+// float frame rounded once. e: the 8-bit image minus the float host's image
+// (the frame CameraInsideTheCloudRendersWithoutHoles holds to the pass model)
+// rounded here, in 8-bit levels; "steps": the RMS of e minus its 5x5 box mean
+// (what changes from pixel to pixel; a smooth offset drops out).
+TEST_F(TetraPassGL, VolumeLayerRoundsAnEightBitHostOnceInsideTheCloud) {
+    Cloud cl;
+    const auto it = std::max_element(cl.field.scalar.begin(), cl.field.scalar.end());
+    const std::size_t i = std::size_t(it - cl.field.scalar.begin());
+    const glm::vec3 eye(float(i % 17), float((i / 17) % 17), float(i / (17 * 17)));
+    const Camera cam = Camera::lookAt(eye, eye + glm::vec3(1.0f, 0.3f, 0.1f), {0, 0, 1}, glm::radians(60.0f), kSize, 0.3f, 200.0f);
+    Frame frame;
+    frame.begin(0.0, cam);
+    FrameVolume& fv = frame.volumes().emplace_back();
+    fv.table = &*cl.table;
+    ASSERT_TRUE(cl.volume->update(cam, {.detailC = 1e6f}, &*cl.transfer, fv.lod)); // finest level: the most tetrahedra per pixel
+    frame.end();
+    auto layered = gl::FrameRenderer::create();
+    auto straight = gl::FrameRenderer::create({.volumeLayer = false});
+    auto fb8 = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y});
+    auto fb32 = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
+    ASSERT_TRUE(layered && straight && fb8 && fb32);
+    auto usesLayer = [](const gl::FrameRenderer& r) {
+        return std::any_of(r.plan().steps.begin(), r.plan().steps.end(), [](const gl::PlanStep& s) { return s.kind == gl::StepKind::ReducedBegin; });
+    };
+    renderFrame(*layered, *fb32, frame, 1.0);
+    const Image ref = fb32->read();
+    EXPECT_FALSE(usesLayer(*layered)) << "an RGBA32F host is drawn into straight";
+    auto fb16 = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F16});
+    ASSERT_TRUE(fb16);
+    renderFrame(*layered, *fb16, frame, 1.0);
+    EXPECT_TRUE(usesLayer(*layered)) << "RGBA16F rounds every blend: it takes the layer";
+    renderFrame(*layered, *fb8, frame, 1.0);
+    const Image once = fb8->read();
+    EXPECT_TRUE(usesLayer(*layered));
+    EXPECT_TRUE(layered->stats().notes.empty()) << layered->stats().notes.front();
+    renderFrame(*straight, *fb8, frame, 1.0);
+    const Image perTet = fb8->read();
+    EXPECT_FALSE(usesLayer(*straight));
+
+    struct Measure {
+        double max = 0.0, steps = 0.0;
+    };
+    auto measure = [&](const Image& img) {
+        std::vector<double> e(std::size_t(kSize.x * kSize.y * 3));
+        auto at = [&](int x, int y, int c) -> double& { return e[std::size_t((y * kSize.x + x) * 3 + c)]; };
+        Measure m;
+        for (int y = 0; y < kSize.y; ++y)
+            for (int x = 0; x < kSize.x; ++x)
+                for (int c = 0; c < 3; ++c) {
+                    at(x, y, c) = 255.0 * double(img.at(x, y, c)) - std::round(255.0 * std::clamp(double(ref.at(x, y, c)), 0.0, 1.0));
+                    m.max = std::max(m.max, std::abs(at(x, y, c)));
+                }
+        double sum2 = 0.0;
+        int n = 0;
+        for (int y = 2; y + 2 < kSize.y; ++y)
+            for (int x = 2; x + 2 < kSize.x; ++x)
+                for (int c = 0; c < 3; ++c) {
+                    double mean = 0.0;
+                    for (int j = -2; j <= 2; ++j)
+                        for (int k = -2; k <= 2; ++k) mean += at(x + k, y + j, c);
+                    const double d = at(x, y, c) - mean / 25.0;
+                    sum2 += d * d, ++n;
+                }
+        m.steps = std::sqrt(sum2 / n);
+        return m;
+    };
+    const Measure a = measure(once), b = measure(perTet);
+    std::printf("8-bit host inside the cloud: through the layer max |e| %.0f, steps %.3f levels; straight max |e| %.0f, steps %.3f levels\n", a.max,
+                a.steps, b.max, b.steps);
+    // The layer (RGBA32F) takes the same blends in the same order from the same
+    // transparent black as the float host, so only the final conversion to 8
+    // bits differs from our rounding: GL allows it to round either way, so
+    // |e| <= 1 level; the steps, at most 1 on scattered pixels, under half a level.
+    EXPECT_LE(a.max, 1.0);
+    EXPECT_LT(a.steps, 0.5);
+    // Straight, the per-tetrahedron rounding is what the measure sees: errors
+    // beyond one rounding, changing from pixel to pixel above the bound.
+    EXPECT_GT(b.max, 1.0);
+    EXPECT_GT(b.steps, 0.5);
 }
 
 // An orthographic camera: rays parallel to forward from the plane through the

@@ -50,6 +50,11 @@ struct Options {
     int fogFrames = 41;
     bool fogOnly = false; // --fog-only: skip the flight and the popping runs
     int scale = 2;        // the flight also at this resolution scale (tetrahedra reduced); 1: only full resolution
+    // Streaks inside a cloud: one frame in the middle of the popping run's field, per target mode.
+    bool streaksOnly = false; // --streaks-only: only this part
+    glm::ivec2 streakSize{512, 384};
+    glm::ivec2 streakExactSize{128, 96}; // the same view against renderTetraExact
+    int streakFrames = 9;
 };
 
 struct CloudSet {
@@ -101,6 +106,139 @@ bool inside(const glm::vec3& ext, const splatfx::Camera& c) {
     return e.x > 0 && e.y > 0 && e.z > 0 && e.x < ext.x && e.y < ext.y && e.z < ext.z;
 }
 
+// ---- 4. Streaks inside a cloud: the volumes rounded per tetrahedron by an 8-bit host ----
+//
+// One frame in the middle of the popping run's field, drawn into an RGBA8
+// host straight (FrameRendererDesc::volumeLayer off: every tetrahedron's
+// blend rounded to 8 bits) and through the volume layer (RGBA16F, RGBA32F:
+// one rounding at the composite), against the same frame drawn straight into
+// an RGBA32F host (GL's own arithmetic, no rounding between tetrahedra) and
+// rounded to 8 bits once here (a float frame too). The error e (in 8-bit levels) of a frame
+// rounded once is 0 (+-1 where GL's conversion and ours part); per-tetrahedron
+// rounding accumulates over the dozens of tetrahedra a pixel sees inside a
+// cloud and jumps along their projected faces. "Steps": the RMS of e minus its
+// 5x5 box mean, the part of the error that changes from pixel to pixel (the
+// straight lines; a smooth offset, such as a rounding bias, drops out of it).
+// The same modes at a small size against renderTetraExact (rounded once) say
+// that the float frame is the exact one up to the table: cracks or faces
+// counted twice would show there, not only in 8 bits.
+struct StreakMeasure {
+    double rms = 0.0, max = 0.0, steps = 0.0; // in 8-bit levels
+};
+
+StreakMeasure streakMeasure(const splatfx::Image& img, const splatfx::Image& ref) {
+    const int w = img.width, h = img.height, r = 2;
+    std::vector<double> e(std::size_t(w) * std::size_t(h) * 3);
+    auto at = [&](int x, int y, int c) -> double& { return e[(std::size_t(y) * std::size_t(w) + std::size_t(x)) * 3 + std::size_t(c)]; };
+    StreakMeasure m;
+    double sum2 = 0.0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const std::size_t p = (std::size_t(y) * std::size_t(w) + std::size_t(x)) * 4 + std::size_t(c);
+                const double d = std::round(255.0 * std::clamp(double(img.pixels[p]), 0.0, 1.0)) - std::round(255.0 * std::clamp(double(ref.pixels[p]), 0.0, 1.0));
+                at(x, y, c) = d;
+                sum2 += d * d, m.max = std::max(m.max, std::abs(d));
+            }
+    m.rms = std::sqrt(sum2 / double(e.size()));
+    double hp2 = 0.0;
+    std::size_t n = 0;
+    for (int y = r; y + r < h; ++y)
+        for (int x = r; x + r < w; ++x)
+            for (int c = 0; c < 3; ++c) {
+                double mean = 0.0;
+                for (int j = -r; j <= r; ++j)
+                    for (int i = -r; i <= r; ++i) mean += at(x + i, y + j, c);
+                const double d = at(x, y, c) - mean / double((2 * r + 1) * (2 * r + 1));
+                hp2 += d * d, ++n;
+            }
+    m.steps = std::sqrt(hp2 / double(std::max<std::size_t>(n, 1)));
+    return m;
+}
+
+bool runStreaks(const Options& o, const splatfx::Materials& materials) {
+    CloudSet cs;
+    if (!makeClouds(o.popDims, o.popDetailC, cs)) return false;
+    struct Mode {
+        const char* name;
+        bool layer;
+        splatfx::gl::Precision layerFormat, host;
+        std::optional<splatfx::gl::FrameRenderer> renderer{};
+        std::vector<double> times{};
+        splatfx::Image image{}, small{};
+    };
+    using splatfx::gl::Precision;
+    Mode modes[] = {{"straight into the host (layer off)", false, Precision::F32, Precision::U8},
+                    {"volume layer RGBA16F", true, Precision::F16, Precision::U8},
+                    {"volume layer RGBA32F (default)", true, Precision::F32, Precision::U8},
+                    {"float host RGBA32F, layer off (reference)", false, Precision::F16, Precision::F32}};
+    for (Mode& m : modes) {
+        auto r = splatfx::gl::FrameRenderer::create({.volumeLayer = m.layer, .volumeLayerPrecision = m.layerFormat});
+        if (!r) return std::fprintf(stderr, "%s\n", r.error().c_str()), false;
+        m.renderer.emplace(std::move(*r));
+    }
+    std::uint64_t drawn = 0;
+    std::size_t tetsSmall = 0;
+    std::vector<std::string> notes;
+    for (int pass = 0; pass < 2; ++pass) { // the timed frame, then the small one for the exact reference
+        const glm::ivec2 size = pass == 0 ? o.streakSize : o.streakExactSize;
+        const splatfx::Camera cam = flight(cs.ext, 1, 3, size); // the middle of the field
+        splatfx::Frame frame;
+        if (auto s = cs.scene.prepare(1.0, cam, materials, frame); !s) return std::fprintf(stderr, "%s\n", s.error().c_str()), false;
+        std::optional<splatfx::gl::Framebuffer> fb8, fb32;
+        auto a = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y});
+        auto b = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y, .color = Precision::F32});
+        if (!a || !b) return std::fprintf(stderr, "streaks: framebuffer failed\n"), false;
+        fb8.emplace(std::move(*a)), fb32.emplace(std::move(*b));
+        const int rounds = pass == 0 ? o.streakFrames : 1;
+        for (int f = -1; f < rounds; ++f) // one warm-up; the modes interleaved, the first one rotating
+            for (std::size_t j = 0; j < std::size(modes); ++j) {
+                Mode& m = modes[(j + std::size_t(std::max(f, 0))) % std::size(modes)];
+                splatfx::gl::Framebuffer& fb = m.host == Precision::U8 ? *fb8 : *fb32;
+                const auto t0 = Clock::now();
+                m.renderer->render(frame, bench::clearedTarget(fb, {0.0f, 0.0f, 0.0f, 0.0f}));
+                glFinish();
+                if (pass == 0 && f >= 0) m.times.push_back(ms(Clock::now() - t0));
+                (pass == 0 ? m.image : m.small) = fb.read();
+                for (const std::string& n : m.renderer->stats().notes) notes.push_back(n);
+            }
+        if (pass == 0) drawn = modes[0].renderer->stats().tetrahedra.drawn;
+        else tetsSmall = frame.volumes().empty() ? 0 : frame.volumes()[0].lod.tets.size();
+        if (pass == 1) {
+            auto tf = splatfx::makeCloudTransfer({}); // the one makeClouds gave the scene
+            if (!tf) return std::fprintf(stderr, "%s\n", tf.error().c_str()), false;
+            const auto r0 = Clock::now();
+            splatfx::TetraExactStats st;
+            auto exact = splatfx::renderTetraExact(frame.volumes()[0].lod.tets, *tf, cam, {}, &st);
+            if (!exact) return std::fprintf(stderr, "%s\n", exact.error().c_str()), false;
+            std::printf("streaks: exact reference %dx%d, %zu tetrahedra, %.0f ms, %llu pixels unconverged\n", size.x, size.y, tetsSmall,
+                        ms(Clock::now() - r0), static_cast<unsigned long long>(st.unconverged));
+            const double refMs = percentile(modes[0].times, 0.5);
+            std::printf("\nstreaks inside a cloud: field %dx%dx%d, c = %.0f, the popping run's flight at its middle; %dx%d, %llu tetrahedra "
+                        "drawn, median of %d frames each (modes interleaved); errors in 8-bit levels (1/255) of RGB against the float "
+                        "frame (and the exact one) rounded to 8 bits once, premultiplied over transparent black\n\n",
+                        o.popDims.x, o.popDims.y, o.popDims.z, double(o.popDetailC), o.streakSize.x, o.streakSize.y,
+                        static_cast<unsigned long long>(drawn), o.streakFrames);
+            std::printf("| target | ms/frame | vs straight | steps vs float | RMS vs float | max vs float | steps vs exact "
+                        "(%dx%d) | RMS vs exact | max vs exact |\n",
+                        o.streakExactSize.x, o.streakExactSize.y);
+            std::printf("| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n");
+            const Mode& ref = modes[3];
+            for (const Mode& m : modes) {
+                const StreakMeasure f = streakMeasure(m.image, ref.image), x = streakMeasure(m.small, *exact);
+                const double t = percentile(m.times, 0.5);
+                std::printf("| %s | %.1f | %.2f | %.3f | %.3f | %.0f | %.3f | %.3f | %.0f |\n", m.name, t, t / refMs, f.steps, f.rms, f.max, x.steps,
+                            x.rms, x.max);
+            }
+            std::printf("\nsteps: RMS of the error minus its 5x5 box mean (what changes from pixel to pixel: the straight lines along the faces).\n");
+        }
+    }
+    std::sort(notes.begin(), notes.end());
+    notes.erase(std::unique(notes.begin(), notes.end()), notes.end());
+    for (const std::string& n : notes) std::printf("note: %s\n", n.c_str());
+    return true;
+}
+
 } // namespace
 
 int runClouds(int argc, char** argv) {
@@ -121,6 +259,10 @@ int runClouds(int argc, char** argv) {
     cli::addInts(app, "--fog-size", &o.fogSize.x, 2, 16, 8192, "frame size of the fog runs", "W H");
     cli::addNumber(app, "--fog-frames", o.fogFrames, 1, 100000, "frames timed per fog mode");
     app.add_flag("--fog-only", o.fogOnly, "skip the flight and the popping runs");
+    app.add_flag("--streaks-only", o.streaksOnly, "only the streaks inside a cloud (8-bit target: direct vs the volume layer)");
+    cli::addInts(app, "--streak-size", &o.streakSize.x, 2, 16, 8192, "frame size of the streaks part", "W H");
+    cli::addInts(app, "--streak-exact-size", &o.streakExactSize.x, 2, 16, 8192, "frame size of the streaks part's exact comparison", "W H");
+    cli::addNumber(app, "--streak-frames", o.streakFrames, 1, 100000, "frames timed per streaks mode");
     cli::addChecked(
         app, "--scale",
         [&o](const std::string& option, const std::string& text) -> splatfx::Status {
@@ -135,6 +277,8 @@ int runClouds(int argc, char** argv) {
     auto fr = splatfx::gl::FrameRenderer::create();
     if (!fr) return std::fprintf(stderr, "%s\n", fr.error().c_str()), 1;
     splatfx::Materials materials{splatfx::Footprint{}};
+
+    if (o.streaksOnly) return runStreaks(o, materials) ? 0 : 1;
 
     // ---- 1. The flight: counts, frame rate, memory ----
     if (!o.fogOnly) {
@@ -271,6 +415,7 @@ int runClouds(int argc, char** argv) {
     }
 
     // ---- 3. Biri fog on the tetrahedra: cost and error against the one-medium reference ----
+    if (!o.fogOnly && !runStreaks(o, materials)) return 1;
     if (o.fogFrames >= 1 && o.fogSize.x >= 1 && o.fogSize.y >= 1) {
         CloudSet cs;
         if (!makeClouds(o.fogDims, 10.0f, cs)) return 1;

@@ -163,6 +163,10 @@ int parse(int argc, char** argv, Args& a) {
     app.add_flag_callback(
         "--no-depth-cut", [&a] { a.renderer.splats.depthCut = false; },
         "the plain depth test at each splat's plane instead of the exact cut (RendererDesc::depthCut)");
+    app.add_flag_callback(
+        "--no-volume-layer", [&a] { a.renderer.volumeLayer = false; },
+        "blend the tetrahedra straight into the 8-bit frame, each rounded on its own (FrameRendererDesc::volumeLayer off; the images "
+        "before it)");
     app.add_flag("--quiet", a.quiet, "no per-frame progress");
     // The engines' depth conventions (docs/integration.md, "Depth conventions"): the host
     // draws with glClipControl and a reversed or infinite projection, splatfx follows.
@@ -234,6 +238,7 @@ splatfx::Result<render::RunSettings> runSettings(const Args& a, const std::strin
         {"sampling", sampling},
         {"fog-texture", fog.x > 0 ? std::to_string(fog.x) + "x" + std::to_string(fog.y) : std::string("per-pixel")},
         {"depth-cut", sp.depthCut ? "yes" : "no"},
+        {"volume-layer", a.renderer.volumeLayer ? "yes" : "no"},
     };
 }
 

@@ -186,8 +186,10 @@ struct GhostsDesc {
     float propagationStepsPerSec = 4.0f;    // faces drifting upwards; default 4
     std::uint32_t seed = 1;                 // texture dynamics (which texture each voxel shows when); default 1
     // Per-splat variation hiding the voxel lattice (splats.hpp); its seed is combined with `seed`. Faces keep
-    // roughly upright: default jitter 0.5, rotation +-0.35 rad, mirrored.
-    SplatVariation variation{.jitter = 0.5f, .rotationRad = 0.35f, .mirror = true};
+    // roughly upright, so their features at the cell's size line up along the column: the size varies
+    // instead (docs/BENCHMARKS.md, "The voxel lattice"). Default jitter 0.5, rotation +-0.35 rad,
+    // mirrored, scale 2^+-0.5.
+    SplatVariation variation{.jitter = 0.5f, .rotationRad = 0.35f, .mirror = true, .scaleLog2 = 0.5f};
     std::uint32_t textureSeed = 1;          // procedural texture set; equal values share one set in Materials; default 1
 };
 Result<Effect> ghosts(Materials& materials, const GhostsDesc& desc = {});

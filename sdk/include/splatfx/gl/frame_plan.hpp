@@ -49,8 +49,8 @@ enum class StepKind : std::uint8_t {
     HostFog,           // the fog of the host's opaque image
     Splats,            // splats of `range`, full resolution
     ReducedSplats,     // every splat, at reduced resolution, composited over the host
-    ReducedBegin,      // clear the reduced image, downsample the host depth into it
-    ReducedComposite,  // upsample the reduced image over the host
+    ReducedBegin,      // clear the reduced image (or the full-size volume layer), downsample the host depth into it
+    ReducedComposite,  // upsample the reduced image (composite the layer) over the host
     Tetrahedra,        // tetrahedra [begin, end) of Frame::volumes()[volume]
     ListsCollect,      // HostTarget::drawTransparent into the per-pixel lists
     ListsSplit,        // the splats as runs behind / between / in front of the surfaces
@@ -73,7 +73,7 @@ enum class StepRange : std::uint8_t {
 // Into which image a drawing step goes.
 enum class StepTarget : std::uint8_t {
     Host,    // the host's framebuffer
-    Reduced, // the reduced image between ReducedBegin and ReducedComposite
+    Reduced, // the reduced image (at resolutionScale 1: the volume layer) between ReducedBegin and ReducedComposite
 };
 
 struct PlanStep {

@@ -19,7 +19,8 @@
 //      interleaved (Frame::drawOrder) with the LOD volumes' pre-integrated
 //      projected tetrahedra (Frame::volumes; at reduced resolution either all
 //      tetrahedra then the splats, or both in one order in the reduced image:
-//      FrameRendererDesc::reduceTetrahedra); with a fog, every splat fragment
+//      FrameRendererDesc::reduceTetrahedra; at full resolution both in one
+//      float layer composited once: FrameRendererDesc::volumeLayer); with a fog, every splat fragment
 //      and every tetrahedron segment is fogged by the medium in front of it
 //   3. the host's transparent pass (HostTarget::drawTransparent), blended
 //      over; or, with HostTarget::transparentToLists, the order-exact path:
@@ -80,6 +81,21 @@ struct FrameRendererDesc {
     // order with them, so their fill cost falls with the splats'; false keeps
     // them at full resolution, all drawn before the splats. Default false.
     bool reduceTetrahedra = false;
+    // With resolutionScale 1 and tetrahedra in the frame: true draws the
+    // volumes (tetrahedra and splats, in their one back-to-front order) into a
+    // layer of the viewport's size (volumeLayerPrecision), composited once
+    // over the host, so an 8-bit host target rounds the volumes once instead
+    // of once per tetrahedron (which leaves faint straight steps along the
+    // tetrahedra's faces inside a cloud); false: straight into the host
+    // target. A host colour buffer of 32-bit floats is drawn into straight
+    // (it rounds no more than the layer; RGBA16F does). Where the layer cannot be
+    // made, FrameRenderStats::notes says so and the volumes go straight into
+    // the host target. Default true.
+    bool volumeLayer = true;
+    // The volume layer's colour format. F16 rounds each of the dozens of
+    // blends inside a cloud to 11 bits, which adds up to about half an 8-bit
+    // level (docs/BENCHMARKS.md, "Clouds"); default F32.
+    Precision volumeLayerPrecision = Precision::F32;
     Precision reducedPrecision = Precision::F16; // reduced-resolution colour format; default F16
     float depthThreshold = 0.1f;                 // reduced resolution: relative view depth still one surface; default 0.1
     // The texture unit the frame's shadow table is bound to while the host's

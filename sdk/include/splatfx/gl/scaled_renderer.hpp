@@ -74,8 +74,8 @@ public:
     // into the layer it returns (premultiplied "over", back to front; drawSplats for
     // splats); composite() upsamples it over the target once. `box` is the
     // full-resolution rectangle (x0, y0, x1, y1, viewport-relative) the passes can
-    // touch: the composite is scissored to it. Expects scale 2 or 4, begin and
-    // composite paired; GL state as draw() (saved at begin, restored at composite).
+    // touch: the composite is scissored to it. Expects begin and composite
+    // paired (at scale 1 the layer is full size and the composite copies it texel for texel); GL state as draw() (saved at begin, restored at composite).
     // The layer is a framebuffer of ceil(width / scale) x ceil(height / scale)
     // pixels, premultiplied RGBA cleared to 0, whose depth attachment
     // (depthTexture) holds the host depth downsampled (farthest of each

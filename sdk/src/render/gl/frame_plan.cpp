@@ -30,17 +30,19 @@ void planInterleaved(const Frame& frame, const FrameRendererDesc& desc, bool red
         plan.steps.push_back(step(StepKind::ReducedSplats));
         return;
     }
-    // Every batch in draw order: into the host target, or (reduceTetrahedra)
-    // all into one reduced image composited once (an "over" sequence drawn
-    // into a cleared layer and then over the host is the same sequence).
-    const StepTarget into = reduced ? StepTarget::Reduced : StepTarget::Host;
-    if (reduced) plan.steps.push_back(step(StepKind::ReducedBegin));
+    // Every batch in draw order: into the host target, or (reduceTetrahedra;
+    // volumeLayer at full resolution) all into one layer composited once (an
+    // "over" sequence drawn into a cleared layer and then over the host is
+    // the same sequence, rounded once by the host's format).
+    const bool layer = reduced || desc.volumeLayer;
+    const StepTarget into = layer ? StepTarget::Reduced : StepTarget::Host;
+    if (layer) plan.steps.push_back(step(StepKind::ReducedBegin));
     for (const DrawBatch& b : frame.drawOrder()) {
         if (b.kind == DrawBatch::Kind::Tetrahedra)
             plan.steps.push_back({.kind = StepKind::Tetrahedra, .target = into, .volume = b.volume, .begin = b.begin, .end = b.end});
         else plan.steps.push_back(splatRange(b.begin, b.end, into));
     }
-    if (reduced) plan.steps.push_back(step(StepKind::ReducedComposite));
+    if (layer) plan.steps.push_back(step(StepKind::ReducedComposite));
 }
 
 std::string multisampledNote(const char* what, int samples) {

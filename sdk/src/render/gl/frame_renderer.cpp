@@ -6,6 +6,8 @@
 #include <memory>
 #include <string>
 
+#include <epoxy/gl.h>
+
 #include "context_check.hpp"
 #include "passes/fog_pass.hpp"
 #include "passes/fragment_list_pass.hpp"
@@ -17,6 +19,34 @@
 #include "passes/tetra_pass.hpp"
 
 namespace splatfx::gl {
+
+namespace {
+
+// Whether the host's colour buffer (its draw buffer 0) stores 32-bit floats:
+// blending into it rounds no more than the volume layer would, so the layer is
+// not used. RGBA16F rounds each blend to 11 bits: that one takes the layer.
+bool hostColorIsFloat32(unsigned framebuffer) {
+    GLint bound = 0, buffer = GL_NONE;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
+    if (GLuint(bound) != framebuffer) glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer);
+    glGetIntegerv(GL_DRAW_BUFFER0, &buffer);
+    if (GLuint(bound) != framebuffer) glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(bound));
+    if (framebuffer == 0) buffer = buffer == GL_FRONT ? GL_FRONT_LEFT : buffer == GL_BACK ? GL_BACK_LEFT : buffer;
+    if (buffer == GL_NONE) return false;
+    GLint object = GL_NONE, type = GL_NONE;
+    glGetNamedFramebufferAttachmentParameteriv(framebuffer, GLenum(buffer), GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &object);
+    // A context without a default framebuffer (surfaceless) answers with an
+    // error: the layer is used, and the error must not reach a later pass's own check.
+    if (framebuffer == 0)
+        while (glGetError() != GL_NO_ERROR) {}
+    if (object == GL_NONE) return false; // asking more of an empty attachment is an error
+    GLint red = 0;
+    glGetNamedFramebufferAttachmentParameteriv(framebuffer, GLenum(buffer), GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE, &type);
+    glGetNamedFramebufferAttachmentParameteriv(framebuffer, GLenum(buffer), GL_FRAMEBUFFER_ATTACHMENT_RED_SIZE, &red);
+    return type == GL_FLOAT && red >= 32;
+}
+
+} // namespace
 
 struct FrameRenderer::Impl {
     Impl(const FrameRendererDesc& d, const detail::Programs& programs, detail::SplatPass s, detail::TetraPass t, detail::FragmentListPass l)
@@ -133,7 +163,10 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
                     ? r.host.depthCopy(target.framebuffer, target.x + frame.camera().viewport.x, target.y + frame.camera().viewport.y)
                     : HostDepth{.missing = "FrameRendererDesc::copyHostDepth is off and neither HostTarget::depthTexture nor a texture depth "
                                            "attachment is given"};
-    r.plan = planFrame(frame, target, r.desc, depth);
+    FrameRendererDesc planDesc = r.desc;
+    if (!r.splats.layerError().empty()) planDesc.volumeLayer = false; // noted in report()
+    else if (planDesc.volumeLayer && planDesc.resolutionScale == 1 && hostColorIsFloat32(target.framebuffer)) planDesc.volumeLayer = false;
+    r.plan = planFrame(frame, target, planDesc, depth);
     for (detail::Pass* p : r.passes()) p->prepare(r.plan, frame);
     detail::StepContext context{.frame = frame, .host = target, .plan = r.plan, .splatLayers = r.splats.renderer().layerTexture()};
     for (const PlanStep& step : r.plan.steps) {
@@ -175,6 +208,7 @@ void FrameRenderer::Impl::report(const Frame& frame, const detail::StepContext& 
     for (const PlanStep& step : plan.steps)
         if (step.range != StepRange::ListsBehindAndBetween) note(step.note); // that one is noted with its count, when it applies
     note(s.lists.note);
+    if (plan.tetrahedra && !plan.reduced && desc.volumeLayer) note(splats.layerError());
 }
 
 } // namespace splatfx::gl

@@ -27,12 +27,21 @@ public:
 
     // The full-resolution renderer (at reduced resolution, the one inside).
     const Renderer& renderer() const { return mFull ? *mFull : mReduced->renderer(); }
+    // Empty, or why the full-size volume layer (FrameRendererDesc::volumeLayer)
+    // could not be made: the frame renderer then plans without it and notes this.
+    const std::string& layerError() const { return mLayerError; }
 
 private:
     SplatPass() = default;
+    Status makeLayer(const FrameRendererDesc& desc, const Programs& programs);
     Renderer& active() { return mFull ? *mFull : mReduced->renderer(); }
     std::optional<Renderer> mFull;          // resolutionScale 1
     std::optional<ScaledRenderer> mReduced; // resolutionScale 2 or 4
+    // resolutionScale 1 with volumeLayer: a scale-1 ScaledRenderer for its
+    // begin (clear, host depth copy) and composite; mFull draws into it.
+    std::optional<ScaledRenderer> mLayer;
+    std::string mLayerError;
+    ScaledRenderer& layered() { return mReduced ? *mReduced : *mLayer; }
     std::uint64_t mDrawCalls = 0;
     bool mFogged = false;
     std::string mFogError;
