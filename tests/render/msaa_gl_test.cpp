@@ -29,6 +29,7 @@
 #include "splatfx/fog.hpp"
 #include "splatfx/gl/frame_plan.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
+#include "splatfx/gl/framebuffer.hpp"
 #include "splatfx/gl/program.hpp"
 #include "splatfx/volume.hpp"
 #include "transparent_glass.hpp"
@@ -368,6 +369,37 @@ TEST_F(MsaaGL, GlassAmongGasSaysWhatRuns) {
         ASSERT_EQ(st.notes.size(), 2u);
         EXPECT_TRUE(std::any_of(st.notes.begin(), st.notes.end(), [](const std::string& n) { return n.find("nearest sample") != std::string::npos; }));
     }
+}
+
+// gl::Framebuffer's MSAA and sRGB fields (what splatfx-render --msaa / --srgb
+// draw into): bad values are refused with the field named; a multisampled one
+// resolves on read() to its clear colour.
+TEST_F(MsaaGL, FramebufferRefusesBadSampleCounts) {
+    auto three = gl::Framebuffer::create({.width = 8, .height = 8, .samples = 3});
+    ASSERT_FALSE(three);
+    EXPECT_EQ(three.error(), "FramebufferDesc::samples must be 0, 1, 2, 4, 8 or 16, got 3");
+    auto many = gl::Framebuffer::create({.width = 8, .height = 8, .samples = 32});
+    ASSERT_FALSE(many);
+    EXPECT_NE(many.error().find("FramebufferDesc::samples must be"), std::string::npos) << many.error();
+    GLint maxSamples = 0;
+    glGetIntegerv(GL_MAX_SAMPLES, &maxSamples);
+    if (maxSamples < 16) {
+        auto above = gl::Framebuffer::create({.width = 8, .height = 8, .samples = 16});
+        ASSERT_FALSE(above);
+        EXPECT_NE(above.error().find("above this driver's GL_MAX_SAMPLES"), std::string::npos) << above.error();
+    }
+    auto srgbFloat = gl::Framebuffer::create({.width = 8, .height = 8, .color = gl::Precision::F16, .srgb = true});
+    ASSERT_FALSE(srgbFloat);
+    EXPECT_EQ(srgbFloat.error(), "FramebufferDesc::srgb needs color Precision::U8 (GL_SRGB8_ALPHA8)");
+    auto ms = gl::Framebuffer::create({.width = 8, .height = 8, .samples = 4});
+    ASSERT_TRUE(ms) << ms.error();
+    ms->clear({0.25f, 0.5f, 0.75f, 1.0f});
+    const Image img = ms->read();
+    ASSERT_EQ(img.pixels.size(), 8u * 8u * 4u);
+    // Every sample holds the clear colour: the mean is it, within the 8-bit step.
+    EXPECT_NEAR(img.pixels[0], 0.25f, 0.5f / 255.0f + 1e-6f);
+    EXPECT_NEAR(img.pixels[2], 0.75f, 0.5f / 255.0f + 1e-6f);
+    EXPECT_TRUE(ms->readDepth().pixels.empty());
 }
 
 } // namespace

@@ -4,10 +4,15 @@
 # draws into a framebuffer of its own and copies it to the window), compared
 # with OpenImageIO's idiff. Both are RGBA8: every channel within one step of
 # 255 (the copy to the window is exact; the tool's PNG is the same bytes).
-# Inputs: XVFB, VIEWER, RENDER, IDIFF, SCENE, NAME (the scene's output.name), OUT.
+# With VIEWER_FLAGS=--into-window the viewer draws into the window's default
+# framebuffer instead (no depth texture: splatfx copies the window's depth
+# buffer once a frame, FrameRendererDesc::copyHostDepth); the bound is the
+# same as long as the window's depth buffer has the tool's 24 bits, which the
+# copy keeps exactly (HostDepthCopyGL).
+# Inputs: XVFB, VIEWER, RENDER, IDIFF, SCENE, NAME (the scene's output.name), OUT, VIEWER_FLAGS (optional).
 file(REMOVE_RECURSE ${OUT})
 file(MAKE_DIRECTORY ${OUT})
-execute_process(COMMAND ${XVFB} -a -s "-screen 0 1280x720x24" ${VIEWER} ${SCENE} --size 200x150 --hide-ui --auto-quit-after 1
+execute_process(COMMAND ${XVFB} -a -s "-screen 0 1280x720x24" ${VIEWER} ${SCENE} --size 200x150 --hide-ui --auto-quit-after 1 ${VIEWER_FLAGS}
                         --screenshot ${OUT}/viewer.png
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0 OR NOT EXISTS ${OUT}/viewer.png)
