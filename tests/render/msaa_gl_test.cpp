@@ -289,7 +289,9 @@ Diff compare(const Frames& f, int samples) {
 
 // exact: held to kBound; otherwise (the tetrahedra) the difference is printed only: on
 // llvmpipe they differ from the shifted frames' mean by up to 19/255 in the cloud's
-// interior, a gap whose cause is not found yet (docs/STABILITY.md).
+// interior, some pixels (in an RGBA32F run) darker than every one of the four shifted
+// frames, so a sample misses a tetrahedron's segment somewhere: a gap whose cause is
+// not found yet (docs/integration.md, the MSAA row).
 void expectPerSample(const char* what, bool fog, bool clouds, bool exact = true) {
     Scene s(fog, clouds);
     Host host;
