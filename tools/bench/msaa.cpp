@@ -85,10 +85,12 @@ int runMsaa(int argc, char** argv) {
             if (f > 0) ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - a).count());
         }
         std::sort(ms.begin(), ms.end());
-        bench::KnobRow r{.knob = "host target samples", .setting = samples == 1 ? "1 (single-sampled)" : std::to_string(samples) + "x MSAA",
-                         .ms = ms[ms.size() / 2], .isDefault = samples == 1};
-        bench::imageError(img, reference, r.rmse, r.maxErr);
         const splatfx::gl::FrameRenderStats& st = player->renderer().stats();
+        // A driver may round a count up (llvmpipe makes 2 samples 4): the count drawn is the frame renderer's.
+        std::string setting = samples == 1 ? "1 (single-sampled)" : std::to_string(samples) + "x MSAA";
+        if (samples > 1 && st.msaa.samples != samples) setting += " (the driver made " + std::to_string(st.msaa.samples) + ")";
+        bench::KnobRow r{.knob = "host target samples", .setting = setting, .ms = ms[ms.size() / 2], .isDefault = samples == 1};
+        bench::imageError(img, reference, r.rmse, r.maxErr);
         r.extra = std::to_string(st.msaa.sampleCopies) + " | " + std::to_string(st.notes.size());
         rows.push_back(r);
     }
