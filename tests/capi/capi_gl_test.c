@@ -599,7 +599,8 @@ static void test_gl_errors(splatfx_error* err) {
     free_drawn(&d);
 }
 
-/* The frame's notes: with a multisampled host depth the depth cut is off, and the renderer says so. */
+/* The frame's notes: none on a single-sampled or a multisampled (4x, read per sample) depth texture; a
+   context whose glClipControl disagrees with the camera's depth convention is one, and the renderer says so. */
 static void test_notes(splatfx_error* err) {
     Drawn d = make_drawn(err);
     Target t = make_clear_target();
@@ -625,11 +626,16 @@ static void test_notes(splatfx_error* err) {
     target.framebuffer = ms_fbo;
     target.depth_texture = ms_depth;
     CHECK_OK(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err);
-    CHECK(splatfx_renderer_note_count(d.r) == 1, "a multisampled depth texture gave %u notes", splatfx_renderer_note_count(d.r));
+    CHECK(splatfx_renderer_note_count(d.r) == 0, "a multisampled depth texture gave %u notes, the first: %s", splatfx_renderer_note_count(d.r),
+          splatfx_renderer_note(d.r, 0));
+    glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE);
+    CHECK_OK(splatfx_renderer_render(d.r, d.m, d.frame, &target, err), err);
+    glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
+    CHECK(splatfx_renderer_note_count(d.r) == 1, "a context whose clip depth is not the camera's gave %u notes", splatfx_renderer_note_count(d.r));
     const char* note = splatfx_renderer_note(d.r, 0);
-    CHECK(note && strstr(note, "depth cut off") && strstr(note, "multisampled (4 samples)"), "note: %s", note ? note : "(NULL)");
+    CHECK(note && strstr(note, "GL_ZERO_TO_ONE"), "note: %s", note ? note : "(NULL)");
     CHECK(splatfx_renderer_note(d.r, 1) == NULL, "note 1 of 1");
-    printf("multisampled host depth: %s\n", note ? note : "(no note)");
+    printf("clip depth mismatch: %s\n", note ? note : "(no note)");
     CHECK(splatfx_renderer_note_count(NULL) == 0 && splatfx_renderer_note(NULL, 0) == NULL, "notes of NULL");
     CHECK(splatfx_renderer_note_count((const splatfx_renderer*)d.frame) == 0, "notes of a frame");
     CHECK(glGetError() == GL_NO_ERROR, "a GL error was raised");

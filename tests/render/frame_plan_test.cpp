@@ -214,17 +214,63 @@ TEST(FramePlan, ACopiedHostDepthIsCopiedAfterTheOpaquePassAndBeforeItIsRead) {
     EXPECT_EQ(std::count(given.begin(), given.end(), StepKind::CopyHostDepth), 0);
 }
 
-// A multisampled host depth cannot be sampled by the passes: the fog and the
-// depth cut say so, and no pass is handed the texture.
-TEST(FramePlan, AMultisampledHostDepthIsNeverHandedToAPassAndEveryFallbackIsNoted) {
+// A multisampled host depth is read one sample at a time: the host fog and
+// the splats run once per sample, each after the step that copies that
+// sample's depth (and restricts the drawing to it), every pass handed the
+// single-sample texture; the last step copies each pixel's nearest sample
+// and ends the restriction. Nothing falls back, so nothing is noted.
+TEST(FramePlan, AMultisampledHostDepthRunsTheFogAndTheVolumesOncePerSample) {
+    TestFrame f(false, true);
+    const gl::HostDepth ms{.texture = 9, .samples = 4, .copied = false, .missing = {}, .sampleTexture = 11};
+    const gl::FramePlan p = gl::planFrame(f.frame, {.framebuffer = 5, .drawOpaque = opaque}, {}, ms);
+    EXPECT_EQ(p.target.depthTexture, 11u);
+    EXPECT_EQ(p.samples, 4);
+    EXPECT_TRUE(p.fogHost);
+    EXPECT_TRUE(p.fogNote.empty()) << p.fogNote;
+    std::vector<StepKind> expected{StepKind::UploadShadow, StepKind::HostOpaque};
+    for (int s = 0; s < 4; ++s) expected.insert(expected.end(), {StepKind::HostDepthSample, StepKind::HostFog, StepKind::Splats});
+    expected.insert(expected.end(), {StepKind::HostDepthSample, StepKind::UnbindShadow});
+    EXPECT_EQ(kinds(p), expected) << show(p);
+    for (int s = 0; s < 4; ++s) EXPECT_EQ(p.steps[2 + 3 * std::size_t(s)].sample, s);
+    EXPECT_EQ(p.steps[14].sample, -1);
+    for (const gl::PlanStep& s : p.steps) EXPECT_TRUE(s.note.empty()) << show(p);
+    // A copied multisampled depth buffer (a window's, a renderbuffer) is copied once, before the first sample.
+    const gl::FramePlan c = gl::planFrame(f.frame, {.drawOpaque = opaque}, {}, {.texture = 9, .samples = 8, .copied = true, .missing = {}, .sampleTexture = 11});
+    const std::vector<StepKind> kc = kinds(c);
+    EXPECT_EQ(kc[2], StepKind::CopyHostDepth) << show(c);
+    EXPECT_EQ(std::count(kc.begin(), kc.end(), StepKind::HostDepthSample), 9) << show(c);
+}
+
+// Without the texture the samples are read into, no pass is handed the
+// multisampled depth: the fog and the depth cut say so.
+TEST(FramePlan, AMultisampledHostDepthWithoutASampleTextureIsNeverHandedToAPassAndEveryFallbackIsNoted) {
     TestFrame f(false, true);
     const gl::FramePlan p = gl::planFrame(f.frame, {.framebuffer = 5}, {}, {.texture = 9, .samples = 4, .copied = false, .missing = {}});
     EXPECT_EQ(p.target.depthTexture, 0u);
+    EXPECT_EQ(p.samples, 0);
     EXPECT_FALSE(p.fogHost);
     EXPECT_NE(p.fogNote.find("multisampled (4 samples)"), std::string::npos) << p.fogNote;
     const auto splats = std::find_if(p.steps.begin(), p.steps.end(), [](const gl::PlanStep& s) { return s.kind == StepKind::Splats; });
     ASSERT_NE(splats, p.steps.end());
     EXPECT_NE(splats->note.find("depth cut off"), std::string::npos) << show(p);
+}
+
+// A list frame on a multisampled host: the splats take the ordered blend
+// under the surfaces (drawn per sample; the list sections are per pixel);
+// the lists run once, after the per-sample volumes, against each pixel's
+// nearest sample, and the step that copies it says so.
+TEST(FramePlan, ListFramesOnAMultisampledHostReadTheNearestSampleAndSaySo) {
+    TestFrame f(false);
+    const gl::FramePlan p = gl::planFrame(f.frame, {.drawTransparent = transparent, .transparentToLists = true}, {},
+                                          {.texture = 9, .samples = 4, .copied = false, .missing = {}, .sampleTexture = 11});
+    EXPECT_TRUE(p.lists && !p.splatsInLists);
+    EXPECT_NE(p.listsNote.find("multisampled host (4 samples)"), std::string::npos) << p.listsNote;
+    const std::vector<StepKind> k = kinds(p);
+    EXPECT_EQ(std::count(k.begin(), k.end(), StepKind::Splats), 4) << show(p);
+    const auto nearest = std::find_if(p.steps.begin(), p.steps.end(), [](const gl::PlanStep& s) { return s.kind == StepKind::HostDepthSample && s.sample == -1; });
+    ASSERT_NE(nearest, p.steps.end()) << show(p);
+    EXPECT_NE(nearest->note.find("nearest sample"), std::string::npos) << nearest->note;
+    EXPECT_LT(nearest - p.steps.begin(), std::find(k.begin(), k.end(), StepKind::ListsCollect) - k.begin()) << show(p);
 }
 
 // The order-exact path: surfaces collected, splats split into runs behind,

@@ -17,6 +17,7 @@ int runCut(int argc, char** argv);          // cut.cpp: splats cut by the host d
 int runSoak(int argc, char** argv);         // soak.cpp: every preset for an hour of scene time; finite, flat bounds and memory (issue 13)
 int runTransparency(int argc, char** argv); // transparency.cpp: glass panes among the fire, fragment lists vs ordered blend (issue 15)
 int runShadowTables(int argc, char** argv); // shadow_tables.cpp: shadow-table build time and error against tracing, CPU only
+int runMsaa(int argc, char** argv);         // msaa.cpp: 1x to 8x MSAA host targets, ms per frame and error vs a 16-sample reference (issue 26)
 int runLighting(int argc, char** argv);     // lighting.cpp: every lighting knob against the lit volume reference, Pareto (issue 24)
 int runLodRefine(int argc, char** argv);    // lod_refine.cpp: LOD cloud refinement on the CPU: tetrahedra, update time, memory
 int runGases(int argc, char** argv);        // gases.cpp: procedural gases' spacing, threshold, octaves vs the continuous gas (issue 24)
@@ -43,6 +44,7 @@ inline constexpr BenchCommand kCommands[] = {
     {"lodrefine", "LOD cloud refinement on the CPU: tetrahedra per frame vs full, update() time, memory, error vs finest", runLodRefine},
     {"groundfog", "LOD ground fog over the Jacksboro DEM: count vs full, ms/frame, error vs full, popping with/without morphing; --knobs: every knob vs the exact field, Pareto", runGroundFog},
     {"scheduling", "a level of 1000 effects with 10 in view vs those 10 alone; camera sweep; catch-up error", runScheduling},
+    {"msaa", "a sample scene into 1x, 2x, 4x and 8x multisampled host targets: ms/frame, error vs a 16-sample anti-aliased reference, Pareto", runMsaa},
     {"lighting", "every lighting knob (self-shadow, table size, lobes, samples per voxel, 8-bit) vs the lit volume reference, Pareto", runLighting},
     {"shadows", "Ebert & Parent 1990 Table 2: steam from a glass, no/geometry/traced/table shadowing, table error", runShadows},
     {"ebert", "Ebert & Parent 1990 Table 1: the gallery, steam and chess-fog scenes at the paper's resolutions, with and without their volumes", runEbert},

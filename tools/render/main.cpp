@@ -61,6 +61,8 @@ struct Args {
     bool assemble = false;                     // --assemble: the GIF from the frames in --out
     splatfx::Budgets budgets{};                // --budget NAME=N
     splatfx::DepthConvention depth{};          // --reverse-z, --clip-01, --infinite-far (the host's depth convention)
+    int msaa = 0;                              // --msaa N: the host's target multisampled
+    bool srgb = false;                         // --srgb: the host's target sRGB, GL_FRAMEBUFFER_SRGB on
 };
 
 // Returns -1 to go on, else the exit code (0 after --help, 2 after a bad command line).
@@ -177,6 +179,11 @@ int parse(int argc, char** argv, Args& a) {
         "--clip-01", [&a] { a.depth.clip = splatfx::ClipDepth::ZeroToOne; }, "clip depth [0, 1] (glClipControl GL_ZERO_TO_ONE) without reversing");
     app.add_flag_callback(
         "--infinite-far", [&a] { a.depth.infiniteFar = true; }, "an infinite far plane (the scene's camera farPlane unused)");
+    // The engines' colour targets (docs/integration.md, "Depth buffers that are not textures, and colour targets").
+    app.add_option("--msaa", a.msaa, "draw into an N-sample (MSAA) colour and depth target, resolved for the PNG")
+        ->check(CLI::IsMember({1, 2, 4, 8, 16}))
+        ->type_name("N");
+    app.add_flag("--srgb", a.srgb, "draw into an sRGB colour target with GL_FRAMEBUFFER_SRGB on (blending in linear; the PNG holds sRGB)");
     cli::addNumber(app, "--abort-after", a.abortAfter, 0, 100000,
                    "testing aid: fail on purpose after N frames (checks that nothing partial is left)");
     // Unset, these come from the scene file: the help says so instead of showing the placeholder 0.
@@ -389,8 +396,10 @@ static int renderMain(int argc, char** argv) {
     if (!outputs) return fail(outputs.error());
     std::map<std::string, std::pair<int, std::string>> hashes; // the run record's frames
 
-    auto fb = splatfx::gl::Framebuffer::create({.width = size.x, .height = size.y, .floatDepth = a.depth.reversed});
+    auto fb = splatfx::gl::Framebuffer::create(
+        {.width = size.x, .height = size.y, .floatDepth = a.depth.reversed, .samples = a.msaa, .srgb = a.srgb});
     if (!fb) return fail(fb.error());
+    if (a.srgb) glEnable(GL_FRAMEBUFFER_SRGB);
     // The host's clip convention: GL state of this context, read by nothing in splatfx but the rasterizer.
     glClipControl(GL_LOWER_LEFT, a.depth.clip == splatfx::ClipDepth::ZeroToOne ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
     std::printf("splatfx-render: %s (%s) on %s\n", a.scene.c_str(), file.title.empty() ? name.c_str() : file.title.c_str(), ctx->renderer().c_str());
@@ -404,6 +413,9 @@ static int renderMain(int argc, char** argv) {
                     size.y, fps, file.seed, a.traditional ? "traditional" : "textured", a.out.c_str(), name.c_str());
 
     if (!(a.depth == splatfx::DepthConvention{})) std::printf("splatfx-render: depth convention %s\n", splatfx::describe(a.depth).c_str());
+    if (a.msaa > 1 || a.srgb)
+        std::printf("splatfx-render: colour target %s%s%s\n", a.msaa > 1 ? (std::to_string(a.msaa) + "x MSAA").c_str() : "",
+                    a.msaa > 1 && a.srgb ? ", " : "", a.srgb ? "sRGB (GL_FRAMEBUFFER_SRGB)" : "");
     std::optional<splatfx::AnimationWriter> gif;
     if (whole) gif.emplace(outputs->path(name + ".gif"), fps);
     using Clock = std::chrono::steady_clock;

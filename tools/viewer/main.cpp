@@ -55,6 +55,7 @@ struct Args {
     std::optional<std::uint32_t> seed;
     std::string camera = "path";
     bool hideUi = false;
+    bool intoWindow = false; // draw into the window's default framebuffer (its depth copied by splatfx) instead of an own one
 };
 
 // Returns -1 to go on, else the exit code (0 after --help, 2 after a bad command line).
@@ -70,6 +71,9 @@ int parse(int argc, char** argv, Args& a) {
     cli::addNumber(app, "--auto-quit-after", a.autoQuitAfter, 1, 1000000, "render N frames at the scene's fps (fixed steps), then quit");
     app.add_option("--screenshot", a.screenshot, "write the last frame (with the UI) to FILE (PNG)")->type_name("FILE");
     app.add_flag("--hide-ui", a.hideUi, "no UI panel");
+    app.add_flag("--into-window", a.intoWindow,
+                 "draw straight into the window's default framebuffer, as many hosts do (splatfx copies its depth once a frame: "
+                 "FrameRendererDesc::copyHostDepth); default: into a framebuffer of the viewer's own, copied to the window");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     if (seedOption->count()) a.seed = seed;
     return -1;
@@ -424,12 +428,20 @@ static int viewerMain(int argc, char** argv) {
         if (v.player && fbSize.x > 0 && fbSize.y > 0) {
             if (!v.paused && frameIndex > 0) v.time += double(dt) * v.timeRate;
             const splatfx::Camera cam = v.camera(fbSize);
-            // Into a framebuffer of our own, as splatfx-render draws (the same
-            // RGBA8 colour and a depth texture), then copied to the window: a
-            // window's default framebuffer has no depth texture, so the passes
-            // that read the host depth (the host fog, the depth cut) would not
-            // run there and the viewer would show another image than the tool.
-            if (!v.target || v.target->width() != fbSize.x || v.target->height() != fbSize.y) {
+            // By default into a framebuffer of our own, as splatfx-render draws
+            // (the same RGBA8 colour and depth texture), then copied to the
+            // window. --into-window draws into the window's default framebuffer
+            // as many hosts do: it has no depth texture, so the frame renderer
+            // copies its depth buffer once a frame for the passes that read it
+            // (the host fog, the depth cut); viewer_matches_render_window holds
+            // that image to the tool's too.
+            if (v.args.intoWindow) {
+                // The window's own depth buffer is copied by the frame renderer after the opaque pass.
+                if (v.time > splatfx::kMaxTimeSec) v.time = 0.0;
+                if (auto st = v.player->renderFrame(v.time, cam, 0, v.frame); !st) v.error = st.error();
+                glBindFramebuffer(GL_FRAMEBUFFER, 0);
+                glViewport(0, 0, fbSize.x, fbSize.y);
+            } else if (!v.target || v.target->width() != fbSize.x || v.target->height() != fbSize.y) {
                 v.target.reset();
                 auto fb = splatfx::gl::Framebuffer::create({.width = fbSize.x, .height = fbSize.y});
                 if (!fb) {
@@ -439,12 +451,14 @@ static int viewerMain(int argc, char** argv) {
                 }
                 v.target.emplace(std::move(*fb));
             }
-            // Past kMaxTimeSec (about 72.8 hours of scene time) the scene refuses the time: restart the clock.
-            if (v.time > splatfx::kMaxTimeSec) v.time = 0.0;
-            if (auto st = v.player->renderFrame(v.time, cam, v.target->handle(), v.frame); !st) v.error = st.error();
-            glBlitNamedFramebuffer(v.target->handle(), 0, 0, 0, fbSize.x, fbSize.y, 0, 0, fbSize.x, fbSize.y, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-            glBindFramebuffer(GL_FRAMEBUFFER, 0);
-            glViewport(0, 0, fbSize.x, fbSize.y);
+            if (!v.args.intoWindow) {
+                // Past kMaxTimeSec (about 72.8 hours of scene time) the scene refuses the time: restart the clock.
+                if (v.time > splatfx::kMaxTimeSec) v.time = 0.0;
+                if (auto st = v.player->renderFrame(v.time, cam, v.target->handle(), v.frame); !st) v.error = st.error();
+                glBlitNamedFramebuffer(v.target->handle(), 0, 0, 0, fbSize.x, fbSize.y, 0, 0, fbSize.x, fbSize.y, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+                glBindFramebuffer(GL_FRAMEBUFFER, 0);
+                glViewport(0, 0, fbSize.x, fbSize.y);
+            }
         } else {
             glBindFramebuffer(GL_FRAMEBUFFER, 0);
             glViewport(0, 0, fbSize.x, fbSize.y);

@@ -40,6 +40,8 @@ constexpr const char* kSectionUniforms[] = {"uViewProj", "uOctagon", "uCut",    
 static_assert(std::size(kSectionUniforms) == section::UniformCount);
 constexpr const char* kListUniforms[] = {"uSize", "uLayers", "uTiles", "uOrigin", "uSectionCount", "uReversed"};
 static_assert(std::size(kListUniforms) == lists::UniformCount);
+constexpr const char* kDepthSampleUniforms[] = {"uSample", "uSamples", "uReversed"};
+static_assert(std::size(kDepthSampleUniforms) == depth_sample::UniformCount);
 
 // Renderer::Impl::program: FOG_PER_SPLAT only with FOG; the cut's variants only with CUT; GENERAL implies NEAR_CUT.
 bool splatValid(const Values& v) {
@@ -105,6 +107,7 @@ const ProgramDesc kDescs[] = {
      .uniforms = kListUniforms,
      .values = {kResolveK}},
     {.name = "fragment lists (composite)", .vertex = "fullscreen.vert", .fragment = "list_composite.frag", .uniforms = kListUniforms},
+    {.name = "host depth sample", .vertex = "fullscreen.vert", .fragment = "depth_sample.frag", .uniforms = kDepthSampleUniforms},
 };
 static_assert(std::size(kDescs) == std::size_t(ProgramId::Count));
 

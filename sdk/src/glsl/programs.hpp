@@ -37,6 +37,7 @@ enum class ProgramId : std::uint8_t {
     ListResolve,     // list_resolve.comp
     ListResolveFrag, // fullscreen.vert + list_resolve.frag
     ListComposite,   // fullscreen.vert + list_composite.frag
+    DepthSample,     // fullscreen.vert + depth_sample.frag (HostPass: a multisampled host depth, one sample at a time)
     Count
 };
 
@@ -134,6 +135,9 @@ namespace section {
 enum Define { FOG, FOG_PER_SPLAT, CUT, HOST_DEPTH, NEAR_CUT, GENERAL, CROSSFADE, SECTIONS };
 enum Uniform { ViewProj, Octagon, Cut, Origin, Eye, Forward, NearZ, Persp, KernelRadius, HostDepthMap, InvViewProj, Viewport, NdcZ, Reversed, UniformCount };
 } // namespace section
+namespace depth_sample {
+enum Uniform { Sample, Samples, Reversed, UniformCount };
+}
 namespace lists { // prepare, tile range, host tiles, resolve (both), composite
 enum Define { K };
 enum Uniform { Size, Layers, Tiles, Origin, SectionCount, Reversed, UniformCount };

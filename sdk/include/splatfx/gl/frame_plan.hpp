@@ -34,11 +34,15 @@ namespace splatfx::gl {
 // framebuffer's depth buffer (the default framebuffer's, a renderbuffer) is
 // copied into after the host's opaque pass. Looked up once a frame by the
 // frame renderer.
+// A multisampled one is read one sample at a time: the HostDepthSample steps
+// copy sample s into `sampleTexture` (single-sampled) and restrict the
+// drawing to sample s (glSampleMaski) before the passes that read it run.
 struct HostDepth {
-    unsigned texture = 0; // GL name; 0: none that can be sampled
-    int samples = 0;      // its sample count (0 or 1: single-sampled)
-    bool copied = false;  // `texture` is filled by the CopyHostDepth step
-    std::string missing;  // with no texture: why none could be read or copied (for the notes)
+    unsigned texture = 0;       // GL name; 0: none that can be sampled
+    int samples = 0;            // its sample count (0 or 1: single-sampled)
+    bool copied = false;        // `texture` is filled by the CopyHostDepth step
+    std::string missing;        // with no texture: why none could be read or copied (for the notes)
+    unsigned sampleTexture = 0; // samples > 1: the single-sample texture the passes read (0: none could be made)
 };
 
 enum class StepKind : std::uint8_t {
@@ -46,6 +50,7 @@ enum class StepKind : std::uint8_t {
     PrepareTetrahedra, // pre-integration tables that changed; per-tetrahedron data
     HostOpaque,        // HostTarget::drawOpaque
     CopyHostDepth,     // the framebuffer's depth buffer into a texture the passes read (HostDepth::copied)
+    HostDepthSample,   // multisampled host: sample `sample` of its depth into the passes' texture, drawing into that sample only
     HostFog,           // the fog of the host's opaque image
     Splats,            // splats of `range`, full resolution
     ReducedSplats,     // every splat, at reduced resolution, composited over the host
@@ -82,6 +87,9 @@ struct PlanStep {
     StepRange range = StepRange::Explicit;
     std::uint32_t volume = 0;       // Tetrahedra: index into Frame::volumes()
     std::size_t begin = 0, end = 0; // StepRange::Explicit: into Frame::splats() or the volume's tetrahedra
+    // HostDepthSample: the sample (drawing restricted to it); -1: the nearest
+    // sample of each pixel, drawing into every sample again.
+    int sample = 0;
     std::string note{};             // empty, or how this step falls back from what was asked
 };
 
@@ -97,6 +105,11 @@ struct FramePlan {
     bool fogHost = false;        // HostFog is among the steps
     bool lists = false;          // the host's surfaces go through the fragment lists
     bool splatsInLists = false;  // ... and the splats are cut into sections at them
+    // A multisampled host depth (HostDepth::samples > 1): the host fog and
+    // the volumes run once per sample, each against that sample's depth and
+    // drawing into that sample only; the fragment lists read each pixel's
+    // nearest sample. 0: a single-sampled host.
+    int samples = 0;
     std::string fogNote;         // why the host image is not fogged although the frame has a fog
     std::string listsNote;       // why the splats take the ordered blend in a list frame
     std::vector<PlanStep> steps; // in order
@@ -104,7 +117,8 @@ struct FramePlan {
 
 // The frame's steps. Expects a frame camera with a positive viewport.
 FramePlan planFrame(const Frame& frame, const HostTarget& host, const FrameRendererDesc& desc, const HostDepth& depth);
-// One line per step, e.g. "Tetrahedra volume 1 [0, 840) into the reduced image".
+// One line per step, e.g. "Tetrahedra volume 1 [0, 840) into the reduced image"
+// or "HostDepthSample 2".
 std::string describe(const PlanStep& step);
 const char* toString(StepKind kind);
 

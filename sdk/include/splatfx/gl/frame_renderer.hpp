@@ -30,9 +30,11 @@
 //      and composites it over the image; the splats behind (in front of)
 //      every surface they cover take the ordinary splat pass before (after)
 //      the resolve.
-// Where a pass cannot run as asked (no host depth texture, a multisampled
-// one, a fog with splat sections, tetrahedra in a list frame) the frame says
-// so in stats().notes and the pass's own block; nothing falls back silently.
+// Where a pass cannot run as asked (no host depth, a fog with splat
+// sections, tetrahedra in a list frame, the lists of a multisampled host)
+// the frame says so in stats().notes and the pass's own block; nothing falls
+// back silently. A multisampled host target (MSAA) gets the host fog and the
+// volumes once per sample (stats().msaa).
 // The host depth is read in the frame camera's depth convention
 // (Camera::depth, depth_convention.hpp); a context whose glClipControl or a
 // projection that disagrees with it is a note too.
@@ -145,17 +147,19 @@ void setShadowUniforms(unsigned program, const ShadowBinding& binding);
 struct HostTarget {
     unsigned framebuffer = 0; // the host's framebuffer object (0: the default framebuffer); default 0
     int x = 0, y = 0;         // viewport origin; its size is the frame camera's viewport; default 0, 0
-    // The host's depth as a texture (GL name, single-sampled, the
-    // framebuffer's size); 0: the framebuffer's depth attachment when it is a
-    // texture, else a copy of its depth buffer (FrameRendererDesc::copyHostDepth),
-    // in the frame camera's depth convention (Camera::depth). Every
-    // pass that reads the host depth reads this one (the depth
-    // cut of the splats, the reduced-resolution upsampling, the host fog, the
-    // tetrahedra's ray end, the list sections). Without any (no depth buffer,
-    // a multisampled one, copyHostDepth off) the splats and
-    // tetrahedra are only depth-tested at their fragments (not exact inside
-    // a volume), the host image gets no fog and the splats take the ordered
-    // blend in a list frame; FrameRenderStats::notes says so. Default 0.
+    // The host's depth as a texture (GL name, the framebuffer's size,
+    // single-sampled or multisampled like the framebuffer); 0: the
+    // framebuffer's depth attachment when it is a texture, else a copy of its
+    // depth buffer (FrameRendererDesc::copyHostDepth), in the frame camera's
+    // depth convention (Camera::depth). Every pass that reads the host depth
+    // reads this one (the depth cut of the splats, the reduced-resolution
+    // upsampling, the host fog, the tetrahedra's ray end, the list
+    // sections); a multisampled one one sample at a time
+    // (FrameRenderStats::msaa). Without any (no depth buffer, copyHostDepth
+    // off) the splats and tetrahedra are only depth-tested at their fragments
+    // (not exact inside a volume), the host image gets no fog and the splats
+    // take the ordered blend in a list frame; FrameRenderStats::notes says
+    // so. Default 0.
     unsigned depthTexture = 0;
     // The host's opaque geometry, drawn with depth writes before the volumes.
     // Empty: the host drew it before render(). Default empty.
@@ -182,11 +186,23 @@ struct FrameRenderStats {
     std::vector<std::string> notes; // every fallback of the frame, one line each (the plan's and the passes'); empty: all ran as asked
     std::string depthConvention;    // the frame camera's (describe(Camera::depth)): how the host depth was read
     bool hostDepthCopied = false;   // the host depth was copied from a depth buffer that is not a texture (FrameRendererDesc::copyHostDepth)
+    // A multisampled host depth (MSAA): what ran on it. The host fog and the
+    // volumes (splats, reduced splats, tetrahedra) run once per sample, each
+    // reading that sample's depth and drawing into that sample only (the
+    // resolved image is the mean of the per-sample images: exact at every
+    // sample, at `samples` times the cost of those passes); the fragment
+    // lists run once, against each pixel's nearest sample (a note says so).
+    struct Msaa {
+        int samples = 0;       // the host depth's sample count; 0: single-sampled
+        bool perSample = false; // the fog and volume passes ran per sample as above (false: a list frame without them)
+        int sampleCopies = 0;  // samples copied out of the host depth (samples, + 1 for the nearest)
+        bool listsNearest = false; // the fragment lists read each pixel's nearest sample
+    } msaa;
     struct Shadow {
         std::uint64_t uploads = 0; // shadow-table uploads (cumulative; only when the frame's changed)
     } shadow;
     struct Fog {
-        bool host = false;       // the host image was fogged (a fog, fogHost and a single-sampled host depth texture)
+        bool host = false;       // the host image was fogged (a fog, fogHost and a host depth to read)
         bool splats = false;     // the splats were drawn with per-fragment fog
         bool tetrahedra = false; // the tetrahedra were drawn with per-segment fog
         std::string error;       // empty, or why a fog that was asked for was not drawn

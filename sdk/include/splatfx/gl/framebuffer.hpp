@@ -25,6 +25,13 @@ struct FramebufferDesc {
     int height = 480;                // default 480
     Precision color = Precision::U8; // colour attachment format; default RGBA8
     bool floatDepth = false;         // depth attachment DEPTH_COMPONENT32F (reverse-Z hosts) instead of DEPTH_COMPONENT24; default false
+    // 0 or 1: single-sampled; 2, 4, 8 or 16 (up to GL_MAX_SAMPLES): colour
+    // and depth multisampled (MSAA), read() resolves. Default 0.
+    int samples = 0;
+    // Colour GL_SRGB8_ALPHA8 (with color U8): draw with GL_FRAMEBUFFER_SRGB on
+    // and GL blends in linear and stores sRGB; read() returns the stored
+    // (sRGB-encoded) values. Default false.
+    bool srgb = false;
 };
 
 class Framebuffer {
@@ -37,18 +44,20 @@ public:
     unsigned handle() const { return mFbo; }
     int width() const { return mDesc.width; }
     int height() const { return mDesc.height; }
-    // The depth attachment, a DEPTH_COMPONENT24 (or 32F) texture (HostTarget::depthTexture).
+    // The depth attachment, a DEPTH_COMPONENT24 (or 32F) texture, multisampled with samples > 1 (HostTarget::depthTexture).
     unsigned depthTexture() const { return mDepth; }
     void clear(glm::vec4 color, float depth = 1.0f);
     // RGBA float, top row first (flipped from GL's bottom-up order).
     Image read() const;
-    // Depth values in [0, 1], top row first, one channel.
+    // Depth values in [0, 1], top row first, one channel (single-sampled
+    // only: an empty image when multisampled).
     Image readDepth() const;
 
 private:
     Framebuffer() = default;
     FramebufferDesc mDesc;
     unsigned mFbo = 0, mColor = 0, mDepth = 0;
+    unsigned mResolveFbo = 0, mResolved = 0; // multisampled: the single-sampled colour read() resolves into
 };
 
 } // namespace splatfx::gl

@@ -45,9 +45,10 @@ void planInterleaved(const Frame& frame, const FrameRendererDesc& desc, bool red
     if (layer) plan.steps.push_back(step(StepKind::ReducedComposite));
 }
 
+// A multisampled host depth whose per-sample texture could not be made (HostDepth::missing says why).
 std::string multisampledNote(const char* what, int samples) {
     return std::string(what) + ": the host depth is multisampled (" + std::to_string(samples) +
-           " samples); resolve it into a single-sample depth texture (HostTarget::depthTexture) first";
+           " samples) and the texture its samples are read into could not be made";
 }
 
 } // namespace
@@ -56,13 +57,14 @@ FramePlan planFrame(const Frame& frame, const HostTarget& host, const FrameRende
     const Camera& camera = frame.camera();
     assert(camera.viewport.x > 0 && camera.viewport.y > 0 && "planFrame: the frame camera's viewport must be positive");
     FramePlan plan;
+    // A multisampled depth is read through the single-sample texture each sample is copied into.
     const bool multisampled = depth.texture != 0 && depth.samples > 1;
     plan.target = {.framebuffer = host.framebuffer,
                    .x = host.x,
                    .y = host.y,
                    .width = camera.viewport.x,
                    .height = camera.viewport.y,
-                   .depthTexture = multisampled ? 0u : depth.texture};
+                   .depthTexture = multisampled ? depth.sampleTexture : depth.texture};
     plan.fog = frame.fog() && !frame.fog()->empty() ? frame.fog() : nullptr;
     plan.timeSec = frame.time();
     if (plan.fog) plan.fogParameters = plan.fog->glslParameters(plan.timeSec, glm::dvec3(camera.eye()));
@@ -70,6 +72,7 @@ FramePlan planFrame(const Frame& frame, const HostTarget& host, const FrameRende
         std::any_of(frame.volumes().begin(), frame.volumes().end(), [](const FrameVolume& v) { return v.table && !v.lod.tets.empty(); });
     plan.reduced = desc.resolutionScale != 1;
     const bool hasDepth = plan.target.depthTexture != 0;
+    plan.samples = multisampled && hasDepth ? depth.samples : 0;
 
     // 0. Uploads: the frame's shadow table (bound while the hooks run), the tetrahedra's tables.
     plan.steps.push_back(step(StepKind::UploadShadow));
@@ -78,20 +81,17 @@ FramePlan planFrame(const Frame& frame, const HostTarget& host, const FrameRende
     // 1. The host's opaque pass: its depth is what the volumes are tested against.
     if (host.drawOpaque) plan.steps.push_back(step(StepKind::HostOpaque));
     // 1a. A depth buffer that cannot be sampled, copied once it is complete (before anything reads it).
-    if (depth.copied && hasDepth) plan.steps.push_back(step(StepKind::CopyHostDepth));
+    if (depth.copied && depth.texture) plan.steps.push_back(step(StepKind::CopyHostDepth));
 
-    // 1b. The fog of the host's opaque image, read from its depth.
-    if (plan.fog && desc.fogHost) {
-        if (hasDepth) {
-            plan.steps.push_back(step(StepKind::HostFog));
-            plan.fogHost = true;
-        } else if (multisampled) {
-            plan.fogNote = multisampledNote("fog of the host image skipped", depth.samples);
-        } else {
-            plan.fogNote = "fog of the host image skipped: no host depth to read (" +
-                           (depth.missing.empty() ? std::string("HostTarget::depthTexture, a texture depth attachment or a depth buffer to copy") : depth.missing) +
-                           ")";
-        }
+    const std::string noDepth = "no host depth to read (" +
+                                (depth.missing.empty() ? std::string("HostTarget::depthTexture, a texture depth attachment or a depth buffer to copy")
+                                                       : depth.missing) +
+                                ")";
+    const bool fogHost = plan.fog && desc.fogHost;
+    if (fogHost) {
+        if (hasDepth) plan.fogHost = true;
+        else if (multisampled) plan.fogNote = multisampledNote("fog of the host image skipped", depth.samples);
+        else plan.fogNote = "fog of the host image skipped: " + noDepth;
     }
 
     // The order-exact path: the splats go into the fragment lists with the
@@ -99,30 +99,48 @@ FramePlan planFrame(const Frame& frame, const HostTarget& host, const FrameRende
     // is in the frame; otherwise they are drawn in step 2 as usual and only
     // the surfaces are sorted (among themselves) in step 3.
     plan.lists = host.transparentToLists && bool(host.drawTransparent);
-    plan.splatsInLists = plan.lists && !plan.reduced && !plan.tetrahedra && hasDepth;
+    plan.splatsInLists = plan.lists && !plan.reduced && !plan.tetrahedra && hasDepth && !multisampled;
     if (plan.lists && !plan.splatsInLists)
         plan.listsNote = plan.reduced      ? "reduced resolution: the splats take the ordered blend under the surfaces"
                          : plan.tetrahedra ? "tetrahedra in the frame: the volumes take the ordered blend under the surfaces"
-                         : multisampled    ? multisampledNote("the splats take the ordered blend under the surfaces", depth.samples)
-                                           : "no host depth to read (" +
-                                                 (depth.missing.empty() ? std::string("HostTarget::depthTexture, a texture depth attachment or a "
-                                                                                      "depth buffer to copy")
-                                                                        : depth.missing) +
-                                                 "): the splats take the ordered blend under the surfaces";
+                         : multisampled && hasDepth
+                             ? "multisampled host (" + std::to_string(depth.samples) +
+                                   " samples): the splats take the ordered blend under the surfaces (drawn per sample; the list sections are per pixel)"
+                         : multisampled ? multisampledNote("the splats take the ordered blend under the surfaces", depth.samples)
+                                           : noDepth + ": the splats take the ordered blend under the surfaces";
 
-    // 2. The volumes, back to front.
+    // 1b. The fog of the host's opaque image, read from its depth, and
+    // 2. the volumes, back to front: once, or (multisampled) once per sample,
+    // each run reading that sample's depth and drawing into that sample only.
     const std::size_t splats = frame.splats().size();
-    if (plan.splatsInLists) {
-        // drawn in step 3
-    } else if (plan.tetrahedra) {
-        planInterleaved(frame, desc, plan.reduced, plan);
-    } else if (!plan.reduced) {
-        plan.steps.push_back(splatRange(0, splats));
+    auto fogAndVolumes = [&] {
+        if (plan.fogHost) plan.steps.push_back(step(StepKind::HostFog));
+        if (plan.splatsInLists) {
+            // drawn in step 3
+        } else if (plan.tetrahedra) {
+            planInterleaved(frame, desc, plan.reduced, plan);
+        } else if (!plan.reduced) {
+            plan.steps.push_back(splatRange(0, splats));
+        } else {
+            plan.steps.push_back(step(StepKind::ReducedSplats));
+        }
+        if (multisampled && !hasDepth && desc.splats.depthCut && splats > 0 && !plan.splatsInLists)
+            plan.steps.back().note = multisampledNote("depth cut off (the plain depth test at each splat's plane)", depth.samples);
+    };
+    if (plan.samples > 1) {
+        // (Nothing per sample when the splats go into the lists and no fog is drawn.)
+        const int perSample = plan.fogHost || !plan.splatsInLists ? plan.samples : 0;
+        for (int s = 0; s < perSample; ++s) {
+            plan.steps.push_back({.kind = StepKind::HostDepthSample, .sample = s});
+            fogAndVolumes();
+        }
+        plan.steps.push_back({.kind = StepKind::HostDepthSample, .sample = -1});
+        if (plan.lists)
+            plan.steps.back().note = "fragment lists on a multisampled host (" + std::to_string(plan.samples) +
+                                     " samples): each pixel resolved once, against its nearest sample's depth";
     } else {
-        plan.steps.push_back(step(StepKind::ReducedSplats));
+        fogAndVolumes();
     }
-    if (multisampled && desc.splats.depthCut && splats > 0 && !plan.splatsInLists)
-        plan.steps.back().note = multisampledNote("depth cut off (the plain depth test at each splat's plane)", depth.samples);
 
     // 3. The host's transparent surfaces, over the volumes: into the lists,
     // the splats cut into sections at them, every pixel sorted and
@@ -159,6 +177,7 @@ const char* toString(StepKind kind) {
     case StepKind::PrepareTetrahedra: return "PrepareTetrahedra";
     case StepKind::HostOpaque: return "HostOpaque";
     case StepKind::CopyHostDepth: return "CopyHostDepth";
+    case StepKind::HostDepthSample: return "HostDepthSample";
     case StepKind::HostFog: return "HostFog";
     case StepKind::Splats: return "Splats";
     case StepKind::ReducedSplats: return "ReducedSplats";
@@ -178,6 +197,7 @@ const char* toString(StepKind kind) {
 std::string describe(const PlanStep& s) {
     std::string line = toString(s.kind);
     if (s.kind == StepKind::Tetrahedra) line += " volume " + std::to_string(s.volume);
+    if (s.kind == StepKind::HostDepthSample) line += s.sample >= 0 ? " " + std::to_string(s.sample) : std::string(" nearest");
     switch (s.range) {
     case StepRange::Explicit:
         if (s.kind == StepKind::Splats || s.kind == StepKind::Tetrahedra) line += " [" + std::to_string(s.begin) + ", " + std::to_string(s.end) + ")";

@@ -52,6 +52,7 @@ struct FrameRenderer::Impl {
     Impl(const FrameRendererDesc& d, const detail::Programs& programs, detail::SplatPass s, detail::TetraPass t, detail::FragmentListPass l)
         : desc(d),
           shadow(d.shadowTextureUnit),
+          host(programs),
           fog(d.fogTextureSize, d.fogDepthThreshold, programs),
           splats(std::move(s)),
           tetra(std::move(t)),
@@ -76,6 +77,7 @@ struct FrameRenderer::Impl {
         case StepKind::UnbindShadow: return shadow;
         case StepKind::HostOpaque:
         case StepKind::CopyHostDepth:
+        case StepKind::HostDepthSample:
         case StepKind::HostTransparent: return host;
         case StepKind::HostFog: return fog;
         case StepKind::Splats:
@@ -163,6 +165,7 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
                     ? r.host.depthCopy(target.framebuffer, target.x + frame.camera().viewport.x, target.y + frame.camera().viewport.y)
                     : HostDepth{.missing = "FrameRendererDesc::copyHostDepth is off and neither HostTarget::depthTexture nor a texture depth "
                                            "attachment is given"};
+    r.host.addSampleTexture(depth, target.x + frame.camera().viewport.x, target.y + frame.camera().viewport.y);
     FrameRendererDesc planDesc = r.desc;
     if (!r.splats.layerError().empty()) planDesc.volumeLayer = false; // noted in report()
     else if (planDesc.volumeLayer && planDesc.resolutionScale == 1 && hostColorIsFloat32(target.framebuffer)) planDesc.volumeLayer = false;
@@ -194,6 +197,9 @@ void FrameRenderer::Impl::report(const Frame& frame, const detail::StepContext& 
         s.tetrahedra.batches = std::uint64_t(std::count_if(plan.steps.begin(), plan.steps.end(), [](const PlanStep& step) {
             return step.kind == StepKind::Tetrahedra || step.kind == StepKind::Splats || step.kind == StepKind::ReducedSplats;
         }));
+    s.msaa.samples = plan.samples;
+    s.msaa.perSample = std::any_of(plan.steps.begin(), plan.steps.end(), [](const PlanStep& step) { return step.kind == StepKind::HostDepthSample && step.sample >= 0; });
+    s.msaa.listsNearest = plan.samples > 1 && plan.lists;
     s.lists.used = plan.lists;
     s.lists.splats = plan.splatsInLists;
     s.lists.note = plan.listsNote.empty() ? context.listsNote : plan.listsNote;
