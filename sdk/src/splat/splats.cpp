@@ -148,6 +148,18 @@ struct Geometry {
     float chord = 0.0f; // optical-depth scale of the ray through the centre
 };
 
+// The view frustum's six planes from the view-projection matrix (Gribb &
+// Hartmann), normalized so a plane's value at a point is its distance.
+void frustumPlanes(const glm::mat4& vp, glm::vec4 (&planes)[6]) {
+    for (int i = 0; i < 3; ++i) {
+        const glm::vec4 row(vp[0][i], vp[1][i], vp[2][i], vp[3][i]);
+        const glm::vec4 w(vp[0][3], vp[1][3], vp[2][3], vp[3][3]);
+        planes[2 * i] = w + row;
+        planes[2 * i + 1] = w - row;
+    }
+    for (auto& p : planes) p /= std::max(glm::length(glm::vec3(p)), 1e-30f);
+}
+
 constexpr int kBatch = 64;
 
 // Geometry of kBatch voxels as structure of arrays, so computeGeometry's
@@ -287,15 +299,8 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
     const float R = materials.footprint().radius();
 
     // Frustum planes (Gribb & Hartmann) for conservative sphere culling.
-    const glm::mat4 vp = cam.proj * cam.view;
     glm::vec4 planes[6];
-    for (int i = 0; i < 3; ++i) {
-        const glm::vec4 row(vp[0][i], vp[1][i], vp[2][i], vp[3][i]);
-        const glm::vec4 w(vp[0][3], vp[1][3], vp[2][3], vp[3][3]);
-        planes[2 * i] = w + row;
-        planes[2 * i + 1] = w - row;
-    }
-    for (auto& p : planes) p /= std::max(glm::length(glm::vec3(p)), 1e-30f);
+    frustumPlanes(cam.proj * cam.view, planes);
 
     const bool hasSet = style.textured && style.textureSet < materials.setCount();
     const Materials::SetRange range = hasSet ? materials.set(style.textureSet) : Materials::SetRange{0, 1, false, 1.0f};
@@ -512,15 +517,8 @@ void SplatBuilder::add(std::span<const Particle> particles, const Materials& mat
     const Camera& cam = mCamera;
     const bool persp = cam.perspective();
     const float R = materials.footprint().radius();
-    const glm::mat4 vp = cam.proj * cam.view;
-    glm::vec4 planes[6]; // as in add(Grid): Gribb & Hartmann, normalized
-    for (int i = 0; i < 3; ++i) {
-        const glm::vec4 row(vp[0][i], vp[1][i], vp[2][i], vp[3][i]);
-        const glm::vec4 w(vp[0][3], vp[1][3], vp[2][3], vp[3][3]);
-        planes[2 * i] = w + row;
-        planes[2 * i + 1] = w - row;
-    }
-    for (auto& p : planes) p /= std::max(glm::length(glm::vec3(p)), 1e-30f);
+    glm::vec4 planes[6];
+    frustumPlanes(cam.proj * cam.view, planes);
     const bool hasSet = style.textured && style.textureSet < materials.setCount();
     const Materials::SetRange range = hasSet ? materials.set(style.textureSet) : Materials::SetRange{0, 1, false, 1.0f};
     const bool hasTable = style.colorTable < materials.colorTableCount();
