@@ -264,7 +264,7 @@ TEST(ParticleEffect, BoundsHoldEverySplatOverTheInterval) {
     for (double t = 0.5; t <= 2.5; t += 0.05) {
         fx.update(t);
         b.begin(cam);
-        fx.emit(b, mat);
+        fx.emit(b, mat, {.textured = false});
         for (const Splat& s : b.splats())
             for (float su : {-1.0f, 1.0f})
                 for (float sv : {-1.0f, 1.0f}) {
@@ -284,7 +284,7 @@ TEST(ParticleEffect, ZeroLifetimeIsNeverAliveAndNeverDividesByIt) {
     none.update(3.0);
     SplatBuilder b;
     b.begin(Camera::lookAt({0, 1, 5}, {0, 1, 0}, {0, 1, 0}, 0.9f, {64, 48}));
-    EXPECT_EQ(none.emit(b, mat), 0u);
+    EXPECT_EQ(none.emit(b, mat, {.textured = false}), 0u);
     EXPECT_FALSE(none.alive(3.0, {}));
     EXPECT_TRUE(none.bounds(0, 10).empty());
     EXPECT_EQ(none.costCells(), 0u);
@@ -301,7 +301,7 @@ TEST(ParticleEffect, AStepFiftyLifetimesLongIsTheFrameEvaluatedDirectly) {
     SplatBuilder b1, b2;
     b1.begin(Camera::lookAt({0, 1, 5}, {0, 1, 0}, {0, 1, 0}, 0.9f, {64, 48}));
     b2.begin(b1.camera());
-    ASSERT_EQ(stepped.emit(b1, mat), direct.emit(b2, mat));
+    ASSERT_EQ(stepped.emit(b1, mat, {.textured = false}), direct.emit(b2, mat, {.textured = false}));
     ASSERT_GT(b1.splats().size(), 3u);
     for (std::size_t i = 0; i < b1.splats().size(); ++i) EXPECT_EQ(b1.splats()[i].center, b2.splats()[i].center);
 }
@@ -317,7 +317,7 @@ TEST(ParticleEffect, ObjectDynamicsOffFreezesTheParticlesAtTimeZero) {
     const Camera cam = Camera::lookAt({0, 1, 5}, {0, 1, 0}, {0, 1, 0}, 0.9f, {64, 48});
     SplatBuilder b0, b1;
     b0.begin(cam), b1.begin(cam);
-    ASSERT_EQ(fx.emit(b0, mat), still.emit(b1, mat)) << "object dynamics off: the particles of t = 0";
+    ASSERT_EQ(fx.emit(b0, mat, {.textured = false}), still.emit(b1, mat, {.textured = false})) << "object dynamics off: the particles of t = 0";
     ASSERT_GT(b0.splats().size(), 10u);
     for (std::size_t i = 0; i < b0.splats().size(); ++i) EXPECT_EQ(b0.splats()[i].center, b1.splats()[i].center);
 }
@@ -336,7 +336,7 @@ TEST(ParticleEffect, HostParticlesAreDrawnBoundedAndOnlyAParticleEffectTakesThem
     EXPECT_FALSE(box.contains({-2, 3, 1})) << "a particle the builder drops must not widen the bounds";
     SplatBuilder b;
     b.begin(Camera::lookAt({0, 1, 10}, {0, 1, 0}, {0, 1, 0}, 1.2f, {64, 48}));
-    EXPECT_EQ(fx.emit(b, mat), 1u);
+    EXPECT_EQ(fx.emit(b, mat, {.textured = false}), 1u);
     EXPECT_EQ(b.stats().rejected, 1u);
     Effect grid = *Effect::fromGrid(*Grid::box({2, 2, 2}), {});
     const Status s = grid.setParticles(host);

@@ -113,9 +113,9 @@ std::size_t EffectBody::emit(SplatBuilder& builder, const Materials& materials, 
     const std::size_t before = builder.splats().size();
     for (std::size_t i = 0; i < layers.size(); ++i) {
         SplatStyle style = layers[i].style;
+        style.textured = style.textured && options.textured;
         assert((!style.textured || style.textureSet < materials.setCount()) && "Effect::emit: layer texture set not in materials");
         assert(style.colorTable < materials.colorTableCount() && "Effect::emit: layer colour table not in materials");
-        style.textured = style.textured && options.textured;
         style.opacityScale *= options.opacityScale;
         builder.add(layerGrids[i], materials, style);
     }

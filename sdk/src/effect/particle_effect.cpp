@@ -73,8 +73,8 @@ public:
                "Effect::emit: the materials' footprint is wider than EffectDesc::footprintRadius; bounds() would be wrong");
         const std::size_t before = builder.splats().size();
         ParticleStyle style{.splat = layers[0].style, .stretchPerSpeed = mEmitter.desc().stretchPerSpeed, .maxStretch = mEmitter.desc().maxStretch};
-        assert((!style.splat.textured || style.splat.textureSet < materials.setCount()) && "Effect::emit: texture set not in materials");
         style.splat.textured = style.splat.textured && options.textured;
+        assert((!style.splat.textured || style.splat.textureSet < materials.setCount()) && "Effect::emit: texture set not in materials");
         style.splat.opacityScale *= options.opacityScale;
         builder.add(mParticles, materials, style);
         builder.add(mHost, materials, style);
