@@ -95,7 +95,9 @@ struct ParticleEmitterDesc {
 inline constexpr std::uint32_t kMaxParticles = 1u << 24;
 
 // The message naming the first bad field of d ("ratePerSec must be finite and
-// >= 0, got -1"), or empty. `field` prefixes the names.
+// >= 0, got -1"), a flight reaching more than 1e18 world units from the
+// origin (float positions), or a budget exceeded; empty when d is valid.
+// `field` prefixes the names.
 std::string checkParticleEmitter(const ParticleEmitterDesc& d, const std::string& field = "");
 
 class ParticleEmitter {

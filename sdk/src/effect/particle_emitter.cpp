@@ -17,6 +17,11 @@ namespace {
 
 constexpr std::uint32_t kParticleSalt = 0x9a71c1e5u; // apart from the other hashes of the same seed
 
+// Farthest a particle may fly from the emitter's origin (checkParticleEmitter):
+// a float position whose squared distance (the splat builder's) stays finite
+// (3 * 10^36 < FLT_MAX), instead of infinite centres and bounds.
+constexpr double kMaxReach = 1e18;
+
 // kMaxTimeSec (effect_kind.hpp): no later time is evaluated by a Scene.
 constexpr double kLatestSec = 262144.0;
 
@@ -90,12 +95,25 @@ std::string checkParticleEmitter(const ParticleEmitterDesc& d, const std::string
     if (!(d.stretchPerSpeed >= 0.0f) || !std::isfinite(d.stretchPerSpeed))
         return f + "stretchPerSpeed must be finite and >= 0, got " + num(d.stretchPerSpeed);
     if (!(d.maxStretch >= 0.0f) || !std::isfinite(d.maxStretch)) return f + "maxStretch must be finite and >= 0, got " + num(d.maxStretch);
+    // The flight's reach per axis stays well inside float range (positions are
+    // floats; the splat builder squares them): at most kMaxReach from the origin.
+    {
+        const double g = flightG(d.dragPerSec, d.lifetimeSec), h = flightH(d.dragPerSec, d.lifetimeSec);
+        const glm::dvec3 drift = glm::abs(glm::dvec3(d.acceleration) + double(d.dragPerSec) * glm::dvec3(d.wind));
+        const glm::dvec3 reach = glm::abs(glm::dvec3(d.position)) + glm::dvec3(d.halfExtent) +
+                                 (glm::abs(glm::dvec3(d.velocity)) + glm::dvec3(d.velocitySpread)) * g + drift * h;
+        const double most = std::max({reach.x, reach.y, reach.z});
+        if (!(most <= kMaxReach))
+            return f + "velocity, acceleration and lifetimeSec reach " + num(most) + " world units from the origin, past " + num(kMaxReach) +
+                   " (float positions); lower them";
+    }
     if (d.maxParticles > kMaxParticles)
         return f + "maxParticles must be at most " + std::to_string(kMaxParticles) + ", got " + std::to_string(d.maxParticles);
     // The budget: at most ceil(rate * lifetime) slots are alive at once (births are 1 / rate apart).
     const double alive = std::ceil(double(d.ratePerSec) * double(d.lifetimeSec));
     if (alive > double(d.maxParticles))
-        return f + "ratePerSec * lifetimeSec = " + num(alive) + " particles alive at once exceeds maxParticles = " + std::to_string(d.maxParticles) +
+        return f + "ratePerSec * lifetimeSec = " + (alive < 1e15 ? std::to_string(std::uint64_t(alive)) : num(alive)) +
+               " particles alive at once exceeds maxParticles = " + std::to_string(d.maxParticles) +
                "; lower the rate or the lifetime, or raise maxParticles (at most " + std::to_string(kMaxParticles) + ")";
     return {};
 }
