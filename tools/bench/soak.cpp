@@ -60,6 +60,26 @@ std::string firstNonFinite(const splatfx::Effect& e) {
     return "";
 }
 
+// A particle effect's splats now (its grid holds no voxels): the first
+// non-finite one, or "". The camera looks at the effect's bounds from afar so
+// every particle is in view and none is culled.
+std::string firstNonFiniteSplat(const splatfx::Effect& e, const splatfx::Materials& materials, splatfx::SplatBuilder& builder) {
+    const splatfx::Aabb b = e.bounds(e.time(), e.time());
+    if (b.empty()) return "";
+    if (!finite3(b.lo) || !finite3(b.hi)) return "bounds";
+    const glm::vec3 c = 0.5f * (b.lo + b.hi);
+    const float r = std::max(glm::length(b.hi - b.lo), 1.0f);
+    builder.begin(splatfx::Camera::lookAt(c + glm::vec3(0.0f, 0.3f * r, 2.0f * r), c, {0, 1, 0}, 1.2f, {320, 240}, 0.1f * r, 10.0f * r));
+    e.emit(builder, materials);
+    for (std::size_t i = 0; i < builder.splats().size(); ++i) {
+        const splatfx::Splat& s = builder.splats()[i];
+        if (!finite3(s.center) || !finite3(s.axisU) || !finite3(s.axisV) || !std::isfinite(s.density) || !std::isfinite(s.colorCoord) ||
+            !std::isfinite(s.depth))
+            return "splat " + std::to_string(i);
+    }
+    return "";
+}
+
 struct Preset {
     const char* name;
     std::function<splatfx::Result<splatfx::Effect>(splatfx::Materials&)> make;
@@ -265,8 +285,8 @@ bool soakScenes(double minutes, double fps) {
 int runSoak(int argc, char** argv) {
     double minutes = 60.0;
     std::string only;
-    CLI::App app{"Steps every preset (fire, smoke, steam, dust, fireToSmoke, ghosts) at 60 Hz for M minutes of scene time (default 60:\n"
-                 "216000 steps each), checking every step for NaN/Inf in the grids and solver fields, and that Effect::bounds and the\n"
+    CLI::App app{"Steps every preset (fire, smoke, steam, dust, fireToSmoke, ghosts, embers) at 60 Hz for M minutes of scene time (default 60:\n"
+                 "216000 steps each), checking every step for NaN/Inf in the grids and solver fields (embers: its splats), and that Effect::bounds and the\n"
                  "resident memory (/proc/self/statm) stay flat; then a lit gas, a lit fireToSmoke with the scene shadow, LOD clouds and\n"
                  "LOD ground fog through Scene::prepare at --scene-fps with an orbiting camera: every splat, tetrahedron and shadow\n"
                  "value finite, no lighting error, memory flat. Exit 1 on any failure.",
@@ -287,11 +307,12 @@ int runSoak(int argc, char** argv) {
         {"dust", [](splatfx::Materials& m) { return P::dust(m); }},
         {"fireToSmoke", [](splatfx::Materials& m) { return P::fireToSmoke(m); }},
         {"ghosts", [](splatfx::Materials& m) { return P::ghosts(m); }},
+        {"embers", [](splatfx::Materials& m) { return P::embers(m); }},
     };
     bool known = only.empty();
     for (const Preset& p : presets) known = known || only == p.name;
     if (!known) {
-        std::fprintf(stderr, "soak: --preset must be fire, smoke, steam, dust, fireToSmoke or ghosts, got '%s'\n", only.c_str());
+        std::fprintf(stderr, "soak: --preset must be fire, smoke, steam, dust, fireToSmoke, ghosts or embers, got '%s'\n", only.c_str());
         return 2;
     }
 
@@ -315,11 +336,14 @@ int runSoak(int argc, char** argv) {
                 return 1;
             }
             splatfx::Effect& e = *made;
+            // A particle effect (embers) holds no voxels: its splats are checked instead.
+            const bool particles = e.grid().voxels.empty() && !e.solver() && e.isStateless();
+            splatfx::SplatBuilder builder;
             const auto start = Clock::now();
             for (long long k = 1; k <= steps; ++k) {
                 e.step(dt);
                 if (o.nonFinite.empty()) {
-                    o.nonFinite = firstNonFinite(e);
+                    o.nonFinite = particles ? firstNonFiniteSplat(e, materials, builder) : firstNonFinite(e);
                     if (!o.nonFinite.empty()) o.nonFiniteAtSec = e.time();
                 }
                 const bool inFirst = k <= tenth, inLast = k > steps - tenth;
@@ -328,7 +352,7 @@ int runSoak(int argc, char** argv) {
                     (inFirst ? o.firstBox : o.lastBox).extend(b);
                     std::size_t& vox = inFirst ? o.voxelsFirst : o.voxelsLast;
                     double& mass = inFirst ? o.massFirst : o.massLast;
-                    vox = std::max(vox, e.grid().voxels.size());
+                    vox = std::max(vox, particles ? builder.splats().size() : e.grid().voxels.size()); // embers: splats drawn
                     if (e.solver()) mass = std::max(mass, e.solver()->totalDensity());
                     if (inFirst && inLast) o.lastBox.extend(b); // runs shorter than 10 steps
                 }
@@ -358,7 +382,7 @@ int runSoak(int argc, char** argv) {
 
     if (!out.empty())
         std::printf("\n| preset | steps | scene time | wall s | us/step | NaN/Inf | bounds extent, first 10%% -> last 10%% | RSS MiB, at max(10%%, 30 s) -> end | "
-                "max voxels, first -> last 10%% | max solver density sum | verdict |\n"
+                "max voxels (embers: splats), first -> last 10%% | max solver density sum | verdict |\n"
                 "|---|---:|---:|---:|---:|---|---|---|---|---|---|\n");
     bool ok = true;
     for (const Outcome& o : out) {
