@@ -319,9 +319,9 @@ TEST(Presets, GhostsUseFaces) {
 
 TEST(Presets, BadVariationIsNamed) {
     Materials m(Footprint{});
-    auto bad = presets::fire(m, {.variation = {.jitter = 0.7f}});
+    auto bad = presets::fire(m, {.variation = {.jitter = 1.2f}});
     ASSERT_FALSE(bad);
-    EXPECT_EQ(bad.error(), "FireDesc.variation.jitter must be in [0, 0.5], got 0.700000");
+    EXPECT_EQ(bad.error(), "FireDesc.variation.jitter must be in [0, 1], got 1.200000");
     auto ghosts = presets::ghosts(m, {.variation = {.scaleLog2 = 2.0f}});
     ASSERT_FALSE(ghosts);
     EXPECT_EQ(ghosts.error(), "GhostsDesc.variation.scaleLog2 must be in [0, 1], got 2.000000");

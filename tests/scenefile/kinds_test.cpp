@@ -157,7 +157,7 @@ TEST(SceneFileKinds, EveryKindTakesAVariationAndDefaultsToTheRecommendedOne) {
 }
 
 TEST(SceneFileKinds, ABadVariationIsNamed) {
-    auto r = parse(R"("effects": [{"kind": "fire", "variation": {"jitter": 0.8, "rotationDeg": -5, "wobble": 1}}])");
+    auto r = parse(R"("effects": [{"kind": "fire", "variation": {"jitter": 1.5, "rotationDeg": -5, "wobble": 1}}])");
     ASSERT_FALSE(r);
     EXPECT_NE(r.error().find("effects[0].variation.jitter"), std::string::npos) << r.error();
     EXPECT_NE(r.error().find("effects[0].variation.rotationDeg"), std::string::npos) << r.error();

@@ -387,7 +387,7 @@ TEST(SplatVariation, JitterStaysInTheCellAndScaleKeepsTheMaterial) {
 }
 
 TEST(SplatVariation, OutOfRangeFieldsAreNamed) {
-    EXPECT_EQ(checkSplatVariation({.jitter = 0.7f}), "variation.jitter must be in [0, 0.5], got 0.700000");
+    EXPECT_EQ(checkSplatVariation({.jitter = 1.2f}), "variation.jitter must be in [0, 1], got 1.200000");
     EXPECT_EQ(checkSplatVariation({.rotationRad = -1.0f}, "style."), "style.rotationRad must be in [0, 3.14159], got -1.000000");
     EXPECT_EQ(checkSplatVariation({.scaleLog2 = std::nanf("")}), "variation.scaleLog2 must be in [0, 1], got nan");
     EXPECT_EQ(checkSplatVariation(SplatVariation::recommended(1)), "");

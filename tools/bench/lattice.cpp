@@ -14,6 +14,8 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include <epoxy/gl.h>
@@ -23,6 +25,7 @@
 #include "lattice_measure.hpp"
 #include "options.hpp"
 #include "splatfx/context.hpp"
+#include "splatfx/reference.hpp"
 #include "splatfx/splatfx.hpp"
 
 namespace {
@@ -44,7 +47,8 @@ const Sample kSamples[] = {
     {"photo-fire", "samples/25-photo-fire/scene.json"},
 };
 
-// "none", "default" or a list like "jitter=0.5,rotation=180,mirror,scale=0.3".
+// "none", "default" or a list like "jitter=0.5,rotation=180,mirror,scale=0.3"
+// (seed=N adds N to every effect's own variation seed: another realisation).
 splatfx::Status parseVariation(const std::string& text, std::optional<splatfx::SplatVariation>& out) {
     if (text == "default") {
         out.reset();
@@ -62,16 +66,19 @@ splatfx::Status parseVariation(const std::string& text, std::optional<splatfx::S
             auto number = [&](double lo, double hi) { return cli::parseReal("--variation " + key, value, lo, hi, x); };
             if (key == "mirror" && value.empty()) v.mirror = true;
             else if (key == "jitter") {
-                if (auto s = number(0.0, 0.5); !s) return s;
+                if (auto s = number(0.0, splatfx::SplatVariation::kMaxJitter); !s) return s;
                 v.jitter = float(x);
             } else if (key == "rotation") {
                 if (auto s = number(0.0, 180.0); !s) return s;
                 v.rotationRad = float(x * 3.14159265358979 / 180.0);
+            } else if (key == "seed") {
+                if (auto s = number(0.0, 1e6); !s) return s;
+                v.seed = std::uint32_t(x);
             } else if (key == "scale") {
                 if (auto s = number(0.0, 1.0); !s) return s;
                 v.scaleLog2 = float(x);
             } else {
-                return splatfx::makeError("--variation expects none, default or a list of jitter=X, rotation=DEG, mirror, scale=X, got '" + text + "'");
+                return splatfx::makeError("--variation expects none, default or a list of jitter=X, rotation=DEG, mirror, scale=X, seed=N, got '" + text + "'");
             }
         }
     }
@@ -108,7 +115,7 @@ splatfx::Result<std::unique_ptr<Loaded>> load(const Sample& s, const std::option
         for (splatfx::EffectId id : l->effects)
             if (splatfx::Effect* e = l->scene().findEffect(id)) {
                 splatfx::SplatVariation v = *variation;
-                v.seed = e->layer(0).style.variation.seed; // keep each effect's own seed
+                v.seed = e->layer(0).style.variation.seed + variation->seed; // each effect's own seed (seed=N: another realisation)
                 if (auto st = e->setSplatVariation(v); !st) return splatfx::makeError(st.error());
             }
     return l;
@@ -164,7 +171,20 @@ struct Row {
     float periodPx = 0.0f;
     int frames = 0;
     std::string probes;
+    double rmse = -1.0, maxErr = -1.0; // --error: the GL frame against the splat-exact reference
 };
+
+// RGB RMSE and largest difference of two images of one size.
+std::pair<double, double> rgbError(const splatfx::Image& a, const splatfx::Image& b) {
+    double sum = 0.0, worst = 0.0;
+    for (int y = 0; y < a.height; ++y)
+        for (int x = 0; x < a.width; ++x)
+            for (int c = 0; c < 3; ++c) {
+                const double d = double(a.at(x, y, c)) - double(b.at(x, y, c));
+                sum += d * d, worst = std::max(worst, std::abs(d));
+            }
+    return {std::sqrt(sum / double(std::max(1, a.width * a.height * 3))), worst};
+}
 
 } // namespace
 
@@ -176,7 +196,7 @@ int runLattice(int argc, char** argv) {
     float fps = 24.0f;
     std::string variationText = "default";
     std::vector<std::string> only;
-    bool verbose = false;
+    bool verbose = false, error = false;
     cli::addNumber(app, "--frames", frames, 4, 10000, "frames per sample");
     cli::addNumber(app, "--fps", fps, 1.0f, 1000.0f, "frames per second of animation time");
     cli::addNumber(app, "--controls", controls, 1, 64, "turbulence seeds of the control (its range)");
@@ -188,6 +208,7 @@ int runLattice(int argc, char** argv) {
     app.add_option("--sample", only, "only these samples (campfire, cow-through-fire, herd-dust, teapot-steam, locomotive-smoke, ghosts, "
                                      "chess-fog, sunlit-smoke, vdb-smoke, photo-fire); default all");
     app.add_flag("--verbose", verbose, "every probe's ratio");
+    app.add_flag("--error", error, "also the middle frame's RGB error against the splat-exact reference (renderSplatExact of the same splats)");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     std::optional<splatfx::SplatVariation> variation;
     if (auto s = parseVariation(variationText, variation); !s) {
@@ -240,6 +261,7 @@ int runLattice(int argc, char** argv) {
         for (int c = 0; c < controls; ++c) noise.emplace_back(glm::ivec2(width, height), 2.5f, std::uint32_t(c + 1));
         std::optional<lattice::Basis> basis;
         int used = 0;
+        double errorRmse = -1.0, errorMax = -1.0;
         for (int f = 0; f < frames; ++f) {
             const double t = f / double(fps);
             const splatfx::Camera cam = L.camera(t, {width, height});
@@ -249,6 +271,14 @@ int runLattice(int argc, char** argv) {
                 break;
             }
             fr->render(frame, bench::clearedTarget(*fb, {0.0f, 0.0f, 0.0f, 1.0f}));
+            if (error && f == frames / 2) {
+                auto ref = splatfx::renderSplatExact(frame.splats(), cam, L.materials);
+                if (!ref) {
+                    std::fprintf(stderr, "lattice: %s: %s\n", s.name, ref.error().c_str());
+                    return 1;
+                }
+                std::tie(errorRmse, errorMax) = rgbError(fb->read(), *ref);
+            }
             const std::optional<lattice::Basis> b = basisOf(L, cam);
             if (!b || b->probes().empty()) continue; // nothing drawn yet (a smoke before it rises)
             if (!basis) basis = b;
@@ -275,7 +305,7 @@ int runLattice(int argc, char** argv) {
         }
         // The last frame's basis scores the averages (the cameras of these samples move little in 2 s).
         const lattice::Score m = measured.score(*basis);
-        Row r{s.name, m.ratio, 1e30, 0.0, basis->probes().empty() ? 0.0f : 1.0f / glm::length(basis->probes()[0].frequency), used, ""};
+        Row r{s.name, m.ratio, 1e30, 0.0, basis->probes().empty() ? 0.0f : 1.0f / glm::length(basis->probes()[0].frequency), used, "", errorRmse, errorMax};
         for (const lattice::Accumulator& c : control) {
             const double v = c.score(*basis).ratio;
             r.controlLo = std::min(r.controlLo, v), r.controlHi = std::max(r.controlHi, v);
@@ -291,10 +321,14 @@ int runLattice(int argc, char** argv) {
         rows.push_back(r);
     }
 
-    std::printf("\n%-17s %8s %15s %10s %7s  %s\n", "sample", "measure", "control range", "period px", "frames", "verdict");
-    for (const Row& r : rows)
-        std::printf("%-17s %8.2f %7.2f-%-7.2f %10.1f %7d  %s\n", r.name.c_str(), r.measure, r.controlLo, r.controlHi, double(r.periodPx), r.frames,
-                    r.measure <= r.controlHi ? "invisible (within the control)" : "VISIBLE (above the control)");
+    std::printf("\n%-17s %8s %15s %10s %7s  %-31s%s\n", "sample", "measure", "control range", "period px", "frames", "verdict",
+                error ? "  RMSE / max vs exact (middle frame)" : "");
+    for (const Row& r : rows) {
+        char err[64] = "";
+        if (error) std::snprintf(err, sizeof err, "  %.5f / %.4f", r.rmse, r.maxErr);
+        std::printf("%-17s %8.2f %7.2f-%-7.2f %10.1f %7d  %-31s%s\n", r.name.c_str(), r.measure, r.controlLo, r.controlHi, double(r.periodPx), r.frames,
+                    r.measure <= r.controlHi ? "invisible (within the control)" : "VISIBLE (above the control)", err);
+    }
     std::printf("\nmeasure: the largest, over the lattice's frequencies (fundamentals, diagonals, second harmonics), of the mean\n"
                 "power within 8 %% of the frequency over the mean power of the ring at that frequency (spectra of the\n"
                 "high-passed, flame-masked luminance averaged over the frames); control: the same for animated turbulence.\n");

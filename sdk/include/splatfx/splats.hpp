@@ -83,10 +83,11 @@ float splatRayScale(const Splat& splat, float footprintRadius);
 // The zero value is the paper's lattice; presets use recommended().
 struct SplatVariation {
     // The splat centre moves by up to +-jitter cells along each lattice axis
-    // (uniform, per voxel). [0, 0.5]; default 0. At 0.5 the centres are
-    // uniform over their cells, and the expected lattice sum has no
-    // component at the lattice's frequencies.
+    // (uniform, per voxel). [0, kMaxJitter]; default 0. At 0.5 the centres
+    // are uniform over their cells, and the expected lattice sum has no
+    // component at the lattice's frequencies (nor at 1: uniform over two).
     float jitter = 0.0f;
+    static constexpr float kMaxJitter = 1.0f;
     // The texture turns about the splat's centre by an angle uniform in
     // +-rotationRad (the footprint is radial, so only the texture turns).
     // [0, pi]; default 0. pi: any orientation (isotropic turbulence); small
@@ -129,7 +130,7 @@ struct ParticleStyle {
 };
 
 // The message naming the first out-of-range field of v ("jitter must be in
-// [0, 0.5], got 0.7"), or empty when v is valid. `field` prefixes the name.
+// [0, 1], got 1.2"), or empty when v is valid. `field` prefixes the name.
 std::string checkSplatVariation(const SplatVariation& v, const std::string& field = "variation.");
 
 enum class SortMode {

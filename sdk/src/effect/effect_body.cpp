@@ -140,7 +140,7 @@ Aabb EffectBody::withSplatExtent(const Aabb& world, float motionScale, const glm
     float maxScale = 1.0f, jitter = 0.0f;
     for (const EffectLayer& l : layers) {
         maxScale = std::max(maxScale, std::exp2(std::clamp(l.style.variation.scaleLog2, 0.0f, 1.0f)));
-        jitter = std::max(jitter, std::clamp(l.style.variation.jitter, 0.0f, 0.5f));
+        jitter = std::max(jitter, std::clamp(l.style.variation.jitter, 0.0f, SplatVariation::kMaxJitter));
     }
     const float extent = motionScale * (desc.footprintRadius * maxScale * kernelNormBound(transform, spacing, maxStretch) +
                                         jitter * 1.7320508f * kernelNormBound(transform, spacing, 0.0f));

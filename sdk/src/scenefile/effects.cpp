@@ -50,7 +50,7 @@ void readEffects(Context& c, const std::string& path, const Json& v, const std::
         variation.seed = hash32(e.seed ^ 0x51a7u);
         if (const Json* va = o.get("variation")) {
             ObjectReader vo(c.d, o.at("variation"), *va);
-            vo.number("jitter", variation.jitter, 0.0, 0.5);
+            vo.number("jitter", variation.jitter, 0.0, SplatVariation::kMaxJitter);
             float rotationDeg = variation.rotationRad * 57.2957795f;
             vo.number("rotationDeg", rotationDeg, 0.0, 180.0);
             variation.rotationRad = std::min(rotationDeg * 0.0174532925f, 3.14159265f);

@@ -126,7 +126,7 @@ VariationDraw drawVariation(const SplatVariation& var, glm::ivec3 cell) {
 SplatVariation sanitized(const SplatVariation& v) {
     assert(checkSplatVariation(v).empty() && "SplatBuilder::add: style.variation out of range (checkSplatVariation)");
     SplatVariation s = v;
-    s.jitter = std::isfinite(v.jitter) ? std::clamp(v.jitter, 0.0f, 0.5f) : 0.0f;
+    s.jitter = std::isfinite(v.jitter) ? std::clamp(v.jitter, 0.0f, SplatVariation::kMaxJitter) : 0.0f;
     s.rotationRad = std::isfinite(v.rotationRad) ? std::clamp(v.rotationRad, 0.0f, 3.14159265f) : 0.0f;
     s.scaleLog2 = std::isfinite(v.scaleLog2) ? std::clamp(v.scaleLog2, 0.0f, 1.0f) : 0.0f;
     return s;
@@ -285,7 +285,7 @@ std::string checkSplatVariation(const SplatVariation& v, const std::string& fiel
         std::snprintf(bound, sizeof bound, "%g", double(hi));
         return x >= 0.0f && x <= hi ? std::string() : field + name + " must be in [0, " + bound + "], got " + std::to_string(x);
     };
-    for (std::string e : {range("jitter", v.jitter, 0.5f), range("rotationRad", v.rotationRad, 3.14159265f), range("scaleLog2", v.scaleLog2, 1.0f)})
+    for (std::string e : {range("jitter", v.jitter, SplatVariation::kMaxJitter), range("rotationRad", v.rotationRad, 3.14159265f), range("scaleLog2", v.scaleLog2, 1.0f)})
         if (!e.empty()) return e;
     return {};
 }
