@@ -13,6 +13,8 @@
 // Stateful (positions are integrated step by step) and deterministic: the same
 // emitter, solver states and times give the same particles, bit for bit.
 // Outside the solver's grid a particle sees the nearest boundary's velocity.
+// Particles are matched between advances by id, so births must stay below
+// 2^32 slots (ids are then the slot indices: 1000 a second for 49 days).
 // Draw them through an Effect::fromParticles with ratePerSec 0
 // (Effect::setParticles) or SplatBuilder::add.
 //
