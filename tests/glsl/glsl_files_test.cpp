@@ -62,6 +62,25 @@ TEST(GlslFiles, AMissingFileIsNamed) {
     EXPECT_NE(stages.error().find("fog pass [MODE=0]: needs the fog's GLSL"), std::string::npos) << stages.error();
 }
 
+// The build compiles exactly forEachVariant's list with glslangValidator (warnings fail it too), so a
+// pass asking for any other variant would reach a driver unchecked: programSources refuses it.
+TEST(GlslFiles, AVariantTheBuildDoesNotCheckIsRefused) {
+    const glsl::ProgramKey outside{glsl::ProgramId::FogPass, {7}, 0}; // MODE takes 0, 1, 2
+    EXPECT_FALSE(glsl::isCheckedVariant(outside));
+    auto stages = glsl::programSources(outside, {.fog = "x"});
+    ASSERT_FALSE(stages);
+    EXPECT_NE(stages.error().find("fog pass [MODE=7]: not among the variants the build checks"), std::string::npos) << stages.error();
+    // A value for a define the program does not have.
+    EXPECT_FALSE(glsl::isCheckedVariant({glsl::ProgramId::DepthSample, {1}, 0}));
+    int listed = 0;
+    for (int p = 0; p < int(glsl::ProgramId::Count); ++p)
+        glsl::forEachVariant(glsl::ProgramId(p), [&](const std::array<int, glsl::kMaxDefines>& values) {
+            EXPECT_TRUE(glsl::isCheckedVariant({glsl::ProgramId(p), values, 0}));
+            ++listed;
+        });
+    EXPECT_EQ(listed, 42 + 18 + 8 + 3 + 22 + 8);
+}
+
 TEST(GlslFiles, SubstituteReplacesWholeWordsOnly) { EXPECT_EQ(glsl::substitute("A A_B xA A", {{"A", "1"}}), "1 A_B xA 1"); }
 
 TEST(GlslFiles, TheHostIncludesAreTheFilesText) {

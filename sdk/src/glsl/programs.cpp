@@ -1,6 +1,8 @@
 // The GL backend's programs as data (programs.hpp).
 #include "glsl/programs.hpp"
 
+#include <algorithm>
+
 #include "glsl/glsl_files.hpp"
 
 namespace splatfx::glsl {
@@ -130,8 +132,26 @@ std::string variantName(const ProgramKey& key) {
     return s + "]";
 }
 
+bool isCheckedVariant(const ProgramKey& key) {
+    const ProgramDesc& d = programDesc(key.id);
+    for (int i = 0; i < kMaxDefines; ++i) {
+        const int v = key.values[std::size_t(i)];
+        if (!d.defines[std::size_t(i)]) {
+            if (v != 0) return false; // a value for a define the program does not have
+            continue;
+        }
+        const auto& allowed = d.values[std::size_t(i)];
+        if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) return false;
+    }
+    return !d.valid || d.valid(key.values);
+}
+
 Result<std::vector<StageSource>> programSources(const ProgramKey& key, const ProgramData& data) {
     const ProgramDesc& d = programDesc(key.id);
+    // Only the variants the build's glslangValidator step compiled (forEachVariant) may reach a
+    // driver: a pass asking for another is a bug, named here rather than compiled unchecked.
+    if (!isCheckedVariant(key))
+        return makeError(variantName(key) + ": not among the variants the build checks with glslangValidator (glsl/programs.cpp's values)");
     std::string head = "#version 450 core\n";
     for (int i = 0; i < kMaxDefines && d.defines[std::size_t(i)]; ++i)
         head += std::string("#define ") + d.defines[std::size_t(i)] + " " + std::to_string(key.values[std::size_t(i)]) + "\n";
