@@ -80,14 +80,17 @@ bundle_step() {
   command -v cmake >/dev/null || die "cmake not found: the bundle half needs the build machine's packages (tools/setup-deps.sh)"
   command -v ldd >/dev/null || die "ldd not found"
   echo "gpu-check: configuring $build (Release, RPATH \$ORIGIN/../lib)"
+  mkdir -p "$build"
   # DT_RPATH (not RUNPATH): the loader then searches it for the libraries' own
   # dependencies too, which Debian's libraries look up without a path of their own.
-  cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release -DSPLATFX_BUILD_TESTS=ON -DSPLATFX_BUILD_TOOLS=ON -DSPLATFX_BUILD_SAMPLES=OFF \
-    '-DCMAKE_BUILD_RPATH=$ORIGIN/../lib' -DCMAKE_EXE_LINKER_FLAGS=-Wl,--disable-new-dtags >"$build.configure.log" 2>&1 ||
-    { tail -30 "$build.configure.log"; die "configure failed (log: $build.configure.log)"; }
+  local launcher=()
+  if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache); fi
+  cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release -DSPLATFX_BUILD_TESTS=ON -DSPLATFX_BUILD_TOOLS=ON "${launcher[@]}" \
+    '-DCMAKE_BUILD_RPATH=$ORIGIN/../lib' -DCMAKE_EXE_LINKER_FLAGS=-Wl,--disable-new-dtags >"$build/gpu-check-configure.log" 2>&1 ||
+    { tail -30 "$build/gpu-check-configure.log"; die "configure failed (log: $build/gpu-check-configure.log)"; }
   echo "gpu-check: building splatfx-bench, egl_probe and ${#test_list[@]} GL test binaries"
-  cmake --build "$build" -j "$jobs" --target splatfx-bench egl_probe "${test_list[@]}" >"$build.build.log" 2>&1 ||
-    { tail -30 "$build.build.log"; die "build failed (log: $build.build.log)"; }
+  cmake --build "$build" -j "$jobs" --target splatfx-bench egl_probe "${test_list[@]}" >"$build/gpu-check-build.log" 2>&1 ||
+    { tail -30 "$build/gpu-check-build.log"; die "build failed (log: $build/gpu-check-build.log)"; }
   rm -rf "$bundle"
   mkdir -p "$bundle/bin" "$bundle/lib"
   local exe

@@ -33,7 +33,8 @@ TEST(Context, HeadlessContextGivesOpenGL45) {
 TEST(ContextBadInput, NoEglDisplayIsAClearError) {
     // Point glvnd at no vendor library: EGL then has no display to offer, as on
     // a machine without Mesa's EGL or a GPU driver.
-    const std::string out = run({probe()}, {"__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent/egl_vendor.json"});
+    // SPLATFX_EGL_DEVICE emptied: the default choice even under tools/gpu-check.sh (which sets it).
+    const std::string out = run({probe()}, {"__EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent/egl_vendor.json", "SPLATFX_EGL_DEVICE="});
     EXPECT_NE(out.find("error: no EGL display"), std::string::npos) << out;
     EXPECT_NE(out.find("Install Mesa's EGL"), std::string::npos) << out;
 }
