@@ -81,12 +81,15 @@ bundle_step() {
   command -v ldd >/dev/null || die "ldd not found"
   echo "gpu-check: configuring $build (Release, RPATH \$ORIGIN/../lib)"
   mkdir -p "$build"
-  # DT_RPATH (not RUNPATH): the loader then searches it for the libraries' own
-  # dependencies too, which Debian's libraries look up without a path of their own.
+  # The install RPATH, linked in as it is (a build RPATH is padded with empty entries, which
+  # the loader reads as the current folder), as DT_RPATH (not RUNPATH): the loader then
+  # searches it for the libraries' own dependencies too, which Debian's libraries look up
+  # without a path of their own. The binaries then find no build-tree shared library
+  # (splatfx_c): the bundle needs none.
   local launcher=()
   if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache); fi
   cmake -S "$repo" -B "$build" -DCMAKE_BUILD_TYPE=Release -DSPLATFX_BUILD_TESTS=ON -DSPLATFX_BUILD_TOOLS=ON "${launcher[@]}" \
-    '-DCMAKE_BUILD_RPATH=$ORIGIN/../lib' -DCMAKE_EXE_LINKER_FLAGS=-Wl,--disable-new-dtags >"$build/gpu-check-configure.log" 2>&1 ||
+    -DCMAKE_BUILD_WITH_INSTALL_RPATH=ON '-DCMAKE_INSTALL_RPATH=$ORIGIN/../lib' -DCMAKE_EXE_LINKER_FLAGS=-Wl,--disable-new-dtags >"$build/gpu-check-configure.log" 2>&1 ||
     { tail -30 "$build/gpu-check-configure.log"; die "configure failed (log: $build/gpu-check-configure.log)"; }
   echo "gpu-check: building splatfx-bench, egl_probe and ${#test_list[@]} GL test binaries"
   cmake --build "$build" -j "$jobs" --target splatfx-bench egl_probe "${test_list[@]}" >"$build/gpu-check-build.log" 2>&1 ||
@@ -109,8 +112,8 @@ bundle_step() {
   local missing
   missing="$(for f in "$bundle"/bin/*; do ldd "$f"; done | grep 'not found' | sort -u || true)"
   [[ -z "$missing" ]] || die "libraries not found while bundling:\n$missing"
-  if ! readelf -d "$bundle/bin/splatfx-bench" | grep -q 'RPATH.*\$ORIGIN/../lib'; then
-    die "splatfx-bench has no RPATH \$ORIGIN/../lib (readelf -d): the bundle would not find its libraries"
+  if ! readelf -d "$bundle/bin/splatfx-bench" | grep -q 'RPATH.*\[\$ORIGIN/../lib\]'; then
+    die "splatfx-bench's RPATH is not exactly \$ORIGIN/../lib (readelf -d): the bundle would not find its libraries"
   fi
   echo "gpu-check: bundle $bundle: $(ls "$bundle/bin" | wc -l) binaries, $copied libraries, $(du -sh "$bundle" | cut -f1)"
 }

@@ -2,6 +2,7 @@
 #include "glsl/programs.hpp"
 
 #include <algorithm>
+#include <array>
 
 #include "glsl/glsl_files.hpp"
 
@@ -16,9 +17,13 @@ constexpr int kOne[] = {1};
 constexpr int kModes[] = {0, 1, 2};
 constexpr int kSections[] = {2, 4, 8}; // FragmentListPass: 2, 4 and kTransparentMaxSections targets
 // FragmentListPass's resolve keeps K = 1, 2, 4, ... up to its budget and the
-// budget itself (1 to 128): K only sizes two arrays, so the powers of two,
-// the ends and two others stand for every K.
-constexpr int kResolveK[] = {1, 2, 3, 4, 8, 16, 32, 64, 100, 127, 128};
+// budget itself (FrameRendererDesc::fragmentsPerPixel, 1 to 128): every K is a
+// variant a pass may ask for, so every one is listed (and compiled by the build's check).
+constexpr auto kResolveK = [] {
+    std::array<int, 128> k{};
+    for (int i = 0; i < 128; ++i) k[std::size_t(i)] = i + 1;
+    return k;
+}();
 
 constexpr const char* kSplatUniforms[] = {"uViewProj", "uOctagon", "uCut",   "uFogEye", "splatfx_fog_params", "splatfx_fog_colour", "splatfx_fog_far",
                                           "uEye",      "uForward", "uNearZ", "uPersp",  "uKernelRadius",      "uHostDepthMap",      "uInvViewProj",
