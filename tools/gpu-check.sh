@@ -74,7 +74,7 @@ for b in "${bench_list[@]}"; do
 done
 
 # Libraries the driver machine provides (or that must come from it): never copied.
-provided='^(libGL|libEGL|libGLX|libGLESv[12]|libOpenGL|libGLdispatch|libEGL_mesa|libEGL_nvidia|libGLX_mesa|libGLX_nvidia|libnvidia-|libcuda|libgbm|libglapi|libdrm|libc|libm|libdl|libpthread|librt|libutil|libresolv|ld-linux)[.-]'
+provided='^(libGL|libEGL|libGLX|libGLESv[12]|libOpenGL|libGLdispatch|libEGL_mesa|libEGL_nvidia|libGLX_mesa|libGLX_nvidia|libnvidia-|libcuda|libgbm|libglapi|libc|libm|libdl|libpthread|librt|libutil|libresolv|ld-linux)[.-]'
 
 bundle_step() {
   command -v cmake >/dev/null || die "cmake not found: the bundle half needs the build machine's packages (tools/setup-deps.sh)"
@@ -158,14 +158,14 @@ run_step() {
     timeout "$limit" "$bundle/bin/$t" --gtest_brief=1 >"$logs/$t.log" 2>&1 || rc=$?
     out="$(cat "$logs/$t.log")"
     passed="$(sed -n 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' <<<"$out" | tail -n 1)"
-    failed="$(sed -n 's/^\[  FAILED  \] \([0-9]*\) test.*/\1/p' <<<"$out" | tail -n 1)"
+    failed="$(grep -c '^\[  FAILED  \] [A-Za-z]' <<<"$out" || true)" # one line per failed test (--gtest_brief prints no count)
     skipped="$(sed -n 's/^\[  SKIPPED \] \([0-9]*\) test.*/\1/p' <<<"$out" | tail -n 1)"
     if [[ $rc -eq 124 ]]; then
       row "test $t" "TIMEOUT" "$((SECONDS - s))" "killed after ${limit} s (log: gpu-check-logs/$t.log)"
     elif [[ $rc -eq 0 ]]; then
       row "test $t" "ok" "$((SECONDS - s))" "${passed:-0} passed, ${skipped:-0} skipped"
     else
-      row "test $t" "FAIL ($rc)" "$((SECONDS - s))" "${passed:-0} passed, ${failed:-?} failed, ${skipped:-0} skipped (log: gpu-check-logs/$t.log)"
+      row "test $t" "FAIL ($rc)" "$((SECONDS - s))" "${passed:-0} passed, ${failed:-0} failed, ${skipped:-0} skipped (log: gpu-check-logs/$t.log)"
     fi
   done
 
@@ -187,7 +187,7 @@ run_step() {
     if [[ $rc -eq 124 ]]; then
       row "bench $b ${args[*]}" "TIMEOUT" "$((SECONDS - s))" "killed after ${limit} s (partial: gpu-check-logs/bench-$b.md)"
     elif [[ $rc -eq 0 ]]; then
-      row "bench $b ${args[*]}" "ok" "$((SECONDS - s))" "$(grep -c '^|' "$logs/bench-$b.md") table lines in gpu-check-logs/bench-$b.md"
+      row "bench $b ${args[*]}" "ok" "$((SECONDS - s))" "$(wc -l <"$logs/bench-$b.md") lines of tables in gpu-check-logs/bench-$b.md"
     else
       row "bench $b ${args[*]}" "FAIL ($rc)" "$((SECONDS - s))" "$(tail -n 1 "$logs/bench-$b.md" | tr '|' '/') (gpu-check-logs/bench-$b.md)"
     fi
