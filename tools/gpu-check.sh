@@ -51,7 +51,7 @@ while [[ $# -gt 0 ]]; do
     --allow-software) software=1 ;;
     --budget) budget="${2:?--budget expects seconds}"; shift ;;
     --jobs) jobs="${2:?--jobs expects a number}"; shift ;;
-    -h|--help) sed -n '2,32p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) awk 'NR > 1 && /^#/ { sub(/^# ?/, ""); print; next } NR > 1 { exit }' "${BASH_SOURCE[0]}"; exit 0 ;;
     *) die "unknown option '$1' (see --help)" ;;
   esac
   shift
