@@ -3,6 +3,7 @@
 // render target against OGRE's depth, with OGRE's camera. OGRE draws the
 // ground, a log in front of the fire and a wall behind it.
 //   ogre-campfire [--frames N] [--size WxH] [--scale 1|2|4] [--seed S] [--time SECONDS] [--screenshot out.png]
+//                 [--reverse-z] [--msaa N] [--srgb]
 // Needs an X display: headless, run it under xvfb-run -a.
 #include <cstdio>
 #include <string>
@@ -30,6 +31,12 @@ int run(int argc, char** argv) {
     samples::addNumber(cli, "--seed", desc.seed, 0u, 0xffffffffu, "seed of every random choice");
     samples::addNumber(cli, "--time", timeSec, 0.0, 1.0e6, "scene time of the last frame, seconds");
     cli.add_option("--screenshot", screenshot, "write the last frame here (PNG)")->type_name("FILE");
+    // An engine's frame (docs/integration.md, "What your engine does"), OGRE's own way.
+    cli.add_flag("--reverse-z", desc.reverseZ, "OGRE's \"Reversed Z-Buffer\": [0, 1] clip depth, near at depth 1 (glClipControl)");
+    cli.add_option("--msaa", desc.msaa, "OGRE's FSAA on the render texture: N samples, resolved by OGRE")
+        ->check(CLI::IsMember({1, 2, 4, 8}))
+        ->type_name("N");
+    cli.add_flag("--srgb", desc.srgb, "an sRGB render texture (OGRE's hardware gamma; blending in linear; the PNG holds sRGB)");
     if (const int code = samples::parseCommandLine(cli, argc, argv); code >= 0) return code;
     auto app = ogrefx::OgreCampfire::create(desc);
     if (!app) return fail(app.error());
@@ -40,11 +47,14 @@ int run(int argc, char** argv) {
     }
     const ogrefx::HookInfo& h = (*app)->hook();
     std::printf("ogre-campfire: %s; %d frames; OGRE framebuffer %u (OGRE says %u), depth %s 0x%x %s, viewport %d %d %d %d, "
-                "scissor %s %d %d %d %d%s; %zu splats\n",
+                "scissor %s %d %d %d %d%s; %zu splats%s%s%s\n",
                 h.glRenderer.c_str(), frames, h.framebuffer, h.framebufferFromOgre, h.depthObjectType == 0x8D41 ? "renderbuffer" : "texture",
                 h.depthInternalFormat, h.depthCopied ? "(copied to a texture)" : "(handed over as it is)", h.viewport[0], h.viewport[1],
                 h.viewport[2], h.viewport[3], h.scissor ? "on" : "off", h.scissorBox[0], h.scissorBox[1], h.scissorBox[2], h.scissorBox[3],
-                h.flipped ? ", flipped" : "", h.splats);
+                h.flipped ? ", flipped" : "", h.splats, h.clipZeroToOne ? "; clip depth [0, 1]" : "",
+                h.msaaSamples > 1 ? ("; " + std::to_string(h.msaaSamples) + "x MSAA, drawn per sample").c_str() : "",
+                h.framebufferSrgb ? "; GL_FRAMEBUFFER_SRGB on" : "");
+    for (const std::string& n : h.notes) std::printf("ogre-campfire: note: %s\n", n.c_str());
     if (!screenshot.empty()) {
         auto image = (*app)->readColour();
         if (!image) return fail(image.error());

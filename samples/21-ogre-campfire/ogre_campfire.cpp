@@ -145,7 +145,11 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
         glm::mat4 proj = toGlm(ogreCamera->getProjectionMatrixWithRSDepth());
         if (target->requiresTextureFlipping())
             for (int c = 0; c < 4; ++c) proj[c][1] = -proj[c][1];
-        return splatfx::Camera::fromMatrices(view, proj, {desc.width, desc.height});
+        // Under OGRE's "Reversed Z-Buffer" the matrix is [0, 1] and reversed
+        // (GL3Plus sets glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE)): read off it.
+        const splatfx::DepthConvention depth =
+            desc.reverseZ ? splatfx::conventionOfProjection(proj, splatfx::ClipDepth::ZeroToOne) : splatfx::DepthConvention{};
+        return splatfx::Camera::fromMatrices(view, proj, {desc.width, desc.height}, depth);
     }
 
     // Makes (or remakes) the depth copy for OGRE's depth attachment of `fbo`.
@@ -166,9 +170,18 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
             hookError = "OGRE's framebuffer " + std::to_string(fbo) + " has no depth attachment";
             return 0;
         }
-        GLint format = 0;
+        GLint format = 0, samples = 0;
         glGetNamedRenderbufferParameteriv(GLuint(name), GL_RENDERBUFFER_INTERNAL_FORMAT, &format);
+        glGetNamedRenderbufferParameteriv(GLuint(name), GL_RENDERBUFFER_SAMPLES, &samples);
         info.depthInternalFormat = unsigned(format);
+        info.depthSamples = samples;
+        if (samples > 1) {
+            // OGRE's FSAA: a multisampled renderbuffer. splatfx copies it into a
+            // multisampled texture itself and reads it sample by sample
+            // (FrameRendererDesc::copyHostDepth): hand over no texture.
+            info.depthCopied = true;
+            return 0;
+        }
         if (!depthCopy || format != depthCopyFormat || w != depthCopyW || h != depthCopyH) {
             if (depthCopyFbo) glDeleteFramebuffers(1, &depthCopyFbo);
             if (depthCopy) glDeleteTextures(1, &depthCopy);
@@ -228,7 +241,7 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
         glGetIntegerv(GL_SCISSOR_BOX, info.scissorBox);
         // 2. OGRE's depth as a texture (a copy: see depthTextureFor).
         const GLuint depth = depthTextureFor(GLuint(fbo), desc.width, desc.height);
-        if (!depth) return;
+        if (!depth && !hookError.empty()) return;
         // 3. OGRE's camera, converted (flip included).
         drawnCamera = convert();
         info.flipped = target->requiresTextureFlipping();
@@ -239,8 +252,19 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
         }
         // 4. Draw. OGRE drew its opaque geometry itself: no drawOpaque hook.
         // The viewport origin is OGRE's (GL's lower left).
+        // An sRGB target blends in linear only with GL_FRAMEBUFFER_SRGB on (OGRE
+        // turns it on for a hardware-gamma target; made sure of, then put back).
+        const bool srgbWasOn = glIsEnabled(GL_FRAMEBUFFER_SRGB) == GL_TRUE;
+        info.framebufferSrgb = srgbWasOn;
+        if (desc.srgb && !srgbWasOn) glEnable(GL_FRAMEBUFFER_SRGB);
+        GLint clipDepth = 0;
+        glGetIntegerv(GL_CLIP_DEPTH_MODE, &clipDepth);
+        info.clipZeroToOne = clipDepth == GL_ZERO_TO_ONE;
         renderer->render(frame, {.framebuffer = unsigned(fbo), .x = vp[0], .y = vp[1], .depthTexture = depth});
+        if (desc.srgb && !srgbWasOn) glDisable(GL_FRAMEBUFFER_SRGB);
         info.splats = renderer->stats().splats;
+        info.msaaSamples = renderer->stats().msaa.samples;
+        info.notes = renderer->stats().notes;
         ++info.calls;
     }
 };
@@ -253,6 +277,8 @@ splatfx::Result<std::unique_ptr<OgreCampfire>> OgreCampfire::create(const OgreCa
     if (desc.width < 16 || desc.height < 16 || desc.width > 8192 || desc.height > 8192)
         return makeError("OgreCampfireDesc::width/height: " + std::to_string(desc.width) + "x" + std::to_string(desc.height) +
                          "; expected each in [16, 8192]");
+    if (desc.msaa != 0 && desc.msaa != 1 && desc.msaa != 2 && desc.msaa != 4 && desc.msaa != 8)
+        return makeError("OgreCampfireDesc::msaa: " + std::to_string(desc.msaa) + "; expected 0, 1, 2, 4 or 8");
     if (desc.resolutionScale != 1 && desc.resolutionScale != 2 && desc.resolutionScale != 4)
         return makeError("OgreCampfireDesc::resolutionScale: " + std::to_string(desc.resolutionScale) + "; expected 1, 2 or 4");
     if (!std::getenv("DISPLAY"))
@@ -273,12 +299,16 @@ splatfx::Result<std::unique_ptr<OgreCampfire>> OgreCampfire::create(const OgreCa
         s.root->loadPlugin(dir + "/RenderSystem_GL3Plus");
         Ogre::RenderSystem* rs = s.root->getRenderSystemByName("OpenGL 3+ Rendering Subsystem");
         if (!rs) return makeError("OGRE has no \"OpenGL 3+ Rendering Subsystem\" after loading " + dir + "/RenderSystem_GL3Plus");
+        if (desc.reverseZ) rs->setConfigOption("Reversed Z-Buffer", "Yes");
         s.root->setRenderSystem(rs);
         s.root->initialise(false);
         // The window only carries the GL context; OGRE draws into a render texture.
         Ogre::NameValuePairList params{{"hidden", "true"}, {"vsync", "false"}};
         s.window = s.root->createRenderWindow("splatfx inside OGRE", 64, 64, false, &params);
         s.window->setAutoUpdated(false);
+        // OGRE decides on its reversed depth once the context exists (it needs GL_ARB_clip_control).
+        if (desc.reverseZ && !rs->isReverseDepthBufferEnabled())
+            return makeError("OGRE's GL3Plus did not enable its \"Reversed Z-Buffer\" (it needs GL_ARB_clip_control)");
 
         s.sceneManager = s.root->createSceneManager();
         s.sceneManager->addRenderQueueListener(&s);
@@ -340,7 +370,8 @@ splatfx::Result<std::unique_ptr<OgreCampfire>> OgreCampfire::create(const OgreCa
 
         // The render target OGRE draws into (as an engine with post-processing does).
         s.colourTexture = Ogre::TextureManager::getSingleton().createManual("splatfx/frame", group, Ogre::TEX_TYPE_2D, Ogre::uint(desc.width),
-                                                                            Ogre::uint(desc.height), 0, Ogre::PF_BYTE_RGBA, Ogre::TU_RENDERTARGET);
+                                                                            Ogre::uint(desc.height), 0, Ogre::PF_BYTE_RGBA, Ogre::TU_RENDERTARGET,
+                                                                            nullptr, desc.srgb, Ogre::uint(desc.msaa > 1 ? desc.msaa : 0));
         s.target = s.colourTexture->getBuffer()->getRenderTarget();
         s.viewport = s.target->addViewport(s.ogreCamera);
         s.viewport->setBackgroundColour(Ogre::ColourValue(0.05f, 0.06f, 0.10f, 1.0f));

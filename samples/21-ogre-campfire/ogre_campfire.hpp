@@ -42,6 +42,12 @@ struct OgreCampfireDesc {
     // control); default true.
     bool restoreState = true;
     std::string pluginDir{}; // OGRE's plugin folder; empty: the one OGRE's CMake package names; default empty
+    // An engine's frame (docs/integration.md, "What your engine does"): OGRE's own
+    // "Reversed Z-Buffer" option (glClipControl [0, 1], near at depth 1), its render
+    // texture multisampled (FSAA) or sRGB (hardware gamma). Defaults: off, 0, false.
+    bool reverseZ = false;
+    int msaa = 0; // 0 or 1: single-sampled; 2, 4, 8: OGRE's FSAA on the render texture
+    bool srgb = false;
 };
 
 struct FrameOptions {
@@ -64,6 +70,11 @@ struct HookInfo {
     bool flipped = false;             // OGRE renders this target upside down (requiresTextureFlipping)
     std::size_t splats = 0;           // splats splatfx drew
     std::string glRenderer;           // GL_RENDERER / GL_VERSION of OGRE's context
+    int depthSamples = 0;             // OGRE's depth renderbuffer's samples (FSAA; then splatfx copies it)
+    int msaaSamples = 0;              // FrameRenderStats::msaa.samples: what splatfx drew per sample (0: single-sampled)
+    bool framebufferSrgb = false;     // OGRE had GL_FRAMEBUFFER_SRGB on at the hook
+    bool clipZeroToOne = false;       // OGRE had glClipControl(..., GL_ZERO_TO_ONE) at the hook
+    std::vector<std::string> notes;   // FrameRenderStats::notes: anything splatfx approximated
 };
 
 class OgreCampfire {

@@ -1,5 +1,6 @@
 #include "gl_fixture.hpp"
 
+#include <cstdlib>
 #include <filesystem>
 #include <memory>
 
@@ -43,11 +44,16 @@ std::string outputDir() {
     std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "unknown";
     for (char& c : name)
         if (c == '/') c = '_';
-    const std::string dir = std::string(SPLATFX_TEST_OUTPUT_DIR) + "/" + name;
+    const char* env = std::getenv("SPLATFX_TEST_OUTPUT_DIR"); // a bundle run elsewhere (tools/gpu-check.sh)
+    const std::string dir = std::string(env && *env ? env : SPLATFX_TEST_OUTPUT_DIR) + "/" + name;
     std::filesystem::create_directories(dir);
     return dir;
 }
 
-std::string sourcePath(const std::string& relative) { return std::string(SPLATFX_SOURCE_DIR) + "/" + relative; }
+// SPLATFX_SOURCE_DIR in the environment wins: tools/gpu-check.sh runs the binaries in another checkout.
+std::string sourcePath(const std::string& relative) {
+    const char* env = std::getenv("SPLATFX_SOURCE_DIR");
+    return std::string(env && *env ? env : SPLATFX_SOURCE_DIR) + "/" + relative;
+}
 
 } // namespace splatfx::test

@@ -1,8 +1,10 @@
 // Test helper: creates a headless context (or a renderer without one) and
-// prints "ok: <renderer>" or "error: <message>". Run by context_gl_test in a
+// prints "ok: <renderer> | vendor <GL_VENDOR>" or "error: <message>". Run by context_gl_test in a
 // child process so environment changes cannot leak into other tests.
 #include <cstdio>
 #include <cstring>
+
+#include <epoxy/gl.h>
 
 #include "splatfx/context.hpp"
 #include "splatfx/gl/renderer.hpp"
@@ -18,6 +20,7 @@ int main(int argc, char** argv) {
         std::printf("error: %s\n", ctx.error().c_str());
         return 1;
     }
-    std::printf("ok: %s\n", ctx->renderer().c_str());
+    const GLubyte* vendor = glGetString(GL_VENDOR);
+    std::printf("ok: %s | vendor %s\n", ctx->renderer().c_str(), vendor ? reinterpret_cast<const char*>(vendor) : "unknown");
     return 0;
 }

@@ -37,9 +37,10 @@ TEST(GlslFiles, EveryVariantAssemblesWithItsIncludesResolved) {
             ++variants;
         });
     // splat 3 fog states (none, per fragment, per splat) x 7 cut states x 2 cross-fade = 42; sections
-    // 6 kinds x 3 section counts = 18; tetrahedra 8; fog pass 3; resolve 11 K x 2 stages = 22; the
-    // eight programs without defines 8 (the host depth sample one among them).
-    EXPECT_EQ(variants, 42 + 18 + 8 + 3 + 22 + 8);
+    // 6 kinds x 3 section counts = 18; tetrahedra 8; fog pass 3; resolve: every K a budget of 1 to
+    // 128 fragments per pixel can ask for x 2 programs = 256; the eight programs without defines 8
+    // (the host depth sample one among them).
+    EXPECT_EQ(variants, 42 + 18 + 8 + 3 + 256 + 8);
 }
 
 TEST(GlslFiles, AnIncludeAppearsOncePerExpansion) {
@@ -60,6 +61,25 @@ TEST(GlslFiles, AMissingFileIsNamed) {
     auto stages = glsl::programSources(key, {});
     ASSERT_FALSE(stages);
     EXPECT_NE(stages.error().find("fog pass [MODE=0]: needs the fog's GLSL"), std::string::npos) << stages.error();
+}
+
+// The build compiles exactly forEachVariant's list with glslangValidator (warnings fail it too), so a
+// pass asking for any other variant would reach a driver unchecked: programSources refuses it.
+TEST(GlslFiles, AVariantTheBuildDoesNotCheckIsRefused) {
+    const glsl::ProgramKey outside{glsl::ProgramId::FogPass, {7}, 0}; // MODE takes 0, 1, 2
+    EXPECT_FALSE(glsl::isCheckedVariant(outside));
+    auto stages = glsl::programSources(outside, {.fog = "x"});
+    ASSERT_FALSE(stages);
+    EXPECT_NE(stages.error().find("fog pass [MODE=7]: not among the variants the build checks"), std::string::npos) << stages.error();
+    // A value for a define the program does not have.
+    EXPECT_FALSE(glsl::isCheckedVariant({glsl::ProgramId::DepthSample, {1}, 0}));
+    int listed = 0;
+    for (int p = 0; p < int(glsl::ProgramId::Count); ++p)
+        glsl::forEachVariant(glsl::ProgramId(p), [&](const std::array<int, glsl::kMaxDefines>& values) {
+            EXPECT_TRUE(glsl::isCheckedVariant({glsl::ProgramId(p), values, 0}));
+            ++listed;
+        });
+    EXPECT_EQ(listed, 42 + 18 + 8 + 3 + 256 + 8);
 }
 
 TEST(GlslFiles, SubstituteReplacesWholeWordsOnly) { EXPECT_EQ(glsl::substitute("A A_B xA A", {{"A", "1"}}), "1 A_B xA 1"); }

@@ -56,6 +56,10 @@ struct Args {
     std::string camera = "path";
     bool hideUi = false;
     bool intoWindow = false; // draw into the window's default framebuffer (its depth copied by splatfx) instead of an own one
+    // An engine's frame, as splatfx-render's flags of the same names (docs/integration.md, "What your engine does").
+    splatfx::DepthConvention depth{}; // --reverse-z, --clip-01, --infinite-far
+    int msaa = 0;                     // --msaa N: the viewer's own target multisampled, resolved before the window
+    bool srgb = false;                // --srgb: the viewer's own target sRGB, GL_FRAMEBUFFER_SRGB on while splatfx draws
 };
 
 // Returns -1 to go on, else the exit code (0 after --help, 2 after a bad command line).
@@ -74,8 +78,26 @@ int parse(int argc, char** argv, Args& a) {
     app.add_flag("--into-window", a.intoWindow,
                  "draw straight into the window's default framebuffer, as many hosts do (splatfx copies its depth once a frame: "
                  "FrameRendererDesc::copyHostDepth); default: into a framebuffer of the viewer's own, copied to the window");
+    app.add_flag_callback(
+        "--reverse-z", [&a] { a.depth.reversed = true, a.depth.clip = splatfx::ClipDepth::ZeroToOne; },
+        "draw as a reverse-Z engine: glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), near at depth 1, far at 0, 32-bit float depth "
+        "(the window's own depth, with --into-window)");
+    app.add_flag_callback(
+        "--clip-01", [&a] { a.depth.clip = splatfx::ClipDepth::ZeroToOne; }, "clip depth [0, 1] (glClipControl GL_ZERO_TO_ONE) without reversing");
+    app.add_flag_callback(
+        "--infinite-far", [&a] { a.depth.infiniteFar = true; }, "an infinite far plane (the scene's camera farPlane unused)");
+    app.add_option("--msaa", a.msaa, "draw into an N-sample (MSAA) colour and depth target, resolved before it is copied to the window")
+        ->check(CLI::IsMember({1, 2, 4, 8, 16}))
+        ->type_name("N");
+    app.add_flag("--srgb", a.srgb, "draw into an sRGB colour target with GL_FRAMEBUFFER_SRGB on (blending in linear; the window shows the sRGB codes)");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     if (seedOption->count()) a.seed = seed;
+    // The window's default framebuffer is single-sampled RGBA8: the engine targets are the viewer's own.
+    if (a.intoWindow && (a.msaa > 1 || a.srgb)) {
+        std::fprintf(stderr, "splatfx-viewer: --msaa and --srgb draw into the viewer's own target; --into-window draws into the window's "
+                             "single-sampled RGBA8 default framebuffer: give one or the other\n");
+        return 2;
+    }
     return -1;
 }
 
@@ -98,7 +120,8 @@ constexpr SamplingChoice kSamplings[] = {
 struct Viewer {
     Args args;
     std::optional<scenehost::ScenePlayer> player;
-    std::optional<splatfx::gl::Framebuffer> target; // what the frame is drawn into, then copied to the window
+    std::optional<splatfx::gl::Framebuffer> target;   // what the frame is drawn into, then copied to the window
+    std::optional<splatfx::gl::Framebuffer> resolved; // --msaa: the target's samples averaged, as Framebuffer::read does
     std::string path;
     std::string error;
     std::vector<std::string> catalogue; // scene files next to the current one
@@ -178,13 +201,13 @@ struct Viewer {
         if (mode == CameraMode::Orbit) {
             const glm::vec3 eye = orbitTarget + orbitDistance * glm::vec3(std::cos(orbitPitch) * std::sin(orbitYaw), std::sin(orbitPitch),
                                                                           std::cos(orbitPitch) * std::cos(orbitYaw));
-            return splatfx::Camera::lookAt(eye, orbitTarget, {0, 1, 0}, fov, vp, cp.nearPlane, cp.farPlane);
+            return splatfx::Camera::lookAt(eye, orbitTarget, {0, 1, 0}, fov, vp, cp.nearPlane, cp.farPlane, args.depth);
         }
         if (mode == CameraMode::Fly) {
             const glm::vec3 f(std::cos(flyPitch) * std::cos(flyYaw), std::sin(flyPitch), std::cos(flyPitch) * std::sin(flyYaw));
-            return splatfx::Camera::lookAt(flyPos, flyPos + f, {0, 1, 0}, fov, vp, cp.nearPlane, cp.farPlane);
+            return splatfx::Camera::lookAt(flyPos, flyPos + f, {0, 1, 0}, fov, vp, cp.nearPlane, cp.farPlane, args.depth);
         }
-        splatfx::Camera c = player->cameraAt(time, vp);
+        splatfx::Camera c = player->cameraAt(time, vp, args.depth);
         return c;
     }
 
@@ -435,6 +458,9 @@ static int viewerMain(int argc, char** argv) {
             // copies its depth buffer once a frame for the passes that read it
             // (the host fog, the depth cut); viewer_matches_render_window holds
             // that image to the tool's too.
+            // The host's clip convention while splatfx and the scene host draw (GL state
+            // read by nothing in splatfx but the rasterizer); GL's default again for the UI.
+            glClipControl(GL_LOWER_LEFT, v.args.depth.clip == splatfx::ClipDepth::ZeroToOne ? GL_ZERO_TO_ONE : GL_NEGATIVE_ONE_TO_ONE);
             if (v.args.intoWindow) {
                 // The window's own depth buffer is copied by the frame renderer after the opaque pass.
                 if (v.time > splatfx::kMaxTimeSec) v.time = 0.0;
@@ -443,22 +469,48 @@ static int viewerMain(int argc, char** argv) {
                 glViewport(0, 0, fbSize.x, fbSize.y);
             } else if (!v.target || v.target->width() != fbSize.x || v.target->height() != fbSize.y) {
                 v.target.reset();
-                auto fb = splatfx::gl::Framebuffer::create({.width = fbSize.x, .height = fbSize.y});
+                v.resolved.reset();
+                // The same target splatfx-render draws into for the same flags.
+                auto fb = splatfx::gl::Framebuffer::create({.width = fbSize.x,
+                                                            .height = fbSize.y,
+                                                            .floatDepth = v.args.depth.reversed,
+                                                            .samples = v.args.msaa,
+                                                            .srgb = v.args.srgb});
                 if (!fb) {
                     std::fprintf(stderr, "splatfx-viewer: %s\n", fb.error().c_str());
                     rc = 1;
                     break;
                 }
                 v.target.emplace(std::move(*fb));
+                if (v.args.msaa > 1) {
+                    auto single = splatfx::gl::Framebuffer::create({.width = fbSize.x, .height = fbSize.y, .srgb = v.args.srgb});
+                    if (!single) {
+                        std::fprintf(stderr, "splatfx-viewer: %s\n", single.error().c_str());
+                        rc = 1;
+                        break;
+                    }
+                    v.resolved.emplace(std::move(*single));
+                }
             }
             if (!v.args.intoWindow) {
                 // Past kMaxTimeSec (about 72.8 hours of scene time) the scene refuses the time: restart the clock.
                 if (v.time > splatfx::kMaxTimeSec) v.time = 0.0;
+                if (v.args.srgb) glEnable(GL_FRAMEBUFFER_SRGB);
                 if (auto st = v.player->renderFrame(v.time, cam, v.target->handle(), v.frame); !st) v.error = st.error();
-                glBlitNamedFramebuffer(v.target->handle(), 0, 0, 0, fbSize.x, fbSize.y, 0, 0, fbSize.x, fbSize.y, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+                unsigned shown = v.target->handle();
+                if (v.resolved) {
+                    // Resolved as splatfx-render's Framebuffer::read resolves (GL_FRAMEBUFFER_SRGB as while drawing:
+                    // an sRGB target's samples are averaged in linear), then the codes copied as they are.
+                    glBlitNamedFramebuffer(shown, v.resolved->handle(), 0, 0, fbSize.x, fbSize.y, 0, 0, fbSize.x, fbSize.y, GL_COLOR_BUFFER_BIT,
+                                           GL_NEAREST);
+                    shown = v.resolved->handle();
+                }
+                glDisable(GL_FRAMEBUFFER_SRGB); // the window gets the stored codes, as the tool's PNG
+                glBlitNamedFramebuffer(shown, 0, 0, 0, fbSize.x, fbSize.y, 0, 0, fbSize.x, fbSize.y, GL_COLOR_BUFFER_BIT, GL_NEAREST);
                 glBindFramebuffer(GL_FRAMEBUFFER, 0);
                 glViewport(0, 0, fbSize.x, fbSize.y);
             }
+            glClipControl(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
         } else {
             glBindFramebuffer(GL_FRAMEBUFFER, 0);
             glViewport(0, 0, fbSize.x, fbSize.y);
@@ -478,6 +530,7 @@ static int viewerMain(int argc, char** argv) {
     }
     v.player.reset(); // its GL objects go while the window's context is still current
     v.target.reset();
+    v.resolved.reset();
     ImGui_ImplOpenGL3_Shutdown();
     ImGui_ImplGlfw_Shutdown();
     ImGui::DestroyContext();

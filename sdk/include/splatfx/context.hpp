@@ -6,6 +6,13 @@
 // without a GPU that is Mesa's llvmpipe); it fails with a clear message when
 // EGL, a display or GL 4.5 core is missing. Link splatfx::context for it.
 //
+// By default the first display that gives a 4.5 core context is taken. The
+// environment variable SPLATFX_EGL_DEVICE restricts it to EGL's device
+// platform (EGL_EXT_device_enumeration + EGL_EXT_platform_device): "any" (the
+// first device), "gpu" (no software device), "nvidia" (GL_VENDOR contains
+// NVIDIA) or a device index; when none fits, create() says which devices it
+// found (tools/gpu-check.sh uses "nvidia").
+//
 //   auto ctx = splatfx::HeadlessContext::create();
 //   if (!ctx) { std::fprintf(stderr, "%s\n", ctx.error().c_str()); return 1; }
 //

@@ -1,6 +1,9 @@
 // The GL backend's programs as data (programs.hpp).
 #include "glsl/programs.hpp"
 
+#include <algorithm>
+#include <array>
+
 #include "glsl/glsl_files.hpp"
 
 namespace splatfx::glsl {
@@ -14,9 +17,13 @@ constexpr int kOne[] = {1};
 constexpr int kModes[] = {0, 1, 2};
 constexpr int kSections[] = {2, 4, 8}; // FragmentListPass: 2, 4 and kTransparentMaxSections targets
 // FragmentListPass's resolve keeps K = 1, 2, 4, ... up to its budget and the
-// budget itself (1 to 128): K only sizes two arrays, so the powers of two,
-// the ends and two others stand for every K.
-constexpr int kResolveK[] = {1, 2, 3, 4, 8, 16, 32, 64, 100, 127, 128};
+// budget itself (FrameRendererDesc::fragmentsPerPixel, 1 to 128): every K is a
+// variant a pass may ask for, so every one is listed (and compiled by the build's check).
+constexpr auto kResolveK = [] {
+    std::array<int, 128> k{};
+    for (int i = 0; i < 128; ++i) k[std::size_t(i)] = i + 1;
+    return k;
+}();
 
 constexpr const char* kSplatUniforms[] = {"uViewProj", "uOctagon", "uCut",   "uFogEye", "splatfx_fog_params", "splatfx_fog_colour", "splatfx_fog_far",
                                           "uEye",      "uForward", "uNearZ", "uPersp",  "uKernelRadius",      "uHostDepthMap",      "uInvViewProj",
@@ -130,8 +137,26 @@ std::string variantName(const ProgramKey& key) {
     return s + "]";
 }
 
+bool isCheckedVariant(const ProgramKey& key) {
+    const ProgramDesc& d = programDesc(key.id);
+    for (int i = 0; i < kMaxDefines; ++i) {
+        const int v = key.values[std::size_t(i)];
+        if (!d.defines[std::size_t(i)]) {
+            if (v != 0) return false; // a value for a define the program does not have
+            continue;
+        }
+        const auto& allowed = d.values[std::size_t(i)];
+        if (std::find(allowed.begin(), allowed.end(), v) == allowed.end()) return false;
+    }
+    return !d.valid || d.valid(key.values);
+}
+
 Result<std::vector<StageSource>> programSources(const ProgramKey& key, const ProgramData& data) {
     const ProgramDesc& d = programDesc(key.id);
+    // Only the variants the build's glslangValidator step compiled (forEachVariant) may reach a
+    // driver: a pass asking for another is a bug, named here rather than compiled unchecked.
+    if (!isCheckedVariant(key))
+        return makeError(variantName(key) + ": not among the variants the build checks with glslangValidator (glsl/programs.cpp's values)");
     std::string head = "#version 450 core\n";
     for (int i = 0; i < kMaxDefines && d.defines[std::size_t(i)]; ++i)
         head += std::string("#define ") + d.defines[std::size_t(i)] + " " + std::to_string(key.values[std::size_t(i)]) + "\n";

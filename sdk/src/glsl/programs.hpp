@@ -86,6 +86,9 @@ struct StageSource {
 Result<std::vector<StageSource>> programSources(const ProgramKey& key, const ProgramData& data);
 // "splat [FOG=1 CUT=0 ...]", for messages.
 std::string variantName(const ProgramKey& key);
+// Whether the key is one forEachVariant lists (the build checks exactly those); programSources
+// refuses any other.
+bool isCheckedVariant(const ProgramKey& key);
 // Calls fn with the define values of every variant of `id` a pass may ask for.
 void forEachVariant(ProgramId id, const std::function<void(const std::array<int, kMaxDefines>&)>& fn);
 // Which generated includes the variant reads.
