@@ -26,6 +26,7 @@ int runLattice(int argc, char** argv);      // lattice.cpp: how visible the voxe
 int runParticles(int argc, char** argv);    // particles.cpp: splats at particle positions vs the same number of grid splats (issue 25)
 int runEbert(int argc, char** argv);        // ebert.cpp: Ebert & Parent 1990 Table 1, the paper's scenes with and without their volumes
 int runObstacles(int argc, char** argv);    // obstacles.cpp: solver step cost with obstacles (bridge, moving locomotive, meshes) against none
+int runHdr(int argc, char** argv);          // hdr.cpp: HDR lit colour and RGBA16F/32F targets against the 8-bit path (issues 26, 27)
 
 // cloud_knobs.cpp, run by accuracy (--clouds-only alone): the LOD clouds' table size, c, C and
 // max vs average Delta against the finest level integrated exactly (issue 17). Needs a current GL context.
@@ -57,5 +58,6 @@ inline constexpr BenchCommand kCommands[] = {
     {"vdb", "OpenVDB import: voxels per cell and splat filter against the file's voxels at full resolution; Pareto plot", runVdb},
     {"particles", "splats at particle positions (host, emitter) vs the same number of grid splats: CPU frame, GL pass, error vs the exact reference", runParticles},
     {"obstacles", "solver step cost with obstacles (a bridge, a moving locomotive, as boxes or meshes, free or no slip) against none", runObstacles},
+    {"hdr", "HDR lit colour against the 8-bit path: RGBA8/16F/32F host targets, ms per frame, error vs the lit volume reference, Pareto", runHdr},
     {"soak", "every preset stepped at 60 Hz for an hour of scene time: no NaN/Inf, bounds and memory flat", runSoak},
 };

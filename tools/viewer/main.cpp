@@ -56,6 +56,7 @@ struct Args {
     std::string camera = "path";
     bool hideUi = false;
     bool intoWindow = false; // draw into the window's default framebuffer (its depth copied by splatfx) instead of an own one
+    bool hdr = false;        // an RGBA16F target of its own and HDR lit colours (shown clamped at 1 in the 8-bit window)
 };
 
 // Returns -1 to go on, else the exit code (0 after --help, 2 after a bad command line).
@@ -74,6 +75,10 @@ int parse(int argc, char** argv, Args& a) {
     app.add_flag("--into-window", a.intoWindow,
                  "draw straight into the window's default framebuffer, as many hosts do (splatfx copies its depth once a frame: "
                  "FrameRendererDesc::copyHostDepth); default: into a framebuffer of the viewer's own, copied to the window");
+    app.add_flag("--hdr", a.hdr,
+                 "draw into an RGBA16F framebuffer of the viewer's own with HDR lit colours (Scene::setHdrLit), as splatfx-render --hdr; "
+                 "the 8-bit window shows it clamped at 1 (no tone curve: exposure is the host's)")
+        ->excludes("--into-window");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     if (seedOption->count()) a.seed = seed;
     return -1;
@@ -137,6 +142,7 @@ struct Viewer {
         }
         error.clear();
         player.emplace(std::move(*r));
+        player->file().scene.setHdrLit(args.hdr);
         path = p;
         std::snprintf(pathInput, sizeof pathInput, "%s", p.c_str());
         time = 0.0;
@@ -443,7 +449,8 @@ static int viewerMain(int argc, char** argv) {
                 glViewport(0, 0, fbSize.x, fbSize.y);
             } else if (!v.target || v.target->width() != fbSize.x || v.target->height() != fbSize.y) {
                 v.target.reset();
-                auto fb = splatfx::gl::Framebuffer::create({.width = fbSize.x, .height = fbSize.y});
+                auto fb = splatfx::gl::Framebuffer::create(
+                    {.width = fbSize.x, .height = fbSize.y, .color = v.args.hdr ? splatfx::gl::Precision::F16 : splatfx::gl::Precision::U8});
                 if (!fb) {
                     std::fprintf(stderr, "splatfx-viewer: %s\n", fb.error().c_str());
                     rc = 1;
