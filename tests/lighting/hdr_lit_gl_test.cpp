@@ -131,7 +131,7 @@ TEST_F(HdrLitGL, ABrightlyLitGasIsSixTimesItsInRangeFrameAgainstTheLitVolumeRefe
     const Grid grid = test::gaussianBlob(3, 0.25f, 0.7f);
     glm::vec3 mid(0.0f);
     for (const Voxel& v : grid.voxels) mid += grid.worldPosition(v.cell) / float(grid.voxels.size());
-    const Camera cam = Camera::lookAt(mid + glm::vec3(0.9f, 0.5f, 2.4f), mid, {0, 1, 0}, 0.55f, {48, 36}, 0.1f, 20.0f);
+    const Camera cam = Camera::lookAt(mid + glm::vec3(0.9f, 0.5f, 2.4f), mid, {0, 1, 0}, 0.55f, {32, 24}, 0.1f, 20.0f);
     const GasLightingDesc gas{.albedo = 0.9f};
     auto frameAt = [&](float intensity, bool hdr) {
         Scene scene;
@@ -161,13 +161,17 @@ TEST_F(HdrLitGL, ABrightlyLitGasIsSixTimesItsInRangeFrameAgainstTheLitVolumeRefe
 
     VolumeField field(m);
     field.add(grid, {.textured = false});
-    VolumeExactStats s1, s6;
-    const std::vector<Light> one = {Light::directional({0.6f, -0.7f, -0.4f}, glm::vec3(1.0f), 1.0f)};
+    // The reference at 6 only: the lit model's light term is linear in the intensity (the
+    // transmittance does not depend on it; no ambient, no emission), so the reference at 1 is
+    // it divided by 6, exactly in the model and within 6x its error estimate in the quadrature.
+    VolumeExactStats s6;
     const std::vector<Light> six = {Light::directional({0.6f, -0.7f, -0.4f}, glm::vec3(1.0f), 6.0f)};
-    const LitVolumeDesc lit1{.lights = one, .gas = gas}, lit6{.lights = six, .gas = gas};
-    auto e1 = renderVolumeExact(field, cam, {.tolerance = 1e-6, .lighting = &lit1}, &s1);
-    auto e6 = renderVolumeExact(field, cam, {.tolerance = 1e-6, .lighting = &lit6}, &s6);
-    ASSERT_TRUE(e1 && e6);
+    const LitVolumeDesc lit6{.lights = six, .gas = gas};
+    auto e6 = renderVolumeExact(field, cam, {.tolerance = 1e-4, .lighting = &lit6}, &s6);
+    ASSERT_TRUE(e6);
+    Image e1 = *e6;
+    for (float& v : e1.pixels) v /= 6.0f;
+    ASSERT_EQ(s6.unconverged, 0u);
 
     // GL at 6 against 6 x GL at 1: the same alphas, so the images differ by at most the largest
     // alpha times the largest difference of a splat's colour: the HDR chroma's rounding (half a
@@ -178,11 +182,13 @@ TEST_F(HdrLitGL, ABrightlyLitGasIsSixTimesItsInRangeFrameAgainstTheLitVolumeRefe
     const double linear = alpha * (mMax + 6.0) * 0.5 / 255.0 + 28.0 * kHalfUlp * maxRgb(gHi) + 1e-5;
     const double eLinear = maxDiffRgb(gHi, gLo, 6.0);
     EXPECT_LE(eLinear, linear);
-    // So against the reference at 6: 6x the in-range frame's own error, plus the above, plus the
-    // two references' error estimates (the reference at 6 against 6x the one at 1).
-    const double eLo = maxDiffRgb(gLo, *e1), eHi = maxDiffRgb(gHi, *e6);
-    const double bound = 6.0 * eLo + linear + 6.0 * s1.maxErrorEstimate + s6.maxErrorEstimate;
-    EXPECT_LE(eHi, bound);
+    // So, by the triangle inequality, the HDR frame's error against the reference at 6 is at most
+    // 6x the in-range frame's error against the reference divided by 6, plus the above: the
+    // HDR path adds no error of its own beyond its rounding (printed; it follows from the above,
+    // so it is not asserted again). What HDR must show: values above 1 in both, and a frame
+    // without the scale missing the reference by far more than that.
+    const double eLo = maxDiffRgb(gLo, e1), eHi = maxDiffRgb(gHi, *e6);
+    const double bound = 6.0 * eLo + linear + 1e-6;
     EXPECT_GT(maxRgb(*e6), 2.0) << "the reference must exceed 1";
     EXPECT_GT(maxRgb(gHi), 2.0) << "so must the half-float frame";
     // Without HDR the frame stops at the colour's saturation and misses the reference by far more.

@@ -119,7 +119,10 @@ int runHdr(int argc, char** argv) {
         img = fb->read();
         std::sort(cpu.begin(), cpu.end());
         std::sort(gpu.begin(), gpu.end());
-        bench::KnobRow row{.knob = "host target, lit colour", .setting = s.name, .isDefault = !s.hdr && s.target == gl::Precision::U8};
+        bench::KnobRow row;
+        row.knob = "host target, lit colour";
+        row.setting = s.name;
+        row.isDefault = !s.hdr && s.target == gl::Precision::U8;
         const double c = cpu[cpu.size() / 2], g = gpu[gpu.size() / 2];
         row.ms = c + g;
         double imgPeak = 0.0;
