@@ -27,6 +27,7 @@ int runParticles(int argc, char** argv);    // particles.cpp: splats at particle
 int runEbert(int argc, char** argv);        // ebert.cpp: Ebert & Parent 1990 Table 1, the paper's scenes with and without their volumes
 int runObstacles(int argc, char** argv);    // obstacles.cpp: solver step cost with obstacles (bridge, moving locomotive, meshes) against none
 int runDevice(int argc, char** argv);       // device.cpp: the GL context the benches get (SPLATFX_EGL_DEVICE), for tools/gpu-check.sh
+int runHdr(int argc, char** argv);          // hdr.cpp: HDR lit colour and RGBA16F/32F targets against the 8-bit path (issues 26, 27)
 
 // cloud_knobs.cpp, run by accuracy (--clouds-only alone): the LOD clouds' table size, c, C and
 // max vs average Delta against the finest level integrated exactly (issue 17). Needs a current GL context.
@@ -59,5 +60,6 @@ inline constexpr BenchCommand kCommands[] = {
     {"particles", "splats at particle positions (host, emitter) vs the same number of grid splats: CPU frame, GL pass, error vs the exact reference", runParticles},
     {"obstacles", "solver step cost with obstacles (a bridge, a moving locomotive, as boxes or meshes, free or no slip) against none", runObstacles},
     {"device", "the OpenGL context the benches get (SPLATFX_EGL_DEVICE selects an EGL device): vendor, renderer, sample limits", runDevice},
+    {"hdr", "HDR lit colour against the 8-bit path: RGBA8/16F/32F host targets, ms per frame, error vs the lit volume reference, Pareto", runHdr},
     {"soak", "every preset stepped at 60 Hz for an hour of scene time: no NaN/Inf, bounds and memory flat", runSoak},
 };

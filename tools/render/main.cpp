@@ -63,6 +63,7 @@ struct Args {
     splatfx::DepthConvention depth{};          // --reverse-z, --clip-01, --infinite-far (the host's depth convention)
     int msaa = 0;                              // --msaa N: the host's target multisampled
     bool srgb = false;                         // --srgb: the host's target sRGB, GL_FRAMEBUFFER_SRGB on
+    bool hdr = false;                          // --hdr: an RGBA16F target, HDR lit colours, an EXR beside each PNG
 };
 
 // Returns -1 to go on, else the exit code (0 after --help, 2 after a bad command line).
@@ -183,7 +184,12 @@ int parse(int argc, char** argv, Args& a) {
     app.add_option("--msaa", a.msaa, "draw into an N-sample (MSAA) colour and depth target, resolved for the PNG")
         ->check(CLI::IsMember({1, 2, 4, 8, 16}))
         ->type_name("N");
-    app.add_flag("--srgb", a.srgb, "draw into an sRGB colour target with GL_FRAMEBUFFER_SRGB on (blending in linear; the PNG holds sRGB)");
+    auto* srgbFlag =
+        app.add_flag("--srgb", a.srgb, "draw into an sRGB colour target with GL_FRAMEBUFFER_SRGB on (blending in linear; the PNG holds sRGB)");
+    app.add_flag("--hdr", a.hdr,
+                 "draw into an RGBA16F colour target with HDR lit colours (Scene::setHdrLit: values above 1 kept) and write each frame "
+                 "also as DIR/<name>_NNNN.exr (linear, unclamped); the PNG and GIF clamp at 1")
+        ->excludes(srgbFlag);
     cli::addNumber(app, "--abort-after", a.abortAfter, 0, 100000,
                    "testing aid: fail on purpose after N frames (checks that nothing partial is left)");
     // Unset, these come from the scene file: the help says so instead of showing the placeholder 0.
@@ -218,6 +224,8 @@ char* frameName(char (&buf)[128], const std::string& name, int i) {
     std::snprintf(buf, sizeof buf, "%s_%04d.png", name.c_str(), i);
     return buf;
 }
+// --hdr's EXR beside a frame's PNG.
+std::string exrName(const std::string& png) { return png.substr(0, png.size() - 4) + ".exr"; }
 
 // Everything that decides a frame's pixels besides its index: the scene
 // file's bytes (not the meshes and images it names) and the options.
@@ -246,6 +254,7 @@ splatfx::Result<render::RunSettings> runSettings(const Args& a, const std::strin
         {"fog-texture", fog.x > 0 ? std::to_string(fog.x) + "x" + std::to_string(fog.y) : std::string("per-pixel")},
         {"depth-cut", sp.depthCut ? "yes" : "no"},
         {"volume-layer", a.renderer.volumeLayer ? "yes" : "no"},
+        {"hdr", a.hdr ? "yes" : "no"},
     };
 }
 
@@ -389,6 +398,7 @@ static int renderMain(int argc, char** argv) {
         if (whole || a.range->contains(i)) {
             char png[128];
             planned.push_back(frameName(png, name, i));
+            if (a.hdr) planned.push_back(exrName(png));
         }
     if (whole) planned.push_back(name + ".gif");
     planned.push_back(runRecord);
@@ -397,7 +407,14 @@ static int renderMain(int argc, char** argv) {
     std::map<std::string, std::pair<int, std::string>> hashes; // the run record's frames
 
     auto fb = splatfx::gl::Framebuffer::create(
-        {.width = size.x, .height = size.y, .floatDepth = a.depth.reversed, .samples = a.msaa, .srgb = a.srgb});
+        {.width = size.x,
+         .height = size.y,
+         .color = a.hdr ? splatfx::gl::Precision::F16 : splatfx::gl::Precision::U8,
+         .floatDepth = a.depth.reversed,
+         .samples = a.msaa,
+         .srgb = a.srgb});
+    // An HDR host: lit colours above 1 keep their brightness (docs/lighting.md, "HDR lit colour").
+    player->file().scene.setHdrLit(a.hdr);
     if (!fb) return fail(fb.error());
     if (a.srgb) glEnable(GL_FRAMEBUFFER_SRGB);
     // The host's clip convention: GL state of this context, read by nothing in splatfx but the rasterizer.
@@ -416,6 +433,7 @@ static int renderMain(int argc, char** argv) {
     if (a.msaa > 1 || a.srgb)
         std::printf("splatfx-render: colour target %s%s%s\n", a.msaa > 1 ? (std::to_string(a.msaa) + "x MSAA").c_str() : "",
                     a.msaa > 1 && a.srgb ? ", " : "", a.srgb ? "sRGB (GL_FRAMEBUFFER_SRGB)" : "");
+    if (a.hdr) std::printf("splatfx-render: colour target RGBA16F, HDR lit colours; frames also as %s/%s_NNNN.exr\n", a.out.c_str(), name.c_str());
     std::optional<splatfx::AnimationWriter> gif;
     if (whole) gif.emplace(outputs->path(name + ".gif"), fps);
     using Clock = std::chrono::steady_clock;
@@ -463,6 +481,15 @@ static int renderMain(int argc, char** argv) {
         char png[128];
         frameName(png, name, i);
         if (auto w = splatfx::writeImage(outputs->path(png), img); !w) return fail(w.error());
+        if (a.hdr) {
+            // The target's half floats as 32-bit float EXR (exactly), linear and unclamped.
+            const std::string exr = exrName(png);
+            if (auto w = splatfx::writeImage(outputs->path(exr), img); !w) return fail(w.error());
+            auto h = render::hashFile(outputs->path(exr));
+            if (!h) return fail(h.error());
+            hashes[exr] = {i, *h};
+            outputs->add(exr);
+        }
         auto hash = render::hashFile(outputs->path(png));
         if (!hash) return fail(hash.error());
         hashes[png] = {i, *hash};

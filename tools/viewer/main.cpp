@@ -60,6 +60,7 @@ struct Args {
     splatfx::DepthConvention depth{}; // --reverse-z, --clip-01, --infinite-far
     int msaa = 0;                     // --msaa N: the viewer's own target multisampled, resolved before the window
     bool srgb = false;                // --srgb: the viewer's own target sRGB, GL_FRAMEBUFFER_SRGB on while splatfx draws
+    bool hdr = false;        // an RGBA16F target of its own and HDR lit colours (shown clamped at 1 in the 8-bit window)
 };
 
 // Returns -1 to go on, else the exit code (0 after --help, 2 after a bad command line).
@@ -90,6 +91,11 @@ int parse(int argc, char** argv, Args& a) {
         ->check(CLI::IsMember({1, 2, 4, 8, 16}))
         ->type_name("N");
     app.add_flag("--srgb", a.srgb, "draw into an sRGB colour target with GL_FRAMEBUFFER_SRGB on (blending in linear; the window shows the sRGB codes)");
+    app.add_flag("--hdr", a.hdr,
+                 "draw into an RGBA16F framebuffer of the viewer's own with HDR lit colours (Scene::setHdrLit), as splatfx-render --hdr; "
+                 "the 8-bit window shows it clamped at 1 (no tone curve: exposure is the host's)")
+        ->excludes("--into-window")
+        ->excludes("--srgb");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
     if (seedOption->count()) a.seed = seed;
     // The window's default framebuffer is single-sampled RGBA8: the engine targets are the viewer's own.
@@ -160,6 +166,7 @@ struct Viewer {
         }
         error.clear();
         player.emplace(std::move(*r));
+        player->file().scene.setHdrLit(args.hdr);
         path = p;
         std::snprintf(pathInput, sizeof pathInput, "%s", p.c_str());
         time = 0.0;
@@ -473,6 +480,7 @@ static int viewerMain(int argc, char** argv) {
                 // The same target splatfx-render draws into for the same flags.
                 auto fb = splatfx::gl::Framebuffer::create({.width = fbSize.x,
                                                             .height = fbSize.y,
+                                                            .color = v.args.hdr ? splatfx::gl::Precision::F16 : splatfx::gl::Precision::U8,
                                                             .floatDepth = v.args.depth.reversed,
                                                             .samples = v.args.msaa,
                                                             .srgb = v.args.srgb});
@@ -483,7 +491,8 @@ static int viewerMain(int argc, char** argv) {
                 }
                 v.target.emplace(std::move(*fb));
                 if (v.args.msaa > 1) {
-                    auto single = splatfx::gl::Framebuffer::create({.width = fbSize.x, .height = fbSize.y, .srgb = v.args.srgb});
+                    auto single = splatfx::gl::Framebuffer::create(
+                        {.width = fbSize.x, .height = fbSize.y, .color = v.args.hdr ? splatfx::gl::Precision::F16 : splatfx::gl::Precision::U8, .srgb = v.args.srgb});
                     if (!single) {
                         std::fprintf(stderr, "splatfx-viewer: %s\n", single.error().c_str());
                         rc = 1;

@@ -127,9 +127,9 @@ struct SplatExactDesc {
     bool trimCorners = false;                        // match RendererDesc::trimCorners (octagon vs square quad); default false, as the renderer's
     int threads = 0;                                 // worker threads; 0 = std::thread::hardware_concurrency(); default 0
     // Lighting: false reads each splat's colour table exactly at its
-    // colour coordinate (unlit splats); true uses the splat's RGBA8 colour,
-    // which is what the GL pass draws and where a Scene puts lit colours
-    // (docs/lighting.md, "In a Scene"). Default false.
+    // colour coordinate (unlit splats); true uses the splat's RGBA8 colour
+    // times its HDR scale (splatColor), which is what the GL pass draws and
+    // where a Scene puts lit colours (docs/lighting.md, "In a Scene"). Default false.
     bool packedColor = false;
     // Fog: the medium the splats and the host are seen through,
     // integrated numerically (integrateFogNumerically, never the closed

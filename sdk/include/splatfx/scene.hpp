@@ -289,6 +289,13 @@ public:
     void setLighting(EffectId id, const EffectLighting& lighting) { mEntries.at(id).options.lighting = lighting; }
     void setSceneShadow(const SceneShadowDesc& desc) { mSceneShadowDesc = desc; }
     const SceneShadowDesc& sceneShadow() const { return mSceneShadowDesc; }
+    // HDR lit colour (docs/lighting.md, "HDR lit colour"): on, a lit colour
+    // brighter than 1 keeps its brightness as a per-splat scale (Splat,
+    // splatColor) for a floating-point target (RGBA16F, RGBA32F); off, it is
+    // scaled down to 1 keeping its hue, for 8-bit targets. Colours <= 1 are
+    // the same either way. Default off.
+    void setHdrLit(bool on) { mHdrLit = on; }
+    bool hdrLit() const { return mHdrLit; }
     // The last lighting failure (a bad EffectLighting or SceneShadowDesc, a
     // sceneShadow.light past the lights, the shadow tables over
     // Budgets::lightingBytes: the effect is drawn unlit, or no scene shadow);
@@ -349,6 +356,7 @@ private:
     bool mUpdated = false;
     std::vector<Light> mLights;
     SceneShadowDesc mSceneShadowDesc;
+    bool mHdrLit = false;
     ShadowTable mSceneShadow;
     ShadowTableDesc mSceneShadowTableDesc; // what mSceneShadow was made with
     std::uint64_t mSceneShadowVersion = 0; // bumped whenever the scene shadow's contents change

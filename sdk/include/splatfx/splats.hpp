@@ -40,6 +40,12 @@ namespace splatfx {
 // at colorCoord in row colorRow, quantized to 8 bits per channel by the
 // builder, so the GPU needs no colour lookup; colorCoord and colorRow stay for
 // the reference renderer, which reads the table exactly.
+// A Scene's HDR lit colour (Scene::setHdrLit, docs/lighting.md "HDR lit
+// colour") is the one exception: colorCoord < 0 marks a lit colour whose
+// largest channel exceeds 1, color.rgb holds its chroma (the colour divided
+// by that channel) and -colorCoord that channel, so
+//   colour = -colorCoord * color.rgb    (splatColor)
+// The vertex fetch already reads that float: the scale costs no bytes.
 struct Splat {
     glm::vec3 center{0.0f};
     float density = 0.0f;  // optical depth scale, log2 units (includes the near-plane fade when SplatBuilderDesc::nearFade)
@@ -67,6 +73,9 @@ static_assert(sizeof(Splat) == 64, "Splat must match the GPU layout");
 // as code = 127 + round(32 log2 rho) in [0, 254] (1.1 % steps, rho in
 // [2^-3.97, 2^3.97], clamped), 255 meaning exactly 1.
 std::uint8_t rayScaleCode(float rho);
+// The linear colour the GL pass draws a splat with: color.rgb / 255, times
+// -colorCoord when colorCoord < 0 (an HDR lit colour, see Splat).
+glm::vec3 splatColor(const Splat& splat);
 float rayScaleRho(std::uint8_t code);
 // World length per kernel unit along the splat's centre ray (see above);
 // 0 for a degenerate ellipse.

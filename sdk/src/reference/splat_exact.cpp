@@ -251,7 +251,8 @@ Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& c
                 }
                 const std::uint32_t row = std::uint32_t(std::lround(s.colorRow));
                 const glm::dvec3 base =
-                    desc.packedColor ? glm::dvec3(double(s.color & 255u), double((s.color >> 8) & 255u), double((s.color >> 16) & 255u)) / 255.0
+                    desc.packedColor ? glm::dvec3(double(s.color & 255u), double((s.color >> 8) & 255u), double((s.color >> 16) & 255u)) / 255.0 *
+                                           (s.colorCoord < 0.0f ? -double(s.colorCoord) : 1.0)
                     : row < materials.colorTableCount() ? reference::rowColor(materials.colorRow(row), s.colorCoord)
                                                         : glm::dvec3(1.0);
                 const glm::dvec3 col = base * glm::dvec3(tex);

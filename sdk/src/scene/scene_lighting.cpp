@@ -6,6 +6,7 @@
 // surfaces (FrameShadow).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "splat/color_table_entry.hpp"
 #include "splatfx/scene.hpp"
@@ -15,14 +16,17 @@ namespace {
 
 // Lit linear colour into the splat's RGBA8: a colour brighter than 1 in any
 // channel is scaled down by its largest channel, keeping its hue (a clamp per
-// channel would turn a bright orange flame yellow-white). So the lights'
-// intensities set the brightness up to the table colour's saturation, and a
-// brighter light can only whiten nothing: keep lit colours <= 1 for an
-// unsaturated look (docs/lighting.md, "In a Scene").
-std::uint32_t packLit(glm::vec3 c) {
-    for (int a = 0; a < 3; ++a) c[a] = std::isfinite(c[a]) ? std::max(c[a], 0.0f) : 0.0f;
+// channel would turn a bright orange flame yellow-white). Without HDR the
+// lights' intensities set the brightness up to the table colour's
+// saturation; with HDR (Scene::setHdrLit) that channel goes into the splat's
+// colorCoord as -m (splats.hpp, Splat), so the GL pass draws m x chroma.
+// Colours <= 1 are packed the same either way (8-bit hosts are unchanged).
+std::uint32_t packLit(glm::vec3 c, float* scale) {
+    // NaN is no light; a product that overflowed float is the brightest colour float holds.
+    for (int a = 0; a < 3; ++a) c[a] = std::isnan(c[a]) ? 0.0f : std::clamp(c[a], 0.0f, std::numeric_limits<float>::max());
     const float m = std::max({c.r, c.g, c.b});
-    if (m > 1.0f) c /= m;
+    *scale = 1.0f;
+    if (m > 1.0f) c /= m, *scale = m;
     return std::uint32_t(c.r * 255.0f + 0.5f) | std::uint32_t(c.g * 255.0f + 0.5f) << 8 | std::uint32_t(c.b * 255.0f + 0.5f) << 16 | 0xff000000u;
 }
 
@@ -130,7 +134,10 @@ void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& mater
         const std::uint32_t row = std::uint32_t(std::lround(sp.colorRow));
         const ColorTable* table = row < materials.colorTableCount() ? &materials.colorTable(row) : nullptr;
         // The top byte is the depth cut's along-ray scale (splats.hpp, rayScaleCode): kept.
-        sp.color = (packLit(glm::vec3(detail::colorTableEntry(table, sp.colorCoord)) * lit.factors[i]) & 0x00ffffffu) | (sp.color & 0xff000000u);
+        float scale = 1.0f;
+        sp.color = (packLit(glm::vec3(detail::colorTableEntry(table, sp.colorCoord)) * lit.factors[i], &scale) & 0x00ffffffu) |
+                   (sp.color & 0xff000000u);
+        if (mHdrLit && scale > 1.0f) sp.colorCoord = -scale;
     }
     e.status.lit = true;
     ++mCounters.litEffects;

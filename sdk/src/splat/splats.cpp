@@ -267,6 +267,11 @@ std::uint8_t rayScaleCode(float rho) {
 
 float rayScaleRho(std::uint8_t code) { return code == 255 ? 1.0f : std::exp2((float(code) - 127.0f) / 32.0f); }
 
+glm::vec3 splatColor(const Splat& sp) {
+    const glm::vec3 c = glm::vec3(float(sp.color & 255u), float((sp.color >> 8) & 255u), float((sp.color >> 16) & 255u)) / 255.0f;
+    return sp.colorCoord < 0.0f ? -sp.colorCoord * c : c;
+}
+
 float splatRayScale(const Splat& sp, float footprintRadius) {
     const float area = glm::length(glm::cross(sp.axisU, sp.axisV));
     if (!(area > 0.0f) || !(footprintRadius > 0.0f) || !std::isfinite(area)) return 0.0f;

@@ -10,7 +10,7 @@
 #include "partial.glsl"
 #endif
 layout(location = 0) in vec4 aCenterDensity;
-layout(location = 1) in vec4 aAxisUColor;
+layout(location = 1) in vec4 aAxisUColor; // w: colorCoord (< 0: an HDR lit colour's scale)
 layout(location = 2) in vec4 aAxisVRow;
 layout(location = 3) in uvec2 aLayers;
 layout(location = 4) in float aBlend;
@@ -124,7 +124,8 @@ void main() {
     vTex = vec2(0.5 + 0.5 * uv.x, 0.5 - 0.5 * uv.y);
     vDensity = aCenterDensity.w;
     vLayers = vec3(float(aLayers.x), float(aLayers.y), aBlend);
-    vColor = aColor.rgb;
+    // colorCoord < 0: an HDR lit colour's scale (splats.hpp, Splat); else exactly the RGBA8 colour.
+    vColor = aAxisUColor.w < 0.0 ? -aAxisUColor.w * aColor.rgb : aColor.rgb;
 #if FOG
 #if FOG_PER_SPLAT
     vFogF = splatfx_fog_transmittance(vec3(0.0), aCenterDensity.xyz - uFogEye);
