@@ -63,6 +63,8 @@ void main() {
     vec3 toLight = normalize(uLight.w == 0.0 ? uLight.xyz : uLight.xyz - vWorld);
     float diffuse = max(dot(n, toLight), 0.0) * splatfx_shadow(vWorld);
     vec3 lit = uColor * (0.25 + 0.75 * diffuse * uLightColor);
+    // Light from the frame's fires (shadowGlsl): a Lambertian surface reflects albedo * E / pi.
+    lit += uColor * splatfx_emittedIrradiance(vWorld, n) * 0.31830989;
     fragColor = vec4(lit, 1.0);
 }
 )";
@@ -102,6 +104,7 @@ void main() {
     vec3 toLight = normalize(uLight.w == 0.0 ? uLight.xyz : uLight.xyz - vWorld);
     float diffuse = max(dot(n, toLight), 0.0) * splatfx_shadow(vWorld);
     vec3 lit = uColor * (0.25 + 0.75 * diffuse * uLightColor);
+    lit += uColor * splatfx_emittedIrradiance(vWorld, n) * 0.31830989;
     fragColor = vec4(mix(splatfx_fog_colour, lit, vFog), 1.0);
 }
 )";

@@ -30,6 +30,7 @@
 #include <glm/glm.hpp>
 
 #include "splatfx/camera.hpp"
+#include "splatfx/emitted_light.hpp"
 #include "splatfx/fog.hpp"
 #include "splatfx/splats.hpp"
 #include "splatfx/volume.hpp"
@@ -122,6 +123,13 @@ public:
     const Fog* fog() const { return mFog.get(); }
     const std::shared_ptr<const Fog>& sharedFog() const { return mFog; }
 
+    // Light the frame's emissive volumes give the host's surfaces (cleared by
+    // begin()): what splatfx_emittedIrradiance of shadowGlsl() adds, through
+    // gl::ShadowBinding. Scene::prepare fills it (EffectOptions::emitsLight),
+    // brightest first, at most kMaxEmittedLights. emitted_light.hpp.
+    std::vector<EmittedLight>& emittedLights() { return mEmittedLights; }
+    const std::vector<EmittedLight>& emittedLights() const { return mEmittedLights; }
+
     // Volumes to draw as tetrahedra (cleared by begin()).
     std::vector<FrameVolume>& volumes() { return mVolumes; }
     const std::vector<FrameVolume>& volumes() const { return mVolumes; }
@@ -136,6 +144,7 @@ private:
     double mTime = 0.0;
     std::shared_ptr<const Fog> mFog; // default none
     std::vector<FrameVolume> mVolumes;
+    std::vector<EmittedLight> mEmittedLights;
     std::vector<DrawBatch> mDrawOrder;
 };
 

@@ -54,6 +54,7 @@
 #include "splatfx/camera.hpp"
 #include "splatfx/effect.hpp"
 #include "splatfx/effect_kind.hpp"
+#include "splatfx/emitted_light.hpp"
 #include "splatfx/fog.hpp"
 #include "splatfx/frame.hpp"
 #include "splatfx/lighting.hpp"
@@ -137,6 +138,11 @@ struct EffectOptions {
     // combined with the options given to prepare()/emit(). Default EmitOptions{}.
     EmitOptions draw{};
     EffectLighting lighting{}; // default unlit
+    // An emissive effect as light for the host's surfaces: point lights
+    // fitted to its splats each frame into Frame::emittedLights()
+    // (emitted_light.hpp). Out of view it is still advanced (not drawn) while
+    // its bounds grown by reachWorld touch the view. Default off.
+    EmittedLightDesc emitsLight{};
     // LOD volumes and ground fog: the per-frame refinement (c, morphing,
     // per-node frustum culling, near clipping). Default LodRefineDesc{}.
     LodRefineDesc refine{};
@@ -158,6 +164,10 @@ struct EffectStatus {
     // (Scene::shadowReachesView): advanced to the time and put into the scene
     // shadow, not emitted (docs/lighting.md, "Scheduled by light influence").
     bool castsIntoView = false;
+    // Not needed (out of view), but emitting light (EffectOptions::emitsLight)
+    // whose reach touches the view: advanced and its lights fitted, not drawn.
+    bool lightsIntoView = false;
+    std::size_t emittedLights = 0;       // point lights it gave the last prepare()
     bool inSceneShadow = false;          // its density was in the frame's scene shadow at the last prepare()
     std::uint64_t framesNeeded = 0;      // updates where it was needed
     std::uint64_t framesCastOnly = 0;    // updates where it was advanced only to cast into the view (castsIntoView)
@@ -194,6 +204,10 @@ struct SceneCounters {
     std::size_t fogTermsDrawn = 0;
     std::size_t fogTermsSkipped = 0;
     bool fogSkipped = false;
+    // Emitted lights (EffectOptions::emitsLight) at the last prepare(): fitted,
+    // and the dimmest dropped past kMaxEmittedLights (the frame keeps the brightest).
+    std::size_t emittedLights = 0;
+    std::size_t emittedLightsDropped = 0;
     // Frames whose dropped terms left a fog that failed validation (a dropped
     // term held the rest non-negative): the full fog was drawn (cumulative).
     std::uint64_t fogCullFallbacks = 0;
@@ -295,6 +309,9 @@ public:
     // empty when the last emit() had none. Hosts must show it: the render
     // tool fails the frame, the C API's prepare returns it.
     const std::string& lightingError() const { return mLightingError; }
+    // The lights the emissive effects gave at the last prepare() (all of
+    // them, brightest first; the Frame keeps the first kMaxEmittedLights).
+    std::span<const EmittedLight> emittedLights() const { return mEmittedLights; }
     // What the scene may spend; only lightingBytes is read here (every light
     // x every table-lit effect's table, plus the scene shadow, checked
     // before any table is built). Default Budgets{}; loadSceneFile sets the
@@ -338,6 +355,8 @@ private:
     // kind has none or it is bad (then mLightingError says why).
     bool updateLitField(Entry& e, const Materials& materials, const EmitOptions& draw);
     void shadeScene(Frame& frame); // fills frame.shadow()
+    // Fits e's emitted lights (EffectOptions::emitsLight) into mEmittedLights.
+    void fitLights(Entry& e, const Camera& camera, const Materials& materials, const EmitOptions& draw);
     // The shadow tables' bytes against mBudgets.lightingBytes; the error when over.
     Status checkLightingBudget() const;
     // The fog this camera's frame draws: mFog without the terms it cannot see (scene_fog.cpp).
@@ -348,6 +367,8 @@ private:
     double mTime = 0.0;
     bool mUpdated = false;
     std::vector<Light> mLights;
+    std::vector<EmittedLight> mEmittedLights;
+    SplatBuilder mLightScratch{SplatBuilderDesc{.frustumCull = false}}; // an emitter's whole splats, fitted, never drawn
     SceneShadowDesc mSceneShadowDesc;
     ShadowTable mSceneShadow;
     ShadowTableDesc mSceneShadowTableDesc; // what mSceneShadow was made with

@@ -116,9 +116,9 @@ Status Scene::update(double timeSec, const Camera& camera) {
     const Light* shadowLight = mSceneShadowDesc.enabled && mSceneShadowDesc.light < mLights.size() ? &mLights[mSceneShadowDesc.light] : nullptr;
     for (Entry& e : mEntries) {
         EffectStatus& s = e.status;
-        const bool wasAdvanced = s.needed || s.castsIntoView;
+        const bool wasAdvanced = s.needed || s.castsIntoView || s.lightsIntoView;
         s.enabled = e.options.enabled;
-        s.needed = s.castsIntoView = false;
+        s.needed = s.castsIntoView = s.lightsIntoView = false;
         if (!s.enabled) {
             ++s.framesSkipped;
             continue;
@@ -134,7 +134,11 @@ Status Scene::update(double timeSec, const Camera& camera) {
         const bool caster = shadowLight && s.inRange && !s.inView && e.options.lighting.enabled && e.options.lighting.castsShadow;
         const bool casts = caster && shadowReachesView(s.bounds, *shadowLight, camera);
         if (caster && !casts) ++mCounters.castersCulled;
-        s.alive = (s.inView || casts) && e.kind->alive(timeSec, AliveHints{.deadDensity = e.options.deadDensity});
+        // Out of view, an emitter still lights what is in view within its reach.
+        const EmittedLightDesc& emits = e.options.emitsLight;
+        const bool lights = emits.enabled && s.inRange && !s.inView && !casts &&
+                            inFrustum(Aabb{s.bounds.lo - glm::vec3(emits.reachWorld), s.bounds.hi + glm::vec3(emits.reachWorld)}, camera);
+        s.alive = (s.inView || casts || lights) && e.kind->alive(timeSec, AliveHints{.deadDensity = e.options.deadDensity});
         if (!s.alive) {
             ++s.framesSkipped;
             continue;
@@ -150,7 +154,9 @@ Status Scene::update(double timeSec, const Camera& camera) {
             ++s.framesNeeded;
             ++mCounters.needed;
         } else {
-            s.castsIntoView = true;
+            // Advanced for its shadow or its light only (counted as cast-only work).
+            s.castsIntoView = casts;
+            s.lightsIntoView = lights;
             ++s.framesCastOnly;
             ++mCounters.castOnly;
         }
@@ -165,6 +171,7 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
     mCounters.litEffects = 0;
     mCounters.shadowTableBuilds = mCounters.shadowTableReuses = mCounters.shadowTableSkips = 0;
     mTablesFit = true;
+    mEmittedLights.clear();
     if (Status s = checkLightingBudget(); !s) {
         mLightingError = s.error();
         mTablesFit = false;
@@ -193,10 +200,26 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
             lightEmitted(e, builder, materials, first, draw);
         // Not drawn but casting into the view: only the density the light sees.
         if (e.status.castsIntoView && !updateLitField(e, materials, draw)) e.status.castsIntoView = false;
+        e.status.emittedLights = 0;
+        if (e.options.emitsLight.enabled && (e.status.needed || e.status.lightsIntoView)) fitLights(e, builder.camera(), materials, draw);
     }
     mCounters.splats = splats;
     mCounters.tetrahedra = tetrahedra;
     return splats;
+}
+
+void Scene::fitLights(Entry& e, const Camera& camera, const Materials& materials, const EmitOptions& draw) {
+    // Every splat, in view or not (no frustum culling), so the light does not
+    // change as the effect crosses the view's edge; drawn nowhere.
+    mLightScratch.begin(camera);
+    e.kind->emit(EmitContext{.splats = mLightScratch, .volumes = nullptr, .materials = materials, .draw = draw});
+    Result<std::vector<EmittedLight>> lights = fitEmittedLights(mLightScratch.splats(), materials, e.options.emitsLight);
+    if (!lights) {
+        mLightingError = "effect '" + e.options.name + "': " + lights.error();
+        return;
+    }
+    e.status.emittedLights = lights->size();
+    mEmittedLights.insert(mEmittedLights.end(), lights->begin(), lights->end());
 }
 
 std::size_t Scene::emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options) {
@@ -209,6 +232,14 @@ Status Scene::prepare(double timeSec, const Camera& camera, const Materials& mat
     frame.begin(timeSec, camera);
     emitInto(frame.builder(), &frame.volumes(), materials, options);
     shadeScene(frame); // the lit effects' shadow on the scene, into frame.shadow()
+    // The emitters' lights, brightest first; the frame keeps what the GLSL holds.
+    std::stable_sort(mEmittedLights.begin(), mEmittedLights.end(), [](const EmittedLight& a, const EmittedLight& b) {
+        return a.intensity.x + a.intensity.y + a.intensity.z > b.intensity.x + b.intensity.y + b.intensity.z;
+    });
+    const std::size_t kept = std::min<std::size_t>(mEmittedLights.size(), kMaxEmittedLights);
+    frame.emittedLights().assign(mEmittedLights.begin(), mEmittedLights.begin() + std::ptrdiff_t(kept));
+    mCounters.emittedLights = mEmittedLights.size();
+    mCounters.emittedLightsDropped = mEmittedLights.size() - kept;
     frame.end();
     frame.setFog(fogForView(camera, timeSec)); // only the terms this view can see
     FrameCounters& c = frame.counters();

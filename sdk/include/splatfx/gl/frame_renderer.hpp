@@ -138,9 +138,12 @@ struct ShadowBinding {
     unsigned texture = 0;                            // GL name of the 3D texture (GL_R32F)
     glm::mat4 worldToTable{1.0f};                    // uniform mat4 splatfx_worldToTable
     glm::vec4 lightInTable{0.0f, -1.0f, 0.0f, 0.0f}; // uniform vec4 splatfx_shadowLight
+    // The frame's emitted lights (Frame::emittedLights): splatfx_emittedIrradiance's uniforms.
+    std::vector<EmittedLight> emittedLights{};
 };
-// Sets shadowGlsl()'s three uniforms on `program` (glProgramUniform: the
-// program need not be bound). Call it in the opaque hook, each frame.
+// Sets shadowGlsl()'s uniforms on `program` (glProgramUniform: the
+// program need not be bound): the table's three and the emitted lights'.
+// Call it in the opaque hook, each frame.
 void setShadowUniforms(unsigned program, const ShadowBinding& binding);
 
 // What the host owns, handed over for one frame.

@@ -24,3 +24,28 @@ float splatfx_shadow(vec3 worldPos) {
     float depth = texture(splatfx_shadowTable, (q * (n - 1.0) + 0.5) / n).r;
     return exp2(-depth);
 }
+
+// Light from emissive volumes (splatfx::EmittedLight, emitted_light.hpp):
+// point lights fitted to a fire's splats each frame. Mirrors
+// splatfx::emittedIrradiance; count 0 (no emitter in the frame) gives 0.
+const int splatfx_kMaxEmittedLights = 8;                            // splatfx::kMaxEmittedLights
+uniform int splatfx_emittedLightCount;                              // <= splatfx_kMaxEmittedLights
+uniform vec4 splatfx_emittedLightPosition[splatfx_kMaxEmittedLights]; // xyz world, w radius
+uniform vec3 splatfx_emittedLightIntensity[splatfx_kMaxEmittedLights]; // linear RGB x world area
+uniform vec3 splatfx_emittedLightEscapePlus[splatfx_kMaxEmittedLights];  // share leaving along +x, +y, +z
+uniform vec3 splatfx_emittedLightEscapeMinus[splatfx_kMaxEmittedLights]; // ... along -x, -y, -z
+
+vec3 splatfx_emittedIrradiance(vec3 worldPos, vec3 normal) {
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < min(splatfx_emittedLightCount, splatfx_kMaxEmittedLights); ++i) {
+        vec3 d = splatfx_emittedLightPosition[i].xyz - worldPos;
+        float d2 = dot(d, d);
+        if (d2 <= 0.0) continue;
+        vec3 w = -d * inversesqrt(d2); // from the light towards the point
+        float cosine = max(dot(normal, -w), 0.0);
+        vec3 escape = mix(splatfx_emittedLightEscapeMinus[i], splatfx_emittedLightEscapePlus[i], step(vec3(0.0), w));
+        float r = splatfx_emittedLightPosition[i].w;
+        sum += splatfx_emittedLightIntensity[i] * (dot(w * w, escape) * cosine / (d2 + r * r));
+    }
+    return sum;
+}

@@ -1,5 +1,7 @@
 #include "shadow_pass.hpp"
 
+#include <algorithm>
+
 #include <epoxy/gl.h>
 #include <glm/gtc/type_ptr.hpp>
 
@@ -57,12 +59,14 @@ void ShadowPass::unbind() {
 }
 
 ShadowBinding ShadowPass::binding() const {
-    return {.valid = mValid, .textureUnit = mUnit, .texture = mTexture, .worldToTable = mWorldToTable, .lightInTable = mLight};
+    return {.valid = mValid, .textureUnit = mUnit, .texture = mTexture, .worldToTable = mWorldToTable, .lightInTable = mLight, .emittedLights = mEmitted};
 }
 
 void ShadowPass::execute(const PlanStep& step, StepContext& context) {
     if (step.kind == StepKind::UploadShadow) {
         if (uploadTable(context.frame.shadow())) ++mUploads;
+        const std::vector<EmittedLight>& lights = context.frame.emittedLights();
+        mEmitted.assign(lights.begin(), lights.begin() + std::min<std::ptrdiff_t>(std::ptrdiff_t(lights.size()), kMaxEmittedLights));
         bind();
     } else {
         unbind();
@@ -79,6 +83,20 @@ void setShadowUniforms(unsigned program, const ShadowBinding& b) {
     glProgramUniform1i(program, glGetUniformLocation(program, "splatfx_shadowTable"), b.textureUnit);
     glProgramUniformMatrix4fv(program, glGetUniformLocation(program, "splatfx_worldToTable"), 1, GL_FALSE, glm::value_ptr(b.worldToTable));
     glProgramUniform4fv(program, glGetUniformLocation(program, "splatfx_shadowLight"), 1, glm::value_ptr(b.lightInTable));
+    const int count = int(std::min<std::size_t>(b.emittedLights.size(), std::size_t(kMaxEmittedLights)));
+    glm::vec4 position[kMaxEmittedLights]{};
+    glm::vec3 intensity[kMaxEmittedLights]{}, plus[kMaxEmittedLights]{}, minus[kMaxEmittedLights]{};
+    for (int i = 0; i < count; ++i) {
+        position[i] = glm::vec4(b.emittedLights[i].position, b.emittedLights[i].radius);
+        intensity[i] = b.emittedLights[i].intensity;
+        plus[i] = b.emittedLights[i].escapePlus;
+        minus[i] = b.emittedLights[i].escapeMinus;
+    }
+    glProgramUniform1i(program, glGetUniformLocation(program, "splatfx_emittedLightCount"), count);
+    glProgramUniform4fv(program, glGetUniformLocation(program, "splatfx_emittedLightPosition"), kMaxEmittedLights, glm::value_ptr(position[0]));
+    glProgramUniform3fv(program, glGetUniformLocation(program, "splatfx_emittedLightIntensity"), kMaxEmittedLights, glm::value_ptr(intensity[0]));
+    glProgramUniform3fv(program, glGetUniformLocation(program, "splatfx_emittedLightEscapePlus"), kMaxEmittedLights, glm::value_ptr(plus[0]));
+    glProgramUniform3fv(program, glGetUniformLocation(program, "splatfx_emittedLightEscapeMinus"), kMaxEmittedLights, glm::value_ptr(minus[0]));
 }
 
 } // namespace splatfx::gl

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "splatfx/frame.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
@@ -41,6 +42,7 @@ private:
     glm::vec4 mLight{0.0f, -1.0f, 0.0f, 0.0f};
     int mSavedBinding = 0;
     std::uint64_t mUploads = 0;
+    std::vector<EmittedLight> mEmitted; // the last frame's, at most kMaxEmittedLights
 };
 
 } // namespace splatfx::gl::detail
