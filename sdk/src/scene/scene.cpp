@@ -111,9 +111,9 @@ Status Scene::update(double timeSec, const Camera& camera) {
     mUpdated = true;
     mCounters.needed = mCounters.simulated = mCounters.castOnly = mCounters.castersCulled = 0;
     const glm::vec3 eye = camera.eye();
-    // The light whose shadow on the scene goes into the frame: casters out of
-    // view are scheduled by where their shadow falls towards it.
-    const Light* shadowLight = mSceneShadowDesc.enabled && mSceneShadowDesc.light < mLights.size() ? &mLights[mSceneShadowDesc.light] : nullptr;
+    // Every light may shadow the scene (SceneShadowDesc): casters out of view
+    // are scheduled by where their shadow falls away from any of them.
+    const bool shadowing = mSceneShadowDesc.enabled && mSceneShadowDesc.light < mLights.size();
     for (Entry& e : mEntries) {
         EffectStatus& s = e.status;
         const bool wasAdvanced = s.needed || s.castsIntoView || s.lightsIntoView;
@@ -131,8 +131,9 @@ Status Scene::update(double timeSec, const Camera& camera) {
         s.inView = s.inRange && inFrustum(s.bounds, camera);
         // Out of view, a lit caster still matters where its shadow reaches the
         // view (light influence, not visibility): it is advanced, not drawn.
-        const bool caster = shadowLight && s.inRange && !s.inView && e.options.lighting.enabled && e.options.lighting.castsShadow;
-        const bool casts = caster && shadowReachesView(s.bounds, *shadowLight, camera);
+        const bool caster = shadowing && s.inRange && !s.inView && e.options.lighting.enabled && e.options.lighting.castsShadow;
+        bool casts = false;
+        for (std::size_t i = 0; caster && !casts && i < mLights.size(); ++i) casts = shadowReachesView(s.bounds, mLights[i], camera);
         if (caster && !casts) ++mCounters.castersCulled;
         // Out of view, an emitter still lights what is in view within its reach.
         const EmittedLightDesc& emits = e.options.emitsLight;
@@ -231,7 +232,7 @@ Status Scene::prepare(double timeSec, const Camera& camera, const Materials& mat
     if (Status s = update(timeSec, camera); !s) return s;
     frame.begin(timeSec, camera);
     emitInto(frame.builder(), &frame.volumes(), materials, options);
-    shadeScene(frame); // the lit effects' shadow on the scene, into frame.shadow()
+    shadeScene(frame); // the lit effects' shadows on the scene, into frame.shadows()
     // The emitters' lights, brightest first; the frame keeps what the GLSL holds.
     std::stable_sort(mEmittedLights.begin(), mEmittedLights.end(), [](const EmittedLight& a, const EmittedLight& b) {
         return a.intensity.x + a.intensity.y + a.intensity.z > b.intensity.x + b.intensity.y + b.intensity.z;
@@ -246,6 +247,8 @@ Status Scene::prepare(double timeSec, const Camera& camera, const Materials& mat
     c.litEffects = mCounters.litEffects;
     c.shadowTableBuilds = mCounters.shadowTableBuilds;
     c.shadowTableReuses = mCounters.shadowTableReuses;
+    c.shadowLights = mCounters.sceneShadowLights;
+    c.shadowLightsDropped = mCounters.sceneShadowLightsOverMax + mCounters.sceneShadowLightsOverBudget;
     c.declared = mCounters.declared;
     c.needed = mCounters.needed;
     c.simulated = mCounters.simulated;
