@@ -267,9 +267,9 @@ TEST(ShadowLightsHardCases, ASpotConeGrazingTheCasterBuildsItsTableAndOneJustMis
     const float dist = glm::length(c - pos), outer = 0.2f;
     const float edge = outer + std::asin(r / dist);
     auto spotAt = [&](float angle) {
-        // Rotate the axis from "at the centre" (+x) by `angle` about z.
-        const glm::vec3 axis(std::cos(angle), std::sin(angle), 0.0f);
-        return Light::spot(pos, axis, 0.1f, outer);
+        // The axis turned `angle` away from the caster's centre, in a plane through it.
+        const glm::vec3 toCentre = glm::normalize(c - pos), across = glm::normalize(glm::cross(toCentre, glm::vec3(0.0f, 0.0f, 1.0f)));
+        return Light::spot(pos, std::cos(angle) * toCentre + std::sin(angle) * across, 0.1f, outer);
     };
     ASSERT_TRUE(s.scene.addLight(kSun));
     ASSERT_TRUE(s.scene.addLight(spotAt(edge - 1e-3f)));

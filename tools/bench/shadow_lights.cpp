@@ -157,6 +157,23 @@ int runShadowLights(const std::string& out, int frames, bool noPlots) {
         std::sort(v.begin(), v.end());
         return v[v.size() / 2];
     };
+    // What Scene::prepare costs without any scene shadow (emitting and lighting the plume): the
+    // traced rows add their tracing to it, so both columns time the same frame.
+    double baseline = 0.0;
+    {
+        Scene scene;
+        scene.add(*Effect::fromGrid(g, desc), {.name = "plume", .lighting = {.enabled = true, .selfShadow = SelfShadow::Off}});
+        (void)scene.addLight(lightAt(0, 0.0f));
+        scene.setSceneShadow({.enabled = false});
+        Frame frame;
+        std::vector<double> t;
+        for (int f = 0; f < frames + 1; ++f) {
+            const std::clock_t a = std::clock();
+            (void)scene.prepare(f / 30.0, cam, materials, frame);
+            if (f > 0) t.push_back(cpuMs(a, std::clock()));
+        }
+        baseline = median(t);
+    }
     for (int dims : {16, 32, 64}) {
         for (int n = 1; n <= kMaxShadowLights; ++n) {
             if (dims != 32 && n != kMaxShadowLights) continue; // the dims knob at 4 lights; the light count at 32^3
@@ -211,15 +228,17 @@ int runShadowLights(const std::string& out, int frames, bool noPlots) {
                         for (glm::vec3 p : ground) sink += field->opticalDepthToLight(p, scene.lights()[std::size_t(i)]);
                     times.push_back(cpuMs(a, std::clock()));
                 }
-                std::snprintf(extra, sizeof extra, "%.3f | - | %d", median(times) + (sink < 0.0f ? 1.0 : 0.0), n);
-                rows.push_back({.knob = "traced ground", .setting = std::to_string(n) + " light(s)", .ms = median(times), .rmse = 0.0, .maxErr = 0.0, .extra = extra});
+                const double tracedMs = baseline + median(times) + (sink < 0.0f ? 1e-9 : 0.0);
+                std::snprintf(extra, sizeof extra, "%.3f | - | %d", tracedMs, n);
+                rows.push_back({.knob = "traced ground", .setting = std::to_string(n) + " light(s)", .ms = tracedMs, .rmse = 0.0, .maxErr = 0.0, .extra = extra});
             }
         }
     }
     bench::markPareto(rows);
     std::printf("\nEvery light casts: ms = Scene::prepare with every light moving (all tables rebuilt); static = nothing moving.\n"
-                "RMSE / max error: the ground's transmittance (every light) against tracing. Traced ground: tracing 19200 points per light\n"
-                "instead (its static cost is the same: tracing keeps nothing).");
+                "RMSE / max error: the ground's transmittance (every light) against tracing. Traced ground: Scene::prepare without\n"
+                "scene shadows (%.3f ms) plus tracing the 19200 points to each light (moving or not: tracing keeps nothing).",
+                baseline);
     bench::printTable(rows, "CPU ms/frame (lights moving)", "static ms/frame | tables built/frame | tables");
 
     // A point light inside the plume: box table against the light's own parameterisation at equal memory.
@@ -268,5 +287,7 @@ int runShadowLights(const std::string& out, int frames, bool noPlots) {
     std::error_code ec;
     std::filesystem::create_directories(out, ec);
     rows.insert(rows.end(), inRows.begin(), inRows.end());
+    // The traced rows are the reference (error 0): off the log-scale plot.
+    rows.erase(std::remove_if(rows.begin(), rows.end(), [](const bench::KnobRow& r) { return r.rmse <= 0.0; }), rows.end());
     return bench::writePlot(rows, out, "shadow_lights", "every light casts: ground transmittance RMSE vs tracing", "CPU ms") ? 0 : 1;
 }

@@ -217,8 +217,7 @@ void Scene::shadeScene(Frame& frame) {
     // Casters per light: the drawn lit effects, and those out of view whose
     // shadow reaches it (castsIntoView); each only where the light reaches it.
     std::vector<std::vector<const DensityField*>> casters(mLights.size());
-    std::vector<std::vector<const Entry*>> casterEntries(mLights.size());
-    std::size_t casting = 0;
+    std::vector<std::vector<Entry*>> casterEntries(mLights.size());
     for (Entry& e : mEntries) {
         e.status.inSceneShadow = false;
         if (!on || !(e.status.lit || e.status.castsIntoView) || !e.options.lighting.castsShadow || !e.lit || e.lit->field.empty()) continue;
@@ -227,13 +226,16 @@ void Scene::shadeScene(Frame& frame) {
             if (lightReaches(mLights[i], box)) {
                 casters[i].push_back(&e.lit->field);
                 casterEntries[i].push_back(&e);
-                e.status.inSceneShadow = true;
             }
-        casting += e.status.inSceneShadow ? 1 : 0;
     }
-    mCounters.sceneShadowCasters = casting;
     mCounters.sceneShadowLightsOverMax = mCounters.sceneShadowLightsOverBudget = 0;
     const std::vector<std::size_t> chosen = on ? chooseShadowLights(casters) : std::vector<std::size_t>{};
+    // What the kept tables cover.
+    std::size_t casting = 0;
+    for (std::size_t li : chosen)
+        for (Entry* e : casterEntries[li])
+            if (!e->status.inSceneShadow) e->status.inSceneShadow = true, ++casting;
+    mCounters.sceneShadowCasters = casting;
     if (mLightShadows.size() > mLights.size()) mLightShadows.resize(mLights.size());
     while (mLightShadows.size() < mLights.size()) mLightShadows.emplace_back();
 

@@ -18,6 +18,7 @@ bool ShadowPass::uploadTable(std::size_t k, const FrameShadow& shadow) {
     const bool valid = shadow.valid && shadow.dims.x > 0 && shadow.dims.y > 0 && shadow.dims.z > 0 &&
                        shadow.depth.size() == std::size_t(shadow.dims.x) * std::size_t(shadow.dims.y) * std::size_t(shadow.dims.z);
     if (slot.uploadedOnce && shadow.version == slot.version) return false;
+    const bool wasValid = slot.valid;
     const glm::ivec3 dims = valid ? shadow.dims : glm::ivec3(1);
     if (!slot.texture || dims != slot.dims) {
         if (slot.texture) glDeleteTextures(1, &slot.texture);
@@ -42,7 +43,7 @@ bool ShadowPass::uploadTable(std::size_t k, const FrameShadow& shadow) {
     slot.lightInTable = valid ? shadow.lightInTable : glm::vec4(0.0f, -1.0f, 0.0f, 0.0f);
     slot.version = shadow.version;
     slot.uploadedOnce = true;
-    return true;
+    return valid || wasValid; // a placeholder for a slot never filled is not a table
 }
 
 void ShadowPass::bind() {

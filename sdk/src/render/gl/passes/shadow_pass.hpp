@@ -25,7 +25,7 @@ public:
 
     // Uploads slot k's shadow if it changed since the last upload (an
     // invalid shadow becomes a 1^3 zero-depth table: splatfx_shadow() = 1).
-    // Returns whether it uploaded.
+    // Returns whether it uploaded a table or emptied one (not the placeholder of a slot never filled).
     bool uploadTable(std::size_t k, const FrameShadow& shadow);
     // Binds every slot's table to its unit (saving what was bound there) / restores them.
     void bind();
