@@ -132,6 +132,12 @@ TEST(ShadowLights, MovingOneLightRebuildsOnlyThatLightsTable) {
     s.prepare(3 / 30.0);
     EXPECT_EQ(s.scene.sceneShadowBuilds(0), 2u);
     EXPECT_EQ(s.scene.sceneShadowBuilds(1), 2u);
+    // New dims: every table is made again, and the frame gets the new ones (not the old data
+    // under a build count that happens to match).
+    s.scene.setSceneShadow({.dims = glm::ivec3(12)});
+    s.prepare(4 / 30.0);
+    EXPECT_EQ(s.frame.shadows()[0].depth, s.tableFor(s.scene.lights()[0], glm::ivec3(12)).data());
+    EXPECT_EQ(s.frame.shadows()[1].depth, s.tableFor(moved, glm::ivec3(12)).data());
 }
 
 TEST(ShadowLights, NPlusOneLightsKeepTheMostInfluentialAndCountTheRest) {
@@ -279,5 +285,6 @@ TEST(ShadowLightsHardCases, ASpotConeGrazingTheCasterBuildsItsTableAndOneJustMis
     s.prepare(1 / 30.0);
     EXPECT_EQ(s.slotLights(), (std::vector<int>{0})) << "just missing: no table, and not counted as dropped";
     EXPECT_EQ(s.frame.counters().shadowLightsDropped, 0u);
-    EXPECT_EQ(s.scene.sceneShadowBuilds(1), 1u) << "the miss builds nothing";
+    EXPECT_EQ(s.frame.counters().shadowTableBuilds, 0u) << "the miss builds nothing";
+    EXPECT_EQ(s.scene.sceneShadowBuilds(1), 0u) << "and the spot's table is freed";
 }

@@ -238,6 +238,19 @@ void Scene::shadeScene(Frame& frame) {
     mCounters.sceneShadowCasters = casting;
     if (mLightShadows.size() > mLights.size()) mLightShadows.resize(mLights.size());
     while (mLightShadows.size() < mLights.size()) mLightShadows.emplace_back();
+    // The slots refer to what they copied by address and build count; a table replaced or freed
+    // at the same address must not pass for the one copied.
+    auto forgetSlotsOf = [&](std::size_t li) {
+        for (ShadowSlot& slot : mShadowSlots)
+            if (slot.light == int(li)) slot.source = nullptr, slot.version = 0;
+    };
+    // A light without a table this frame frees it (the budget counts only the kept ones); it is
+    // rebuilt when the light gets a slot again.
+    for (std::size_t li = 0; li < mLightShadows.size(); ++li)
+        if (std::find(chosen.begin(), chosen.end(), li) == chosen.end() && mLightShadows[li].table.builds() > 0) {
+            mLightShadows[li] = LightShadow{};
+            forgetSlotsOf(li);
+        }
 
     std::array<const ShadowTable*, kMaxShadowLights> sources{};
     std::array<int, kMaxShadowLights> lights;
@@ -263,6 +276,7 @@ void Scene::shadeScene(Frame& frame) {
         if (td.dims != ls.desc.dims || td.memoryBudgetBytes != ls.desc.memoryBudgetBytes) {
             ls.table = ShadowTable(td);
             ls.desc = td;
+            forgetSlotsOf(li); // a new table at the same address: its build count starts again
         }
         const std::uint64_t builds = ls.table.builds(), reuses = ls.table.reuses();
         if (Status s = ls.table.update(casters[li], mLights[li]); !s) {
