@@ -199,6 +199,39 @@ TEST(ShadowLights, OverTheMemoryBudgetTheLeastInfluentialLightIsDroppedAndCounte
     EXPECT_EQ(s.frame.counters().shadowLightsDropped, 0u);
 }
 
+TEST(ShadowLights, ACasterOutOfViewIsAdvancedWhenAnyLightsShadowReachesTheView) {
+    // tests/lighting/shadow_schedule_test.cpp's camera B: the plume just outside its left edge.
+    const Camera camB = Camera::lookAt({1.0f, 9.0f, 6.0f}, {1.5f, 0.0f, 0.0f}, {0, 1, 0}, glm::radians(36.0f), {64, 64}, 0.1f, 100.0f);
+    const Light away = Light::directional({-1.0f, -1.0f, 0.0f}); // throws the plume's shadow further left, out of view
+    const Light into = Light::directional({1.0f, -1.0f, 0.0f});  // throws it right, onto the ground in view
+    Materials materials{Footprint{}};
+    const std::uint32_t row = materials.addColorTable(ColorTable::constant({0.8f, 0.8f, 0.8f, 1.0f}));
+    Scene scene;
+    Grid g = test::gaussianBlob(12, 0.2f, 0.9f);
+    g.transform = glm::translate(glm::mat4(1.0f), glm::vec3(-4.0f, 3.0f, -1.1f));
+    EffectDesc desc;
+    desc.layers = {EffectLayer{.style = {.colorTable = row, .textured = false}}};
+    const EffectId plume = scene.add(*Effect::fromGrid(g, desc), {.name = "plume", .lighting = {.enabled = true, .selfShadow = SelfShadow::Off}});
+    ASSERT_TRUE(scene.addLight(away));
+    Frame frame;
+    ASSERT_TRUE(scene.prepare(0.0, camB, materials, frame));
+    ASSERT_FALSE(scene.status(plume).inView);
+    EXPECT_FALSE(scene.status(plume).castsIntoView) << "light 0 alone throws the shadow away from the view";
+    EXPECT_EQ(scene.counters().castersCulled, 1u);
+    // A second light whose shadow of the plume does reach the view: the plume is advanced and
+    // cast (undrawn), and light 1 gets its table although it is not slot 0's light.
+    ASSERT_TRUE(scene.addLight(into));
+    ASSERT_TRUE(scene.prepare(1 / 30.0, camB, materials, frame));
+    EXPECT_TRUE(scene.status(plume).castsIntoView);
+    EXPECT_EQ(scene.status(plume).splatsDrawn, 0u);
+    EXPECT_TRUE(scene.status(plume).inSceneShadow);
+    ASSERT_TRUE(frame.shadows()[1].valid);
+    EXPECT_EQ(frame.shadows()[1].light, 1);
+    ShadowTable ref({.dims = glm::ivec3(64)});
+    ASSERT_TRUE(ref.update(*DensityField::fromGrid(g), into));
+    EXPECT_EQ(frame.shadows()[1].depth, ref.data());
+}
+
 // ---- Named hard cases (docs/STABILITY.md, lighting)
 
 TEST(ShadowLightsHardCases, TwoLightsAtTheSamePositionGetEqualIndependentTables) {
