@@ -7,8 +7,8 @@
 // same Frame can be drawn by the GL backend and integrated by the CPU
 // reference, which is how the backend is measured.
 // It does not simulate (Scene does), render (gl::FrameRenderer does) or own
-// GPU resources. Besides the splats it holds the gas's shadow on the scene
-// (shadow(), FrameShadow), the fog (fog()), LOD volumes (volumes(): their
+// GPU resources. Besides the splats it holds the gas's shadows on the scene
+// (shadows(), one FrameShadow per shadowing light), the fog (fog()), LOD volumes (volumes(): their
 // tetrahedra and tables) and drawOrder(): splats and tetrahedra interleaved
 // back to front, made by end().
 //

@@ -19,8 +19,8 @@
 // (EffectOptions::lighting) and whose kind exposes the density the light sees
 // (EffectKind::lightingDensity: every Effect does; LOD volumes and ground fog
 // do not, their light is part of their data): their splat colours follow Ebert & Parent's low-albedo model with
-// self-shadowing, and prepare() puts their shadow on the scene into
-// Frame::shadow() (docs/lighting.md, "In a Scene"). And the scene's fog
+// self-shadowing, and prepare() puts their shadows on the scene, one per
+// shadowing light, into Frame::shadows() (docs/lighting.md, "In a Scene"). And the scene's fog
 // (setFog), handed to every Frame without the terms the view cannot see
 // (FogCullDesc). Shadows are scheduled by light influence, not visibility: a
 // lit caster out of view whose shadow can fall into the view

@@ -5,8 +5,8 @@
 // depth texture, and hooks for its own opaque and transparent geometry).
 // render() makes the frame's plan (frame_plan.hpp: every ordering and
 // fallback decision, as data) and runs its steps:
-//   0. uploads what changed: the frame's shadow table (Frame::shadow(), a 3D
-//      texture bound to FrameRendererDesc::shadowTextureUnit during the hooks;
+//   0. uploads what changed: the frame's shadow tables (Frame::shadows(), 3D
+//      textures bound to FrameRendererDesc::shadowTextureUnit and below during the hooks;
 //      see shadowBinding() and docs/integration.md, "Shadows of the gas"), the
 //      LOD volumes' pre-integration tables
 //   1. the host's opaque pass (HostTarget::drawOpaque; its depth is what cuts the volumes)
