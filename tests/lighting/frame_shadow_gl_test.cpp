@@ -178,6 +178,10 @@ TEST_F(FrameShadowGL, BadShadowUnitIsRefusedByName) {
     auto fr = gl::FrameRenderer::create({.shadowTextureUnit = 16});
     ASSERT_FALSE(fr);
     EXPECT_NE(fr.error().find("shadowTextureUnit"), std::string::npos) << fr.error();
+    // Slots 1 to 3 take the units below it: 2 would put slot 3 on unit -1.
+    fr = gl::FrameRenderer::create({.shadowTextureUnit = 2});
+    ASSERT_FALSE(fr);
+    EXPECT_EQ(fr.error(), "FrameRendererDesc::shadowTextureUnit must be in [3, 15] (the other shadow slots take the units below it), got 2");
 }
 
 TEST_F(FrameShadowGL, TurningTheCameraOffACasterLeavesTheGroundsShadowInViewUnchanged) {

@@ -122,22 +122,23 @@ TEST(SceneLighting, StaticEffectsTablesAreNotRebuilt) {
     ASSERT_TRUE(s.scene.addLight(Light::directional({0.4f, -1.0f, 0.1f})));
     ASSERT_TRUE(s.scene.addLight(Light::point({1.0f, 4.0f, 1.0f})));
     s.prepare(0.0);
-    // First frame: one self-shadow table per light and the scene shadow.
-    EXPECT_EQ(s.frame.counters().shadowTableBuilds, 3u);
+    // First frame: one self-shadow table per light and one scene shadow per light.
+    EXPECT_EQ(s.frame.counters().shadowTableBuilds, 4u);
     const std::uint64_t version = s.frame.shadow().version;
     EXPECT_TRUE(s.frame.shadow().valid);
     for (int f = 1; f < 5; ++f) {
         s.prepare(f / 30.0); // a grid effect at rest: the same density every frame
         EXPECT_EQ(s.frame.counters().shadowTableBuilds, 0u) << "frame " << f;
-        EXPECT_EQ(s.frame.counters().shadowTableReuses, 3u) << "frame " << f;
+        EXPECT_EQ(s.frame.counters().shadowTableReuses, 4u) << "frame " << f;
     }
     EXPECT_EQ(s.scene.status(s.id).shadowTableBuilds, 2u);
     EXPECT_EQ(s.scene.status(s.id).shadowTableReuses, 8u);
     EXPECT_EQ(s.frame.shadow().version, version) << "an unchanged scene shadow is not copied again";
-    // A light that moves rebuilds its own table and the scene shadow's (light 0), not the other.
+    // A light that moves rebuilds its own two tables (self-shadow and scene shadow), not the other's.
     ASSERT_TRUE(s.scene.setLight(1, Light::point({1.5f, 4.0f, 1.0f})));
     s.prepare(5 / 30.0);
-    EXPECT_EQ(s.frame.counters().shadowTableBuilds, 1u);
+    EXPECT_EQ(s.frame.counters().shadowTableBuilds, 2u);
+    EXPECT_EQ(s.frame.shadow().version, version) << "light 0's scene shadow is untouched";
     ASSERT_TRUE(s.scene.setLight(0, Light::directional({0.5f, -1.0f, 0.1f})));
     s.prepare(6 / 30.0);
     EXPECT_EQ(s.frame.counters().shadowTableBuilds, 2u);

@@ -147,6 +147,8 @@ TEST(ShadowSchedule, ALightThatCannotReachAnEffectBuildsNoTableForIt) {
     ShadowScene s;
     const EffectId gas = s.addBlob("gas", {-1.1f, 1.5f, -1.1f}, {.enabled = true, .selfShadow = SelfShadow::Table, .tableDims = glm::ivec3(16)});
     ASSERT_TRUE(s.scene.addLight(kSun));
+    s.scene.setSceneShadow({.maxLights = 1}); // one scene shadow, the sun's: the counts below are the self-shadowing tables'
+
     // A spot light well above the gas, pointing straight up: its cone (0.3 rad) misses the gas.
     ASSERT_TRUE(s.scene.addLight(Light::spot({0.0f, 8.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 0.2f, 0.3f)));
     s.prepare(0.0, cameraA());
@@ -161,7 +163,7 @@ TEST(ShadowSchedule, ALightThatCannotReachAnEffectBuildsNoTableForIt) {
     EXPECT_EQ(s.frame.counters().shadowTableBuilds, 1u) << "only the spot's table (the sun's is reused)";
     // The scene shadow cast by a spot that misses every caster: no table at all.
     ASSERT_TRUE(s.scene.setLight(1, Light::spot({0.0f, 8.0f, 0.0f}, {0.0f, 1.0f, 0.0f}, 0.2f, 0.3f)));
-    s.scene.setSceneShadow({.light = 1});
+    s.scene.setSceneShadow({.light = 1, .maxLights = 1});
     const std::uint64_t before = s.scene.counters().sceneShadowBuilds;
     s.prepare(2 / 30.0, cameraA());
     EXPECT_FALSE(s.frame.shadow().valid);

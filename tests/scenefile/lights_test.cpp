@@ -78,3 +78,19 @@ TEST(SceneFileLights, BadInputNamesTheField) {
     expectError(R"("effects": [{"kind": "steam", "lighting": {"tableDims": 0}}])", {"effects[0].lighting.tableDims"});
     expectError(R"("effects": [{"kind": "steam", "lighting": {"albdo": 0.5}}])", {"effects[0].lighting", "albdo"});
 }
+
+TEST(SceneFileLights, SceneShadowMaxLightsAndMemoryAreReadAndCheckedByName) {
+    const std::string lights = R"("lights": [{"type": "directional"}, {"type": "point", "position": [0, 3, 0]}], )";
+    auto r = parse(lights + R"("sceneShadow": {"maxLights": 2, "memoryMiB": 16, "dims": 32})");
+    ASSERT_TRUE(r.ok()) << r.error();
+    EXPECT_EQ(r->scene.sceneShadow().maxLights, 2);
+    EXPECT_EQ(r->scene.sceneShadow().memoryBudgetBytes, 16ull << 20);
+    r = parse(lights + R"("sceneShadow": {})");
+    ASSERT_TRUE(r.ok()) << r.error();
+    EXPECT_EQ(r->scene.sceneShadow().maxLights, splatfx::kMaxShadowLights) << "every light casts by default";
+    expectError(lights + R"("sceneShadow": {"maxLights": 5})", {"sceneShadow.maxLights"});
+    expectError(lights + R"("sceneShadow": {"maxLights": 0})", {"sceneShadow.maxLights"});
+    expectError(lights + R"("sceneShadow": {"memoryMiB": 0})", {"sceneShadow.memoryMiB"});
+    // One 64^3 table takes 4.25 MiB (17 bytes a node): a 4 MiB budget cannot hold even slot 0's.
+    expectError(lights + R"("sceneShadow": {"memoryMiB": 4, "dims": 64})", {"sceneShadow.dims", "over the 4 MiB budget (memoryMiB)"});
+}

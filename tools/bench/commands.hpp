@@ -4,12 +4,15 @@
 // progress and a summary, and returns the process exit code.
 #pragma once
 
+#include <string>
+
 #include <glm/glm.hpp>
 
 int runAccuracy(int argc, char** argv);     // accuracy.cpp: error vs time per quality knob (issue 5)
 int runTable1(int argc, char** argv);       // table1.cpp: the paper's Table I, fill limit, CPU scaling (issue 7)
 int runScheduling(int argc, char** argv);   // scheduling.cpp: 1000 effects, 10 in view; catch-up error (issue 6)
 int runShadows(int argc, char** argv);      // shadows.cpp: Ebert & Parent 1990 Table 2, shadow tables vs tracing (issue 16)
+int runShadowLights(const std::string& out, int frames, bool noPlots); // shadow_lights.cpp: shadows --lights (issue 27.1)
 int runFog(int argc, char** argv);          // fog.cpp: Biri et al. 2002 Table 1, fog cost per pixel and per fog texture (issue 14)
 int runClouds(int argc, char** argv);       // clouds.cpp: LOD volumes as projected tetrahedra, flight, popping (issue 17)
 int runGroundFog(int argc, char** argv);    // groundfog.cpp: LOD ground fog over the Jacksboro DEM: count, time, error, popping (issue 17); --knobs vs the exact field (issue 24)

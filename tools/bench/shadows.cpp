@@ -23,6 +23,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "bench_gl.hpp"
+#include "commands.hpp"
 #include "options.hpp"
 #include "geometry_renderer.hpp"
 #include "splatfx/context.hpp"
@@ -269,7 +270,15 @@ int runShadows(int argc, char** argv) {
     CLI::Option* framesOption = cli::addNumber(app, "--frames", frames, 3, 100000, "timed frames per configuration");
     app.add_flag("--static", still, "the steam does not evolve (tables reused)");
     app.add_flag("--quick", quick, "one size, 5 frames (unless --frames is given), 1 warm-up");
+    bool lights = false, noPlots = false;
+    std::string out = "bench-shadow-lights";
+    app.add_flag("--lights", lights,
+                 "every light casts (issue 27): 1..4 lights' scene-shadow tables (16^3..64^3) vs tracing the ground, and a point light\n"
+                 "inside the plume: box table vs a direction x distance table at the same memory (CPU only)");
+    app.add_option("--out", out, "--lights: where shadow_lights.dat, .gp and the PNG plots go")->type_name("DIR")->capture_default_str();
+    app.add_flag("--no-plots", noPlots, "--lights: print the tables only");
     if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+    if (lights) return runShadowLights(out, frames, noPlots);
     animated = !still;
     if (quick) {
         if (framesOption->count() == 0) frames = 5;
@@ -334,7 +343,7 @@ int runShadows(int argc, char** argv) {
                 fr->render(frame, {.framebuffer = fb->handle(), .drawOpaque = [&] {
                                        bench::clearHost({0.1f, 0.1f, 0.12f, 1.0f});
                                        scenehost::GeometryLighting gl;
-                                       gl.light = glm::vec4(-glm::normalize(light.direction), 0.0f);
+                                       gl.lights[0].light = glm::vec4(-glm::normalize(light.direction), 0.0f);
                                        gl.shadow = fr->shadowBinding();
                                        geo->draw(t, cam, gl);
                                    }});

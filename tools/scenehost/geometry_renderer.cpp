@@ -1,5 +1,6 @@
 #include "geometry_renderer.hpp"
 
+#include <algorithm>
 #include <bit>
 #include <map>
 #include <string>
@@ -45,6 +46,27 @@ vec3 twoSidedNormal(vec3 normal, vec3 world, vec3 eye) {
     if (dot(face, eye - world) < 0.0) face = -face;
     return dot(n, face) < 0.0 ? -n : n;
 }
+// The host's lights (GeometryLighting), each with its own shadow.
+const int kLights = 8; // scenehost::kMaxGeometryLights
+uniform int uLightCount;
+uniform vec4 uLight[kLights];      // xyz: direction towards the light (w = 0) or its position (w = 1)
+uniform vec3 uLightColor[kLights];
+uniform int uShadowLight[kLights]; // splatfx_shadowTo's index; -1 unshadowed
+uniform vec4 uSpot[kLights];       // xyz: the spot's axis (zero: not a spot), w: cos of the outer half-angle
+uniform float uSpotInner[kLights]; // cos of the inner half-angle
+vec3 hostDirect(vec3 n, vec3 world, bool shadowed) {
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < min(uLightCount, kLights); ++i) {
+        vec3 toLight = normalize(uLight[i].w == 0.0 ? uLight[i].xyz : uLight[i].xyz - world);
+        float d = max(dot(n, toLight), 0.0);
+        if (dot(uSpot[i].xyz, uSpot[i].xyz) > 0.0) d *= smoothstep(uSpot[i].w, uSpotInner[i], dot(-toLight, normalize(uSpot[i].xyz)));
+#ifndef HOST_UNSHADOWED
+        if (shadowed && d > 0.0) d *= splatfx_shadowTo(uShadowLight[i], world);
+#endif
+        sum += d * uLightColor[i];
+    }
+    return sum;
+}
 )";
 
 // The host's surface shader with the SDK's shadow include (shadowGlsl(),
@@ -55,14 +77,12 @@ in vec3 vNormal;
 in vec3 vWorld;
 uniform vec3 uColor;
 uniform vec3 uEye;
-uniform vec4 uLight;      // xyz: direction towards the light (w = 0) or its position (w = 1)
-uniform vec3 uLightColor;
 out vec4 fragColor;
 void main() {
     vec3 n = twoSidedNormal(vNormal, vWorld, uEye);
-    vec3 toLight = normalize(uLight.w == 0.0 ? uLight.xyz : uLight.xyz - vWorld);
-    float diffuse = max(dot(n, toLight), 0.0) * splatfx_shadow(vWorld);
-    vec3 lit = uColor * (0.25 + 0.75 * diffuse * uLightColor);
+    vec3 lit = uColor * (0.25 + 0.75 * hostDirect(n, vWorld, true));
+    // Light from the frame's fires (shadowGlsl): a Lambertian surface reflects albedo * E / pi.
+    lit += uColor * splatfx_emittedIrradiance(vWorld, n) * 0.31830989;
     fragColor = vec4(lit, 1.0);
 }
 )";
@@ -93,15 +113,12 @@ in vec3 vWorld;
 in float vFog;
 uniform vec3 uColor;
 uniform vec3 uEye;
-uniform vec4 uLight;
-uniform vec3 uLightColor;
 uniform vec3 splatfx_fog_colour;
 out vec4 fragColor;
 void main() {
     vec3 n = twoSidedNormal(vNormal, vWorld, uEye);
-    vec3 toLight = normalize(uLight.w == 0.0 ? uLight.xyz : uLight.xyz - vWorld);
-    float diffuse = max(dot(n, toLight), 0.0) * splatfx_shadow(vWorld);
-    vec3 lit = uColor * (0.25 + 0.75 * diffuse * uLightColor);
+    vec3 lit = uColor * (0.25 + 0.75 * hostDirect(n, vWorld, true));
+    lit += uColor * splatfx_emittedIrradiance(vWorld, n) * 0.31830989;
     fragColor = vec4(mix(splatfx_fog_colour, lit, vFog), 1.0);
 }
 )";
@@ -115,16 +132,32 @@ in vec3 vWorld;
 uniform vec3 uColor;
 uniform float uOpacity;
 uniform vec3 uEye;
-uniform vec4 uLight;
-uniform vec3 uLightColor;
 out vec4 fragColor;
 void main() {
     vec3 n = twoSidedNormal(vNormal, vWorld, uEye);
-    vec3 toLight = normalize(uLight.w == 0.0 ? uLight.xyz : uLight.xyz - vWorld);
-    vec3 lit = uColor * (0.25 + 0.75 * max(dot(n, toLight), 0.0) * uLightColor);
+    vec3 lit = uColor * (0.25 + 0.75 * hostDirect(n, vWorld, false));
     fragColor = splatfx_emitTransparent(vec4(lit * uOpacity, uOpacity), gl_FragCoord.z);
 }
 )";
+
+void setLightUniforms(GLuint program, const GeometryLighting& lighting) {
+    const int n = std::clamp(lighting.lightCount, 0, kMaxGeometryLights);
+    glm::vec4 light[kMaxGeometryLights]{}, spot[kMaxGeometryLights]{};
+    glm::vec3 color[kMaxGeometryLights]{};
+    int shadow[kMaxGeometryLights]{};
+    float inner[kMaxGeometryLights]{};
+    for (int i = 0; i < n; ++i) {
+        const GeometryLight& l = lighting.lights[std::size_t(i)];
+        light[i] = l.light, color[i] = l.color, shadow[i] = l.shadowLight;
+        spot[i] = glm::vec4(l.spotAxis, l.cosOuter), inner[i] = l.cosInner;
+    }
+    glUniform1i(glGetUniformLocation(program, "uLightCount"), n);
+    glUniform4fv(glGetUniformLocation(program, "uLight"), kMaxGeometryLights, glm::value_ptr(light[0]));
+    glUniform3fv(glGetUniformLocation(program, "uLightColor"), kMaxGeometryLights, glm::value_ptr(color[0]));
+    glUniform1iv(glGetUniformLocation(program, "uShadowLight"), kMaxGeometryLights, shadow);
+    glUniform4fv(glGetUniformLocation(program, "uSpot"), kMaxGeometryLights, glm::value_ptr(spot[0]));
+    glUniform1fv(glGetUniformLocation(program, "uSpotInner"), kMaxGeometryLights, inner);
+}
 
 } // namespace
 
@@ -194,7 +227,7 @@ splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<spl
     impl->program = *program;
     {
         const std::string include = splatfx::transparentGlsl();
-        auto tp = splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n", include.c_str(), kHostNormal, kTransparentBody},
+        auto tp = splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n#define HOST_UNSHADOWED\n", include.c_str(), kHostNormal, kTransparentBody},
                                            "GeometryRenderer (transparent)");
         if (!tp) return splatfx::makeError(tp.error());
         impl->transparentProgram = *tp;
@@ -341,8 +374,7 @@ void GeometryRenderer::draw(double t, const splatfx::Camera& camera, const Geome
     const glm::vec3 eye = camera.eye();
     glUniformMatrix4fv(glGetUniformLocation(program, "uViewProj"), 1, GL_FALSE, glm::value_ptr(viewProj));
     glUniform3fv(glGetUniformLocation(program, "uEye"), 1, glm::value_ptr(eye));
-    glUniform4fv(glGetUniformLocation(program, "uLight"), 1, glm::value_ptr(lighting.light));
-    glUniform3fv(glGetUniformLocation(program, "uLightColor"), 1, glm::value_ptr(lighting.lightColor));
+    setLightUniforms(program, lighting);
     splatfx::gl::setShadowUniforms(program, lighting.shadow);
     const GLint model = glGetUniformLocation(program, "uModel"), color = glGetUniformLocation(program, "uColor");
     for (const Impl::Object& o : r.objects) {
@@ -375,8 +407,7 @@ void GeometryRenderer::drawTransparent(double t, const splatfx::Camera& camera, 
     const glm::vec3 eye = camera.eye();
     glUniformMatrix4fv(glGetUniformLocation(p, "uViewProj"), 1, GL_FALSE, glm::value_ptr(viewProj));
     glUniform3fv(glGetUniformLocation(p, "uEye"), 1, glm::value_ptr(eye));
-    glUniform4fv(glGetUniformLocation(p, "uLight"), 1, glm::value_ptr(lighting.light));
-    glUniform3fv(glGetUniformLocation(p, "uLightColor"), 1, glm::value_ptr(lighting.lightColor));
+    setLightUniforms(p, lighting);
     const GLint model = glGetUniformLocation(p, "uModel"), color = glGetUniformLocation(p, "uColor"), opacity = glGetUniformLocation(p, "uOpacity");
     for (const Impl::Object& o : r.objects) {
         if (!o.vao || !(o.desc.opacity < 1.0f)) continue;

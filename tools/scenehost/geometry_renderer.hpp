@@ -18,6 +18,7 @@
 // Threading: the GL thread only. Move-only.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -35,11 +36,24 @@ struct GeometryStats {
     std::size_t triangles = 0; // triangles drawn
 };
 
-// The light the geometry is lit by, and the gas's shadow on it.
-struct GeometryLighting {
+// One light the geometry is lit by. Lambertian, no distance falloff (the
+// host's look: a light's colour times min(intensity, 1) for a sun, its colour
+// for a point or spot light), inside a spot's cone only.
+struct GeometryLight {
     glm::vec4 light{0.4f, 1.0f, 0.6f, 0.0f}; // direction towards the light (w = 0) or position (w = 1); default a sun
-    glm::vec3 lightColor{1.0f};              // default white
-    splatfx::gl::ShadowBinding shadow{};     // FrameRenderer::shadowBinding(); default none (unshadowed)
+    glm::vec3 color{1.0f};                   // default white
+    int shadowLight = 0;                     // splatfx_shadowTo's index (the scene light); -1: unshadowed
+    glm::vec3 spotAxis{0.0f};                // spot: the direction it shines; zero: not a spot
+    float cosInner = 1.0f, cosOuter = -1.0f; // spot: full light within the inner half-angle, none beyond the outer
+};
+inline constexpr int kMaxGeometryLights = 8;
+
+// The lights the geometry is lit by, and the gas's shadows on it: each light
+// darkened by its own shadow (splatfx_shadowTo).
+struct GeometryLighting {
+    std::array<GeometryLight, kMaxGeometryLights> lights{}; // the first lightCount are used
+    int lightCount = 1;                                      // [0, kMaxGeometryLights]; default 1 (a sun)
+    splatfx::gl::ShadowBinding shadow{};                     // FrameRenderer::shadowBinding(); default none (unshadowed)
     // Biri et al.'s buffer method (sec. 4.3): the opaque objects fog themselves,
     // the transmittance evaluated per vertex (at draw()'s time) and interpolated,
     // instead of the frame renderer's per-pixel pass (turn that off: fogHost).

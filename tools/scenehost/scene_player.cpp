@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <span>
+#include <vector>
 
 #include <epoxy/gl.h>
 
@@ -32,16 +35,32 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// The geometry's light: the scene's shadow light (its first by default), so
-// the gas's shadow on the ground falls where that light puts it.
+// The geometry's lights: the scene's, each darkened by its own shadow
+// (splatfx_shadowTo; 1 for a light without a table). Slot 0's light first,
+// so a one-light scene looks as it did.
 GeometryLighting geometryLighting(const splatfx::Scene& scene, const splatfx::gl::FrameRenderer& renderer) {
     GeometryLighting g;
     g.shadow = renderer.shadowBinding();
-    const std::size_t i = scene.sceneShadow().light;
-    if (i < scene.lights().size()) {
-        const splatfx::Light& l = scene.lights()[i];
-        g.light = l.type == splatfx::LightType::Directional ? glm::vec4(-glm::normalize(l.direction), 0.0f) : glm::vec4(l.position, 1.0f);
-        g.lightColor = l.color * std::min(l.type == splatfx::LightType::Directional ? l.intensity : 1.0f, 1.0f);
+    const std::span<const splatfx::Light> lights = scene.lights();
+    if (lights.empty()) return g; // the default sun, unshadowed by any table
+    std::vector<std::size_t> order;
+    const std::size_t first = scene.sceneShadow().light;
+    if (first < lights.size()) order.push_back(first);
+    for (std::size_t i = 0; i < lights.size(); ++i)
+        if (i != first) order.push_back(i);
+    g.lightCount = int(std::min<std::size_t>(order.size(), scenehost::kMaxGeometryLights));
+    for (int k = 0; k < g.lightCount; ++k) {
+        const std::size_t i = order[std::size_t(k)];
+        const splatfx::Light& l = lights[i];
+        GeometryLight& h = g.lights[std::size_t(k)];
+        h.light = l.type == splatfx::LightType::Directional ? glm::vec4(-glm::normalize(l.direction), 0.0f) : glm::vec4(l.position, 1.0f);
+        h.color = l.color * std::min(l.type == splatfx::LightType::Directional ? l.intensity : 1.0f, 1.0f);
+        h.shadowLight = int(i);
+        if (l.type == splatfx::LightType::Spot) {
+            h.spotAxis = glm::normalize(l.direction);
+            h.cosInner = std::max(std::cos(l.innerConeRad), std::cos(l.outerConeRad) + 1e-4f); // smoothstep needs inner > outer
+            h.cosOuter = std::cos(l.outerConeRad);
+        }
     }
     return g;
 }

@@ -7,8 +7,8 @@
 // same Frame can be drawn by the GL backend and integrated by the CPU
 // reference, which is how the backend is measured.
 // It does not simulate (Scene does), render (gl::FrameRenderer does) or own
-// GPU resources. Besides the splats it holds the gas's shadow on the scene
-// (shadow(), FrameShadow), the fog (fog()), LOD volumes (volumes(): their
+// GPU resources. Besides the splats it holds the gas's shadows on the scene
+// (shadows(), one FrameShadow per shadowing light), the fog (fog()), LOD volumes (volumes(): their
 // tetrahedra and tables) and drawOrder(): splats and tetrahedra interleaved
 // back to front, made by end().
 //
@@ -22,6 +22,7 @@
 // Threading: a plain value; one thread at a time.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -30,7 +31,9 @@
 #include <glm/glm.hpp>
 
 #include "splatfx/camera.hpp"
+#include "splatfx/emitted_light.hpp"
 #include "splatfx/fog.hpp"
+#include "splatfx/lighting.hpp"
 #include "splatfx/splats.hpp"
 #include "splatfx/volume.hpp"
 
@@ -48,9 +51,14 @@ struct FrameCounters {
     std::size_t litEffects = 0;          // needed effects lit by the scene's lights
     std::uint64_t shadowTableBuilds = 0; // shadow tables (self-shadowing and the scene's) rebuilt for this frame
     std::uint64_t shadowTableReuses = 0; // ... and reused because density and light had not changed
+    std::size_t shadowLights = 0;        // lights with a table in shadows() (SceneShadowDesc::maxLights)
+    // Lights that cast onto the view but got no table: past maxLights, or
+    // over SceneShadowDesc::memoryBudgetBytes / Budgets::lightingBytes (the
+    // least influential are dropped first). SceneCounters says which.
+    std::size_t shadowLightsDropped = 0;
 };
 
-// The shadow the frame's gas casts on the scene.
+// The shadow the frame's gas casts on the scene towards one light.
 // One shadow table (lighting.hpp, ShadowTable) for one light, covering every
 // needed effect that casts shadows, as plain data: what gl::FrameRenderer
 // uploads as a 3D texture before the host's opaque pass, and what the GLSL
@@ -61,6 +69,7 @@ struct FrameShadow {
     glm::ivec3 dims{0};
     glm::mat4 worldToTable{1.0f};                    // world to the table's [0, 1]^3 (ShadowTable::worldToTable)
     glm::vec4 lightInTable{0.0f, -1.0f, 0.0f, 0.0f}; // ShadowTable::lightInTable
+    int light = 0;                                   // the scene light (index into Scene::lights()) it is cast by; default 0
     // Changes whenever the contents do (a renderer re-uploads only then); 0 when never filled.
     std::uint64_t version = 0;
 };
@@ -109,9 +118,14 @@ public:
     const SplatStats& splatStats() const { return mBuilder.stats(); }
     const FrameCounters& counters() const { return mCounters; }
     FrameCounters& counters() { return mCounters; }
-    // The gas's shadow on the scene: kept across begin() (its version says when it changed).
-    const FrameShadow& shadow() const { return mShadow; }
-    FrameShadow& shadow() { return mShadow; }
+    // The gas's shadow on the scene, one slot per shadowing light: kept
+    // across begin() (each version says when it changed). Slot 0 is
+    // SceneShadowDesc::light's (splatfx_shadow() of shadowGlsl()); the others
+    // hold the next lights by influence, in light order; unused slots are invalid.
+    const std::array<FrameShadow, kMaxShadowLights>& shadows() const { return mShadows; }
+    std::array<FrameShadow, kMaxShadowLights>& shadows() { return mShadows; }
+    const FrameShadow& shadow() const { return mShadows[0]; }
+    FrameShadow& shadow() { return mShadows[0]; }
 
     // The one medium the frame is seen through: gl::FrameRenderer fogs the
     // host's opaque image with it and applies it per fragment to every
@@ -121,6 +135,13 @@ public:
     void setFog(std::shared_ptr<const Fog> fog) { mFog = std::move(fog); }
     const Fog* fog() const { return mFog.get(); }
     const std::shared_ptr<const Fog>& sharedFog() const { return mFog; }
+
+    // Light the frame's emissive volumes give the host's surfaces (cleared by
+    // begin()): what splatfx_emittedIrradiance of shadowGlsl() adds, through
+    // gl::ShadowBinding. Scene::prepare fills it (EffectOptions::emitsLight),
+    // brightest first, at most kMaxEmittedLights. emitted_light.hpp.
+    std::vector<EmittedLight>& emittedLights() { return mEmittedLights; }
+    const std::vector<EmittedLight>& emittedLights() const { return mEmittedLights; }
 
     // Volumes to draw as tetrahedra (cleared by begin()).
     std::vector<FrameVolume>& volumes() { return mVolumes; }
@@ -132,10 +153,11 @@ public:
 private:
     SplatBuilder mBuilder;
     FrameCounters mCounters;
-    FrameShadow mShadow;
+    std::array<FrameShadow, kMaxShadowLights> mShadows{};
     double mTime = 0.0;
     std::shared_ptr<const Fog> mFog; // default none
     std::vector<FrameVolume> mVolumes;
+    std::vector<EmittedLight> mEmittedLights;
     std::vector<DrawBatch> mDrawOrder;
 };
 

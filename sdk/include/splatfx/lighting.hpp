@@ -302,12 +302,19 @@ private:
     std::vector<ShadowTable> mTables;
 };
 
+// How many lights shadow the scene at once (SceneShadowDesc::maxLights,
+// Frame::shadows(), the slots of shadowGlsl()).
+inline constexpr int kMaxShadowLights = 4;
+
 // The GLSL include a host's surface shader compiles (GLSL 4.50 core, no
-// #version line): uniforms splatfx_shadowTable (sampler3D: data()),
+// #version line). Slot 0: uniforms splatfx_shadowTable (sampler3D: data()),
 // splatfx_worldToTable (mat4: worldToTable()) and splatfx_shadowLight (vec4:
-// lightInTable()), and
-//   float splatfx_shadow(vec3 worldPos); // transmittance towards the light, [0, 1]
-// which matches ShadowTable::transmittance up to the texture unit's filtering precision.
+// lightInTable()); slots 1 to kMaxShadowLights - 1 the same names suffixed
+// 1, 2, 3; splatfx_shadowLightIndex[kMaxShadowLights] (int: the scene light
+// each slot's table is for, -1 none). And
+//   float splatfx_shadow(vec3 worldPos);              // slot 0's table, [0, 1]
+//   float splatfx_shadowTo(int light, vec3 worldPos); // towards scene light `light`; 1 without a table
+// which match ShadowTable::transmittance up to the texture unit's filtering precision.
 // The text is the SDK's GLSL file shadow.glsl, embedded at build time.
 std::string shadowGlsl();
 

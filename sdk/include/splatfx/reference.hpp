@@ -177,6 +177,28 @@ struct SplatExactStats {
 Result<Image> renderSplatExact(const std::vector<Splat>& splats, const Camera& camera, const Materials& materials, const SplatExactDesc& desc = {},
                                SplatExactStats* stats = nullptr);
 
+// The exact irradiance the splats' emission gives a surface point with unit
+// normal `normal` (emitted_light.hpp): the radiance renderSplatExact composites
+// along every ray from the point (every splat's occlusion of the others
+// included), times the cosine, integrated over the sphere as six cube faces of
+// faceSize^2 pixels, each weighted by its exact solid angle. `splats` must be
+// built with the point as the eye (a SplatBuilder with frustumCull off and a
+// camera at the point: the ellipses face it). errorEstimate: the difference
+// from the same integral at half the resolution (the quadrature's error is
+// below it when the pixel rule converges at first order or better).
+struct IrradianceExactDesc {
+    int faceSize = 64;          // pixels per cube-face side, [2, 4096]; default 64
+    bool packedColor = false;   // as SplatExactDesc::packedColor; default false
+    double nearDistance = 1e-4; // the faces' near plane, world units; default 1e-4
+    int threads = 0;            // as SplatExactDesc::threads; default 0
+};
+struct IrradianceExact {
+    glm::dvec3 irradiance{0.0};
+    double errorEstimate = 0.0; // max channel |E(faceSize) - E(faceSize / 2)|
+};
+Result<IrradianceExact> emittedIrradianceExact(const std::vector<Splat>& splats, const Materials& materials, glm::dvec3 point, glm::dvec3 normal,
+                                               const IrradianceExactDesc& desc = {});
+
 // A continuous medium the volume-exact reference integrates beside (or
 // instead of) the voxel kernels: extinction and colour as a function of the
 // world point, through the same quadrature (so a gas's turbulence or a VDB

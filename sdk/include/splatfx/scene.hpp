@@ -19,8 +19,8 @@
 // (EffectOptions::lighting) and whose kind exposes the density the light sees
 // (EffectKind::lightingDensity: every Effect does; LOD volumes and ground fog
 // do not, their light is part of their data): their splat colours follow Ebert & Parent's low-albedo model with
-// self-shadowing, and prepare() puts their shadow on the scene into
-// Frame::shadow() (docs/lighting.md, "In a Scene"). And the scene's fog
+// self-shadowing, and prepare() puts their shadows on the scene, one per
+// shadowing light, into Frame::shadows() (docs/lighting.md, "In a Scene"). And the scene's fog
 // (setFog), handed to every Frame without the terms the view cannot see
 // (FogCullDesc). Shadows are scheduled by light influence, not visibility: a
 // lit caster out of view whose shadow can fall into the view
@@ -43,6 +43,7 @@
 // Threading: one thread at a time.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -54,6 +55,7 @@
 #include "splatfx/camera.hpp"
 #include "splatfx/effect.hpp"
 #include "splatfx/effect_kind.hpp"
+#include "splatfx/emitted_light.hpp"
 #include "splatfx/fog.hpp"
 #include "splatfx/frame.hpp"
 #include "splatfx/lighting.hpp"
@@ -92,15 +94,25 @@ struct EffectLighting {
     bool castsShadow = true;
 };
 
-// The shadow the lit effects cast on the scene: one table for one light over
-// every needed, lit, shadow-casting effect, put into Frame::shadow(). When
-// exactly one effect casts and its self-shadowing table for that light has
-// these dims, that table is used (no second build).
+// The shadow the lit effects cast on the scene: per shadowing light, one
+// table over every needed, lit, shadow-casting effect that light reaches,
+// put into Frame::shadows() (docs/lighting.md, "Every light casts"). Slot 0
+// is `light`'s; the other slots go to the most influential of the other
+// lights (the largest sum over its casters of the light's irradiance at the
+// caster's box), at most maxLights in all. A light that reaches no caster
+// builds nothing. Each light's table is rebuilt only when its casters'
+// density or that light changes. When exactly one effect casts and its
+// self-shadowing table for a light has these dims, that table is used (no
+// second build). Tables that would not fit memoryBudgetBytes (or what
+// Budgets::lightingBytes leaves) are not built, least influential first,
+// and counted (SceneCounters::sceneShadowLightsOverBudget,
+// FrameCounters::shadowLightsDropped); slot 0's is always tried.
 struct SceneShadowDesc {
     bool enabled = true;                           // default true (when a light exists)
-    std::size_t light = 0;                         // index into Scene::lights(); default 0 (the first)
-    glm::ivec3 dims{64};                           // entries per axis, each in [1, 1024]; default 64^3
-    std::uint64_t memoryBudgetBytes = 64ull << 20; // as ShadowTableDesc; default 64 MiB
+    std::size_t light = 0;                         // index into Scene::lights(): slot 0, splatfx_shadow(); default 0 (the first)
+    int maxLights = kMaxShadowLights;              // lights with a table at once, [1, kMaxShadowLights]; default kMaxShadowLights (4)
+    glm::ivec3 dims{64};                           // entries per axis of each table, each in [1, 1024]; default 64^3
+    std::uint64_t memoryBudgetBytes = 64ull << 20; // every table together, ShadowTable::memoryBytes each; default 64 MiB
 };
 
 // Which of the scene's fog terms a frame draws (docs/fog.md, "Terms out of
@@ -137,6 +149,11 @@ struct EffectOptions {
     // combined with the options given to prepare()/emit(). Default EmitOptions{}.
     EmitOptions draw{};
     EffectLighting lighting{}; // default unlit
+    // An emissive effect as light for the host's surfaces: point lights
+    // fitted to its splats each frame into Frame::emittedLights()
+    // (emitted_light.hpp). Out of view it is still advanced (not drawn) while
+    // its bounds grown by reachWorld touch the view. Default off.
+    EmittedLightDesc emitsLight{};
     // LOD volumes and ground fog: the per-frame refinement (c, morphing,
     // per-node frustum culling, near clipping). Default LodRefineDesc{}.
     LodRefineDesc refine{};
@@ -154,11 +171,15 @@ struct EffectStatus {
     bool alive = false;                  // with material present (only tested when in view, or out of view but casting into it)
     bool needed = false;                 // enabled && inRange && inView && alive
     // Not needed (out of view), but lit, shadow-casting, in range and alive,
-    // and its shadow towards the scene-shadow light can reach the view
-    // (Scene::shadowReachesView): advanced to the time and put into the scene
+    // and its shadow away from one of the lights can reach the view
+    // of any light (Scene::shadowReachesView): advanced to the time and put into the scene
     // shadow, not emitted (docs/lighting.md, "Scheduled by light influence").
     bool castsIntoView = false;
-    bool inSceneShadow = false;          // its density was in the frame's scene shadow at the last prepare()
+    // Not needed (out of view), but emitting light (EffectOptions::emitsLight)
+    // whose reach touches the view: advanced and its lights fitted, not drawn.
+    bool lightsIntoView = false;
+    std::size_t emittedLights = 0;       // point lights it gave the last prepare()
+    bool inSceneShadow = false;          // its density was in one of the frame's scene shadows at the last prepare()
     std::uint64_t framesNeeded = 0;      // updates where it was needed
     std::uint64_t framesCastOnly = 0;    // updates where it was advanced only to cast into the view (castsIntoView)
     std::uint64_t framesSkipped = 0;     // updates where it was neither (no work done)
@@ -185,7 +206,14 @@ struct SceneCounters {
     std::uint64_t shadowTableBuilds = 0; // self-shadowing and scene-shadow tables built at the last emit()
     std::uint64_t shadowTableReuses = 0; // ... reused unchanged at the last emit()
     std::uint64_t sceneShadowBuilds = 0; // scene-shadow table builds (cumulative)
-    std::size_t sceneShadowCasters = 0;  // effects in the scene shadow at the last prepare()
+    std::size_t sceneShadowCasters = 0;  // effects in a scene shadow at the last prepare()
+    // Scene shadows at the last prepare(): lights with a table, and lights
+    // that reach a caster but got none: past SceneShadowDesc::maxLights, or
+    // over SceneShadowDesc::memoryBudgetBytes or Budgets::lightingBytes (the
+    // least influential dropped first; never slot 0's light).
+    std::size_t sceneShadowLights = 0;
+    std::size_t sceneShadowLightsOverMax = 0;
+    std::size_t sceneShadowLightsOverBudget = 0;
     // Self-shadowing tables not updated at the last emit() because their
     // light cannot reach the effect (a spot light's cone misses its bounds).
     std::uint64_t shadowTableSkips = 0;
@@ -194,6 +222,10 @@ struct SceneCounters {
     std::size_t fogTermsDrawn = 0;
     std::size_t fogTermsSkipped = 0;
     bool fogSkipped = false;
+    // Emitted lights (EffectOptions::emitsLight) at the last prepare(): fitted,
+    // and the dimmest dropped past kMaxEmittedLights (the frame keeps the brightest).
+    std::size_t emittedLights = 0;
+    std::size_t emittedLightsDropped = 0;
     // Frames whose dropped terms left a fog that failed validation (a dropped
     // term held the rest non-negative): the full fog was drawn (cumulative).
     std::uint64_t fogCullFallbacks = 0;
@@ -296,15 +328,22 @@ public:
     // the same either way. Default off.
     void setHdrLit(bool on) { mHdrLit = on; }
     bool hdrLit() const { return mHdrLit; }
+    // Builds of light i's scene-shadow table since it was made (0 for a light
+    // that never had one, or whose table is a caster's own self-shadowing table).
+    std::uint64_t sceneShadowBuilds(std::size_t light) const;
     // The last lighting failure (a bad EffectLighting or SceneShadowDesc, a
-    // sceneShadow.light past the lights, the shadow tables over
+    // sceneShadow.light past the lights, a sceneShadow.maxLights outside [1, kMaxShadowLights], the shadow tables over
     // Budgets::lightingBytes: the effect is drawn unlit, or no scene shadow);
     // empty when the last emit() had none. Hosts must show it: the render
     // tool fails the frame, the C API's prepare returns it.
     const std::string& lightingError() const { return mLightingError; }
+    // The lights the emissive effects gave at the last prepare() (all of
+    // them, brightest first; the Frame keeps the first kMaxEmittedLights).
+    std::span<const EmittedLight> emittedLights() const { return mEmittedLights; }
     // What the scene may spend; only lightingBytes is read here (every light
-    // x every table-lit effect's table, plus the scene shadow, checked
-    // before any table is built). Default Budgets{}; loadSceneFile sets the
+    // x every table-lit effect's table, plus slot 0's scene shadow, checked
+    // before any table is built; the other lights' scene shadows only use
+    // what is left). Default Budgets{}; loadSceneFile sets the
     // file's budgets.
     void setBudgets(const Budgets& budgets) { mBudgets = budgets; }
     const Budgets& budgets() const { return mBudgets; }
@@ -344,7 +383,12 @@ private:
     // Refreshes e.lit->field from the kind's lighting density; false when the
     // kind has none or it is bad (then mLightingError says why).
     bool updateLitField(Entry& e, const Materials& materials, const EmitOptions& draw);
-    void shadeScene(Frame& frame); // fills frame.shadow()
+    void shadeScene(Frame& frame); // fills frame.shadows()
+    // Which lights get a scene-shadow table this frame, slot order (scene_lighting.cpp).
+    std::vector<std::size_t> chooseShadowLights(const std::vector<std::vector<const DensityField*>>& casters);
+    std::uint64_t requiredLightingBytes() const;
+    // Fits e's emitted lights (EffectOptions::emitsLight) into mEmittedLights.
+    void fitLights(Entry& e, const Camera& camera, const Materials& materials, const EmitOptions& draw);
     // The shadow tables' bytes against mBudgets.lightingBytes; the error when over.
     Status checkLightingBudget() const;
     // The fog this camera's frame draws: mFog without the terms it cannot see (scene_fog.cpp).
@@ -355,13 +399,27 @@ private:
     double mTime = 0.0;
     bool mUpdated = false;
     std::vector<Light> mLights;
+    std::vector<EmittedLight> mEmittedLights;
+    SplatBuilder mLightScratch{SplatBuilderDesc{.frustumCull = false}}; // an emitter's whole splats, fitted, never drawn
     SceneShadowDesc mSceneShadowDesc;
     bool mHdrLit = false;
-    ShadowTable mSceneShadow;
-    ShadowTableDesc mSceneShadowTableDesc; // what mSceneShadow was made with
-    std::uint64_t mSceneShadowVersion = 0; // bumped whenever the scene shadow's contents change
-    std::uint64_t mSceneShadowLastBuilds = 0;
-    const ShadowTable* mSceneShadowSource = nullptr; // mSceneShadow, or a lit effect's own table it shares
+    // One scene-shadow table per light (index into mLights), kept while the
+    // light exists so a light moving does not rebuild another's.
+    struct LightShadow {
+        ShadowTable table;
+        ShadowTableDesc desc; // what `table` was made with
+    };
+    std::vector<LightShadow> mLightShadows;
+    // What each Frame::shadows() slot holds: a light's table or a lit
+    // effect's own, and the builds it had when copied.
+    struct ShadowSlot {
+        const ShadowTable* source = nullptr;
+        int light = -1;
+        std::uint64_t builds = 0;
+        std::uint64_t version = 0; // bumped whenever the slot's contents change
+    };
+    std::array<ShadowSlot, kMaxShadowLights> mShadowSlots{};
+    std::uint64_t mShadowVersions = 0; // the last version handed out (versions are unique across slots)
     std::string mLightingError;
     Budgets mBudgets;
     bool mTablesFit = true; // checkLightingBudget() at the last emit

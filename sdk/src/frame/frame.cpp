@@ -7,6 +7,7 @@ void Frame::begin(double timeSec, const Camera& camera) {
     mCounters = {};
     mBuilder.begin(camera);
     mVolumes.clear(); // [clouds]
+    mEmittedLights.clear();
 }
 
 void Frame::end(SortMode mode) {

@@ -111,14 +111,14 @@ Status Scene::update(double timeSec, const Camera& camera) {
     mUpdated = true;
     mCounters.needed = mCounters.simulated = mCounters.castOnly = mCounters.castersCulled = 0;
     const glm::vec3 eye = camera.eye();
-    // The light whose shadow on the scene goes into the frame: casters out of
-    // view are scheduled by where their shadow falls towards it.
-    const Light* shadowLight = mSceneShadowDesc.enabled && mSceneShadowDesc.light < mLights.size() ? &mLights[mSceneShadowDesc.light] : nullptr;
+    // Every light may shadow the scene (SceneShadowDesc): casters out of view
+    // are scheduled by where their shadow falls away from any of them.
+    const bool shadowing = mSceneShadowDesc.enabled && mSceneShadowDesc.light < mLights.size();
     for (Entry& e : mEntries) {
         EffectStatus& s = e.status;
-        const bool wasAdvanced = s.needed || s.castsIntoView;
+        const bool wasAdvanced = s.needed || s.castsIntoView || s.lightsIntoView;
         s.enabled = e.options.enabled;
-        s.needed = s.castsIntoView = false;
+        s.needed = s.castsIntoView = s.lightsIntoView = false;
         if (!s.enabled) {
             ++s.framesSkipped;
             continue;
@@ -131,10 +131,15 @@ Status Scene::update(double timeSec, const Camera& camera) {
         s.inView = s.inRange && inFrustum(s.bounds, camera);
         // Out of view, a lit caster still matters where its shadow reaches the
         // view (light influence, not visibility): it is advanced, not drawn.
-        const bool caster = shadowLight && s.inRange && !s.inView && e.options.lighting.enabled && e.options.lighting.castsShadow;
-        const bool casts = caster && shadowReachesView(s.bounds, *shadowLight, camera);
+        const bool caster = shadowing && s.inRange && !s.inView && e.options.lighting.enabled && e.options.lighting.castsShadow;
+        bool casts = false;
+        for (std::size_t i = 0; caster && !casts && i < mLights.size(); ++i) casts = shadowReachesView(s.bounds, mLights[i], camera);
         if (caster && !casts) ++mCounters.castersCulled;
-        s.alive = (s.inView || casts) && e.kind->alive(timeSec, AliveHints{.deadDensity = e.options.deadDensity});
+        // Out of view, an emitter still lights what is in view within its reach.
+        const EmittedLightDesc& emits = e.options.emitsLight;
+        const bool lights = emits.enabled && s.inRange && !s.inView && !casts &&
+                            inFrustum(Aabb{s.bounds.lo - glm::vec3(emits.reachWorld), s.bounds.hi + glm::vec3(emits.reachWorld)}, camera);
+        s.alive = (s.inView || casts || lights) && e.kind->alive(timeSec, AliveHints{.deadDensity = e.options.deadDensity});
         if (!s.alive) {
             ++s.framesSkipped;
             continue;
@@ -150,7 +155,9 @@ Status Scene::update(double timeSec, const Camera& camera) {
             ++s.framesNeeded;
             ++mCounters.needed;
         } else {
-            s.castsIntoView = true;
+            // Advanced for its shadow or its light only (counted as cast-only work).
+            s.castsIntoView = casts;
+            s.lightsIntoView = lights;
             ++s.framesCastOnly;
             ++mCounters.castOnly;
         }
@@ -165,6 +172,7 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
     mCounters.litEffects = 0;
     mCounters.shadowTableBuilds = mCounters.shadowTableReuses = mCounters.shadowTableSkips = 0;
     mTablesFit = true;
+    mEmittedLights.clear();
     if (Status s = checkLightingBudget(); !s) {
         mLightingError = s.error();
         mTablesFit = false;
@@ -193,10 +201,26 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
             lightEmitted(e, builder, materials, first, draw);
         // Not drawn but casting into the view: only the density the light sees.
         if (e.status.castsIntoView && !updateLitField(e, materials, draw)) e.status.castsIntoView = false;
+        e.status.emittedLights = 0;
+        if (e.options.emitsLight.enabled && (e.status.needed || e.status.lightsIntoView)) fitLights(e, builder.camera(), materials, draw);
     }
     mCounters.splats = splats;
     mCounters.tetrahedra = tetrahedra;
     return splats;
+}
+
+void Scene::fitLights(Entry& e, const Camera& camera, const Materials& materials, const EmitOptions& draw) {
+    // Every splat, in view or not (no frustum culling), so the light does not
+    // change as the effect crosses the view's edge; drawn nowhere.
+    mLightScratch.begin(camera);
+    e.kind->emit(EmitContext{.splats = mLightScratch, .volumes = nullptr, .materials = materials, .draw = draw});
+    Result<std::vector<EmittedLight>> lights = fitEmittedLights(mLightScratch.splats(), materials, e.options.emitsLight);
+    if (!lights) {
+        mLightingError = "effect '" + e.options.name + "': " + lights.error();
+        return;
+    }
+    e.status.emittedLights = lights->size();
+    mEmittedLights.insert(mEmittedLights.end(), lights->begin(), lights->end());
 }
 
 std::size_t Scene::emit(SplatBuilder& builder, const Materials& materials, const EmitOptions& options) {
@@ -208,13 +232,23 @@ Status Scene::prepare(double timeSec, const Camera& camera, const Materials& mat
     if (Status s = update(timeSec, camera); !s) return s;
     frame.begin(timeSec, camera);
     emitInto(frame.builder(), &frame.volumes(), materials, options);
-    shadeScene(frame); // the lit effects' shadow on the scene, into frame.shadow()
+    shadeScene(frame); // the lit effects' shadows on the scene, into frame.shadows()
+    // The emitters' lights, brightest first; the frame keeps what the GLSL holds.
+    std::stable_sort(mEmittedLights.begin(), mEmittedLights.end(), [](const EmittedLight& a, const EmittedLight& b) {
+        return a.intensity.x + a.intensity.y + a.intensity.z > b.intensity.x + b.intensity.y + b.intensity.z;
+    });
+    const std::size_t kept = std::min<std::size_t>(mEmittedLights.size(), kMaxEmittedLights);
+    frame.emittedLights().assign(mEmittedLights.begin(), mEmittedLights.begin() + std::ptrdiff_t(kept));
+    mCounters.emittedLights = mEmittedLights.size();
+    mCounters.emittedLightsDropped = mEmittedLights.size() - kept;
     frame.end();
     frame.setFog(fogForView(camera, timeSec)); // only the terms this view can see
     FrameCounters& c = frame.counters();
     c.litEffects = mCounters.litEffects;
     c.shadowTableBuilds = mCounters.shadowTableBuilds;
     c.shadowTableReuses = mCounters.shadowTableReuses;
+    c.shadowLights = mCounters.sceneShadowLights;
+    c.shadowLightsDropped = mCounters.sceneShadowLightsOverMax + mCounters.sceneShadowLightsOverBudget;
     c.declared = mCounters.declared;
     c.needed = mCounters.needed;
     c.simulated = mCounters.simulated;

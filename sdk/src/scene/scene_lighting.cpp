@@ -46,20 +46,31 @@ Status Scene::setLight(std::size_t i, const Light& light) {
     return {};
 }
 
-Status Scene::checkLightingBudget() const {
-    if (mLights.empty()) return {};
+std::uint64_t Scene::requiredLightingBytes() const {
     std::uint64_t total = 0;
-    std::size_t tableLit = 0;
     for (const Entry& e : mEntries) {
         const EffectLighting& L = e.options.lighting;
         if (!e.options.enabled || !L.enabled || L.selfShadow != SelfShadow::Table) continue;
         total += ShadowTable::memoryBytes(L.tableDims) * mLights.size(); // one table per light
-        ++tableLit;
     }
-    if (mSceneShadowDesc.enabled) total += ShadowTable::memoryBytes(mSceneShadowDesc.dims);
+    if (mSceneShadowDesc.enabled) total += ShadowTable::memoryBytes(mSceneShadowDesc.dims); // slot 0's
+    return total;
+}
+
+Status Scene::checkLightingBudget() const {
+    if (mLights.empty()) return {};
+    std::size_t tableLit = 0;
+    for (const Entry& e : mEntries) {
+        const EffectLighting& L = e.options.lighting;
+        if (e.options.enabled && L.enabled && L.selfShadow == SelfShadow::Table) ++tableLit;
+    }
     return checkBudget("lighting: the shadow tables of " + std::to_string(mLights.size()) + " light(s) x " + std::to_string(tableLit) +
                            " table-lit effect(s)" + (mSceneShadowDesc.enabled ? " and the scene shadow" : ""),
-                       total, "bytes", mBudgets.lightingBytes, "lightingBytes");
+                       requiredLightingBytes(), "bytes", mBudgets.lightingBytes, "lightingBytes");
+}
+
+std::uint64_t Scene::sceneShadowBuilds(std::size_t light) const {
+    return light < mLightShadows.size() ? mLightShadows[light].table.builds() : 0;
 }
 
 bool Scene::updateLitField(Entry& e, const Materials& materials, const EmitOptions& draw) {
@@ -143,83 +154,178 @@ void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& mater
     ++mCounters.litEffects;
 }
 
+namespace {
+
+// How much light i can put into a shadow: its irradiance at each caster's
+// box, summed (a point or spot light's at the box's nearest point, but no
+// closer than the box's bounding radius, so a light inside stays finite),
+// times its brightest colour channel. Spot cones that miss were removed
+// before (Scene::lightReaches).
+double influence(const Light& light, std::span<const DensityField* const> casters) {
+    const double power = double(light.intensity) * double(std::max({light.color.r, light.color.g, light.color.b}));
+    if (light.type == LightType::Directional) return power * double(casters.size());
+    double sum = 0.0;
+    for (const DensityField* f : casters) {
+        const glm::dvec3 lo(f->boundsMin()), hi(f->boundsMax()), p(light.position);
+        const glm::dvec3 q = glm::clamp(p, lo, hi);
+        const double r = 0.5 * glm::length(hi - lo);
+        const double d2 = std::max({glm::dot(p - q, p - q), r * r, double(light.radiusWorld) * double(light.radiusWorld)});
+        sum += d2 > 0.0 ? power / d2 : 0.0;
+    }
+    return sum;
+}
+
+} // namespace
+
+std::vector<std::size_t> Scene::chooseShadowLights(const std::vector<std::vector<const DensityField*>>& casters) {
+    const SceneShadowDesc& d = mSceneShadowDesc;
+    std::vector<std::size_t> candidates; // lights that reach a caster, except slot 0's
+    std::vector<double> weight(mLights.size(), 0.0);
+    for (std::size_t i = 0; i < mLights.size(); ++i) {
+        if (casters[i].empty()) continue;
+        weight[i] = influence(mLights[i], casters[i]);
+        if (i != d.light) candidates.push_back(i);
+    }
+    // Most influential first; ties (and NaN-free equal weights) by light order, so the choice is deterministic.
+    std::stable_sort(candidates.begin(), candidates.end(), [&](std::size_t a, std::size_t b) { return weight[a] > weight[b]; });
+    std::vector<std::size_t> chosen;
+    const bool first = d.light < mLights.size() && !casters[d.light].empty();
+    if (first) chosen.push_back(d.light);
+    // Slot 0 is kept for d.light even when it casts nothing this frame: splatfx_shadow() reads it.
+    const std::size_t room = std::size_t(std::clamp(d.maxLights, 1, kMaxShadowLights)) - 1;
+    const std::size_t wanted = std::min(room, candidates.size());
+    mCounters.sceneShadowLightsOverMax = candidates.size() - wanted;
+    // Memory: each table costs memoryBytes(dims); all of them within the
+    // desc's budget and within what Budgets::lightingBytes leaves once the
+    // required tables (checkLightingBudget: slot 0's included) are counted.
+    const std::uint64_t each = ShadowTable::memoryBytes(d.dims);
+    const std::uint64_t required = requiredLightingBytes();
+    const std::uint64_t leftOver = mBudgets.lightingBytes > required ? mBudgets.lightingBytes - required : 0;
+    const std::uint64_t ownBudget = d.memoryBudgetBytes > each ? d.memoryBudgetBytes - each : 0; // slot 0's is counted in both
+    const std::uint64_t fit = each > 0 ? std::min(leftOver, ownBudget) / each : 0;
+    const std::size_t kept = std::size_t(std::min<std::uint64_t>(wanted, fit));
+    mCounters.sceneShadowLightsOverBudget = wanted - kept;
+    // The kept ones take the slots after slot 0 in light order, so a change of ranking moves no table between slots.
+    std::vector<std::size_t> rest(candidates.begin(), candidates.begin() + std::ptrdiff_t(kept));
+    std::sort(rest.begin(), rest.end());
+    chosen.insert(chosen.end(), rest.begin(), rest.end());
+    return chosen;
+}
+
 void Scene::shadeScene(Frame& frame) {
     const SceneShadowDesc& d = mSceneShadowDesc;
-    std::vector<const DensityField*> fields;
-    const Entry* only = nullptr; // the one casting effect, when there is one
     // A shadow cast by a light the scene does not have would silently be no shadow.
     if (d.enabled && !mLights.empty() && d.light >= mLights.size() && mLightingError.empty())
         mLightingError = "sceneShadow.light: expected the index of one of the scene's " + std::to_string(mLights.size()) +
                          " light(s), 0 to " + std::to_string(mLights.size() - 1) + ", got " + std::to_string(d.light);
-    // Casters: the drawn lit effects, and those out of view whose shadow
-    // reaches it (castsIntoView); each only where the light reaches it.
-    for (Entry& e : mEntries) e.status.inSceneShadow = false;
-    if (d.enabled && d.light < mLights.size() && mTablesFit)
-        for (Entry& e : mEntries)
-            if ((e.status.lit || e.status.castsIntoView) && e.options.lighting.castsShadow && e.lit && !e.lit->field.empty() &&
-                lightReaches(mLights[d.light], Aabb{e.lit->field.boundsMin(), e.lit->field.boundsMax()})) {
-                fields.push_back(&e.lit->field);
-                e.status.inSceneShadow = true;
-                only = &e;
+    if (d.enabled && (d.maxLights < 1 || d.maxLights > kMaxShadowLights) && mLightingError.empty())
+        mLightingError = "sceneShadow.maxLights: expected 1 to " + std::to_string(kMaxShadowLights) + ", got " + std::to_string(d.maxLights);
+    const bool on = d.enabled && d.light < mLights.size() && d.maxLights >= 1 && d.maxLights <= kMaxShadowLights && mTablesFit;
+    // Casters per light: the drawn lit effects, and those out of view whose
+    // shadow reaches it (castsIntoView); each only where the light reaches it.
+    std::vector<std::vector<const DensityField*>> casters(mLights.size());
+    std::vector<std::vector<Entry*>> casterEntries(mLights.size());
+    for (Entry& e : mEntries) {
+        e.status.inSceneShadow = false;
+        if (!on || !(e.status.lit || e.status.castsIntoView) || !e.options.lighting.castsShadow || !e.lit || e.lit->field.empty()) continue;
+        const Aabb box{e.lit->field.boundsMin(), e.lit->field.boundsMax()};
+        for (std::size_t i = 0; i < mLights.size(); ++i)
+            if (lightReaches(mLights[i], box)) {
+                casters[i].push_back(&e.lit->field);
+                casterEntries[i].push_back(&e);
             }
-    mCounters.sceneShadowCasters = fields.size();
-    // Only a drawn effect's self-shadowing tables are current.
-    if (fields.size() != 1 || !only->status.lit) only = nullptr;
-    // One casting effect whose self-shadowing table for this light has the
-    // scene shadow's dims: that table is the scene shadow (the paper's one
-    // table serves both), so nothing more is built.
-    const ShadowTable* shared = nullptr;
-    if (only && only->options.lighting.selfShadow == SelfShadow::Table && only->options.lighting.tableDims == d.dims &&
-        d.light < only->lit->tables.tables().size())
-        shared = &only->lit->tables.tables()[d.light];
-    const ShadowTable* src = nullptr;
-    if (shared) {
-        src = shared;
-        if (shared != mSceneShadowSource || shared->builds() != mSceneShadowLastBuilds) {
-            mSceneShadowSource = shared;
-            mSceneShadowLastBuilds = shared->builds();
-            ++mSceneShadowVersion;
+    }
+    mCounters.sceneShadowLightsOverMax = mCounters.sceneShadowLightsOverBudget = 0;
+    const std::vector<std::size_t> chosen = on ? chooseShadowLights(casters) : std::vector<std::size_t>{};
+    // What the kept tables cover.
+    std::size_t casting = 0;
+    for (std::size_t li : chosen)
+        for (Entry* e : casterEntries[li])
+            if (!e->status.inSceneShadow) e->status.inSceneShadow = true, ++casting;
+    mCounters.sceneShadowCasters = casting;
+    if (mLightShadows.size() > mLights.size()) mLightShadows.resize(mLights.size());
+    while (mLightShadows.size() < mLights.size()) mLightShadows.emplace_back();
+    // The slots refer to what they copied by address and build count; a table replaced or freed
+    // at the same address must not pass for the one copied.
+    auto forgetSlotsOf = [&](std::size_t li) {
+        for (ShadowSlot& slot : mShadowSlots)
+            if (slot.light == int(li)) slot.source = nullptr, slot.version = 0;
+    };
+    // A light without a table this frame frees it (the budget counts only the kept ones); it is
+    // rebuilt when the light gets a slot again.
+    for (std::size_t li = 0; li < mLightShadows.size(); ++li)
+        if (std::find(chosen.begin(), chosen.end(), li) == chosen.end() && mLightShadows[li].table.builds() > 0) {
+            mLightShadows[li] = LightShadow{};
+            forgetSlotsOf(li);
         }
-    } else if (!fields.empty()) {
+
+    std::array<const ShadowTable*, kMaxShadowLights> sources{};
+    std::array<int, kMaxShadowLights> lights;
+    lights.fill(-1);
+    // chosen[0] is d.light's when it casts; otherwise slot 0 stays empty and the rest start at slot 1.
+    const std::size_t firstSlot = !chosen.empty() && chosen[0] == d.light && !casters[d.light].empty() ? 0 : 1;
+    for (std::size_t c = 0; c < chosen.size(); ++c) {
+        const std::size_t k = c + firstSlot;
+        const std::size_t li = chosen[c];
+        // One casting effect whose self-shadowing table for this light has the
+        // scene shadow's dims: that table is the scene shadow (the paper's one
+        // table serves both), so nothing more is built. Only a drawn effect's
+        // self-shadowing tables are current.
+        const Entry* only = casterEntries[li].size() == 1 && casterEntries[li][0]->status.lit ? casterEntries[li][0] : nullptr;
+        if (only && only->options.lighting.selfShadow == SelfShadow::Table && only->options.lighting.tableDims == d.dims &&
+            li < only->lit->tables.tables().size()) {
+            sources[k] = &only->lit->tables.tables()[li];
+            lights[k] = int(li);
+            continue;
+        }
+        LightShadow& ls = mLightShadows[li];
         const ShadowTableDesc td{.dims = d.dims, .memoryBudgetBytes = d.memoryBudgetBytes};
-        if (td.dims != mSceneShadowTableDesc.dims || td.memoryBudgetBytes != mSceneShadowTableDesc.memoryBudgetBytes) {
-            mSceneShadow = ShadowTable(td);
-            mSceneShadowTableDesc = td;
+        if (td.dims != ls.desc.dims || td.memoryBudgetBytes != ls.desc.memoryBudgetBytes) {
+            ls.table = ShadowTable(td);
+            ls.desc = td;
+            forgetSlotsOf(li); // a new table at the same address: its build count starts again
         }
-        const std::uint64_t reuses = mSceneShadow.reuses();
-        if (Status s = mSceneShadow.update(fields, mLights[d.light]); !s) {
-            mLightingError = "sceneShadow: " + s.error();
+        const std::uint64_t builds = ls.table.builds(), reuses = ls.table.reuses();
+        if (Status s = ls.table.update(casters[li], mLights[li]); !s) {
+            if (mLightingError.empty()) mLightingError = "sceneShadow (light " + std::to_string(li) + "): " + s.error();
+            continue;
+        }
+        if (ls.table.builds() != builds) {
+            ++mCounters.shadowTableBuilds;
+            ++mCounters.sceneShadowBuilds;
+        }
+        mCounters.shadowTableReuses += ls.table.reuses() - reuses;
+        sources[k] = &ls.table;
+        lights[k] = int(li);
+    }
+    std::size_t withTable = 0;
+    for (std::size_t k = 0; k < std::size_t(kMaxShadowLights); ++k) {
+        ShadowSlot& slot = mShadowSlots[k];
+        const ShadowTable* src = sources[k];
+        withTable += src ? 1 : 0;
+        const std::uint64_t builds = src ? src->builds() : 0;
+        if (src != slot.source || lights[k] != slot.light || builds != slot.builds || slot.version == 0) {
+            slot.source = src;
+            slot.light = lights[k];
+            slot.builds = builds;
+            slot.version = ++mShadowVersions;
+        }
+        FrameShadow& out = frame.shadows()[k];
+        if (out.version == slot.version) continue; // unchanged: nothing to copy
+        out.valid = src != nullptr;
+        out.version = slot.version;
+        out.light = src ? lights[k] : (k == 0 ? int(d.light) : -1);
+        if (src) {
+            out.depth = src->data();
+            out.dims = src->dims();
+            out.worldToTable = src->worldToTable();
+            out.lightInTable = src->lightInTable();
         } else {
-            src = &mSceneShadow;
-            if (mSceneShadowSource != &mSceneShadow || mSceneShadow.builds() != mSceneShadowLastBuilds) {
-                if (mSceneShadow.builds() != mSceneShadowLastBuilds) {
-                    ++mCounters.shadowTableBuilds;
-                    ++mCounters.sceneShadowBuilds;
-                }
-                mSceneShadowSource = &mSceneShadow;
-                mSceneShadowLastBuilds = mSceneShadow.builds();
-                ++mSceneShadowVersion;
-            }
-            mCounters.shadowTableReuses += mSceneShadow.reuses() - reuses;
+            out.depth.clear();
+            out.dims = glm::ivec3(0);
         }
     }
-    if (!src && mSceneShadowSource) {
-        mSceneShadowSource = nullptr;
-        ++mSceneShadowVersion;
-    }
-    FrameShadow& out = frame.shadow();
-    if (out.version == mSceneShadowVersion && mSceneShadowVersion != 0) return; // unchanged: nothing to copy
-    out.valid = src != nullptr;
-    out.version = mSceneShadowVersion;
-    if (src) {
-        out.depth = src->data();
-        out.dims = src->dims();
-        out.worldToTable = src->worldToTable();
-        out.lightInTable = src->lightInTable();
-    } else {
-        out.depth.clear();
-        out.dims = glm::ivec3(0);
-    }
+    mCounters.sceneShadowLights = withTable;
 }
 
 } // namespace splatfx

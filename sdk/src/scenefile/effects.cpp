@@ -66,6 +66,17 @@ void readEffects(Context& c, const std::string& path, const Json& v, const std::
             to.finish();
         }
         if (const Json* l = o.get("lighting")) readEffectLighting(c, o.at("lighting"), *l, e.options.lighting); // issue 16
+        if (const Json* em = o.get("emitsLight")) { // the effect as light for the host (emitted_light.hpp)
+            ObjectReader eo(c.d, o.at("emitsLight"), *em);
+            EmittedLightDesc& d = e.options.emitsLight;
+            d.enabled = true; // giving the block asks for it
+            eo.boolean("enabled", d.enabled);
+            eo.integer("lights", d.lights, 1, kMaxEmittedLights);
+            eo.number("scale", d.scale, 0.0, 1e6);
+            eo.boolean("occlusion", d.occlusion);
+            eo.number("reachWorld", d.reachWorld, 1e-6, 1e30);
+            eo.finish();
+        }
         o.string("attachTo", e.attachTo);
         if (const Json* m = o.get("motion")) {
             if (!e.attachTo.empty()) c.d.error(o.at("motion"), "an effect either has its own \"motion\" or is attached to geometry; not both");

@@ -90,11 +90,16 @@ void readSceneShadow(Context& c, const std::string& path, const Json& v, SceneFi
                        lights == 0 ? "the scene has no \"lights\"; the scene shadow is cast by one of them (add one, or set \"enabled\": false)"
                                    : "expected the index of one of the scene's " + std::to_string(lights) + " light(s), 0 to " +
                                          std::to_string(lights - 1) + ", got " + std::to_string(s.light));
+        o.integer("maxLights", s.maxLights, 1, kMaxShadowLights);
+        int budgetMiB = int(s.memoryBudgetBytes >> 20);
+        o.integer("memoryMiB", budgetMiB, 1, 65536);
+        s.memoryBudgetBytes = std::uint64_t(budgetMiB) << 20;
         readAxisCounts(cc, o, "dims", s.dims, 1, 1024);
         const std::uint64_t bytes = ShadowTable::memoryBytes(s.dims);
         if (bytes > s.memoryBudgetBytes)
             cc.d.error(o.at("dims"), std::to_string(s.dims.x) + "x" + std::to_string(s.dims.y) + "x" + std::to_string(s.dims.z) + " needs " +
-                                         std::to_string(bytes >> 20) + " MiB to build, over the 64 MiB budget");
+                                         std::to_string((bytes + (1u << 20) - 1) >> 20) + " MiB to build, over the " + std::to_string(budgetMiB) +
+                                         " MiB budget (memoryMiB)");
     });
     if (d) out.scene.setSceneShadow(*d);
 }

@@ -5,8 +5,8 @@
 // depth texture, and hooks for its own opaque and transparent geometry).
 // render() makes the frame's plan (frame_plan.hpp: every ordering and
 // fallback decision, as data) and runs its steps:
-//   0. uploads what changed: the frame's shadow table (Frame::shadow(), a 3D
-//      texture bound to FrameRendererDesc::shadowTextureUnit during the hooks;
+//   0. uploads what changed: the frame's shadow tables (Frame::shadows(), 3D
+//      textures bound to FrameRendererDesc::shadowTextureUnit and below during the hooks;
 //      see shadowBinding() and docs/integration.md, "Shadows of the gas"), the
 //      LOD volumes' pre-integration tables
 //   1. the host's opaque pass (HostTarget::drawOpaque; its depth is what cuts the volumes)
@@ -56,6 +56,7 @@
 // Threading: every call on the thread whose context is current. Move-only.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -100,9 +101,11 @@ struct FrameRendererDesc {
     Precision volumeLayerPrecision = Precision::F32;
     Precision reducedPrecision = Precision::F16; // reduced-resolution colour format; default F16
     float depthThreshold = 0.1f;                 // reduced resolution: relative view depth still one surface; default 0.1
-    // The texture unit the frame's shadow table is bound to while the host's
-    // hooks run (splatfx_shadowTable of shadowGlsl()).
-    int shadowTextureUnit = 15; // [0, 15] (GL 4.5 guarantees 16 per stage); default 15
+    // The texture unit the frame's shadow table of slot 0 is bound to while
+    // the host's hooks run (splatfx_shadowTable of shadowGlsl()); slot k's
+    // (Frame::shadows(), splatfx_shadowTable<k>) takes the unit
+    // shadowTextureUnit - k, so units 15, 14, 13, 12 by default.
+    int shadowTextureUnit = 15; // [kMaxShadowLights - 1, 15] (GL 4.5 guarantees 16 per stage); default 15
     // Fog (docs/fog.md).
     // (0, 0): the host image's fog evaluated per pixel; otherwise the size of
     // the reduced fog texture it is evaluated into (the paper's Table 1:
@@ -128,19 +131,37 @@ struct FrameRendererDesc {
     int fragmentsPerPixel = 8;
 };
 
+// One of slots 1 to kMaxShadowLights - 1 of a ShadowBinding (uniforms
+// suffixed with the slot's number: splatfx_shadowTable1, ...).
+struct ShadowSlotBinding {
+    bool valid = false;                              // the frame had a shadow in this slot
+    int light = -1;                                  // splatfx_shadowLightIndex[k]: the scene light; -1 none
+    int textureUnit = 0;                             // uniform sampler3D splatfx_shadowTable<k>
+    unsigned texture = 0;                            // GL name of the 3D texture (GL_R32F)
+    glm::mat4 worldToTable{1.0f};                    // uniform mat4 splatfx_worldToTable<k>
+    glm::vec4 lightInTable{0.0f, -1.0f, 0.0f, 0.0f}; // uniform vec4 splatfx_shadowLight<k>
+};
+
 // What a host surface shader with shadowGlsl()
-// (lighting.hpp) needs: the table's unit and the two matrices. Without a
-// shadow in the frame the unit holds a 1^3 table of zero depth, so
-// splatfx_shadow() returns 1 and the host shader needs no variant.
+// (lighting.hpp) needs: each table's unit and the two matrices. Without a
+// shadow in a slot its unit holds a 1^3 table of zero depth, so
+// splatfx_shadow() / splatfx_shadowTo() return 1 and the host shader needs no variant.
 struct ShadowBinding {
-    bool valid = false;                              // the frame had a shadow
+    bool valid = false;                              // the frame had a shadow in slot 0
     int textureUnit = 15;                            // uniform sampler3D splatfx_shadowTable
     unsigned texture = 0;                            // GL name of the 3D texture (GL_R32F)
     glm::mat4 worldToTable{1.0f};                    // uniform mat4 splatfx_worldToTable
     glm::vec4 lightInTable{0.0f, -1.0f, 0.0f, 0.0f}; // uniform vec4 splatfx_shadowLight
+    int light = 0;                                   // splatfx_shadowLightIndex[0]: slot 0's scene light; default 0
+    // Slots 1 to 3 (Frame::shadows()[1...]); by default no light, on units 14, 13, 12.
+    std::array<ShadowSlotBinding, kMaxShadowLights - 1> slots{ShadowSlotBinding{.textureUnit = 14}, ShadowSlotBinding{.textureUnit = 13},
+                                                               ShadowSlotBinding{.textureUnit = 12}};
+    // The frame's emitted lights (Frame::emittedLights): splatfx_emittedIrradiance's uniforms.
+    std::vector<EmittedLight> emittedLights{};
 };
-// Sets shadowGlsl()'s three uniforms on `program` (glProgramUniform: the
-// program need not be bound). Call it in the opaque hook, each frame.
+// Sets shadowGlsl()'s uniforms on `program` (glProgramUniform: the
+// program need not be bound): the table's three and the emitted lights'.
+// Call it in the opaque hook, each frame.
 void setShadowUniforms(unsigned program, const ShadowBinding& binding);
 
 // What the host owns, handed over for one frame.
@@ -199,7 +220,8 @@ struct FrameRenderStats {
         bool listsNearest = false; // the fragment lists read each pixel's nearest sample
     } msaa;
     struct Shadow {
-        std::uint64_t uploads = 0; // shadow-table uploads (cumulative; only when the frame's changed)
+        std::uint64_t uploads = 0; // shadow-table uploads, every slot (cumulative; only when the frame's changed)
+        int tables = 0;            // slots with a valid table at the last render (Frame::shadows())
     } shadow;
     struct Fog {
         bool host = false;       // the host image was fogged (a fog, fogHost and a host depth to read)

@@ -99,8 +99,9 @@ struct FrameRenderer::Impl {
 Result<FrameRenderer> FrameRenderer::create(const FrameRendererDesc& desc) {
     if (desc.resolutionScale != 1 && desc.resolutionScale != 2 && desc.resolutionScale != 4)
         return makeError("FrameRendererDesc::resolutionScale must be 1, 2 or 4, got " + std::to_string(desc.resolutionScale));
-    if (desc.shadowTextureUnit < 0 || desc.shadowTextureUnit > 15)
-        return makeError("FrameRendererDesc::shadowTextureUnit must be in [0, 15], got " + std::to_string(desc.shadowTextureUnit));
+    if (desc.shadowTextureUnit < kMaxShadowLights - 1 || desc.shadowTextureUnit > 15)
+        return makeError("FrameRendererDesc::shadowTextureUnit must be in [" + std::to_string(kMaxShadowLights - 1) +
+                         ", 15] (the other shadow slots take the units below it), got " + std::to_string(desc.shadowTextureUnit));
     if (desc.fogTextureSize.x < 0 || desc.fogTextureSize.y < 0 || desc.fogTextureSize.x > 8192 || desc.fogTextureSize.y > 8192 ||
         (desc.fogTextureSize.x == 0) != (desc.fogTextureSize.y == 0))
         return makeError("FrameRendererDesc::fogTextureSize must be (0, 0) (per pixel) or between 1 and 8192 on each side, got " +

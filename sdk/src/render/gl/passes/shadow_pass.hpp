@@ -1,10 +1,13 @@
-// The frame's shadow on the scene: uploads Frame::shadow() as a 3D
+// The frame's shadows on the scene: uploads each of Frame::shadows() as a 3D
 // texture when its version changed, and binds it for the host's hooks, so a
 // host surface shader with shadowGlsl() samples the gas's shadow.
 // Private to gl; a pass of FrameRenderer (steps UploadShadow and UnbindShadow).
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "splatfx/frame.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
@@ -14,16 +17,17 @@ namespace splatfx::gl::detail {
 
 class ShadowPass final : public Pass {
 public:
-    explicit ShadowPass(int textureUnit) : mUnit(textureUnit) {}
+    // Slot k's table goes to unit firstUnit - k.
+    explicit ShadowPass(int firstUnit) : mUnit(firstUnit) {}
     ShadowPass(const ShadowPass&) = delete;
     ShadowPass& operator=(const ShadowPass&) = delete;
     ~ShadowPass();
 
-    // Uploads the frame's shadow if it changed since the last upload (an
+    // Uploads slot k's shadow if it changed since the last upload (an
     // invalid shadow becomes a 1^3 zero-depth table: splatfx_shadow() = 1).
-    // Returns whether it uploaded.
-    bool uploadTable(const FrameShadow& shadow);
-    // Binds the table to the unit (saving what was bound there) / restores it.
+    // Returns whether it uploaded a table or emptied one (not the placeholder of a slot never filled).
+    bool uploadTable(std::size_t k, const FrameShadow& shadow);
+    // Binds every slot's table to its unit (saving what was bound there) / restores them.
     void bind();
     void unbind();
     ShadowBinding binding() const;
@@ -32,15 +36,20 @@ public:
     void report(FrameRenderStats& stats) const override;
 
 private:
+    struct Slot {
+        unsigned texture = 0;
+        std::uint64_t version = 0;
+        bool uploadedOnce = false, valid = false;
+        int light = -1;
+        glm::ivec3 dims{0};
+        glm::mat4 worldToTable{1.0f};
+        glm::vec4 lightInTable{0.0f, -1.0f, 0.0f, 0.0f};
+        int savedBinding = 0;
+    };
     int mUnit;
-    unsigned mTexture = 0;
-    std::uint64_t mVersion = 0;
-    bool mUploadedOnce = false, mValid = false;
-    glm::ivec3 mDims{0};
-    glm::mat4 mWorldToTable{1.0f};
-    glm::vec4 mLight{0.0f, -1.0f, 0.0f, 0.0f};
-    int mSavedBinding = 0;
+    std::array<Slot, kMaxShadowLights> mSlots{};
     std::uint64_t mUploads = 0;
+    std::vector<EmittedLight> mEmitted; // the last frame's, at most kMaxEmittedLights
 };
 
 } // namespace splatfx::gl::detail

@@ -1,0 +1,239 @@
+#include "splatfx/emitted_light.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+
+namespace splatfx {
+namespace {
+
+constexpr int kSamplesPerSide = 16; // texture samples per side of a splat's quad for its intensity
+
+bool finite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+glm::vec3 rowColor(const std::vector<glm::vec4>& row, float coord) {
+    if (row.empty()) return glm::vec3(1.0f);
+    const float f = std::clamp(std::isfinite(coord) ? coord : 0.0f, 0.0f, 1.0f) * float(row.size() - 1);
+    const std::size_t i = std::min(std::size_t(f), row.size() - 1), j = std::min(i + 1, row.size() - 1);
+    const float t = f - float(i);
+    return glm::vec3(row[i]) * (1.0f - t) + glm::vec3(row[j]) * t;
+}
+
+// One splat's emission: its radiant intensity (premultiplied colour
+// integrated over the ellipse) and its optical area (log2 depth integrated
+// over the ellipse), from point samples at texel centres of its layers.
+struct SplatEmission {
+    glm::vec3 intensity{0.0f};
+    float opticalArea = 0.0f;
+};
+
+SplatEmission emission(const Splat& s, const Materials& m, bool packedColor) {
+    const int n = m.layerSize();
+    if (s.layer >= m.layerCount() || s.nextLayer >= m.layerCount() || !(s.density > 0.0f) || !finite(s.center)) return {};
+    const float area = glm::length(glm::cross(s.axisU, s.axisV)); // world area per unit of (u, v)
+    if (!(area > 0.0f) || !std::isfinite(area)) return {};
+    glm::vec3 base(1.0f);
+    if (packedColor) base = glm::vec3(float(s.color & 255u), float((s.color >> 8) & 255u), float((s.color >> 16) & 255u)) / 255.0f;
+    else if (std::uint32_t(std::lround(s.colorRow)) < m.colorTableCount()) base = rowColor(m.colorRow(std::uint32_t(std::lround(s.colorRow))), s.colorCoord);
+    const std::vector<float>& a = m.layer(s.layer);
+    const std::vector<float>& b = m.layer(s.nextLayer);
+    const float w = std::clamp(s.blend, 0.0f, 1.0f);
+    const int stride = std::max(1, n / kSamplesPerSide);
+    glm::vec3 sumColor(0.0f);
+    float sumAlpha = 0.0f;
+    int count = 0;
+    for (int y = stride / 2; y < n; y += stride)
+        for (int x = stride / 2; x < n; x += stride, ++count) {
+            const std::size_t p = (std::size_t(y) * n + x) * 4;
+            const glm::vec4 t = glm::vec4(a[p], a[p + 1], a[p + 2], a[p + 3]) * (1.0f - w) + glm::vec4(b[p], b[p + 1], b[p + 2], b[p + 3]) * w;
+            const float alpha = -std::expm1(-0.69314718f * s.density * t.a);
+            sumAlpha += alpha;
+            sumColor += glm::vec3(t) * alpha; // premultiplied
+        }
+    if (count == 0) return {};
+    const float quad = 4.0f * area; // (u, v) in [-1, 1]^2: area 4 per unit
+    // What the splat takes from light crossing it anywhere in its quad is its
+    // mean opacity (a textured splat has holes), as an optical depth.
+    const float meanAlpha = std::min(sumAlpha / float(count), 1.0f - 1e-6f);
+    return {base * sumColor * (quad / float(count)), -std::log2(1.0f - meanAlpha) * quad};
+}
+
+// The fraction of a splat's light that leaves the volume, averaged over the
+// six axis directions: the splats' optical areas binned on a coarse grid,
+// each bin's mean optical depth across a face = its optical area / the face.
+class Occlusion {
+public:
+    Occlusion(std::span<const Splat> splats, std::span<const SplatEmission> e, const std::vector<std::size_t>& emitting) {
+        glm::vec3 lo(1e30f), hi(-1e30f);
+        float radius = 0.0f;
+        for (std::size_t i : emitting) {
+            lo = glm::min(lo, splats[i].center), hi = glm::max(hi, splats[i].center);
+            radius += std::sqrt(glm::length(glm::cross(splats[i].axisU, splats[i].axisV)));
+        }
+        radius /= float(std::max<std::size_t>(emitting.size(), 1));
+        const float cell = std::max(radius, 1e-6f);
+        mLo = lo - 0.5f * cell;
+        const glm::vec3 extent = hi - lo + cell;
+        // A bin about one splat radius wide, at most 32 a side.
+        mDims = glm::clamp(glm::ivec3(glm::ceil(extent / cell)), glm::ivec3(1), glm::ivec3(32));
+        mCell = extent / glm::vec3(mDims);
+        mDepth.assign(std::size_t(mDims.x) * mDims.y * mDims.z, 0.0f);
+        for (std::size_t i : emitting) mDepth[index(bin(splats[i].center))] += e[i].opticalArea;
+    }
+    // Transmittance from p out of the volume along +x, +y, +z (plus) and -x, -y, -z (minus).
+    void escape(glm::vec3 p, glm::vec3& plus, glm::vec3& minus) const {
+        const glm::ivec3 c = bin(p);
+        for (int axis = 0; axis < 3; ++axis) {
+            const float face = mCell[(axis + 1) % 3] * mCell[(axis + 2) % 3];
+            for (int dir : {-1, 1}) {
+                float tau = 0.5f * mDepth[index(c)]; // half of its own bin lies ahead
+                glm::ivec3 q = c;
+                for (q[axis] += dir; q[axis] >= 0 && q[axis] < mDims[axis]; q[axis] += dir) tau += mDepth[index(q)];
+                (dir > 0 ? plus : minus)[axis] = std::exp2(-tau / face);
+            }
+        }
+    }
+
+private:
+    glm::ivec3 bin(glm::vec3 p) const { return glm::clamp(glm::ivec3(glm::floor((p - mLo) / mCell)), glm::ivec3(0), mDims - 1); }
+    std::size_t index(glm::ivec3 c) const { return (std::size_t(c.z) * mDims.y + c.y) * mDims.x + c.x; }
+    glm::vec3 mLo{0.0f}, mCell{1.0f};
+    glm::ivec3 mDims{1};
+    std::vector<float> mDepth;
+};
+
+} // namespace
+
+Status validate(const EmittedLightDesc& d) {
+    if (d.lights < 1 || d.lights > kMaxEmittedLights)
+        return makeError("EmittedLightDesc.lights must be in [1, " + std::to_string(kMaxEmittedLights) + "], got " + std::to_string(d.lights));
+    if (!(d.scale >= 0.0f) || !std::isfinite(d.scale)) return makeError("EmittedLightDesc.scale must be finite and >= 0");
+    if (!(d.reachWorld > 0.0f)) return makeError("EmittedLightDesc.reachWorld must be > 0");
+    return {};
+}
+
+Result<std::vector<EmittedLight>> fitEmittedLights(std::span<const Splat> splats, const Materials& materials, const EmittedLightDesc& desc,
+                                                   bool packedColor) {
+    if (Status s = validate(desc); !s) return makeError(s.error());
+    std::vector<SplatEmission> e(splats.size());
+    std::vector<std::size_t> emitting;
+    for (std::size_t i = 0; i < splats.size(); ++i) {
+        e[i] = emission(splats[i], materials, packedColor);
+        if (e[i].intensity.x + e[i].intensity.y + e[i].intensity.z > 0.0f) emitting.push_back(i);
+    }
+    if (emitting.empty()) return std::vector<EmittedLight>{};
+    std::vector<glm::vec3> plus(splats.size(), glm::vec3(1.0f)), minus(splats.size(), glm::vec3(1.0f));
+    if (desc.occlusion) {
+        const Occlusion occlusion(splats, e, emitting);
+        for (std::size_t i : emitting) occlusion.escape(splats[i].center, plus[i], minus[i]);
+    }
+    // Weighted k-means on the centres, weight = the light that leaves (channel sum, mean escape).
+    std::vector<float> w(emitting.size());
+    glm::dvec3 mean(0.0);
+    double total = 0.0;
+    for (std::size_t k = 0; k < emitting.size(); ++k) {
+        const std::size_t i = emitting[k];
+        const glm::vec3 I = e[i].intensity;
+        const glm::vec3 esc = 0.5f * (plus[i] + minus[i]);
+        w[k] = (I.x + I.y + I.z) * std::max((esc.x + esc.y + esc.z) / 3.0f, 1e-12f);
+        mean += double(w[k]) * glm::dvec3(splats[emitting[k]].center);
+        total += w[k];
+    }
+    mean /= total;
+    // Start from equal-weight slices along the principal axis (power iteration on the covariance).
+    glm::dmat3 cov(0.0);
+    for (std::size_t k = 0; k < emitting.size(); ++k) {
+        const glm::dvec3 d = glm::dvec3(splats[emitting[k]].center) - mean;
+        cov += double(w[k]) * glm::outerProduct(d, d);
+    }
+    glm::dvec3 axis(0.3, 1.0, 0.2);
+    for (int it = 0; it < 16; ++it) {
+        const glm::dvec3 next = cov * axis;
+        const double len = glm::length(next);
+        if (!(len > 0.0)) break;
+        axis = next / len;
+    }
+    std::vector<std::size_t> order(emitting.size());
+    std::iota(order.begin(), order.end(), std::size_t(0));
+    std::vector<double> along(emitting.size());
+    for (std::size_t k = 0; k < emitting.size(); ++k) along[k] = glm::dot(glm::dvec3(splats[emitting[k]].center) - mean, axis);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return along[a] < along[b]; });
+    const int K = int(std::min<std::size_t>(std::size_t(desc.lights), emitting.size()));
+    std::vector<int> label(emitting.size());
+    double run = 0.0;
+    for (std::size_t k : order) {
+        label[k] = std::min(K - 1, int(run / total * K));
+        run += w[k];
+    }
+    std::vector<glm::dvec3> centre(K);
+    std::vector<double> mass(K);
+    auto centroids = [&] {
+        std::fill(centre.begin(), centre.end(), glm::dvec3(0.0));
+        std::fill(mass.begin(), mass.end(), 0.0);
+        for (std::size_t k = 0; k < emitting.size(); ++k) {
+            centre[label[k]] += double(w[k]) * glm::dvec3(splats[emitting[k]].center);
+            mass[label[k]] += w[k];
+        }
+        for (int c = 0; c < K; ++c)
+            if (mass[c] > 0.0) centre[c] /= mass[c];
+    };
+    centroids();
+    for (int it = 0; it < 8; ++it) {
+        bool moved = false;
+        for (std::size_t k = 0; k < emitting.size(); ++k) {
+            const glm::dvec3 p(splats[emitting[k]].center);
+            int best = label[k];
+            double bestD = glm::dot(p - centre[best], p - centre[best]);
+            for (int c = 0; c < K; ++c) {
+                const double d = glm::dot(p - centre[c], p - centre[c]);
+                if (mass[c] > 0.0 && d < bestD) best = c, bestD = d;
+            }
+            moved |= best != label[k];
+            label[k] = best;
+        }
+        if (!moved) break;
+        centroids();
+    }
+    std::vector<EmittedLight> lights(K);
+    std::vector<double> spread(K, 0.0), power(K, 0.0);
+    std::vector<glm::dvec3> plusSum(K, glm::dvec3(0.0)), minusSum(K, glm::dvec3(0.0));
+    for (std::size_t k = 0; k < emitting.size(); ++k) {
+        const int c = label[k];
+        const std::size_t i = emitting[k];
+        lights[c].intensity += e[i].intensity * desc.scale;
+        const double p = double(e[i].intensity.x + e[i].intensity.y + e[i].intensity.z);
+        power[c] += p;
+        plusSum[c] += p * glm::dvec3(plus[i]);
+        minusSum[c] += p * glm::dvec3(minus[i]);
+        const glm::dvec3 d = glm::dvec3(splats[i].center) - centre[c];
+        spread[c] += double(w[k]) * glm::dot(d, d);
+    }
+    for (int c = 0; c < K; ++c) {
+        lights[c].position = glm::vec3(centre[c]);
+        lights[c].radius = mass[c] > 0.0 ? float(std::sqrt(spread[c] / mass[c])) : 0.0f;
+        if (power[c] > 0.0) lights[c].escapePlus = glm::vec3(plusSum[c] / power[c]), lights[c].escapeMinus = glm::vec3(minusSum[c] / power[c]);
+    }
+    std::erase_if(lights, [](const EmittedLight& l) { return !(l.intensity.x + l.intensity.y + l.intensity.z > 0.0f); });
+    std::stable_sort(lights.begin(), lights.end(), [](const EmittedLight& a, const EmittedLight& b) {
+        return a.intensity.x + a.intensity.y + a.intensity.z > b.intensity.x + b.intensity.y + b.intensity.z;
+    });
+    return lights;
+}
+
+glm::vec3 emittedIrradiance(std::span<const EmittedLight> lights, glm::vec3 point, glm::vec3 normal) {
+    glm::vec3 sum(0.0f);
+    for (const EmittedLight& l : lights) {
+        const glm::vec3 d = l.position - point;
+        const float d2 = glm::dot(d, d);
+        if (!(d2 > 0.0f)) continue;
+        const glm::vec3 out = -d / std::sqrt(d2); // from the light towards the point
+        const float cosine = std::max(glm::dot(normal, -out), 0.0f);
+        const glm::vec3 sq = out * out;
+        const glm::vec3 escape = glm::mix(l.escapeMinus, l.escapePlus, glm::step(glm::vec3(0.0f), out));
+        sum += l.intensity * (glm::dot(sq, escape) * cosine / (d2 + l.radius * l.radius));
+    }
+    return sum;
+}
+
+} // namespace splatfx
