@@ -1,0 +1,20 @@
+// Private to the SDK: the sun's transmittance through a cloud's grid by a
+// plane sweep (clouds.cpp, cloud.cpp).
+#pragma once
+
+#include <vector>
+
+#include <glm/glm.hpp>
+
+namespace splatfx::detail {
+
+// Transmittance toward the sun at every grid point (x fastest), through the
+// extinction scale * field (optical depth per cell length, natural log units): a plane sweep along the sun's main axis, one plane per step,
+// each point attenuated from the point one step toward the sun (bilinear in
+// the previous plane, trapezoid rule on the extinction). Light entering from
+// outside the grid is unattenuated. `towardSun` is in grid axes, non-zero.
+// Exact for a field that is affine within the planes; first order in the
+// cell size otherwise. O(points).
+void sweepSunTransmittance(glm::ivec3 dims, const std::vector<float>& field, double scale, glm::dvec3 towardSun, std::vector<float>& trans);
+
+} // namespace splatfx::detail
