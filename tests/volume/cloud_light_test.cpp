@@ -5,6 +5,7 @@
 // low-albedo model's per-vertex source is the lighting model's.
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include <gtest/gtest.h>
 
@@ -97,35 +98,114 @@ TEST(CloudLight, RelightsOnlyWhenTheLightOrTheDensityChanges) {
     EXPECT_EQ(cloud->tableBuilds(), 3u);
 }
 
-// A uniform cloud (density f everywhere) with the sun straight down and at
-// the horizon: the sweep is exact for a field that is constant across its
-// planes, T = exp(-sigma * distance to the grid's sun-side face), sigma =
-// maxExtinctionPerWorld f, in world units (spacing 0.5). Float transmittance
-// through at most 16 steps: 1e-5 covers the rounding.
-TEST(CloudLight, LowAlbedoSelfShadowThroughItsOwnExtinction) {
+// Hard cases of the relight (docs/STABILITY.md, "Cloud lighting"). A uniform
+// cloud (density f everywhere, spacing 0.5) in the low-albedo model: with
+// the sun along an axis or a diagonal the sweep is exact for it, T =
+// exp(-sigma * length of the ray to the sun inside the grid), sigma =
+// maxExtinctionPerWorld f. Float
+// transmittance through at most 16 steps: 1e-5 covers the rounding.
+class CloudLightHardCases : public ::testing::Test {
+protected:
+    static constexpr float kF = 0.4f, kH = 0.5f;
+    static constexpr double kSigma = 1.5 * double(kF);
+    void SetUp() override {
+        CloudCreateDesc d = small();
+        d.lighting.model = CloudLightModel::LowAlbedo;
+        d.volume.spacingWorld = kH;
+        d.transfer.maxExtinctionPerWorld = 1.5f;
+        auto c = Cloud::create(d);
+        ASSERT_TRUE(c) << c.error();
+        cloud.emplace(std::move(*c));
+        ASSERT_TRUE(cloud->setDensity(std::vector<float>(cloud->density().size(), kF)));
+        n = cloud->dims();
+    }
+    void sun(glm::vec3 travel) {
+        CloudLighting L = cloud->lighting();
+        L.sun.direction = travel;
+        ASSERT_TRUE(cloud->setLight(L));
+    }
+    float T(int x, int y, int z) const { return cloud->sunTransmittance()[index(n, x, y, z)]; }
+    std::optional<Cloud> cloud;
+    glm::ivec3 n{0};
+};
+
+TEST_F(CloudLightHardCases, SunStraightDown) {
+    sun({0.0f, 0.0f, -1.0f}); // the sun is at +z: the sweep runs plane by plane from the top
+    for (int z = 0; z < n.z; ++z)
+        for (int x = 0; x < n.x; x += 4) EXPECT_NEAR(T(x, 3, z), std::exp(-kSigma * kH * double(n.z - 1 - z)), 1e-5) << x << " " << z;
+}
+
+TEST_F(CloudLightHardCases, SunAtTheHorizon) {
+    sun({1.0f, 0.0f, 0.0f}); // travelling +x, grazing every z plane: the sun is at -x
+    for (int z = 0; z < n.z; z += 2)
+        for (int x = 0; x < n.x; ++x) EXPECT_NEAR(T(x, 5, z), std::exp(-kSigma * kH * double(x)), 1e-5) << x << " " << z;
+}
+
+// A sun at exactly 45 degrees ties the sweep's main axis (|x| = |z|), and its
+// rays leave through the top face as well as the far side: every step lands
+// on grid points, so the sweep is exact. At a shallower angle the bilinear
+// lookup between rows smears the kink where rays switch from leaving through
+// the side to leaving through the top; a point whose lookups stay on the
+// side-exit rows (x <= nz - 1 - z: k steps reach at most k rows up) is exact,
+// and points on the top face toward the sun see it unattenuated.
+TEST_F(CloudLightHardCases, SunOnADiagonalAndRaysLeavingThroughTheSideFaces) {
+    sun({1.0f, 0.0f, -1.0f}); // toward the sun: (-1, 0, +1)
+    for (int z = 0; z < n.z; ++z)
+        for (int x = 0; x < n.x; ++x)
+            EXPECT_NEAR(T(x, 2, z), std::exp(-kSigma * kH * std::sqrt(2.0) * double(std::min(x, n.z - 1 - z))), 1e-5) << x << " " << z;
+    sun({1.0f, 0.0f, -0.4f}); // toward the sun: (-1, 0, 0.4), main axis x
+    const double len = std::sqrt(1.0 + 0.4 * 0.4);
+    for (int z = 0; z < n.z; ++z)
+        for (int x = 0; x <= n.z - 1 - z; ++x) EXPECT_NEAR(T(x, 2, z), std::exp(-kSigma * kH * len * double(x)), 1e-5) << x << " " << z;
+    for (int x = 0; x < n.x; ++x) EXPECT_EQ(T(x, 2, n.z - 1), 1.0f) << x;
+}
+
+// The transfer's step: density exactly at the threshold is cloud, a float
+// below it is air (nothing attenuates, nothing casts).
+TEST_F(CloudLightHardCases, DensityExactlyAtTheThreshold) {
+    const float t = CloudTransferDesc{}.threshold;
+    sun({0.0f, 0.0f, -1.0f});
+    ASSERT_TRUE(cloud->setDensity(std::vector<float>(cloud->density().size(), t)));
+    EXPECT_NEAR(T(4, 4, 0), std::exp(-1.5 * double(t) * kH * double(n.z - 1)), 1e-5);
+    EXPECT_FALSE(cloud->densityField().empty());
+    ASSERT_TRUE(cloud->setDensity(std::vector<float>(cloud->density().size(), std::nextafter(t, 0.0f))));
+    for (float v : cloud->sunTransmittance()) EXPECT_EQ(v, 1.0f);
+    EXPECT_TRUE(cloud->densityField().empty());
+}
+
+// An empty cloud: T = 1 everywhere, no field to cast, and what it draws is
+// finite: every vertex's source is the lit-air value (s = phase / max phase).
+TEST_F(CloudLightHardCases, EmptyCloud) {
+    ASSERT_TRUE(cloud->setDensity(std::vector<float>(cloud->density().size(), 0.0f)));
+    for (float v : cloud->sunTransmittance()) EXPECT_EQ(v, 1.0f);
+    EXPECT_TRUE(cloud->densityField().empty());
+    LodFrame frame;
+    const Camera cam = Camera::lookAt({4.0f, -12.0f, 6.0f}, {4.0f, 4.0f, 2.0f}, {0.0f, 0.0f, 1.0f}, 0.8f, {64, 48});
+    ASSERT_TRUE(cloud->update(cam, {.zeroOpacityTest = false}, frame));
+    for (const Tetrahedron& t : frame.tets)
+        for (int k = 0; k < 4; ++k) {
+            EXPECT_TRUE(std::isfinite(t.scalar[std::size_t(k)]));
+            EXPECT_EQ(t.lengthScale[std::size_t(k)], 0.0f); // no extinction: draws nothing
+        }
+}
+
+// An opaque cloud (extinction 10^6 per unit): T underflows to 0 one cell in,
+// and the source there is the ambient and multiple-scattering part alone.
+TEST_F(CloudLightHardCases, OpaqueCloudUnderflowsToItsAmbientLight) {
     CloudCreateDesc d = small();
     d.lighting.model = CloudLightModel::LowAlbedo;
-    d.volume.spacingWorld = 0.5f;
-    d.transfer.maxExtinctionPerWorld = 1.5f;
-    auto cloud = Cloud::create(d);
-    ASSERT_TRUE(cloud) << cloud.error();
-    const float f = 0.4f;
-    ASSERT_TRUE(cloud->setDensity(std::vector<float>(cloud->density().size(), f)));
-    const glm::ivec3 n = cloud->dims();
-    const double sigma = 1.5 * double(f);
-    CloudLighting L = cloud->lighting();
-    L.sun.direction = {0.0f, 0.0f, -1.0f}; // straight down: the sun is at +z
-    ASSERT_TRUE(cloud->setLight(L));
-    for (int z = 0; z < n.z; ++z)
-        for (int x = 0; x < n.x; x += 5)
-            EXPECT_NEAR(cloud->sunTransmittance()[index(n, x, 3, z)], std::exp(-sigma * 0.5 * double(n.z - 1 - z)), 1e-5) << x << " " << z;
-    L.sun.direction = {1.0f, 0.0f, 0.0f}; // at the horizon, travelling +x: the sun is at -x
-    ASSERT_TRUE(cloud->setLight(L));
-    for (int x = 0; x < n.x; ++x)
-        EXPECT_NEAR(cloud->sunTransmittance()[index(n, x, 5, 4)], std::exp(-sigma * 0.5 * double(x)), 1e-5) << x;
-    // Below the threshold the cloud is air: nothing attenuates.
-    ASSERT_TRUE(cloud->setDensity(std::vector<float>(cloud->density().size(), 0.5f * d.transfer.threshold)));
-    for (float T : cloud->sunTransmittance()) EXPECT_EQ(T, 1.0f);
+    d.lighting.gas.ambient = glm::vec3(0.2f);
+    d.transfer.maxExtinctionPerWorld = 1e6f;
+    auto c = Cloud::create(d);
+    ASSERT_TRUE(c) << c.error();
+    ASSERT_TRUE(c->setDensity(std::vector<float>(c->density().size(), 1.0f)));
+    for (std::size_t i = 0; i < c->sunTransmittance().size(); ++i) {
+        const float v = c->sunTransmittance()[i];
+        EXPECT_TRUE(v == 0.0f || v == 1.0f) << i; // 1 only on the faces toward the sun
+    }
+    const glm::dvec3 a = c->sourceAt(0.0, {0.0f, 0.0f, 1.0f});
+    EXPECT_NEAR(a.x, 0.9 * 0.2, 1e-7); // albedo x ambient
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(c->transfer().color(0.0)[k], a[k], 1e-7); // the table's colour at s = 0 (float)
 }
 
 // What the tetrahedra draw at each vertex, kappa(s) with s = T phase /
@@ -161,6 +241,30 @@ TEST(CloudLight, LowAlbedoVertexSourceIsTheModel) {
             const glm::dvec3 got = cloud->transfer().color(t.scalar[std::size_t(k)]);
             for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], tol);
         }
+}
+
+// A y-up cloud is the z-up one turned: density and sun transmittance at
+// world (x, y, z) are the z-up cloud's at (x, z, y) under the turned sun. The
+// sweep's two in-plane axes swap roles, so its bilinear sums add in another
+// order: float rounding, 1e-6.
+TEST(CloudLight, YUpIsTheGeneratorTurned) {
+    CloudCreateDesc d = small();
+    d.lighting.model = CloudLightModel::LowAlbedo;
+    d.lighting.sun = Light::directional({0.3f, -0.5f, -1.0f});
+    auto zUp = Cloud::create(d);
+    d.yUp = true;
+    d.lighting.sun = Light::directional({0.3f, -1.0f, -0.5f});
+    auto yUp = Cloud::create(d);
+    ASSERT_TRUE(zUp && yUp);
+    const glm::ivec3 n = zUp->dims();
+    ASSERT_EQ(yUp->dims(), glm::ivec3(n.x, n.z, n.y));
+    for (int z = 0; z < n.z; ++z)
+        for (int y = 0; y < n.y; ++y)
+            for (int x = 0; x < n.x; ++x) {
+                const std::size_t a = index(n, x, y, z), b = index(yUp->dims(), x, z, y);
+                EXPECT_EQ(zUp->density()[a], yUp->density()[b]);
+                EXPECT_NEAR(zUp->sunTransmittance()[a], yUp->sunTransmittance()[b], 1e-6);
+            }
 }
 
 TEST(CloudLight, BadLightingIsRejectedNamingTheField) {

@@ -27,7 +27,9 @@
 // exact for a colour affine in s, so the per-vertex phase costs no table.
 //
 // It does NOT: draw (the tetrahedra go to the projected-tetrahedra pass), take
-// more than one light (the sun: a directional Light), or shadow other volumes.
+// more than one light (the sun: a directional Light), or receive the shadows
+// of other volumes. It casts through densityField() (a Scene puts a lit
+// cloud's field into the scene shadow, scene.hpp).
 //
 //   auto cloud = splatfx::Cloud::create({.cloud = {.dims = {65, 65, 17}}});
 //   cloud->setLight(splatfx::Light::directional({-1, -0.2f, -0.3f}));  // relights once
@@ -72,6 +74,10 @@ struct CloudCreateDesc {
     CloudTransferDesc transfer{};    // extinction, threshold and colours
     LodVolumeDesc volume{};          // origin, spacing, C, budget
     PreIntegrationDesc table{};      // its maxLengthWorld is set to the longest tetrahedron edge of a root (sqrt(3) 2^rootLevel spacing)
+    // Default false: the generator's up (CloudDesc's z) is world z. True: it
+    // is world y (y-up worlds); the grid is then cloud.dims.x x .z x .y
+    // points, x fastest, and densities passed to setDensity use that layout.
+    bool yUp = false;
 };
 
 class Cloud {
@@ -103,6 +109,14 @@ public:
     glm::ivec3 dims() const { return mDims; }
     // The sun's transmittance at each grid point from the last relight (x fastest).
     const std::vector<float>& sunTransmittance() const { return mTrans; }
+    // The cloud's extinction sigma = maxExtinctionPerWorld f (f >= threshold,
+    // else 0) as the field shadow tables read (lighting.hpp): one voxel per
+    // grid point, opacity 1 - exp(-sigma spacing), so a ray through it loses
+    // exp(-integral of sigma), the field falling to zero half a cell beyond the
+    // outermost point with material as an effect's does. For both models (the
+    // Roettger model's light-scaled length is not an extinction the scene
+    // sees). Rebuilt with the density; empty for a cloud of air.
+    const DensityField& densityField() const { return mField; }
     // Relights (sweep + LOD rebuild) and transfer-table builds since creation (create() does one of each).
     std::uint64_t relights() const { return mRelights; }
     std::uint64_t tableBuilds() const { return mTableBuilds; }
@@ -118,11 +132,13 @@ private:
     Cloud() = default;
     Status relight();
     Status rebuildTable();
+    Status rebuildField();
     CloudCreateDesc mDesc;
     CloudLighting mLighting;
     glm::ivec3 mDims{0};
     std::vector<float> mDensity, mTrans;
     LodVolume mVolume;
+    DensityField mField;
     TransferFunction mTransfer;
     PreIntegrationTable mTable;
     float mPhaseMax = 1.0f;

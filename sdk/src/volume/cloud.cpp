@@ -65,8 +65,21 @@ Result<Cloud> Cloud::create(const CloudCreateDesc& desc) {
     c.mLighting = desc.lighting;
     c.mDims = field->dims;
     c.mDensity = std::move(field->scalar);
+    if (desc.yUp) {
+        // Generator (x, y, z) with z up to world (x, z, y): y up.
+        const glm::ivec3 g = c.mDims;
+        std::vector<float> up(c.mDensity.size());
+        for (int z = 0; z < g.z; ++z)
+            for (int y = 0; y < g.y; ++y)
+                for (int x = 0; x < g.x; ++x)
+                    up[std::size_t(x) + std::size_t(g.x) * (std::size_t(z) + std::size_t(g.z) * std::size_t(y))] =
+                        c.mDensity[std::size_t(x) + std::size_t(g.x) * (std::size_t(y) + std::size_t(g.y) * std::size_t(z))];
+        c.mDensity = std::move(up);
+        c.mDims = {g.x, g.z, g.y};
+    }
     if (Status s = c.relight(); !s) return makeError(s.error());
     if (Status s = c.rebuildTable(); !s) return makeError(s.error());
+    if (Status s = c.rebuildField(); !s) return makeError(s.error());
     return c;
 }
 
@@ -126,6 +139,35 @@ Status Cloud::rebuildTable() {
     return {};
 }
 
+Status Cloud::rebuildField() {
+    const float h = mDesc.volume.spacingWorld, maxExt = mDesc.transfer.maxExtinctionPerWorld, t = mDesc.transfer.threshold;
+    Grid g;
+    g.dims = mDims;
+    g.spacing = glm::vec3(h);
+    // Grid::localPosition centres x and z; undo it so cell c sits at origin + c h.
+    const glm::vec3 half = glm::vec3(mDims - 1) * 0.5f;
+    g.transform = glm::mat4(1.0f);
+    g.transform[3] = glm::vec4(mDesc.volume.originWorld + glm::vec3(half.x, 0.0f, half.z) * h, 1.0f);
+    for (int z = 0, i = 0; z < mDims.z; ++z)
+        for (int y = 0; y < mDims.y; ++y)
+            for (int x = 0; x < mDims.x; ++x, ++i) {
+                const float f = mDensity[std::size_t(i)];
+                if (!(f >= t) || f <= 0.0f) continue;
+                Voxel v;
+                v.cell = {x, y, z};
+                v.opacity = float(-std::expm1(-double(maxExt) * double(f) * double(h)));
+                if (v.opacity > 0.0f) g.voxels.push_back(v);
+            }
+    if (g.voxels.empty()) {
+        mField = DensityField();
+        return {};
+    }
+    auto field = DensityField::fromGrid(g);
+    if (!field) return makeError("Cloud: density field: " + field.error());
+    mField = std::move(*field);
+    return {};
+}
+
 Status Cloud::setLight(const CloudLighting& lighting) {
     if (Status s = checkLighting(lighting); !s) return s;
     const bool field = !sameField(lighting, mLighting), colour = !sameColour(lighting, mLighting);
@@ -151,7 +193,7 @@ Status Cloud::setDensity(std::vector<float> density) {
     if (density == mDensity) return {};
     std::swap(mDensity, density);
     if (Status s = relight(); !s) return std::swap(mDensity, density), s;
-    return {};
+    return rebuildField();
 }
 
 Status Cloud::update(const Camera& camera, const LodRefineDesc& refine, LodFrame& out) {

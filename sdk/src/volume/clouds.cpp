@@ -25,8 +25,7 @@ void sweepSunTransmittance(glm::ivec3 n, const std::vector<float>& ext, double s
     const double stepLen = glm::length(stepToSun);
     const int towardSun = sun[axis] > 0.0 ? 1 : -1;
     const int planes = n[axis];
-    auto sample = [&](const std::vector<float>& f, int plane, double pu, double pv, float outside) {
-        if (pu < 0.0 || pv < 0.0 || pu > double(n[u] - 1) || pv > double(n[v] - 1)) return double(outside);
+    auto sample = [&](const std::vector<float>& f, int plane, double pu, double pv) { // inside the plane
         const int iu = std::min(int(pu), n[u] - 2), iv = std::min(int(pv), n[v] - 2);
         const double fu = pu - iu, fv = pv - iv;
         auto g = [&](int a, int b) {
@@ -48,8 +47,15 @@ void sweepSunTransmittance(glm::ivec3 n, const std::vector<float>& ext, double s
                 p[u] = a;
                 p[v] = b;
                 const double qu = a + stepToSun[u], qv = b + stepToSun[v];
-                const double tPrev = sample(trans, prev, qu, qv, 1.0f);
-                const double rho = 0.5 * (double(ext[at(p.x, p.y, p.z)]) + sample(ext, prev, qu, qv, 0.0f));
+                if (qu < 0.0 || qv < 0.0 || qu > double(n[u] - 1) || qv > double(n[v] - 1)) {
+                    // The step leaves the grid: a sideways step is at most one
+                    // cell, so the point lies on a face toward the sun and its
+                    // ray leaves at once (no material on the way).
+                    trans[at(p.x, p.y, p.z)] = 1.0f;
+                    continue;
+                }
+                const double tPrev = sample(trans, prev, qu, qv);
+                const double rho = 0.5 * (double(ext[at(p.x, p.y, p.z)]) + sample(ext, prev, qu, qv));
                 trans[at(p.x, p.y, p.z)] = float(tPrev * std::exp(-scale * rho * stepLen));
             }
     }
