@@ -73,7 +73,9 @@ struct CloudCreateDesc {
     CloudLighting lighting{};        // default Roettger under the default sun
     CloudTransferDesc transfer{};    // extinction, threshold and colours
     LodVolumeDesc volume{};          // origin, spacing, C, budget
-    PreIntegrationDesc table{};      // its maxLengthWorld is set to the longest tetrahedron edge of a root (sqrt(3) 2^rootLevel spacing)
+    // Its maxLengthWorld is set to the longest tetrahedron edge of a root (sqrt(3) 2^rootLevel spacing);
+    // LowAlbedo uses 2 scalar samples (its entries are affine in each scalar: exact).
+    PreIntegrationDesc table{};
     // Default false: the generator's up (CloudDesc's z) is world z. True: it
     // is world y (y-up worlds); the grid is then cloud.dims.x x .z x .y
     // points, x fastest, and densities passed to setDensity use that layout.

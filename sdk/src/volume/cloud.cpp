@@ -130,6 +130,9 @@ Status Cloud::rebuildTable() {
     }
     if (!tf) return makeError(tf.error());
     PreIntegrationDesc pd = mDesc.table;
+    // LowAlbedo: with rho constant the entry is A alpha(l) + B (s_f alpha(l) + (s_b - s_f) g(l)),
+    // affine in each scalar, so two samples per scalar axis interpolate it exactly.
+    if (mLighting.model == CloudLightModel::LowAlbedo) pd.scalarResolution = 2;
     pd.maxLengthWorld = std::sqrt(3.0f) * float(1 << mVolume.rootLevel()) * mVolume.spacingWorld();
     auto table = PreIntegrationTable::create(*tf, pd);
     if (!table) return makeError("CloudCreateDesc.table: " + table.error());
