@@ -340,6 +340,8 @@ void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& 
         EffectLighting lighting;
         const Json* lit = o.get("lighting");
         if (lit) readEffectLighting(c, o.at("lighting"), *lit, lighting);
+        // A cloud shadows itself by its own sweep: no self-shadowing tables to budget.
+        lighting.selfShadow = SelfShadow::Off;
         std::string lightModel = "roettger";
         o.string("lightModel", lightModel);
         if (lightModel != "roettger" && lightModel != "lowAlbedo")
