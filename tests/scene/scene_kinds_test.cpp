@@ -8,6 +8,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
+#include "splatfx/cloud.hpp"
 #include "splatfx/presets.hpp"
 #include "splatfx/scene.hpp"
 
@@ -302,4 +303,110 @@ TEST(SceneKinds, LightingAppliesToEveryKindThatExposesADensity) {
     EXPECT_FALSE(s.scene.status(s.fog).lit);
     EXPECT_EQ(frame.counters().litEffects, 2u);
     EXPECT_TRUE(frame.shadow().valid) << "the lit kinds cast the frame's shadow";
+}
+
+// A lit Cloud in a Scene follows the scene's first directional light: relit
+// when that light moves, not when it stays, and not while the cloud is out
+// of view; unlit, it keeps its own sun. What it puts into the Frame is its
+// own update() for the camera, drawn with its table.
+TEST(SceneKinds, LitCloudFollowsTheSceneSun) {
+    CloudCreateDesc cd;
+    cd.cloud = {.dims = {17, 17, 9}, .seed = 2, .featureCells = 6.0f, .coverage = 0.6f};
+    cd.volume.originWorld = {-8.0f, 10.0f, -4.0f};
+    cd.table = {.scalarResolution = 8, .lengthResolution = 8};
+    auto made = Cloud::create(cd);
+    ASSERT_TRUE(made) << made.error();
+    Scene scene;
+    const EffectId id = scene.add(std::move(*made), {.name = "cloud", .lighting = {.enabled = true}});
+    ASSERT_TRUE(scene.addLight(Light::point({0.0f, 30.0f, 0.0f}))); // not a sun: skipped
+    ASSERT_TRUE(scene.addLight(Light::directional({0.2f, -1.0f, 0.1f})));
+    const Materials materials{Footprint{}};
+    Frame frame;
+    const Cloud* cloud = scene.findCloud(id);
+    ASSERT_NE(cloud, nullptr);
+    EXPECT_EQ(cloud->relights(), 1u);
+    ASSERT_TRUE(scene.prepare(0.0, front(), materials, frame));
+    EXPECT_EQ(cloud->relights(), 2u);
+    EXPECT_EQ(cloud->lighting().sun.direction, glm::vec3(0.2f, -1.0f, 0.1f));
+    EXPECT_TRUE(scene.status(id).lit);
+    ASSERT_TRUE(scene.prepare(0.1, front(), materials, frame));
+    EXPECT_EQ(cloud->relights(), 2u); // the sun stayed
+    ASSERT_EQ(frame.volumes().size(), 1u);
+    EXPECT_EQ(frame.volumes()[0].table, &cloud->table());
+    Cloud copy = *scene.findCloud(id);
+    LodFrame own;
+    ASSERT_TRUE(copy.update(front(), {}, own));
+    ASSERT_EQ(own.tets.size(), frame.volumes()[0].lod.tets.size());
+    for (std::size_t i = 0; i < own.tets.size(); ++i) EXPECT_EQ(own.tets[i].scalar, frame.volumes()[0].lod.tets[i].scalar);
+
+    ASSERT_TRUE(scene.setLight(1, Light::directional({0.6f, -1.0f, 0.1f}))); // the sun moves
+    ASSERT_TRUE(scene.prepare(0.2, front(), materials, frame));
+    EXPECT_EQ(cloud->relights(), 3u);
+    ASSERT_TRUE(scene.setLight(1, Light::directional({0.9f, -1.0f, 0.1f})));
+    ASSERT_TRUE(scene.prepare(0.3, away(), materials, frame)); // out of view: no work
+    EXPECT_EQ(cloud->relights(), 3u);
+    ASSERT_TRUE(scene.prepare(0.4, front(), materials, frame)); // back in view: catches the sun up once
+    EXPECT_EQ(cloud->relights(), 4u);
+    scene.setLighting(id, {.enabled = false});
+    ASSERT_TRUE(scene.setLight(1, Light::directional({-0.5f, -1.0f, 0.1f})));
+    ASSERT_TRUE(scene.prepare(0.5, front(), materials, frame));
+    EXPECT_EQ(cloud->relights(), 4u);
+    EXPECT_FALSE(scene.status(id).lit);
+}
+
+// A lit cloud casts into the scene shadow: a uniform cloud (extinction sigma
+// everywhere, 9x5x9 points, spacing 1) with the sun straight down. Below its
+// middle the field it casts through holds sigma over its 4 cells of height
+// and falls to zero over one more cell at each end (an effect's convention,
+// cloud.hpp): depth sigma (4 + 1) nats. The table sweeps down with the
+// trapezoid rule at node spacing D = 6 / 63 (its box is the field's support,
+// 4 + 2 cells high); on a piecewise-linear profile each of the 4 slope kinks
+// (jump sigma per cell) costs at most D^2 / 8 of it: |error| <= sigma D^2 / 2
+// nats, and x, z are uniform there (bilinear exact). The shadow does not
+// depend on whether the cloud is in view (scheduled by light influence).
+TEST(SceneKinds, LitCloudCastsIntoTheSceneShadow) {
+    CloudCreateDesc cd;
+    cd.cloud = {.dims = {9, 5, 9}, .seed = 2, .featureCells = 6.0f, .coverage = 0.6f};
+    cd.volume.originWorld = {-4.0f, 20.0f, -4.0f};
+    cd.transfer.maxExtinctionPerWorld = 2.0f;
+    cd.table = {.scalarResolution = 8, .lengthResolution = 8};
+    auto made = Cloud::create(cd);
+    ASSERT_TRUE(made) << made.error();
+    const double sigma = 2.0 * 0.2;
+    ASSERT_TRUE(made->setDensity(std::vector<float>(made->density().size(), 0.2f)));
+    Scene scene;
+    const EffectId id = scene.add(std::move(*made), {.name = "cloud", .lighting = {.enabled = true}});
+    ASSERT_TRUE(scene.addLight(Light::directional({0.0f, -1.0f, 0.0f})));
+    const Materials materials{Footprint{}};
+    Frame frame;
+    // Seeing the cloud and the ground under it.
+    const Camera both = lookingAt({0, 10, 0}, {0, 12, 60});
+    ASSERT_TRUE(scene.prepare(0.0, both, materials, frame));
+    EXPECT_TRUE(scene.status(id).inView);
+    EXPECT_TRUE(scene.status(id).inSceneShadow);
+    EXPECT_EQ(scene.counters().sceneShadowCasters, 1u);
+    const FrameShadow& sh = frame.shadow();
+    ASSERT_TRUE(sh.valid);
+    const glm::ivec3 n = sh.dims;
+    // The bottom node under the middle: the ray from it to the sun crosses the whole cloud.
+    const int ix = n.x / 2, iz = n.z / 2;
+    const double depthNats = double(sh.depth[std::size_t(ix) + std::size_t(n.x) * std::size_t(n.y) * std::size_t(iz)]) * std::log(2.0);
+    const double D = 6.0 / double(n.y - 1);
+    EXPECT_NEAR(depthNats, sigma * 5.0, sigma * D * D / 2.0 + 1e-5);
+    const std::vector<float> seen = sh.depth;
+
+    // Looking down at the ground only, the cloud out of view above: it still casts.
+    const Camera ground = Camera::lookAt({0, 5, 0.1f}, {0, 0, 0}, {0, 1, 0}, glm::radians(40.0f), {320, 240}, 0.1f, 500.0f);
+    ASSERT_TRUE(scene.prepare(0.1, ground, materials, frame));
+    EXPECT_FALSE(scene.status(id).inView);
+    EXPECT_TRUE(scene.status(id).castsIntoView);
+    EXPECT_TRUE(scene.status(id).inSceneShadow);
+    ASSERT_TRUE(frame.shadow().valid);
+    EXPECT_EQ(frame.shadow().depth, seen);
+
+    // Unlit, it casts nothing.
+    scene.setLighting(id, {.enabled = false});
+    ASSERT_TRUE(scene.prepare(0.2, both, materials, frame));
+    EXPECT_FALSE(scene.status(id).inSceneShadow);
+    EXPECT_FALSE(frame.shadow().valid);
 }

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "splatfx/cloud.hpp"
 #include "splatfx/scene_file.hpp"
 
 namespace {
@@ -93,4 +94,45 @@ TEST(SceneFileLights, SceneShadowMaxLightsAndMemoryAreReadAndCheckedByName) {
     expectError(lights + R"("sceneShadow": {"memoryMiB": 0})", {"sceneShadow.memoryMiB"});
     // One 64^3 table takes 4.25 MiB (17 bytes a node): a 4 MiB budget cannot hold even slot 0's.
     expectError(lights + R"("sceneShadow": {"memoryMiB": 4, "dims": 64})", {"sceneShadow.dims", "over the 4 MiB budget (memoryMiB)"});
+}
+
+// A cloud with "lighting" becomes a relightable Cloud (y up: dims [x, height,
+// z]) lit by the scene; "lightModel" picks the model; a bad one is named.
+TEST(SceneFileLights, LitCloudsAreRelightableAndTheirModelIsRead) {
+    auto r = parse(R"("lights": [{"type": "directional", "direction": [0.3, -1, 0.2]}],
+      "volumes": [{"kind": "clouds", "name": "c", "dims": [9, 5, 9], "tableScalars": 4, "tableLengths": 4,
+                   "lightModel": "lowAlbedo", "lighting": {"albedo": 0.8}},
+                  {"kind": "clouds", "dims": [9, 5, 9], "tableScalars": 4, "tableLengths": 4}])");
+    ASSERT_TRUE(r.ok()) << r.error();
+    ASSERT_EQ(r->volumes.size(), 2u);
+    const splatfx::Cloud* lit = r->scene.findCloud(r->volumes[0].id);
+    ASSERT_NE(lit, nullptr);
+    EXPECT_EQ(lit->dims(), glm::ivec3(9, 5, 9));
+    EXPECT_EQ(lit->lighting().model, splatfx::CloudLightModel::LowAlbedo);
+    EXPECT_TRUE(r->scene.options(r->volumes[0].id).lighting.enabled);
+    EXPECT_FLOAT_EQ(r->scene.options(r->volumes[0].id).lighting.gas.albedo, 0.8f);
+    EXPECT_EQ(r->scene.findCloud(r->volumes[1].id), nullptr); // unlit: the baked LOD volume as before
+    EXPECT_NE(r->scene.findLodVolume(r->volumes[1].id), nullptr);
+    expectError(R"("volumes": [{"kind": "clouds", "dims": [9, 5, 9], "lightModel": "physical", "lighting": {}}])",
+                {"volumes[0].lightModel", "expected \"roettger\" or \"lowAlbedo\", got 'physical'"});
+}
+
+// A moving sun: from "direction" at t = 0 to "directionEnd" at "moveSec"
+// along the great circle (half the angle at half the time), then held.
+// Float directions normalised: 1e-6.
+TEST(SceneFileLights, ALightsDirectionMovesAlongTheGreatCircle) {
+    auto r = parse(R"("lights": [{"type": "point"}, {"type": "directional", "direction": [1, 0, 0], "directionEnd": [0, -2, 0], "moveSec": 4}])");
+    ASSERT_TRUE(r.ok()) << r.error();
+    ASSERT_EQ(r->lightMotions.size(), 1u);
+    const splatfx::LightMotion& m = r->lightMotions[0];
+    EXPECT_EQ(m.light, 1u);
+    const splatfx::Light base = r->scene.lights()[1];
+    auto dir = [&](double t) { return m.at(base, t).direction; };
+    EXPECT_NEAR(glm::length(dir(0.0) - glm::vec3(1, 0, 0)), 0.0, 1e-6);
+    EXPECT_NEAR(glm::length(dir(2.0) - glm::vec3(std::sqrt(0.5f), -std::sqrt(0.5f), 0)), 0.0, 1e-6);
+    EXPECT_NEAR(glm::length(dir(4.0) - glm::vec3(0, -1, 0)), 0.0, 1e-6);
+    EXPECT_NEAR(glm::length(dir(9.0) - glm::vec3(0, -1, 0)), 0.0, 1e-6);
+    EXPECT_EQ(m.at(base, 1.0).intensity, base.intensity);
+    expectError(R"("lights": [{"type": "directional", "moveSec": 2}])", {"lights[0]", "\"moveSec\" needs \"directionEnd\""});
+    expectError(R"("lights": [{"type": "directional", "directionEnd": [0, 0, 0]}])", {"lights[0].directionEnd", "must not be zero"});
 }

@@ -11,6 +11,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "gl_fixture.hpp"
+#include "splatfx/cloud.hpp"
 #include "splatfx/gl/frame_plan.hpp"
 #include "scenes.hpp"
 
@@ -20,13 +21,13 @@ namespace {
 
 constexpr glm::ivec2 kSize{64, 48};
 
-struct Cloud {
+struct TestCloud {
     ScalarVolume field;
     std::optional<LodVolume> volume;
     std::optional<TransferFunction> transfer;
     std::optional<PreIntegrationTable> table;
     float maxExtinction = 2.0f;
-    explicit Cloud(CloudModel model = CloudModel::DensityTableLightLength) {
+    explicit TestCloud(CloudModel model = CloudModel::DensityTableLightLength) {
         auto f = makeCloudVolume({.dims = {17, 17, 9}, .seed = 5, .featureCells = 6.0f, .coverage = 0.6f, .model = model});
         field = *f;
         volume.emplace(*LodVolume::create(field, {.spacingWorld = 1.0f}));
@@ -175,7 +176,7 @@ void renderFrame(gl::FrameRenderer& fr, gl::Framebuffer& fb, Frame& frame, doubl
 // frame, and the two drawn by hand in a chosen order: the volume alone through
 // a frame renderer, the splats alone through gl::Renderer.
 struct FireAndCloud {
-    Cloud cl;
+    TestCloud cl;
     Materials materials{Footprint{}};
     std::uint32_t set = materials.addTextureSet(TextureSet::turbulence({.count = 4, .size = 16, .seed = 3}));
     std::uint32_t colors = materials.addColorTable(ColorTable::fire());
@@ -212,15 +213,8 @@ struct FireAndCloud {
 // Outside the cloud, LOD refinement: the GL image equals the pass's CPU model
 // within the derived bound at every pixel, and so stays within the table's own
 // error of the exact integral through the same emitted mesh.
-void expectPassMatchesTheReference(Cloud cl) {
-    const Camera cam = Camera::lookAt({-14.0f, 6.0f, 10.0f}, {8.0f, 8.0f, 4.0f}, {0, 0, 1}, glm::radians(50.0f), kSize, 0.5f, 200.0f);
-    Frame frame;
-    frame.begin(0.0, cam);
-    FrameVolume& fv = frame.volumes().emplace_back();
-    fv.table = &*cl.table;
-    ASSERT_TRUE(cl.volume->update(cam, {.detailC = 20.0f}, &*cl.transfer, fv.lod));
-    frame.end();
-    ASSERT_GT(fv.lod.tets.size(), 50u);
+void expectFrameMatchesTheReference(const Camera& cam, Frame& frame, const PreIntegrationTable& table, const TransferFunction& transfer) {
+    const FrameVolume& fv = frame.volumes()[0];
     auto fr = gl::FrameRenderer::create();
     auto fb = gl::Framebuffer::create({.width = kSize.x, .height = kSize.y, .color = gl::Precision::F32});
     ASSERT_TRUE(fr && fb);
@@ -233,8 +227,8 @@ void expectPassMatchesTheReference(Cloud cl) {
         for (int x = 0; x < kSize.x; ++x) {
             const glm::dvec3 d = pixelRay(cam, x, y), o(cam.eye());
             double bound = 0.0;
-            const glm::dvec4 model = passModel(fv.lod.tets, *cl.table, o, d, 1e30, bound);
-            const glm::dvec4 exact = integrateRay(fv.lod.tets, *cl.transfer, o, d, 0.0, 1e30);
+            const glm::dvec4 model = passModel(fv.lod.tets, table, o, d, 1e30, bound);
+            const glm::dvec4 exact = integrateRay(fv.lod.tets, transfer, o, d, 0.0, 1e30);
             double eModel = 0.0, eExact = 0.0, eME = 0.0;
             for (int c = 0; c < 4; ++c) {
                 eModel = std::max(eModel, std::abs(double(img.at(x, y, c)) - model[c]));
@@ -258,14 +252,56 @@ void expectPassMatchesTheReference(Cloud cl) {
                 r.worstRatio, r.maxGlVsExact, r.maxModelVsExact);
 }
 
-TEST_F(TetraPassGL, MatchesTheReferenceOnTheSameMeshWithinADerivedBound) { expectPassMatchesTheReference(Cloud()); }
+void expectPassMatchesTheReference(TestCloud cl) {
+    const Camera cam = Camera::lookAt({-14.0f, 6.0f, 10.0f}, {8.0f, 8.0f, 4.0f}, {0, 0, 1}, glm::radians(50.0f), kSize, 0.5f, 200.0f);
+    Frame frame;
+    frame.begin(0.0, cam);
+    FrameVolume& fv = frame.volumes().emplace_back();
+    fv.table = &*cl.table;
+    ASSERT_TRUE(cl.volume->update(cam, {.detailC = 20.0f}, &*cl.transfer, fv.lod));
+    frame.end();
+    ASSERT_GT(fv.lod.tets.size(), 50u);
+    expectFrameMatchesTheReference(cam, frame, *cl.table, *cl.transfer);
+}
+
+TEST_F(TetraPassGL, MatchesTheReferenceOnTheSameMeshWithinADerivedBound) { expectPassMatchesTheReference(TestCloud()); }
 
 // Roettger & Ertl's sec. 5.1 model: the table indexed by the light gamma
 // (rho = Id) and the density entering through the length, l' = l f / f_max
 // (eq. 9). The same pass and the same bound; the exact integral takes the
 // length scale per tetrahedron as the pass does.
 TEST_F(TetraPassGL, PaperEquation9ModelMatchesTheReferenceWithinTheSameBound) {
-    expectPassMatchesTheReference(Cloud{CloudModel::LightTableDensityLength});
+    expectPassMatchesTheReference(TestCloud{CloudModel::LightTableDensityLength});
+}
+
+// A Cloud in the low-albedo model (cloud.hpp) with two HG lobes: the source
+// per vertex s = T phase / max phase written by Cloud::update, drawn with
+// the cloud's own affine transfer and table, against the exact integral of
+// the lit cloud through the same emitted mesh, within the same derived
+// bound. The sun (intensity 0.15) keeps the peak source A + B below 1, as
+// the bound's "colours <= 1" needs.
+TEST_F(TetraPassGL, LowAlbedoCloudMatchesTheReferenceWithinTheSameBound) {
+    splatfx::CloudCreateDesc d;
+    d.cloud = {.dims = {17, 17, 9}, .seed = 5, .featureCells = 6.0f, .coverage = 0.6f};
+    d.lighting.model = CloudLightModel::LowAlbedo;
+    d.lighting.sun = Light::directional({-0.6f, 0.3f, -1.0f}, glm::vec3(1.0f), 0.15f);
+    const HgLobe lobes[] = {{0.6f, 0.7f}, {-0.3f, 0.3f}};
+    d.lighting.gas.phase = *PhaseFunction::create(lobes);
+    d.lighting.gas.ambient = glm::vec3(0.03f);
+    d.table = {.scalarResolution = 32, .lengthResolution = 64};
+    auto cloud = splatfx::Cloud::create(d);
+    ASSERT_TRUE(cloud) << cloud.error();
+    const glm::dvec3 peak = cloud->transfer().color(1.0);
+    ASSERT_LE(std::max({peak.x, peak.y, peak.z}), 1.0);
+    const Camera cam = Camera::lookAt({-14.0f, 6.0f, 10.0f}, {8.0f, 8.0f, 4.0f}, {0, 0, 1}, glm::radians(50.0f), kSize, 0.5f, 200.0f);
+    Frame frame;
+    frame.begin(0.0, cam);
+    FrameVolume& fv = frame.volumes().emplace_back();
+    fv.table = &cloud->table();
+    ASSERT_TRUE(cloud->update(cam, {.detailC = 6.0f}, fv.lod)); // coarse: the brute-force model costs O(tetrahedra) per pixel
+    frame.end();
+    ASSERT_GT(fv.lod.tets.size(), 50u);
+    expectFrameMatchesTheReference(cam, frame, cloud->table(), cloud->transfer());
 }
 
 // The host's depth ends every segment: a plane through the middle of the
@@ -273,7 +309,7 @@ TEST_F(TetraPassGL, PaperEquation9ModelMatchesTheReferenceWithinTheSameBound) {
 // part of each tetrahedron in front of it is drawn exactly (the scalar at the
 // cut interpolated), against the references integrated to the same depth.
 TEST_F(TetraPassGL, HostDepthCutsSegmentsInsideTetrahedra) {
-    Cloud cl;
+    TestCloud cl;
     const float nearP = 0.5f, farP = 200.0f;
     const Camera cam = Camera::lookAt({-14.0f, 6.0f, 10.0f}, {8.0f, 8.0f, 4.0f}, {0, 0, 1}, glm::radians(50.0f), kSize, nearP, farP);
     Frame frame;
@@ -335,7 +371,7 @@ TEST_F(TetraPassGL, HostDepthCutsSegmentsInsideTetrahedra) {
 // only in the depths' last bits, which can move a value across one rounding
 // boundary, never two).
 TEST_F(TetraPassGL, HostDepthCutIsTheSameInAllFourConventions) {
-    Cloud cl;
+    TestCloud cl;
     const DepthConvention conventions[] = {
         {}, {.clip = ClipDepth::ZeroToOne}, {.reversed = true}, {.clip = ClipDepth::ZeroToOne, .reversed = true}};
     Image base;
@@ -374,7 +410,7 @@ TEST_F(TetraPassGL, HostDepthCutIsTheSameInAllFourConventions) {
 // the GL image matches the pass model within the bound at every pixel: no
 // pixel loses a tetrahedron at the near plane (no holes).
 TEST_F(TetraPassGL, CameraInsideTheCloudRendersWithoutHoles) {
-    Cloud cl;
+    TestCloud cl;
     // The eye at the densest grid point, looking along +x.
     const auto it = std::max_element(cl.field.scalar.begin(), cl.field.scalar.end());
     const std::size_t i = std::size_t(it - cl.field.scalar.begin());
@@ -426,7 +462,7 @@ TEST_F(TetraPassGL, CameraInsideTheCloudRendersWithoutHoles) {
 // rounded here, in 8-bit levels; "steps": the RMS of e minus its 5x5 box mean
 // (what changes from pixel to pixel; a smooth offset drops out).
 TEST_F(TetraPassGL, VolumeLayerRoundsAnEightBitHostOnceInsideTheCloud) {
-    Cloud cl;
+    TestCloud cl;
     const auto it = std::max_element(cl.field.scalar.begin(), cl.field.scalar.end());
     const std::size_t i = std::size_t(it - cl.field.scalar.begin());
     const glm::vec3 eye(float(i % 17), float((i / 17) % 17), float(i / (17 * 17)));
@@ -505,7 +541,7 @@ TEST_F(TetraPassGL, VolumeLayerRoundsAnEightBitHostOnceInsideTheCloud) {
 // An orthographic camera: rays parallel to forward from the plane through the
 // eye; the pass's other shader variant, against the same model.
 TEST_F(TetraPassGL, OrthographicCameraMatchesTheModel) {
-    Cloud cl;
+    TestCloud cl;
     const glm::vec3 eye{-14.0f, 6.0f, 10.0f}, target{8.0f, 8.0f, 4.0f};
     const glm::mat4 view = glm::lookAt(eye, target, glm::vec3(0, 0, 1));
     const glm::mat4 proj = glm::ortho(-12.0f, 12.0f, -9.0f, 9.0f, 0.5f, 200.0f);
@@ -547,7 +583,7 @@ TEST_F(TetraPassGL, OrthographicCameraMatchesTheModel) {
 // non-finite vertex and a transparent one are skipped (counted), and the image
 // is exactly that of the one visible tetrahedron.
 TEST_F(TetraPassGL, DegenerateNonFiniteAndTransparentTetrahedraAreSkipped) {
-    Cloud cl;
+    TestCloud cl;
     const Camera cam = Camera::lookAt({0.0f, -6.0f, 0.5f}, {0.0f, 0.0f, 0.3f}, {0, 0, 1}, glm::radians(50.0f), kSize, 0.1f, 100.0f);
     Tetrahedron visible;
     visible.position = {glm::vec3(-1, 0, 0), glm::vec3(1, 0, 0), glm::vec3(0, 1.5f, 0), glm::vec3(0, 0.5f, 1.5f)};
@@ -670,7 +706,7 @@ TEST_F(TetraPassGL, GroundFogDrawsThroughThePass) {
 // the tetrahedra are still drawn at full resolution: a frame of tetrahedra
 // alone gives exactly the full-resolution image.
 TEST_F(TetraPassGL, ReducedResolutionSplatsLeaveTheTetrahedraAtFullResolution) {
-    Cloud cl;
+    TestCloud cl;
     const Camera cam = Camera::lookAt({-14.0f, 6.0f, 10.0f}, {8.0f, 8.0f, 4.0f}, {0, 0, 1}, glm::radians(50.0f), kSize, 0.5f, 200.0f);
     Frame frame;
     frame.begin(0.0, cam);
@@ -739,7 +775,7 @@ TEST_F(TetraPassGL, ReducedTetrahedraKeepTheOneOrderWithTheSplats) {
 // every pixel (no holes), within the derived bound of its CPU model, and the
 // pieces integrate to the original tetrahedron's integral from the near plane.
 TEST_F(TetraPassGL, CameraInsideOneTetrahedronIsClippedWithoutHoles) {
-    Cloud cl;
+    TestCloud cl;
     const float nearP = 0.2f;
     const glm::vec3 eye{0.3f, 0.2f, 0.0f};
     const Camera cam = Camera::lookAt(eye, eye + glm::vec3(0.1f, 0.05f, 1.0f), {0, 1, 0}, glm::radians(40.0f), kSize, nearP, 200.0f);
@@ -804,7 +840,7 @@ TEST_F(TetraPassGL, CameraInsideOneTetrahedronIsClippedWithoutHoles) {
 // the model's bound, i.e. its huge barycentric gradients do not blow up the
 // entry and exit distances.
 TEST_F(TetraPassGL, SliverTetrahedraStayFiniteAndWithinTheBound) {
-    Cloud cl;
+    TestCloud cl;
     Tetrahedron sliver;
     sliver.position = {glm::vec3(-2, -2, 0), glm::vec3(2, -2, 0), glm::vec3(0, 2.5f, 0), glm::vec3(0.1f, 0.0f, 0.004f)};
     if (glm::dot(sliver.position[1] - sliver.position[0],
@@ -953,7 +989,7 @@ TEST_F(TetraPassGL, SortFreeGroundFogMatchesTheSortedImage) {
 // plus the placement bound. The fog changes most covered pixels by far more
 // than the bound, so a pass that dropped the fog would fail.
 TEST_F(TetraPassGL, FogAttenuatesEveryTetrahedronAsOneMedium) {
-    Cloud cl;
+    TestCloud cl;
     const Camera cam = Camera::lookAt({-14.0f, 6.0f, 10.0f}, {8.0f, 8.0f, 4.0f}, {0, 0, 1}, glm::radians(50.0f), kSize, 0.5f, 200.0f);
     FogDesc fd;
     fd.terms = {FogTerm::constant(0.05), FogTerm::cosine(0.03, 0.5, {1.0, 0.0, 0.3}, 0.4)};

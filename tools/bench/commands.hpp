@@ -28,6 +28,7 @@ int runVdb(int argc, char** argv);          // vdb.cpp: VDB resampling block siz
 int runLattice(int argc, char** argv);      // lattice.cpp: how visible the voxel lattice is in the effect samples (issue 25)
 int runParticles(int argc, char** argv);    // particles.cpp: splats at particle positions vs the same number of grid splats (issue 25)
 int runEbert(int argc, char** argv);        // ebert.cpp: Ebert & Parent 1990 Table 1, the paper's scenes with and without their volumes
+int runCloudLight(int argc, char** argv);   // cloudlight.cpp: cloud relight per sun move, per model and size; swept vs exact sun transmittance (issue 27)
 int runObstacles(int argc, char** argv);    // obstacles.cpp: solver step cost with obstacles (bridge, moving locomotive, meshes) against none
 int runDevice(int argc, char** argv);       // device.cpp: the GL context the benches get (SPLATFX_EGL_DEVICE), for tools/gpu-check.sh
 int runHdr(int argc, char** argv);          // hdr.cpp: HDR lit colour and RGBA16F/32F targets against the 8-bit path (issues 26, 27)
@@ -61,6 +62,7 @@ inline constexpr BenchCommand kCommands[] = {
     {"gases", "procedural gases: grid spacing, threshold, octaves against the continuous turbulence gas; Pareto plot", runGases},
     {"vdb", "OpenVDB import: voxels per cell and splat filter against the file's voxels at full resolution; Pareto plot", runVdb},
     {"particles", "splats at particle positions (host, emitter) vs the same number of grid splats: CPU frame, GL pass, error vs the exact reference", runParticles},
+    {"cloudlight", "LOD cloud relit as the sun moves: ms per relight per model and size, skipped relight, table rebuild; transmittance vs exact", runCloudLight},
     {"obstacles", "solver step cost with obstacles (a bridge, a moving locomotive, as boxes or meshes, free or no slip) against none", runObstacles},
     {"device", "the OpenGL context the benches get (SPLATFX_EGL_DEVICE selects an EGL device): vendor, renderer, sample limits", runDevice},
     {"hdr", "HDR lit colour against the 8-bit path: RGBA8/16F/32F host targets, ms per frame, error vs the lit volume reference, Pareto", runHdr},

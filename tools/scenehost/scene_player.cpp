@@ -141,6 +141,10 @@ splatfx::Status ScenePlayer::advance(double t, const splatfx::Camera& camera, co
     splatfx::SceneFile& f = *p.file;
     FrameStats& s = p.stats;
     const auto t0 = Clock::now();
+    // Moving lights (scene file "directionEnd"/"moveSec"): set before the frame, so lit clouds relight.
+    for (const splatfx::LightMotion& m : f.lightMotions)
+        if (m.light < f.scene.lights().size())
+            if (splatfx::Status st = f.scene.setLight(m.light, m.at(f.scene.lights()[m.light], t)); !st) return st;
     if (splatfx::Status st =
             f.scene.prepare(t, camera, p.materials, p.frame, {.textured = !options.traditional, .opacityScale = options.opacityScale});
         !st)

@@ -18,7 +18,8 @@
 // It also holds lights (addLight) and lights the effects that opt in
 // (EffectOptions::lighting) and whose kind exposes the density the light sees
 // (EffectKind::lightingDensity: every Effect does; LOD volumes and ground fog
-// do not, their light is part of their data): their splat colours follow Ebert & Parent's low-albedo model with
+// do not, their light is part of their data; a Cloud, cloud.hpp, follows the
+// scene's first directional light and is relit when it moves): their splat colours follow Ebert & Parent's low-albedo model with
 // self-shadowing, and prepare() puts their shadows on the scene, one per
 // shadowing light, into Frame::shadows() (docs/lighting.md, "In a Scene"). And the scene's fog
 // (setFog), handed to every Frame without the terms the view cannot see
@@ -64,6 +65,8 @@
 #include "splatfx/volume.hpp"
 
 namespace splatfx {
+
+class Cloud; // cloud.hpp
 
 // One id space for every effect a Scene holds, of any kind: ids are 0, 1, ...
 // in the order of add().
@@ -242,6 +245,10 @@ public:
     // A ground fog layer with its transfer function and table, refined by
     // options.refine (a layer made with GroundFogDesc::lod).
     EffectId add(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, EffectOptions options = {});
+    // A relightable cloud (cloud.hpp). With options.lighting.enabled it
+    // follows the scene's first directional light (and, in the low-albedo
+    // model, options.lighting.gas), relit only when those change.
+    EffectId add(Cloud cloud, EffectOptions options = {});
     // Any other kind (effect_kind.hpp). Expects kind != nullptr.
     EffectId add(std::unique_ptr<EffectKind> kind, EffectOptions options = {});
     // Effects of every kind; ids are [0, size()).
@@ -256,6 +263,8 @@ public:
     LodVolume* findLodVolume(EffectId id);
     const LodVolume* findLodVolume(EffectId id) const;
     const GroundFog* findGroundFog(EffectId id) const;
+    Cloud* findCloud(EffectId id);
+    const Cloud* findCloud(EffectId id) const;
     // Expects an Effect (asserts otherwise; use findEffect for any kind).
     Effect& effect(EffectId id);
     const Effect& effect(EffectId id) const;

@@ -141,6 +141,19 @@ struct GroundFogTerrain {
     EffectId fog = 0;     // the layer in SceneFile::scene (Scene::groundFogTerrain(fog), findGroundFog(fog))
 };
 
+// A light whose direction moves over time (a light's "directionEnd" and
+// "moveSec" keys): from the file's direction at t = 0 to directionEnd at
+// t = moveSec, the unit direction interpolated along the great circle, then
+// held. The host applies it each frame (Scene::setLight): lit clouds relight.
+struct LightMotion {
+    std::size_t light = 0;   // index into SceneFile::scene.lights()
+    glm::vec3 from{0, -1, 0}; // direction at t = 0
+    glm::vec3 to{0, -1, 0};   // direction at t >= seconds
+    float seconds = 1.0f;     // > 0
+    // The light at timeSec: `base` with the interpolated direction.
+    Light at(const Light& base, double timeSec) const;
+};
+
 struct SceneFile {
     std::string path;       // the file as given
     std::string title;      // default empty
@@ -152,6 +165,7 @@ struct SceneFile {
     CameraPath camera;
     OutputSettings output;
     std::vector<GroundFogTerrain> groundFogTerrain; // default none
+    std::vector<LightMotion> lightMotions;          // default none
 };
 
 struct SceneFileOptions {

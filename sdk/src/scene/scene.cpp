@@ -19,6 +19,8 @@ EffectId Scene::add(GroundFog fog, TransferFunction transfer, PreIntegrationTabl
     return push(std::make_unique<detail::GroundFogKind>(std::move(fog), std::move(transfer), std::move(table)), std::move(options));
 }
 
+EffectId Scene::add(Cloud cloud, EffectOptions options) { return push(std::make_unique<detail::CloudKind>(std::move(cloud)), std::move(options)); }
+
 EffectId Scene::add(std::unique_ptr<EffectKind> kind, EffectOptions options) {
     assert(kind && "Scene::add: kind must not be null");
     return push(std::move(kind), std::move(options));
@@ -41,6 +43,16 @@ LodVolume* Scene::findLodVolume(EffectId id) {
 const LodVolume* Scene::findLodVolume(EffectId id) const {
     const auto* k = dynamic_cast<const detail::LodVolumeKind*>(mEntries.at(id).kind.get());
     return k ? &k->volume() : nullptr;
+}
+
+Cloud* Scene::findCloud(EffectId id) {
+    auto* k = dynamic_cast<detail::CloudKind*>(mEntries.at(id).kind.get());
+    return k ? &k->cloud() : nullptr;
+}
+
+const Cloud* Scene::findCloud(EffectId id) const {
+    const auto* k = dynamic_cast<const detail::CloudKind*>(mEntries.at(id).kind.get());
+    return k ? &k->cloud() : nullptr;
 }
 
 const GroundFog* Scene::findGroundFog(EffectId id) const {
@@ -181,6 +193,23 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
         const EmitOptions draw{.textured = e.options.draw.textured && options.textured,
                                .opacityScale = e.options.draw.opacityScale * options.opacityScale};
         const std::size_t first = builder.splats().size();
+        // A lit cloud takes the scene's sun before it refines (relit only when
+        // it changed), and its extinction joins the scene's shadow casters
+        // (shadeScene reads e.lit->field; copied only when the density changed).
+        bool cloudLit = false;
+        auto* cloud = dynamic_cast<detail::CloudKind*>(e.kind.get());
+        if (cloud && (e.status.needed || e.status.castsIntoView) && e.options.lighting.enabled) {
+            Status s = e.status.needed ? cloud->follow(mLights, e.options.lighting) : Status{};
+            if (!s) {
+                mLightingError = "effect '" + e.options.name + "': lighting: " + s.error();
+                e.status.castsIntoView = false;
+            } else {
+                cloudLit = e.status.needed;
+                if (!e.lit) e.lit = std::make_unique<LitState>();
+                const DensityField& f = cloud->cloud().densityField();
+                if (e.lit->field.empty() != f.empty() || e.lit->field.fingerprint() != f.fingerprint()) e.lit->field = f;
+            }
+        }
         EmitResult r;
         if (e.status.needed)
             r = e.kind->emit(EmitContext{.splats = builder,
@@ -194,13 +223,14 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
         splats += r.splats;
         tetrahedra += r.tetrahedra;
         // Colour the splats just emitted; unlit effects skip this.
-        e.status.lit = false;
+        e.status.lit = cloudLit;
+        mCounters.litEffects += cloudLit ? 1 : 0;
         // Tables over the budget are never built: those effects stay unlit (the error says why).
         const bool tableLit = e.options.lighting.selfShadow == SelfShadow::Table;
-        if (e.status.needed && e.options.lighting.enabled && !mLights.empty() && (mTablesFit || !tableLit))
+        if (!cloud && e.status.needed && e.options.lighting.enabled && !mLights.empty() && (mTablesFit || !tableLit))
             lightEmitted(e, builder, materials, first, draw);
         // Not drawn but casting into the view: only the density the light sees.
-        if (e.status.castsIntoView && !updateLitField(e, materials, draw)) e.status.castsIntoView = false;
+        if (e.status.castsIntoView && !cloud && !updateLitField(e, materials, draw)) e.status.castsIntoView = false;
         e.status.emittedLights = 0;
         if (e.options.emitsLight.enabled && (e.status.needed || e.status.lightsIntoView)) fitLights(e, builder.camera(), materials, draw);
     }

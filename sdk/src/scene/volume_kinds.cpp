@@ -26,4 +26,28 @@ EmitResult GroundFogKind::emit(const EmitContext& context) {
     });
 }
 
+EmitResult CloudKind::emit(const EmitContext& context) {
+    if (!context.volumes) return {};
+    FrameVolume& fv = context.volumes->emplace_back();
+    fv.table = &mCloud.table();
+    fv.tableVersion = mCloud.tableVersion();
+    if (!mCloud.update(context.splats.camera(), context.refine, fv.lod)) {
+        context.volumes->pop_back();
+        return {};
+    }
+    return {.tetrahedra = fv.lod.tets.size()};
+}
+
+Status CloudKind::follow(std::span<const Light> lights, const EffectLighting& lighting) {
+    for (const Light& l : lights)
+        if (l.type == LightType::Directional) {
+            CloudLighting L = mCloud.lighting();
+            L.sun = l;
+            L.gas = lighting.gas;
+            L.gas.colorTable = nullptr;
+            return mCloud.setLight(L);
+        }
+    return {};
+}
+
 } // namespace splatfx::detail

@@ -5,7 +5,12 @@
 #include <cstdint>
 #include <vector>
 
+#include <span>
+
+#include "splatfx/cloud.hpp"
 #include "splatfx/effect_kind.hpp"
+#include "splatfx/lighting.hpp"
+#include "splatfx/scene.hpp"
 #include "splatfx/volume.hpp"
 
 namespace splatfx::detail {
@@ -84,6 +89,32 @@ public:
 
 private:
     std::vector<glm::vec3> mTerrain;
+};
+
+// A relightable cloud (cloud.hpp): static like the other volumes, drawn with
+// the table the Cloud owns (its version bumps when a relight rebuilds it).
+class CloudKind final : public EffectKind {
+public:
+    explicit CloudKind(Cloud cloud) : mCloud(std::move(cloud)) {}
+    Aabb bounds(double, double) const override { return mCloud.volume().boundsWorld(); }
+    bool alive(double, const AliveHints&) const override { return true; }
+    AdvanceResult advanceTo(double timeSec, const AdvanceContext&) override {
+        mTime = timeSec;
+        return {};
+    }
+    double time() const override { return mTime; }
+    std::uint64_t costCells() const override { return 0; }
+    EmitResult emit(const EmitContext& context) override;
+    // The scene's sun is its first directional light: the cloud takes it
+    // (and, for the low-albedo model, the effect's gas desc) and relights
+    // only when that changed. No directional light: the cloud keeps its own.
+    Status follow(std::span<const Light> lights, const EffectLighting& lighting);
+    Cloud& cloud() { return mCloud; }
+    const Cloud& cloud() const { return mCloud; }
+
+private:
+    Cloud mCloud;
+    double mTime = 0.0;
 };
 
 } // namespace splatfx::detail

@@ -1,6 +1,7 @@
 // Scene files: lighting (issue 16; docs/scene-format.md, "lights"). The
 // top-level "lights" list and "sceneShadow" object, and each effect's
 // "lighting" object (read from effects.cpp with the keys every kind takes).
+#include <algorithm>
 #include <cmath>
 
 #include "scenefile/reader.hpp"
@@ -21,8 +22,16 @@ void readAxisCounts(Context& c, ObjectReader& o, const std::string& key, glm::iv
     }
 }
 
-std::optional<Light> readLight(Context& c, const std::string& path, const Json& v) {
+std::optional<Light> readLight(Context& c, const std::string& path, const Json& v, std::optional<LightMotion>& motion) {
     return readObject<Light>(c, path, v, [&](Context& cc, ObjectReader& o, Light& l) {
+        if (o.has("directionEnd") || o.has("moveSec")) {
+            LightMotion m;
+            o.vec3("directionEnd", m.to, -kMaxCoord, kMaxCoord);
+            o.number("moveSec", m.seconds, 1e-3, 1e6);
+            if (!o.has("directionEnd")) cc.d.error(path, "\"moveSec\" needs \"directionEnd\" (where the light's direction goes)");
+            else if (!(glm::length(m.to) > 0.0f)) cc.d.error(o.at("directionEnd"), "must not be zero");
+            motion = m;
+        }
         if (const Json* t = o.get("type")) {
             if (auto s = readChoice(cc.d, o.at("type"), *t, {"directional", "point", "spot"}))
                 l.type = *s == "point" ? LightType::Point : *s == "spot" ? LightType::Spot : LightType::Directional;
@@ -69,10 +78,19 @@ void readLights(Context& c, const std::string& path, const Json& v, SceneFile& o
         c.d.error(path, "expected an array of at most " + std::to_string(kMaxLights) + " lights, got " + typeName(v) + " " + brief(v));
         return;
     }
-    for (std::size_t i = 0; i < v.size() && !c.d.full(); ++i)
-        if (auto l = readLight(c, index(path, i), v[i])) {
-            if (auto r = out.scene.addLight(*l); !r) c.d.error(index(path, i), r.error());
+    for (std::size_t i = 0; i < v.size() && !c.d.full(); ++i) {
+        std::optional<LightMotion> motion;
+        if (auto l = readLight(c, index(path, i), v[i], motion)) {
+            auto r = out.scene.addLight(*l);
+            if (!r) {
+                c.d.error(index(path, i), r.error());
+            } else if (motion) {
+                motion->light = *r;
+                motion->from = l->direction;
+                out.lightMotions.push_back(*motion);
+            }
         }
+    }
 }
 
 void readSceneShadow(Context& c, const std::string& path, const Json& v, SceneFile& out) {
@@ -174,3 +192,20 @@ void readEffectLighting(Context& c, const std::string& path, const Json& v, Effe
 }
 
 } // namespace splatfx::scenefile
+
+namespace splatfx {
+
+Light LightMotion::at(const Light& base, double timeSec) const {
+    Light l = base;
+    const double w = std::clamp(timeSec / double(seconds), 0.0, 1.0);
+    const glm::dvec3 a = glm::normalize(glm::dvec3(from)), b = glm::normalize(glm::dvec3(to));
+    // Spherical interpolation: constant angular speed; opposite ends (no
+    // unique great circle) fall back to the straight line, normalised.
+    const double cosAngle = std::clamp(glm::dot(a, b), -1.0, 1.0), angle = std::acos(cosAngle), s = std::sin(angle);
+    glm::dvec3 d = s > 1e-6 ? (std::sin((1.0 - w) * angle) * a + std::sin(w * angle) * b) / s : glm::mix(a, b, w);
+    if (!(glm::length(d) > 1e-9)) d = w < 0.5 ? a : b;
+    l.direction = glm::vec3(glm::normalize(d));
+    return l;
+}
+
+} // namespace splatfx

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "scenefile/reader.hpp"
+#include "splatfx/cloud.hpp"
 #include "splatfx/image_io.hpp"
 #include "splatfx/volume.hpp"
 
@@ -334,6 +335,17 @@ void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& 
         o.boolean("morph", morph);
         o.integer("tableScalars", scalarRes, 2, 256);
         o.integer("tableLengths", lengthRes, 2, 512);
+        // Lit by the scene (issue 27): a relightable Cloud that follows the
+        // scene's first directional light and casts into the scene shadow.
+        EffectLighting lighting;
+        const Json* lit = o.get("lighting");
+        if (lit) readEffectLighting(c, o.at("lighting"), *lit, lighting);
+        // A cloud shadows itself by its own sweep: no self-shadowing tables to budget.
+        lighting.selfShadow = SelfShadow::Off;
+        std::string lightModel = "roettger";
+        o.string("lightModel", lightModel);
+        if (lightModel != "roettger" && lightModel != "lowAlbedo")
+            c.d.error(o.at("lightModel"), "expected \"roettger\" or \"lowAlbedo\", got '" + lightModel + "'");
         o.finish();
         if (c.d.count() != before) continue;
         if (double(dims.x) * dims.y * dims.z > kMaxVolumePoints) {
@@ -350,8 +362,10 @@ void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& 
             // table, and the tetrahedra of a full refinement (five a cell).
             const std::uint64_t points = std::uint64_t(dims.x) * std::uint64_t(dims.y) * std::uint64_t(dims.z);
             const std::uint64_t tets = 5 * std::uint64_t(dims.x - 1) * std::uint64_t(dims.y - 1) * std::uint64_t(dims.z - 1);
-            const std::uint64_t bytes =
-                16 * points + LodVolume::bytesFor(dims, true) + 16ull * scalarRes * scalarRes * lengthRes + kFrameBytesPerTetrahedron * tets;
+            // A lit cloud also keeps its density, sun transmittance and cast
+            // field (12 bytes a point) and builds the field from 40-byte voxels.
+            const std::uint64_t bytes = (lit ? 68 : 16) * points + LodVolume::bytesFor(dims, true) + 16ull * scalarRes * scalarRes * lengthRes +
+                                        kFrameBytesPerTetrahedron * tets;
             if (!addVolumeBytes(c, p,
                                 "clouds '" + name + "' (" + dimsText(dims) + " points, up to " + std::to_string(tets) + " tetrahedra a frame, a " +
                                     dimsText({scalarRes, scalarRes, lengthRes}) + " table)",
@@ -361,6 +375,29 @@ void readVolumes(Context& c, const std::string& path, const Json& v, SceneFile& 
         cd.dims = {dims.x, dims.z, dims.y}; // generator: z up
         cd.sunDirection = {sun.x, sun.z, sun.y};
         cd.seed = c.sceneSeed * 1000003u + 7919u + localSeed; // like effects: --seed changes them all
+        if (lit) {
+            CloudCreateDesc ccd{.cloud = cd,
+                                .lighting = {.model = lightModel == "lowAlbedo" ? CloudLightModel::LowAlbedo : CloudLightModel::Roettger,
+                                             .sun = Light::directional(-sun),
+                                             .ambient = cd.ambient,
+                                             .diffuse = cd.diffuse,
+                                             .gas = lighting.gas},
+                                .transfer = td,
+                                .volume = {.originWorld = origin, .spacingWorld = spacing, .minAccuracyC = minC},
+                                .table = {.scalarResolution = scalarRes, .lengthResolution = lengthRes},
+                                .yUp = true};
+            auto cloud = Cloud::create(ccd);
+            if (!cloud) {
+                c.d.error(p, cloud.error());
+                continue;
+            }
+            const EffectId id = out.scene.add(std::move(*cloud), {.name = name,
+                                                                  .enabled = enabled,
+                                                                  .lighting = lighting,
+                                                                  .refine = {.detailC = detailC, .morph = morph}});
+            out.volumes.push_back({id, name, "clouds"});
+            continue;
+        }
         auto field = makeCloudVolume(cd);
         if (!field) {
             c.d.error(p, field.error());

@@ -8,8 +8,60 @@
 #include <string>
 
 #include "texture/noise.hpp"
+#include "volume/cloud_sweep.hpp"
 
 namespace splatfx {
+
+namespace detail {
+
+void sweepSunTransmittance(glm::ivec3 n, const std::vector<float>& ext, double scale, glm::dvec3 sun, std::vector<float>& trans) {
+    const std::size_t count = std::size_t(n.x) * std::size_t(n.y) * std::size_t(n.z);
+    auto at = [&](int x, int y, int z) { return std::size_t(x) + std::size_t(n.x) * (std::size_t(y) + std::size_t(n.y) * std::size_t(z)); };
+    trans.assign(count, 1.0f);
+    const int axis =
+        (std::fabs(sun.x) >= std::fabs(sun.y) && std::fabs(sun.x) >= std::fabs(sun.z)) ? 0 : (std::fabs(sun.y) >= std::fabs(sun.z) ? 1 : 2);
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    const glm::dvec3 stepToSun = sun / std::fabs(sun[axis]); // one plane toward the sun
+    const double stepLen = glm::length(stepToSun);
+    const int towardSun = sun[axis] > 0.0 ? 1 : -1;
+    const int planes = n[axis];
+    auto sample = [&](const std::vector<float>& f, int plane, double pu, double pv) { // inside the plane
+        const int iu = std::min(int(pu), n[u] - 2), iv = std::min(int(pv), n[v] - 2);
+        const double fu = pu - iu, fv = pv - iv;
+        auto g = [&](int a, int b) {
+            glm::ivec3 p;
+            p[axis] = plane;
+            p[u] = a;
+            p[v] = b;
+            return double(f[at(p.x, p.y, p.z)]);
+        };
+        return (1 - fu) * (1 - fv) * g(iu, iv) + fu * (1 - fv) * g(iu + 1, iv) + (1 - fu) * fv * g(iu, iv + 1) + fu * fv * g(iu + 1, iv + 1);
+    };
+    for (int k = 1; k < planes; ++k) {
+        const int plane = towardSun > 0 ? planes - 1 - k : k;
+        const int prev = plane + towardSun;
+        for (int b = 0; b < n[v]; ++b)
+            for (int a = 0; a < n[u]; ++a) {
+                glm::ivec3 p;
+                p[axis] = plane;
+                p[u] = a;
+                p[v] = b;
+                const double qu = a + stepToSun[u], qv = b + stepToSun[v];
+                if (qu < 0.0 || qv < 0.0 || qu > double(n[u] - 1) || qv > double(n[v] - 1)) {
+                    // The step leaves the grid: a sideways step is at most one
+                    // cell, so the point lies on a face toward the sun and its
+                    // ray leaves at once (no material on the way).
+                    trans[at(p.x, p.y, p.z)] = 1.0f;
+                    continue;
+                }
+                const double tPrev = sample(trans, prev, qu, qv);
+                const double rho = 0.5 * (double(ext[at(p.x, p.y, p.z)]) + sample(ext, prev, qu, qv));
+                trans[at(p.x, p.y, p.z)] = float(tPrev * std::exp(-scale * rho * stepLen));
+            }
+    }
+}
+
+} // namespace detail
 
 Result<ScalarVolume> makeCloudVolume(const CloudDesc& desc) {
     const glm::ivec3 n = desc.dims;
@@ -54,46 +106,9 @@ Result<ScalarVolume> makeCloudVolume(const CloudDesc& desc) {
             }
     }
 
-    // Light: a plane sweep along the sun's main axis, one cell per step, each
-    // point attenuated from the point one step toward the sun (bilinear in the
-    // previous plane). Light entering from outside the grid is unattenuated.
-    std::vector<float> light(count, 1.0f);
-    const int axis =
-        (std::fabs(sun.x) >= std::fabs(sun.y) && std::fabs(sun.x) >= std::fabs(sun.z)) ? 0 : (std::fabs(sun.y) >= std::fabs(sun.z) ? 1 : 2);
-    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-    const glm::dvec3 stepToSun = sun / std::fabs(sun[axis]); // one plane toward the sun
-    const double stepLen = glm::length(stepToSun);
-    const int towardSun = sun[axis] > 0.0 ? 1 : -1;
-    const int planes = n[axis];
-    std::vector<float> trans(count, 1.0f);
-    auto sample = [&](const std::vector<float>& f, int plane, double pu, double pv, float outside) {
-        if (pu < 0.0 || pv < 0.0 || pu > double(n[u] - 1) || pv > double(n[v] - 1)) return double(outside);
-        const int iu = std::min(int(pu), n[u] - 2), iv = std::min(int(pv), n[v] - 2);
-        const double fu = pu - iu, fv = pv - iv;
-        auto g = [&](int a, int b) {
-            glm::ivec3 p;
-            p[axis] = plane;
-            p[u] = a;
-            p[v] = b;
-            return double(f[at(p.x, p.y, p.z)]);
-        };
-        return (1 - fu) * (1 - fv) * g(iu, iv) + fu * (1 - fv) * g(iu + 1, iv) + (1 - fu) * fv * g(iu, iv + 1) + fu * fv * g(iu + 1, iv + 1);
-    };
-    for (int k = 1; k < planes; ++k) {
-        const int plane = towardSun > 0 ? planes - 1 - k : k;
-        const int prev = plane + towardSun;
-        for (int b = 0; b < n[v]; ++b)
-            for (int a = 0; a < n[u]; ++a) {
-                glm::ivec3 p;
-                p[axis] = plane;
-                p[u] = a;
-                p[v] = b;
-                const double qu = a + stepToSun[u], qv = b + stepToSun[v];
-                const double tPrev = sample(trans, prev, qu, qv, 1.0f);
-                const double rho = 0.5 * (double(density[at(p.x, p.y, p.z)]) + sample(density, prev, qu, qv, 0.0f));
-                trans[at(p.x, p.y, p.z)] = float(tPrev * std::exp(-double(desc.lightExtinctionPerCell) * rho * stepLen));
-            }
-    }
+    // Light: the sun's transmittance by a plane sweep through the density.
+    std::vector<float> light(count, 1.0f), trans;
+    detail::sweepSunTransmittance(n, density, double(desc.lightExtinctionPerCell), sun, trans);
     float fMax = 0.0f;
     for (std::size_t i = 0; i < count; ++i) {
         light[i] = std::min(1.0f, desc.ambient + desc.diffuse * trans[i]);

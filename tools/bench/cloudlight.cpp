@@ -1,0 +1,195 @@
+// splatfx-bench cloudlight (issue 27): what relighting a LOD cloud costs when
+// its sun moves (Cloud::setLight: the sun's transmittance swept through the
+// density, the LOD fields rebuilt), per light model and cloud size, against
+// the relight that is skipped (the light unchanged) and the low-albedo
+// model's table rebuild (a new sun colour). The error column is the swept
+// transmittance against the exact one: the extinction integrated along the
+// ray to the sun through the finest tetrahedral mesh of the same density
+// (LodVolume::integrateRay, double), at sampled grid points with material.
+// CPU only.
+#include <algorithm>
+#include <ctime>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "bench_stats.hpp"
+#include "commands.hpp"
+#include "knob_table.hpp"
+#include "options.hpp"
+#include "splatfx/cloud.hpp"
+
+namespace {
+
+// CPU time of this thread's work (the relight is single-threaded): steadier
+// than wall time on a shared machine.
+struct Clock {
+    static std::clock_t now() { return std::clock(); }
+};
+double ms(std::clock_t d) { return 1000.0 * double(d) / double(CLOCKS_PER_SEC); }
+
+// The sun at `step` of a day: from one horizon over the top to the other, a
+// little off the x-z plane, travelling toward the cloud (-z down).
+splatfx::Light sunAt(int step, int steps) {
+    const double a = 0.2 + 2.74 * double(step) / double(std::max(1, steps - 1)); // radians above the +x horizon
+    return splatfx::Light::directional({-float(std::cos(a)), -0.15f, -float(std::sin(a))});
+}
+
+struct Measure {
+    double relightMs = 0.0; // median over the steps
+    double rmse = 0.0, maxErr = 0.0;
+    std::uint64_t relights = 0;
+};
+
+// RMSE and max of the swept transmittance against the exact one, at up to
+// `samples` grid points with density (every k-th), for the cloud's current sun.
+void transmittanceError(const splatfx::Cloud& cloud, const splatfx::CloudCreateDesc& desc, int samples, double& rmse, double& maxErr) {
+    const bool roettger = cloud.lighting().model == splatfx::CloudLightModel::Roettger;
+    const glm::ivec3 n = cloud.dims();
+    splatfx::ScalarVolume field;
+    field.dims = n;
+    field.scalar = cloud.density();
+    // The extinction each model attenuates by, per world unit, linear in the stored scalar.
+    double perUnit = double(desc.cloud.lightExtinctionPerCell) / double(desc.volume.spacingWorld);
+    if (!roettger) {
+        perUnit = desc.transfer.maxExtinctionPerWorld;
+        for (float& f : field.scalar) f = f >= desc.transfer.threshold ? f : 0.0f;
+    }
+    auto vol = splatfx::LodVolume::create(field, desc.volume);
+    auto tf = splatfx::TransferFunction::create({{0.0f, glm::vec3(0.0f), 0.0f}, {1.0f, glm::vec3(0.0f), float(perUnit)}});
+    if (!vol || !tf) return;
+    std::vector<std::size_t> cloudy;
+    for (std::size_t i = 0; i < field.scalar.size(); ++i)
+        if (field.scalar[i] > 0.0f) cloudy.push_back(i);
+    const std::size_t stride = std::max<std::size_t>(1, cloudy.size() / std::size_t(samples));
+    const glm::dvec3 toSun = -glm::normalize(glm::dvec3(cloud.lighting().sun.direction));
+    double sum = 0.0;
+    std::size_t count = 0;
+    maxErr = 0.0;
+    for (std::size_t k = 0; k < cloudy.size(); k += stride) {
+        const std::size_t i = cloudy[k];
+        const glm::ivec3 g(int(i % std::size_t(n.x)), int((i / std::size_t(n.x)) % std::size_t(n.y)), int(i / (std::size_t(n.x) * std::size_t(n.y))));
+        const glm::dvec3 p = glm::dvec3(vol->originWorld()) + glm::dvec3(g) * double(vol->spacingWorld());
+        // The sweep reads the float density; the reference the stored 8-bit one.
+        const double exact = 1.0 - vol->integrateRay(*tf, p, toSun, 0.0, 1e9).a;
+        const double d = double(cloud.sunTransmittance()[i]) - exact;
+        sum += d * d;
+        maxErr = std::max(maxErr, std::fabs(d));
+        ++count;
+    }
+    rmse = count ? std::sqrt(sum / double(count)) : 0.0;
+}
+
+bool measure(const splatfx::CloudCreateDesc& desc, int steps, int samples, Measure& out) {
+    auto cloud = splatfx::Cloud::create(desc);
+    if (!cloud) return std::fprintf(stderr, "cloudlight: %s\n", cloud.error().c_str()), false;
+    std::vector<double> times;
+    double rmse = 0.0, maxErr = 0.0;
+    for (int s = 0; s < steps; ++s) {
+        splatfx::CloudLighting L = cloud->lighting();
+        L.sun = sunAt(s, steps);
+        const auto t0 = Clock::now();
+        if (splatfx::Status st = cloud->setLight(L); !st) return std::fprintf(stderr, "cloudlight: %s\n", st.error().c_str()), false;
+        times.push_back(ms(Clock::now() - t0));
+        // The error over three suns: low, high, low on the other side.
+        if (s == 0 || s == steps / 2 || s == steps - 1) {
+            double r = 0.0, m = 0.0;
+            transmittanceError(*cloud, desc, samples, r, m);
+            rmse = std::max(rmse, r);
+            maxErr = std::max(maxErr, m);
+        }
+    }
+    out.relightMs = bench::percentile(times, 0.5);
+    out.rmse = rmse;
+    out.maxErr = maxErr;
+    out.relights = cloud->relights();
+    return true;
+}
+
+std::string dimsText(glm::ivec3 d) { return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z); }
+
+} // namespace
+
+int runCloudLight(int argc, char** argv) {
+    CLI::App app{"Cloud relighting as the sun moves: ms per relight per model and cloud size, the skipped relight, the low-albedo table\n"
+                 "rebuild; the swept sun transmittance against the exact one through the finest mesh.",
+                 "splatfx-bench cloudlight"};
+    glm::ivec3 dims{129, 129, 33};
+    int steps = 24, samples = 400;
+    std::string out = "bench-cloudlight";
+    bool noPlots = false;
+    cli::addInts(app, "--dims", &dims.x, 3, 2, 4097, "grid points of the default cloud per axis", "X Y Z");
+    cli::addNumber(app, "--steps", steps, 2, 10000, "sun positions over the day, one relight each (median reported)");
+    cli::addNumber(app, "--samples", samples, 1, 1000000, "grid points with material checked against the exact transmittance");
+    app.add_option("--out", out, "where cloudlight.dat, cloudlight.gp and the PNG plots go")->type_name("DIR")->capture_default_str();
+    app.add_flag("--no-plots", noPlots, "print the table only");
+    if (const int code = cli::parse(app, argc, argv); code >= 0) return code;
+
+    auto base = [&](glm::ivec3 d, splatfx::CloudLightModel model) {
+        splatfx::CloudCreateDesc desc;
+        desc.cloud.dims = d;
+        desc.lighting.model = model;
+        desc.lighting.gas.phase = *splatfx::PhaseFunction::create(std::vector<splatfx::HgLobe>{{0.6f, 0.8f}, {-0.2f, 0.2f}});
+        return desc;
+    };
+    std::printf("splatfx-bench cloudlight: %d sun positions over a day, %s cloud by default, error at up to %d points\n", steps, dimsText(dims).c_str(),
+                samples);
+    std::vector<bench::KnobRow> rows;
+    struct Case {
+        std::string knob, setting;
+        glm::ivec3 dims;
+        splatfx::CloudLightModel model;
+        bool isDefault;
+    };
+    std::vector<Case> cases = {
+        {"model", "Roettger (sec. 5.2)", dims, splatfx::CloudLightModel::Roettger, true},
+        {"model", "low albedo, 2 HG lobes", dims, splatfx::CloudLightModel::LowAlbedo, false},
+    };
+    for (glm::ivec3 d : {glm::ivec3(65, 65, 17), glm::ivec3(257, 257, 33)})
+        if (d != dims) cases.push_back({"dims", dimsText(d), d, splatfx::CloudLightModel::Roettger, false});
+    for (const Case& c : cases) {
+        Measure m;
+        std::printf("  %s %s ...\n", c.knob.c_str(), c.setting.c_str());
+        std::fflush(stdout);
+        if (!measure(base(c.dims, c.model), steps, samples, m)) return 1;
+        rows.push_back({.knob = c.knob,
+                        .setting = c.setting,
+                        .ms = m.relightMs,
+                        .rmse = m.rmse,
+                        .maxErr = m.maxErr,
+                        .extra = std::to_string(m.relights) + " | " + dimsText(c.dims),
+                        .isDefault = c.isDefault});
+    }
+    // The light unchanged: the relight skipped (counter unchanged); and the
+    // low-albedo model's new sun colour: the transfer table rebuilt, no sweep.
+    {
+        auto cloud = splatfx::Cloud::create(base(dims, splatfx::CloudLightModel::LowAlbedo));
+        if (!cloud) return std::fprintf(stderr, "cloudlight: %s\n", cloud.error().c_str()), 1;
+        std::vector<double> same, colour;
+        for (int s = 0; s < steps; ++s) {
+            splatfx::CloudLighting L = cloud->lighting();
+            auto t0 = Clock::now();
+            if (!cloud->setLight(L)) return 1;
+            same.push_back(ms(Clock::now() - t0));
+            L.sun.color = glm::vec3(1.0f, 0.6f + 0.4f * float(s % 2), 0.4f + 0.6f * float(s % 2));
+            t0 = Clock::now();
+            if (!cloud->setLight(L)) return 1;
+            colour.push_back(ms(Clock::now() - t0));
+        }
+        double r = 0.0, m = 0.0;
+        transmittanceError(*cloud, base(dims, splatfx::CloudLightModel::LowAlbedo), samples, r, m);
+        rows.push_back({.knob = "change", .setting = "none (skipped)", .ms = bench::percentile(same, 0.5), .rmse = r, .maxErr = m,
+                        .extra = std::to_string(cloud->relights()) + " | " + dimsText(dims)});
+        rows.push_back({.knob = "change", .setting = "sun colour (low-albedo table)", .ms = bench::percentile(colour, 0.5), .rmse = r, .maxErr = m,
+                        .extra = std::to_string(cloud->tableBuilds()) + " table builds | " + dimsText(dims)});
+    }
+    bench::markPareto(rows);
+    bench::printTable(rows, "CPU ms per relight (median)", "relights | cloud");
+    std::printf("\nRMSE / max error: swept sun transmittance against the exact one through the finest mesh (worst of three suns).\n");
+    if (noPlots) return 0;
+    std::error_code ec;
+    std::filesystem::create_directories(out, ec);
+    return bench::writePlot(rows, out, "cloudlight", "cloud relight: CPU ms per relight vs sun transmittance error", "CPU ms per relight") ? 0 : 1;
+}
