@@ -255,7 +255,7 @@ void Scene::shadeScene(Frame& frame) {
     // rebuilt when the light gets a slot again.
     for (std::size_t li = 0; li < mLightShadows.size(); ++li)
         if (std::find(chosen.begin(), chosen.end(), li) == chosen.end() && mLightShadows[li].table.builds() > 0) {
-            mLightShadows[li] = LightShadow{};
+            mLightShadows[li] = LightShadow{ShadowTable{}, {}};
             forgetSlotsOf(li);
         }
 
