@@ -1,14 +1,17 @@
 // Sample scenes, headless (GL): every sample loads and renders a frame that is
 // not empty, and geometry is depth-correct against the splats (Fig. 3: the
-// cow in front of the fire hides it, the fire in front of the cow veils it).
+// cow in front of the fire hides it, the fire in front of the cow veils it),
+// and lit by a fire that emits light by what the CPU predicts.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <span>
 
 #include <gtest/gtest.h>
 
 #include "gl_fixture.hpp"
 #include "scene_player.hpp"
+#include "splatfx/emitted_light.hpp"
 #include "splatfx/gl/framebuffer.hpp"
 
 namespace {
@@ -193,4 +196,80 @@ TEST_F(SamplesGL, ALightingFailureIsThePlayersProblemNotASilentlyUnlitFrame) {
     ASSERT_TRUE(player->advance(1.1, player->cameraAt(1.1, {64, 48})));
     EXPECT_NE(player->problem().find("effect 'lit': lighting.tableDims: "), std::string::npos) << player->problem();
     EXPECT_NE(player->problem().find("over ShadowTableDesc.memoryBudgetBytes"), std::string::npos) << player->problem();
+}
+
+namespace {
+
+// A ground plane beside a small fire that emits light (or not), seen from
+// above and in front, so the ground nearest the camera is clear of splats.
+// The one light has zero intensity: the ground is its albedo times the host's
+// ambient 0.25 (geometry_renderer.cpp) plus, with emitsLight, albedo x E / pi.
+// Scale 20 (as the samples' 12: the flame's radiance above display white)
+// lifts the light on the ground well above the 8-bit step.
+std::string emittingFireScene(bool emits) {
+    return std::string(R"({"format": "splatfx-scene", "version": 1, "output": {"background": [0, 0, 0]},
+      "camera": {"position": [0, 5, 7], "target": [0, 0, 1.5], "fovDeg": 40},
+      "geometry": [{"name": "ground", "type": "plane", "size": [40, 1, 40], "color": [0.3, 0.3, 0.3]}],
+      "lights": [{"type": "directional", "intensity": 0}],
+      "effects": [{"kind": "fire", "dims": [7, 20, 5], "spacing": 0.2, "emitsLight": {"enabled": )") +
+           (emits ? "true" : "false") + R"(, "lights": 2, "scale": 20}}]})";
+}
+
+} // namespace
+
+// Issue 27 item 3, the host side: the scene host's surface shader adds the
+// fire's light (splatfx_emittedIrradiance, albedo x E / pi). Each ground pixel
+// clear of the fire is brighter with emitsLight on by exactly what the CPU's
+// emittedIrradiance gives the lights the frame passed, at the point the
+// pixel's centre sees on the ground (normal +y).
+TEST_F(SamplesGL, FireLightBrightensTheGroundByTheIrradianceTheCpuPredicts) {
+    const double t = 1.0;
+    const glm::ivec2 size{64, 48};
+    auto on = scenehost::ScenePlayer::fromText(emittingFireScene(true), "fire-light-test.json");
+    auto off = scenehost::ScenePlayer::fromText(emittingFireScene(false), "fire-light-test.json");
+    ASSERT_TRUE(on.ok()) << on.error();
+    ASSERT_TRUE(off.ok()) << off.error();
+    const splatfx::Image lit = render(*on, {t}, size);
+    const splatfx::Image dark = render(*off, {t}, size);
+    const std::span<const splatfx::EmittedLight> lights = on->file().scene.emittedLights();
+    ASSERT_EQ(lights.size(), 2u);
+    EXPECT_TRUE(off->file().scene.emittedLights().empty());
+
+    const float albedo = 0.3f, ambient = 0.25f; // the scene's ground colour; the host's ambient share
+    const splatfx::Camera camera = on->cameraAt(t, size);
+    const glm::dmat4 clipToWorld = glm::inverse(glm::dmat4(camera.proj) * glm::dmat4(camera.view));
+    const glm::dvec3 eye(camera.eye());
+    // The fire's splats reach z = 0.5 + their radius (well under 1.5); only
+    // ground points in front of z = 2 are compared, so no splat covers them.
+    std::size_t compared = 0;
+    double worst = 0.0, largest = 0.0;
+    for (int y = 0; y < size.y; ++y)
+        for (int x = 0; x < size.x; ++x) {
+            // Framebuffer::read gives the top row first; GL's window y grows upwards.
+            const glm::dvec2 ndc{2.0 * (x + 0.5) / size.x - 1.0, 1.0 - 2.0 * (y + 0.5) / size.y};
+            const glm::dvec4 far = clipToWorld * glm::dvec4(ndc, 1.0, 1.0);
+            const glm::dvec3 dir = glm::dvec3(far) / far.w - eye;
+            if (dir.y >= 0.0) continue;
+            const glm::dvec3 p = eye + dir * (-eye.y / dir.y); // on the ground, y = 0
+            if (p.z < 2.0 || std::fabs(p.x) > 6.0) continue;
+            const glm::vec3 e = splatfx::emittedIrradiance(lights, glm::vec3(p), glm::vec3(0, 1, 0));
+            for (int c = 0; c < 3; ++c) {
+                const double base = albedo * ambient, expected = albedo * double(e[c]) / 3.14159265358979;
+                if (base + expected > 254.0 / 255.0) continue; // clamped by the 8-bit target
+                // Each image holds its value rounded to 8 bits (half a step each way), so the
+                // difference is within one step of albedo x E / pi; the shader's float
+                // arithmetic adds ~1e-6 on values below 1.
+                const double step = 1.0 / 255.0 + 1e-5;
+                ASSERT_NEAR(dark.at(x, y, c), base, step / 2) << "pixel " << x << "," << y << " is not bare ground";
+                const double diff = double(lit.at(x, y, c)) - double(dark.at(x, y, c));
+                worst = std::max(worst, std::fabs(diff - expected));
+                largest = std::max(largest, expected);
+                EXPECT_NEAR(diff, expected, step) << "pixel " << x << "," << y << " channel " << c;
+                ++compared;
+            }
+        }
+    EXPECT_GT(compared, 300u);
+    // The fire's light is well above the 8-bit step where the ground is nearest the fire.
+    EXPECT_GT(largest, 20.0 / 255.0);
+    std::printf("fire light on the ground: %zu channel values, largest albedo x E / pi %.4f, worst error %.5f\n", compared, largest, worst);
 }
