@@ -9,12 +9,15 @@
 #include <cstdlib>
 #include <cstring>
 #include <optional>
+#include <string>
+#include <utility>
 
 #include <epoxy/gl.h>
 
 #include <Ogre.h>
 
 #include "splatfx/gl/frame_renderer.hpp"
+#include "splatfx/lighting.hpp"
 #include "splatfx/materials.hpp"
 #include "splatfx/presets.hpp"
 #include "splatfx/scene.hpp"
@@ -51,9 +54,12 @@ void main() {
     vWorld = (world * vertex).xyz;
 }
 )";
-// Lambert from a low sun plus the fire's warm light (1 / (1 + d^2) falloff),
-// and a checker on surfaces that ask for it (the ground).
-const char* kFragmentShader = R"(#version 330 core
+// Lambert from a low sun plus the fire's own light: splatfx's emitted lights
+// (splatfx_emittedIrradiance from shadowGlsl(), set each frame from
+// Frame::emittedLights() as OGRE parameters), a Lambertian surface
+// reflecting albedo x E / pi; and a checker on surfaces that ask for it (the
+// ground). Compiled after "#version 330 core" and splatfx::shadowGlsl().
+const char* kFragmentShader = R"(
 in vec3 vNormal;
 in vec3 vWorld;
 uniform vec3 albedo;
@@ -62,15 +68,28 @@ out vec4 fragColour;
 void main() {
     vec3 n = normalize(vNormal);
     vec3 sun = normalize(vec3(-0.4, 0.8, 0.45));
-    vec3 toFire = vec3(0.0, 1.5, 0.0) - vWorld;
-    float d2 = dot(toFire, toFire);
-    vec3 fireLight = vec3(1.0, 0.55, 0.2) * 6.0 * max(dot(n, normalize(toFire)), 0.0) / (1.0 + d2);
+    vec3 fireLight = splatfx_emittedIrradiance(vWorld, n) * 0.31830989;
     vec3 light = vec3(0.10, 0.11, 0.16) + vec3(0.35, 0.35, 0.42) * max(dot(n, sun), 0.0) + fireLight;
     float c = 1.0;
     if (checker > 0.0) c = (mod(floor(vWorld.x) + floor(vWorld.z), 2.0) < 1.0) ? 1.0 : 0.7;
     fragColour = vec4(albedo * c * light, 1.0);
 }
 )";
+
+// OGRE 1.12 learns a uniform array's size from the GLSL text and reads only
+// a literal there: an array sized by a named constant gets size 0 and its
+// parameters cannot be set. The include's two such sizes, spelled out.
+std::string ogreReadable(std::string glsl) {
+    for (const auto& [name, n] : {std::pair<std::string, int>{"splatfx_kMaxEmittedLights]", splatfx::kMaxEmittedLights},
+                                  std::pair<std::string, int>{"splatfx_kMaxShadowLights]", splatfx::kMaxShadowLights}}) {
+        std::string literal = std::to_string(n);
+        literal += ']';
+        for (std::size_t at = glsl.find(name); at != std::string::npos; at = glsl.find(name, at))
+            if (at > 0 && glsl[at - 1] == '[') glsl.replace(at, name.size(), literal);
+            else at += name.size();
+    }
+    return glsl;
+}
 
 // OGRE's matrices act on column vectors, as GL's and glm's do, but are
 // stored by rows: m[row][col], where glm is g[col][row].
@@ -105,6 +124,8 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
     Ogre::RenderTexture* target = nullptr;
     Ogre::Viewport* viewport = nullptr;
     Ogre::SceneNode* logNode = nullptr;
+    // The fragment parameters of the three materials: the fire's lights go there each frame.
+    std::vector<Ogre::GpuProgramParametersSharedPtr> surfaceParams;
 
     // splatfx.
     splatfx::Materials materials{splatfx::Footprint{}};
@@ -123,6 +144,34 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
     FrameOptions frameOptions;
     HookInfo info;
     std::string hookError;
+
+    // The frame's emitted lights (Frame::emittedLights) into shadowGlsl()'s
+    // uniforms on every surface material: what gl::setShadowUniforms does for
+    // a GL program, through OGRE's parameters (OGRE uploads its own copy of
+    // every uniform it knows, so glProgramUniform would be overwritten).
+    void setFireLight() {
+        constexpr int kMax = splatfx::kMaxEmittedLights;
+        const std::vector<splatfx::EmittedLight>& lights = frame.emittedLights();
+        const int count = int(std::min<std::size_t>(lights.size(), std::size_t(kMax)));
+        float position[4 * kMax] = {}, intensity[3 * kMax] = {}, plus[3 * kMax] = {}, minus[3 * kMax] = {};
+        for (int i = 0; i < count; ++i) {
+            const splatfx::EmittedLight& l = lights[std::size_t(i)];
+            for (int c = 0; c < 3; ++c) {
+                position[4 * i + c] = l.position[c];
+                intensity[3 * i + c] = l.intensity[c];
+                plus[3 * i + c] = l.escapePlus[c];
+                minus[3 * i + c] = l.escapeMinus[c];
+            }
+            position[4 * i + 3] = l.radius;
+        }
+        for (const Ogre::GpuProgramParametersSharedPtr& fp : surfaceParams) {
+            fp->setNamedConstant("splatfx_emittedLightCount", count);
+            fp->setNamedConstant("splatfx_emittedLightPosition", position, kMax, 4);
+            fp->setNamedConstant("splatfx_emittedLightIntensity", intensity, kMax, 3);
+            fp->setNamedConstant("splatfx_emittedLightEscapePlus", plus, kMax, 3);
+            fp->setNamedConstant("splatfx_emittedLightEscapeMinus", minus, kMax, 3);
+        }
+    }
 
     ~Impl() override {
         if (depthCopyFbo) glDeleteFramebuffers(1, &depthCopyFbo);
@@ -242,14 +291,10 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
         // 2. OGRE's depth as a texture (a copy: see depthTextureFor).
         const GLuint depth = depthTextureFor(GLuint(fbo), desc.width, desc.height);
         if (!depth && !hookError.empty()) return;
-        // 3. OGRE's camera, converted (flip included).
+        // 3. OGRE's camera, converted (flip included): the one render() prepared the frame with.
         drawnCamera = convert();
         info.flipped = target->requiresTextureFlipping();
         if (!frameOptions.fire) return; // the depth copy is still made: tests compare frames with and without
-        if (auto s = scene.prepare(frameOptions.timeSec, drawnCamera, materials, frame); !s) {
-            std::fprintf(stderr, "ogre_campfire: %s\n", s.error().c_str());
-            return;
-        }
         // 4. Draw. OGRE drew its opaque geometry itself: no drawOpaque hook.
         // The viewport origin is OGRE's (GL's lower left).
         // An sRGB target blends in linear only with GL_FRAMEBUFFER_SRGB on (OGRE
@@ -319,7 +364,7 @@ splatfx::Result<std::unique_ptr<OgreCampfire>> OgreCampfire::create(const OgreCa
         auto vs = programs.createProgram("splatfx/lambert.vert", group, "glsl", Ogre::GPT_VERTEX_PROGRAM);
         vs->setSource(kVertexShader);
         auto fs = programs.createProgram("splatfx/lambert.frag", group, "glsl", Ogre::GPT_FRAGMENT_PROGRAM);
-        fs->setSource(kFragmentShader);
+        fs->setSource("#version 330 core\n" + ogreReadable(splatfx::shadowGlsl()) + kFragmentShader);
         vs->load();
         fs->load();
         if (vs->hasCompileError() || fs->hasCompileError()) return makeError("OGRE could not compile the sample's GLSL materials");
@@ -334,6 +379,7 @@ splatfx::Result<std::unique_ptr<OgreCampfire>> OgreCampfire::create(const OgreCa
             auto fp = pass->getFragmentProgramParameters();
             fp->setNamedConstant("albedo", albedo);
             fp->setNamedConstant("checker", checker);
+            s.surfaceParams.push_back(fp);
             m->load();
             return m;
         };
@@ -391,7 +437,17 @@ splatfx::Result<std::unique_ptr<OgreCampfire>> OgreCampfire::create(const OgreCa
                                                      .crossfade = true,
                                                      .seed = desc.seed});
     if (!fire) return makeError(fire.error());
-    s.scene.add(std::move(*fire), {.name = "campfire"});
+    // The fire lights OGRE's ground, log and wall: two point lights fitted to its
+    // splats each frame (emitted_light.hpp), at 6x the splats' own emission (a
+    // flame is far brighter than the display white its colour table stops at;
+    // docs/samples.md, 03: the scene-file samples take 12; this wall stands
+    // nearer a larger fire, which at 12 lit it to white).
+    splatfx::EffectOptions fireOptions;
+    fireOptions.name = "campfire";
+    fireOptions.emitsLight.enabled = true;
+    fireOptions.emitsLight.lights = 2;
+    fireOptions.emitsLight.scale = 6.0f;
+    s.scene.add(std::move(*fire), std::move(fireOptions));
     splatfx::gl::FrameRendererDesc frd;
     frd.resolutionScale = desc.resolutionScale;
     frd.splats.restoreState = desc.restoreState;
@@ -409,6 +465,12 @@ splatfx::Status OgreCampfire::render(const FrameOptions& options) {
     s.info.calls = 0;
     s.info.splats = 0;
     s.hookError.clear();
+    // The frame is prepared before OGRE draws: its emitted lights light OGRE's
+    // surfaces, which OGRE draws before the hook (with options.fire off too:
+    // only the splats are left out then).
+    s.drawnCamera = s.convert();
+    if (auto st = s.scene.prepare(options.timeSec, s.drawnCamera, s.materials, s.frame); !st) return st;
+    s.setFireLight();
     try {
         s.logNode->setVisible(options.log);
         if (!s.root->renderOneFrame()) return splatfx::makeError("OGRE's renderOneFrame asked to stop");

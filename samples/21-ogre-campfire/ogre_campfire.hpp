@@ -52,7 +52,7 @@ struct OgreCampfireDesc {
 
 struct FrameOptions {
     double timeSec = 1.0; // the fire's time; default 1
-    bool fire = true;     // draw splatfx in OGRE's frame; default true
+    bool fire = true;     // draw splatfx's splats in OGRE's frame (off: its light on OGRE's surfaces stays); default true
     bool log = true;      // OGRE draws the log in front of the fire; default true
 };
 
