@@ -149,10 +149,10 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
     // uniforms on every surface material: what gl::setShadowUniforms does for
     // a GL program, through OGRE's parameters (OGRE uploads its own copy of
     // every uniform it knows, so glProgramUniform would be overwritten).
-    void setFireLight() {
+    void setFireLight(bool on) {
         constexpr int kMax = splatfx::kMaxEmittedLights;
         const std::vector<splatfx::EmittedLight>& lights = frame.emittedLights();
-        const int count = int(std::min<std::size_t>(lights.size(), std::size_t(kMax)));
+        const int count = on ? int(std::min<std::size_t>(lights.size(), std::size_t(kMax))) : 0;
         float position[4 * kMax] = {}, intensity[3 * kMax] = {}, plus[3 * kMax] = {}, minus[3 * kMax] = {};
         for (int i = 0; i < count; ++i) {
             const splatfx::EmittedLight& l = lights[std::size_t(i)];
@@ -470,7 +470,7 @@ splatfx::Status OgreCampfire::render(const FrameOptions& options) {
     // only the splats are left out then).
     s.drawnCamera = s.convert();
     if (auto st = s.scene.prepare(options.timeSec, s.drawnCamera, s.materials, s.frame); !st) return st;
-    s.setFireLight();
+    s.setFireLight(options.fireLight);
     try {
         s.logNode->setVisible(options.log);
         if (!s.root->renderOneFrame()) return splatfx::makeError("OGRE's renderOneFrame asked to stop");

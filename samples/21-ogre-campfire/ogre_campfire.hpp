@@ -4,9 +4,9 @@
 //
 // What it is: a small OGRE application (its Root, a hidden window for the GL
 // context, a scene manager with a ground, a log in front of the fire and a
-// wall behind it, drawn with GLSL materials made in code) whose main render
-// queue ends with splatfx's gl::FrameRenderer drawing the campfire into the
-// framebuffer OGRE has bound. It shows what an engine hands over (its
+// wall behind it, drawn with GLSL materials made in code, lit by the fire's
+// emitted lights) whose main render queue ends with splatfx's
+// gl::FrameRenderer drawing the campfire into the framebuffer OGRE has bound. It shows what an engine hands over (its
 // framebuffer name, its depth as a texture, its camera) and what state has
 // to survive (docs/integration.md, "Inside an engine").
 // What it does not do: load OGRE's sample media (Debian ships none), use
@@ -54,6 +54,7 @@ struct FrameOptions {
     double timeSec = 1.0; // the fire's time; default 1
     bool fire = true;     // draw splatfx's splats in OGRE's frame (off: its light on OGRE's surfaces stays); default true
     bool log = true;      // OGRE draws the log in front of the fire; default true
+    bool fireLight = true; // the fire's emitted lights on OGRE's surfaces; off: none (the test's comparison); default true
 };
 
 // What the render-queue hook saw in the last frame (for the docs and tests).

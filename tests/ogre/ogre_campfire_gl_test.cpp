@@ -17,6 +17,7 @@
 
 #include "gl_fixture.hpp"
 #include "ogre_campfire.hpp"
+#include "splatfx/emitted_light.hpp"
 #include "splatfx/image_io.hpp"
 
 namespace {
@@ -133,6 +134,60 @@ TEST_F(OgreCampfireTest, OgresDepthMatchesTheConvertedCameraOnTheGround) {
     // one centimetre at 10 m distance already moves depth by ~1e-5 here.
     EXPECT_LT(worst, 1.0e-6) << "over " << checked << " ground pixels";
     std::printf("ground pixels %d, worst depth error %.3g\n", checked, worst);
+}
+
+// The fire lights OGRE's ground (issue 27, item 3): OGRE's material includes
+// shadowGlsl() and adds albedo x splatfx_emittedIrradiance / pi, its uniforms
+// set as OGRE parameters. Frames without the splats (fire off, so nothing
+// covers the ground), with and without the fire's light: every ground pixel in
+// front of the log differs by what the CPU's emittedIrradiance gives the
+// frame's lights at that pixel's ground point. A wrong array layout in OGRE's
+// parameters (or size 0, as OGRE reads named sizes) would miss by far more.
+TEST_F(OgreCampfireTest, TheFireLightsOgresGroundAsTheCpuPredicts) {
+    const Shot dark = shot({.timeSec = kTime, .fire = false, .log = true, .fireLight = false});
+    const Shot lit = shot({.timeSec = kTime, .fire = false, .log = true, .fireLight = true});
+    ASSERT_FALSE(dark.rgba.empty() || lit.rgba.empty());
+    const std::vector<splatfx::EmittedLight>& lights = sApp->frame().emittedLights();
+    ASSERT_EQ(lights.size(), 2u);
+    const glm::dvec3 albedo(0.45, 0.42, 0.36); // the ground's material (ogre_campfire.cpp)
+    const splatfx::Camera cam = sApp->camera();
+    const glm::dmat4 inv = glm::inverse(glm::dmat4(cam.proj) * glm::dmat4(cam.view));
+    int checked = 0;
+    double worst = 0.0, largest = 0.0;
+    for (int r = 0; r < kH; ++r)
+        for (int x = 0; x < kW; ++x) {
+            const int y = glRow(r);
+            const glm::dvec2 ndc(2.0 * (x + 0.5) / kW - 1.0, 2.0 * (y + 0.5) / kH - 1.0);
+            glm::dvec4 a = inv * glm::dvec4(ndc, -1.0, 1.0), b = inv * glm::dvec4(ndc, 1.0, 1.0);
+            const glm::dvec3 p0 = glm::dvec3(a) / a.w, p1 = glm::dvec3(b) / b.w;
+            if (p1.y >= p0.y) continue;
+            const double t = p0.y / (p0.y - p1.y);
+            if (t <= 0.0 || t >= 1.0) continue;
+            const glm::dvec3 hit = p0 + t * (p1 - p0);
+            if (hit.z < 3.2 || std::abs(hit.x) > 29.0 || hit.z > 29.0) continue; // in front of the log, on the plane
+            // The shader's checker: 1 or 0.7 by floor(x) + floor(z); pixels within 1 mm of a
+            // square's edge are left out (the interpolated position may fall either side).
+            const double fx = hit.x - std::floor(hit.x), fz = hit.z - std::floor(hit.z);
+            if (std::min({fx, 1.0 - fx, fz, 1.0 - fz}) < 1e-3) continue;
+            const double checker = (long(std::floor(hit.x)) + long(std::floor(hit.z))) % 2 == 0 ? 1.0 : 0.7;
+            const glm::vec3 e = splatfx::emittedIrradiance(lights, glm::vec3(hit), glm::vec3(0.0f, 1.0f, 0.0f));
+            const std::size_t p = std::size_t(r) * kW + x;
+            for (int c = 0; c < 3; ++c) {
+                const double expected = albedo[c] * checker * double(e[c]) / 3.14159265358979;
+                const double before = dark.rgba[p * 4 + c] / 255.0;
+                if (before + expected > 254.0 / 255.0) continue; // clamped by the 8-bit target
+                // Each frame is rounded to 8 bits (half a step each way): the difference is
+                // within one step, plus the shader's float arithmetic (~1e-6 below 1).
+                const double diff = (int(lit.rgba[p * 4 + c]) - int(dark.rgba[p * 4 + c])) / 255.0;
+                worst = std::max(worst, std::abs(diff - expected));
+                largest = std::max(largest, expected);
+                ++checked;
+            }
+        }
+    ASSERT_GT(checked, kW * 10) << "the ground in front of the log should fill the bottom rows";
+    EXPECT_LE(worst, 1.0 / 255.0 + 1e-5) << "over " << checked << " ground channel values";
+    EXPECT_GT(largest, 10.0 / 255.0) << "the fire's light should be well above one 8-bit step";
+    std::printf("fire light on OGRE's ground: %d channel values, largest %.4f, worst error %.5f\n", checked, largest, worst);
 }
 
 // A: log, no fire; B: log and fire; C: no log, no fire; D: fire, no log.
