@@ -206,12 +206,15 @@ namespace {
 // ambient 0.25 (geometry_renderer.cpp) plus, with emitsLight, albedo x E / pi.
 // Scale 20 (as the samples' 12: the flame's radiance above display white)
 // lifts the light on the ground well above the 8-bit step.
-std::string emittingFireScene(bool emits) {
+// With `glass`, a flat pane of opacity 0.5 lies 0.5 above the ground in front of the fire.
+std::string emittingFireScene(bool emits, bool glass = false) {
     return std::string(R"({"format": "splatfx-scene", "version": 1, "output": {"background": [0, 0, 0]},
       "camera": {"position": [0, 5, 7], "target": [0, 0, 1.5], "fovDeg": 40},
-      "geometry": [{"name": "ground", "type": "plane", "size": [40, 1, 40], "color": [0.3, 0.3, 0.3]}],
+      "geometry": [{"name": "ground", "type": "plane", "size": [40, 1, 40], "color": [0.3, 0.3, 0.3]})") +
+           (glass ? R"(, {"name": "pane", "type": "plane", "size": [3, 1, 1.6], "position": [0, 0.5, 3.2], "color": [0.6, 0.6, 0.6], "opacity": 0.5})" : "") +
+           R"(],
       "lights": [{"type": "directional", "intensity": 0}],
-      "effects": [{"kind": "fire", "dims": [7, 20, 5], "spacing": 0.2, "emitsLight": {"enabled": )") +
+      "effects": [{"kind": "fire", "dims": [7, 20, 5], "spacing": 0.2, "emitsLight": {"enabled": )" +
            (emits ? "true" : "false") + R"(, "lights": 2, "scale": 20}}]})";
 }
 
@@ -272,4 +275,61 @@ TEST_F(SamplesGL, FireLightBrightensTheGroundByTheIrradianceTheCpuPredicts) {
     // The fire's light is well above the 8-bit step where the ground is nearest the fire.
     EXPECT_GT(largest, 20.0 / 255.0);
     std::printf("fire light on the ground: %zu channel values, largest albedo x E / pi %.4f, worst error %.5f\n", compared, largest, worst);
+}
+
+// The same through glass (GeometryDesc::opacity < 1: drawn by the host into
+// the frame's fragment lists): a pane pixel is the pane's premultiplied colour
+// over the ground behind it, so with the fire's light it gains
+// a x albedo_pane x E(pane point) / pi + (1 - a) x albedo_ground x E(ground point) / pi.
+TEST_F(SamplesGL, FireLightBrightensGlassAndTheGroundSeenThroughIt) {
+    const double t = 1.0;
+    const glm::ivec2 size{64, 48};
+    auto on = scenehost::ScenePlayer::fromText(emittingFireScene(true, true), "fire-light-glass-test.json");
+    auto off = scenehost::ScenePlayer::fromText(emittingFireScene(false, true), "fire-light-glass-test.json");
+    ASSERT_TRUE(on.ok()) << on.error();
+    ASSERT_TRUE(off.ok()) << off.error();
+    const splatfx::Image lit = render(*on, {t}, size);
+    const splatfx::Image dark = render(*off, {t}, size);
+    const std::span<const splatfx::EmittedLight> lights = on->file().scene.emittedLights();
+    ASSERT_EQ(lights.size(), 2u);
+
+    const double a = 0.5, pane = 0.6, ground = 0.3, ambient = 0.25, pi = 3.14159265358979;
+    const splatfx::Camera camera = on->cameraAt(t, size);
+    const glm::dmat4 clipToWorld = glm::inverse(glm::dmat4(camera.proj) * glm::dmat4(camera.view));
+    const glm::dvec3 eye(camera.eye());
+    // Per image: the ground is rounded to 8 bits in the host's target (half a
+    // step), seen through the pane at (1 - a), the pane's fragment is stored
+    // as half floats (2^-11 relative: under 0.13 of a step below 1), and the
+    // composite is rounded again (half a step): 0.5 (1 - a) + 0.13 + 0.5 steps.
+    // The difference of two images: twice that.
+    const double perImage = (0.5 * (1.0 - a) + 0.13 + 0.5) / 255.0, step = 2.0 * perImage;
+    std::size_t compared = 0;
+    double worst = 0.0, largest = 0.0;
+    for (int y = 0; y < size.y; ++y)
+        for (int x = 0; x < size.x; ++x) {
+            const glm::dvec2 ndc{2.0 * (x + 0.5) / size.x - 1.0, 1.0 - 2.0 * (y + 0.5) / size.y};
+            const glm::dvec4 far = clipToWorld * glm::dvec4(ndc, 1.0, 1.0);
+            const glm::dvec3 dir = glm::dvec3(far) / far.w - eye;
+            if (dir.y >= 0.0) continue;
+            const glm::dvec3 q = eye + dir * ((0.5 - eye.y) / dir.y); // on the pane's plane, y = 0.5
+            const glm::dvec3 p = eye + dir * (-eye.y / dir.y);        // on the ground
+            // Well inside the pane (1.5 x 0.8 half-extents about (0, 3.2)): its edge pixels are partly ground.
+            if (std::fabs(q.x) > 1.4 || std::fabs(q.z - 3.2) > 0.7 || p.z < 2.0) continue;
+            const glm::vec3 eq = splatfx::emittedIrradiance(lights, glm::vec3(q), glm::vec3(0, 1, 0));
+            const glm::vec3 ep = splatfx::emittedIrradiance(lights, glm::vec3(p), glm::vec3(0, 1, 0));
+            for (int c = 0; c < 3; ++c) {
+                const double base = a * pane * ambient + (1.0 - a) * ground * ambient;
+                const double expected = (a * pane * double(eq[c]) + (1.0 - a) * ground * double(ep[c])) / pi;
+                if (base + expected > 254.0 / 255.0 || ground * (ambient + double(ep[c]) / pi) > 254.0 / 255.0) continue; // clamped
+                ASSERT_NEAR(dark.at(x, y, c), base, perImage) << "pixel " << x << "," << y << " is not the bare pane over the ground";
+                const double diff = double(lit.at(x, y, c)) - double(dark.at(x, y, c));
+                worst = std::max(worst, std::fabs(diff - expected));
+                largest = std::max(largest, expected);
+                EXPECT_NEAR(diff, expected, step) << "pixel " << x << "," << y << " channel " << c;
+                ++compared;
+            }
+        }
+    EXPECT_GT(compared, 100u);
+    EXPECT_GT(largest, 20.0 / 255.0);
+    std::printf("fire light through glass: %zu channel values, largest %.4f, worst error %.5f (bound %.5f)\n", compared, largest, worst, step);
 }

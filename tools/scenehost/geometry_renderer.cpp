@@ -136,6 +136,7 @@ out vec4 fragColor;
 void main() {
     vec3 n = twoSidedNormal(vNormal, vWorld, uEye);
     vec3 lit = uColor * (0.25 + 0.75 * hostDirect(n, vWorld, false));
+    lit += uColor * splatfx_emittedIrradiance(vWorld, n) * 0.31830989; // the fire's light, as on the opaque surfaces
     fragColor = splatfx_emitTransparent(vec4(lit * uOpacity, uOpacity), gl_FragCoord.z);
 }
 )";
@@ -226,8 +227,10 @@ splatfx::Result<GeometryRenderer> GeometryRenderer::create(const std::vector<spl
     if (!program) return splatfx::makeError(program.error());
     impl->program = *program;
     {
+        // Unshadowed (HOST_UNSHADOWED), but lit by the frame's fires: shadowGlsl() for
+        // splatfx_emittedIrradiance, whose uniforms drawTransparent sets.
         const std::string include = splatfx::transparentGlsl();
-        auto tp = splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n#define HOST_UNSHADOWED\n", include.c_str(), kHostNormal, kTransparentBody},
+        auto tp = splatfx::gl::linkProgram({kVertex}, {"#version 450 core\n#define HOST_UNSHADOWED\n", shadow.c_str(), include.c_str(), kHostNormal, kTransparentBody},
                                            "GeometryRenderer (transparent)");
         if (!tp) return splatfx::makeError(tp.error());
         impl->transparentProgram = *tp;
@@ -408,6 +411,7 @@ void GeometryRenderer::drawTransparent(double t, const splatfx::Camera& camera, 
     glUniformMatrix4fv(glGetUniformLocation(p, "uViewProj"), 1, GL_FALSE, glm::value_ptr(viewProj));
     glUniform3fv(glGetUniformLocation(p, "uEye"), 1, glm::value_ptr(eye));
     setLightUniforms(p, lighting);
+    splatfx::gl::setShadowUniforms(p, lighting.shadow); // the emitted lights (its tables are not sampled here)
     const GLint model = glGetUniformLocation(p, "uModel"), color = glGetUniformLocation(p, "uColor"), opacity = glGetUniformLocation(p, "uOpacity");
     for (const Impl::Object& o : r.objects) {
         if (!o.vao || !(o.desc.opacity < 1.0f)) continue;
