@@ -5,7 +5,9 @@
 // ambient light, depth test and depth writes on), one vertex array per
 // object. Its surface shader includes the SDK's shadowGlsl(): with the
 // shadow binding of gl::FrameRenderer (GeometryLighting::shadow), smoke
-// darkens the ground and the objects under it. Drawn before the splats, its depth buffer is what makes the splats
+// darkens the ground and the objects under it, and the frame's fires
+// (EffectOptions::emitsLight) light them and the glass
+// (splatfx_emittedIrradiance, albedo x E / pi). Drawn before the splats, its depth buffer is what makes the splats
 // depth-correct (a cow inside the fire is partly hidden by it, and hides the
 // part behind it). Meshes are loaded once, by path, through mesh.hpp.
 // Not part of the SDK (it is the host's job to draw its own scene).
