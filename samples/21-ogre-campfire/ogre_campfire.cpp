@@ -386,6 +386,19 @@ splatfx::Result<std::unique_ptr<OgreCampfire>> OgreCampfire::create(const OgreCa
         auto ground = material("splatfx/ground", {0.45f, 0.42f, 0.36f}, 1.0f);
         auto wood = material("splatfx/log", {0.42f, 0.25f, 0.13f}, 0.0f);
         auto stone = material("splatfx/wall", {0.50f, 0.50f, 0.52f}, 0.0f);
+        // setFireLight writes whole arrays: had OGRE read an array's size wrongly
+        // (ogreReadable), the write would assert inside OGRE. Checked here, once.
+        for (const Ogre::GpuProgramParametersSharedPtr& fp : s.surfaceParams)
+            for (const auto& [name, floats] : {std::pair<const char*, std::size_t>{"splatfx_emittedLightPosition", 4},
+                                               {"splatfx_emittedLightIntensity", 3},
+                                               {"splatfx_emittedLightEscapePlus", 3},
+                                               {"splatfx_emittedLightEscapeMinus", 3}}) {
+                const Ogre::GpuConstantDefinition* d = fp->_findNamedConstantDefinition(name, false);
+                if (!d || d->elementSize * d->arraySize < floats * std::size_t(splatfx::kMaxEmittedLights))
+                    return makeError(std::string("OGRE did not take the fire-light uniform ") + name + "[" +
+                                     std::to_string(splatfx::kMaxEmittedLights) + "] of the sample's material" +
+                                     (d ? " (it reads " + std::to_string(d->arraySize) + " elements)" : ""));
+            }
 
         Ogre::SceneNode* rootNode = s.sceneManager->getRootSceneNode();
         Ogre::MeshManager::getSingleton().createPlane("splatfx/groundPlane", group, Ogre::Plane(Ogre::Vector3::UNIT_Y, 0.0f), 60.0f, 60.0f, 1, 1,
