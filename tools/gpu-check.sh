@@ -12,10 +12,19 @@
 #   tools/gpu-check.sh --run-only      # the GPU machine, in a copy of this checkout holding BUILD/bundle
 #   tools/gpu-check.sh                 # both, on one machine
 #
+# The bundle's binaries are stripped, and it is packed as BUILD/bundle.tar.xz
+# (xz -9) for the trip to the GPU machine. With --light it holds only the
+# binaries that need no library beyond the driver's, libepoxy, libstdc++ and
+# libgcc_s (most GL tests: a few MB packed); the others (splatfx-bench and the
+# tests that read or write images through OpenImageIO, whose Debian build
+# brings about 250 libraries, ffmpeg, GDAL, OpenCV, Qt 5 and OpenVDB among
+# them) are left out and their rows say so (docs/BENCHMARKS.md, "A GPU check").
+#
 # Options:
 #   --build-dir DIR     the build (default build-gpu); its bundle is DIR/bundle
 #   --tests A,B         only these GL test binaries (default: every one registered with LABEL gl)
 #   --benches A,B       only these benches (default: table1,fog,clouds,shadows,transparency)
+#   --light             bundle only what needs no library beyond libepoxy, libstdc++ and libgcc_s
 #   --quick             the benches' short settings (--quick / few frames): the script itself, not figures
 #   --allow-software    without an NVIDIA device, run on whatever EGL gives (Mesa's llvmpipe), said
 #                       in the table's title: for testing this script on a machine without a GPU
@@ -35,6 +44,7 @@ mode="both"
 tests=""
 benches="table1,fog,clouds,shadows,transparency"
 quick=0
+light=0
 software=0
 budget=540
 jobs=2
@@ -48,6 +58,7 @@ while [[ $# -gt 0 ]]; do
     --tests) tests="${2:?--tests expects a comma-separated list}"; shift ;;
     --benches) benches="${2:?--benches expects a comma-separated list}"; shift ;;
     --quick) quick=1 ;;
+    --light) light=1 ;;
     --allow-software) software=1 ;;
     --budget) budget="${2:?--budget expects seconds}"; shift ;;
     --jobs) jobs="${2:?--jobs expects a number}"; shift ;;
@@ -94,14 +105,25 @@ bundle_step() {
   echo "gpu-check: building splatfx-bench, egl_probe and ${#test_list[@]} GL test binaries"
   cmake --build "$build" -j "$jobs" --target splatfx-bench egl_probe "${test_list[@]}" >"$build/gpu-check-build.log" 2>&1 ||
     { tail -30 "$build/gpu-check-build.log"; die "build failed (log: $build/gpu-check-build.log)"; }
-  rm -rf "$bundle"
+  rm -rf "$bundle" "$build/bundle.tar.xz"
   mkdir -p "$bundle/bin" "$bundle/lib"
-  local exe
+  local exe extra left_out=()
   for t in splatfx-bench egl_probe "${test_list[@]}"; do
     exe="$(find "$build" -path "$bundle" -prune -o -type f -name "$t" -perm -u+x -print | head -n 1)"
     [[ -n "$exe" ]] || die "built $t but cannot find it under $build"
+    if [[ $light -eq 1 ]]; then
+      # Every library it loads that the driver machine does not provide, less the light three.
+      extra="$(ldd "$exe" | awk '$2 == "=>" {print $1}' | grep -Ev "$provided" | grep -Ev '^(libepoxy\.so|libstdc\+\+\.so|libgcc_s\.so)' || true)"
+      if [[ -n "$extra" ]]; then left_out+=("$t"); continue; fi
+    fi
     cp "$exe" "$bundle/bin/"
   done
+  # Symbols are of no use on the GPU machine (a crash there is reported by its log).
+  strip --strip-unneeded "$bundle"/bin/*
+  if [[ ${#left_out[@]} -gt 0 ]]; then
+    echo "gpu-check: --light: left out (they need more libraries): ${left_out[*]}"
+    printf '%s\n' "${left_out[@]}" >"$bundle/left-out.txt"
+  fi
   # Every shared library the binaries load, found by ldd here, less the provided ones.
   local copied=0 lib name
   while read -r lib; do
@@ -112,10 +134,13 @@ bundle_step() {
   local missing
   missing="$(for f in "$bundle"/bin/*; do ldd "$f"; done | grep 'not found' | sort -u || true)"
   [[ -z "$missing" ]] || die "libraries not found while bundling:\n$missing"
-  if ! readelf -d "$bundle/bin/splatfx-bench" | grep -q 'RPATH.*\[\$ORIGIN/../lib\]'; then
-    die "splatfx-bench's RPATH is not exactly \$ORIGIN/../lib (readelf -d): the bundle would not find its libraries"
+  local rpath_of=splatfx-bench
+  [[ -e "$bundle/bin/$rpath_of" ]] || rpath_of=egl_probe
+  if ! readelf -d "$bundle/bin/$rpath_of" | grep -q 'RPATH.*\[\$ORIGIN/../lib\]'; then
+    die "$rpath_of's RPATH is not exactly \$ORIGIN/../lib (readelf -d): the bundle would not find its libraries"
   fi
-  echo "gpu-check: bundle $bundle: $(ls "$bundle/bin" | wc -l) binaries, $copied libraries, $(du -sh "$bundle" | cut -f1)"
+  XZ_OPT="-9 -T$jobs" tar -C "$build" -cJf "$build/bundle.tar.xz" bundle
+  echo "gpu-check: bundle $bundle: $(ls "$bundle/bin" | wc -l) binaries, $copied libraries, $(du -sh "$bundle" | cut -f1); packed $build/bundle.tar.xz: $(du -h "$build/bundle.tar.xz" | cut -f1)"
 }
 
 # ---- the run half: nothing here needs a Debian package beyond bash, coreutils and the driver ----
@@ -131,26 +156,30 @@ run_step() {
   mkdir -p "$logs" "$build/gpu-check-output"
   export SPLATFX_SOURCE_DIR="$repo" SPLATFX_TEST_OUTPUT_DIR="$build/gpu-check-output" SPLATFX_EGL_PROBE="$bundle/bin/egl_probe"
   local bench="$bundle/bin/splatfx-bench" device where
+  # The device table of splatfx-bench, or (a --light bundle) egl_probe's one line.
+  probe() { if [[ -x "$bench" ]]; then "$bench" device 2>&1; else "$bundle/bin/egl_probe" 2>&1; fi; }
   export SPLATFX_EGL_DEVICE=nvidia
-  if device="$("$bench" device 2>&1)"; then
+  if device="$(probe)"; then
     where="NVIDIA GPU through EGL's device platform (SPLATFX_EGL_DEVICE=nvidia)"
   else
-    echo "gpu-check: no NVIDIA device: ${device#device: }" >&2
+    device="${device#device: }"
+    echo "gpu-check: no NVIDIA device: ${device#error: }" >&2
     if [[ $software -eq 0 ]]; then
       echo "gpu-check: nothing run (pass --allow-software to test this script on Mesa's llvmpipe instead)" >&2
       exit 3
     fi
     unset SPLATFX_EGL_DEVICE
-    device="$("$bench" device 2>&1)" || die "no OpenGL 4.5 context at all: ${device#device: }"
+    device="$(probe)" || die "no OpenGL 4.5 context at all: ${device#device: }"
     where="NOT A GPU: --allow-software, EGL's default choice"
   fi
   local renderer
-  renderer="$(sed -n 's/^| GL_RENDERER | \(.*\) |$/\1/p' <<<"$device")"
+  renderer="$(sed -n -e 's/^| GL_RENDERER | \(.*\) |$/\1/p' -e 's/^ok: \(.*\) | vendor .*/\1/p' <<<"$device")"
   echo "$device" >"$logs/device.md"
 
   local t out rc s passed failed skipped limit
   for t in "${test_list[@]}"; do
     limit=$(left)
+    if [[ ! -x "$bundle/bin/$t" ]]; then row "test $t" "not bundled" "-" "needs libraries beyond a --light bundle's"; continue; fi
     if [[ $limit -le 5 ]]; then row "test $t" "not run" "-" "the ${budget} s budget is spent"; continue; fi
     [[ $limit -gt 240 ]] && limit=240
     s=$SECONDS
@@ -172,6 +201,7 @@ run_step() {
   local b args
   for b in "${bench_list[@]}"; do
     limit=$(left)
+    if [[ ! -x "$bench" ]]; then row "bench $b" "not bundled" "-" "splatfx-bench needs OpenImageIO's libraries: not in a --light bundle"; continue; fi
     if [[ $limit -le 5 ]]; then row "bench $b" "not run" "-" "the ${budget} s budget is spent"; continue; fi
     [[ $limit -gt 180 ]] && limit=180
     args=()

@@ -2,9 +2,10 @@
 //
 // A sample supplies setup (materials, grids) and a per-frame callback that
 // draws into the given target; SampleApp handles the command line
-// (--frames N --out DIR --size WxH --seed S, --reverse-z / --clip-01 / --infinite-far), the context (a GLFW window by
-// default, headless EGL when --frames is given), PNG frames, the animated
-// GIF, progress output and a summary. Public SDK API only.
+// (--frames N --out DIR --size WxH --seed S; the host's frame: --reverse-z / --clip-01 / --infinite-far,
+// --msaa N, --srgb, --hdr), the context (a GLFW window by default, headless EGL when --frames is
+// given), PNG frames (and EXR with --hdr), the animated GIF, progress output and a summary.
+// Public SDK API only.
 #pragma once
 
 #include <functional>
@@ -29,6 +30,12 @@ struct Options {
     // (the loop sets glClipControl and, reversed, a float depth buffer; the sample's camera and
     // clear follow FrameContext::depth).
     splatfx::DepthConvention depth{};
+    // --msaa N, --srgb, --hdr: the colour target the sample's host draws into (docs/integration.md,
+    // "what your engine does"): N-sample colour and depth, resolved for the PNG and the window;
+    // GL_SRGB8_ALPHA8 with GL_FRAMEBUFFER_SRGB on; RGBA16F, each frame also as a linear EXR.
+    int msaa = 0;
+    bool srgb = false;
+    bool hdr = false;
 };
 
 // Parses argv (samples/common/sample_options.hpp). Returns -1 when the sample
@@ -44,12 +51,15 @@ struct FrameContext {
     // (write at outputs->path(f), then outputs->add(f)); null when windowed.
     splatfx::OutputSet* outputs = nullptr;
     splatfx::DepthConvention depth{}; // Options::depth: build the camera with it, clear depth to depth.farWindow()
+    bool hdr = false;                 // Options::hdr: an RGBA16F target (a scene with lights: Scene::setHdrLit)
 };
 
 // Runs the loop. frame() draws one frame (the host part: clear, geometry, then
 // splats) and returns false to stop with an error it has printed.
-// Headless: writes DIR/<name>_NNNN.png and DIR/<name>.gif as one output set
-// (splatfx/output_set.hpp). Returns the process exit code.
+// Headless: writes DIR/<name>_NNNN.png (and, with --hdr, DIR/<name>_NNNN.exr)
+// and DIR/<name>.gif as one output set (splatfx/output_set.hpp). Windowed with
+// --msaa/--srgb/--hdr: the frame is drawn into a target of that kind and copied
+// to the window, as splatfx-viewer does. Returns the process exit code.
 int run(const Options& options, const char* name, const std::function<bool()>& setup, const std::function<bool(const FrameContext&)>& frame);
 
 } // namespace samples

@@ -9,14 +9,12 @@
 #  - --reverse-z against the default: the bound of render_depth_conventions.cmake
 #    (one step; two on at most 0.05 % of the pixels, where a carry meets a
 #    second rounding under a splat layer; never three: -hardfail 0.0081).
-#  - --msaa 4 against the default: each sample is the single-sampled frame at a
-#    point at most half a pixel from the pixel centre, so the mean |4x - 1x|
-#    must stay below the mean |1x shifted by one pixel - 1x| (as
-#    render_msaa_srgb.cmake), and no fallback note is printed.
-#  - --srgb against the default: the stored sRGB codes, converted to linear
-#    (oiiotool), must be nearer the default (linear) frame than as stored.
+#  - --msaa 4 and --srgb against the default: expect_msaa_srgb
+#    (host_targets.cmake: the one-pixel-shift bound, the sRGB codes), and no
+#    fallback note is printed.
 # Inputs: XVFB, VIEWER, RENDER, IDIFF, OIIOTOOL, PYTHON, SCENE, NAME (the scene's output.name), OUT.
 include(${CMAKE_CURRENT_LIST_DIR}/render_functions.cmake)
+include(${CMAKE_CURRENT_LIST_DIR}/host_targets.cmake)
 file(REMOVE_RECURSE ${OUT})
 file(MAKE_DIRECTORY ${OUT})
 set(common ${SCENE} --frames 1 --size 200x150 --quiet)
@@ -28,25 +26,6 @@ function(viewer dir)
                   RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
   if(NOT rc EQUAL 0 OR NOT EXISTS ${OUT}/${dir}/viewer.png)
     message(FATAL_ERROR "splatfx-viewer ${ARGN} failed (${rc}):\n${out}\n${err}")
-  endif()
-endfunction()
-function(within_steps a b bound what)
-  execute_process(COMMAND ${IDIFF} ${bound} ${a} ${b} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "${what} (idiff exit ${rc}):\n${out}\n${err}")
-  endif()
-endfunction()
-function(mean_error a b var)
-  execute_process(COMMAND ${IDIFF} -fail 0 -warn 0 ${a} ${b} OUTPUT_VARIABLE out ERROR_VARIABLE err) # the statistics are printed only for a difference
-  if(NOT out MATCHES "Mean error = ([0-9.e+-]+)")
-    message(FATAL_ERROR "idiff ${a} ${b} gave no mean error:\n${out}\n${err}")
-  endif()
-  set(${var} ${CMAKE_MATCH_1} PARENT_SCOPE)
-endfunction()
-function(expect_less lo hi what)
-  execute_process(COMMAND ${PYTHON} -c "import sys; sys.exit(0 if float('${lo}') < float('${hi}') else 1)" RESULT_VARIABLE less)
-  if(NOT less EQUAL 0)
-    message(FATAL_ERROR "${what}: ${lo} >= ${hi}")
   endif()
 endfunction()
 
@@ -68,15 +47,4 @@ endforeach()
 within_steps(${default} ${OUT}/reversez/viewer.png "-fail;0.004;-failpercent;0.05;-warn;0.004;-warnpercent;0.05;-hardfail;0.0081"
              "the viewer with --reverse-z differs from the default convention")
 
-execute_process(COMMAND ${OIIOTOOL} ${default} --cshift +1+0 -o ${OUT}/shifted.png RESULT_VARIABLE rc)
-execute_process(COMMAND ${OIIOTOOL} ${OUT}/srgb/viewer.png --colorconvert sRGB linear -o ${OUT}/srgb_linear.png RESULT_VARIABLE rc2)
-if(NOT rc EQUAL 0 OR NOT rc2 EQUAL 0)
-  message(FATAL_ERROR "oiiotool failed (${rc}, ${rc2})")
-endif()
-mean_error(${default} ${OUT}/msaa4/viewer.png msaa)
-mean_error(${default} ${OUT}/shifted.png shift)
-mean_error(${default} ${OUT}/srgb_linear.png srgb_linear)
-mean_error(${default} ${OUT}/srgb/viewer.png srgb_stored)
-message(STATUS "viewer: mean |4x - 1x| ${msaa}, |1x shifted one pixel - 1x| ${shift}; sRGB linearized ${srgb_linear}, as stored ${srgb_stored}")
-expect_less(${msaa} ${shift} "the viewer's --msaa 4 moves the image more than a one-pixel shift")
-expect_less(${srgb_linear} ${srgb_stored} "the viewer's --srgb does not show the sRGB codes")
+expect_msaa_srgb(${default} ${OUT}/msaa4/viewer.png ${OUT}/srgb/viewer.png viewer)

@@ -12,16 +12,20 @@
 # one channel may cross a rounding boundary and a later blend carry it to a
 # second step, as in render_depth_conventions.cmake: two steps allowed on at
 # most 0.05 % of the pixels (idiff -hardfail 0.0081), never three.
-# Inputs: XVFB, VIEWER, RENDER, IDIFF, SCENE, NAME (the scene's output.name), OUT, VIEWER_FLAGS (optional).
+# Inputs: XVFB, VIEWER, RENDER, IDIFF, SCENE, NAME (the scene's output.name), OUT, VIEWER_FLAGS (optional),
+# SIZE (optional, default 200x150).
+if(NOT SIZE)
+  set(SIZE 200x150)
+endif()
 file(REMOVE_RECURSE ${OUT})
 file(MAKE_DIRECTORY ${OUT})
-execute_process(COMMAND ${XVFB} -a -s "-screen 0 1280x720x24" ${VIEWER} ${SCENE} --size 200x150 --hide-ui --auto-quit-after 1 ${VIEWER_FLAGS}
+execute_process(COMMAND ${XVFB} -a -s "-screen 0 1280x720x24" ${VIEWER} ${SCENE} --size ${SIZE} --hide-ui --auto-quit-after 1 ${VIEWER_FLAGS}
                         --screenshot ${OUT}/viewer.png
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0 OR NOT EXISTS ${OUT}/viewer.png)
   message(FATAL_ERROR "viewer failed (${rc}):\n${out}\n${err}")
 endif()
-execute_process(COMMAND ${RENDER} ${SCENE} --frames 1 --size 200x150 --quiet --out ${OUT}/render
+execute_process(COMMAND ${RENDER} ${SCENE} --frames 1 --size ${SIZE} --quiet --out ${OUT}/render
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 0 OR NOT EXISTS ${OUT}/render/${NAME}_0000.png)
   message(FATAL_ERROR "splatfx-render failed (${rc}):\n${out}\n${err}")
