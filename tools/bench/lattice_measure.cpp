@@ -216,13 +216,38 @@ Score Accumulator::score(const Basis& basis) const {
                 if (!nearProbe) ring.push_back(pw);
             }
         if (ring.empty() || peakBins == 0) continue;
+        // The same direction at other periods: discs (radius scaled with the
+        // frequency) at 0.75 f and 4/3 f, leaving out every lattice frequency.
+        double alongLog = 0.0;
+        int alongDiscs = 0;
+        for (const double scale : {0.75, 4.0 / 3.0}) {
+            const glm::dvec2 g = scale * f;
+            const double rg = scale * r;
+            double sum = 0.0;
+            int bins = 0;
+            for (int j = 0; j < mFft.y; ++j)
+                for (int i = 0; i < mFft.x; ++i) {
+                    const glm::dvec2 k = binFrequency(i, j, mFft);
+                    if (glm::length(k - g) > rg && glm::length(k + g) > rg) continue;
+                    bool nearProbe = false;
+                    for (const Basis::Probe& o : probes) {
+                        const glm::dvec2 h(o.frequency);
+                        const double ro = 2.0 * discRadius(h);
+                        nearProbe = nearProbe || glm::length(k - h) <= ro || glm::length(k + h) <= ro;
+                    }
+                    if (!nearProbe) sum += mPower[std::size_t(j) * mFft.x + i], ++bins;
+                }
+            if (bins > 0 && sum > 0.0) alongLog += std::log(sum / bins), ++alongDiscs;
+        }
         double ringMean = 0.0;
         for (double v : ring) ringMean += v;
         ringMean /= double(ring.size());
         peak /= double(peakBins);
         ProbeScore ps{p, peak, ringMean, ringMean > 0.0 ? peak / ringMean : 0.0};
+        if (alongDiscs > 0) ps.along = std::exp(alongLog / alongDiscs), ps.peak = peak / ps.along;
         s.probes.push_back(ps);
         s.ratio = std::max(s.ratio, ps.ratio);
+        s.peak = std::max(s.peak, ps.peak);
         s.meanRatio += ps.ratio;
     }
     if (!s.probes.empty()) s.meanRatio /= double(s.probes.size());

@@ -12,7 +12,12 @@
 // power over the ring of the same radius (other periods of the same
 // frequency, away from every lattice frequency). A lattice-free image reads
 // about 1, give or take its bins' noise; the turbulence control below
-// calibrates what "no lattice" reads.
+// calibrates what "no lattice" reads. An anisotropic image (a flame's
+// upright tongues) also stands above its ring along its preferred direction,
+// at every period; the second ratio tells the two apart: the disc's power
+// over the same direction's at 0.75 and 4/3 of the frequency (geometric
+// mean, so any power law reads 1): a lattice is a peak in period, a texture's
+// direction is not.
 // Plain CPU code: no GL, testable on synthetic images (tests/tools/lattice_measure_test.cpp).
 // It does not render anything; splatfx-bench lattice feeds it frames.
 //
@@ -56,11 +61,13 @@ struct Basis {
 struct ProbeScore {
     Basis::Probe probe;
     double disc = 0.0, ring = 0.0, ratio = 0.0; // mean power in the disc, in the ring, their ratio
+    double along = 0.0, peak = 0.0; // the same direction's power at 0.75 and 4/3 of the frequency (geometric mean); disc / along
 };
 
 struct Score {
     double ratio = 0.0;    // largest probe ratio (the measure)
     double meanRatio = 0.0; // mean over the probes
+    double peak = 0.0;      // largest probe's disc / along (a peak in period, whatever the direction's level)
     std::vector<ProbeScore> probes;
     int frames = 0;
 };
