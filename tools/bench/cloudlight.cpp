@@ -6,20 +6,29 @@
 // transmittance against the exact one: the extinction integrated along the
 // ray to the sun through the finest tetrahedral mesh of the same density
 // (LodVolume::integrateRay, double), at sampled grid points with material.
+// The receive rows: a lit plume under the cloud in a Scene, its light traced
+// through the cloud's field (scene.hpp) or not; their error is the plume's
+// received transmittance (its splat colour) against the exact one through the
+// cloud (the lit reference, litFactor, with the cloud as a trilinear medium).
 // CPU only.
 #include <algorithm>
 #include <ctime>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
+
+#include <glm/gtc/matrix_transform.hpp>
 
 #include "bench_stats.hpp"
 #include "commands.hpp"
 #include "knob_table.hpp"
 #include "options.hpp"
 #include "splatfx/cloud.hpp"
+#include "splatfx/reference.hpp"
+#include "splatfx/scene.hpp"
 
 namespace {
 
@@ -108,6 +117,74 @@ bool measure(const splatfx::CloudCreateDesc& desc, int steps, int samples, Measu
     return true;
 }
 
+// A lit plume (12x12x26 voxels of 0.5, white, albedo 1, isotropic, no
+// self-shadow: its colour is the sun's transmittance through the cloud) under
+// the middle of the cloud, in a Scene with the cloud (lit, casting or not) or
+// without it. ms: CPU time of Scene::prepare (median over `frames`, the sun
+// fixed, so the cloud is not relit); error: the splats' colour against the
+// exact transmittance through the cloud.
+struct Receive {
+    double ms = 0.0, rmse = 0.0, maxErr = 0.0;
+    std::size_t splats = 0;
+};
+bool measureReceive(const splatfx::CloudCreateDesc& desc, int cloudMode /* 0 none, 1 not casting, 2 casting */, int frames, Receive& out) {
+    using namespace splatfx;
+    auto cloud = Cloud::create(desc);
+    if (!cloud) return std::fprintf(stderr, "cloudlight: %s\n", cloud.error().c_str()), false;
+    const glm::vec3 n(cloud->dims());
+    const glm::vec3 below = desc.volume.originWorld + glm::vec3(0.5f * (n.x - 1), 0.5f * (n.y - 1), -20.0f) * desc.volume.spacingWorld;
+    Materials materials{Footprint{}};
+    const std::uint32_t white = materials.addColorTable(ColorTable::constant(glm::vec4(1.0f)));
+    Grid g = *Grid::box({12, 12, 26}, glm::vec3(0.5f));
+    for (Voxel& v : g.voxels) v.opacity = 0.4f;
+    g.transform = glm::translate(glm::mat4(1.0f), below - g.localPosition({6, 6, 0}));
+    EffectDesc ed;
+    ed.name = "plume";
+    ed.layers = {EffectLayer{.style = {.colorTable = white, .textured = false}}};
+    auto plume = Effect::fromGrid(g, ed);
+    if (!plume) return std::fprintf(stderr, "cloudlight: %s\n", plume.error().c_str()), false;
+    Scene scene;
+    scene.setSceneShadow({.enabled = false});
+    const Light sun = desc.lighting.sun;
+    if (!scene.addLight(sun)) return false;
+    const EffectId pid = scene.add(std::move(*plume), {.name = "plume", .lighting = {.enabled = true, .gas = {.albedo = 1.0f}, .selfShadow = SelfShadow::Off}});
+    const Cloud copy = *cloud;
+    if (cloudMode > 0) scene.add(std::move(*cloud), {.name = "cloud", .lighting = {.enabled = true, .castsShadow = cloudMode == 2}});
+    // From the side and below: the plume and the cloud's underside in view.
+    const Camera camera = Camera::lookAt(below + glm::vec3(0.0f, -60.0f, 10.0f), below + glm::vec3(0.0f, 0.0f, 15.0f), {0, 0, 1}, glm::radians(60.0f),
+                                         {320, 240}, 0.1f, 2000.0f);
+    Frame frame;
+    std::vector<double> times;
+    for (int f = 0; f < frames; ++f) {
+        const auto t0 = Clock::now();
+        if (Status st = scene.prepare(0.0, camera, materials, frame); !st) return std::fprintf(stderr, "cloudlight: %s\n", st.error().c_str()), false;
+        times.push_back(ms(Clock::now() - t0));
+    }
+    if (!scene.status(pid).lit) return std::fprintf(stderr, "cloudlight: the plume was not lit\n"), false;
+    // The truth: the cloud's extinction at its grid points (thresholded), trilinear, as a medium.
+    auto voxels = std::make_shared<DenseVoxels>();
+    voxels->dims = copy.dims();
+    voxels->origin = glm::dvec3(desc.volume.originWorld);
+    voxels->voxelSize = desc.volume.spacingWorld;
+    voxels->values = copy.density();
+    for (float& v : voxels->values) v = v >= desc.transfer.threshold ? v : 0.0f;
+    VolumeField field(materials);
+    field.addMedium(denseMedium(voxels, DenseFilter::Trilinear, desc.transfer.maxExtinctionPerWorld));
+    const LitVolumeDesc lit{.lights = {sun}, .gas = {.albedo = 1.0f}};
+    double sum = 0.0, maxErr = 0.0;
+    for (const Splat& sp : frame.splats()) {
+        const double exact = litFactor(field, glm::dvec3(sp.center), glm::dvec3(camera.eye()), lit).x;
+        const double d = double(sp.color & 255u) / 255.0 - exact;
+        sum += d * d;
+        maxErr = std::max(maxErr, std::fabs(d));
+    }
+    out.splats = frame.splats().size();
+    out.rmse = out.splats ? std::sqrt(sum / double(out.splats)) : 0.0;
+    out.maxErr = maxErr;
+    out.ms = bench::percentile(times, 0.5);
+    return true;
+}
+
 std::string dimsText(glm::ivec3 d) { return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z); }
 
 } // namespace
@@ -117,11 +194,12 @@ int runCloudLight(int argc, char** argv) {
                  "rebuild; the swept sun transmittance against the exact one through the finest mesh.",
                  "splatfx-bench cloudlight"};
     glm::ivec3 dims{129, 129, 33};
-    int steps = 24, samples = 400;
+    int steps = 24, samples = 400, frames = 8;
     std::string out = "bench-cloudlight";
     bool noPlots = false;
     cli::addInts(app, "--dims", &dims.x, 3, 2, 4097, "grid points of the default cloud per axis", "X Y Z");
     cli::addNumber(app, "--steps", steps, 2, 10000, "sun positions over the day, one relight each (median reported)");
+    cli::addNumber(app, "--frames", frames, 1, 10000, "Scene::prepare calls per receive row (median reported)");
     cli::addNumber(app, "--samples", samples, 1, 1000000, "grid points with material checked against the exact transmittance");
     app.add_option("--out", out, "where cloudlight.dat, cloudlight.gp and the PNG plots go")->type_name("DIR")->capture_default_str();
     app.add_flag("--no-plots", noPlots, "print the table only");
@@ -185,9 +263,23 @@ int runCloudLight(int argc, char** argv) {
         rows.push_back({.knob = "change", .setting = "sun colour (low-albedo table)", .ms = bench::percentile(colour, 0.5), .rmse = r, .maxErr = m,
                         .extra = std::to_string(cloud->tableBuilds()) + " table builds | " + dimsText(dims)});
     }
+    // Receiving: the plume's lighting with the cloud's shadow traced, against
+    // no cloud and a cloud that does not cast (the receive cost is the difference).
+    {
+        const char* names[] = {"plume, no cloud", "plume + cloud, not casting", "plume + cloud, casting (traced)"};
+        for (int mode = 0; mode < 3; ++mode) {
+            std::printf("  receive %s ...\n", names[mode]);
+            std::fflush(stdout);
+            Receive r;
+            if (!measureReceive(base(dims, splatfx::CloudLightModel::Roettger), mode, frames, r)) return 1;
+            rows.push_back({.knob = "receive", .setting = names[mode], .ms = r.ms, .rmse = r.rmse, .maxErr = r.maxErr,
+                            .extra = std::to_string(r.splats) + " plume splats | " + (mode ? dimsText(dims) : std::string("none"))});
+        }
+    }
     bench::markPareto(rows);
-    bench::printTable(rows, "CPU ms per relight (median)", "relights | cloud");
-    std::printf("\nRMSE / max error: swept sun transmittance against the exact one through the finest mesh (worst of three suns).\n");
+    bench::printTable(rows, "CPU ms per relight or frame (median)", "relights | cloud");
+    std::printf("\nRMSE / max error: swept sun transmittance against the exact one through the finest mesh (worst of three suns);\n"
+                "receive rows: the plume's received transmittance (8-bit colour) against the exact one through the cloud.\n");
     if (noPlots) return 0;
     std::error_code ec;
     std::filesystem::create_directories(out, ec);

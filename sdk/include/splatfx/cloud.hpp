@@ -28,8 +28,9 @@
 //
 // It does NOT: draw (the tetrahedra go to the projected-tetrahedra pass), take
 // more than one light (the sun: a directional Light), or receive the shadows
-// of other volumes. It casts through densityField() (a Scene puts a lit
-// cloud's field into the scene shadow, scene.hpp).
+// of other volumes. It casts through densityField(): a Scene puts a lit
+// cloud's field into the scene shadow and traces the light of its lit
+// effects through it (scene.hpp).
 //
 //   auto cloud = splatfx::Cloud::create({.cloud = {.dims = {65, 65, 17}}});
 //   cloud->setLight(splatfx::Light::directional({-1, -0.2f, -0.3f}));  // relights once

@@ -295,8 +295,9 @@ public:
 
     explicit VolumeField(const Materials& materials);
 
-    // Adds a continuous medium beside the kernels (evaluate() and
-    // renderVolumeExact include it; lineOpticalDepth does not).
+    // Adds a continuous medium beside the kernels (evaluate(),
+    // renderVolumeExact, segmentOpticalDepth and opticalDepthToLight include
+    // it, so a lit field's light is shadowed by it; lineOpticalDepth does not).
     void addMedium(ContinuousMedium medium) { mMedia.push_back(std::move(medium)); }
     const std::vector<ContinuousMedium>& media() const { return mMedia; }
 
@@ -320,7 +321,9 @@ public:
     // `tolerance` (relative to the kernel's whole-line depth). Along a line
     // the Crawfis-Max kernel is a polynomial of degree 10 in the line
     // parameter, which 6 points integrate exactly, so it converges at once;
-    // the Gaussian kernel needs a few doublings.
+    // the Gaussian kernel needs a few doublings. Each medium: clipped to its
+    // box, cut at its breaks, each piece doubled until two results agree to
+    // `tolerance` in absolute optical depth (a trilinear medium at once).
     double segmentOpticalDepth(glm::dvec3 from, glm::dvec3 to, double tolerance = 1e-10) const;
     // From a world point to the light: to its position (point, spot), or out
     // of the field against the direction a directional light travels.

@@ -20,7 +20,9 @@
 // (EffectKind::lightingDensity: every Effect does; LOD volumes and ground fog
 // do not, their light is part of their data; a Cloud, cloud.hpp, follows the
 // scene's first directional light and is relit when it moves): their splat colours follow Ebert & Parent's low-albedo model with
-// self-shadowing, and prepare() puts their shadows on the scene, one per
+// self-shadowing, the light also attenuated through every lit, shadow-casting
+// cloud between them and it (a cloud's shadow on a plume; effects do not
+// shadow one another), and prepare() puts their shadows on the scene, one per
 // shadowing light, into Frame::shadows() (docs/lighting.md, "In a Scene"). And the scene's fog
 // (setFog), handed to every Frame without the terms the view cannot see
 // (FogCullDesc). Shadows are scheduled by light influence, not visibility: a
@@ -409,6 +411,8 @@ private:
     bool mUpdated = false;
     std::vector<Light> mLights;
     std::vector<EmittedLight> mEmittedLights;
+    // This emit's shadow-casting lit clouds' fields: each lit effect's light is attenuated through them.
+    std::vector<const DensityField*> mVolumeCasters;
     SplatBuilder mLightScratch{SplatBuilderDesc{.frustumCull = false}}; // an emitter's whole splats, fitted, never drawn
     SceneShadowDesc mSceneShadowDesc;
     bool mHdrLit = false;

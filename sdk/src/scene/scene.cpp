@@ -189,27 +189,34 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
         mLightingError = s.error();
         mTablesFit = false;
     }
-    for (Entry& e : mEntries) {
+    // Lit clouds first: each takes the scene's sun before it refines (relit
+    // only when it changed), and its extinction joins the scene's shadow
+    // casters (shadeScene reads e.lit->field; copied only when the density
+    // changed) and shadows the effects lit below (mVolumeCasters).
+    mVolumeCasters.clear();
+    std::vector<char> cloudLit(mEntries.size(), 0);
+    for (std::size_t i = 0; i < mEntries.size(); ++i) {
+        Entry& e = mEntries[i];
+        auto* cloud = dynamic_cast<detail::CloudKind*>(e.kind.get());
+        if (!cloud || !(e.status.needed || e.status.castsIntoView) || !e.options.lighting.enabled) continue;
+        Status s = e.status.needed ? cloud->follow(mLights, e.options.lighting) : Status{};
+        if (!s) {
+            mLightingError = "effect '" + e.options.name + "': lighting: " + s.error();
+            e.status.castsIntoView = false;
+            continue;
+        }
+        cloudLit[i] = e.status.needed;
+        if (!e.lit) e.lit = std::make_unique<LitState>();
+        const DensityField& f = cloud->cloud().densityField();
+        if (e.lit->field.empty() != f.empty() || e.lit->field.fingerprint() != f.fingerprint()) e.lit->field = f;
+        if (e.options.lighting.castsShadow && !e.lit->field.empty()) mVolumeCasters.push_back(&e.lit->field);
+    }
+    for (std::size_t i = 0; i < mEntries.size(); ++i) {
+        Entry& e = mEntries[i];
         const EmitOptions draw{.textured = e.options.draw.textured && options.textured,
                                .opacityScale = e.options.draw.opacityScale * options.opacityScale};
         const std::size_t first = builder.splats().size();
-        // A lit cloud takes the scene's sun before it refines (relit only when
-        // it changed), and its extinction joins the scene's shadow casters
-        // (shadeScene reads e.lit->field; copied only when the density changed).
-        bool cloudLit = false;
         auto* cloud = dynamic_cast<detail::CloudKind*>(e.kind.get());
-        if (cloud && (e.status.needed || e.status.castsIntoView) && e.options.lighting.enabled) {
-            Status s = e.status.needed ? cloud->follow(mLights, e.options.lighting) : Status{};
-            if (!s) {
-                mLightingError = "effect '" + e.options.name + "': lighting: " + s.error();
-                e.status.castsIntoView = false;
-            } else {
-                cloudLit = e.status.needed;
-                if (!e.lit) e.lit = std::make_unique<LitState>();
-                const DensityField& f = cloud->cloud().densityField();
-                if (e.lit->field.empty() != f.empty() || e.lit->field.fingerprint() != f.fingerprint()) e.lit->field = f;
-            }
-        }
         EmitResult r;
         if (e.status.needed)
             r = e.kind->emit(EmitContext{.splats = builder,
@@ -223,8 +230,8 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
         splats += r.splats;
         tetrahedra += r.tetrahedra;
         // Colour the splats just emitted; unlit effects skip this.
-        e.status.lit = cloudLit;
-        mCounters.litEffects += cloudLit ? 1 : 0;
+        e.status.lit = cloudLit[i] != 0;
+        mCounters.litEffects += cloudLit[i] != 0 ? 1 : 0;
         // Tables over the budget are never built: those effects stay unlit (the error says why).
         const bool tableLit = e.options.lighting.selfShadow == SelfShadow::Table;
         if (!cloud && e.status.needed && e.options.lighting.enabled && !mLights.empty() && (mTablesFit || !tableLit))

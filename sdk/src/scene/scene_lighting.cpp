@@ -30,6 +30,29 @@ std::uint32_t packLit(glm::vec3 c, float* scale) {
     return std::uint32_t(c.r * 255.0f + 0.5f) | std::uint32_t(c.g * 255.0f + 0.5f) << 8 | std::uint32_t(c.b * 255.0f + 0.5f) << 16 | 0xff000000u;
 }
 
+// An effect's own shadow (self-shadowing: traced, table or none) times the
+// transmittance through the other volumes between it and the light (the lit
+// clouds): a product, since optical depths along one ray add. Each other
+// volume is traced through its own trilinear field (DensityField: exact for
+// it up to float rounding); a ray that misses a field's box costs one clip.
+class VolumeShadows final : public ShadowProvider {
+public:
+    VolumeShadows(const ShadowProvider* own, std::span<const Light> lights, std::span<const DensityField* const> others)
+        : mOwn(own), mLights(lights), mOthers(others) {}
+    float transmittance(std::size_t light, glm::vec3 world) const override {
+        float t = mOwn ? mOwn->transmittance(light, world) : 1.0f;
+        if (light >= mLights.size()) return t;
+        float depth = 0.0f;
+        for (const DensityField* f : mOthers) depth += f->opticalDepthToLight(world, mLights[light]);
+        return depth > 0.0f ? t * std::exp2(-depth) : t;
+    }
+
+private:
+    const ShadowProvider* mOwn;
+    std::span<const Light> mLights;
+    std::span<const DensityField* const> mOthers;
+};
+
 } // namespace
 
 Result<std::size_t> Scene::addLight(const Light& light) {
@@ -136,6 +159,8 @@ void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& mater
         glm::mat3(dg.transform) * glm::mat3(glm::vec3(dg.spacing.x, 0, 0), glm::vec3(0, dg.spacing.y, 0), glm::vec3(0, 0, dg.spacing.z));
     const float det = std::abs(glm::determinant(shape));
     const float voxelSize = std::isfinite(det) ? std::cbrt(det) : 0.0f;
+    const VolumeShadows withVolumes(shadows, mLights, mVolumeCasters);
+    if (!mVolumeCasters.empty()) shadows = &withVolumes;
     if (Status s = lightPoints(lit.points, voxelSize, builder.camera().eye(), mLights, shadows, L.gas, lit.factors); !s) {
         mLightingError = at + "gas: " + s.error();
         return;

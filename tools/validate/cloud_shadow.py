@@ -1,0 +1,99 @@
+#!/usr/bin/env python3
+"""Outside check of a cloud's shadow on a plume (tests/lighting/volume_shadows_test.cpp,
+VolumeShadows.PlumeUnderACloudIsDarkerByTheCloudsTransmittance), standard library
+only, no splatfx code linked.
+
+The cloud of that test is written out here from its definition: 9x5x9 grid points,
+spacing 1, point (0, 0, 0) at (-4, 20, -4), density 0.12 + 0.05 x + 0.06 y + 0.03 z
+(0.05 in the column x = z = 0, under the threshold 0.08, so no extinction there),
+extinction 2 per unit at density 1, trilinear between points and falling to zero one
+point beyond the grid (zero outside). The plume's 4x4x4 splat centres sit at
+(-1.5, 4, -1.5) + (i, j, k). For each, the optical depth towards the sun (travelling
+along (0.25, -1, 0.15)) is integrated piece by piece between the ray's crossings of
+the grid planes (a cubic on each piece) by Simpson's rule; the transmittance is exp(-depth). Prints
+the smallest, the largest and the mean transmittance over the 64 centres, which the
+test prints from the lit reference (litFactor) as "reference T".
+
+    python3 tools/validate/cloud_shadow.py
+"""
+import math
+
+ORIGIN = (-4.0, 20.0, -4.0)
+DIMS = (9, 5, 9)
+MAX_EXT = 2.0
+THRESHOLD = 0.08
+
+
+def density(x, y, z):
+    if x == 0 and z == 0:
+        return 0.05
+    return 0.12 + 0.05 * x + 0.06 * y + 0.03 * z
+
+
+def value(x, y, z):
+    if x < 0 or y < 0 or z < 0 or x >= DIMS[0] or y >= DIMS[1] or z >= DIMS[2]:
+        return 0.0
+    f = density(x, y, z)
+    return f if f >= THRESHOLD else 0.0
+
+
+def extinction(p):
+    u = [(p[a] - ORIGIN[a]) for a in range(3)]
+    i = [math.floor(c) for c in u]
+    w = [u[a] - i[a] for a in range(3)]
+    s = 0.0
+    for dx in (0, 1):
+        for dy in (0, 1):
+            for dz in (0, 1):
+                wt = (w[0] if dx else 1 - w[0]) * (w[1] if dy else 1 - w[1]) * (w[2] if dz else 1 - w[2])
+                if wt > 0.0:
+                    s += wt * value(i[0] + dx, i[1] + dy, i[2] + dz)
+    return MAX_EXT * s
+
+
+def depth_to_sun(p, travel):
+    n = math.sqrt(sum(c * c for c in travel))
+    d = [-c / n for c in travel]
+    # Far enough to leave the cloud's support (its box reaches y = 25).
+    length = (30.0 - p[1]) / d[1]
+    # Between two crossings of grid planes the trilinear field is a cubic along the ray:
+    # Simpson's rule on each piece, with 2 and 4 panels, must agree (a check of that claim).
+    cuts = {0.0, length}
+    for a in range(3):
+        if d[a] != 0.0:
+            for m in range(-2, 40):
+                t = (ORIGIN[a] + m - p[a]) / d[a]
+                if 0.0 < t < length:
+                    cuts.add(t)
+    cuts = sorted(cuts)
+
+    def simpson(t0, t1, panels):
+        h = (t1 - t0) / panels
+        total = 0.0
+        for k in range(panels + 1):
+            wgt = 1 if k in (0, panels) else (4 if k % 2 else 2)
+            total += wgt * extinction([p[a] + (t0 + k * h) * d[a] for a in range(3)])
+        return total * h / 3.0
+
+    tau, worst = 0.0, 0.0
+    for t0, t1 in zip(cuts, cuts[1:]):
+        two, four = simpson(t0, t1, 2), simpson(t0, t1, 4)
+        worst = max(worst, abs(two - four))
+        tau += four
+    return tau, worst
+
+
+def main():
+    ts, worst = [], 0.0
+    for i in range(4):
+        for j in range(4):
+            for k in range(4):
+                tau, w = depth_to_sun((-1.5 + i, 4.0 + j, -1.5 + k), (0.25, -1.0, 0.15))
+                ts.append(math.exp(-tau))
+                worst = max(worst, w)
+    print("outside check: min T %.9f, max T %.9f, mean T %.9f over %d centres" % (min(ts), max(ts), sum(ts) / len(ts), len(ts)))
+    print("largest change of a piece's depth from 2 to 4 Simpson panels: %.3g (0 up to rounding: cubic pieces)" % worst)
+
+
+if __name__ == "__main__":
+    main()
