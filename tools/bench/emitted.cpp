@@ -5,7 +5,8 @@
 // points around it: the ground at 0.5 to 1.5 m, a wall 1 to 3 m away, and a
 // point inside the flame. Each receiver sees the splats built by a camera
 // at it (billboards facing it), over a few frames of the texture cycling.
-// Time: fitEmittedLights per frame (CPU, median). Separately, what
+// Time: fitEmittedLights per frame (CPU, median), also for the same flame at
+// 8 and 27 times the voxels. Separately, what
 // splatfx_emittedIrradiance costs per shaded pixel: a full-screen host pass
 // with a Lambert sun, with and without the emitted lights, glFinish, median.
 // --validate FILE writes the small case tools/validate/emitted_irradiance.py checks.
