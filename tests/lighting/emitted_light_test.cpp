@@ -263,6 +263,25 @@ TEST(EmittedLight, FarFieldFitMeetsTheExactIrradianceWithinTheMultipoleBound) {
             auto lights = fitEmittedLights(b.splats(), m, {.enabled = true, .lights = lightsAsked, .occlusion = false});
             ASSERT_TRUE(lights) << lights.error();
             ASSERT_EQ(int(lights->size()), lightsAsked);
+            // The dipole term vanishes only if the lights' intensity-weighted
+            // centroid is the splats': checked directly against the splats'
+            // closed-form intensities. Weights off by at most eps relative
+            // (the fit's quadrature and stored window, as farTruth) move a
+            // weighted mean by at most 2 eps / (1 - eps) x the splats' spread.
+            glm::dvec3 cFit(0.0), cRef(0.0);
+            double wFit = 0.0, wRef = 0.0, eps = 0.0, spread = 0.0;
+            for (const EmittedLight& l : *lights) cFit += sum3(glm::dvec3(l.intensity)) * glm::dvec3(l.position), wFit += sum3(glm::dvec3(l.intensity));
+            for (const Splat& sp : b.splats()) {
+                const double a = std::sqrt(glm::length(glm::cross(sp.axisU, sp.axisV)));
+                const double I = plainIntensity(m.footprint(), a, sp.density);
+                const double w = sum3(glm::dvec3(rowColorAt(m, row, sp.colorCoord))) * I;
+                cRef += w * glm::dvec3(sp.center), wRef += w;
+                eps = std::max(eps, (std::abs(sampledIntensity(m.footprint(), m.layerSize(), a, sp.density) - I) +
+                                     std::log(2.0) * sp.density * storedWindowError(m) * 4.0 * a * a) / I + 512.0 * 0x1p-24);
+            }
+            cFit /= wFit, cRef /= wRef;
+            for (const Splat& sp : b.splats()) spread = std::max(spread, glm::length(glm::dvec3(sp.center) - cRef));
+            EXPECT_LT(glm::length(cFit - cRef), 2.0 * eps / (1.0 - eps) * spread + 1e-6) << "the lights' centroid is the emission's";
             const double bound = multipoleBound(*lights, b.splats(), p);
             const double fit = sum3(glm::dvec3(emittedIrradiance(*lights, p, n)));
             EXPECT_NEAR(fit, t.truth, bound + t.slack) << lightsAsked << " lights at " << dist;
