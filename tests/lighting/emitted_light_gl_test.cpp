@@ -10,6 +10,7 @@
 
 #include "gl_fixture.hpp"
 #include "splatfx/emitted_light.hpp"
+#include "splatfx/frame.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/gl/program.hpp"
 #include "splatfx/lighting.hpp"
@@ -99,4 +100,33 @@ TEST_F(EmittedLightGL, GlslIrradianceEqualsTheCpuOnTheSameLights) {
         }
     EXPECT_LE(worst, 1.0f) << "largest GPU-CPU difference in units of its tolerance";
     EXPECT_GT(lit, 0.5f);
+}
+
+// The frame's lights reach the host's binding through FrameRenderer: at most
+// kMaxEmittedLights of them (the brightest first, as the frame orders them),
+// and none the next frame when it has none (no light lingering from the last).
+TEST_F(EmittedLightGL, FrameRendererBindsTheFramesLightsAndDropsThemTheNextFrame) {
+    auto fr = gl::FrameRenderer::create();
+    ASSERT_TRUE(fr) << fr.error();
+    Materials materials{Footprint{}};
+    ASSERT_TRUE(fr->upload(materials));
+    auto fb = gl::Framebuffer::create({.width = 16, .height = 16});
+    ASSERT_TRUE(fb);
+    const Camera cam = Camera::lookAt({0, 1, 4}, {0, 0, 0}, {0, 1, 0}, 1.0f, {16, 16});
+    auto render = [&](const std::vector<EmittedLight>& lights) {
+        Frame frame;
+        frame.begin(0.0, cam);
+        frame.end();
+        frame.emittedLights() = lights;
+        gl::ShadowBinding seen;
+        fr->render(frame, {.framebuffer = fb->handle(), .drawOpaque = [&] { seen = fr->shadowBinding(); }});
+        return seen.emittedLights;
+    };
+    std::vector<EmittedLight> ten;
+    for (int i = 0; i < kMaxEmittedLights + 2; ++i)
+        ten.push_back({.position = {float(i), 0.5f, 0.0f}, .radius = 0.1f, .intensity = glm::vec3(float(20 - i))});
+    const std::vector<EmittedLight> bound = render(ten);
+    ASSERT_EQ(int(bound.size()), kMaxEmittedLights);
+    for (int i = 0; i < kMaxEmittedLights; ++i) EXPECT_EQ(bound[std::size_t(i)].intensity, ten[std::size_t(i)].intensity);
+    EXPECT_TRUE(render({}).empty()) << "a frame without emitters binds no light";
 }
