@@ -31,6 +31,7 @@ int runEbert(int argc, char** argv);        // ebert.cpp: Ebert & Parent 1990 Ta
 int runCloudLight(int argc, char** argv);   // cloudlight.cpp: cloud relight per sun move, per model and size; swept vs exact sun transmittance (issue 27)
 int runObstacles(int argc, char** argv);    // obstacles.cpp: solver step cost with obstacles (bridge, moving locomotive, meshes) against none
 int runDevice(int argc, char** argv);       // device.cpp: the GL context the benches get (SPLATFX_EGL_DEVICE), for tools/gpu-check.sh
+int runEmitted(int argc, char** argv);      // emitted.cpp: a campfire as light: fitted lights vs the exact irradiance, fit and GLSL cost (issue 27.3)
 int runHdr(int argc, char** argv);          // hdr.cpp: HDR lit colour and RGBA16F/32F targets against the 8-bit path (issues 26, 27)
 
 // cloud_knobs.cpp, run by accuracy (--clouds-only alone): the LOD clouds' table size, c, C and
@@ -66,5 +67,6 @@ inline constexpr BenchCommand kCommands[] = {
     {"obstacles", "solver step cost with obstacles (a bridge, a moving locomotive, as boxes or meshes, free or no slip) against none", runObstacles},
     {"device", "the OpenGL context the benches get (SPLATFX_EGL_DEVICE selects an EGL device): vendor, renderer, sample limits", runDevice},
     {"hdr", "HDR lit colour against the 8-bit path: RGBA8/16F/32F host targets, ms per frame, error vs the lit volume reference, Pareto", runHdr},
+    {"emitted", "a campfire as light for the host: fitted point lights (1..8, occlusion on/off) vs the exact irradiance, fit ms, GLSL ns/pixel, Pareto", runEmitted},
     {"soak", "every preset stepped at 60 Hz for an hour of scene time: no NaN/Inf, bounds and memory flat", runSoak},
 };

@@ -53,6 +53,7 @@ SplatEmission emission(const Splat& s, const Materials& m, bool packedColor) {
         }
     if (count == 0) return {};
     const float quad = 4.0f * area; // (u, v) in [-1, 1]^2: area 4 per unit
+    if (!std::isfinite(quad)) return {};
     // What the splat takes from light crossing it anywhere in its quad is its
     // mean opacity (a textured splat has holes), as an optical depth.
     const float meanAlpha = std::min(sumAlpha / float(count), 1.0f - 1e-6f);
@@ -76,7 +77,8 @@ public:
         mLo = lo - 0.5f * cell;
         const glm::vec3 extent = hi - lo + cell;
         // A bin about one splat radius wide, at most 32 a side.
-        mDims = glm::clamp(glm::ivec3(glm::ceil(extent / cell)), glm::ivec3(1), glm::ivec3(32));
+        // Clamped before the conversion: a splat 1e30 away must not overflow the int.
+        mDims = glm::ivec3(glm::clamp(glm::ceil(extent / cell), glm::vec3(1.0f), glm::vec3(32.0f)));
         mCell = extent / glm::vec3(mDims);
         mDepth.assign(std::size_t(mDims.x) * mDims.y * mDims.z, 0.0f);
         for (std::size_t i : emitting) mDepth[index(bin(splats[i].center))] += e[i].opticalArea;
@@ -96,7 +98,7 @@ public:
     }
 
 private:
-    glm::ivec3 bin(glm::vec3 p) const { return glm::clamp(glm::ivec3(glm::floor((p - mLo) / mCell)), glm::ivec3(0), mDims - 1); }
+    glm::ivec3 bin(glm::vec3 p) const { return glm::ivec3(glm::clamp(glm::floor((p - mLo) / mCell), glm::vec3(0.0f), glm::vec3(mDims - 1))); }
     std::size_t index(glm::ivec3 c) const { return (std::size_t(c.z) * mDims.y + c.y) * mDims.x + c.x; }
     glm::vec3 mLo{0.0f}, mCell{1.0f};
     glm::ivec3 mDims{1};
@@ -214,6 +216,9 @@ Result<std::vector<EmittedLight>> fitEmittedLights(std::span<const Splat> splats
         lights[c].radius = mass[c] > 0.0 ? float(std::sqrt(spread[c] / mass[c])) : 0.0f;
         if (power[c] > 0.0) lights[c].escapePlus = glm::vec3(plusSum[c] / power[c]), lights[c].escapeMinus = glm::vec3(minusSum[c] / power[c]);
     }
+    for (const EmittedLight& l : lights)
+        if (!std::isfinite(l.intensity.x + l.intensity.y + l.intensity.z))
+            return makeError("EmittedLightDesc.scale: the lights' intensity overflows float (scale " + std::to_string(desc.scale) + ")");
     std::erase_if(lights, [](const EmittedLight& l) { return !(l.intensity.x + l.intensity.y + l.intensity.z > 0.0f); });
     std::stable_sort(lights.begin(), lights.end(), [](const EmittedLight& a, const EmittedLight& b) {
         return a.intensity.x + a.intensity.y + a.intensity.z > b.intensity.x + b.intensity.y + b.intensity.z;

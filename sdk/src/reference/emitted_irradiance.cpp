@@ -58,8 +58,8 @@ Result<IrradianceExact> emittedIrradianceExact(const std::vector<Splat>& splats,
         return makeError("IrradianceExactDesc.faceSize must be in [2, 4096], got " + std::to_string(desc.faceSize));
     if (!(desc.nearDistance > 0.0) || !std::isfinite(desc.nearDistance)) return makeError("IrradianceExactDesc.nearDistance must be finite and > 0");
     const double len = glm::length(normal);
-    if (!(len > 0.0) || !std::isfinite(len) || !std::isfinite(point.x + point.y + point.z))
-        return makeError("emittedIrradianceExact: the point and a non-zero normal must be finite");
+    if (!(len > 0.0) || !std::isfinite(len)) return makeError("emittedIrradianceExact: normal must be finite and non-zero");
+    if (!std::isfinite(point.x + point.y + point.z)) return makeError("emittedIrradianceExact: point must be finite");
     normal /= len;
     Result<glm::dvec3> fine = sphereIntegral(splats, materials, point, normal, desc.faceSize, desc);
     if (!fine) return makeError(fine.error());
