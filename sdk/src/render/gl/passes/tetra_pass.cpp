@@ -230,7 +230,8 @@ void TetraPass::uploadTables(const Frame& frame) {
     }
 }
 
-void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const PassTarget& target) {
+void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const PassTarget& target,
+                     const Camera* cameraIn) {
     Impl& r = *mImpl;
     if (volume >= r.firstRecord.size() || r.tableOfVolume[volume] < 0) return;
     const auto& first = r.firstRecord[volume];
@@ -240,7 +241,7 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     if (a >= b) return;
     const PreIntegrationTable& table = *frame.volumes()[volume].table;
     const Impl::Table& tex = r.tables[std::size_t(r.tableOfVolume[volume])];
-    const Camera& camera = frame.camera();
+    const Camera& camera = cameraIn ? *cameraIn : frame.camera();
 
     const GLuint hostDepth = target.depthTexture;
 
@@ -346,8 +347,9 @@ void TetraPass::execute(const PlanStep& step, StepContext& context) {
     }
     assert(step.kind == StepKind::Tetrahedra);
     mFrameParams = &context.plan.fogParameters;
-    draw(context.frame, step.volume, std::uint32_t(step.begin), std::uint32_t(step.end),
-         step.target == StepTarget::Reduced ? context.reduced : context.plan.target);
+    const bool layer = step.target == StepTarget::Reduced;
+    draw(context.frame, step.volume, std::uint32_t(step.begin), std::uint32_t(step.end), layer ? context.reduced : context.plan.target,
+         layer ? context.layerCamera : nullptr);
     mFrameParams = nullptr;
 }
 
