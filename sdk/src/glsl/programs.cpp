@@ -39,7 +39,8 @@ constexpr const char* kFogPassUniforms[] = {"uRay",  "uDepthAxis", "uHostDepthMa
                                             "uFogSize", "uThreshold"};
 static_assert(std::size(kFogPassUniforms) == fog_pass::UniformCount);
 constexpr const char* kTetraUniforms[] = {"uViewProjRel", "uFirst",     "uForward",           "uHostDepthMap",       "uTexScale",
-                                          "uTexOffset",   "uMaxLength", "splatfx_fog_params", "splatfx_fog_colour", "splatfx_fog_far"};
+                                          "uTexOffset",   "uMaxLength", "splatfx_fog_params", "splatfx_fog_colour", "splatfx_fog_far",
+                                          "uSampleRay",   "uInvViewProjRel", "uViewport", "uNdcZ"};
 static_assert(std::size(kTetraUniforms) == tetra::UniformCount);
 constexpr const char* kSectionUniforms[] = {"uViewProj", "uOctagon", "uCut",          "uOrigin",      "uEye",         "uForward",
                                             "uNearZ",    "uPersp",   "uKernelRadius", "uHostDepthMap", "uInvViewProj", "uViewport",

@@ -132,7 +132,7 @@ enum Uniform { Ray, DepthAxis, HostDepthMap, Origin, Size, FogParams, FogColour,
 } // namespace fog_pass
 namespace tetra {
 enum Define { PERSPECTIVE, HAS_DEPTH, FOG };
-enum Uniform { ViewProjRel, First, Forward, HostDepthMap, TexScale, TexOffset, MaxLength, FogParams, FogColour, FogFar, UniformCount };
+enum Uniform { ViewProjRel, First, Forward, HostDepthMap, TexScale, TexOffset, MaxLength, FogParams, FogColour, FogFar, SampleRay, InvViewProjRel, Viewport, NdcZ, UniformCount };
 } // namespace tetra
 namespace section {
 enum Define { FOG, FOG_PER_SPLAT, CUT, HOST_DEPTH, NEAR_CUT, GENERAL, CROSSFADE, SECTIONS };

@@ -218,6 +218,10 @@ struct FrameRenderStats {
         bool perSample = false; // the fog and volume passes ran per sample as above (false: a list frame without them)
         int sampleCopies = 0;  // samples copied out of the host depth (samples, + 1 for the nearest)
         bool listsNearest = false; // the fragment lists read each pixel's nearest sample
+        // The volumes went through the full-resolution volume layer (single-sampled):
+        // each sample's run drew it with the image shifted onto that sample's
+        // positions (glGetMultisamplefv) and composited it into that sample.
+        bool layerPerSample = false;
     } msaa;
     struct Shadow {
         std::uint64_t uploads = 0; // shadow-table uploads, every slot (cumulative; only when the frame's changed)

@@ -5,6 +5,7 @@
 #include <array>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <epoxy/gl.h>
 
@@ -46,6 +47,35 @@ bool hostColorIsFloat32(unsigned framebuffer) {
     return type == GL_FLOAT && red >= 32;
 }
 
+// The per-sample runs of a multisampled host that draw the volumes into the
+// full-resolution layer: that layer is single-sampled, so each run draws it
+// with the image shifted by (pixel centre - sample position), putting its
+// pixel centres on the sample's positions, and composites it into that sample
+// only: each sample gets what a single-sampled frame with a pixel centre
+// there gets. One camera per sample; none when no run goes through the layer.
+std::vector<Camera> layerCameras(const Camera& camera, unsigned framebuffer, const FramePlan& plan) {
+    std::vector<Camera> out;
+    const bool layer = !plan.reduced && std::any_of(plan.steps.begin(), plan.steps.end(), [](const PlanStep& step) { return step.kind == StepKind::ReducedBegin; });
+    const bool perSample = std::any_of(plan.steps.begin(), plan.steps.end(), [](const PlanStep& step) { return step.kind == StepKind::HostDepthSample && step.sample >= 0; });
+    if (plan.samples <= 1 || !layer || !perSample || plan.target.width <= 0 || plan.target.height <= 0) return out;
+    GLint bound = 0;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer);
+    for (int i = 0; i < plan.samples; ++i) {
+        glm::vec2 o(0.5f);
+        glGetMultisamplefv(GL_SAMPLE_POSITION, GLuint(i), &o.x);
+        // ndc spans the layer's width (height) in 2: a shift of one pixel is 2 / width.
+        glm::mat4 shift(1.0f);
+        shift[3][0] = 2.0f * (0.5f - o.x) / float(plan.target.width);
+        shift[3][1] = 2.0f * (0.5f - o.y) / float(plan.target.height);
+        Camera c = camera;
+        c.proj = shift * camera.proj;
+        out.push_back(c);
+    }
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(bound));
+    return out;
+}
+
 } // namespace
 
 struct FrameRenderer::Impl {
@@ -63,6 +93,7 @@ struct FrameRenderer::Impl {
     FramePlan plan;
     FrameRenderStats stats;
     std::string depthNote; // the camera's depth convention against the context and its projection
+    bool layerPerSample = false; // the last frame's per-sample runs drew the volume layer per sample (layerCameras)
     detail::ShadowPass shadow;
     detail::HostPass host;
     detail::FogPass fog;
@@ -173,7 +204,11 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
     r.plan = planFrame(frame, target, planDesc, depth);
     for (detail::Pass* p : r.passes()) p->prepare(r.plan, frame);
     detail::StepContext context{.frame = frame, .host = target, .plan = r.plan, .splatLayers = r.splats.renderer().layerTexture()};
+    const std::vector<Camera> sampleCameras = layerCameras(frame.camera(), target.framebuffer, r.plan);
+    r.layerPerSample = !sampleCameras.empty();
     for (const PlanStep& step : r.plan.steps) {
+        if (step.kind == StepKind::HostDepthSample)
+            context.layerCamera = step.sample >= 0 && std::size_t(step.sample) < sampleCameras.size() ? &sampleCameras[std::size_t(step.sample)] : nullptr;
         r.passFor(step.kind).execute(step, context);
         // A hook that made another context current (or none): the next GL call would reach that one's objects, or abort.
         if (step.kind == StepKind::HostOpaque || step.kind == StepKind::HostTransparent)
@@ -201,6 +236,7 @@ void FrameRenderer::Impl::report(const Frame& frame, const detail::StepContext& 
     s.msaa.samples = plan.samples;
     s.msaa.perSample = std::any_of(plan.steps.begin(), plan.steps.end(), [](const PlanStep& step) { return step.kind == StepKind::HostDepthSample && step.sample >= 0; });
     s.msaa.listsNearest = plan.samples > 1 && plan.lists;
+    s.msaa.layerPerSample = layerPerSample;
     s.lists.used = plan.lists;
     s.lists.splats = plan.splatsInLists;
     s.lists.note = plan.listsNote.empty() ? context.listsNote : plan.listsNote;

@@ -6,6 +6,22 @@ uniform vec3 uForward;      // unit view direction
 uniform vec3 uTexScale;     // (n-1)/n, (n-1)/n, (m-1)/m: texel centres at the table's samples
 uniform vec3 uTexOffset;    // 0.5/n, 0.5/n, 0.5/m
 uniform float uMaxLength;   // the table's maxLengthWorld
+// A multisampled host's per-sample runs (uSampleRay = 1): each sample's ray
+// from its own window position. The entry point interpolated at the sample
+// (vRel, even `sample`-qualified) is not it on llvmpipe: up to 19/255 off the
+// frames shifted onto the samples inside a cloud (tests/render/msaa_gl_test.cpp).
+uniform int uSampleRay;
+uniform mat4 uInvViewProjRel; // inverse of uViewProjRel
+uniform vec4 uViewport;       // x, y, width, height
+uniform float uNdcZ;          // ndc z of a finite point in front of the eye
+
+// A point on this sample's ray, relative to the eye (gl_SamplePosition: the
+// shader runs per sample).
+vec3 sampleRayPoint() {
+    vec2 ndc = (floor(gl_FragCoord.xy) + gl_SamplePosition - uViewport.xy) / uViewport.zw * 2.0 - 1.0;
+    vec4 h = uInvViewProjRel * vec4(ndc, uNdcZ, 1.0);
+    return h.xyz / h.w;
+}
 in vec3 vRel;
 flat in vec4 vPlane[4];
 flat in vec4 vScalar;
@@ -46,13 +62,23 @@ void main() {
     float tIn = length(vRel);
     vec3 d = vRel / tIn, o = vec3(0.0);
     float tOut = 3.0e38;
+    if (uSampleRay != 0) {
+        // Not on the face at the sample: the entering planes bound tIn too.
+        d = normalize(sampleRayPoint());
+        tIn = 0.0;
+        for (int i = 0; i < 4; ++i) {
+            float s = dot(vPlane[i].xyz, d);
+            if (s > 0.0) tIn = max(tIn, -vPlane[i].w / s);
+        }
+    }
     for (int i = 0; i < 4; ++i) {
         // lambda_i(t) = w + s t >= 0 inside (o = 0): only the leaving planes bound tOut.
         float s = dot(vPlane[i].xyz, d);
         if (s < 0.0) tOut = min(tOut, -vPlane[i].w / s);
     }
 #else
-    vec3 d = uForward, o = vRel - d * dot(vRel, d); // o on the plane through the eye
+    vec3 d = uForward, rel = uSampleRay != 0 ? sampleRayPoint() : vRel;
+    vec3 o = rel - d * dot(rel, d); // o on the plane through the eye
     float tIn = -3.0e38, tOut = 3.0e38;
     for (int i = 0; i < 4; ++i) {
         float a = dot(vPlane[i].xyz, o) + vPlane[i].w, s = dot(vPlane[i].xyz, d);

@@ -29,6 +29,11 @@ struct StepContext {
     bool listsReady = false;  // ListsCollect succeeded (the later list steps run only then)
     unsigned splatLayers = 0; // the splat pass's texture array (the list sections sample it)
     std::string listsNote{};  // why (some) splats took the ordered blend, found while executing
+    // A multisampled host's per-sample run through the full-resolution volume
+    // layer (single-sampled): the frame's camera with its image shifted so the
+    // layer's pixel centres lie on that sample's positions, what the volume
+    // steps into the layer project with; null otherwise (frame.camera()).
+    const Camera* layerCamera = nullptr;
 
     // The splats a step draws: [begin, end) of Frame::splats().
     std::pair<std::size_t, std::size_t> range(const PlanStep& step) const;

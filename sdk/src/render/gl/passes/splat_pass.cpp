@@ -71,7 +71,8 @@ void SplatPass::prepare(const FramePlan& plan, const Frame&) {
 }
 
 void SplatPass::execute(const PlanStep& step, StepContext& context) {
-    const Camera& camera = context.frame.camera();
+    // Into the layer of a per-sample run: the image shifted onto the sample (StepContext::layerCamera).
+    const Camera& camera = step.target == StepTarget::Reduced && context.layerCamera ? *context.layerCamera : context.frame.camera();
     const std::span<const Splat> all = context.frame.splats();
     switch (step.kind) {
     case StepKind::Splats: {

@@ -230,7 +230,8 @@ void TetraPass::uploadTables(const Frame& frame) {
     }
 }
 
-void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const PassTarget& target) {
+void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const PassTarget& target,
+                     const Camera* cameraIn, bool sampleRay) {
     Impl& r = *mImpl;
     if (volume >= r.firstRecord.size() || r.tableOfVolume[volume] < 0) return;
     const auto& first = r.firstRecord[volume];
@@ -240,7 +241,7 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     if (a >= b) return;
     const PreIntegrationTable& table = *frame.volumes()[volume].table;
     const Impl::Table& tex = r.tables[std::size_t(r.tableOfVolume[volume])];
-    const Camera& camera = frame.camera();
+    const Camera& camera = cameraIn ? *cameraIn : frame.camera();
 
     const GLuint hostDepth = target.depthTexture;
 
@@ -298,6 +299,14 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     glUniform3f(p.uniform(glsl::tetra::TexScale), (n.x - 1.0f) / n.x, (n.y - 1.0f) / n.y, (n.z - 1.0f) / n.z);
     glUniform3f(p.uniform(glsl::tetra::TexOffset), 0.5f / n.x, 0.5f / n.y, 0.5f / n.z);
     glUniform1f(p.uniform(glsl::tetra::MaxLength), table.maxLengthWorld());
+    glUniform1i(p.uniform(glsl::tetra::SampleRay), sampleRay ? 1 : 0);
+    if (sampleRay) {
+        const glm::mat4 inv(glm::inverse(glm::dmat4(vpRel)));
+        const glm::vec4 hc = vp * glm::vec4(c, 1.0f); // c: a finite point in front of the eye
+        glUniformMatrix4fv(p.uniform(glsl::tetra::InvViewProjRel), 1, GL_FALSE, glm::value_ptr(inv));
+        glUniform4f(p.uniform(glsl::tetra::Viewport), float(target.x), float(target.y), float(target.width), float(target.height));
+        glUniform1f(p.uniform(glsl::tetra::NdcZ), hc.z / hc.w);
+    }
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, r.ssbo);
     glBindTextureUnit(1, hostDepth);
     glBindTextureUnit(2, tex.texture);
@@ -346,8 +355,10 @@ void TetraPass::execute(const PlanStep& step, StepContext& context) {
     }
     assert(step.kind == StepKind::Tetrahedra);
     mFrameParams = &context.plan.fogParameters;
-    draw(context.frame, step.volume, std::uint32_t(step.begin), std::uint32_t(step.end),
-         step.target == StepTarget::Reduced ? context.reduced : context.plan.target);
+    const bool layer = step.target == StepTarget::Reduced;
+    // Straight into a multisampled host (per sample): the ray from the sample.
+    draw(context.frame, step.volume, std::uint32_t(step.begin), std::uint32_t(step.end), layer ? context.reduced : context.plan.target,
+         layer ? context.layerCamera : nullptr, !layer && context.plan.samples > 1);
     mFrameParams = nullptr;
 }
 

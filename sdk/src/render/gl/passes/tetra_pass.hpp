@@ -57,7 +57,12 @@ public:
     // builds the per-tetrahedron data of every volume. Resets the frame stats.
     void uploadTables(const Frame& frame);
     // Draws tetrahedra [begin, end) of frame.volumes()[volume] (after uploadTables).
-    void draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const PassTarget& target);
+    // `camera`: the one to project with instead of frame.camera() (the same eye; a
+    // multisampled host's per-sample run shifts its image, StepContext::layerCamera).
+    // `sampleRay`: each fragment's ray from its sample's window position (a
+    // multisampled target drawn per sample), not the interpolated entry point.
+    void draw(const Frame& frame, std::uint32_t volume, std::uint32_t begin, std::uint32_t end, const PassTarget& target,
+              const Camera* camera = nullptr, bool sampleRay = false);
     // (issue 14) The fog every following draw is seen through (null
     // or empty: none): each segment's colour becomes f c + (1 - f) alpha C_fog
     // with f from the eye to the segment's opacity centroid. Builds the fog
