@@ -648,6 +648,217 @@ static void test_notes(splatfx_error* err) {
     free_drawn(&d);
 }
 
+/* ---- HDR lit colour into the host's float target ---------------------------------------------- */
+
+/* A scene file for the HDR test: a 3x3x3 sphere of plain splats (no texture, no dynamics) of colour
+ * (0.8, 0.7, 0.6), lit by one white sun of `intensity`, traced self-shadow, isotropic, no ambient or
+ * emission, no scene-shadow table. The lit colour is then linear in the intensity. */
+static void write_hdr_scene(const char* path, double intensity) {
+    FILE* f = fopen(path, "w");
+    CHECK(f != NULL, "cannot write %s", path);
+    if (!f) return;
+    fprintf(f, "{\"format\": \"splatfx-scene\", \"version\": 1, \"seed\": 3,\n"
+               " \"lights\": [{\"type\": \"directional\", \"direction\": [0.6, -0.7, -0.4], \"color\": [1, 1, 1], \"intensity\": %.17g}],\n"
+               " \"sceneShadow\": {\"enabled\": false},\n"
+               " \"effects\": [{\"kind\": \"grid\", \"name\": \"blob\", \"dims\": [3, 3, 3], \"spacing\": 0.25, \"traditional\": true,\n"
+               "   \"shapes\": [{\"type\": \"sphere\", \"center\": [1, 1, 1], \"radius\": 1.5}], \"opacity\": 0.7,\n"
+               "   \"colorTable\": {\"constant\": [0.8, 0.7, 0.6, 1]}, \"propagation\": {\"mode\": \"none\"}, \"cycling\": {\"mode\": \"none\"},\n"
+               "   \"lighting\": {\"albedo\": 0.9, \"selfShadow\": \"traced\"}}]}\n",
+            intensity);
+    fclose(f);
+}
+
+/* A colour target of `format` (GL_RGBA8, GL_RGBA16F, GL_RGBA32F) with a depth texture, cleared to 0 and depth 1. */
+static Target make_colour_target(GLenum format) {
+    Target t;
+    glCreateTextures(GL_TEXTURE_2D, 1, &t.color);
+    glTextureStorage2D(t.color, 1, format, W, H);
+    glCreateTextures(GL_TEXTURE_2D, 1, &t.depth);
+    glTextureStorage2D(t.depth, 1, GL_DEPTH_COMPONENT32F, W, H);
+    glCreateFramebuffers(1, &t.fbo);
+    glNamedFramebufferTexture(t.fbo, GL_COLOR_ATTACHMENT0, t.color, 0);
+    glNamedFramebufferTexture(t.fbo, GL_DEPTH_ATTACHMENT, t.depth, 0);
+    CHECK(glCheckNamedFramebufferStatus(t.fbo, GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE, "incomplete framebuffer");
+    const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f}, far_depth = 1.0f;
+    glClearNamedFramebufferfv(t.fbo, GL_COLOR, 0, zero);
+    glClearNamedFramebufferfv(t.fbo, GL_DEPTH, 0, &far_depth);
+    return t;
+}
+
+static void free_target(Target* t) {
+    glDeleteFramebuffers(1, &t->fbo);
+    glDeleteTextures(1, &t->color);
+    glDeleteTextures(1, &t->depth);
+}
+
+/* The scene at `intensity`, HDR lit colour on or off, prepared and drawn into a new target of
+ * `format`; its pixels as floats into `out` (W x H x 4). Returns the frame's splat count. */
+static uint64_t draw_hdr_scene(splatfx_error* err, double intensity, int hdr, GLenum format, float* out) {
+    const char* path = "capi_hdr_scene.json";
+    write_hdr_scene(path, intensity);
+    splatfx_materials* m = NULL;
+    splatfx_scene* scene = NULL;
+    splatfx_frame* frame = NULL;
+    splatfx_renderer* r = NULL;
+    CHECK_OK(splatfx_materials_create(NULL, &m, err), err);
+    CHECK_OK(splatfx_scene_load_file(path, m, NULL, &scene, err), err);
+    CHECK_OK(splatfx_scene_set_hdr_lit(scene, hdr, err), err);
+    CHECK_OK(splatfx_frame_create(&frame, err), err);
+    CHECK_OK(splatfx_renderer_create(NULL, &r, err), err);
+    /* The lattice is centred on x and z and starts at y = 0: its centre is (0, 0.25, 0). */
+    const float eye[3] = {0.9f, 0.75f, 2.4f}, at[3] = {0.0f, 0.25f, 0.0f}, up[3] = {0.0f, 1.0f, 0.0f};
+    splatfx_camera cam;
+    CHECK_OK(splatfx_camera_look_at(eye, at, up, 0.55f, W, H, 0.1f, 20.0f, &cam, err), err);
+    CHECK_OK(splatfx_scene_prepare(scene, 0.0, &cam, m, frame, err), err);
+    splatfx_frame_stats fs;
+    CHECK_OK(splatfx_frame_get_stats(frame, &fs, err), err);
+    Target t = make_colour_target(format);
+    splatfx_host_target target;
+    splatfx_host_target_init(&target);
+    target.framebuffer = t.fbo;
+    target.depth_texture = t.depth;
+    CHECK_OK(splatfx_renderer_render(r, m, frame, &target, err), err);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, t.fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(0, 0, W, H, GL_RGBA, GL_FLOAT, out);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
+    free_target(&t);
+    splatfx_renderer_destroy(r);
+    splatfx_frame_destroy(frame);
+    splatfx_scene_destroy(scene);
+    splatfx_materials_destroy(m);
+    return fs.splats;
+}
+
+static float max_rgb(const float* img) {
+    float v = 0.0f;
+    for (int i = 0; i < W * H * 4; ++i)
+        if (i % 4 != 3 && img[i] > v) v = img[i];
+    return v;
+}
+
+/* max over pixels and colour channels of |a - k b|; the alpha channel's largest |a - b| into *alpha_diff. */
+static double max_diff_rgb(const float* a, const float* b, double k, double* alpha_diff) {
+    double worst = 0.0, worst_alpha = 0.0;
+    for (int i = 0; i < W * H * 4; ++i) {
+        const double e = i % 4 == 3 ? fabs((double)a[i] - b[i]) : fabs((double)a[i] - k * b[i]);
+        if (i % 4 == 3) worst_alpha = e > worst_alpha ? e : worst_alpha;
+        else worst = e > worst ? e : worst;
+    }
+    if (alpha_diff) *alpha_diff = worst_alpha;
+    return worst;
+}
+
+/* A lit colour above 1 reaches the host's float target through the C API: a scene file's gas under a
+ * sun of 1 (every lit colour <= 1) and of 6, HDR lit colour on; the frame at 6 is 6x the frame at 1
+ * up to each path's 8-bit colour rounding (the model is linear in the intensity, the alphas do not
+ * depend on it). Without HDR the frame at 6 stops at 1 and fails that. An HDR frame into an 8-bit
+ * target is refused, drawing nothing. */
+static void test_hdr_lit(splatfx_error* err) {
+    float* lo = malloc(sizeof(float) * W * H * 4);
+    float* lo_ldr = malloc(sizeof(float) * W * H * 4);
+    float* hi = malloc(sizeof(float) * W * H * 4);
+    float* hi_half = malloc(sizeof(float) * W * H * 4);
+    float* hi_ldr = malloc(sizeof(float) * W * H * 4);
+    CHECK(lo && lo_ldr && hi && hi_half && hi_ldr, "out of memory");
+    if (!lo || !lo_ldr || !hi || !hi_half || !hi_ldr) goto done;
+    const uint64_t n = draw_hdr_scene(err, 1.0, 1, GL_RGBA32F, lo);
+    CHECK(n > 0 && n <= 27, "splats %llu, expected 1..27 (one at most per voxel)", (unsigned long long)n);
+    draw_hdr_scene(err, 1.0, 0, GL_RGBA32F, lo_ldr);
+    draw_hdr_scene(err, 6.0, 1, GL_RGBA32F, hi);
+    draw_hdr_scene(err, 6.0, 1, GL_RGBA16F, hi_half);
+    draw_hdr_scene(err, 6.0, 0, GL_RGBA32F, hi_ldr);
+
+    /* Colours <= 1 are packed bit for bit the same with HDR on or off: equal frames at 1 say every
+     * lit colour there is <= 1, so at 6 every one is <= 6 (its brightest channel m <= 6). */
+    CHECK(memcmp(lo, lo_ldr, sizeof(float) * W * H * 4) == 0, "at intensity 1 the HDR frame differs from the 8-bit one: a lit colour above 1");
+    float alpha = 0.0f;
+    for (int i = 3; i < W * H * 4; i += 4) alpha = lo[i] > alpha ? lo[i] : alpha;
+    CHECK(alpha > 0.1f, "the gas is not in view (largest alpha %g)", alpha);
+    /* GL at 6 against 6 x GL at 1, both RGBA32F, with a clear of 0: each pixel is sum_i w_i c_i with
+     * the same weights (sum <= the pixel's alpha <= the largest alpha A), so they differ by at most A
+     * times the largest difference of a splat's colour: 6 x the in-range colour's rounding (half an
+     * 8-bit level, 6 x 0.5/255) plus the HDR chroma's (half a level of its brightest channel,
+     * m x 0.5/255 <= 6 x 0.5/255); plus RGBA32F's rounding at each of its n + 1 writes (2^-24 of a
+     * value <= 6, at 7x: 7 (n + 1) x 2^-24 x 6 < 1e-5 for n <= 27). The alphas are the same
+     * computation on the same inputs: equal to F32's rounding (n + 1) x 2^-24. */
+    double alpha_diff = 0.0;
+    const double bound = alpha * (6.0 + 6.0) * 0.5 / 255.0 + 1e-5;
+    const double e = max_diff_rgb(hi, lo, 6.0, &alpha_diff);
+    CHECK(e <= bound, "|GL(6) - 6 GL(1)| = %g, over its bound %g", e, bound);
+    CHECK(alpha_diff <= (double)(n + 1) * ldexp(1.0, -24), "the alphas at 6 and 1 differ by %g", alpha_diff);
+    /* The frame at 6 keeps values above 1: the peak at 1 times 6, within the bound. */
+    const float peak_lo = max_rgb(lo), peak = max_rgb(hi);
+    CHECK(6.0 * peak_lo - bound > 1.5, "the peak at 1 is %g: too dim for this test to show values above 1", peak_lo);
+    CHECK(peak > 1.5f, "the HDR frame's peak is %g; a lit colour above 1 did not reach the float target", peak);
+    /* RGBA16F, the usual HDR target: the same frame but for the half float's rounding, half an ulp
+     * (2^-11) of a value <= 6 at each of its n + 1 writes, each carried on scaled by <= 1. */
+    const double half_bound = (double)(n + 1) * ldexp(1.0, -11) * 6.0;
+    const double e_half = max_diff_rgb(hi_half, hi, 1.0, NULL);
+    CHECK(e_half <= half_bound, "RGBA16F against RGBA32F: %g, over %g", e_half, half_bound);
+    CHECK(max_rgb(hi_half) > 1.5f, "the RGBA16F frame's peak is %g", max_rgb(hi_half));
+    /* Without HDR the frame at 6 stops at 1 (an over blend of colours <= 1 onto 0) and misses 6 x the
+     * frame at 1 by far more than the bound: dropping the switch fails this test. */
+    const double e_ldr = max_diff_rgb(hi_ldr, lo, 6.0, NULL);
+    CHECK(max_rgb(hi_ldr) <= 1.0f + 1e-5f, "without HDR the peak is %g", max_rgb(hi_ldr));
+    CHECK(e_ldr > 4.0 * bound, "without HDR the frame at 6 is within %g of 6x the frame at 1 (bound %g)", e_ldr, bound);
+    printf("HDR lit colour: peak %.3f (6 x the peak at 1: %.3f; RGBA16F %.3f; without HDR %.3f); |GL(6) - 6 GL(1)| %.5f (bound %.5f), "
+           "without HDR %.3f; RGBA16F - RGBA32F %.5f (bound %.5f)\n",
+           peak, 6.0 * peak_lo, max_rgb(hi_half), max_rgb(hi_ldr), e, bound, e_ldr, e_half, half_bound);
+
+    /* An HDR frame into an 8-bit target: refused before drawing (the target keeps its clear colour). */
+    {
+        splatfx_materials* m = NULL;
+        splatfx_scene* scene = NULL;
+        splatfx_frame* frame = NULL;
+        splatfx_renderer* r = NULL;
+        write_hdr_scene("capi_hdr_scene.json", 6.0);
+        CHECK_OK(splatfx_materials_create(NULL, &m, err), err);
+        CHECK_OK(splatfx_scene_load_file("capi_hdr_scene.json", m, NULL, &scene, err), err);
+        CHECK_OK(splatfx_scene_set_hdr_lit(scene, 1, err), err);
+        CHECK_OK(splatfx_frame_create(&frame, err), err);
+        CHECK_OK(splatfx_renderer_create(NULL, &r, err), err);
+        const float eye[3] = {0.9f, 0.75f, 2.4f}, at[3] = {0.0f, 0.25f, 0.0f}, up[3] = {0.0f, 1.0f, 0.0f};
+        splatfx_camera cam;
+        CHECK_OK(splatfx_camera_look_at(eye, at, up, 0.55f, W, H, 0.1f, 20.0f, &cam, err), err);
+        CHECK_OK(splatfx_scene_prepare(scene, 0.0, &cam, m, frame, err), err);
+        Target t = make_colour_target(GL_RGBA8);
+        splatfx_host_target target;
+        splatfx_host_target_init(&target);
+        target.framebuffer = t.fbo;
+        target.depth_texture = t.depth;
+        CHECK_FAILS(splatfx_renderer_render(r, m, frame, &target, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                    "GL_COLOR_ATTACHMENT0 is fixed-point (GL_UNSIGNED_NORMALIZED)");
+        printf("HDR frame into RGBA8: %s\n", splatfx_error_message(err));
+        unsigned char* px = malloc((size_t)W * H * 4);
+        if (px) {
+            read_pixels(&t, px);
+            int drawn = 0;
+            for (int i = 0; i < W * H * 4; ++i) drawn += px[i] != 0;
+            CHECK(drawn == 0, "the refused render drew %d channel values", drawn);
+            free(px);
+        }
+        /* The same frame into a float target draws. */
+        free_target(&t);
+        t = make_colour_target(GL_RGBA16F);
+        target.framebuffer = t.fbo;
+        target.depth_texture = t.depth;
+        CHECK_OK(splatfx_renderer_render(r, m, frame, &target, err), err);
+        CHECK(glGetError() == GL_NO_ERROR, "a GL error was raised");
+        free_target(&t);
+        splatfx_renderer_destroy(r);
+        splatfx_frame_destroy(frame);
+        splatfx_scene_destroy(scene);
+        splatfx_materials_destroy(m);
+    }
+done:
+    free(lo);
+    free(lo_ldr);
+    free(hi);
+    free(hi_half);
+    free(hi_ldr);
+}
+
 int main(void) {
     splatfx_error* err = splatfx_error_create();
     splatfx_headless_context* ctx = NULL;
@@ -665,6 +876,7 @@ int main(void) {
     test_wrong_context(err, ctx);
     test_gl_errors(err);
     test_notes(err);
+    test_hdr_lit(err);
     test_hook_destroys_its_context(err, ctx);
     CHECK(glGetError() == GL_NO_ERROR, "a GL error was raised");
     /* A renderer outliving its context: destroying it then must not abort in the GL loader, and

@@ -82,6 +82,16 @@ static void test_fire_prepares(void) {
     CHECK_OK(splatfx_frame_get_stats(frame, &st, err), err);
     CHECK(st.needed == 0 && st.splats == 0, "disabled: needed %llu splats %llu", (unsigned long long)st.needed, (unsigned long long)st.splats);
     CHECK_FAILS(splatfx_scene_set_effect_enabled(scene, 1, 1, err), err, SPLATFX_ERROR_NOT_FOUND, "id 1 is not an effect of this scene (it has 1)");
+    /* HDR lit colour: off by default, a host switch (capi_gl_test draws with it). */
+    CHECK(splatfx_scene_hdr_lit(scene) == 0, "HDR lit colour is on by default");
+    CHECK_OK(splatfx_scene_set_hdr_lit(scene, 7, err), err);
+    CHECK(splatfx_scene_hdr_lit(scene) == 1, "HDR lit colour did not turn on");
+    CHECK_OK(splatfx_scene_set_hdr_lit(scene, 0, err), err);
+    CHECK(splatfx_scene_hdr_lit(scene) == 0, "HDR lit colour did not turn off");
+    CHECK_FAILS(splatfx_scene_set_hdr_lit(NULL, 1, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "splatfx_scene_set_hdr_lit: scene is NULL");
+    CHECK_FAILS(splatfx_scene_set_hdr_lit((splatfx_scene*)m, 1, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
+                "scene is not a splatfx_scene (it is a splatfx_materials)");
+    CHECK(splatfx_scene_hdr_lit(NULL) == 0 && splatfx_scene_hdr_lit((const splatfx_scene*)m) == 0, "HDR lit colour of a non-scene");
     /* Out of range: a range of 1 world unit from 30 units away skips it. */
     options.range_world = 1.0f;
     CHECK_OK(splatfx_scene_add_fire(scene, m, NULL, &options, &id, err), err);
@@ -594,6 +604,8 @@ static void test_destroy_twice(void) {
     CHECK(splatfx_scene_effect_count(scene) == 0, "a destroyed scene has %u effects", splatfx_scene_effect_count(scene));
     CHECK_FAILS(splatfx_scene_set_effect_enabled(scene, 0, 0, err), err, SPLATFX_ERROR_INVALID_ARGUMENT,
                 "scene is not a splatfx_scene (it was destroyed");
+    CHECK_FAILS(splatfx_scene_set_hdr_lit(scene, 1, err), err, SPLATFX_ERROR_INVALID_ARGUMENT, "scene is not a splatfx_scene (it was destroyed");
+    CHECK(splatfx_scene_hdr_lit(scene) == 0, "HDR lit colour of a destroyed scene");
     splatfx_materials_destroy(m);
     splatfx_materials_destroy(m);
     CHECK(splatfx_materials_layer_count(m) == 0, "destroyed materials have %u layers", splatfx_materials_layer_count(m));

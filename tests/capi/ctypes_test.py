@@ -53,9 +53,11 @@ fx.splatfx_camera_look_at.argtypes = [C.c_float * 3] * 3 + [C.c_float, C.c_int32
                                                            C.POINTER(Camera), P]
 fx.splatfx_scene_prepare.argtypes = [P, C.c_double, C.POINTER(Camera), P, P, P]
 fx.splatfx_frame_get_stats.argtypes = [P, C.POINTER(FrameStats), P]
+fx.splatfx_scene_set_hdr_lit.argtypes = [P, C.c_int, P]
+fx.splatfx_scene_hdr_lit.argtypes = [P]
 
 SPLATFX_OK, INVALID_ARGUMENT = 0, 1
-check(fx.splatfx_c_api_version() == 3, "API version")
+check(fx.splatfx_c_api_version() == 4, "API version")
 err = fx.splatfx_error_create()
 m, scene, frame = P(), P(), P()
 check(fx.splatfx_materials_create(None, C.byref(m), err) == SPLATFX_OK, "materials")
@@ -83,6 +85,13 @@ check(fx.splatfx_frame_get_stats(frame, C.byref(st), err) == SPLATFX_OK, "stats"
 # The 3x4x2 dims reached the preset through ctypes' layout: at most one splat per voxel.
 check(st.declared == 1 and st.needed == 1 and 0 < st.splats <= 24 and st.time_sec == 0.5,
       f"stats: declared {st.declared} needed {st.needed} splats {st.splats} time {st.time_sec}")
+
+# HDR lit colour: a host switch, an int on both sides.
+check(fx.splatfx_scene_hdr_lit(scene) == 0, "HDR lit colour off by default")
+check(fx.splatfx_scene_set_hdr_lit(scene, 1, err) == SPLATFX_OK and fx.splatfx_scene_hdr_lit(scene) == 1, "HDR lit colour on")
+rc = fx.splatfx_scene_set_hdr_lit(m, 1, err)  # materials passed as the scene
+msg = fx.splatfx_error_message(err).decode()
+check(rc == INVALID_ARGUMENT and "scene is not a splatfx_scene (it is a splatfx_materials)" in msg, f"HDR on a wrong handle: {rc} {msg}")
 
 rc = fx.splatfx_scene_prepare(scene, math.nan, C.byref(cam), m, frame, err)
 msg = fx.splatfx_error_message(err).decode()

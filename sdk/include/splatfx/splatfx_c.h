@@ -96,8 +96,9 @@ extern "C" {
  * library's, so a binding can refuse a library it was not written for.
  * Versions only add: a program written for 1 runs unchanged on 2
  * (2 added splatfx_renderer_note_count and splatfx_renderer_note; 3 added
- * splatfx_embers_desc and splatfx_scene_add_embers). */
-#define SPLATFX_C_API_VERSION 3
+ * splatfx_embers_desc and splatfx_scene_add_embers; 4 added
+ * splatfx_scene_set_hdr_lit and splatfx_scene_hdr_lit). */
+#define SPLATFX_C_API_VERSION 4
 SPLATFX_C_API uint32_t splatfx_c_api_version(void);
 
 /* ---- [errors] ------------------------------------------------------------ */
@@ -397,6 +398,20 @@ SPLATFX_C_API splatfx_status splatfx_scene_load_file(const char* path, splatfx_m
 SPLATFX_C_API uint32_t splatfx_scene_effect_count(const splatfx_scene* scene);
 SPLATFX_C_API splatfx_status splatfx_scene_set_effect_enabled(splatfx_scene* scene, uint32_t id, int enabled, splatfx_error* error);
 
+/* HDR lit colour (Scene::setHdrLit; docs/lighting.md, "HDR lit colour"), for
+ * a host whose colour target is floating point (GL_RGBA16F, GL_RGBA32F):
+ * on, a lit or emissive colour brighter than 1 keeps its brightness through
+ * to the target, exposure and tone mapping left to the host; off (the
+ * default), it is scaled down to 1 keeping its hue, for 8-bit targets.
+ * Colours at or below 1 are drawn the same either way. A host option, not a
+ * scene-file key: it depends on the host's target, which the file does not
+ * know. Takes effect at the next prepare; the frame remembers it, and
+ * splatfx_renderer_render refuses to draw such a frame into a fixed-point
+ * colour target (it would clamp each channel at 1, shifting the hue). */
+SPLATFX_C_API splatfx_status splatfx_scene_set_hdr_lit(splatfx_scene* scene, int on, splatfx_error* error);
+/* 1 when on, 0 when off or for a NULL or destroyed scene. */
+SPLATFX_C_API int splatfx_scene_hdr_lit(const splatfx_scene* scene);
+
 /* ---- [camera] ---------------------------------------------------------------- */
 
 /* The host's camera, a plain value (camera.hpp). */
@@ -503,7 +518,11 @@ SPLATFX_C_API splatfx_status splatfx_renderer_upload(splatfx_renderer* renderer,
 /* Draws the frame into the host target: the opaque hook, the volumes tested
  * against the host depth, the transparent hook (gl::FrameRenderer::render).
  * `materials` must be those the frame was prepared with. Never clears, never
- * writes depth; restores the GL state it touches. */
+ * writes depth; restores the GL state it touches. A frame prepared with HDR
+ * lit colour (splatfx_scene_set_hdr_lit) needs a floating-point colour
+ * target (the framebuffer's GL_COLOR_ATTACHMENT0, or the default
+ * framebuffer's back buffer): a fixed-point one is
+ * SPLATFX_ERROR_INVALID_ARGUMENT and nothing is drawn. */
 SPLATFX_C_API splatfx_status splatfx_renderer_render(splatfx_renderer* renderer, const splatfx_materials* materials, const splatfx_frame* frame,
                                                      const splatfx_host_target* target, splatfx_error* error);
 SPLATFX_C_API splatfx_status splatfx_renderer_get_stats(const splatfx_renderer* renderer, splatfx_render_stats* out, splatfx_error* error);

@@ -540,6 +540,16 @@ splatfx_status splatfx_scene_set_effect_enabled(splatfx_scene* scene, uint32_t i
     });
 }
 
+splatfx_status splatfx_scene_set_hdr_lit(splatfx_scene* scene, int on, splatfx_error* error) {
+    return guard("splatfx_scene_set_hdr_lit", error, [&] {
+        if (auto bad = checkHandle(scene, Magic::Scene, "scene", "splatfx_scene")) return *bad;
+        scene->value.setHdrLit(on != 0);
+        return success();
+    });
+}
+
+int splatfx_scene_hdr_lit(const splatfx_scene* scene) { return isLive(scene, Magic::Scene) && scene->value.hdrLit() ? 1 : 0; }
+
 void splatfx_obstacle_desc_init(splatfx_obstacle_desc* desc) {
     if (!desc) return;
     *desc = {};
@@ -683,6 +693,7 @@ splatfx_status splatfx_scene_prepare(splatfx_scene* scene, double time_sec, cons
         if (auto bad = checkCamera(*camera, "camera")) return *bad;
         if (Status s = scene->value.prepare(time_sec, toCamera(*camera), materials->value, frame->value); !s) return invalid(s.error());
         frame->prepared = true;
+        frame->hdrLit = scene->value.hdrLit();
         frame->materials = materials->identity;
         // Drawn without what was asked for: the host hears it, and may still render the frame.
         if (const std::string& lit = scene->value.lightingError(); !lit.empty())

@@ -105,6 +105,25 @@ std::optional<Outcome> sdkErrors(const GlErrors& e, const std::string& what) {
     return failure(SPLATFX_ERROR_GL, e.names() + " raised by splatfx's own GL calls during " + what);
 }
 
+// A frame prepared with HDR lit colour keeps colours above 1 only in a
+// floating-point target; a fixed-point one clamps each channel at 1 (an orange
+// flame turns yellow-white). The colour buffer drawn into: the framebuffer
+// object's attachment 0, or the default framebuffer's back buffer.
+std::optional<Outcome> checkHdrTarget(GLuint fb) {
+    const GLenum attachment = fb == 0 ? GL_BACK_LEFT : GL_COLOR_ATTACHMENT0;
+    GLint objectType = GL_NONE, componentType = GL_NONE;
+    glGetNamedFramebufferAttachmentParameteriv(fb, attachment, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &objectType);
+    if (objectType != GL_NONE) glGetNamedFramebufferAttachmentParameteriv(fb, attachment, GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE, &componentType);
+    // A default framebuffer without that buffer (a surfaceless context) answers with an error: nothing to check.
+    dropHostErrors();
+    if (componentType != GL_UNSIGNED_NORMALIZED && componentType != GL_SIGNED_NORMALIZED) return std::nullopt;
+    return invalid("frame was prepared with HDR lit colour (splatfx_scene_set_hdr_lit) but target->framebuffer " + std::to_string(fb) + "'s " +
+                   (fb == 0 ? "back buffer" : "GL_COLOR_ATTACHMENT0") + " is fixed-point (" +
+                   (componentType == GL_UNSIGNED_NORMALIZED ? "GL_UNSIGNED_NORMALIZED" : "GL_SIGNED_NORMALIZED") +
+                   "): its lit colours above 1 would clamp at 1, shifting their hue; draw into a GL_RGBA16F or GL_RGBA32F target, or turn HDR "
+                   "lit colour off and prepare the frame again");
+}
+
 // A fresh FrameRenderer has uploaded nothing, so its first upload is complete.
 Outcome recreate(splatfx_renderer& r) {
     r.value.reset();
@@ -319,6 +338,8 @@ splatfx_status splatfx_renderer_render(splatfx_renderer* renderer, const splatfx
                 return failure(SPLATFX_ERROR_GL, "target->depth_texture " + std::to_string(target->depth_texture) +
                                                      " has no depth component (GL_TEXTURE_DEPTH_SIZE is 0); expected the host's depth texture");
         }
+        if (frame->hdrLit)
+            if (auto bad = checkHdrTarget(target->framebuffer)) return *bad;
         if (Outcome o = upload(*renderer, *materials); !o.ok()) return o;
 
         // From here to the end the handles are held: a hook may destroy them, and they are deleted after the render.

@@ -185,6 +185,7 @@ struct splatfx_frame {
     splatfx::capi::Magic magic = splatfx::capi::Magic::Frame;
     splatfx::Frame value;
     bool prepared = false;
+    bool hdrLit = false;          // prepared with Scene::hdrLit(): needs a floating-point colour target
     std::weak_ptr<int> materials; // identity of the materials it was prepared with
 };
 
