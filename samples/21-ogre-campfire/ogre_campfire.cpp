@@ -54,22 +54,27 @@ void main() {
     vWorld = (world * vertex).xyz;
 }
 )";
-// Lambert from a low sun plus the fire's own light: splatfx's emitted lights
-// (splatfx_emittedIrradiance from shadowGlsl(), set each frame from
-// Frame::emittedLights() as OGRE parameters), a Lambertian surface
+// Lambert from the sun, shadowed by the smoke (splatfx_shadowTo(0, ...): the
+// transmittance towards scene light 0 through the frame's shadow table,
+// bound as an OGRE texture unit), plus the fire's own light: splatfx's
+// emitted lights (splatfx_emittedIrradiance), a Lambertian surface
 // reflecting albedo x E / pi; and a checker on surfaces that ask for it (the
-// ground). Compiled after "#version 330 core" and splatfx::shadowGlsl().
+// ground). Both from shadowGlsl(), their uniforms set each frame as OGRE
+// parameters. Compiled after "#version 330 core" and splatfx::shadowGlsl().
 const char* kFragmentShader = R"(
 in vec3 vNormal;
 in vec3 vWorld;
 uniform vec3 albedo;
 uniform float checker;
+uniform vec3 sunTowards;
+uniform vec3 sunColour;
 out vec4 fragColour;
 void main() {
     vec3 n = normalize(vNormal);
-    vec3 sun = normalize(vec3(-0.4, 0.8, 0.45));
+    vec3 sun = normalize(sunTowards);
     vec3 fireLight = splatfx_emittedIrradiance(vWorld, n) * 0.31830989;
-    vec3 light = vec3(0.10, 0.11, 0.16) + vec3(0.35, 0.35, 0.42) * max(dot(n, sun), 0.0) + fireLight;
+    float smokeShadow = splatfx_shadowTo(0, vWorld);
+    vec3 light = vec3(0.10, 0.11, 0.16) + sunColour * max(dot(n, sun), 0.0) * smokeShadow + fireLight;
     float c = 1.0;
     if (checker > 0.0) c = (mod(floor(vWorld.x) + floor(vWorld.z), 2.0) < 1.0) ? 1.0 : 0.7;
     fragColour = vec4(albedo * c * light, 1.0);
@@ -126,6 +131,13 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
     Ogre::SceneNode* logNode = nullptr;
     // The fragment parameters of the three materials: the fire's lights go there each frame.
     std::vector<Ogre::GpuProgramParametersSharedPtr> surfaceParams;
+    // The smoke's shadow table (FrameShadow of slot 0) as an OGRE 3D texture,
+    // on texture unit 0 of each material's pass; re-uploaded when its version changes.
+    Ogre::TexturePtr shadowTexture;
+    std::vector<Ogre::TextureUnitState*> shadowUnits;
+    glm::ivec3 shadowDims{0};
+    std::uint64_t shadowVersion = 0;
+    bool shadowUploaded = false;
 
     // splatfx.
     splatfx::Materials materials{splatfx::Footprint{}};
@@ -173,10 +185,58 @@ struct OgreCampfire::Impl : public Ogre::RenderQueueListener {
         }
     }
 
+    // (Re)makes the shadow texture for `dims` when they changed (the units
+    // follow it) and uploads `depth` (dims.x * dims.y * dims.z floats, x fastest).
+    void uploadShadow(glm::ivec3 dims, const float* depth) {
+        if (dims != shadowDims || !shadowTexture) {
+            if (shadowTexture) Ogre::TextureManager::getSingleton().remove(shadowTexture);
+            shadowTexture = Ogre::TextureManager::getSingleton().createManual("splatfx/smokeShadow", Ogre::RGN_DEFAULT, Ogre::TEX_TYPE_3D,
+                                                                              Ogre::uint(dims.x), Ogre::uint(dims.y), Ogre::uint(dims.z), 0,
+                                                                              Ogre::PF_FLOAT32_R, Ogre::TU_DYNAMIC_WRITE_ONLY);
+            for (Ogre::TextureUnitState* u : shadowUnits) u->setTexture(shadowTexture);
+            shadowDims = dims;
+        }
+        const Ogre::PixelBox box(Ogre::uint32(dims.x), Ogre::uint32(dims.y), Ogre::uint32(dims.z), Ogre::PF_FLOAT32_R, const_cast<float*>(depth));
+        shadowTexture->getBuffer()->blitFromMemory(box);
+    }
+
+    // shadowGlsl()'s table of slot 0 (the sun's: the smoke's transmittance)
+    // through OGRE: what gl::setShadowUniforms and the FrameRenderer's own
+    // upload do for a GL program, but as an OGRE texture and OGRE parameters,
+    // because OGRE draws its surfaces before splatfx's hook runs (the
+    // FrameRenderer binds its tables only while it renders). The table is the
+    // frame's optical depth in log2 units, R32F, linear, clamped
+    // (docs/lighting.md, "For a GL pass"); off, or without a table, slot 0
+    // names no light and splatfx_shadowTo(0, ...) returns 1.
+    splatfx::Status setSmokeShadow(bool on) {
+        const splatfx::FrameShadow& sh = frame.shadows()[0];
+        const bool valid = on && sh.valid && sh.light == 0 && sh.dims.x > 0 && sh.dims.y > 0 && sh.dims.z > 0 &&
+                           sh.depth.size() == std::size_t(sh.dims.x) * std::size_t(sh.dims.y) * std::size_t(sh.dims.z);
+        try {
+            if (valid && (!shadowUploaded || sh.version != shadowVersion || sh.dims != shadowDims)) {
+                uploadShadow(sh.dims, sh.depth.data());
+                shadowVersion = sh.version;
+                shadowUploaded = true;
+            }
+        } catch (const Ogre::Exception& e) { return splatfx::makeError("OGRE: the smoke's shadow table: " + describe(e)); }
+        const int index[splatfx::kMaxShadowLights] = {valid ? 0 : -1, -1, -1, -1};
+        // OGRE keeps matrices by rows (Ogre::Matrix4) and GL3Plus uploads them transposed
+        // (glUniformMatrix4fv, transpose GL_TRUE), raw floats too: hand it the rows.
+        const glm::mat4 worldToTable = glm::transpose(valid ? sh.worldToTable : glm::mat4(1.0f));
+        const glm::vec4 light = valid ? sh.lightInTable : glm::vec4(0.0f, -1.0f, 0.0f, 0.0f);
+        for (const Ogre::GpuProgramParametersSharedPtr& fp : surfaceParams) {
+            fp->setNamedConstant("splatfx_shadowLightIndex", index, 1, splatfx::kMaxShadowLights);
+            fp->setNamedConstant("splatfx_worldToTable", &worldToTable[0][0], 4, 4);
+            fp->setNamedConstant("splatfx_shadowLight", &light[0], 1, 4);
+        }
+        return {};
+    }
+
     ~Impl() override {
         if (depthCopyFbo) glDeleteFramebuffers(1, &depthCopyFbo);
         if (depthCopy) glDeleteTextures(1, &depthCopy);
         renderer.reset(); // its GL objects live in OGRE's context: before the Root goes
+        shadowTexture.reset();
         if (sceneManager) sceneManager->removeRenderQueueListener(this);
         colourTexture.reset();
         root.reset(); // destroys the window and the context
@@ -379,6 +439,17 @@ splatfx::Result<std::unique_ptr<OgreCampfire>> OgreCampfire::create(const OgreCa
             auto fp = pass->getFragmentProgramParameters();
             fp->setNamedConstant("albedo", albedo);
             fp->setNamedConstant("checker", checker);
+            fp->setNamedConstant("sunTowards", Ogre::Vector3(kSunTowards[0], kSunTowards[1], kSunTowards[2]));
+            fp->setNamedConstant("sunColour", Ogre::Vector3(kSunColour[0], kSunColour[1], kSunColour[2]));
+            // The smoke's shadow table on the pass's texture unit 0 (its texture set by
+            // setSmokeShadow). Every slot's sampler3D reads unit 0: slots 1 to 3 name no
+            // light and are never sampled, but a sampler must not share a unit with another type.
+            Ogre::TextureUnitState* unit = pass->createTextureUnitState();
+            unit->setTextureFiltering(Ogre::FO_LINEAR, Ogre::FO_LINEAR, Ogre::FO_NONE);
+            unit->setTextureAddressingMode(Ogre::TextureUnitState::TAM_CLAMP);
+            s.shadowUnits.push_back(unit);
+            for (const char* table : {"splatfx_shadowTable", "splatfx_shadowTable1", "splatfx_shadowTable2", "splatfx_shadowTable3"})
+                fp->setNamedConstant(table, 0);
             s.surfaceParams.push_back(fp);
             m->load();
             return m;
@@ -399,6 +470,16 @@ splatfx::Result<std::unique_ptr<OgreCampfire>> OgreCampfire::create(const OgreCa
                                      std::to_string(splatfx::kMaxEmittedLights) + "] of the sample's material" +
                                      (d ? " (it reads " + std::to_string(d->arraySize) + " elements)" : ""));
             }
+        // Until the first frame with a table, the units hold a 1^3 table of zero depth (unshadowed).
+        const float zeroDepth = 0.0f;
+        s.uploadShadow(glm::ivec3(1), &zeroDepth);
+        // The same for the shadow slots' light indices (setSmokeShadow writes all four).
+        for (const Ogre::GpuProgramParametersSharedPtr& fp : s.surfaceParams) {
+            const Ogre::GpuConstantDefinition* d = fp->_findNamedConstantDefinition("splatfx_shadowLightIndex", false);
+            if (!d || d->elementSize * d->arraySize < std::size_t(splatfx::kMaxShadowLights))
+                return makeError("OGRE did not take the shadow uniform splatfx_shadowLightIndex[" + std::to_string(splatfx::kMaxShadowLights) +
+                                 "] of the sample's material" + (d ? " (it reads " + std::to_string(d->arraySize) + " elements)" : ""));
+        }
 
         Ogre::SceneNode* rootNode = s.sceneManager->getRootSceneNode();
         Ogre::MeshManager::getSingleton().createPlane("splatfx/groundPlane", group, Ogre::Plane(Ogre::Vector3::UNIT_Y, 0.0f), 60.0f, 60.0f, 1, 1,
@@ -461,6 +542,32 @@ splatfx::Result<std::unique_ptr<OgreCampfire>> OgreCampfire::create(const OgreCa
     fireOptions.emitsLight.lights = 2;
     fireOptions.emitsLight.scale = 6.0f;
     s.scene.add(std::move(*fire), std::move(fireOptions));
+    if (desc.smoke) {
+        // The sun of OGRE's shader as splatfx's scene light 0 (it travels away from
+        // kSunTowards): it lights the smoke, and the frame's scene-shadow table for it
+        // (SceneShadowDesc's default: light 0, 64^3) is the smoke's shadow on OGRE's surfaces.
+        const glm::vec3 towards(kSunTowards[0], kSunTowards[1], kSunTowards[2]);
+        if (auto l = s.scene.addLight(splatfx::Light::directional(-glm::normalize(towards), {1.0f, 0.97f, 0.92f}, 1.0f)); !l)
+            return makeError(l.error());
+        // Above the flames (the fire's lattice is 10 tall, its flames end lower), the
+        // emitter at the domain's left; a breeze carries the smoke right and a little forward.
+        splatfx::presets::SmokeDesc smoke;
+        smoke.dims = {14, 14, 8};
+        smoke.spacing = glm::vec3(0.5f);
+        smoke.position = {2.5f, 7.0f, 0.0f};
+        smoke.sourceOffset = {-2.5f, 0.5f, 0.0f};
+        smoke.sourceRadius = 0.9f;
+        smoke.windWorld = {1.6f, 0.0f, 0.4f};
+        smoke.seed = desc.seed;
+        auto plume = splatfx::presets::smoke(s.materials, smoke);
+        if (!plume) return makeError(plume.error());
+        splatfx::EffectOptions smokeOptions;
+        smokeOptions.name = "smoke";
+        smokeOptions.lighting.enabled = true;
+        smokeOptions.lighting.gas.albedo = 0.7f;
+        smokeOptions.lighting.gas.ambient = {0.16f, 0.17f, 0.24f};
+        s.scene.add(std::move(*plume), std::move(smokeOptions));
+    }
     splatfx::gl::FrameRendererDesc frd;
     frd.resolutionScale = desc.resolutionScale;
     frd.splats.restoreState = desc.restoreState;
@@ -484,6 +591,7 @@ splatfx::Status OgreCampfire::render(const FrameOptions& options) {
     s.drawnCamera = s.convert();
     if (auto st = s.scene.prepare(options.timeSec, s.drawnCamera, s.materials, s.frame); !st) return st;
     s.setFireLight(options.fireLight);
+    if (auto st = s.setSmokeShadow(options.smokeShadow); !st) return st;
     try {
         s.logNode->setVisible(options.log);
         if (!s.root->renderOneFrame()) return splatfx::makeError("OGRE's renderOneFrame asked to stop");

@@ -4,8 +4,8 @@
 //
 // What it is: a small OGRE application (its Root, a hidden window for the GL
 // context, a scene manager with a ground, a log in front of the fire and a
-// wall behind it, drawn with GLSL materials made in code, lit by the fire's
-// emitted lights) whose main render queue ends with splatfx's
+// wall behind it, drawn with GLSL materials made in code, lit by a sun that
+// the fire's smoke shadows and by the fire's emitted lights) whose main render queue ends with splatfx's
 // gl::FrameRenderer drawing the campfire into the framebuffer OGRE has bound. It shows what an engine hands over (its
 // framebuffer name, its depth as a texture, its camera) and what state has
 // to survive (docs/integration.md, "Inside an engine").
@@ -32,6 +32,15 @@
 
 namespace ogrefx {
 
+// Towards the sun (not normalised): high, from the left and a little in front,
+// so the smoke drifting right above the fire throws its shadow onto the ground
+// right of the fire, in front of the wall. One direction for OGRE's shader
+// (uniform sunTowards, Lambert) and splatfx's scene light 0 (lights the smoke
+// and casts its shadow).
+inline constexpr float kSunTowards[3] = {-0.35f, 1.0f, 0.25f};
+// The sun's colour x intensity in OGRE's shader (irradiance on a surface facing it).
+inline constexpr float kSunColour[3] = {0.35f, 0.35f, 0.42f};
+
 struct OgreCampfireDesc {
     int width = 640;         // render-texture size, pixels; default 640
     int height = 360;        // default 360
@@ -48,6 +57,10 @@ struct OgreCampfireDesc {
     bool reverseZ = false;
     int msaa = 0; // 0 or 1: single-sampled; 2, 4, 8: OGRE's FSAA on the render texture
     bool srgb = false;
+    // The fire's smoke, lit by the sun that lights OGRE's surfaces (splatfx's
+    // scene light 0), drifting right; its shadow falls on OGRE's ground through
+    // shadowGlsl() in OGRE's material. Default true.
+    bool smoke = true;
 };
 
 struct FrameOptions {
@@ -55,6 +68,7 @@ struct FrameOptions {
     bool fire = true;     // draw splatfx's splats in OGRE's frame (off: its light on OGRE's surfaces stays); default true
     bool log = true;      // OGRE draws the log in front of the fire; default true
     bool fireLight = true; // the fire's emitted lights on OGRE's surfaces; off: none (the test's comparison); default true
+    bool smokeShadow = true; // the smoke's shadow (the frame's scene-shadow table) on OGRE's surfaces; off: none; default true
 };
 
 // What the render-queue hook saw in the last frame (for the docs and tests).

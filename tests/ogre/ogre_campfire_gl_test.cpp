@@ -190,6 +190,133 @@ TEST_F(OgreCampfireTest, TheFireLightsOgresGroundAsTheCpuPredicts) {
     std::printf("fire light on OGRE's ground: %d channel values, largest %.4f, worst error %.5f\n", checked, largest, worst);
 }
 
+// shadow.glsl's splatfx_shadowIn in double, on the frame's own table (FrameShadow):
+// a point outside the table moves along its ray to the light to where the ray
+// enters the table (one that misses it is unshadowed); trilinear between nodes,
+// node i of n at table coordinate i / (n - 1).
+double cpuShadow(const splatfx::FrameShadow& s, const glm::dvec3& world) {
+    const glm::dvec3 p = glm::dvec3(glm::dmat4(s.worldToTable) * glm::dvec4(world, 1.0));
+    const glm::dvec4 light(s.lightInTable);
+    const bool isPoint = light.w > 0.5;
+    const glm::dvec3 d = isPoint ? glm::dvec3(light) - p : -glm::dvec3(light);
+    double tNear = 0.0, tFar = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < 3; ++i) {
+        const double inv = (d[i] >= 0.0 ? 1.0 : -1.0) / std::max(std::abs(d[i]), 1e-30);
+        const double ta = -p[i] * inv, tb = (1.0 - p[i]) * inv;
+        tNear = std::max(tNear, std::min(ta, tb));
+        tFar = std::min(tFar, std::max(ta, tb));
+    }
+    if (isPoint) tFar = std::min(tFar, 1.0);
+    if (tNear > tFar) return 1.0;
+    const glm::dvec3 q = glm::clamp(p + d * tNear, glm::dvec3(0.0), glm::dvec3(1.0));
+    const glm::ivec3 n = s.dims;
+    const glm::dvec3 g = q * glm::dvec3(n - 1);
+    const glm::ivec3 i0 = glm::min(glm::ivec3(glm::floor(g)), glm::max(n - 2, glm::ivec3(0)));
+    const glm::dvec3 f = g - glm::dvec3(i0);
+    auto at = [&](int x, int y, int z) {
+        x = std::min(x, n.x - 1), y = std::min(y, n.y - 1), z = std::min(z, n.z - 1);
+        return double(s.depth[(std::size_t(z) * n.y + y) * n.x + x]);
+    };
+    double depth = 0.0;
+    for (int c = 0; c < 8; ++c) {
+        const int dx = c & 1, dy = (c >> 1) & 1, dz = (c >> 2) & 1;
+        depth += (dx ? f.x : 1.0 - f.x) * (dy ? f.y : 1.0 - f.y) * (dz ? f.z : 1.0 - f.z) * at(i0.x + dx, i0.y + dy, i0.z + dz);
+    }
+    return std::exp2(-depth);
+}
+
+// The largest optical-depth difference between neighbouring nodes (log2 units).
+double maxNeighbourStep(const splatfx::FrameShadow& s) {
+    const glm::ivec3 n = s.dims;
+    double step = 0.0;
+    auto at = [&](int x, int y, int z) { return double(s.depth[(std::size_t(z) * n.y + y) * n.x + x]); };
+    for (int z = 0; z < n.z; ++z)
+        for (int y = 0; y < n.y; ++y)
+            for (int x = 0; x < n.x; ++x) {
+                if (x + 1 < n.x) step = std::max(step, std::abs(at(x + 1, y, z) - at(x, y, z)));
+                if (y + 1 < n.y) step = std::max(step, std::abs(at(x, y + 1, z) - at(x, y, z)));
+                if (z + 1 < n.z) step = std::max(step, std::abs(at(x, y, z + 1) - at(x, y, z)));
+            }
+    return step;
+}
+
+// The smoke's shadow on OGRE's ground (issue 27, items 1 and 3: shadowGlsl() in
+// a host's own material): OGRE's material multiplies the sun's Lambert term by
+// splatfx_shadowTo(0, ...), its table the frame's scene-shadow table for the
+// sun, handed to OGRE as a 3D texture on the pass's texture unit and OGRE
+// parameters. Frames without the splats and the fire's light, with and without
+// the shadow: every ground pixel differs by albedo x checker x sun x cos x (T - 1),
+// T the CPU's transmittance from the same table. A transposed matrix, a wrong
+// texture unit, format or filtering would miss by far more than the bound.
+TEST_F(OgreCampfireTest, TheSmokeShadowsOgresGroundAsTheCpuTableSays) {
+    const Shot sunlit = shot({.timeSec = kTime, .fire = false, .log = true, .fireLight = false, .smokeShadow = false});
+    const Shot shaded = shot({.timeSec = kTime, .fire = false, .log = true, .fireLight = false, .smokeShadow = true});
+    ASSERT_FALSE(sunlit.rgba.empty() || shaded.rgba.empty());
+    const splatfx::FrameShadow& table = sApp->frame().shadows()[0];
+    ASSERT_TRUE(table.valid) << "the smoke should cast a scene shadow";
+    ASSERT_EQ(table.light, 0);
+    const glm::dvec3 albedo(0.45, 0.42, 0.36); // the ground's material (ogre_campfire.cpp)
+    const glm::dvec3 sunColour(ogrefx::kSunColour[0], ogrefx::kSunColour[1], ogrefx::kSunColour[2]);
+    const double cosine = glm::normalize(glm::dvec3(ogrefx::kSunTowards[0], ogrefx::kSunTowards[1], ogrefx::kSunTowards[2])).y;
+    // Bound on T (tests/lighting/shadow_gl_test.cpp's): GL may filter with 8-bit weights, an error of
+    // 3/256 of the largest node step in depth, ln 2 times that in transmittance (T <= 1); the shader's
+    // interpolated world position (float, within 2^-20 x 20 m of the pixel centre's ground point) moves
+    // the lookup by at most 2e-5 m, times the steepest slope ln 2 x step / node spacing; float rounding.
+    const double step = maxNeighbourStep(table);
+    double spacing = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < 3; ++i) {
+        const glm::dmat4 m(table.worldToTable);
+        const double perWorld = glm::length(glm::dvec3(m[0][i], m[1][i], m[2][i]));
+        spacing = std::min(spacing, 1.0 / (perWorld * std::max(table.dims[i] - 1, 1)));
+    }
+    const double tolT = std::log(2.0) * (3.0 / 256.0 * step + 2e-5 * step / spacing) + 1e-5;
+    const splatfx::Camera cam = sApp->camera();
+    const glm::dmat4 viewProj = glm::dmat4(cam.proj) * glm::dmat4(cam.view);
+    const glm::dmat4 inv = glm::inverse(viewProj);
+    int checked = 0, underSmoke = 0;
+    double worst = 0.0, darkest = 1.0;
+    for (int r = 0; r < kH; ++r)
+        for (int x = 0; x < kW; ++x) {
+            const int y = glRow(r);
+            const glm::dvec2 ndc(2.0 * (x + 0.5) / kW - 1.0, 2.0 * (y + 0.5) / kH - 1.0);
+            glm::dvec4 a = inv * glm::dvec4(ndc, -1.0, 1.0), b = inv * glm::dvec4(ndc, 1.0, 1.0);
+            const glm::dvec3 p0 = glm::dvec3(a) / a.w, p1 = glm::dvec3(b) / b.w;
+            if (p1.y >= p0.y) continue;
+            const double t = p0.y / (p0.y - p1.y);
+            if (t <= 0.0 || t >= 1.0) continue;
+            const glm::dvec3 hit = p0 + t * (p1 - p0);
+            if (std::abs(hit.x) > 29.0 || std::abs(hit.z) > 29.0) continue;
+            // OGRE drew the ground here (not the log or the wall in front of it): its depth is the
+            // ground point's (within 1e-6, OgresDepthMatchesTheConvertedCameraOnTheGround).
+            const std::size_t p = std::size_t(r) * kW + x;
+            const glm::dvec4 c = viewProj * glm::dvec4(hit, 1.0);
+            if (std::abs(double(sunlit.depth[p]) - (0.5 * (c.z / c.w) + 0.5)) > 1e-6) continue;
+            const double fx = hit.x - std::floor(hit.x), fz = hit.z - std::floor(hit.z);
+            if (std::min({fx, 1.0 - fx, fz, 1.0 - fz}) < 1e-3) continue;
+            const double checker = (long(std::floor(hit.x)) + long(std::floor(hit.z))) % 2 == 0 ? 1.0 : 0.7;
+            const double T = cpuShadow(table, hit);
+            darkest = std::min(darkest, T);
+            for (int ch = 0; ch < 3; ++ch) {
+                const double sun = albedo[ch] * checker * sunColour[ch] * cosine;
+                if (sunlit.rgba[p * 4 + ch] >= 255) continue; // clamped by the 8-bit target
+                const double expected = sun * (T - 1.0);
+                // Each frame rounded to 8 bits (half a step each way): within one step of the exact difference.
+                const double diff = (int(shaded.rgba[p * 4 + ch]) - int(sunlit.rgba[p * 4 + ch])) / 255.0;
+                const double bound = 1.0 / 255.0 + sun * tolT;
+                worst = std::max(worst, std::abs(diff - expected) / bound);
+                EXPECT_LE(std::abs(diff - expected), bound) << "pixel " << x << "," << r << " channel " << ch << ", T " << T << ": GL " << diff << ", CPU " << expected;
+                underSmoke += ch == 0 && expected < -3.0 / 255.0;
+                ++checked;
+            }
+        }
+    ASSERT_GT(checked, kW * 10) << "the ground should fill the lower rows";
+    EXPECT_LT(darkest, 0.8) << "the smoke's shadow should reach the visible ground";
+    EXPECT_GT(underSmoke, 100) << "ground pixels darker by more than three 8-bit steps";
+    std::printf("smoke shadow on OGRE's ground: %d channel values, %d pixels darker by > 3/255, darkest T %.3f, "
+                "worst error / bound %.3f (T bound %.5f, node step %.3f)\n",
+                checked, underSmoke, darkest, worst, tolT, step);
+}
+
 // A: log, no fire; B: log and fire; C: no log, no fire; D: fire, no log.
 // Where OGRE's surface is nearer than every splat fragment can be, the fire
 // leaves OGRE's pixel untouched (bit for bit); where the log is absent, the
