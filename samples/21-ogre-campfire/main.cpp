@@ -1,7 +1,8 @@
 // Sample 21: splatfx's campfire drawn inside OGRE 1.12 (GL3Plus), in OGRE's
 // frame (a RenderQueueListener at the end of the main queue), into OGRE's
 // render target against OGRE's depth, with OGRE's camera. OGRE draws the
-// ground, a log in front of the fire and a wall behind it.
+// ground, a log in front of the fire and a wall behind it, lit by a sun whose
+// light the fire's smoke shadows (splatfx's shadow table in OGRE's material).
 //   ogre-campfire [--frames N] [--size WxH] [--scale 1|2|4] [--seed S] [--time SECONDS] [--screenshot out.png]
 //                 [--reverse-z] [--msaa N] [--srgb]
 // Needs an X display: headless, run it under xvfb-run -a.
@@ -22,7 +23,7 @@ int fail(const std::string& why) {
 int run(int argc, char** argv) {
     ogrefx::OgreCampfireDesc desc;
     int frames = 24;
-    double timeSec = 1.0;
+    double timeSec = 6.0; // the smoke has risen and drifts over the ground by then
     std::string screenshot;
     CLI::App cli{"splatfx's campfire drawn inside OGRE 1.12 (GL3Plus); needs an X display (headless: xvfb-run -a)", "ogre-campfire"};
     samples::addNumber(cli, "--frames", frames, 1, 100000, "frames rendered, 24 per second, ending at --time");

@@ -558,6 +558,7 @@ splatfx::Result<std::unique_ptr<OgreCampfire>> OgreCampfire::create(const OgreCa
         smoke.sourceOffset = {-2.5f, 0.5f, 0.0f};
         smoke.sourceRadius = 0.9f;
         smoke.windWorld = {1.6f, 0.0f, 0.4f};
+        smoke.dissipation = 0.05f; // a thick campfire smoke: it thins slowly
         smoke.seed = desc.seed;
         auto plume = splatfx::presets::smoke(s.materials, smoke);
         if (!plume) return makeError(plume.error());
@@ -566,6 +567,7 @@ splatfx::Result<std::unique_ptr<OgreCampfire>> OgreCampfire::create(const OgreCa
         smokeOptions.lighting.enabled = true;
         smokeOptions.lighting.gas.albedo = 0.7f;
         smokeOptions.lighting.gas.ambient = {0.16f, 0.17f, 0.24f};
+        smokeOptions.draw.opacityScale = 2.5f;
         s.scene.add(std::move(*plume), std::move(smokeOptions));
     }
     splatfx::gl::FrameRendererDesc frd;

@@ -39,7 +39,7 @@ namespace ogrefx {
 // and casts its shadow).
 inline constexpr float kSunTowards[3] = {-0.35f, 1.0f, 0.25f};
 // The sun's colour x intensity in OGRE's shader (irradiance on a surface facing it).
-inline constexpr float kSunColour[3] = {0.35f, 0.35f, 0.42f};
+inline constexpr float kSunColour[3] = {0.6f, 0.58f, 0.55f};
 
 struct OgreCampfireDesc {
     int width = 640;         // render-texture size, pixels; default 640
