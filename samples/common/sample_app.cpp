@@ -26,7 +26,7 @@ int parseOptions(int argc, char** argv, const char* name, const char* about, Opt
     addNumber(app, "--seed", o.seed, 0u, 4294967295u, "seed of every random choice");
     app.add_option_function<std::string>(
            "--fps",
-           [&o, name](const std::string& text) {
+           [&o](const std::string& text) {
                float fps = 0.0f;
                if (!option_text::readAll(text, fps) || !(fps > 0.0f && fps <= 240.0f))
                    throw CLI::ValidationError(std::string("--fps must be in (0, 240], got '") + text + "'");
