@@ -209,7 +209,7 @@ const char* toString(StepKind kind) {
 std::string describe(const PlanStep& s) {
     std::string line = toString(s.kind);
     if (s.kind == StepKind::Tetrahedra) line += " volume " + std::to_string(s.volume);
-    if (s.kind == StepKind::HostDepthSample) line += s.sample >= 0 ? " " + std::to_string(s.sample) : std::string(" nearest");
+    if (s.kind == StepKind::HostDepthSample) line.append(" ").append(s.sample >= 0 ? std::to_string(s.sample) : std::string("nearest"));
     switch (s.range) {
     case StepRange::Explicit:
         if (s.kind == StepKind::Splats || s.kind == StepKind::Tetrahedra) line += " [" + std::to_string(s.begin) + ", " + std::to_string(s.end) + ")";
