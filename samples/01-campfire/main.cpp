@@ -5,7 +5,7 @@
 // with cross-fades). Every frame is computed directly from its time (the
 // fire is stateless), so frames can be rendered in any order. The frame is
 // the SDK's: Scene::prepare, then gl::FrameRenderer with the clear as the
-// host's opaque pass.
+// host's opaque pass; its fallbacks (stats().notes) are printed once each.
 // Headless it also writes campfire_figure1.png: traditional splatting (left,
 // Fig. 1a) beside textured splatting (right, Fig. 1b) of the same grid.
 #include <cstdio>
@@ -41,7 +41,7 @@ struct Campfire {
         auto f = splatfx::presets::fire(materials, desc);
         if (!f) return fail(f.error());
         scene.add(std::move(*f), {.name = "campfire"});
-        auto r = splatfx::gl::FrameRenderer::create();
+        auto r = splatfx::gl::FrameRenderer::create({.resolutionScale = options.scale});
         if (!r) return fail(r.error());
         renderer = std::move(*r);
         if (auto s = renderer->upload(materials); !s) return fail(s.error());
@@ -68,16 +68,18 @@ struct Campfire {
         glClearDepth(1.0);
     }
 
-    void draw(double timeSec, glm::ivec2 size, unsigned framebuffer, bool textured) {
+    // What the frame renderer could not do as asked goes to `notes` (printed once each).
+    void draw(double timeSec, glm::ivec2 size, unsigned framebuffer, bool textured, samples::Notes& notes) {
         if (auto s = scene.prepare(timeSec, camera(size), materials, splatFrame, {.textured = textured}); !s) {
             std::fprintf(stderr, "campfire: %s\n", s.error().c_str());
             return;
         }
         renderer->render(splatFrame, {.framebuffer = framebuffer, .drawOpaque = [this] { clearBackground(); }});
+        notes.add(renderer->stats().notes);
     }
 
     bool frame(const samples::FrameContext& fc) {
-        draw(fc.timeSec, fc.size, fc.target.framebuffer, !options.traditional);
+        draw(fc.timeSec, fc.size, fc.target.framebuffer, !options.traditional, *fc.notes);
         return figureWritten || !fc.outputs || writeFigure1(fc);
     }
 
@@ -88,7 +90,7 @@ struct Campfire {
         for (int textured = 0; textured < 2; ++textured) {
             auto fb = splatfx::gl::Framebuffer::create({.width = fc.size.x, .height = fc.size.y, .floatDepth = options.depth.reversed});
             if (!fb) return fail(fb.error());
-            draw(fc.timeSec, fc.size, fb->handle(), textured == 1);
+            draw(fc.timeSec, fc.size, fb->handle(), textured == 1, *fc.notes);
             halves[textured] = fb->read();
         }
         splatfx::Image both;

@@ -3,6 +3,7 @@
 
 #include "splatfx/output_set.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -26,7 +27,7 @@ int parseOptions(int argc, char** argv, const char* name, const char* about, Opt
     addNumber(app, "--seed", o.seed, 0u, 4294967295u, "seed of every random choice");
     app.add_option_function<std::string>(
            "--fps",
-           [&o, name](const std::string& text) {
+           [&o](const std::string& text) {
                float fps = 0.0f;
                if (!option_text::readAll(text, fps) || !(fps > 0.0f && fps <= 240.0f))
                    throw CLI::ValidationError(std::string("--fps must be in (0, 240], got '") + text + "'");
@@ -51,7 +52,19 @@ int parseOptions(int argc, char** argv, const char* name, const char* about, Opt
                  "draw into an RGBA16F colour target and write each frame also as DIR/<name>_NNNN.exr (linear, unclamped); the PNG and "
                  "GIF clamp at 1")
         ->excludes(srgb);
+    app.add_option("--scale", o.scale, "draw the volumes at 1/N resolution per axis (1, 2 or 4; default 1) with depth-aware upsampling")
+        ->check(CLI::IsMember({1, 2, 4}))
+        ->type_name("N");
     return parseCommandLine(app, argc, argv);
+}
+
+void Notes::add(const std::vector<std::string>& lines) {
+    for (const std::string& line : lines)
+        if (std::find(mLines.begin(), mLines.end(), line) == mLines.end()) {
+            mLines.push_back(line);
+            std::printf("%s%s: note: %s\n", mMidLine ? "\n" : "", mName.c_str(), line.c_str());
+            mMidLine = false;
+        }
 }
 
 namespace {
@@ -97,9 +110,11 @@ int runHeadless(const Options& o, const char* name, const std::function<bool()>&
         return 1;
     }
     splatfx::AnimationWriter gif(outputs->path(std::string(name) + ".gif"), o.fps);
+    Notes notes(name);
     const auto start = std::chrono::steady_clock::now();
     for (int i = 0; i < o.frames; ++i) {
         FrameContext fc;
+        fc.notes = &notes;
         fc.index = i;
         fc.timeSec = i / double(o.fps);
         fc.size = o.size;
@@ -132,6 +147,7 @@ int runHeadless(const Options& o, const char* name, const std::function<bool()>&
         }
         std::printf("\r%s: frame %d/%d", name, i + 1, o.frames);
         std::fflush(stdout);
+        notes.setMidLine(true);
     }
     const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     std::printf("\n%s: writing %s/%s.gif\n", name, o.out.c_str(), name);
@@ -145,6 +161,7 @@ int runHeadless(const Options& o, const char* name, const std::function<bool()>&
         return 1;
     }
     std::printf("%s: %d frames in %.2f s (%.1f ms per frame including PNG writes)\n", name, o.frames, sec, 1000.0 * sec / o.frames);
+    for (const std::string& line : notes.lines()) std::printf("%s:   note %s\n", name, line.c_str());
     return 0;
 }
 
@@ -163,10 +180,12 @@ int runWindowed(const Options& o, const char* name, const std::function<bool()>&
     const bool ownTarget = o.msaa > 1 || o.srgb || o.hdr;
     std::optional<splatfx::gl::Framebuffer> target, resolved;
     describeTarget(o, name);
+    Notes notes(name);
     const auto start = std::chrono::steady_clock::now();
     for (int i = 0; !window->shouldClose(); ++i) {
         if (glfwGetKey(window->handle(), GLFW_KEY_ESCAPE) == GLFW_PRESS) break;
         FrameContext fc;
+        fc.notes = &notes;
         fc.index = i;
         // Windowed playback follows real time so motion looks right at any frame rate.
         fc.timeSec = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

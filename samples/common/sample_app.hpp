@@ -3,13 +3,15 @@
 // A sample supplies setup (materials, grids) and a per-frame callback that
 // draws into the given target; SampleApp handles the command line
 // (--frames N --out DIR --size WxH --seed S; the host's frame: --reverse-z / --clip-01 / --infinite-far,
-// --msaa N, --srgb, --hdr), the context (a GLFW window by default, headless EGL when --frames is
-// given), PNG frames (and EXR with --hdr), the animated GIF, progress output and a summary.
+// --msaa N, --srgb, --hdr; --scale N), the context (a GLFW window by default, headless EGL when --frames is
+// given), PNG frames (and EXR with --hdr), the animated GIF, progress output, the frame renderer's
+// notes and a summary.
 // Public SDK API only.
 #pragma once
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -36,6 +38,24 @@ struct Options {
     int msaa = 0;
     bool srgb = false;
     bool hdr = false;
+    // --scale N: the sample's volumes at 1/N resolution per axis (FrameRendererDesc::resolutionScale: 1, 2 or 4).
+    int scale = 1;
+};
+
+// The frame renderer's fallbacks (gl::FrameRenderStats::notes), as splatfx-render
+// says them: each line printed once, "<name>: note: <line>", the first frame it
+// appears, and all of them again under the headless summary.
+class Notes {
+public:
+    explicit Notes(std::string name) : mName(std::move(name)) {}
+    void add(const std::vector<std::string>& lines);
+    const std::vector<std::string>& lines() const { return mLines; }
+    void setMidLine(bool midLine) { mMidLine = midLine; } // the loop's progress line is open: start a new one first
+
+private:
+    std::string mName;
+    std::vector<std::string> mLines;
+    bool mMidLine = false;
 };
 
 // Parses argv (samples/common/sample_options.hpp). Returns -1 when the sample
@@ -52,6 +72,7 @@ struct FrameContext {
     splatfx::OutputSet* outputs = nullptr;
     splatfx::DepthConvention depth{}; // Options::depth: build the camera with it, clear depth to depth.farWindow()
     bool hdr = false;                 // Options::hdr: an RGBA16F target (a scene with lights: Scene::setHdrLit)
+    Notes* notes = nullptr;           // add the frame renderer's stats().notes after each render (never null in run())
 };
 
 // Runs the loop. frame() draws one frame (the host part: clear, geometry, then

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "splatfx/shapes.hpp"
 #include "splatfx/splatfx.hpp"
@@ -24,5 +25,27 @@ inline Grid campfireGrid(std::uint32_t seed) {
 }
 
 inline Camera campfireCamera(glm::ivec2 size) { return Camera::lookAt({0.0f, 4.8f, 15.0f}, {0.0f, 4.6f, 0.0f}, {0, 1, 0}, 0.7853982f, size); }
+
+// One voxel of opacity 0.6 at the origin, seen slightly off-axis at 64x48: the
+// lone splat the GL-versus-reference bounds are derived for.
+inline Grid loneVoxel() {
+    Grid g;
+    g.voxels.push_back({.cell = {0, 0, 0}, .opacity = 0.6f});
+    return g;
+}
+inline Camera loneSplatCamera() { return Camera::lookAt({0.4f, 0.3f, 5.0f}, {0, 0, 0}, {0, 1, 0}, 0.9f, {64, 48}); }
+
+// That voxel as one untextured splat of a constant colour, and its materials.
+struct LoneSplat {
+    Materials mat{Footprint{}};
+    Camera cam = loneSplatCamera();
+    SplatBuilder builder;
+    explicit LoneSplat(glm::vec4 colour = {0.9f, 0.6f, 0.3f, 1.0f}) {
+        mat.addColorTable(ColorTable::constant(colour));
+        builder.begin(cam);
+        builder.add(loneVoxel(), mat, {.textured = false});
+    }
+    const std::vector<Splat>& splats() const { return builder.splats(); }
+};
 
 } // namespace splatfx::test

@@ -185,7 +185,9 @@ TEST(Footprint, CrawfisMaxVariedReconstructsAConstantFieldOnAverage) {
                     100.0 * perRealisation, kReal, 100.0 * averaged);
         // Jitter: the plain lattice's bound (0.7 %, above); the midpoint rule's
         // error is far smaller (the kernel is smooth over a 1/6 step, 1/3 at jitter 1).
-        if (o.jitter > 0.0f) EXPECT_LT(averaged, 0.007) << o.name;
+        if (o.jitter > 0.0f) {
+            EXPECT_LT(averaged, 0.007) << o.name;
+        }
         // Any variation ripples more in one realisation than the lattice does.
         EXPECT_GT(perRealisation, 0.007) << o.name;
     }

@@ -10,6 +10,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "gl_fixture.hpp"
+#include "ground_gl.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/lighting.hpp"
 #include "splatfx/scene.hpp"
@@ -19,17 +20,7 @@ using namespace splatfx;
 
 namespace {
 
-// docs/integration.md, "Shadows of the gas": the host's ground shader. Keep the two in step.
-const char* kVertex = R"(#version 450 core
-uniform mat4 uViewProj;
-uniform float uHalf;          // the ground quad: [-uHalf, uHalf]^2 at y = 0
-out vec3 vWorldPos;
-void main() {
-    vec2 c = vec2((gl_VertexID & 1) != 0 ? 1.0 : -1.0, (gl_VertexID & 2) != 0 ? 1.0 : -1.0) * uHalf;
-    vWorldPos = vec3(c.x, 0.0, c.y);
-    gl_Position = uViewProj * vec4(vWorldPos, 1.0);
-}
-)";
+// docs/integration.md, "Shadows of the gas": the host's ground shader (test::kGroundVertex and this). Keep the two in step.
 const char* kFragmentBody = R"(
 in vec3 vWorldPos;
 uniform vec3 uAlbedo;
@@ -44,7 +35,7 @@ void main() {
 // The docs' ground shader: version line + shadowGlsl() + body, built with the SDK's own helper.
 GLuint groundProgram(std::string& log) {
     const std::string include = shadowGlsl();
-    auto p = gl::linkProgram({kVertex}, {"#version 450 core\n", include.c_str(), kFragmentBody}, "ground");
+    auto p = gl::linkProgram({test::kGroundVertex}, {"#version 450 core\n", include.c_str(), kFragmentBody}, "ground");
     if (!p) return log = p.error(), 0u;
     return *p;
 }
@@ -54,22 +45,16 @@ constexpr float kHalf = 3.0f;
 const glm::vec3 kAlbedo{0.9f, 0.8f, 0.7f};
 
 // Looking straight down on the ground: pixel centres map to known world points.
-Camera topDown() {
-    const glm::mat4 view = glm::lookAt(glm::vec3(0, 10, 0), glm::vec3(0), glm::vec3(0, 0, -1));
-    const glm::mat4 proj = glm::ortho(-kHalf, kHalf, -kHalf, kHalf, 0.1f, 100.0f);
-    return Camera::fromMatrices(view, proj, {kSize, kSize});
-}
+Camera topDown() { return test::topDown({kSize, kSize}, {kHalf, kHalf}); }
 
 // A gas blob floating 1.5 above the ground, its table for an oblique sun.
 struct Shadowed {
     ShadowTable table{{.dims = glm::ivec3(32)}};
     Frame frame;
     Shadowed() {
-        Grid g = test::gaussianBlob(12, 0.2f, 0.9f);
-        g.transform = glm::translate(glm::mat4(1.0f), glm::vec3(-1.1f, 1.5f, -1.1f));
-        auto field = DensityField::fromGrid(g);
+        auto field = DensityField::fromGrid(test::floatingBlob());
         EXPECT_TRUE(field);
-        EXPECT_TRUE(table.update(*field, Light::directional({0.3f, -1.0f, 0.2f})));
+        EXPECT_TRUE(table.update(*field, test::shadowSun()));
         frame.begin(0.0, topDown());
         frame.end();
         FrameShadow& s = frame.shadow(); // by hand, as a host without a Scene would
@@ -84,37 +69,8 @@ struct Shadowed {
 
 class FrameShadowGL : public test::GLTest {};
 
-struct Drawn {
-    Image image;
-    gl::ShadowBinding binding;
-};
-
-Drawn draw(gl::FrameRenderer& fr, const Frame& frame, GLuint prog, const Camera& cam = topDown(), float half = kHalf) {
-    auto fb = gl::Framebuffer::create({.width = kSize, .height = kSize, .color = gl::Precision::F32});
-    EXPECT_TRUE(fb);
-    const glm::mat4 vp = cam.proj * cam.view;
-    GLuint vao = 0;
-    glCreateVertexArrays(1, &vao);
-    Drawn out;
-    fr.render(frame, {.framebuffer = fb->handle(), .drawOpaque = [&] {
-                          glClearColor(0, 0, 0, 1);
-                          glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-                          glDisable(GL_BLEND);
-                          glDisable(GL_DEPTH_TEST);
-                          glUseProgram(prog);
-                          gl::setShadowUniforms(prog, fr.shadowBinding());
-                          glUniformMatrix4fv(glGetUniformLocation(prog, "uViewProj"), 1, GL_FALSE, glm::value_ptr(vp));
-                          glUniform1f(glGetUniformLocation(prog, "uHalf"), half);
-                          glUniform3fv(glGetUniformLocation(prog, "uAlbedo"), 1, glm::value_ptr(kAlbedo));
-                          glBindVertexArray(vao);
-                          glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-                          glBindVertexArray(0);
-                          glUseProgram(0);
-                      }});
-    glDeleteVertexArrays(1, &vao);
-    out.image = fb->read();
-    out.binding = fr.shadowBinding();
-    return out;
+test::GroundDrawn draw(gl::FrameRenderer& fr, const Frame& frame, GLuint prog, const Camera& cam = topDown(), float half = kHalf) {
+    return test::drawGround(fr, frame, prog, cam, half, [](GLuint p) { glUniform3fv(glGetUniformLocation(p, "uAlbedo"), 1, glm::value_ptr(kAlbedo)); });
 }
 
 } // namespace
@@ -126,7 +82,7 @@ TEST_F(FrameShadowGL, HostGroundShaderDarkensUnderTheGasAsTheTableSays) {
     Shadowed s;
     auto fr = gl::FrameRenderer::create();
     ASSERT_TRUE(fr);
-    const Drawn d = draw(*fr, s.frame, prog);
+    const test::GroundDrawn d = draw(*fr, s.frame, prog);
     EXPECT_TRUE(d.binding.valid);
     EXPECT_EQ(d.binding.textureUnit, 15);
     EXPECT_EQ(fr->stats().shadow.uploads, 1u);
@@ -135,13 +91,10 @@ TEST_F(FrameShadowGL, HostGroundShaderDarkensUnderTheGasAsTheTableSays) {
     // times 0.8 (the shader's sun share) in colour, plus float rounding.
     const float tol = 0.8f * std::log(2.0f) * 3.0f / 256.0f * test::maxNeighbourStep(s.table) + 1e-5f;
     const Camera cam = topDown();
-    const glm::mat4 inv = glm::inverse(cam.proj * cam.view);
     float darkest = 1.0f, worst = 0.0f;
     for (int y = 0; y < kSize; ++y)
         for (int x = 0; x < kSize; ++x) {
-            const glm::vec4 ndc((x + 0.5f) / kSize * 2.0f - 1.0f, 1.0f - (y + 0.5f) / kSize * 2.0f, 0.0f, 1.0f);
-            glm::vec4 w = inv * ndc;
-            const glm::vec3 world(w.x / w.w, 0.0f, w.z / w.w);
+            const glm::vec3 world = test::groundPoint(cam, x, y);
             const float T = s.table.transmittance(world);
             darkest = std::min(darkest, T);
             for (int c = 0; c < 3; ++c) {
@@ -166,7 +119,7 @@ TEST_F(FrameShadowGL, WithoutAShadowTheIncludeReturnsOne) {
     frame.end();
     auto fr = gl::FrameRenderer::create();
     ASSERT_TRUE(fr);
-    const Drawn d = draw(*fr, frame, prog);
+    const test::GroundDrawn d = draw(*fr, frame, prog);
     EXPECT_FALSE(d.binding.valid);
     for (int y = 0; y < kSize; ++y)
         for (int x = 0; x < kSize; ++x)
@@ -198,10 +151,7 @@ TEST_F(FrameShadowGL, TurningTheCameraOffACasterLeavesTheGroundsShadowInViewUnch
     ASSERT_TRUE(scene.addLight(sun));
     Grid g = test::gaussianBlob(12, 0.2f, 0.9f);
     g.transform = glm::translate(glm::mat4(1.0f), glm::vec3(-4.0f, 3.0f, -1.1f));
-    EffectDesc desc;
-    desc.layers = {EffectLayer{.style = {.colorTable = row, .textured = false}}};
-    const EffectId plume =
-        scene.add(*Effect::fromGrid(g, desc), {.name = "plume", .lighting = {.enabled = true, .selfShadow = SelfShadow::Off}});
+    const EffectId plume = test::addLitEffect(scene, g, row, "plume", {.enabled = true, .selfShadow = SelfShadow::Off});
     const glm::vec3 eye(1.0f, 9.0f, 6.0f);
     const Camera a = Camera::lookAt(eye, {-1.5f, 2.0f, 0.0f}, {0, 1, 0}, glm::radians(36.0f), {kSize, kSize}, 0.1f, 100.0f);
     const Camera b = Camera::lookAt(eye, {1.5f, 0.0f, 0.0f}, {0, 1, 0}, glm::radians(36.0f), {kSize, kSize}, 0.1f, 100.0f);
@@ -219,8 +169,8 @@ TEST_F(FrameShadowGL, TurningTheCameraOffACasterLeavesTheGroundsShadowInViewUnch
     withCasterDrawn.shadow() = frameA.shadow();
     auto fr = gl::FrameRenderer::create();
     ASSERT_TRUE(fr);
-    const Drawn turned = draw(*fr, frameB, prog, b, 20.0f);
-    const Drawn reference = draw(*fr, withCasterDrawn, prog, b, 20.0f);
+    const test::GroundDrawn turned = draw(*fr, frameB, prog, b, 20.0f);
+    const test::GroundDrawn reference = draw(*fr, withCasterDrawn, prog, b, 20.0f);
     ASSERT_TRUE(turned.binding.valid);
     // The same table, camera and shader: the same pixels, bit for bit (tolerance 0).
     float darkest = 1.0f;

@@ -13,6 +13,7 @@
 
 #include "../reference/gl_bounds.hpp"
 #include "gl_fixture.hpp"
+#include "scenes.hpp"
 #include "splatfx/gl/renderer.hpp"
 #include "splatfx/reference.hpp"
 #include "splatfx/scene.hpp"
@@ -53,22 +54,17 @@ Image draw(gl::Renderer& r, const std::vector<Splat>& splats, const Camera& cam,
     return fb->read();
 }
 
-// One voxel of fire (emission 5, lit by a sun too) as a Scene lights it.
+// GLvsReference.LoneSplat's voxel as fire (emission 5, lit by a sun too), as a Scene lights it.
 struct Fire {
     Materials m{Footprint{}};
-    Camera cam = Camera::lookAt({0.4f, 0.3f, 5.0f}, {0, 0, 0}, {0, 1, 0}, 0.9f, {64, 48});
+    Camera cam = test::loneSplatCamera();
     std::vector<Splat> splats;
     explicit Fire(bool hdr) {
         const std::uint32_t row = m.addColorTable(ColorTable::constant({1.0f, 0.45f, 0.1f, 1.0f}));
-        Grid g;
-        g.voxels.push_back({.cell = {0, 0, 0}, .opacity = 0.6f});
-        EffectDesc desc;
-        desc.name = "fire";
-        desc.layers = {EffectLayer{.style = {.colorTable = row, .textured = false}}};
         Scene scene;
-        EXPECT_TRUE(scene.addLight(Light::directional({0.3f, -1.0f, 0.2f})));
-        (void)scene.add(*Effect::fromGrid(g, desc),
-                        {.name = "fire", .lighting = {.enabled = true, .gas = {.albedo = 0.5f, .emission = 5.0f}, .selfShadow = SelfShadow::Off}});
+        EXPECT_TRUE(scene.addLight(test::shadowSun()));
+        (void)test::addLitEffect(scene, test::loneVoxel(), row, "fire",
+                                 {.enabled = true, .gas = {.albedo = 0.5f, .emission = 5.0f}, .selfShadow = SelfShadow::Off});
         scene.setHdrLit(hdr);
         Frame frame;
         EXPECT_TRUE(scene.prepare(0.0, cam, m, frame));
@@ -126,20 +122,14 @@ TEST_F(HdrLitGL, ABrightlyLitGasIsSixTimesItsInRangeFrameAgainstTheLitVolumeRefe
     // traced self-shadow, isotropic, no ambient or emission: the model is linear in the
     // intensity, so the frame at 6 is 6x the one at 1 up to each path's 8-bit colour.
     Materials m{Footprint{}};
-    const glm::vec4 base{0.8f, 0.7f, 0.6f, 1.0f};
-    const std::uint32_t row = m.addColorTable(ColorTable::constant(base));
-    const Grid grid = test::gaussianBlob(3, 0.25f, 0.7f);
-    glm::vec3 mid(0.0f);
-    for (const Voxel& v : grid.voxels) mid += grid.worldPosition(v.cell) / float(grid.voxels.size());
-    const Camera cam = Camera::lookAt(mid + glm::vec3(0.9f, 0.5f, 2.4f), mid, {0, 1, 0}, 0.55f, {32, 24}, 0.1f, 20.0f);
+    const std::uint32_t row = m.addColorTable(ColorTable::constant(test::smallLitBlobBase())); // LitReferenceGL's blob and camera
+    const Grid grid = test::smallLitBlob();
+    const Camera cam = test::smallLitBlobCamera(grid, {32, 24});
     const GasLightingDesc gas{.albedo = 0.9f};
     auto frameAt = [&](float intensity, bool hdr) {
         Scene scene;
-        EXPECT_TRUE(scene.addLight(Light::directional({0.6f, -0.7f, -0.4f}, glm::vec3(1.0f), intensity)));
-        EffectDesc desc;
-        desc.name = "blob";
-        desc.layers = {EffectLayer{.style = {.colorTable = row, .textured = false}}};
-        (void)scene.add(*Effect::fromGrid(grid, desc), {.name = "blob", .lighting = {.enabled = true, .gas = gas, .selfShadow = SelfShadow::Traced}});
+        EXPECT_TRUE(scene.addLight(Light::directional(test::smallLitBlobSunDir(), glm::vec3(1.0f), intensity)));
+        (void)test::addLitEffect(scene, grid, row, "blob", {.enabled = true, .gas = gas, .selfShadow = SelfShadow::Traced});
         scene.setHdrLit(hdr);
         Frame frame;
         EXPECT_TRUE(scene.prepare(0.0, cam, m, frame));
@@ -165,7 +155,7 @@ TEST_F(HdrLitGL, ABrightlyLitGasIsSixTimesItsInRangeFrameAgainstTheLitVolumeRefe
     // transmittance does not depend on it; no ambient, no emission), so the reference at 1 is
     // it divided by 6, exactly in the model and within 6x its error estimate in the quadrature.
     VolumeExactStats s6;
-    const std::vector<Light> six = {Light::directional({0.6f, -0.7f, -0.4f}, glm::vec3(1.0f), 6.0f)};
+    const std::vector<Light> six = {Light::directional(test::smallLitBlobSunDir(), glm::vec3(1.0f), 6.0f)};
     const LitVolumeDesc lit6{.lights = six, .gas = gas};
     auto e6 = renderVolumeExact(field, cam, {.tolerance = 1e-4, .lighting = &lit6}, &s6);
     ASSERT_TRUE(e6);

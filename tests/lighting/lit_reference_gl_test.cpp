@@ -55,25 +55,20 @@ class LitReferenceGL : public test::GLTest {};
 
 TEST_F(LitReferenceGL, ALitFrameDecomposesIntoTableLightFieldLobeSplattingEightBitAndPerVoxelTerms) {
     Materials m{Footprint{}};
-    const glm::vec4 base{0.8f, 0.7f, 0.6f, 1.0f};
+    const glm::vec4 base = test::smallLitBlobBase();
     const std::uint32_t row = m.addColorTable(ColorTable::constant(base));
-    const Grid grid = test::gaussianBlob(3, 0.25f, 0.7f);
+    const Grid grid = test::smallLitBlob();
     std::vector<glm::vec3> centres;
-    glm::vec3 mid(0.0f);
-    for (const Voxel& v : grid.voxels) centres.push_back(grid.worldPosition(v.cell)), mid += centres.back() / float(grid.voxels.size());
-    const Camera cam = Camera::lookAt(mid + glm::vec3(0.9f, 0.5f, 2.4f), mid, {0, 1, 0}, 0.55f, {48, 36}, 0.1f, 20.0f);
-    const std::vector<Light> lights = {Light::directional({0.6f, -0.7f, -0.4f}, glm::vec3(1.0f), 1.6f)};
+    for (const Voxel& v : grid.voxels) centres.push_back(grid.worldPosition(v.cell));
+    const Camera cam = test::smallLitBlobCamera(grid, {48, 36});
+    const std::vector<Light> lights = {Light::directional(test::smallLitBlobSunDir(), glm::vec3(1.0f), 1.6f)};
     const HgLobe lobes[] = {{.g = 0.82f, .weight = 0.992f}, {.g = -0.54f, .weight = 0.008f}}; // fitted to Cornette-Shanks
     const GasLightingDesc gas{.phase = *PhaseFunction::create(lobes), .albedo = 0.9f, .ambient = glm::vec3(0.05f)};
 
     // The frame the GL path draws: a Scene's lit effect, table self-shadowing at 8^3.
     Scene scene;
     ASSERT_TRUE(scene.addLight(lights[0]));
-    EffectDesc desc;
-    desc.name = "blob";
-    desc.layers = {EffectLayer{.style = {.colorTable = row, .textured = false}}};
-    (void)scene.add(*Effect::fromGrid(grid, desc),
-                    {.name = "blob", .lighting = {.enabled = true, .gas = gas, .selfShadow = SelfShadow::Table, .tableDims = glm::ivec3(8)}});
+    (void)test::addLitEffect(scene, grid, row, "blob", {.enabled = true, .gas = gas, .selfShadow = SelfShadow::Table, .tableDims = glm::ivec3(8)});
     Frame frame;
     ASSERT_TRUE(scene.prepare(0.0, cam, m, frame));
     ASSERT_TRUE(scene.lightingError().empty()) << scene.lightingError();

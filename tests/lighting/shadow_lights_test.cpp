@@ -16,9 +16,9 @@ using namespace splatfx;
 
 namespace {
 
-const Light kSun = Light::directional({0.3f, -1.0f, 0.2f});
+const Light kSun = test::shadowSun();
 // A torch up and to the right of the gas, and a spot up to the left aimed at its centre.
-const Light kTorch = Light::point({2.5f, 4.5f, 0.0f}, {1.0f, 0.6f, 0.3f}, 6.0f);
+const Light kTorch = test::shadowTorch();
 const Light kSpot = Light::spot({-3.0f, 6.0f, 0.5f}, glm::vec3(0.0f, 2.6f, 0.0f) - glm::vec3(-3.0f, 6.0f, 0.5f), 0.3f, 0.5f);
 
 Camera camera() { return Camera::lookAt({0.0f, 6.0f, 10.0f}, {0.0f, 1.0f, 0.0f}, {0, 1, 0}, glm::radians(60.0f), {64, 48}, 0.1f, 100.0f); }
@@ -32,12 +32,7 @@ struct LightsScene {
     EffectId id = 0;
     LightsScene() {
         const std::uint32_t table = materials.addColorTable(ColorTable::constant({0.8f, 0.8f, 0.8f, 1.0f}));
-        Grid g = test::gaussianBlob(12, 0.2f, 0.9f);
-        g.transform = glm::translate(glm::mat4(1.0f), glm::vec3(-1.1f, 1.5f, -1.1f));
-        EffectDesc desc;
-        desc.name = "gas";
-        desc.layers = {EffectLayer{.style = {.colorTable = table, .textured = false}}};
-        id = scene.add(*Effect::fromGrid(g, desc), {.name = "gas", .lighting = {.enabled = true, .selfShadow = SelfShadow::Off}});
+        id = test::addLitEffect(scene, test::floatingBlob(), table, "gas", {.enabled = true, .selfShadow = SelfShadow::Off});
         scene.setSceneShadow({.dims = glm::ivec3(16)});
     }
     void prepare(double t) { ASSERT_TRUE(scene.prepare(t, camera(), materials, frame)) << scene.lightingError(); }
@@ -209,9 +204,7 @@ TEST(ShadowLights, ACasterOutOfViewIsAdvancedWhenAnyLightsShadowReachesTheView) 
     Scene scene;
     Grid g = test::gaussianBlob(12, 0.2f, 0.9f);
     g.transform = glm::translate(glm::mat4(1.0f), glm::vec3(-4.0f, 3.0f, -1.1f));
-    EffectDesc desc;
-    desc.layers = {EffectLayer{.style = {.colorTable = row, .textured = false}}};
-    const EffectId plume = scene.add(*Effect::fromGrid(g, desc), {.name = "plume", .lighting = {.enabled = true, .selfShadow = SelfShadow::Off}});
+    const EffectId plume = test::addLitEffect(scene, g, row, "plume", {.enabled = true, .selfShadow = SelfShadow::Off});
     ASSERT_TRUE(scene.addLight(away));
     Frame frame;
     ASSERT_TRUE(scene.prepare(0.0, camB, materials, frame));

@@ -8,6 +8,7 @@
 
 #include "gl_bounds.hpp"
 #include "gl_fixture.hpp"
+#include "scenes.hpp"
 #include "splatfx/reference.hpp"
 
 namespace splatfx {
@@ -16,18 +17,12 @@ namespace {
 class GLvsReference : public test::GLTest {};
 
 TEST_F(GLvsReference, LoneSplatAgreesWithinTheDerivedBoundWithAndWithoutHostDepth) {
-    const glm::vec4 colour{0.9f, 0.6f, 0.3f, 1.0f};
-    Materials mat{Footprint{}};
-    mat.addColorTable(ColorTable::constant(colour));
-    Grid g;
-    g.voxels.push_back({.cell = {0, 0, 0}, .opacity = 0.6f});
-    const glm::ivec2 size{64, 48};
-    const Camera cam = Camera::lookAt({0.4f, 0.3f, 5.0f}, {0, 0, 0}, {0, 1, 0}, 0.9f, size);
-    SplatBuilder b;
-    b.begin(cam);
-    b.add(g, mat, {.textured = false});
-    ASSERT_EQ(b.splats().size(), 1u);
-    const double density = b.splats()[0].density;
+    const test::LoneSplat lone;
+    const Materials& mat = lone.mat;
+    const Camera& cam = lone.cam;
+    const glm::ivec2 size = cam.viewport;
+    ASSERT_EQ(lone.splats().size(), 1u);
+    const double density = lone.splats()[0].density;
 
     // The bound below is derived for bilinear sampling, so name it (Auto may
     // pick upsampled layers; UpsampledSamplingApproachesBilinear covers those).
@@ -51,12 +46,12 @@ TEST_F(GLvsReference, LoneSplatAgreesWithinTheDerivedBoundWithAndWithoutHostDept
             glBindFramebuffer(GL_FRAMEBUFFER, 0);
         }
         const Image depth = fb->readDepth();
-        r->draw(b.splats(), cam, {.framebuffer = fb->handle(), .width = size.x, .height = size.y});
+        r->draw(lone.splats(), cam, {.framebuffer = fb->handle(), .width = size.x, .height = size.y});
         const Image got = fb->read();
         SplatExactDesc rd;
         rd.host.background = bg;
         rd.host.depth = &depth;
-        auto ref = renderSplatExact(b.splats(), cam, mat, rd);
+        auto ref = renderSplatExact(lone.splats(), cam, mat, rd);
         ASSERT_TRUE(ref) << ref.error();
         // d alpha / d detail = ln2 density 2^(-density detail) <= ln2 density; the
         // colour row is RGBA16F (relative error 2^-11); F32 blending adds ~1e-7.

@@ -228,8 +228,9 @@ TEST(FramePlan, AMultisampledHostDepthRunsTheFogAndTheVolumesOncePerSample) {
     EXPECT_TRUE(p.fogHost);
     EXPECT_TRUE(p.fogNote.empty()) << p.fogNote;
     std::vector<StepKind> expected{StepKind::UploadShadow, StepKind::HostOpaque};
-    for (int s = 0; s < 4; ++s) expected.insert(expected.end(), {StepKind::HostDepthSample, StepKind::HostFog, StepKind::Splats});
-    expected.insert(expected.end(), {StepKind::HostDepthSample, StepKind::UnbindShadow});
+    for (int s = 0; s < 4; ++s)
+        for (StepKind k : {StepKind::HostDepthSample, StepKind::HostFog, StepKind::Splats}) expected.push_back(k);
+    for (StepKind k : {StepKind::HostDepthSample, StepKind::UnbindShadow}) expected.push_back(k);
     EXPECT_EQ(kinds(p), expected) << show(p);
     for (int s = 0; s < 4; ++s) EXPECT_EQ(p.steps[2 + 3 * std::size_t(s)].sample, s);
     EXPECT_EQ(p.steps[14].sample, -1);

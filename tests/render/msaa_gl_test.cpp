@@ -399,6 +399,41 @@ TEST_F(MsaaGL, GlassAmongGasSaysWhatRunsAt8x) {
     expectListsSayWhatRuns(8);
 }
 
+// The reduced-resolution layer (resolutionScale 2 or 4) is drawn at its own texel
+// centres in every sample's run, not shifted onto the sample positions as the
+// full-resolution layer is: a multisampled host is told so in stats().notes, once;
+// a single-sampled host, or full resolution, has no such line.
+TEST_F(MsaaGL, TheReducedLayerOnAMultisampledHostIsNoted) {
+    Scene s(false, false);
+    Host host;
+    ASSERT_TRUE(host.error().empty()) << host.error();
+    const std::string reduced = "the reduced layer is drawn at its own texel centres in every sample's run";
+    for (int scale : {1, 2, 4})
+        for (int samples : {1, 4}) {
+            SCOPED_TRACE("resolutionScale " + std::to_string(scale) + ", " + std::to_string(samples) + " samples");
+            auto fr = gl::FrameRenderer::create({.resolutionScale = scale});
+            ASSERT_TRUE(fr) << fr.error();
+            ASSERT_TRUE(fr->upload(s.materials));
+            Target t(samples);
+            ASSERT_TRUE(t.complete());
+            Frame frame;
+            s.build(frame, {0, 0});
+            fr->render(frame, {.framebuffer = t.fbo, .drawOpaque = [&] { host.draw(Wall::Triangle, s.wallZ); }});
+            const gl::FrameRenderStats& st = fr->stats();
+            EXPECT_EQ(st.resolutionScale, scale);
+            EXPECT_EQ(st.msaa.perSample, samples > 1);
+            const auto n = std::count_if(st.notes.begin(), st.notes.end(), [&](const std::string& l) { return l.find(reduced) != std::string::npos; });
+            if (scale > 1 && samples > 1) {
+                ASSERT_EQ(n, 1) << "one line for every sample's run";
+                const auto line = std::find_if(st.notes.begin(), st.notes.end(), [&](const std::string& l) { return l.find(reduced) != std::string::npos; });
+                EXPECT_NE(line->find("resolutionScale " + std::to_string(scale)), std::string::npos) << *line;
+                EXPECT_NE(line->find("(" + std::to_string(st.msaa.samples) + " samples)"), std::string::npos) << *line;
+            } else {
+                EXPECT_EQ(n, 0);
+            }
+        }
+}
+
 // gl::Framebuffer's MSAA and sRGB fields (what splatfx-render --msaa / --srgb
 // draw into): bad values are refused with the field named; a multisampled one
 // resolves on read() to its clear colour.

@@ -7,12 +7,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include <epoxy/gl.h>
 #include <gtest/gtest.h>
 
 #include "../reference/gl_bounds.hpp"
 #include "gl_fixture.hpp"
+#include "scenes.hpp"
 #include "splatfx/gl/framebuffer.hpp"
 #include "splatfx/gl/renderer.hpp"
 #include "splatfx/reference.hpp"
@@ -33,17 +35,12 @@ class SrgbReferenceGL : public test::GLTest {};
 } // namespace
 
 TEST_F(SrgbReferenceGL, StoredCodesAreTheLinearReferenceEncodedWithinTheDerivedBound) {
-    const glm::vec4 colour{0.9f, 0.6f, 0.3f, 1.0f};
-    Materials mat{Footprint{}};
-    mat.addColorTable(ColorTable::constant(colour));
-    Grid g;
-    g.voxels.push_back({.cell = {0, 0, 0}, .opacity = 0.6f});
-    const glm::ivec2 size{64, 48};
-    const Camera cam = Camera::lookAt({0.4f, 0.3f, 5.0f}, {0, 0, 0}, {0, 1, 0}, 0.9f, size);
-    SplatBuilder b;
-    b.begin(cam);
-    b.add(g, mat, {.textured = false});
-    ASSERT_EQ(b.splats().size(), 1u);
+    const test::LoneSplat lone; // GLvsReference.LoneSplat's splat, materials and camera
+    const Materials& mat = lone.mat;
+    const Camera& cam = lone.cam;
+    const glm::ivec2 size = cam.viewport;
+    const std::vector<Splat>& splats = lone.splats();
+    ASSERT_EQ(splats.size(), 1u);
     auto r = gl::Renderer::create({.sampling = gl::TextureSampling::Bilinear}); // GLvsReference's bound is bilinear's
     ASSERT_TRUE(r && r->upload(mat));
     auto fb = gl::Framebuffer::create({.width = size.x, .height = size.y, .srgb = true});
@@ -53,15 +50,15 @@ TEST_F(SrgbReferenceGL, StoredCodesAreTheLinearReferenceEncodedWithinTheDerivedB
     glEnable(GL_FRAMEBUFFER_SRGB);
     glClearColor(bg.r, bg.g, bg.b, bg.a);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    r->draw(b.splats(), cam, {.framebuffer = fb->handle(), .width = size.x, .height = size.y});
+    r->draw(splats, cam, {.framebuffer = fb->handle(), .width = size.x, .height = size.y});
     glDisable(GL_FRAMEBUFFER_SRGB);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     const Image got = fb->read(); // sRGB codes / 255, as stored
     SplatExactDesc rd;
     rd.host.background = bg;
-    auto ref = renderSplatExact(b.splats(), cam, mat, rd);
+    auto ref = renderSplatExact(splats, cam, mat, rd);
     rd.host.background = glm::vec4(0.0f); // the splat alone: its alpha and premultiplied colour
-    auto splat = renderSplatExact(b.splats(), cam, mat, rd);
+    auto splat = renderSplatExact(splats, cam, mat, rd);
     ASSERT_TRUE(ref && splat) << ref.error();
 
     // In linear, GL against the reference: GLvsReference.LoneSplat's bound L (the window's
@@ -69,7 +66,7 @@ TEST_F(SrgbReferenceGL, StoredCodesAreTheLinearReferenceEncodedWithinTheDerivedB
     // code, decoded at the clear's slope, passed on times 1 - alpha <= 1). Encoding that linear
     // difference moves it by at most the encoding's largest slope over it, and the stored
     // result is rounded to the nearest code: half a code more. Alpha is stored linear (8 bits).
-    const double L = std::log(2.0) * b.splats()[0].density * test::windowErrorBound(mat) + std::ldexp(1.0, -11) + 1e-6;
+    const double L = std::log(2.0) * splats[0].density * test::windowErrorBound(mat) + std::ldexp(1.0, -11) + 1e-6;
     double worst = 0.0, gammaWorst = 0.0, maxBound = 0.0;
     for (int y = 0; y < size.y; ++y)
         for (int x = 0; x < size.x; ++x) {

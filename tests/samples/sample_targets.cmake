@@ -15,7 +15,9 @@
 #    layers over a pixel, a count this test cannot see), so no per-pixel bound
 #    is derived here; the mean |HDR - 8 bit| must stay below the mean |1x shifted
 #    by one pixel - 1x|, the bound the MSAA frames are held to.
-#  - --hdr --srgb is refused (an 8-bit target).
+#  - --hdr --srgb is refused (an 8-bit target), and --scale 3 (1, 2 or 4).
+#  - The frame renderer's notes are printed: none for the runs above; --msaa 4
+#    --scale 2 prints the reduced layer's (once as it happens, once in the summary).
 # Inputs: RENDER (the sample), IDIFF, OIIOTOOL, PYTHON, NAME (the frames' name), OUT.
 include(${CMAKE_CURRENT_LIST_DIR}/render_functions.cmake)
 include(${CMAKE_CURRENT_LIST_DIR}/host_targets.cmake)
@@ -33,7 +35,18 @@ foreach(variant "msaa4;4x MSAA;--msaa;4" "srgb;sRGB;--srgb" "hdr;RGBA16F;--hdr")
   if(NOT rc EQUAL 0 OR NOT out MATCHES "${said}")
     message(FATAL_ERROR "${NAME} ${flags} (${rc}) failed or did not say '${said}':\n${out}\n${err}")
   endif()
+  if(out MATCHES "note")
+    message(FATAL_ERROR "${NAME} ${flags}: the frame renderer noted a fallback where none is expected:\n${out}")
+  endif()
 endforeach()
+# The frame renderer's notes are printed (once, and under the summary): --scale 2 on --msaa 4 draws
+# the reduced layer unshifted in every sample's run, and says so.
+execute_process(COMMAND ${RENDER} ${common} --out ${OUT}/msaa4_scale2 --msaa 4 --scale 2 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+string(REGEX MATCHALL "note:? reduced resolution \\(resolutionScale 2\\) on a multisampled host" said "${out}")
+list(LENGTH said count)
+if(NOT rc EQUAL 0 OR NOT count EQUAL 2)
+  message(FATAL_ERROR "${NAME} --msaa 4 --scale 2 (${rc}) must print its reduced-layer note once and under the summary (${count} times):\n${out}\n${err}")
+endif()
 set(default ${OUT}/default/${NAME}_0000.png)
 expect_msaa_srgb(${default} ${OUT}/msaa4/${NAME}_0000.png ${OUT}/srgb/${NAME}_0000.png ${NAME})
 
@@ -60,4 +73,8 @@ expect_less(${hdr_error} ${shift_error} "${NAME} --hdr is not the default pictur
 execute_process(COMMAND ${RENDER} ${common} --out ${OUT}/both --hdr --srgb RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 if(NOT rc EQUAL 2 OR NOT "${out}${err}" MATCHES "excludes")
   message(FATAL_ERROR "--hdr --srgb must be refused (exit 2, CLI11's 'excludes'), got ${rc}:\n${out}\n${err}")
+endif()
+execute_process(COMMAND ${RENDER} ${common} --out ${OUT}/scale3 --scale 3 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT "${out}${err}" MATCHES "--scale: 3 not in" OR EXISTS ${OUT}/scale3)
+  message(FATAL_ERROR "--scale 3 must be refused (exit 2, naming --scale) with nothing written, got ${rc}:\n${out}\n${err}")
 endif()

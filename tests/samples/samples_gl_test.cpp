@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <span>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -218,6 +219,47 @@ std::string emittingFireScene(bool emits, bool glass = false) {
            (emits ? "true" : "false") + R"(, "lights": 2, "scale": 20}}]})";
 }
 
+// emittingFireScene(true, glass) and (false, glass) rendered at t = 1, 64x48 (both players
+// load, the lit one passes two lights and the dark one none), with the lit one's lights.
+struct FireLightPair {
+    splatfx::Image lit, dark;
+    std::vector<splatfx::EmittedLight> lights;
+    splatfx::Camera camera;
+};
+constexpr double kFireLightTime = 1.0;
+void renderFireLightPair(bool glass, const char* name, FireLightPair& out) {
+    const glm::ivec2 size{64, 48};
+    auto on = scenehost::ScenePlayer::fromText(emittingFireScene(true, glass), name);
+    auto off = scenehost::ScenePlayer::fromText(emittingFireScene(false, glass), name);
+    ASSERT_TRUE(on.ok()) << on.error();
+    ASSERT_TRUE(off.ok()) << off.error();
+    out.lit = render(*on, {kFireLightTime}, size);
+    out.dark = render(*off, {kFireLightTime}, size);
+    const std::span<const splatfx::EmittedLight> lights = on->file().scene.emittedLights();
+    ASSERT_EQ(lights.size(), 2u);
+    EXPECT_TRUE(off->file().scene.emittedLights().empty());
+    out.lights.assign(lights.begin(), lights.end());
+    out.camera = on->cameraAt(kFireLightTime, size);
+}
+
+// Calls fn(x, y, at) for each pixel whose centre's ray goes down, where at(h) is the point
+// that ray meets the plane y = h; stops at the first fatal failure fn raises.
+template <class Fn>
+void forEachDownwardRay(const splatfx::Camera& camera, Fn fn) {
+    const glm::dmat4 clipToWorld = glm::inverse(glm::dmat4(camera.proj) * glm::dmat4(camera.view));
+    const glm::dvec3 eye(camera.eye());
+    for (int y = 0; y < camera.viewport.y; ++y)
+        for (int x = 0; x < camera.viewport.x; ++x) {
+            // Framebuffer::read gives the top row first; GL's window y grows upwards.
+            const glm::dvec2 ndc{2.0 * (x + 0.5) / camera.viewport.x - 1.0, 1.0 - 2.0 * (y + 0.5) / camera.viewport.y};
+            const glm::dvec4 far = clipToWorld * glm::dvec4(ndc, 1.0, 1.0);
+            const glm::dvec3 dir = glm::dvec3(far) / far.w - eye;
+            if (dir.y >= 0.0) continue;
+            fn(x, y, [&](double h) { return eye + dir * ((h - eye.y) / dir.y); });
+            if (::testing::Test::HasFatalFailure()) return;
+        }
+}
+
 } // namespace
 
 // Issue 27 item 3, the host side: the scene host's surface shader adds the
@@ -226,51 +268,33 @@ std::string emittingFireScene(bool emits, bool glass = false) {
 // emittedIrradiance gives the lights the frame passed, at the point the
 // pixel's centre sees on the ground (normal +y).
 TEST_F(SamplesGL, FireLightBrightensTheGroundByTheIrradianceTheCpuPredicts) {
-    const double t = 1.0;
-    const glm::ivec2 size{64, 48};
-    auto on = scenehost::ScenePlayer::fromText(emittingFireScene(true), "fire-light-test.json");
-    auto off = scenehost::ScenePlayer::fromText(emittingFireScene(false), "fire-light-test.json");
-    ASSERT_TRUE(on.ok()) << on.error();
-    ASSERT_TRUE(off.ok()) << off.error();
-    const splatfx::Image lit = render(*on, {t}, size);
-    const splatfx::Image dark = render(*off, {t}, size);
-    const std::span<const splatfx::EmittedLight> lights = on->file().scene.emittedLights();
-    ASSERT_EQ(lights.size(), 2u);
-    EXPECT_TRUE(off->file().scene.emittedLights().empty());
-
+    FireLightPair pair;
+    ASSERT_NO_FATAL_FAILURE(renderFireLightPair(false, "fire-light-test.json", pair));
     const float albedo = 0.3f, ambient = 0.25f; // the scene's ground colour; the host's ambient share
-    const splatfx::Camera camera = on->cameraAt(t, size);
-    const glm::dmat4 clipToWorld = glm::inverse(glm::dmat4(camera.proj) * glm::dmat4(camera.view));
-    const glm::dvec3 eye(camera.eye());
     // The fire's splats reach z = 0.5 + their radius (well under 1.5); only
     // ground points in front of z = 2 are compared, so no splat covers them.
     std::size_t compared = 0;
     double worst = 0.0, largest = 0.0;
-    for (int y = 0; y < size.y; ++y)
-        for (int x = 0; x < size.x; ++x) {
-            // Framebuffer::read gives the top row first; GL's window y grows upwards.
-            const glm::dvec2 ndc{2.0 * (x + 0.5) / size.x - 1.0, 1.0 - 2.0 * (y + 0.5) / size.y};
-            const glm::dvec4 far = clipToWorld * glm::dvec4(ndc, 1.0, 1.0);
-            const glm::dvec3 dir = glm::dvec3(far) / far.w - eye;
-            if (dir.y >= 0.0) continue;
-            const glm::dvec3 p = eye + dir * (-eye.y / dir.y); // on the ground, y = 0
-            if (p.z < 2.0 || std::fabs(p.x) > 6.0) continue;
-            const glm::vec3 e = splatfx::emittedIrradiance(lights, glm::vec3(p), glm::vec3(0, 1, 0));
-            for (int c = 0; c < 3; ++c) {
-                const double base = albedo * ambient, expected = albedo * double(e[c]) / 3.14159265358979;
-                if (base + expected > 254.0 / 255.0) continue; // clamped by the 8-bit target
-                // Each image holds its value rounded to 8 bits (half a step each way), so the
-                // difference is within one step of albedo x E / pi; the shader's float
-                // arithmetic adds ~1e-6 on values below 1.
-                const double step = 1.0 / 255.0 + 1e-5;
-                ASSERT_NEAR(dark.at(x, y, c), base, step / 2) << "pixel " << x << "," << y << " is not bare ground";
-                const double diff = double(lit.at(x, y, c)) - double(dark.at(x, y, c));
-                worst = std::max(worst, std::fabs(diff - expected));
-                largest = std::max(largest, expected);
-                EXPECT_NEAR(diff, expected, step) << "pixel " << x << "," << y << " channel " << c;
-                ++compared;
-            }
+    forEachDownwardRay(pair.camera, [&](int x, int y, auto at) {
+        const glm::dvec3 p = at(0.0); // on the ground, y = 0
+        if (p.z < 2.0 || std::fabs(p.x) > 6.0) return;
+        const glm::vec3 e = splatfx::emittedIrradiance(pair.lights, glm::vec3(p), glm::vec3(0, 1, 0));
+        for (int c = 0; c < 3; ++c) {
+            const double base = albedo * ambient, expected = albedo * double(e[c]) / 3.14159265358979;
+            if (base + expected > 254.0 / 255.0) continue; // clamped by the 8-bit target
+            // Each image holds its value rounded to 8 bits (half a step each way), so the
+            // difference is within one step of albedo x E / pi; the shader's float
+            // arithmetic adds ~1e-6 on values below 1.
+            const double step = 1.0 / 255.0 + 1e-5;
+            ASSERT_NEAR(pair.dark.at(x, y, c), base, step / 2) << "pixel " << x << "," << y << " is not bare ground";
+            const double diff = double(pair.lit.at(x, y, c)) - double(pair.dark.at(x, y, c));
+            worst = std::max(worst, std::fabs(diff - expected));
+            largest = std::max(largest, expected);
+            EXPECT_NEAR(diff, expected, step) << "pixel " << x << "," << y << " channel " << c;
+            ++compared;
         }
+    });
+    if (HasFatalFailure()) return;
     EXPECT_GT(compared, 300u);
     // The fire's light is well above the 8-bit step where the ground is nearest the fire.
     EXPECT_GT(largest, 20.0 / 255.0);
@@ -282,21 +306,9 @@ TEST_F(SamplesGL, FireLightBrightensTheGroundByTheIrradianceTheCpuPredicts) {
 // over the ground behind it, so with the fire's light it gains
 // a x albedo_pane x E(pane point) / pi + (1 - a) x albedo_ground x E(ground point) / pi.
 TEST_F(SamplesGL, FireLightBrightensGlassAndTheGroundSeenThroughIt) {
-    const double t = 1.0;
-    const glm::ivec2 size{64, 48};
-    auto on = scenehost::ScenePlayer::fromText(emittingFireScene(true, true), "fire-light-glass-test.json");
-    auto off = scenehost::ScenePlayer::fromText(emittingFireScene(false, true), "fire-light-glass-test.json");
-    ASSERT_TRUE(on.ok()) << on.error();
-    ASSERT_TRUE(off.ok()) << off.error();
-    const splatfx::Image lit = render(*on, {t}, size);
-    const splatfx::Image dark = render(*off, {t}, size);
-    const std::span<const splatfx::EmittedLight> lights = on->file().scene.emittedLights();
-    ASSERT_EQ(lights.size(), 2u);
-
+    FireLightPair pair;
+    ASSERT_NO_FATAL_FAILURE(renderFireLightPair(true, "fire-light-glass-test.json", pair));
     const double a = 0.5, pane = 0.6, ground = 0.3, ambient = 0.25, pi = 3.14159265358979;
-    const splatfx::Camera camera = on->cameraAt(t, size);
-    const glm::dmat4 clipToWorld = glm::inverse(glm::dmat4(camera.proj) * glm::dmat4(camera.view));
-    const glm::dvec3 eye(camera.eye());
     // Per image: the ground is rounded to 8 bits in the host's target (half a
     // step), seen through the pane at (1 - a), the pane's fragment is stored
     // as half floats (2^-11 relative: under 0.13 of a step below 1), and the
@@ -305,30 +317,26 @@ TEST_F(SamplesGL, FireLightBrightensGlassAndTheGroundSeenThroughIt) {
     const double perImage = (0.5 * (1.0 - a) + 0.13 + 0.5) / 255.0, step = 2.0 * perImage;
     std::size_t compared = 0;
     double worst = 0.0, largest = 0.0;
-    for (int y = 0; y < size.y; ++y)
-        for (int x = 0; x < size.x; ++x) {
-            const glm::dvec2 ndc{2.0 * (x + 0.5) / size.x - 1.0, 1.0 - 2.0 * (y + 0.5) / size.y};
-            const glm::dvec4 far = clipToWorld * glm::dvec4(ndc, 1.0, 1.0);
-            const glm::dvec3 dir = glm::dvec3(far) / far.w - eye;
-            if (dir.y >= 0.0) continue;
-            const glm::dvec3 q = eye + dir * ((0.5 - eye.y) / dir.y); // on the pane's plane, y = 0.5
-            const glm::dvec3 p = eye + dir * (-eye.y / dir.y);        // on the ground
-            // Well inside the pane (1.5 x 0.8 half-extents about (0, 3.2)): its edge pixels are partly ground.
-            if (std::fabs(q.x) > 1.4 || std::fabs(q.z - 3.2) > 0.7 || p.z < 2.0) continue;
-            const glm::vec3 eq = splatfx::emittedIrradiance(lights, glm::vec3(q), glm::vec3(0, 1, 0));
-            const glm::vec3 ep = splatfx::emittedIrradiance(lights, glm::vec3(p), glm::vec3(0, 1, 0));
-            for (int c = 0; c < 3; ++c) {
-                const double base = a * pane * ambient + (1.0 - a) * ground * ambient;
-                const double expected = (a * pane * double(eq[c]) + (1.0 - a) * ground * double(ep[c])) / pi;
-                if (base + expected > 254.0 / 255.0 || ground * (ambient + double(ep[c]) / pi) > 254.0 / 255.0) continue; // clamped
-                ASSERT_NEAR(dark.at(x, y, c), base, perImage) << "pixel " << x << "," << y << " is not the bare pane over the ground";
-                const double diff = double(lit.at(x, y, c)) - double(dark.at(x, y, c));
-                worst = std::max(worst, std::fabs(diff - expected));
-                largest = std::max(largest, expected);
-                EXPECT_NEAR(diff, expected, step) << "pixel " << x << "," << y << " channel " << c;
-                ++compared;
-            }
+    forEachDownwardRay(pair.camera, [&](int x, int y, auto at) {
+        const glm::dvec3 q = at(0.5); // on the pane's plane, y = 0.5
+        const glm::dvec3 p = at(0.0); // on the ground
+        // Well inside the pane (1.5 x 0.8 half-extents about (0, 3.2)): its edge pixels are partly ground.
+        if (std::fabs(q.x) > 1.4 || std::fabs(q.z - 3.2) > 0.7 || p.z < 2.0) return;
+        const glm::vec3 eq = splatfx::emittedIrradiance(pair.lights, glm::vec3(q), glm::vec3(0, 1, 0));
+        const glm::vec3 ep = splatfx::emittedIrradiance(pair.lights, glm::vec3(p), glm::vec3(0, 1, 0));
+        for (int c = 0; c < 3; ++c) {
+            const double base = a * pane * ambient + (1.0 - a) * ground * ambient;
+            const double expected = (a * pane * double(eq[c]) + (1.0 - a) * ground * double(ep[c])) / pi;
+            if (base + expected > 254.0 / 255.0 || ground * (ambient + double(ep[c]) / pi) > 254.0 / 255.0) continue; // clamped
+            ASSERT_NEAR(pair.dark.at(x, y, c), base, perImage) << "pixel " << x << "," << y << " is not the bare pane over the ground";
+            const double diff = double(pair.lit.at(x, y, c)) - double(pair.dark.at(x, y, c));
+            worst = std::max(worst, std::fabs(diff - expected));
+            largest = std::max(largest, expected);
+            EXPECT_NEAR(diff, expected, step) << "pixel " << x << "," << y << " channel " << c;
+            ++compared;
         }
+    });
+    if (HasFatalFailure()) return;
     EXPECT_GT(compared, 100u);
     EXPECT_GT(largest, 20.0 / 255.0);
     std::printf("fire light through glass: %zu channel values, largest %.4f, worst error %.5f (bound %.5f)\n", compared, largest, worst, step);

@@ -89,7 +89,11 @@ int runMsaa(int argc, char** argv) {
         // A driver may round a count up (llvmpipe makes 2 samples 4): the count drawn is the frame renderer's.
         std::string setting = samples == 1 ? "1 (single-sampled)" : std::to_string(samples) + "x MSAA";
         if (samples > 1 && st.msaa.samples != samples) setting += " (the driver made " + std::to_string(st.msaa.samples) + ")";
-        bench::KnobRow r{.knob = "host target samples", .setting = setting, .ms = ms[ms.size() / 2], .isDefault = samples == 1};
+        bench::KnobRow r;
+        r.knob = "host target samples";
+        r.setting = setting;
+        r.ms = ms[ms.size() / 2];
+        r.isDefault = samples == 1;
         bench::imageError(img, reference, r.rmse, r.maxErr);
         r.extra = std::to_string(st.msaa.sampleCopies) + " | " + std::to_string(st.notes.size());
         rows.push_back(r);

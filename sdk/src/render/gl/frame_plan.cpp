@@ -134,6 +134,18 @@ FramePlan planFrame(const Frame& frame, const HostTarget& host, const FrameRende
             plan.steps.push_back({.kind = StepKind::HostDepthSample, .sample = s});
             fogAndVolumes();
         }
+        // Unlike the full-resolution layer (shifted onto each sample's positions), the reduced
+        // one is drawn at its own texel centres in every sample's run: said once, on the first.
+        if (plan.reduced && perSample > 0 && (splats > 0 || plan.tetrahedra)) {
+            const auto first = std::find_if(plan.steps.begin(), plan.steps.end(), [](const PlanStep& st) {
+                return st.kind == StepKind::ReducedSplats || st.kind == StepKind::ReducedBegin;
+            });
+            if (first != plan.steps.end() && first->note.empty())
+                first->note = "reduced resolution (resolutionScale " + std::to_string(desc.resolutionScale) + ") on a multisampled host (" +
+                              std::to_string(plan.samples) +
+                              " samples): the reduced layer is drawn at its own texel centres in every sample's run, not shifted onto the "
+                              "sample positions";
+        }
         plan.steps.push_back({.kind = StepKind::HostDepthSample, .sample = -1});
         if (plan.lists)
             plan.steps.back().note = "fragment lists on a multisampled host (" + std::to_string(plan.samples) +
@@ -197,7 +209,7 @@ const char* toString(StepKind kind) {
 std::string describe(const PlanStep& s) {
     std::string line = toString(s.kind);
     if (s.kind == StepKind::Tetrahedra) line += " volume " + std::to_string(s.volume);
-    if (s.kind == StepKind::HostDepthSample) line += s.sample >= 0 ? " " + std::to_string(s.sample) : std::string(" nearest");
+    if (s.kind == StepKind::HostDepthSample) line.append(" ").append(s.sample >= 0 ? std::to_string(s.sample) : std::string("nearest"));
     switch (s.range) {
     case StepRange::Explicit:
         if (s.kind == StepKind::Splats || s.kind == StepKind::Tetrahedra) line += " [" + std::to_string(s.begin) + ", " + std::to_string(s.end) + ")";
