@@ -567,8 +567,11 @@ TEST(EmittedLight, GridSamplerIsTrilinearInsideAndThePointSourceBeyondACorner) {
         const glm::vec3 node(i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f);
         const glm::vec3 w = glm::normalize(c - node);
         const float d2 = glm::dot(c - node, c - node);
-        for (int a = 0; a < 3; ++a)
-            g.nodes[std::size_t(i)][std::size_t(2 * a)] = I * (std::max(w[a], 0.0f) / d2), g.nodes[std::size_t(i)][std::size_t(2 * a + 1)] = I * (std::max(-w[a], 0.0f) / d2);
+        auto& node = g.nodes[std::size_t(i)];
+        for (int a = 0; a < 3; ++a) {
+            node[std::size_t(2 * a)] = I * (std::max(w[a], 0.0f) / d2);
+            node[std::size_t(2 * a + 1)] = I * (std::max(-w[a], 0.0f) / d2);
+        }
     }
     const float ulp64 = 64.0f * 0x1p-24f;
     const glm::vec3 mid = emittedIrradiance(g, {0.0f, -1.0f, -1.0f}, {0, 1, 0}); // between nodes 0 and 1

@@ -204,13 +204,15 @@ int flicker(const std::string& path, int frames, int faceSize) {
             // How far the fit's frame-to-frame change is from the exact's (both relative to their means).
             follow += (v[i] / mean - exact[i] / em) * (v[i] / mean - exact[i] / em);
         }
-        std::printf("| %s | %.4g | %.4f | %.4f | %.4f | %.4f |\n", name, mean, std::sqrt(sq / double(v.size())), lo, hi, std::sqrt(follow / double(v.size())));
+        std::printf("| %s | %.4g | %.4f | %.4f | %.4f | %.4f |\n", name, mean, std::sqrt(sq / double(v.size())), lo, hi,
+                    std::sqrt(follow / double(v.size())));
     };
     std::printf("\nFlicker: sample 29's fire (%s), %d frames at %d fps, the irradiance (channel sum) on the cabin wall at (%.2f, %.2f, %.2f);\n"
                 "the exact at %d^2-pixel faces took %.1f s (largest relative error estimate %.4f). Flicker: RMS of E / mean(E) - 1; range: its\n"
                 "smallest and largest E / mean(E); vs exact: RMS over frames of (E / mean(E) - E_exact / mean(E_exact)).\n\n"
                 "| irradiance | mean | flicker RMS | min / mean | max / mean | vs exact |\n| --- | ---: | ---: | ---: | ---: | ---: |\n",
-                path.c_str(), frames, int(file->output.fps), double(wall.x), double(wall.y), double(wall.z), faceSize, ms(t0, Clock::now()) / 1e3, worstEstimate);
+                path.c_str(), frames, int(file->output.fps), double(wall.x), double(wall.y), double(wall.z), faceSize, ms(t0, Clock::now()) / 1e3,
+                worstEstimate);
     stats(exact, "exact (emittedIrradianceExact)");
     stats(fitted, "fitted lights (the sample's emitsLight)");
     stats(gridded, "grid (the default 3x3x3)");
@@ -320,7 +322,12 @@ int runEmitted(int argc, char** argv) {
         char extra[160];
         std::snprintf(extra, sizeof extra, "%.3f | %.3f | %.3f | %.3f | %+.3f", std::sqrt(group[0] / groupN[0]), std::sqrt(group[1] / groupN[1]),
                       std::sqrt(group[2] / groupN[2]), std::sqrt(group[3] / groupN[3]), signedSum / nOutside);
-        rows.push_back({.knob = knob, .setting = setting, .ms = bench::median(times), .rmse = std::sqrt(sq / n), .maxErr = worst, .extra = extra,
+        rows.push_back({.knob = knob,
+                        .setting = setting,
+                        .ms = bench::median(times),
+                        .rmse = std::sqrt(sq / n),
+                        .maxErr = worst,
+                        .extra = extra,
                         .isDefault = isDefault});
         return true;
     };
@@ -328,13 +335,14 @@ int runEmitted(int argc, char** argv) {
     for (bool occlusion : {true, false})
         for (int lights : {1, 2, 4, 8}) {
             const EmittedLightDesc desc{.enabled = true, .lights = lights, .occlusion = occlusion};
-            const bool ok = addRow(occlusion ? "lights, occlusion on" : "lights, occlusion off", std::to_string(lights) + (lights == 1 ? " light" : " lights"),
-                                   occlusion && lights == defaults.lights && defaults.mode == EmittedLightMode::PointLights,
-                                   [&](std::size_t f) -> std::optional<Irradiance> {
-                                       auto fit = fitEmittedLights(viewSplats[f], m, desc);
-                                       if (!fit) return std::fprintf(stderr, "emitted: %s\n", fit.error().c_str()), std::nullopt;
-                                       return Irradiance([l = std::move(*fit)](glm::vec3 p, glm::vec3 n) { return emittedIrradiance(l, p, n); });
-                                   });
+            const bool ok =
+                addRow(occlusion ? "lights, occlusion on" : "lights, occlusion off", std::to_string(lights) + (lights == 1 ? " light" : " lights"),
+                       occlusion && lights == defaults.lights && defaults.mode == EmittedLightMode::PointLights,
+                       [&](std::size_t f) -> std::optional<Irradiance> {
+                           auto fit = fitEmittedLights(viewSplats[f], m, desc);
+                           if (!fit) return std::fprintf(stderr, "emitted: %s\n", fit.error().c_str()), std::nullopt;
+                           return Irradiance([l = std::move(*fit)](glm::vec3 p, glm::vec3 n) { return emittedIrradiance(l, p, n); });
+                       });
             if (!ok) return 1;
         }
     struct GridSetting {
@@ -342,26 +350,27 @@ int runEmitted(int argc, char** argv) {
         float margin;
         bool occlusion;
     };
-    const GridSetting grids[] = {{{2, 2, 2}, 0.5f, true},  {{2, 3, 2}, 0.5f, true}, {{3, 3, 3}, 0.5f, true},
-                                 {{2, 8, 2}, 0.5f, true},  {{3, 3, 3}, 1.0f, true}, {{3, 3, 3}, 0.5f, false}};
+    const GridSetting grids[] = {{{2, 2, 2}, 0.5f, true}, {{2, 3, 2}, 0.5f, true}, {{3, 3, 3}, 0.5f, true},
+                                 {{2, 8, 2}, 0.5f, true}, {{3, 3, 3}, 1.0f, true}, {{3, 3, 3}, 0.5f, false}};
     for (const auto& [dims, margin, occlusion] : grids) {
-            const EmittedLightDesc desc{.enabled = true, .mode = EmittedLightMode::Grid, .occlusion = occlusion, .gridDims = dims, .gridMargin = margin};
-            char setting[64];
-            std::snprintf(setting, sizeof setting, "%dx%dx%d, margin %.1f", dims.x, dims.y, dims.z, double(margin));
-            const bool ok = addRow(occlusion ? "grid, occlusion on" : "grid, occlusion off", setting,
-                                   defaults.mode == EmittedLightMode::Grid && dims == defaults.gridDims && margin == defaults.gridMargin && occlusion,
-                                   [&](std::size_t f) -> std::optional<Irradiance> {
-                                       auto fit = fitEmittedGrid(viewSplats[f], m, desc);
-                                       if (!fit) return std::fprintf(stderr, "emitted: %s\n", fit.error().c_str()), std::nullopt;
-                                       return Irradiance([g = std::move(*fit)](glm::vec3 p, glm::vec3 n) { return emittedIrradiance(g, p, n); });
-                                   });
-            if (!ok) return 1;
-        }
+        const EmittedLightDesc desc{.enabled = true, .mode = EmittedLightMode::Grid, .occlusion = occlusion, .gridDims = dims, .gridMargin = margin};
+        char setting[64];
+        std::snprintf(setting, sizeof setting, "%dx%dx%d, margin %.1f", dims.x, dims.y, dims.z, double(margin));
+        const bool ok = addRow(occlusion ? "grid, occlusion on" : "grid, occlusion off", setting,
+                               defaults.mode == EmittedLightMode::Grid && dims == defaults.gridDims && margin == defaults.gridMargin && occlusion,
+                               [&](std::size_t f) -> std::optional<Irradiance> {
+                                   auto fit = fitEmittedGrid(viewSplats[f], m, desc);
+                                   if (!fit) return std::fprintf(stderr, "emitted: %s\n", fit.error().c_str()), std::nullopt;
+                                   return Irradiance([g = std::move(*fit)](glm::vec3 p, glm::vec3 n) { return emittedIrradiance(g, p, n); });
+                               });
+        if (!ok) return 1;
+    }
     bench::markPareto(rows);
-    std::printf("\nError: relative, of the irradiance (channel sum) against the exact one, RMS and largest over every receiver and frame;\n"
-                "per group RMS; mean signed: the mean relative error outside the flame (below 0: the fit too dark). Time: fitEmittedLights / fitEmittedGrid\n"
-                "on one frame's %zu splats.\n",
-                viewSplats[0].size());
+    std::printf(
+        "\nError: relative, of the irradiance (channel sum) against the exact one, RMS and largest over every receiver and frame;\n"
+        "per group RMS; mean signed: the mean relative error outside the flame (below 0: the fit too dark). Time: fitEmittedLights / fitEmittedGrid\n"
+        "on one frame's %zu splats.\n",
+        viewSplats[0].size());
     bench::printTable(rows, "fit ms/frame", "ground RMS | wall RMS | far RMS | inside RMS | mean signed");
 
     // The fit's cost as the emitter grows (same flame, finer voxels).

@@ -27,9 +27,9 @@
 // itself at the nodes of a coarse box around the emitter, for the six axis
 // normals, summed over the splats with each splat-node ray's own occlusion
 // (marched through the binned optical depth); sampled trilinearly by
-// splatfx_emittedGridIrradiance(worldPos, normal), falling off as 1 / d^2
-// from the emitter's centre outside the box. It serves inside the flame,
-// where a few point lights cannot (docs/lighting.md).
+// splatfx_emittedGridIrradiance(worldPos, normal); outside the box a point
+// source at the emitter's centre calibrated at the box. It errs less than
+// point lights inside the flame, more outside it (docs/BENCHMARKS.md).
 //
 // Threading: plain functions of their arguments.
 #pragma once
@@ -91,7 +91,7 @@ struct EmittedLightDesc {
 struct EmittedGrid {
     glm::ivec3 dims{0};
     glm::vec3 boxMin{0.0f}, boxMax{0.0f}; // world; the nodes span it, corners included
-    glm::vec3 centre{0.0f};               // emission-weighted centre: outside the box the light falls off as 1 / d^2 from it
+    glm::vec3 centre{0.0f};               // emission-weighted centre: where the point source outside the box sits
     // Per node (x fastest, then y, z): the irradiance (linear RGB) a surface
     // with normal +x, -x, +y, -y, +z, -z receives there; a unit normal n
     // gets sum_a n_a^2 times its sign's value (exact for an axis normal).
@@ -119,9 +119,9 @@ Result<std::vector<EmittedLight>> fitEmittedLights(std::span<const Splat> splats
 // Deterministic. Fails on a bad desc; an empty grid without emitting splats.
 Result<EmittedGrid> fitEmittedGrid(std::span<const Splat> splats, const Materials& materials, const EmittedLightDesc& desc, bool packedColor = false);
 
-// The grid's irradiance at a point with unit normal n: trilinear inside the
-// box; outside, the box's nearest point's times |q - centre|^2 / |p - centre|^2
-// (what splatfx_emittedGridIrradiance computes in GLSL).
+// The grid's irradiance at a point with unit normal n: trilinear inside the box; outside, a point source at the
+// centre whose intensity is read from the six values at the box's nearest point q, plus the grid's departure from it at q
+// falling as (|q - c| / |p - c|)^4 (what splatfx_emittedGridIrradiance computes in GLSL).
 glm::vec3 emittedIrradiance(const EmittedGrid& grid, glm::vec3 point, glm::vec3 normal);
 
 // The irradiance the lights give a surface point with unit normal n

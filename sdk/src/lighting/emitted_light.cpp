@@ -335,12 +335,14 @@ Result<EmittedGrid> fitEmittedGrid(std::span<const Splat> splats, const Material
                     const double t = occlusion ? double(std::exp2(-occlusion->depthAlong(s.center, p, e[i].opticalArea))) : 1.0;
                     const glm::dvec3 f = glm::dvec3(e[i].intensity) * (t / (d2 + a2));
                     const glm::dvec3 dir = glm::dvec3(w) / std::sqrt(d2);
-                    for (int a = 0; a < 3; ++a) sum[std::size_t(2 * a)] += f * std::max(dir[a], 0.0), sum[std::size_t(2 * a + 1)] += f * std::max(-dir[a], 0.0);
+                    for (int a = 0; a < 3; ++a)
+                        sum[std::size_t(2 * a)] += f * std::max(dir[a], 0.0), sum[std::size_t(2 * a + 1)] += f * std::max(-dir[a], 0.0);
                 }
                 auto& node = g.nodes[(std::size_t(z) * n.y + y) * n.x + x];
                 for (std::size_t k = 0; k < 6; ++k) node[k] = glm::vec3(sum[k] * double(desc.scale));
                 for (const glm::vec3& v : node)
-                    if (!finite(v)) return makeError("EmittedLightDesc.scale: the grid's irradiance overflows float (scale " + std::to_string(desc.scale) + ")");
+                    if (!finite(v))
+                        return makeError("EmittedLightDesc.scale: the grid's irradiance overflows float (scale " + std::to_string(desc.scale) + ")");
             }
     return g;
 }
