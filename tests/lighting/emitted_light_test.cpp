@@ -567,10 +567,10 @@ TEST(EmittedLight, GridSamplerIsTrilinearInsideAndThePointSourceBeyondACorner) {
         const glm::vec3 node(i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f);
         const glm::vec3 w = glm::normalize(c - node);
         const float d2 = glm::dot(c - node, c - node);
-        auto& node = g.nodes[std::size_t(i)];
+        auto& values = g.nodes[std::size_t(i)];
         for (int a = 0; a < 3; ++a) {
-            node[std::size_t(2 * a)] = I * (std::max(w[a], 0.0f) / d2);
-            node[std::size_t(2 * a + 1)] = I * (std::max(-w[a], 0.0f) / d2);
+            values[std::size_t(2 * a)] = I * (std::max(w[a], 0.0f) / d2);
+            values[std::size_t(2 * a + 1)] = I * (std::max(-w[a], 0.0f) / d2);
         }
     }
     const float ulp64 = 64.0f * 0x1p-24f;
@@ -647,4 +647,9 @@ TEST(EmittedLight, BadGridDescsGiveNamedErrorsAndHugeSplatsAFiniteGrid) {
         for (const glm::vec3& v : node) EXPECT_TRUE(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z));
     const glm::vec3 e = emittedIrradiance(*g, g->centre, {0, 1, 0});
     EXPECT_TRUE(std::isfinite(e.x));
+    // A NaN point, or a host's grid with a flat box: 0, no float-to-int of a NaN.
+    EXPECT_EQ(emittedIrradiance(*g, glm::vec3(std::nanf("")), {0, 1, 0}), glm::vec3(0.0f));
+    EmittedGrid flat = *g;
+    flat.boxMax.x = flat.boxMin.x;
+    EXPECT_EQ(emittedIrradiance(flat, flat.boxMin, {0, 1, 0}), glm::vec3(0.0f));
 }

@@ -352,6 +352,7 @@ glm::vec3 emittedIrradiance(const EmittedGrid& g, glm::vec3 point, glm::vec3 nor
     if (n.x < 2 || n.y < 2 || n.z < 2 || g.nodes.size() != std::size_t(n.x) * n.y * n.z) return glm::vec3(0.0f);
     const glm::vec3 q = glm::clamp(point, g.boxMin, g.boxMax);
     const glm::vec3 t = (q - g.boxMin) / (g.boxMax - g.boxMin) * glm::vec3(n - 1);
+    if (!finite(t) || !finite(normal)) return glm::vec3(0.0f); // a NaN point or a flat box: no float-to-int of a NaN
     const glm::ivec3 i0 = glm::clamp(glm::ivec3(glm::floor(t)), glm::ivec3(0), n - 2);
     const glm::vec3 f = t - glm::vec3(i0);
     const glm::ivec3 k(normal.x >= 0.0f ? 0 : 1, normal.y >= 0.0f ? 2 : 3, normal.z >= 0.0f ? 4 : 5);
