@@ -487,3 +487,169 @@ TEST(EmittedLight, NonFiniteAndHugeSplatsLeaveFiniteLights) {
     const glm::vec3 e = emittedIrradiance(*clean, (*clean)[0].position, {0, 1, 0});
     EXPECT_TRUE(std::isfinite(e.x) && std::isfinite(e.y) && std::isfinite(e.z));
 }
+
+// A splat alone has nothing in front of it: occlusion on, all its light
+// leaves (escape shares exactly 1, the grid as without occlusion). The
+// binned optical depth once counted the splat's own opacity in its bin, so a
+// lone splat of opacity 0.3 kept half its light, and a whole fire was fitted
+// too dark (docs/BENCHMARKS.md, "Volumes as light").
+TEST(EmittedLight, ALoneSplatDoesNotOccludeItsOwnLight) {
+    Materials m{Footprint{}};
+    const std::uint32_t row = m.addColorTable(ColorTable::constant({1.0f, 0.5f, 0.25f, 1.0f}));
+    const std::vector<Splat> splats{facing({0.3f, 0.5f, -2.0f}, {0.0f, 0.0f, 0.0f}, 0.2f, 4.0f, row)};
+    auto lights = fitEmittedLights(splats, m, {.enabled = true, .occlusion = true});
+    ASSERT_TRUE(lights) << lights.error();
+    ASSERT_EQ(lights->size(), 1u);
+    EXPECT_EQ((*lights)[0].escapePlus, glm::vec3(1.0f));
+    EXPECT_EQ((*lights)[0].escapeMinus, glm::vec3(1.0f));
+    auto on = fitEmittedGrid(splats, m, {.enabled = true, .mode = EmittedLightMode::Grid, .occlusion = true});
+    auto off = fitEmittedGrid(splats, m, {.enabled = true, .mode = EmittedLightMode::Grid, .occlusion = false});
+    ASSERT_TRUE(on && off);
+    ASSERT_EQ(on->nodes.size(), 27u);
+    for (std::size_t i = 0; i < on->nodes.size(); ++i)
+        for (std::size_t k = 0; k < 6; ++k) EXPECT_EQ(on->nodes[i][k], off->nodes[i][k]) << "node " << i << " normal " << k;
+}
+
+// A grid node against the exact irradiance of one plain splat facing it.
+// The node stores I cos / (d^2 + a^2); the exact is cos x the integral of
+// L d^2 / (d^2 + rho^2)^2 over the disc (the tilt's first-order term cancels
+// over the symmetric disc; every ray within a/d = 0.06 rad of the centre's,
+// so no cosine clamps). Both lie in [(1 + a^2/d^2)^-2, 1] x I cos / d^2, so
+// they differ by at most 1 - (1 + a^2/d^2)^-2 of it; plus the fit's intensity
+// quadrature (as OneSplatFitsOneLightWithItsIntensity) and the reference's
+// error estimate. The sampler at the node returns the node's value (weight
+// exactly 1), and the normal facing away from the splat gets exactly 0.
+TEST(EmittedLight, GridNodeMeetsTheExactIrradianceOfOneSplat) {
+    Materials m{Footprint{}};
+    const std::uint32_t row = m.addColorTable(ColorTable::constant({1.0f, 0.5f, 0.25f, 1.0f}));
+    const glm::vec3 c(0.2f, 0.4f, -0.3f);
+    const float margin = 1.0f, a = 0.1f, density = 1.5f;
+    const glm::vec3 node = c - glm::vec3(margin); // the grid's first corner
+    const std::vector<Splat> splats{facing(c, node, a, density, row)};
+    auto g = fitEmittedGrid(splats, m, {.enabled = true, .mode = EmittedLightMode::Grid, .gridDims = {2, 2, 2}, .gridMargin = margin});
+    ASSERT_TRUE(g) << g.error();
+    ASSERT_EQ(g->boxMin, node);
+    EXPECT_EQ(g->centre, c);
+    const double I = plainIntensity(m.footprint(), a, density);
+    const double quadrature = std::abs(sampledIntensity(m.footprint(), m.layerSize(), a, density) - I) +
+                              std::log(2.0) * density * storedWindowError(m) * 4.0 * a * a + 256.0 * 0x1p-24 * I;
+    const double d2 = glm::dot(c - node, c - node), cosine = 1.0 / std::sqrt(3.0);
+    for (int axis = 0; axis < 3; ++axis) {
+        glm::dvec3 n(0.0);
+        n[axis] = 1.0;
+        auto e = emittedIrradianceExact(splats, m, glm::dvec3(node), n, {.faceSize = 256});
+        ASSERT_TRUE(e) << e.error();
+        const double law = I * cosine / d2;
+        const double tol = (1.0 - 1.0 / ((1.0 + a * a / d2) * (1.0 + a * a / d2))) * law + quadrature * cosine / d2 + e->errorEstimate;
+        const glm::vec3 stored = g->nodes[0][std::size_t(2 * axis)];
+        EXPECT_NEAR(stored.x, e->irradiance.x, tol) << "axis " << axis;
+        EXPECT_NEAR(stored.z, e->irradiance.z, 0.25 * tol) << "axis " << axis;
+        EXPECT_EQ(emittedIrradiance(*g, node, glm::vec3(n)), stored);
+        EXPECT_EQ(g->nodes[0][std::size_t(2 * axis + 1)], glm::vec3(0.0f)) << "the splat lies on the + side";
+    }
+}
+
+// The sampler on a grid filled from a point source at its centre c
+// (E(+-a) = I max(+-w_a, 0) / d^2 at each node): inside the box trilinear
+// (halfway between two nodes, their mean); beyond a corner, on the ray from c
+// through it, the point source itself (the corner's values are exact, so the
+// intensity read there is I and the departure there is 0 for an axis normal);
+// continuous across the box's faces. Float rounding: a few dozen operations
+// on values of order 1: 64 ulp.
+TEST(EmittedLight, GridSamplerIsTrilinearInsideAndThePointSourceBeyondACorner) {
+    const glm::vec3 c(0.2f, -0.1f, 0.3f), I(2.0f, 1.0f, 0.5f);
+    EmittedGrid g;
+    g.dims = {2, 2, 2};
+    g.boxMin = glm::vec3(-1.0f), g.boxMax = glm::vec3(1.0f);
+    g.centre = c;
+    g.nodes.resize(8);
+    for (int i = 0; i < 8; ++i) {
+        const glm::vec3 node(i & 1 ? 1.0f : -1.0f, i & 2 ? 1.0f : -1.0f, i & 4 ? 1.0f : -1.0f);
+        const glm::vec3 w = glm::normalize(c - node);
+        const float d2 = glm::dot(c - node, c - node);
+        auto& values = g.nodes[std::size_t(i)];
+        for (int a = 0; a < 3; ++a) {
+            values[std::size_t(2 * a)] = I * (std::max(w[a], 0.0f) / d2);
+            values[std::size_t(2 * a + 1)] = I * (std::max(-w[a], 0.0f) / d2);
+        }
+    }
+    const float ulp64 = 64.0f * 0x1p-24f;
+    const glm::vec3 mid = emittedIrradiance(g, {0.0f, -1.0f, -1.0f}, {0, 1, 0}); // between nodes 0 and 1
+    const glm::vec3 mean = 0.5f * (g.nodes[0][2] + g.nodes[1][2]);
+    EXPECT_NEAR(mid.x, mean.x, mean.x * ulp64);
+    const glm::vec3 corner(1.0f);
+    for (float s : {2.0f, 5.0f})
+        for (glm::vec3 n : {glm::vec3(-1, 0, 0), glm::vec3(0, -1, 0), glm::vec3(0, 0, -1)}) {
+            const glm::vec3 p = c + s * (corner - c);
+            const glm::vec3 law = I * (std::max(glm::dot(n, glm::normalize(c - p)), 0.0f) / glm::dot(c - p, c - p));
+            const glm::vec3 e = emittedIrradiance(g, p, n);
+            EXPECT_NEAR(e.x, law.x, law.x * ulp64 + 1e-30f) << "s " << s;
+            EXPECT_NEAR(e.z, law.z, law.z * ulp64 + 1e-30f) << "s " << s;
+        }
+    // Continuous across a face: the change from the face point to one h
+    // outside is linear in h (a smooth function of d^2 = 0.69 + O(h)), so
+    // h = 1e-4 changes it by 0.1 of what h = 1e-3 does, up to the O(h^2)
+    // term (1e-3 / 0.69 of it: 0.2 leaves that twice over) and rounding; a
+    // jump at the face would change both alike.
+    const glm::vec3 atFace = emittedIrradiance(g, {1.0f, 0.1f, 0.2f}, {-1, 0, 0});
+    const float far = std::abs(emittedIrradiance(g, {1.001f, 0.1f, 0.2f}, {-1, 0, 0}).x - atFace.x);
+    const float near = std::abs(emittedIrradiance(g, {1.0001f, 0.1f, 0.2f}, {-1, 0, 0}).x - atFace.x);
+    EXPECT_GT(atFace.x, 0.0f);
+    EXPECT_GT(far, 0.0f);
+    EXPECT_LT(near, 0.2f * far + atFace.x * ulp64);
+    EmittedGrid none;
+    EXPECT_EQ(emittedIrradiance(none, {0, 0, 0}, {0, 1, 0}), glm::vec3(0.0f));
+}
+
+// A Scene effect in grid mode gives the frame its grid (the desc's dims,
+// around the fire) and no point lights; fitted again, bit for bit the same.
+TEST(EmittedLight, SceneFillsTheFramesGridInGridMode) {
+    FireScene fs(8.0f);
+    EffectOptions& o = fs.scene.options(fs.fire);
+    o.emitsLight.mode = EmittedLightMode::Grid;
+    o.emitsLight.gridDims = {2, 4, 2};
+    Frame a, b;
+    ASSERT_TRUE(fs.scene.prepare(0.0, towardsFire(), fs.materials, a));
+    ASSERT_TRUE(fs.scene.lightingError().empty()) << fs.scene.lightingError();
+    EXPECT_TRUE(a.emittedLights().empty());
+    ASSERT_EQ(a.emittedGrid().dims, glm::ivec3(2, 4, 2));
+    EXPECT_GT(emittedIrradiance(a.emittedGrid(), {1.5f, 0.0f, 0.0f}, {0, 1, 0}).x, 0.0f);
+    ASSERT_TRUE(fs.scene.prepare(0.0, towardsFire(), fs.materials, b));
+    ASSERT_EQ(b.emittedGrid().nodes.size(), a.emittedGrid().nodes.size());
+    for (std::size_t i = 0; i < a.emittedGrid().nodes.size(); ++i)
+        for (std::size_t k = 0; k < 6; ++k) EXPECT_EQ(b.emittedGrid().nodes[i][k], a.emittedGrid().nodes[i][k]);
+}
+
+// Bad grid descs: named errors; huge and non-finite splats: a finite grid.
+TEST(EmittedLight, BadGridDescsGiveNamedErrorsAndHugeSplatsAFiniteGrid) {
+    FireMaterials fm;
+    std::vector<Splat> splats = fireSplats(fm, smallFire({2, 3, 2}, 0.15f, 0.6f, 0), {0.0f, 1.0f, 4.0f});
+    auto fails = [&](EmittedLightDesc d, const char* field) {
+        auto r = fitEmittedGrid(splats, fm.m, d);
+        ASSERT_FALSE(r) << field;
+        EXPECT_NE(r.error().find(field), std::string::npos) << r.error();
+    };
+    fails({.enabled = true, .mode = EmittedLightMode::Grid, .gridDims = {1, 3, 3}}, "EmittedLightDesc.gridDims");
+    fails({.enabled = true, .mode = EmittedLightMode::Grid, .gridDims = {4, 4, 4}}, "EmittedLightDesc.gridDims"); // 64 nodes
+    fails({.enabled = true, .mode = EmittedLightMode::Grid, .gridDims = {2, -2, 2}}, "EmittedLightDesc.gridDims");
+    fails({.enabled = true, .mode = EmittedLightMode::Grid, .gridMargin = -0.1f}, "EmittedLightDesc.gridMargin");
+    fails({.enabled = true, .mode = EmittedLightMode::Grid, .gridMargin = std::numeric_limits<float>::quiet_NaN()}, "EmittedLightDesc.gridMargin");
+    fails({.enabled = true, .mode = EmittedLightMode(7)}, "EmittedLightDesc.mode");
+    Splat bad = splats[0];
+    bad.center = glm::vec3(std::nanf(""), 0.0f, 0.0f);
+    splats.push_back(bad);
+    bad = splats[0];
+    bad.center = glm::vec3(1e30f, -1e30f, 1e30f);
+    splats.push_back(bad);
+    auto g = fitEmittedGrid(splats, fm.m, {.enabled = true, .mode = EmittedLightMode::Grid});
+    ASSERT_TRUE(g) << g.error();
+    for (const auto& node : g->nodes)
+        for (const glm::vec3& v : node) EXPECT_TRUE(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z));
+    const glm::vec3 e = emittedIrradiance(*g, g->centre, {0, 1, 0});
+    EXPECT_TRUE(std::isfinite(e.x));
+    // A NaN point, or a host's grid with a flat box: 0, no float-to-int of a NaN.
+    EXPECT_EQ(emittedIrradiance(*g, glm::vec3(std::nanf("")), {0, 1, 0}), glm::vec3(0.0f));
+    EmittedGrid flat = *g;
+    flat.boxMax.x = flat.boxMin.x;
+    EXPECT_EQ(emittedIrradiance(flat, flat.boxMin, {0, 1, 0}), glm::vec3(0.0f));
+}

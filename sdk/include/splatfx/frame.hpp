@@ -142,6 +142,11 @@ public:
     // brightest first, at most kMaxEmittedLights. emitted_light.hpp.
     std::vector<EmittedLight>& emittedLights() { return mEmittedLights; }
     const std::vector<EmittedLight>& emittedLights() const { return mEmittedLights; }
+    // The frame's irradiance grid (cleared by begin()): what
+    // splatfx_emittedGridIrradiance adds. Scene::prepare fills it from the
+    // first effect in EmittedLightMode::Grid (the GLSL holds one grid).
+    EmittedGrid& emittedGrid() { return mEmittedGrid; }
+    const EmittedGrid& emittedGrid() const { return mEmittedGrid; }
 
     // Volumes to draw as tetrahedra (cleared by begin()).
     std::vector<FrameVolume>& volumes() { return mVolumes; }
@@ -158,6 +163,7 @@ private:
     std::shared_ptr<const Fog> mFog; // default none
     std::vector<FrameVolume> mVolumes;
     std::vector<EmittedLight> mEmittedLights;
+    EmittedGrid mEmittedGrid;
     std::vector<DrawBatch> mDrawOrder;
 };
 

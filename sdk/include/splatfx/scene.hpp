@@ -351,6 +351,9 @@ public:
     // The lights the emissive effects gave at the last prepare() (all of
     // them, brightest first; the Frame keeps the first kMaxEmittedLights).
     std::span<const EmittedLight> emittedLights() const { return mEmittedLights; }
+    // The first EmittedLightMode::Grid effect's grid at the last prepare()
+    // (dims 0: none); later grid effects' are dropped (emittedLightsDropped).
+    const EmittedGrid& emittedGrid() const { return mEmittedGrid; }
     // What the scene may spend; only lightingBytes is read here (every light
     // x every table-lit effect's table, plus slot 0's scene shadow, checked
     // before any table is built; the other lights' scene shadows only use
@@ -411,6 +414,8 @@ private:
     bool mUpdated = false;
     std::vector<Light> mLights;
     std::vector<EmittedLight> mEmittedLights;
+    EmittedGrid mEmittedGrid;
+    std::size_t mEmittedGridsDropped = 0;
     // This emit's shadow-casting lit clouds' fields: each lit effect's light is attenuated through them.
     std::vector<const DensityField*> mVolumeCasters;
     SplatBuilder mLightScratch{SplatBuilderDesc{.frustumCull = false}}; // an emitter's whole splats, fitted, never drawn

@@ -8,6 +8,7 @@ void Frame::begin(double timeSec, const Camera& camera) {
     mBuilder.begin(camera);
     mVolumes.clear(); // [clouds]
     mEmittedLights.clear();
+    mEmittedGrid = {};
 }
 
 void Frame::end(SortMode mode) {

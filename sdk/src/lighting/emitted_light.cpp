@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <string>
 
 namespace splatfx {
@@ -83,18 +84,54 @@ public:
         mDepth.assign(std::size_t(mDims.x) * mDims.y * mDims.z, 0.0f);
         for (std::size_t i : emitting) mDepth[index(bin(splats[i].center))] += e[i].opticalArea;
     }
-    // Transmittance from p out of the volume along +x, +y, +z (plus) and -x, -y, -z (minus).
-    void escape(glm::vec3 p, glm::vec3& plus, glm::vec3& minus) const {
+    // Transmittance from p (a splat of optical area `own`) out of the volume
+    // along +x, +y, +z (plus) and -x, -y, -z (minus).
+    void escape(glm::vec3 p, float own, glm::vec3& plus, glm::vec3& minus) const {
         const glm::ivec3 c = bin(p);
         for (int axis = 0; axis < 3; ++axis) {
             const float face = mCell[(axis + 1) % 3] * mCell[(axis + 2) % 3];
             for (int dir : {-1, 1}) {
-                float tau = 0.5f * mDepth[index(c)]; // half of its own bin lies ahead
+                // Half of its own bin lies ahead, less the splat itself: its
+                // emission is premultiplied, it does not pass through itself.
+                float tau = 0.5f * std::max(mDepth[index(c)] - own, 0.0f);
                 glm::ivec3 q = c;
                 for (q[axis] += dir; q[axis] >= 0 && q[axis] < mDims[axis]; q[axis] += dir) tau += mDepth[index(q)];
                 (dir > 0 ? plus : minus)[axis] = std::exp2(-tau / face);
             }
         }
+    }
+
+    // Optical depth (log2) along the segment from a splat's centre to `to`,
+    // through the bins it crosses (midpoint rule, half a bin per step), the
+    // splat's own optical area `own` taken out of its bin.
+    float depthAlong(glm::vec3 from, glm::vec3 to, float own) const {
+        const glm::vec3 hi = mLo + mCell * glm::vec3(mDims);
+        // Clip to the grid's box (slab test): outside it there is no depth.
+        const glm::vec3 d = to - from;
+        float t0 = 0.0f, t1 = 1.0f;
+        for (int a = 0; a < 3; ++a) {
+            if (d[a] == 0.0f) continue;
+            float ta = (mLo[a] - from[a]) / d[a], tb = (hi[a] - from[a]) / d[a];
+            if (ta > tb) std::swap(ta, tb);
+            t0 = std::max(t0, ta), t1 = std::min(t1, tb);
+        }
+        if (!(t1 > t0)) return 0.0f;
+        // Scaled: a splat 1e30 away must not overflow the length's square.
+        const float big = std::max(std::abs(d.x), std::max(std::abs(d.y), std::abs(d.z)));
+        const float length = glm::length(d / big) * big * (t1 - t0);
+        // Two steps per bin crossed (it crosses at most sum_a |d_a| / cell_a
+        // bin faces, <= 3 x 32); clamped in float before the conversion.
+        const glm::vec3 crossed = glm::abs(d) * (t1 - t0) / mCell;
+        const int steps = int(std::clamp(std::ceil(2.0f * (crossed.x + crossed.y + crossed.z)), 1.0f, 2.0f * 3.0f * 32.0f));
+        const float dt = (t1 - t0) / float(steps), step = length / float(steps);
+        const float volume = mCell.x * mCell.y * mCell.z;
+        const glm::ivec3 start = bin(from);
+        float depth = 0.0f;
+        for (int k = 0; k < steps; ++k) {
+            const glm::ivec3 c = bin(from + d * (t0 + (float(k) + 0.5f) * dt));
+            depth += std::max(mDepth[index(c)] - (c == start ? own : 0.0f), 0.0f);
+        }
+        return depth * step / volume;
     }
 
 private:
@@ -105,6 +142,17 @@ private:
     std::vector<float> mDepth;
 };
 
+// Each splat's emission into e; the indices of those that emit.
+std::vector<std::size_t> collect(std::span<const Splat> splats, const Materials& materials, bool packedColor, std::vector<SplatEmission>& e) {
+    e.assign(splats.size(), SplatEmission{});
+    std::vector<std::size_t> emitting;
+    for (std::size_t i = 0; i < splats.size(); ++i) {
+        e[i] = emission(splats[i], materials, packedColor);
+        if (e[i].intensity.x + e[i].intensity.y + e[i].intensity.z > 0.0f) emitting.push_back(i);
+    }
+    return emitting;
+}
+
 } // namespace
 
 Status validate(const EmittedLightDesc& d) {
@@ -112,23 +160,25 @@ Status validate(const EmittedLightDesc& d) {
         return makeError("EmittedLightDesc.lights must be in [1, " + std::to_string(kMaxEmittedLights) + "], got " + std::to_string(d.lights));
     if (!(d.scale >= 0.0f) || !std::isfinite(d.scale)) return makeError("EmittedLightDesc.scale must be finite and >= 0");
     if (!(d.reachWorld > 0.0f)) return makeError("EmittedLightDesc.reachWorld must be > 0");
+    if (d.mode != EmittedLightMode::PointLights && d.mode != EmittedLightMode::Grid) return makeError("EmittedLightDesc.mode is not a known mode");
+    if (d.gridDims.x < 2 || d.gridDims.y < 2 || d.gridDims.z < 2 || d.gridDims.x > kMaxEmittedGridNodes || d.gridDims.y > kMaxEmittedGridNodes ||
+        d.gridDims.z > kMaxEmittedGridNodes || d.gridDims.x * d.gridDims.y * d.gridDims.z > kMaxEmittedGridNodes)
+        return makeError("EmittedLightDesc.gridDims must be >= 2 on each axis with at most " + std::to_string(kMaxEmittedGridNodes) + " nodes, got " +
+                         std::to_string(d.gridDims.x) + " x " + std::to_string(d.gridDims.y) + " x " + std::to_string(d.gridDims.z));
+    if (!(d.gridMargin >= 0.0f) || !std::isfinite(d.gridMargin)) return makeError("EmittedLightDesc.gridMargin must be finite and >= 0");
     return {};
 }
 
 Result<std::vector<EmittedLight>> fitEmittedLights(std::span<const Splat> splats, const Materials& materials, const EmittedLightDesc& desc,
                                                    bool packedColor) {
     if (Status s = validate(desc); !s) return makeError(s.error());
-    std::vector<SplatEmission> e(splats.size());
-    std::vector<std::size_t> emitting;
-    for (std::size_t i = 0; i < splats.size(); ++i) {
-        e[i] = emission(splats[i], materials, packedColor);
-        if (e[i].intensity.x + e[i].intensity.y + e[i].intensity.z > 0.0f) emitting.push_back(i);
-    }
+    std::vector<SplatEmission> e;
+    const std::vector<std::size_t> emitting = collect(splats, materials, packedColor, e);
     if (emitting.empty()) return std::vector<EmittedLight>{};
     std::vector<glm::vec3> plus(splats.size(), glm::vec3(1.0f)), minus(splats.size(), glm::vec3(1.0f));
     if (desc.occlusion) {
         const Occlusion occlusion(splats, e, emitting);
-        for (std::size_t i : emitting) occlusion.escape(splats[i].center, plus[i], minus[i]);
+        for (std::size_t i : emitting) occlusion.escape(splats[i].center, e[i].opticalArea, plus[i], minus[i]);
     }
     // Weighted k-means on the centres, weight = the light that leaves (channel sum, mean escape).
     std::vector<float> w(emitting.size());
@@ -239,6 +289,106 @@ glm::vec3 emittedIrradiance(std::span<const EmittedLight> lights, glm::vec3 poin
         sum += l.intensity * (glm::dot(sq, escape) * cosine / (d2 + l.radius * l.radius));
     }
     return sum;
+}
+
+} // namespace splatfx
+
+namespace splatfx {
+
+Result<EmittedGrid> fitEmittedGrid(std::span<const Splat> splats, const Materials& materials, const EmittedLightDesc& desc, bool packedColor) {
+    if (Status s = validate(desc); !s) return makeError(s.error());
+    std::vector<SplatEmission> e;
+    const std::vector<std::size_t> emitting = collect(splats, materials, packedColor, e);
+    if (emitting.empty()) return EmittedGrid{};
+    glm::vec3 lo(1e30f), hi(-1e30f);
+    glm::dvec3 centre(0.0);
+    double power = 0.0;
+    for (std::size_t i : emitting) {
+        lo = glm::min(lo, splats[i].center), hi = glm::max(hi, splats[i].center);
+        const double p = double(e[i].intensity.x + e[i].intensity.y + e[i].intensity.z);
+        centre += p * glm::dvec3(splats[i].center), power += p;
+    }
+    EmittedGrid g;
+    g.dims = desc.gridDims;
+    // A flat or point-like emitter with no margin still needs a box: grow an
+    // empty axis by the largest splat's half-width.
+    float half = 0.0f;
+    for (std::size_t i : emitting) half = std::max(half, std::sqrt(glm::length(glm::cross(splats[i].axisU, splats[i].axisV))));
+    const glm::vec3 grow = glm::max(glm::vec3(desc.gridMargin), glm::vec3(glm::greaterThanEqual(lo, hi)) * half);
+    g.boxMin = lo - grow, g.boxMax = hi + grow;
+    g.centre = glm::vec3(centre / power);
+    if (!finite(g.boxMin) || !finite(g.boxMax) || !finite(g.centre)) return makeError("fitEmittedGrid: the emitting splats' bounds overflow float");
+    const std::optional<Occlusion> occlusion = desc.occlusion ? std::optional<Occlusion>(std::in_place, splats, e, emitting) : std::nullopt;
+    const glm::ivec3 n = g.dims;
+    g.nodes.assign(std::size_t(n.x) * n.y * n.z, {});
+    for (int z = 0; z < n.z; ++z)
+        for (int y = 0; y < n.y; ++y)
+            for (int x = 0; x < n.x; ++x) {
+                const glm::vec3 p = g.boxMin + (g.boxMax - g.boxMin) * (glm::vec3(x, y, z) / glm::vec3(n - 1));
+                std::array<glm::dvec3, 6> sum{};
+                for (std::size_t i : emitting) {
+                    const Splat& s = splats[i];
+                    const glm::vec3 w = s.center - p; // towards the splat
+                    const double d2 = double(glm::dot(w, w));
+                    if (!(d2 > 0.0)) continue; // no direction to it: its light falls on no axis normal
+                    const double a2 = double(glm::length(glm::cross(s.axisU, s.axisV)));
+                    const double t = occlusion ? double(std::exp2(-occlusion->depthAlong(s.center, p, e[i].opticalArea))) : 1.0;
+                    const glm::dvec3 f = glm::dvec3(e[i].intensity) * (t / (d2 + a2));
+                    const glm::dvec3 dir = glm::dvec3(w) / std::sqrt(d2);
+                    for (int a = 0; a < 3; ++a)
+                        sum[std::size_t(2 * a)] += f * std::max(dir[a], 0.0), sum[std::size_t(2 * a + 1)] += f * std::max(-dir[a], 0.0);
+                }
+                auto& node = g.nodes[(std::size_t(z) * n.y + y) * n.x + x];
+                for (std::size_t k = 0; k < 6; ++k) node[k] = glm::vec3(sum[k] * double(desc.scale));
+                for (const glm::vec3& v : node)
+                    if (!finite(v))
+                        return makeError("EmittedLightDesc.scale: the grid's irradiance overflows float (scale " + std::to_string(desc.scale) + ")");
+            }
+    return g;
+}
+
+glm::vec3 emittedIrradiance(const EmittedGrid& g, glm::vec3 point, glm::vec3 normal) {
+    const glm::ivec3 n = g.dims;
+    if (n.x < 2 || n.y < 2 || n.z < 2 || g.nodes.size() != std::size_t(n.x) * n.y * n.z) return glm::vec3(0.0f);
+    const glm::vec3 q = glm::clamp(point, g.boxMin, g.boxMax);
+    const glm::vec3 t = (q - g.boxMin) / (g.boxMax - g.boxMin) * glm::vec3(n - 1);
+    if (!finite(t) || !finite(normal)) return glm::vec3(0.0f); // a NaN point or a flat box: no float-to-int of a NaN
+    const glm::ivec3 i0 = glm::clamp(glm::ivec3(glm::floor(t)), glm::ivec3(0), n - 2);
+    const glm::vec3 f = t - glm::vec3(i0);
+    const glm::ivec3 k(normal.x >= 0.0f ? 0 : 1, normal.y >= 0.0f ? 2 : 3, normal.z >= 0.0f ? 4 : 5);
+    const glm::vec3 nn = normal * normal;
+    glm::vec3 sum(0.0f);
+    for (int c = 0; c < 8; ++c) {
+        const glm::ivec3 o(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+        const glm::vec3 w3 = glm::mix(glm::vec3(1.0f) - f, f, glm::vec3(o));
+        const glm::ivec3 i = i0 + o;
+        const auto& node = g.nodes[(std::size_t(i.z) * n.y + i.y) * n.x + i.x];
+        sum += (w3.x * w3.y * w3.z) * (nn.x * node[std::size_t(k.x)] + nn.y * node[std::size_t(k.y)] + nn.z * node[std::size_t(k.z)]);
+    }
+    if (q == point) return sum;
+    // Outside the box: a point source at the centre whose intensity towards
+    // q is read from q's six values (for a point source E(+-a) = I max(+-w_a, 0)
+    // / d^2, so I = d^2 x their sum / sum_a |w_a|), shining on p with p's own
+    // cosine; plus the grid's departure from it at q, falling as d^-4 (the
+    // weighted centre cancels the dipole term): continuous at the box, the
+    // point source far away.
+    const glm::vec3 dq = g.centre - q, dp = g.centre - point;
+    const float dq2 = glm::dot(dq, dq), dp2 = glm::dot(dp, dp);
+    if (!(dq2 > 0.0f) || !(dp2 > 0.0f)) return sum;
+    const glm::vec3 wq = dq / std::sqrt(dq2), wp = dp / std::sqrt(dp2);
+    glm::vec3 all(0.0f);
+    for (int c = 0; c < 8; ++c) {
+        const glm::ivec3 o(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+        const glm::vec3 w3 = glm::mix(glm::vec3(1.0f) - f, f, glm::vec3(o));
+        const glm::ivec3 i = i0 + o;
+        const auto& node = g.nodes[(std::size_t(i.z) * n.y + i.y) * n.x + i.x];
+        all += (w3.x * w3.y * w3.z) * (node[0] + node[1] + node[2] + node[3] + node[4] + node[5]);
+    }
+    const glm::vec3 intensity = all * (dq2 / (std::abs(wq.x) + std::abs(wq.y) + std::abs(wq.z)));
+    const glm::vec3 atQ = intensity * (std::max(glm::dot(normal, wq), 0.0f) / dq2);
+    const glm::vec3 atP = intensity * (std::max(glm::dot(normal, wp), 0.0f) / dp2);
+    const float r = dq2 / dp2;
+    return glm::max(atP + (sum - atQ) * (r * r), glm::vec3(0.0f));
 }
 
 } // namespace splatfx

@@ -185,6 +185,8 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
     mCounters.shadowTableBuilds = mCounters.shadowTableReuses = mCounters.shadowTableSkips = 0;
     mTablesFit = true;
     mEmittedLights.clear();
+    mEmittedGrid = {};
+    mEmittedGridsDropped = 0;
     if (Status s = checkLightingBudget(); !s) {
         mLightingError = s.error();
         mTablesFit = false;
@@ -251,6 +253,19 @@ void Scene::fitLights(Entry& e, const Camera& camera, const Materials& materials
     // change as the effect crosses the view's edge; drawn nowhere.
     mLightScratch.begin(camera);
     e.kind->emit(EmitContext{.splats = mLightScratch, .volumes = nullptr, .materials = materials, .draw = draw});
+    if (e.options.emitsLight.mode == EmittedLightMode::Grid) {
+        if (mEmittedGrid.dims.x > 0) {
+            ++mEmittedGridsDropped;
+            return;
+        }
+        Result<EmittedGrid> grid = fitEmittedGrid(mLightScratch.splats(), materials, e.options.emitsLight);
+        if (!grid) {
+            mLightingError = "effect '" + e.options.name + "': " + grid.error();
+            return;
+        }
+        mEmittedGrid = std::move(*grid);
+        return;
+    }
     Result<std::vector<EmittedLight>> lights = fitEmittedLights(mLightScratch.splats(), materials, e.options.emitsLight);
     if (!lights) {
         mLightingError = "effect '" + e.options.name + "': " + lights.error();
@@ -277,7 +292,8 @@ Status Scene::prepare(double timeSec, const Camera& camera, const Materials& mat
     const std::size_t kept = std::min<std::size_t>(mEmittedLights.size(), kMaxEmittedLights);
     frame.emittedLights().assign(mEmittedLights.begin(), mEmittedLights.begin() + std::ptrdiff_t(kept));
     mCounters.emittedLights = mEmittedLights.size();
-    mCounters.emittedLightsDropped = mEmittedLights.size() - kept;
+    mCounters.emittedLightsDropped = mEmittedLights.size() - kept + mEmittedGridsDropped;
+    frame.emittedGrid() = mEmittedGrid;
     frame.end();
     frame.setFog(fogForView(camera, timeSec)); // only the terms this view can see
     FrameCounters& c = frame.counters();

@@ -75,6 +75,14 @@ void readEffects(Context& c, const std::string& path, const Json& v, const std::
             eo.number("scale", d.scale, 0.0, 1e6);
             eo.boolean("occlusion", d.occlusion);
             eo.number("reachWorld", d.reachWorld, 1e-6, 1e30);
+            std::string mode = "lights";
+            eo.string("mode", mode);
+            if (mode == "grid") d.mode = EmittedLightMode::Grid;
+            else if (mode != "lights") c.d.error(eo.at("mode"), "mode must be \"lights\" or \"grid\", got \"" + mode + "\"");
+            eo.ivec3("gridDims", d.gridDims, 2, kMaxEmittedGridNodes);
+            if (d.gridDims.x * d.gridDims.y * d.gridDims.z > kMaxEmittedGridNodes)
+                c.d.error(eo.at("gridDims"), "gridDims may hold at most " + std::to_string(kMaxEmittedGridNodes) + " nodes");
+            eo.number("gridMargin", d.gridMargin, 0.0, 1e6);
             eo.finish();
         }
         o.string("attachTo", e.attachTo);

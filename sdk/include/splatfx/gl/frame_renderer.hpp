@@ -158,6 +158,8 @@ struct ShadowBinding {
                                                                ShadowSlotBinding{.textureUnit = 12}};
     // The frame's emitted lights (Frame::emittedLights): splatfx_emittedIrradiance's uniforms.
     std::vector<EmittedLight> emittedLights{};
+    // An irradiance grid (fitEmittedGrid; dims 0: none): splatfx_emittedGridIrradiance's uniforms.
+    EmittedGrid emittedGrid{};
 };
 // Sets shadowGlsl()'s uniforms on `program` (glProgramUniform: the
 // program need not be bound): the table's three and the emitted lights'.

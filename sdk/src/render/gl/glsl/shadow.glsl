@@ -72,3 +72,60 @@ vec3 splatfx_emittedIrradiance(vec3 worldPos, vec3 normal) {
     }
     return sum;
 }
+
+// The irradiance grid alternative (splatfx::EmittedGrid, fitEmittedGrid):
+// per node the irradiance for the normals +x, -x, +y, -y, +z, -z, RGB, packed
+// 18 floats a node in vec4s. Mirrors splatfx::emittedIrradiance(grid, ...):
+// trilinear from texelFetch-like exact reads (no filtering hardware, so the
+// CPU and GLSL agree to float rounding); outside the box a point source at
+// the centre calibrated at the box. Dims below 2 (no grid this frame) give 0.
+const int splatfx_kMaxEmittedGridNodes = 32; // splatfx::kMaxEmittedGridNodes
+uniform ivec3 splatfx_emittedGridDims;
+uniform vec3 splatfx_emittedGridMin, splatfx_emittedGridMax, splatfx_emittedGridCentre;
+uniform vec4 splatfx_emittedGrid[splatfx_kMaxEmittedGridNodes * 18 / 4];
+
+vec3 splatfx_emittedGridValue(int node, int k) {
+    int i = (node * 6 + k) * 3;
+    return vec3(splatfx_emittedGrid[i >> 2][i & 3], splatfx_emittedGrid[(i + 1) >> 2][(i + 1) & 3], splatfx_emittedGrid[(i + 2) >> 2][(i + 2) & 3]);
+}
+
+vec3 splatfx_emittedGridIrradiance(vec3 worldPos, vec3 normal) {
+    ivec3 n = splatfx_emittedGridDims;
+    if (n.x < 2 || n.y < 2 || n.z < 2 || n.x * n.y * n.z > splatfx_kMaxEmittedGridNodes) return vec3(0.0);
+    vec3 q = clamp(worldPos, splatfx_emittedGridMin, splatfx_emittedGridMax);
+    vec3 t = (q - splatfx_emittedGridMin) / (splatfx_emittedGridMax - splatfx_emittedGridMin) * vec3(n - 1);
+    ivec3 i0 = clamp(ivec3(floor(t)), ivec3(0), n - 2);
+    vec3 f = t - vec3(i0);
+    ivec3 k = ivec3(normal.x >= 0.0 ? 0 : 1, normal.y >= 0.0 ? 2 : 3, normal.z >= 0.0 ? 4 : 5);
+    vec3 nn = normal * normal;
+    vec3 sum = vec3(0.0);
+    for (int c = 0; c < 8; ++c) {
+        ivec3 o = ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+        vec3 w3 = mix(vec3(1.0) - f, f, vec3(o));
+        ivec3 i = i0 + o;
+        int node = (i.z * n.y + i.y) * n.x + i.x;
+        sum += (w3.x * w3.y * w3.z) * (nn.x * splatfx_emittedGridValue(node, k.x) + nn.y * splatfx_emittedGridValue(node, k.y) +
+                                       nn.z * splatfx_emittedGridValue(node, k.z));
+    }
+    if (all(equal(q, worldPos))) return sum;
+    // Outside: a point source at the centre, its intensity read from q's six
+    // values, on p's cosine; plus the grid's departure from it at q as d^-4.
+    vec3 dq = splatfx_emittedGridCentre - q, dp = splatfx_emittedGridCentre - worldPos;
+    float dq2 = dot(dq, dq), dp2 = dot(dp, dp);
+    if (!(dq2 > 0.0) || !(dp2 > 0.0)) return sum;
+    vec3 wq = dq / sqrt(dq2), wp = dp / sqrt(dp2);
+    vec3 total = vec3(0.0);
+    for (int c = 0; c < 8; ++c) {
+        ivec3 o = ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+        vec3 w3 = mix(vec3(1.0) - f, f, vec3(o));
+        ivec3 i = i0 + o;
+        int node = (i.z * n.y + i.y) * n.x + i.x;
+        total += (w3.x * w3.y * w3.z) * (splatfx_emittedGridValue(node, 0) + splatfx_emittedGridValue(node, 1) + splatfx_emittedGridValue(node, 2) +
+                                          splatfx_emittedGridValue(node, 3) + splatfx_emittedGridValue(node, 4) + splatfx_emittedGridValue(node, 5));
+    }
+    vec3 intensity = total * (dq2 / (abs(wq.x) + abs(wq.y) + abs(wq.z)));
+    vec3 atQ = intensity * (max(dot(normal, wq), 0.0) / dq2);
+    vec3 atP = intensity * (max(dot(normal, wp), 0.0) / dp2);
+    float r = dq2 / dp2;
+    return max(atP + (sum - atQ) * (r * r), vec3(0.0));
+}

@@ -1,6 +1,7 @@
 #include "shadow_pass.hpp"
 
 #include <algorithm>
+#include <array>
 #include <string>
 
 #include <epoxy/gl.h>
@@ -75,7 +76,8 @@ ShadowBinding ShadowPass::binding() const {
                     .worldToTable = s0.worldToTable,
                     .lightInTable = s0.lightInTable,
                     .light = s0.light,
-                    .emittedLights = mEmitted};
+                    .emittedLights = mEmitted,
+                    .emittedGrid = mEmittedGrid};
     for (std::size_t k = 1; k < mSlots.size(); ++k) {
         const Slot& s = mSlots[k];
         b.slots[k - 1] = {.valid = s.valid, .light = s.light, .textureUnit = mUnit - int(k), .texture = s.texture, .worldToTable = s.worldToTable, .lightInTable = s.lightInTable};
@@ -89,6 +91,7 @@ void ShadowPass::execute(const PlanStep& step, StepContext& context) {
             if (uploadTable(k, context.frame.shadows()[k])) ++mUploads;
         const std::vector<EmittedLight>& lights = context.frame.emittedLights();
         mEmitted.assign(lights.begin(), lights.begin() + std::min<std::ptrdiff_t>(std::ptrdiff_t(lights.size()), kMaxEmittedLights));
+        mEmittedGrid = context.frame.emittedGrid();
         bind();
     } else {
         unbind();
@@ -133,6 +136,19 @@ void setShadowUniforms(unsigned program, const ShadowBinding& b) {
     glProgramUniform3fv(program, glGetUniformLocation(program, "splatfx_emittedLightIntensity"), kMaxEmittedLights, glm::value_ptr(intensity[0]));
     glProgramUniform3fv(program, glGetUniformLocation(program, "splatfx_emittedLightEscapePlus"), kMaxEmittedLights, glm::value_ptr(plus[0]));
     glProgramUniform3fv(program, glGetUniformLocation(program, "splatfx_emittedLightEscapeMinus"), kMaxEmittedLights, glm::value_ptr(minus[0]));
+    const EmittedGrid& g = b.emittedGrid;
+    const std::size_t nodes = std::size_t(std::max(g.dims.x, 0)) * std::size_t(std::max(g.dims.y, 0)) * std::size_t(std::max(g.dims.z, 0));
+    const bool grid = nodes > 0 && nodes <= std::size_t(kMaxEmittedGridNodes) && g.nodes.size() == nodes;
+    std::array<float, kMaxEmittedGridNodes * 18> packed{};
+    for (std::size_t i = 0; grid && i < nodes; ++i)
+        for (std::size_t k = 0; k < 6; ++k)
+            for (int c = 0; c < 3; ++c) packed[(i * 6 + k) * 3 + std::size_t(c)] = g.nodes[i][k][c];
+    const glm::ivec3 dims = grid ? g.dims : glm::ivec3(0);
+    glProgramUniform3iv(program, glGetUniformLocation(program, "splatfx_emittedGridDims"), 1, glm::value_ptr(dims));
+    glProgramUniform3fv(program, glGetUniformLocation(program, "splatfx_emittedGridMin"), 1, glm::value_ptr(g.boxMin));
+    glProgramUniform3fv(program, glGetUniformLocation(program, "splatfx_emittedGridMax"), 1, glm::value_ptr(g.boxMax));
+    glProgramUniform3fv(program, glGetUniformLocation(program, "splatfx_emittedGridCentre"), 1, glm::value_ptr(g.centre));
+    glProgramUniform4fv(program, glGetUniformLocation(program, "splatfx_emittedGrid"), kMaxEmittedGridNodes * 18 / 4, packed.data());
 }
 
 } // namespace splatfx::gl

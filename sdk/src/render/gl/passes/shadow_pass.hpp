@@ -50,6 +50,7 @@ private:
     std::array<Slot, kMaxShadowLights> mSlots{};
     std::uint64_t mUploads = 0;
     std::vector<EmittedLight> mEmitted; // the last frame's, at most kMaxEmittedLights
+    EmittedGrid mEmittedGrid;           // the last frame's
 };
 
 } // namespace splatfx::gl::detail
