@@ -15,9 +15,11 @@
 // (< 1e-5 nats over the <= 12 cells), moving the colour (<= 1) by less than
 // 1e-5. So |colour - base T| <= 0.5/255 + 1e-5.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -180,6 +182,36 @@ TEST(CrossShadows, PointLightBetweenTwoEffectsShadowsNeitherUntilItMovesPastOne)
     EXPECT_LT(s.check(above, 0), 0.5);
     s.check(above, 1, false);
     EXPECT_EQ(s.scene.counters().crossShadowPairs, 1u);
+}
+
+// The camera turned away from the caster (its box out of the frustum, the
+// receiver still in view): the caster is advanced for its shadow only
+// (castsIntoView), not drawn, and the receiver's splats are unchanged, with
+// the scene shadow off (the cross-shadow alone must keep the caster scheduled).
+TEST(CrossShadows, TurningTheCameraAwayFromTheCasterLeavesTheReceiverUnchanged) {
+    TwoPlumes s({-1.5f, 4.0f, -1.5f}, {-2.0f, 11.0f, -1.0f});
+    const Light sun = Light::directional({0.15f, -1.0f, -0.1f});
+    ASSERT_TRUE(s.scene.addLight(sun));
+    s.scene.setSceneShadow({.enabled = false});
+    const glm::vec3 eye{0.0f, 5.5f, 40.0f};
+    s.camera = Camera::lookAt(eye, {0.0f, 9.0f, 0.0f}, {0, 1, 0}, glm::radians(30.0f), {64, 48}, 0.1f, 500.0f);
+    auto receiverColours = [&] {
+        std::vector<std::pair<std::array<float, 3>, std::uint32_t>> c;
+        for (const Splat& sp : s.frame.splats())
+            if (std::lround(sp.colorRow) == long(s.rows[0])) c.push_back({{sp.center.x, sp.center.y, sp.center.z}, sp.color});
+        std::sort(c.begin(), c.end());
+        return c;
+    };
+    ASSERT_TRUE(s.scene.prepare(0.0, s.camera, s.materials, s.frame));
+    ASSERT_TRUE(s.scene.status(s.ids[1]).needed);
+    const auto both = receiverColours();
+    // 8 degrees around the receiver: the caster (y 10 to 15) is above the view (y 2.7 to 8.3 at the plumes).
+    s.camera = Camera::lookAt(eye, {0.0f, 5.5f, 0.0f}, {0, 1, 0}, glm::radians(8.0f), {64, 48}, 0.1f, 500.0f);
+    ASSERT_TRUE(s.scene.prepare(0.1, s.camera, s.materials, s.frame));
+    EXPECT_FALSE(s.scene.status(s.ids[1]).needed);
+    EXPECT_TRUE(s.scene.status(s.ids[1]).castsIntoView);
+    EXPECT_LT(s.check(sun, 0), 2.0 / 3.0); // still shadowed, against the reference
+    EXPECT_EQ(receiverColours(), both);
 }
 
 // shadowFallsOn against boxes whose answer is known: the exact edge cases

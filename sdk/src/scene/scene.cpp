@@ -123,9 +123,10 @@ Status Scene::update(double timeSec, const Camera& camera) {
     mUpdated = true;
     mCounters.needed = mCounters.simulated = mCounters.castOnly = mCounters.castersCulled = 0;
     const glm::vec3 eye = camera.eye();
-    // Every light may shadow the scene (SceneShadowDesc): casters out of view
-    // are scheduled by where their shadow falls away from any of them.
-    const bool shadowing = mSceneShadowDesc.enabled && mSceneShadowDesc.light < mLights.size();
+    // Every light may shadow the scene (SceneShadowDesc) and the lit effects in
+    // view (effects shadow one another, with or without a scene shadow):
+    // casters out of view are scheduled by where their shadow falls away from any of them.
+    const bool shadowing = !mLights.empty();
     for (Entry& e : mEntries) {
         EffectStatus& s = e.status;
         const bool wasAdvanced = s.needed || s.castsIntoView || s.lightsIntoView;
