@@ -180,8 +180,9 @@ struct EffectStatus {
     bool needed = false;                 // enabled && inRange && inView && alive
     // Not needed (out of view), but lit, shadow-casting, in range and alive,
     // and its shadow away from one of the lights can reach the view
-    // of any light (Scene::shadowReachesView): advanced to the time and put into the scene
-    // shadow, not emitted (docs/lighting.md, "Scheduled by light influence").
+    // of any light (Scene::shadowReachesView): advanced to the time, put into the scene
+    // shadow and traced for the lit effects' splats, not emitted (docs/lighting.md,
+    // "Scheduled by light influence").
     bool castsIntoView = false;
     // Not needed (out of view), but emitting light (EffectOptions::emitsLight)
     // whose reach touches the view: advanced and its lights fitted, not drawn.
