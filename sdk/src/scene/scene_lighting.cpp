@@ -33,7 +33,7 @@ std::uint32_t packLit(glm::vec3 c, float* scale) {
 
 // An effect's own shadow (self-shadowing: traced, table or none) times the
 // transmittance through the other volumes between it and the light (the lit
-// clouds): a product, since optical depths along one ray add. Each other
+// clouds and the other lit effects): a product, since optical depths along one ray add. Each other
 // volume is traced through its own trilinear field (DensityField: exact for
 // it up to float rounding); a ray that misses a field's box costs one clip.
 class VolumeShadows final : public ShadowProvider {
