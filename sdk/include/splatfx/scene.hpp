@@ -20,9 +20,11 @@
 // (EffectKind::lightingDensity: every Effect does; LOD volumes and ground fog
 // do not, their light is part of their data; a Cloud, cloud.hpp, follows the
 // scene's first directional light and is relit when it moves): their splat colours follow Ebert & Parent's low-albedo model with
-// self-shadowing, the light also attenuated through every lit, shadow-casting
-// cloud between them and it (a cloud's shadow on a plume; effects do not
-// shadow one another), and prepare() puts their shadows on the scene, one per
+// self-shadowing, the light also attenuated through every other lit,
+// shadow-casting volume between them and it (a cloud's shadow on a plume, a
+// plume's on another effect: every effect's field is updated before any is
+// lit; only casters whose box can shadow the receiver's for that light are
+// traced, shadowFallsOn), and prepare() puts their shadows on the scene, one per
 // shadowing light, into Frame::shadows() (docs/lighting.md, "In a Scene"). And the scene's fog
 // (setFog), handed to every Frame without the terms the view cannot see
 // (FogCullDesc). Shadows are scheduled by light influence, not visibility: a
@@ -95,7 +97,8 @@ struct EffectLighting {
     SelfShadow selfShadow = SelfShadow::Table; // default Table
     glm::ivec3 tableDims{32};                  // self-shadowing table entries per axis, each in [1, 1024]; default 32^3
     // Whether the effect's gas is in the frame's shadow on the scene
-    // (FrameShadow, Scene::setSceneShadow). Default true.
+    // (FrameShadow, Scene::setSceneShadow) and shadows the other lit
+    // effects' splats. Default true.
     bool castsShadow = true;
 };
 
@@ -177,8 +180,9 @@ struct EffectStatus {
     bool needed = false;                 // enabled && inRange && inView && alive
     // Not needed (out of view), but lit, shadow-casting, in range and alive,
     // and its shadow away from one of the lights can reach the view
-    // of any light (Scene::shadowReachesView): advanced to the time and put into the scene
-    // shadow, not emitted (docs/lighting.md, "Scheduled by light influence").
+    // of any light (Scene::shadowReachesView): advanced to the time, put into the scene
+    // shadow and traced for the lit effects' splats, not emitted (docs/lighting.md,
+    // "Scheduled by light influence").
     bool castsIntoView = false;
     // Not needed (out of view), but emitting light (EffectOptions::emitsLight)
     // whose reach touches the view: advanced and its lights fitted, not drawn.
@@ -234,6 +238,11 @@ struct SceneCounters {
     // Frames whose dropped terms left a fog that failed validation (a dropped
     // term held the rest non-negative): the full fog was drawn (cumulative).
     std::uint64_t fogCullFallbacks = 0;
+    // Volumes shadowing the lit effects at the last emit(): (caster, light)
+    // pairs traced for a receiving effect's splats, and pairs skipped because
+    // the caster's box cannot shadow the receiver's for that light (shadowFallsOn).
+    std::size_t crossShadowPairs = 0;
+    std::size_t crossShadowPairsSkipped = 0;
 };
 
 class Scene {
@@ -320,6 +329,10 @@ public:
     // the frustum's planes, and a light that cannot reach the box casts no
     // shadow. Used to schedule casters by light influence (docs/lighting.md).
     static bool shadowReachesView(const Aabb& caster, const Light& light, const Camera& camera);
+    // True when some ray from a point of `receiver` to the light may cross
+    // `caster` (conservative only by a 1e-5 relative margin: the test is
+    // exact for boxes): only such casters are traced for a lit effect's splats.
+    static bool shadowFallsOn(const Aabb& caster, const Light& light, const Aabb& receiver);
 
     // ---- Lights (docs/lighting.md, "In a Scene") ---------------------------
     // Adds a light; fails on an invalid light (the message names the field).
@@ -382,6 +395,7 @@ private:
         glm::ivec3 tableDims{0};                // what `tables` was made with
         std::vector<glm::vec3> points, factors; // scratch: splat centres and their light factors
         std::vector<bool> reaches;              // scratch: which lights reach the effect (Scene::lightReaches)
+        bool fieldReady = false;                // `field` is this emit's (updateEffectCasters)
     };
     struct Entry {
         std::unique_ptr<EffectKind> kind; // never null; on the heap, so what a Frame points at stays put
@@ -392,11 +406,18 @@ private:
     EffectId push(std::unique_ptr<EffectKind> kind, EffectOptions options);
     // Emits every needed effect in id order; `volumes` null: splats only.
     std::size_t emitInto(SplatBuilder& builder, std::vector<FrameVolume>* volumes, const Materials& materials, const EmitOptions& options);
-    // Lights the splats [first, end) the entry just emitted.
-    void lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first, const EmitOptions& draw);
+    // Lights the splats [first, end) the entry just emitted (its field from updateEffectCasters).
+    void lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first);
     // Refreshes e.lit->field from the kind's lighting density; false when the
     // kind has none or it is bad (then mLightingError says why).
     bool updateLitField(Entry& e, const Materials& materials, const EmitOptions& draw);
+    // Before any effect is lit: the field of every effect lit or casting this
+    // emit, and the shadow-casting ones appended to mVolumeCasters, so each
+    // lit effect is shadowed by all the others (scene_lighting.cpp).
+    void updateEffectCasters(const Materials& materials, const EmitOptions& options);
+    // mCastersPerLight: per light, the casters other than e's own field whose
+    // box can shadow e's (shadowFallsOn).
+    void scheduleCasters(const Entry& e);
     void shadeScene(Frame& frame); // fills frame.shadows()
     // Which lights get a scene-shadow table this frame, slot order (scene_lighting.cpp).
     std::vector<std::size_t> chooseShadowLights(const std::vector<std::vector<const DensityField*>>& casters);
@@ -416,8 +437,10 @@ private:
     std::vector<EmittedLight> mEmittedLights;
     EmittedGrid mEmittedGrid;
     std::size_t mEmittedGridsDropped = 0;
-    // This emit's shadow-casting lit clouds' fields: each lit effect's light is attenuated through them.
+    // This emit's shadow-casting lit volumes' fields (clouds, then effects):
+    // each lit effect's light is attenuated through the others'.
     std::vector<const DensityField*> mVolumeCasters;
+    std::vector<std::vector<const DensityField*>> mCastersPerLight; // scratch (scheduleCasters)
     SplatBuilder mLightScratch{SplatBuilderDesc{.frustumCull = false}}; // an emitter's whole splats, fitted, never drawn
     SceneShadowDesc mSceneShadowDesc;
     bool mHdrLit = false;

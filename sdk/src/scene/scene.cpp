@@ -123,9 +123,10 @@ Status Scene::update(double timeSec, const Camera& camera) {
     mUpdated = true;
     mCounters.needed = mCounters.simulated = mCounters.castOnly = mCounters.castersCulled = 0;
     const glm::vec3 eye = camera.eye();
-    // Every light may shadow the scene (SceneShadowDesc): casters out of view
-    // are scheduled by where their shadow falls away from any of them.
-    const bool shadowing = mSceneShadowDesc.enabled && mSceneShadowDesc.light < mLights.size();
+    // Every light may shadow the scene (SceneShadowDesc) and the lit effects in
+    // view (effects shadow one another, with or without a scene shadow):
+    // casters out of view are scheduled by where their shadow falls away from any of them.
+    const bool shadowing = !mLights.empty();
     for (Entry& e : mEntries) {
         EffectStatus& s = e.status;
         const bool wasAdvanced = s.needed || s.castsIntoView || s.lightsIntoView;
@@ -213,6 +214,7 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
         if (e.lit->field.empty() != f.empty() || e.lit->field.fingerprint() != f.fingerprint()) e.lit->field = f;
         if (e.options.lighting.castsShadow && !e.lit->field.empty()) mVolumeCasters.push_back(&e.lit->field);
     }
+    updateEffectCasters(materials, options); // every effect's field before any is lit: they shadow one another
     for (std::size_t i = 0; i < mEntries.size(); ++i) {
         Entry& e = mEntries[i];
         const EmitOptions draw{.textured = e.options.draw.textured && options.textured,
@@ -237,9 +239,7 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
         // Tables over the budget are never built: those effects stay unlit (the error says why).
         const bool tableLit = e.options.lighting.selfShadow == SelfShadow::Table;
         if (!cloud && e.status.needed && e.options.lighting.enabled && !mLights.empty() && (mTablesFit || !tableLit))
-            lightEmitted(e, builder, materials, first, draw);
-        // Not drawn but casting into the view: only the density the light sees.
-        if (e.status.castsIntoView && !cloud && !updateLitField(e, materials, draw)) e.status.castsIntoView = false;
+            lightEmitted(e, builder, materials, first);
         e.status.emittedLights = 0;
         if (e.options.emitsLight.enabled && (e.status.needed || e.status.lightsIntoView)) fitLights(e, builder.camera(), materials, draw);
     }

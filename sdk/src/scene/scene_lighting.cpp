@@ -10,6 +10,7 @@
 
 #include "splat/color_table_entry.hpp"
 #include "splatfx/scene.hpp"
+#include "volume_kinds.hpp"
 
 namespace splatfx {
 namespace {
@@ -32,25 +33,26 @@ std::uint32_t packLit(glm::vec3 c, float* scale) {
 
 // An effect's own shadow (self-shadowing: traced, table or none) times the
 // transmittance through the other volumes between it and the light (the lit
-// clouds): a product, since optical depths along one ray add. Each other
+// clouds and the other lit effects): a product, since optical depths along one ray add. Each other
 // volume is traced through its own trilinear field (DensityField: exact for
 // it up to float rounding); a ray that misses a field's box costs one clip.
 class VolumeShadows final : public ShadowProvider {
 public:
-    VolumeShadows(const ShadowProvider* own, std::span<const Light> lights, std::span<const DensityField* const> others)
+    // others[i]: the volumes that can shadow the receiver for light i (Scene::scheduleCasters).
+    VolumeShadows(const ShadowProvider* own, std::span<const Light> lights, std::span<const std::vector<const DensityField*>> others)
         : mOwn(own), mLights(lights), mOthers(others) {}
     float transmittance(std::size_t light, glm::vec3 world) const override {
         float t = mOwn ? mOwn->transmittance(light, world) : 1.0f;
-        if (light >= mLights.size()) return t;
+        if (light >= mLights.size() || light >= mOthers.size()) return t;
         float depth = 0.0f;
-        for (const DensityField* f : mOthers) depth += f->opticalDepthToLight(world, mLights[light]);
+        for (const DensityField* f : mOthers[light]) depth += f->opticalDepthToLight(world, mLights[light]);
         return depth > 0.0f ? t * std::exp2(-depth) : t;
     }
 
 private:
     const ShadowProvider* mOwn;
     std::span<const Light> mLights;
-    std::span<const DensityField* const> mOthers;
+    std::span<const std::vector<const DensityField*>> mOthers;
 };
 
 } // namespace
@@ -111,10 +113,52 @@ bool Scene::updateLitField(Entry& e, const Materials& materials, const EmitOptio
     return true;
 }
 
-void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first, const EmitOptions& draw) {
+// Volumes shadow one another (scene.hpp): an effect's light passes through
+// the lit clouds and the other lit effects, so every field must be this
+// emit's before the first effect is lit. Effects out of view that cast into
+// it (castsIntoView) only need their field.
+void Scene::updateEffectCasters(const Materials& materials, const EmitOptions& options) {
+    mCounters.crossShadowPairs = mCounters.crossShadowPairsSkipped = 0;
+    for (Entry& e : mEntries) {
+        if (e.lit) e.lit->fieldReady = false;
+        if (dynamic_cast<const detail::CloudKind*>(e.kind.get())) continue; // clouds: their own relight (emitInto)
+        const EmitOptions draw{.textured = e.options.draw.textured && options.textured,
+                               .opacityScale = e.options.draw.opacityScale * options.opacityScale};
+        const bool tableLit = e.options.lighting.selfShadow == SelfShadow::Table;
+        // As emitInto decides who is lit: tables over the budget are never built, those effects stay unlit.
+        const bool lit = e.status.needed && e.options.lighting.enabled && !mLights.empty() && (mTablesFit || !tableLit);
+        if (!lit && !e.status.castsIntoView) continue;
+        if (!updateLitField(e, materials, draw)) {
+            e.status.castsIntoView = false;
+            continue;
+        }
+        e.lit->fieldReady = true;
+        if (e.options.lighting.castsShadow && !e.lit->field.empty()) mVolumeCasters.push_back(&e.lit->field);
+    }
+}
+
+void Scene::scheduleCasters(const Entry& e) {
+    mCastersPerLight.resize(mLights.size());
+    const DensityField& own = e.lit->field;
+    const Aabb box{own.boundsMin(), own.boundsMax()};
+    for (std::size_t i = 0; i < mLights.size(); ++i) {
+        mCastersPerLight[i].clear();
+        for (const DensityField* f : mVolumeCasters) {
+            if (f == &own) continue; // its own shadow is its self-shadowing
+            if (shadowFallsOn(Aabb{f->boundsMin(), f->boundsMax()}, mLights[i], box)) {
+                mCastersPerLight[i].push_back(f);
+                ++mCounters.crossShadowPairs;
+            } else {
+                ++mCounters.crossShadowPairsSkipped;
+            }
+        }
+    }
+}
+
+void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first) {
     const EffectLighting& L = e.options.lighting;
     const std::string at = "effect '" + e.options.name + "': lighting.";
-    if (!updateLitField(e, materials, draw)) return;
+    if (!e.lit || !e.lit->fieldReady) return;
     LitState& lit = *e.lit;
     const Grid& dg = lit.densityGrid;
 
@@ -159,8 +203,11 @@ void Scene::lightEmitted(Entry& e, SplatBuilder& builder, const Materials& mater
         glm::mat3(dg.transform) * glm::mat3(glm::vec3(dg.spacing.x, 0, 0), glm::vec3(0, dg.spacing.y, 0), glm::vec3(0, 0, dg.spacing.z));
     const float det = std::abs(glm::determinant(shape));
     const float voxelSize = std::isfinite(det) ? std::cbrt(det) : 0.0f;
-    const VolumeShadows withVolumes(shadows, mLights, mVolumeCasters);
-    if (!mVolumeCasters.empty()) shadows = &withVolumes;
+    scheduleCasters(e);
+    const VolumeShadows withVolumes(shadows, mLights, mCastersPerLight);
+    bool anyCaster = false;
+    for (const auto& c : mCastersPerLight) anyCaster = anyCaster || !c.empty();
+    if (anyCaster) shadows = &withVolumes;
     if (Status s = lightPoints(lit.points, voxelSize, builder.camera().eye(), mLights, shadows, L.gas, lit.factors); !s) {
         mLightingError = at + "gas: " + s.error();
         return;

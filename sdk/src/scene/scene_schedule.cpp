@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "splatfx/scene.hpp"
 
@@ -28,6 +29,13 @@ std::array<glm::vec4, 6> frustumPlanes(const Camera& camera) {
 float support(const Aabb& box, glm::vec3 n) {
     const glm::vec3 p(n.x >= 0 ? box.hi.x : box.lo.x, n.y >= 0 ? box.hi.y : box.lo.y, n.z >= 0 ? box.hi.z : box.lo.z);
     return glm::dot(n, p);
+}
+
+// Narrows [lo, hi] to the x with a + b x <= c.
+void keepWhere(double a, double b, double c, double& lo, double& hi) {
+    if (b > 0.0) hi = std::min(hi, (c - a) / b);
+    else if (b < 0.0) lo = std::max(lo, (c - a) / b);
+    else if (a > c) hi = -1.0, lo = 1.0; // never
 }
 
 } // namespace
@@ -65,6 +73,38 @@ bool Scene::shadowReachesView(const Aabb& caster, const Light& light, const Came
         if (sweepStaysBehind) return false;
     }
     return true;
+}
+
+bool Scene::shadowFallsOn(const Aabb& caster, const Light& light, const Aabb& receiver) {
+    if (!lightReaches(light, caster) || !lightReaches(light, receiver)) return false;
+    // The caster, grown by a relative 1e-5 so float rounding in the boxes
+    // cannot turn a grazing ray into a miss.
+    const glm::dvec3 r0(receiver.lo), r1(receiver.hi);
+    glm::dvec3 c0(caster.lo), c1(caster.hi);
+    const double pad = 1e-5 * (1.0 + std::max({glm::length(c1 - c0), glm::length(c0), glm::length(c1)}));
+    c0 -= pad, c1 += pad;
+    // Is there a receiver point p and a ray parameter x with p + (ray to the
+    // light at x) inside the caster? Per axis both bounds are linear in x, so
+    // the feasible x form one interval. Directional (towards the light u):
+    // p = c - x u, x >= 0. Point or spot at q: p = q + x (c - q), x >= 1
+    // (x = 1 / the fraction of the way from p to q where c lies).
+    double lo = 0.0, hi = std::numeric_limits<double>::infinity();
+    if (light.type == LightType::Directional) {
+        const glm::dvec3 u = -glm::normalize(glm::dvec3(light.direction));
+        for (int a = 0; a < 3; ++a) {
+            keepWhere(c0[a], -u[a], r1[a], lo, hi);   // c0 - x u <= r1
+            keepWhere(-c1[a], u[a], -r0[a], lo, hi);  // c1 - x u >= r0
+        }
+    } else {
+        const glm::dvec3 q(light.position);
+        if (glm::all(glm::greaterThanEqual(q, c0)) && glm::all(glm::lessThanEqual(q, c1))) return true; // the light is in the caster's box
+        lo = 1.0;
+        for (int a = 0; a < 3; ++a) {
+            keepWhere(q[a], c0[a] - q[a], r1[a], lo, hi);    // q + x (c0 - q) <= r1
+            keepWhere(-q[a], q[a] - c1[a], -r0[a], lo, hi);  // q + x (c1 - q) >= r0
+        }
+    }
+    return lo <= hi;
 }
 
 } // namespace splatfx
