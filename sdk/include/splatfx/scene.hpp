@@ -389,6 +389,9 @@ private:
     EffectId push(std::unique_ptr<EffectKind> kind, EffectOptions options);
     // Emits every needed effect in id order; `volumes` null: splats only.
     std::size_t emitInto(SplatBuilder& builder, std::vector<FrameVolume>* volumes, const Materials& materials, const EmitOptions& options);
+    // Lights and emits the needed ground fog layers with lighting enabled,
+    // shadowed by this emit's casters (scene_ground_fog.cpp); their tetrahedra.
+    std::uint64_t emitLitGroundFogs(SplatBuilder& builder, std::vector<FrameVolume>* volumes, const Materials& materials, const EmitOptions& options);
     // Lights the splats [first, end) the entry just emitted.
     void lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first, const EmitOptions& draw);
     // Refreshes e.lit->field from the kind's lighting density; false when the
