@@ -138,3 +138,27 @@ TEST(GroundFogShadow, UnlitByDefault) {
     for (const Tetrahedron& t : frame.volumes()[0].lod.tets)
         for (float l : t.lengthScale) EXPECT_EQ(l, 1.0f);
 }
+
+// A lit layer needs sigma = rho s in one colour (makeGroundFogTransfer's
+// form): another transfer function is refused by name and drawn unlit.
+TEST(GroundFogShadow, ATransferOfAnotherFormIsRefusedAndDrawnUnlit) {
+    Materials materials{Footprint{}};
+    Scene scene;
+    GroundFogDesc d;
+    d.dims = {4, 4};
+    d.terrainHeight.assign(16, 0.0f);
+    d.fogTop.assign(16, 1.0f);
+    const TransferFunction ramp = *TransferFunction::create({{0.0f, glm::vec3(1.0f), 0.0f}, {1.0f, glm::vec3(0.2f), 1.0f}});
+    const EffectId id = scene.add(*GroundFog::create(d), ramp, *PreIntegrationTable::create(ramp, {.scalarResolution = 4, .lengthResolution = 4}),
+                                  {.name = "mist", .lighting = {.enabled = true}});
+    ASSERT_TRUE(scene.addLight(Light::directional({0.0f, -1.0f, 0.0f})));
+    Frame frame;
+    const Camera cam = Camera::lookAt({1.5f, 5.0f, 9.0f}, {1.5f, 0.5f, 1.5f}, {0, 1, 0}, glm::radians(50.0f), {64, 48}, 0.1f, 100.0f);
+    ASSERT_TRUE(scene.prepare(0.0, cam, materials, frame));
+    EXPECT_NE(scene.lightingError().find("effect 'mist': lighting: a lit ground fog needs a transfer function of makeGroundFogTransfer's form"),
+              std::string::npos)
+        << scene.lightingError();
+    EXPECT_FALSE(scene.status(id).lit);
+    ASSERT_EQ(frame.volumes().size(), 1u);
+    EXPECT_FALSE(frame.volumes()[0].lod.tets.empty()); // drawn, unlit
+}
