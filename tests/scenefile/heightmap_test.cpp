@@ -234,7 +234,7 @@ TEST(SceneFileHeightmap, GroundFogLightingKeyLightsTheLayer) {
     splatfx::Materials m(splatfx::Footprint{});
     auto r = t.parse(R"("lights": [{"type": "directional", "direction": [0.3, -1, 0.2]}],
                         "volumes": [{"kind": "groundFog", "name": "lit", "heightmap": "dem.pgm", "fogTop": 0.8, "extinctionPerWorld": 2,
-                                     "colour": [0.8, 0.85, 0.9], "lighting": {"enabled": true, "gas": {"albedo": 0.7}}},
+                                     "colour": [0.8, 0.85, 0.9], "lighting": {"enabled": true, "albedo": 0.7}},
                                     {"kind": "groundFog", "name": "plain", "heightmap": "dem.pgm", "fogTop": 0.8}])",
                      m);
     ASSERT_TRUE(r) << r.error();
