@@ -17,9 +17,10 @@
 // simulation is measured in docs/BENCHMARKS.md).
 // It also holds lights (addLight) and lights the effects that opt in
 // (EffectOptions::lighting) and whose kind exposes the density the light sees
-// (EffectKind::lightingDensity: every Effect does; LOD volumes and ground fog
-// do not, their light is part of their data; a Cloud, cloud.hpp, follows the
-// scene's first directional light and is relit when it moves): their splat colours follow Ebert & Parent's low-albedo model with
+// (EffectKind::lightingDensity: every Effect does; LOD volumes do not, their
+// light is part of their data; a Cloud, cloud.hpp, and a ground fog layer,
+// GroundFog::setLighting, follow the scene's first directional light and are
+// relit when it moves, the fog also shadowed by the lit clouds and effects): their splat colours follow Ebert & Parent's low-albedo model with
 // self-shadowing, the light also attenuated through every lit, shadow-casting
 // cloud between them and it (a cloud's shadow on a plume; effects do not
 // shadow one another), and prepare() puts their shadows on the scene, one per
@@ -245,7 +246,10 @@ public:
     // uses and the table it is drawn with, refined by options.refine.
     EffectId add(LodVolume volume, TransferFunction transfer, PreIntegrationTable table, EffectOptions options = {});
     // A ground fog layer with its transfer function and table, refined by
-    // options.refine (a layer made with GroundFogDesc::lod).
+    // options.refine (a layer made with GroundFogDesc::lod). With
+    // options.lighting.enabled it is lit (GroundFog::setLighting: the first
+    // directional light, options.lighting.gas, the transfer's colour and
+    // extinction) and drawn with its lit table, emitted after the other effects.
     EffectId add(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, EffectOptions options = {});
     // A relightable cloud (cloud.hpp). With options.lighting.enabled it
     // follows the scene's first directional light (and, in the low-albedo
