@@ -225,3 +225,32 @@ TEST(SceneFileHeightmap, TerrainGeometryGivesTheLayerTheGeometrysTerrain) {
                                                {"name": "terrain", "type": "heightmap", "heightmap": "dem.pgm", "attachTo": "cart"}], )";
     expectError(moving, "", "volumes[0].terrainGeometry: geometry 'terrain' (geometry[1]) moves");
 }
+
+// "lighting" on a ground fog layer (issue 27): the layer is lit by the scene's
+// sun with the block's gas desc and its own colour and extinction; without
+// it the layer stays unlit, drawn with its transfer function.
+TEST(SceneFileHeightmap, GroundFogLightingKeyLightsTheLayer) {
+    const TempTerrain t(9, 5, "lit");
+    splatfx::Materials m(splatfx::Footprint{});
+    auto r = t.parse(R"("lights": [{"type": "directional", "direction": [0.3, -1, 0.2]}],
+                        "volumes": [{"kind": "groundFog", "name": "lit", "heightmap": "dem.pgm", "fogTop": 0.8, "extinctionPerWorld": 2,
+                                     "colour": [0.8, 0.85, 0.9], "lighting": {"enabled": true, "albedo": 0.7}},
+                                    {"kind": "groundFog", "name": "plain", "heightmap": "dem.pgm", "fogTop": 0.8}])",
+                     m);
+    ASSERT_TRUE(r) << r.error();
+    ASSERT_EQ(r->volumes.size(), 2u);
+    const splatfx::EffectId lit = r->volumes[0].id, plain = r->volumes[1].id;
+    EXPECT_TRUE(r->scene.options(lit).lighting.enabled);
+    EXPECT_FLOAT_EQ(r->scene.options(lit).lighting.gas.albedo, 0.7f);
+    EXPECT_FALSE(r->scene.options(plain).lighting.enabled);
+    const splatfx::Camera cam = splatfx::Camera::lookAt({4, 30, 30}, {4, 0, 2}, {0, 1, 0}, glm::radians(60.0f), {64, 48}, 0.5f, 500.0f);
+    splatfx::Frame frame;
+    ASSERT_TRUE(r->scene.prepare(0.0, cam, m, frame));
+    const splatfx::GroundFog* fog = r->scene.findGroundFog(lit);
+    ASSERT_TRUE(fog->lit());
+    EXPECT_TRUE(r->scene.status(lit).lit);
+    EXPECT_FALSE(r->scene.findGroundFog(plain)->lit());
+    EXPECT_FLOAT_EQ(fog->lighting().extinctionPerWorld, 2.0f);
+    EXPECT_NEAR(fog->lighting().color.g, 0.85f, 1e-6f);
+    EXPECT_EQ(fog->lighting().sun.direction, glm::vec3(0.3f, -1.0f, 0.2f));
+}

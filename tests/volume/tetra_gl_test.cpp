@@ -304,6 +304,45 @@ TEST_F(TetraPassGL, LowAlbedoCloudMatchesTheReferenceWithinTheSameBound) {
     expectFrameMatchesTheReference(cam, frame, cloud->table(), cloud->transfer());
 }
 
+// A lit ground fog layer (GroundFog::setLighting, low albedo, a forward HG
+// lobe): the vertices carry s = T phase / max phase and the fog's scalar as
+// length scale, drawn with the layer's affine lit transfer and its 2 x 2 x 128
+// table, against the exact integral through the same emitted mesh within the
+// same derived bound. The sun (intensity 0.15) keeps the peak source A + B
+// below 1, as the bound's "colours <= 1" needs.
+TEST_F(TetraPassGL, LitGroundFogMatchesTheReferenceWithinTheSameBound) {
+    GroundFogDesc d;
+    d.dims = {9, 7};
+    d.originWorld = {-4.0f, 0.0f, -3.0f};
+    d.density = 0.8f;
+    for (int j = 0; j < 7; ++j)
+        for (int i = 0; i < 9; ++i) {
+            const float x = float(i) / 8.0f, z = float(j) / 6.0f;
+            d.terrainHeight.push_back(1.2f * std::sin(5.0f * x) * std::cos(4.0f * z) + 0.3f * x);
+            d.fogTop.push_back(1.0f + 0.4f * std::cos(3.0f * z));
+        }
+    auto fog = GroundFog::create(d);
+    ASSERT_TRUE(fog) << fog.error();
+    GroundFogLighting L;
+    L.sun = Light::directional({0.5f, -0.6f, 0.3f}, glm::vec3(1.0f), 0.15f);
+    const HgLobe lobe{.g = 0.5f};
+    L.gas.phase = *PhaseFunction::create(std::span<const HgLobe>(&lobe, 1));
+    L.gas.ambient = glm::vec3(0.05f);
+    L.extinctionPerWorld = 1.5f;
+    ASSERT_TRUE(fog->setLighting(L));
+    const glm::dvec3 peak = fog->litTransfer().color(1.0);
+    ASSERT_LE(std::max({peak.x, peak.y, peak.z}), 1.0);
+    const Camera cam = Camera::lookAt({-7.0f, 5.0f, 8.0f}, {0.0f, 0.5f, 0.0f}, {0, 1, 0}, glm::radians(50.0f), kSize, 0.5f, 200.0f);
+    Frame frame;
+    frame.begin(0.0, cam);
+    FrameVolume& fv = frame.volumes().emplace_back();
+    fv.table = &fog->litTable();
+    ASSERT_TRUE(fog->update(cam, fv.lod));
+    frame.end();
+    ASSERT_GT(fv.lod.tets.size(), 50u);
+    expectFrameMatchesTheReference(cam, frame, fog->litTable(), fog->litTransfer());
+}
+
 // The host's depth ends every segment: a plane through the middle of the
 // cloud (the depth buffer cleared to it) hides what lies behind it and the
 // part of each tetrahedron in front of it is drawn exactly (the scalar at the

@@ -18,8 +18,10 @@
 // It also holds lights (addLight) and lights the effects that opt in
 // (EffectOptions::lighting) and whose kind exposes the density the light sees
 // (EffectKind::lightingDensity: every Effect does; LOD volumes and ground fog
-// do not, their light is part of their data; a Cloud, cloud.hpp, follows the
-// scene's first directional light and is relit when it moves): their splat colours follow Ebert & Parent's low-albedo model with
+// do not, their light is part of their data; a Cloud, cloud.hpp, and a ground
+// fog layer, GroundFog::setLighting, follow the scene's first directional light
+// and are relit when it moves, the fog also shadowed by the lit clouds and
+// effects): their splat colours follow Ebert & Parent's low-albedo model with
 // self-shadowing, the light also attenuated through every other lit,
 // shadow-casting volume between them and it (a cloud's shadow on a plume, a
 // plume's on another effect: every effect's field is updated before any is
@@ -254,7 +256,10 @@ public:
     // uses and the table it is drawn with, refined by options.refine.
     EffectId add(LodVolume volume, TransferFunction transfer, PreIntegrationTable table, EffectOptions options = {});
     // A ground fog layer with its transfer function and table, refined by
-    // options.refine (a layer made with GroundFogDesc::lod).
+    // options.refine (a layer made with GroundFogDesc::lod). With
+    // options.lighting.enabled it is lit (GroundFog::setLighting: the first
+    // directional light, options.lighting.gas, the transfer's colour and
+    // extinction) and drawn with its lit table, emitted after the other effects.
     EffectId add(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, EffectOptions options = {});
     // A relightable cloud (cloud.hpp). With options.lighting.enabled it
     // follows the scene's first directional light (and, in the low-albedo
@@ -406,6 +411,9 @@ private:
     EffectId push(std::unique_ptr<EffectKind> kind, EffectOptions options);
     // Emits every needed effect in id order; `volumes` null: splats only.
     std::size_t emitInto(SplatBuilder& builder, std::vector<FrameVolume>* volumes, const Materials& materials, const EmitOptions& options);
+    // Lights and emits the needed ground fog layers with lighting enabled,
+    // shadowed by this emit's casters (scene_ground_fog.cpp); their tetrahedra.
+    std::uint64_t emitLitGroundFogs(SplatBuilder& builder, std::vector<FrameVolume>* volumes, const Materials& materials, const EmitOptions& options);
     // Lights the splats [first, end) the entry just emitted (its field from updateEffectCasters).
     void lightEmitted(Entry& e, SplatBuilder& builder, const Materials& materials, std::size_t first);
     // Refreshes e.lit->field from the kind's lighting density; false when the

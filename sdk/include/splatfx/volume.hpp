@@ -36,7 +36,10 @@
 
 #include <glm/glm.hpp>
 
+#include <span>
+
 #include "splatfx/camera.hpp"
+#include "splatfx/lighting.hpp"
 #include "splatfx/motion.hpp"
 #include "splatfx/result.hpp"
 
@@ -382,6 +385,29 @@ struct GroundFogDesc {
     float minAccuracyC = 4.0f;
 };
 
+// How a lit ground fog layer is lit (GroundFog::setLighting; opt-in: a
+// layer never given one draws its transfer function's colour, unlit). The
+// low-albedo model the effects and LowAlbedo clouds are lit by (Ebert &
+// Parent 1990, lighting.hpp): the layer absorbs sigma = extinctionPerWorld s
+// (s the fog's scalar, as makeGroundFogTransfer's transfer) and emits per
+// unit extinction J = color (albedo (ambient + c I (4 pi phase(theta) T + m))),
+// T the sun's transmittance through the layer's own field and the casters.
+struct GroundFogLighting {
+    // The sun: a directional light (y is up); default travelling down and a little sideways.
+    Light sun = Light::directional({-0.3f, -1.0f, -0.2f});
+    // Albedo, phase lobes, ambient (RGB), multipleScattering; emission and
+    // colorTable are ignored (the base colour is `color`). Default albedo 0.9.
+    GasLightingDesc gas{.albedo = 0.9f};
+    glm::vec3 color{1.0f};           // default white: the fog's own colour (kappa before the light), each >= 0
+    float extinctionPerWorld = 1.0f; // default 1: extinction at scalar 1 (sigma = extinctionPerWorld s), >= 0
+    // The pre-integration table's length samples (its scalars need 2: exact). Default 128.
+    int lengthResolution = 128;
+};
+
+namespace detail {
+struct FogFieldView;
+} // namespace detail
+
 // A fog layer over a terrain height field as vertical prisms of three
 // tetrahedra (sec. 6): every triangle a prism from the terrain to the fog
 // top, split into three tetrahedra by the global vertex order so neighbouring
@@ -455,7 +481,50 @@ public:
     static std::size_t bytesFor(glm::ivec2 dims, bool lod);
     std::size_t memoryBytes() const;
 
+    // ---- Lighting (GroundFogLighting; docs/lighting.md, "Ground fog") ----
+    // Lights the layer from now on: update() then writes each vertex's
+    // scalar s = T phase(theta) / max phase (theta between the sun's travel
+    // and the direction to the eye) and its length scale = the fog's scalar,
+    // to be drawn with litTransfer() / litTable(): kappa(s) = A + B s, rho =
+    // extinctionPerWorld, so the extinction is the unlit layer's and
+    // pre-integration stays exact. T at each grid point's terrain and fog top
+    // is exp(-optical depth toward the sun) through the layer's own
+    // continuous field (reference.hpp's integrateGroundFogRay field: in each
+    // triangle terrain and thickness linear; integrated in closed form per
+    // triangle stretch) times exp2(-DensityField::opticalDepthToLight)
+    // through each caster (a lit cloud's or effect's field: smoke shadowing
+    // the fog); vertices between grid points (LOD clipping at the grid's
+    // edge, near-plane clipping) interpolate it. Relights (O(points x cells
+    // crossed toward the sun)) only when the sun's direction or a caster's
+    // fingerprint changed; rebuilds the table only when a colour term did.
+    // Fails, changing nothing, on a bad field (the message names it) or a
+    // null caster.
+    Status setLighting(const GroundFogLighting& lighting, std::span<const DensityField* const> casters = {});
+    // Back to the unlit layer (the transfer function's colour).
+    void clearLighting() { mLit = false; }
+    bool lit() const { return mLit; }
+    const GroundFogLighting& lighting() const { return mLighting; }
+    const TransferFunction& litTransfer() const { return mLitTransfer; }
+    const PreIntegrationTable& litTable() const { return mLitTable; }
+    // Relights (transmittance recomputed) and lit-table builds since creation.
+    std::uint64_t relights() const { return mRelights; }
+    std::uint64_t litTableBuilds() const { return mLitTableBuilds; }
+    // The sun's transmittance at the terrain (even entries) and fog top (odd)
+    // of each point of the field's grid (x fastest: dims, or the LOD's
+    // padded grid), from the last relight.
+    const std::vector<float>& sunTransmittance() const { return mSunT; }
+    // The layer's own optical depth (natural log) from a world point toward
+    // the sun (`towardSun` need not be unit) under the current lighting's
+    // extinctionPerWorld: the self-shadowing the relight uses. Double.
+    double opticalDepthToSun(glm::dvec3 pointWorld, glm::dvec3 towardSun) const;
+    // The model's emission per unit extinction at sun transmittance T seen
+    // along toEye (unit, world): what the lit tetrahedra draw, in double.
+    glm::dvec3 sourceAt(double sunTransmittance, glm::vec3 toEye) const;
+
 private:
+    detail::FogFieldView fieldView() const;
+    Status relightFog(std::span<const DensityField* const> casters);
+    Status rebuildLitTable();
     GroundFogDesc mDesc;
     std::uint64_t mPrisms = 0;
     Aabb mBounds;
@@ -463,6 +532,15 @@ private:
     int mN = 0, mMaxDepth = 0;
     double mMaxThickness = 0.0;
     std::vector<float> mHeight, mThickness, mDelta, mRadius;
+    // Lighting (setLighting).
+    bool mLit = false;
+    GroundFogLighting mLighting;
+    std::vector<float> mSunT;                   // 2 per field-grid point: terrain, top
+    std::vector<std::uint64_t> mCasterPrints;   // the casters' fingerprints at the last relight
+    TransferFunction mLitTransfer;
+    PreIntegrationTable mLitTable;
+    float mPhaseMax = 1.0f;
+    std::uint64_t mRelights = 0, mLitTableBuilds = 0;
 };
 
 // A fog transfer function: constant colour, extinction linear in the scalar

@@ -221,8 +221,10 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
                                .opacityScale = e.options.draw.opacityScale * options.opacityScale};
         const std::size_t first = builder.splats().size();
         auto* cloud = dynamic_cast<detail::CloudKind*>(e.kind.get());
+        // Lit ground fog is emitted after every caster's field is current (emitLitGroundFogs).
+        const bool litFog = e.options.lighting.enabled && dynamic_cast<detail::GroundFogKind*>(e.kind.get());
         EmitResult r;
-        if (e.status.needed)
+        if (e.status.needed && !litFog)
             r = e.kind->emit(EmitContext{.splats = builder,
                                          .volumes = volumes,
                                          .materials = materials,
@@ -238,11 +240,12 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
         mCounters.litEffects += cloudLit[i] != 0 ? 1 : 0;
         // Tables over the budget are never built: those effects stay unlit (the error says why).
         const bool tableLit = e.options.lighting.selfShadow == SelfShadow::Table;
-        if (!cloud && e.status.needed && e.options.lighting.enabled && !mLights.empty() && (mTablesFit || !tableLit))
+        if (!cloud && !litFog && e.status.needed && e.options.lighting.enabled && !mLights.empty() && (mTablesFit || !tableLit))
             lightEmitted(e, builder, materials, first);
         e.status.emittedLights = 0;
         if (e.options.emitsLight.enabled && (e.status.needed || e.status.lightsIntoView)) fitLights(e, builder.camera(), materials, draw);
     }
+    tetrahedra += emitLitGroundFogs(builder, volumes, materials, options);
     mCounters.splats = splats;
     mCounters.tetrahedra = tetrahedra;
     return splats;

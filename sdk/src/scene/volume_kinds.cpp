@@ -1,5 +1,7 @@
 #include "volume_kinds.hpp"
 
+#include <cmath>
+
 namespace splatfx::detail {
 
 AdvanceResult TetraKind::advanceTo(double timeSec, const AdvanceContext&) {
@@ -19,11 +21,48 @@ EmitResult LodVolumeKind::emit(const EmitContext& context) {
 
 EmitResult GroundFogKind::emit(const EmitContext& context) {
     mTerrain.clear();
-    return emitVolume(context, [&](LodFrame& out) {
+    auto refine = [&](LodFrame& out) {
         const bool ok = bool(mVolume.update(context.splats.camera(), context.refine, out, context.keepTerrain ? &mTerrain : nullptr));
         if (!ok) mTerrain.clear();
         return ok;
-    });
+    };
+    if (!mVolume.lit()) return emitVolume(context, refine);
+    if (!context.volumes) return {};
+    FrameVolume& fv = context.volumes->emplace_back();
+    fv.table = &mVolume.litTable();
+    fv.tableVersion = mVolume.litTableBuilds();
+    if (!refine(fv.lod)) {
+        context.volumes->pop_back();
+        return {};
+    }
+    return {.tetrahedra = fv.lod.tets.size()};
+}
+
+Status GroundFogKind::follow(std::span<const Light> lights, const EffectLighting& lighting, std::span<const DensityField* const> casters) {
+    for (const Light& l : lights) {
+        if (l.type != LightType::Directional) continue;
+        // The fog's colour and extinction: sigma = rho s with one colour (makeGroundFogTransfer).
+        const double rho = mTransfer.extinction(1.0);
+        const glm::dvec3 colour = mTransfer.color(1.0);
+        for (const TransferPoint& p : mTransfer.points())
+            if (std::abs(double(p.extinctionPerWorld) - double(p.scalar) * rho) > 1e-6 * rho || glm::length(glm::dvec3(p.color) - colour) > 1e-6) {
+                mVolume.clearLighting();
+                return makeError("a lit ground fog needs a transfer function of makeGroundFogTransfer's form (one colour, extinction linear from 0)");
+            }
+        GroundFogLighting L = mVolume.lighting();
+        L.sun = l;
+        L.gas = lighting.gas;
+        L.gas.colorTable = nullptr;
+        L.color = glm::vec3(colour);
+        L.extinctionPerWorld = float(rho);
+        if (Status s = mVolume.setLighting(L, casters); !s) {
+            mVolume.clearLighting();
+            return s;
+        }
+        return {};
+    }
+    mVolume.clearLighting();
+    return {};
 }
 
 EmitResult CloudKind::emit(const EmitContext& context) {

@@ -86,6 +86,12 @@ public:
     EmitResult emit(const EmitContext& context) override;
     // The terrain the last emit refined with keepTerrain; empty otherwise.
     const std::vector<glm::vec3>& terrain() const { return mTerrain; }
+    // Lit (EffectOptions::lighting.enabled): the scene's first directional
+    // light is the sun, lighting.gas the model, the transfer function's colour
+    // and extinction at scalar 1 the fog's (it must be makeGroundFogTransfer's
+    // form), shadowed by `casters`; relit only when those change. No
+    // directional light: drawn unlit. On an error the layer is drawn unlit.
+    Status follow(std::span<const Light> lights, const EffectLighting& lighting, std::span<const DensityField* const> casters);
 
 private:
     std::vector<glm::vec3> mTerrain;

@@ -173,6 +173,13 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     o.boolean("morph", morph);
     float densityDepth = 0.0f;
     o.number("densityDepthWorld", densityDepth, 0.0, 1e6);
+    // Lit by the scene's sun (issue 27; GroundFog::setLighting): the same
+    // "lighting" object as the effects' and the clouds' (its gas desc), the
+    // layer's "colour" and "extinctionPerWorld" as the fog's own.
+    EffectLighting lighting;
+    const Json* lit = o.get("lighting");
+    if (lit) readEffectLighting(c, o.at("lighting"), *lit, lighting);
+    lighting.selfShadow = SelfShadow::Off; // it shadows itself through its own field: no tables to budget
     if (!lod)
         for (const char* key : {"detailC", "minAccuracyC", "morph", "terrainGeometry"})
             if (o.has(key)) c.d.error(o.at(key), std::string("only with \"lod\": true (the full-resolution layer has no LOD)"));
@@ -203,9 +210,11 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
             cells = (n - 1) * (n - 1);
         }
         const std::uint64_t tets = 6 * cells;
+        // Lit: the sun's transmittance at each point's terrain and top (8 bytes a point, the LOD's padded grid at most 4 x the points) and a 2 x 2 x tableLengths table.
+        const std::uint64_t litBytes = lit ? 8 * (lod ? 4 : 1) * sx * sz + 16ull * 4 * lengthRes : 0;
         const std::uint64_t bytes = 16 * std::uint64_t(info->width) * std::uint64_t(info->height) + 8 * sx * sz +
                                     GroundFog::bytesFor(glm::ivec2(int(sx), int(sz)), lod) + 16ull * scalarRes * scalarRes * lengthRes +
-                                    kFrameBytesPerTetrahedron * tets;
+                                    kFrameBytesPerTetrahedron * tets + litBytes;
         if (!addVolumeBytes(c, p,
                             "groundFog '" + name + "' (" + std::to_string(sx) + "x" + std::to_string(sz) + " points, up to " + std::to_string(tets) +
                                 " tetrahedra a frame, a " + dimsText({scalarRes, scalarRes, lengthRes}) + " table)",
@@ -278,7 +287,7 @@ void readGroundFog(Context& c, const std::string& p, ObjectReader& o, const std:
     refine.detailC = detailC;
     refine.morph = morph;
     const EffectId id = out.scene.add(std::move(*layer), std::move(*tf), std::move(*table),
-                                      {.name = name, .enabled = enabled, .refine = refine, .keepTerrain = !terrainGeometry.empty()});
+                                      {.name = name, .enabled = enabled, .lighting = lighting, .refine = refine, .keepTerrain = !terrainGeometry.empty()});
     out.volumes.push_back({id, name, "groundFog"});
     if (!terrainGeometry.empty()) out.groundFogTerrain.push_back({terrainGeometry, id});
 }

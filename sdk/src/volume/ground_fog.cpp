@@ -7,6 +7,7 @@
 #include <string>
 
 #include "splatfx/volume.hpp"
+#include "volume/ground_fog_light.hpp"
 
 namespace splatfx {
 namespace {
@@ -37,6 +38,7 @@ struct Emitter {
     glm::dvec4 planes[6]{};     // the view frustum, normalized, inside >= 0
     double yLo = 0.0, yHi = 0.0; // the layer's lowest terrain and highest fog top
     bool prisms = true;          // false below a culled node: terrain only
+    const detail::FogLitView* lit = nullptr; // lit layer: light scalars and density as length scale
 
     // Cells [x0, x1) x [z0, z1) (every prism over them within yLo..yHi) outside the frustum?
     bool outside(int x0, int x1, int z0, int z1) const {
@@ -169,18 +171,26 @@ struct Emitter {
         t[1].scalar = {sb[1], sb[2], 0.0f, 0.0f};
         t[2].position = {B[2], T[0], T[1], T[2]};
         t[2].scalar = {sb[2], 0.0f, 0.0f, 0.0f};
+        for (int k = 0; k < 3; ++k) t[k].lengthScale = {1.0f, 1.0f, 1.0f, 1.0f};
+        if (lit) { // the fog's scalar becomes the length scale (sigma = rho f), the light the scalar
+            float lb[3], lt[3];
+            for (int k = 0; k < 3; ++k) lb[k] = lit->scalarAt(B[k], false), lt[k] = lit->scalarAt(T[k], true);
+            t[0].lengthScale = t[0].scalar, t[0].scalar = {lb[0], lb[1], lb[2], lt[0]};
+            t[1].lengthScale = t[1].scalar, t[1].scalar = {lb[1], lb[2], lt[0], lt[1]};
+            t[2].lengthScale = t[2].scalar, t[2].scalar = {lb[2], lt[0], lt[1], lt[2]};
+        }
         bool keep[3];
         // The prism's horizontal extent for the degenerate test (the grid spacing at full resolution).
         const double ext = std::max({std::abs(double(B[1].x) - B[0].x), std::abs(double(B[1].z) - B[0].z), std::abs(double(B[2].x) - B[0].x),
                                      std::abs(double(B[2].z) - B[0].z)});
         for (int k = 0; k < 3; ++k) {
-            t[k].lengthScale = {1.0f, 1.0f, 1.0f, 1.0f};
             const double o = orient(t[k]);
             const double scale = ext * ext * std::max({h[0], h[1], h[2]});
             keep[k] = std::abs(o) > 1e-9 * scale;
             if (o < 0.0) { // positively oriented, as the pass expects
                 std::swap(t[k].position[0], t[k].position[1]);
                 std::swap(t[k].scalar[0], t[k].scalar[1]);
+                std::swap(t[k].lengthScale[0], t[k].lengthScale[1]);
             }
         }
         // Chain t0 - t1 - t2 through faces (B1, B2, T0) and (B2, T0, T1): a
@@ -621,6 +631,20 @@ Status GroundFog::update(const Camera& camera, const LodRefineDesc& refine, LodF
         return makeError("GroundFog::update: the camera is not finite");
     if (!std::isfinite(refine.detailC) || refine.detailC < 0.0f) return makeError("GroundFog::update: LodRefineDesc.detailC must be finite and >= 0");
     Emitter em{mDesc, camera, out, {}, 0.0f, {}, refine.clipNear, terrainTriangles};
+    detail::FogFieldView field;
+    detail::FogLitView litView;
+    if (mLit) {
+        field = fieldView();
+        litView.field = &field;
+        litView.sunT = mSunT.data();
+        litView.phase = &mLighting.gas.phase;
+        litView.travel = glm::normalize(mLighting.sun.direction);
+        litView.eye = e, litView.back = -f, litView.perspective = camera.perspective();
+        const PhaseFunction& ph = mLighting.gas.phase;
+        litView.isotropic = ph.lobeCount() == 1 && ph.lobe(0).g == 0.0f; // s = T
+        litView.invPhaseMax = 1.0f / mPhaseMax;
+        em.lit = &litView;
+    }
     em.nearNormal = f;
     em.nearOffset = glm::dot(f, e) + camera.nearPlane();
     glm::dvec4 planes[6];
