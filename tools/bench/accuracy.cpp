@@ -46,6 +46,8 @@
 #include "splatfx/solver.hpp"
 #include "splatfx/splatfx.hpp"
 
+namespace accuracy_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 using bench::median;
@@ -811,3 +813,6 @@ int runAccuracy(int argc, char** argv) {
     std::printf("accuracy: done in %.1f s; load average at the end: %s\n", ms(start, Clock::now()) / 1e3, loadAverage().c_str());
     return 0;
 }
+} // namespace accuracy_cmd
+
+int runAccuracy(int argc, char** argv) { return accuracy_cmd::runAccuracy(argc, argv); }

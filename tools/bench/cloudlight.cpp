@@ -31,6 +31,8 @@
 #include "splatfx/scene.hpp"
 #include "splatfx/volume.hpp"
 
+namespace cloudlight_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 // CPU time of this thread's work (the relight is single-threaded): steadier
@@ -346,3 +348,6 @@ int runCloudLight(int argc, char** argv) {
     std::filesystem::create_directories(out, ec);
     return bench::writePlot(rows, out, "cloudlight", "cloud relight: CPU ms per relight vs sun transmittance error", "CPU ms per relight") ? 0 : 1;
 }
+} // namespace cloudlight_cmd
+
+int runCloudLight(int argc, char** argv) { return cloudlight_cmd::runCloudLight(argc, argv); }

@@ -28,6 +28,8 @@
 #include "splatfx/scene.hpp"
 #include "splatfx/volume.hpp"
 
+namespace clouds_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 using bench::percentile;
@@ -483,3 +485,6 @@ int runClouds(int argc, char** argv) {
     }
     return 0;
 }
+} // namespace clouds_cmd
+
+int runClouds(int argc, char** argv) { return clouds_cmd::runClouds(argc, argv); }

@@ -26,6 +26,8 @@
 #include "splatfx/reference.hpp"
 #include "splatfx/scene.hpp"
 
+namespace crossshadow_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 constexpr float kGrey = 0.7f;
@@ -180,3 +182,6 @@ int runCrossShadow(int argc, char** argv) {
     return bench::writePlot(rows, out, "crossshadow", "effects shadowing one another: CPU ms per frame vs colour error", "CPU ms per Scene::prepare") ? 0
                                                                                                                                   : 1;
 }
+} // namespace crossshadow_cmd
+
+int runCrossShadow(int argc, char** argv) { return crossshadow_cmd::runCrossShadow(argc, argv); }

@@ -19,6 +19,8 @@
 #include "splatfx/context.hpp"
 #include "splatfx/splatfx.hpp"
 
+namespace cut_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -371,3 +373,6 @@ int runCut(int argc, char** argv) {
     if (doCow) return cowPopping(cowPath, steps);
     return 0;
 }
+} // namespace cut_cmd
+
+int runCut(int argc, char** argv) { return cut_cmd::runCut(argc, argv); }

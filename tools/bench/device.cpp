@@ -10,6 +10,8 @@
 #include "options.hpp"
 #include "splatfx/context.hpp"
 
+namespace device_cmd { // one namespace per command: the commands build as one unity translation unit
+
 int runDevice(int argc, char** argv) {
     CLI::App app{"The OpenGL context the benches get (SPLATFX_EGL_DEVICE selects an EGL device): vendor, renderer, limits.",
                  "splatfx-bench device"};
@@ -35,3 +37,6 @@ int runDevice(int argc, char** argv) {
                 integer(GL_MAX_DEPTH_TEXTURE_SAMPLES), integer(GL_MAX_TEXTURE_SIZE));
     return 0;
 }
+} // namespace device_cmd
+
+int runDevice(int argc, char** argv) { return device_cmd::runDevice(argc, argv); }

@@ -20,6 +20,8 @@
 #include "splatfx/context.hpp"
 #include "splatfx/gl/framebuffer.hpp"
 
+namespace ebert_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -126,3 +128,6 @@ int runEbert(int argc, char** argv) {
     }
     return 0;
 }
+} // namespace ebert_cmd
+
+int runEbert(int argc, char** argv) { return ebert_cmd::runEbert(argc, argv); }

@@ -40,6 +40,8 @@
 #include "splatfx/shapes.hpp"
 #include "splatfx/splats.hpp"
 
+namespace emitted_cmd { // one namespace per command: the commands build as one unity translation unit
+
 using namespace splatfx;
 
 namespace {
@@ -475,3 +477,6 @@ int runEmitted(int argc, char** argv) {
     bench::writePlot(rows, out, "emitted", "Fitted lights against the exact irradiance of a campfire", "fitEmittedLights ms per frame");
     return 0;
 }
+} // namespace emitted_cmd
+
+int runEmitted(int argc, char** argv) { return emitted_cmd::runEmitted(argc, argv); }

@@ -34,6 +34,8 @@
 #include "splatfx/reference.hpp"
 #include "splatfx/splatfx.hpp"
 
+namespace gases_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -198,3 +200,6 @@ int runGases(int argc, char** argv) {
                ? 0
                : 1;
 }
+} // namespace gases_cmd
+
+int runGases(int argc, char** argv) { return gases_cmd::runGases(argc, argv); }

@@ -39,6 +39,8 @@
 #include "splatfx/scene_file.hpp"
 #include "splatfx/volume.hpp"
 
+namespace groundfog_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 using bench::percentile;
@@ -478,3 +480,6 @@ int runGroundFog(int argc, char** argv) {
     }
     return 0;
 }
+} // namespace groundfog_cmd
+
+int runGroundFog(int argc, char** argv) { return groundfog_cmd::runGroundFog(argc, argv); }

@@ -29,6 +29,8 @@
 #include "splatfx/reference.hpp"
 #include "splatfx/scene.hpp"
 
+namespace hdr_cmd { // one namespace per command: the commands build as one unity translation unit
+
 using namespace splatfx;
 
 int runHdr(int argc, char** argv) {
@@ -163,3 +165,6 @@ int runHdr(int argc, char** argv) {
     }
     return 0;
 }
+} // namespace hdr_cmd
+
+int runHdr(int argc, char** argv) { return hdr_cmd::runHdr(argc, argv); }

@@ -28,6 +28,8 @@
 #include "splatfx/reference.hpp"
 #include "splatfx/splatfx.hpp"
 
+namespace lattice_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 struct Sample {
@@ -347,3 +349,6 @@ int runLattice(int argc, char** argv) {
                 "upright flame tongues, raises the disc and its neighbours alike); control: the same for animated turbulence.\n");
     return failed ? 1 : 0;
 }
+} // namespace lattice_cmd
+
+int runLattice(int argc, char** argv) { return lattice_cmd::runLattice(argc, argv); }

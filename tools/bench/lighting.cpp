@@ -25,6 +25,8 @@
 #include "splatfx/reference.hpp"
 #include "splatfx/scene.hpp"
 
+namespace lighting_cmd { // one namespace per command: the commands build as one unity translation unit
+
 using namespace splatfx;
 
 namespace {
@@ -294,3 +296,6 @@ int runLighting(int argc, char** argv) {
     }
     return 0;
 }
+} // namespace lighting_cmd
+
+int runLighting(int argc, char** argv) { return lighting_cmd::runLighting(argc, argv); }

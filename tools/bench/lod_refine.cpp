@@ -15,6 +15,8 @@
 #include "options.hpp"
 #include "splatfx/volume.hpp"
 
+namespace lod_refine_cmd { // one namespace per command: the commands build as one unity translation unit
+
 int runLodRefine(int argc, char** argv) {
     glm::ivec3 dims(257, 257, 33);
     float detailC = 10.0f, minC = 4.0f;
@@ -138,3 +140,6 @@ int runLodRefine(int argc, char** argv) {
     }
     return 0;
 }
+} // namespace lod_refine_cmd
+
+int runLodRefine(int argc, char** argv) { return lod_refine_cmd::runLodRefine(argc, argv); }

@@ -20,6 +20,8 @@
 #include "splatfx/context.hpp"
 #include "splatfx/gl/framebuffer.hpp"
 
+namespace msaa_cmd { // one namespace per command: the commands build as one unity translation unit
+
 int runMsaa(int argc, char** argv) {
     std::string scene = "samples/09-fog-countryside/scene.json", out = "bench-msaa";
     int width = 320, height = 240, frames = 5;
@@ -110,3 +112,6 @@ int runMsaa(int argc, char** argv) {
     }
     return 0;
 }
+} // namespace msaa_cmd
+
+int runMsaa(int argc, char** argv) { return msaa_cmd::runMsaa(argc, argv); }

@@ -21,6 +21,8 @@
 #include "options.hpp"
 #include "splatfx/solver.hpp"
 
+namespace obstacles_cmd { // one namespace per command: the commands build as one unity translation unit
+
 using namespace splatfx;
 
 namespace {
@@ -168,3 +170,6 @@ int runObstacles(int argc, char** argv) {
     }
     return 0;
 }
+} // namespace obstacles_cmd
+
+int runObstacles(int argc, char** argv) { return obstacles_cmd::runObstacles(argc, argv); }

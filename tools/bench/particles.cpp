@@ -23,6 +23,8 @@
 #include "splatfx/context.hpp"
 #include "splatfx/splatfx.hpp"
 
+namespace particles_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -173,3 +175,6 @@ int runParticles(int argc, char** argv) {
                ? 0
                : 1;
 }
+} // namespace particles_cmd
+
+int runParticles(int argc, char** argv) { return particles_cmd::runParticles(argc, argv); }

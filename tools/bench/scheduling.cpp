@@ -25,6 +25,8 @@
 #include "splatfx/presets.hpp"
 #include "splatfx/scene.hpp"
 
+namespace scheduling_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 using bench::median;
@@ -343,3 +345,6 @@ int runScheduling(int argc, char** argv) {
     }
     return 0;
 }
+} // namespace scheduling_cmd
+
+int runScheduling(int argc, char** argv) { return scheduling_cmd::runScheduling(argc, argv); }

@@ -23,6 +23,8 @@
 #include "knob_table.hpp"
 #include "splatfx/scene.hpp"
 
+namespace shadow_lights_cmd { // one namespace per command: the commands build as one unity translation unit
+
 using namespace splatfx;
 
 namespace {
@@ -291,3 +293,6 @@ int runShadowLights(const std::string& out, int frames, bool noPlots) {
     rows.erase(std::remove_if(rows.begin(), rows.end(), [](const bench::KnobRow& r) { return r.rmse <= 0.0; }), rows.end());
     return bench::writePlot(rows, out, "shadow_lights", "every light casts: ground transmittance RMSE vs tracing", "CPU ms") ? 0 : 1;
 }
+} // namespace shadow_lights_cmd
+
+int runShadowLights(const std::string& out, int frames, bool noPlots) { return shadow_lights_cmd::runShadowLights(out, frames, noPlots); }

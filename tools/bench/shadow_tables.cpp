@@ -15,6 +15,8 @@
 #include "options.hpp"
 #include "splatfx/lighting.hpp"
 
+namespace shadow_tables_cmd { // one namespace per command: the commands build as one unity translation unit
+
 using namespace splatfx;
 using Clock = std::chrono::steady_clock;
 
@@ -112,3 +114,6 @@ int runShadowTables(int argc, char** argv) {
     }
     return 0;
 }
+} // namespace shadow_tables_cmd
+
+int runShadowTables(int argc, char** argv) { return shadow_tables_cmd::runShadowTables(argc, argv); }

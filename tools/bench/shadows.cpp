@@ -31,6 +31,8 @@
 #include "splatfx/procedural_gas.hpp"
 #include "splatfx/splatfx.hpp"
 
+namespace shadows_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -400,3 +402,6 @@ int runShadows(int argc, char** argv) {
     }
     return phaseLobes(gasAt(2.5), steamTable);
 }
+} // namespace shadows_cmd
+
+int runShadows(int argc, char** argv) { return shadows_cmd::runShadows(argc, argv); }

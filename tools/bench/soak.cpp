@@ -23,6 +23,8 @@
 #include "commands.hpp"
 #include "splatfx/splatfx.hpp"
 
+namespace soak_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -402,3 +404,6 @@ int runSoak(int argc, char** argv) {
     std::printf("\nsoak: %s\n", ok ? "every preset and scene stayed finite with flat bounds and memory" : "FAILED (see the tables)");
     return ok ? 0 : 1;
 }
+} // namespace soak_cmd
+
+int runSoak(int argc, char** argv) { return soak_cmd::runSoak(argc, argv); }

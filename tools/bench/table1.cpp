@@ -24,6 +24,8 @@
 #include "splatfx/gl/scaled_renderer.hpp"
 #include "splatfx/splatfx.hpp"
 
+namespace table1_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -611,3 +613,6 @@ int runTable1(int argc, char** argv) {
     }
     return 0;
 }
+} // namespace table1_cmd
+
+int runTable1(int argc, char** argv) { return table1_cmd::runTable1(argc, argv); }

@@ -23,6 +23,8 @@
 #include "splatfx/context.hpp"
 #include "splatfx/transparency.hpp"
 
+namespace transparency_cmd { // one namespace per command: the commands build as one unity translation unit
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -306,3 +308,6 @@ int runTransparency(int argc, char** argv) {
                 "Targets (issue 15): one pane in front, lists <= 2x the opaque-only frame, error within the opaque-only error.\n");
     return 0;
 }
+} // namespace transparency_cmd
+
+int runTransparency(int argc, char** argv) { return transparency_cmd::runTransparency(argc, argv); }

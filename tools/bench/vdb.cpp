@@ -27,6 +27,11 @@
 #include "splatfx/reference.hpp"
 #include "splatfx/splatfx.hpp"
 #include "splatfx/vdb.hpp"
+#endif
+
+namespace vdb_cmd { // one namespace per command: the commands build as one unity translation unit
+
+#if SPLATFX_WITH_VDB
 
 namespace {
 
@@ -192,3 +197,6 @@ int runVdb(int, char**) {
 }
 
 #endif
+} // namespace vdb_cmd
+
+int runVdb(int argc, char** argv) { return vdb_cmd::runVdb(argc, argv); }
