@@ -30,7 +30,9 @@ using namespace splatfx;
 
 namespace {
 
-std::size_t index(glm::ivec3 n, int x, int y, int z) { return std::size_t(x) + std::size_t(n.x) * (std::size_t(y) + std::size_t(n.y) * std::size_t(z)); }
+std::size_t index(glm::ivec3 n, int x, int y, int z) {
+    return std::size_t(x) + std::size_t(n.x) * (std::size_t(y) + std::size_t(n.y) * std::size_t(z));
+}
 
 CloudCreateDesc lowAlbedo(glm::ivec3 dims, float maxExtinction) {
     CloudCreateDesc d;
@@ -278,9 +280,7 @@ TEST(CloudRelightHardCases, PhaseLobesAtPlusMinus0999AndIsotropic) {
                 const double Tv = c->volume().scalarAt(gp);
                 const glm::vec3 toEye = glm::normalize(cam.eye() - p);
                 ASSERT_LT(std::abs(glm::dot(toEye, travel)), std::cos(glm::radians(30.0f)));
-                if (g == 0.0f) {
-                    EXPECT_EQ(s, float(Tv));
-                }
+                if (g == 0.0f) { EXPECT_EQ(s, float(Tv)); }
                 const glm::dvec3 want = c->sourceAt(Tv, toEye), got = c->transfer().color(s);
                 for (int a = 0; a < 3; ++a) EXPECT_NEAR(got[a], want[a], 2e-5 * want[a]) << g;
             }
@@ -309,18 +309,14 @@ TEST(CloudRelightHardCases, RoettgerLightAtItsLimits) {
             const double want = std::min(1.0, double(amb) + double(dif) * std::exp(-ext * double(f) * double(5 - z)));
             EXPECT_NEAR(c->volume().lengthScaleAt({4, 4, z}), want, 0.5 / 255.0 + 1e-6) << amb << " " << z;
         }
-        if (amb + dif == 1.0f) {
-            EXPECT_EQ(c->volume().lengthScaleAt({4, 4, 5}), 1.0f);
-        }
+        if (amb + dif == 1.0f) { EXPECT_EQ(c->volume().lengthScaleAt({4, 4, 5}), 1.0f); }
         LodFrame frame;
         const Camera cam = Camera::lookAt({4.0f, -14.0f, 3.0f}, {4.0f, 4.0f, 2.0f}, {0.0f, 0.0f, 1.0f}, 0.8f, {64, 48});
         ASSERT_TRUE(c->update(cam, {.zeroOpacityTest = false}, frame));
         for (const Tetrahedron& t : frame.tets)
             for (int k = 0; k < 4; ++k) {
                 EXPECT_TRUE(std::isfinite(t.lengthScale[std::size_t(k)]));
-                if (amb + dif == 0.0f) {
-                    EXPECT_EQ(t.lengthScale[std::size_t(k)], 0.0f);
-                }
+                if (amb + dif == 0.0f) { EXPECT_EQ(t.lengthScale[std::size_t(k)], 0.0f); }
             }
     }
 }
@@ -349,9 +345,7 @@ Cloud sceneCloud(glm::vec3 origin, std::vector<float> density) {
     cd.table = {.scalarResolution = 8, .lengthResolution = 8};
     auto made = Cloud::create(cd);
     EXPECT_TRUE(made) << made.error();
-    if (!density.empty()) {
-        EXPECT_TRUE(made->setDensity(std::move(density)));
-    }
+    if (!density.empty()) { EXPECT_TRUE(made->setDensity(std::move(density))); }
     return std::move(*made);
 }
 
@@ -409,7 +403,8 @@ struct PlumeUnderClouds {
                           {.name = "plume", .lighting = {.enabled = true, .gas = {.albedo = 1.0f}, .selfShadow = SelfShadow::Off}});
     }
     void addCloud(glm::vec3 at, std::vector<float> density) {
-        clouds.push_back(scene.add(sceneCloud(at, std::move(density)), {.name = "cloud" + std::to_string(clouds.size()), .lighting = {.enabled = true}}));
+        clouds.push_back(
+            scene.add(sceneCloud(at, std::move(density)), {.name = "cloud" + std::to_string(clouds.size()), .lighting = {.enabled = true}}));
     }
 
     // Prepares frame t and checks every plume splat against base x T(centre)
@@ -426,7 +421,9 @@ struct PlumeUnderClouds {
             const glm::dvec3 f = litFactor(field, glm::dvec3(sp.center), glm::dvec3(camera.eye()), lit);
             minT = std::min(minT, f.x);
             const glm::vec3 got = unpack(sp.color);
-            for (int a = 0; a < 3; ++a) EXPECT_NEAR(got[a], double(base[a]) * f[a], kShadowTolerance) << "t " << t << " splat " << sp.center.x << "," << sp.center.y << "," << sp.center.z;
+            for (int a = 0; a < 3; ++a)
+                EXPECT_NEAR(got[a], double(base[a]) * f[a], kShadowTolerance)
+                    << "t " << t << " splat " << sp.center.x << "," << sp.center.y << "," << sp.center.z;
             ++n;
         }
         EXPECT_EQ(n, 64u);

@@ -233,7 +233,8 @@ TEST(GroundFogLightHardCases, TheSmallestLayerTwoByTwo) {
     d.terrainHeight = {0.0f, 0.3f, 0.5f, 0.1f};
     d.fogTop = {1.2f, 1.0f, 1.4f, 1.1f};
     double lowest = 1.0;
-    for (glm::vec3 travel : {glm::vec3(0.5f, -0.6f, 0.4f), glm::vec3(-0.5f, -0.6f, 0.4f), glm::vec3(0.5f, -0.6f, -0.4f), glm::vec3(-0.5f, -0.6f, -0.4f)})
+    for (glm::vec3 travel :
+         {glm::vec3(0.5f, -0.6f, 0.4f), glm::vec3(-0.5f, -0.6f, 0.4f), glm::vec3(0.5f, -0.6f, -0.4f), glm::vec3(-0.5f, -0.6f, -0.4f)})
         lowest = std::min(lowest, litAgainstTheReference(d, travel, 2.0f));
     EXPECT_LT(lowest, 0.9);
 }
@@ -284,7 +285,8 @@ TEST(GroundFogLightHardCases, ALodLayersPaddedGridIsReadWithItsOwnStride) {
         for (int i = 0; i < d.dims.x; ++i)
             for (int top = 0; top < 2; ++top) {
                 const float want = full->sunTransmittance()[2 * at(d, i, j) + std::size_t(top)];
-                EXPECT_EQ(lod->sunTransmittance()[2 * (std::size_t(i) + n * std::size_t(j)) + std::size_t(top)], want) << i << ", " << j << " " << top;
+                EXPECT_EQ(lod->sunTransmittance()[2 * (std::size_t(i) + n * std::size_t(j)) + std::size_t(top)], want)
+                    << i << ", " << j << " " << top;
                 lowest = std::min(lowest, double(want));
             }
     EXPECT_LT(lowest, 0.9);
@@ -329,9 +331,7 @@ TEST(GroundFogLightHardCases, PhaseLobesAtPlusMinus0999AndAlbedoZeroAndOne) {
                     const glm::dvec3 got = fog->litTransfer().color(s);
                     const double phaseRel = double(L.gas.phase(travel, toEye)) / double(L.gas.phase(1.0f));
                     for (int a = 0; a < 3; ++a) {
-                        if (albedo == 0.0f) {
-                            EXPECT_EQ(got[a], 0.0);
-                        }
+                        if (albedo == 0.0f) { EXPECT_EQ(got[a], 0.0); }
                         EXPECT_NEAR(got[a], want[a], 2e-5 * std::abs(want[a]) + b * phaseRel * (kFloatT + 2.0 * err)) << g << " " << albedo;
                     }
                     EXPECT_EQ(t.lengthScale[std::size_t(c)] > 0.0f, p.y < 1.2f - 1e-4f); // the unlit scalar: 0 only at the top
