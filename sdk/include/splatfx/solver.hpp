@@ -19,7 +19,8 @@
 //   5. dissipation (implicit decay); optional global mass correction.
 // Obstacles (obstacle.hpp) are voxelized at the start of each substep: a
 // cell whose centre is inside one is solid. Faces touching a solid cell carry
-// the obstacle's velocity (its motion over the substep) and are walls to the
+// the obstacle's velocity (its motion over the substep, or over the last
+// millisecond when the substep is shorter) and are walls to the
 // projection, so no gas flows into it relative to its motion; Slip::None also
 // pins the fluid faces beside it. Density never sits in a solid cell: what a
 // moving obstacle covers is handed to the nearest fluid cell, emitters skip
@@ -191,7 +192,7 @@ private:
     void advectVelocity(float dt);
     void dissipate(float dt);
     // Voxelizes the obstacles at mTime (velocities from their motion over the
-    // last dt), hands covered density to fluid cells, fixes the wall faces.
+    // last dt, at least 1 ms), hands covered density to fluid cells, fixes the wall faces.
     void updateObstacles(float dt);
     void enforceObstacleFaces();
     bool fixedFace(int axis, std::size_t faceIndex) const { return !mFixed[axis].empty() && mFixed[axis][faceIndex] != 0; }
