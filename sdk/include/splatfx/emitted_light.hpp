@@ -101,7 +101,7 @@ struct EmittedGrid {
 // Checks desc (the message names the field).
 Status validate(const EmittedLightDesc& desc);
 
-// Fits desc.lights point lights (fewer when there are fewer emitting splats)
+// Fits desc.lights point lights (fewer when the emitting splats have fewer distinct centres)
 // to the emission of `splats` (one effect's, any order), brightest first.
 // Colours come from materials' colour tables at each splat's colour
 // coordinate times its texture's RGB (packedColor: the splat's RGB8 colour

@@ -88,7 +88,8 @@ enum class SelfShadow {
 // How an effect is lit by the scene's lights. Off by default: an unlit
 // effect draws its colour tables' colours and costs nothing more.
 // A lit effect's splats get colour = table colour * lightPoints(...) factor
-// at each splat's centre (per splat, on the CPU; the GL pass is unchanged).
+// at each splat's centre (per splat, on the CPU; the GL pass is unchanged),
+// also in a scene with no light (emission and ambient alone).
 // Only kinds that expose the density the light sees are lit
 // (EffectKind::lightingDensity: every Effect); the others stay unlit.
 struct EffectLighting {

@@ -211,7 +211,15 @@ Result<std::vector<EmittedLight>> fitEmittedLights(std::span<const Splat> splats
     std::vector<double> along(emitting.size());
     for (std::size_t k = 0; k < emitting.size(); ++k) along[k] = glm::dot(glm::dvec3(splats[emitting[k]].center) - mean, axis);
     std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return along[a] < along[b]; });
-    const int K = int(std::min<std::size_t>(std::size_t(desc.lights), emitting.size()));
+    // No more lights than distinct centres: splats all at one point (or at a
+    // few) would otherwise be sliced into coincident clusters that k-means
+    // never separates, several lights at one place taking the frame's slots.
+    std::vector<glm::vec3> centres(emitting.size());
+    for (std::size_t k = 0; k < emitting.size(); ++k) centres[k] = splats[emitting[k]].center;
+    auto lexLess = [](glm::vec3 a, glm::vec3 b) { return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z; };
+    std::sort(centres.begin(), centres.end(), lexLess);
+    const std::size_t distinct = std::size_t(std::unique(centres.begin(), centres.end()) - centres.begin());
+    const int K = int(std::min<std::size_t>(std::size_t(desc.lights), distinct));
     std::vector<int> label(emitting.size());
     double run = 0.0;
     for (std::size_t k : order) {

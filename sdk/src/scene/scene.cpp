@@ -240,7 +240,7 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
         mCounters.litEffects += cloudLit[i] != 0 ? 1 : 0;
         // Tables over the budget are never built: those effects stay unlit (the error says why).
         const bool tableLit = e.options.lighting.selfShadow == SelfShadow::Table;
-        if (!cloud && !litFog && e.status.needed && e.options.lighting.enabled && !mLights.empty() && (mTablesFit || !tableLit))
+        if (!cloud && !litFog && e.status.needed && e.options.lighting.enabled && (mTablesFit || !tableLit))
             lightEmitted(e, builder, materials, first);
         e.status.emittedLights = 0;
         if (e.options.emitsLight.enabled && (e.status.needed || e.status.lightsIntoView)) fitLights(e, builder.camera(), materials, draw);

@@ -126,7 +126,7 @@ void Scene::updateEffectCasters(const Materials& materials, const EmitOptions& o
                                .opacityScale = e.options.draw.opacityScale * options.opacityScale};
         const bool tableLit = e.options.lighting.selfShadow == SelfShadow::Table;
         // As emitInto decides who is lit: tables over the budget are never built, those effects stay unlit.
-        const bool lit = e.status.needed && e.options.lighting.enabled && !mLights.empty() && (mTablesFit || !tableLit);
+        const bool lit = e.status.needed && e.options.lighting.enabled && (mTablesFit || !tableLit);
         if (!lit && !e.status.castsIntoView) continue;
         if (!updateLitField(e, materials, draw)) {
             e.status.castsIntoView = false;
