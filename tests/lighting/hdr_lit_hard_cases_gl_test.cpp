@@ -26,12 +26,14 @@ namespace {
 
 constexpr double kHalfUlp = 1.0 / 2048.0; // half float: 11 significant bits, a rounding <= 2^-11 relative
 
-// HdrLitGL's lone fire voxel (emission 5, a sun of 1): one splat of scale 5.5.
+// HdrLitGL's lone fire voxel (emission 5, a sun of 1): one splat of scale 5.5,
+// seen at 32x24 (the same projection at half its size: the references' cost).
 struct Fire {
     Materials m{Footprint{}};
     Camera cam = test::loneSplatCamera();
     Frame frame;
     explicit Fire(bool hdr) {
+        cam.viewport = {32, 24};
         const std::uint32_t row = m.addColorTable(ColorTable::constant({1.0f, 0.45f, 0.1f, 1.0f}));
         Scene scene;
         EXPECT_TRUE(scene.addLight(test::shadowSun()));
@@ -103,7 +105,8 @@ TEST_F(HdrLitHardCasesGL, EdgeEncodingsReadTheSameInTheGlslAsOnTheCpu) {
                     ASSERT_LE(std::abs(g - want), m * (alphaBound + kHalfUlp) + 1e-6 * want + 1e-6) << e.name << " at " << x << "," << y;
                     peak = std::max(peak, want);
                 }
-        EXPECT_GT(peak, 0.5 * m * 0.2) << e.name << ": the splat must be drawn"; // its brightest channel's byte is >= 0xc8 / 255 of m
+        // Its brightest byte is at least 0xc8 and the voxel's opacity 0.6: a peak of at least 0.47 m.
+        EXPECT_GT(peak, 0.4 * m) << e.name << ": the splat must be drawn";
     }
 }
 
