@@ -68,7 +68,6 @@ std::optional<Light> readLight(Context& c, const std::string& path, const Json& 
     });
 }
 
-std::string dimsText(glm::ivec3 d) { return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z); }
 
 } // namespace
 

@@ -122,6 +122,8 @@ std::optional<TextureSpec> readPresetTextureSet(Context& c, ObjectReader& o, std
 std::optional<ColorTable> readColorTable(Context& c, const std::string& path, const Json& v);
 
 std::uint64_t cells(glm::ivec3 d);
+// "64x32x16", as messages write lattice sizes.
+std::string dimsText(glm::ivec3 d);
 // Reads "dims" (required positive) with the kind's cell limit; `why` explains the limit.
 // dims checked against a budget: `field` names the Budgets member it is (messages say how to raise it).
 void readDims(Context& c, ObjectReader& o, glm::ivec3& dims, std::uint64_t limit, const char* field, const char* why);

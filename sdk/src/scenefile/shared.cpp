@@ -303,6 +303,8 @@ std::optional<ColorTable> readColorTable(Context& c, const std::string& path, co
 
 std::uint64_t cells(glm::ivec3 d) { return std::uint64_t(d.x) * std::uint64_t(d.y) * std::uint64_t(d.z); }
 
+std::string dimsText(glm::ivec3 d) { return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z); }
+
 void readDims(Context& c, ObjectReader& o, glm::ivec3& dims, std::uint64_t limit, const char* field, const char* why) {
     if (const Json* v = o.get("dims"))
         if (auto x = readIvec3(c.d, o.at("dims"), *v, 1, kMaxAxis)) {
