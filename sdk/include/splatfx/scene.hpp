@@ -245,6 +245,11 @@ struct SceneCounters {
     // the caster's box cannot shadow the receiver's for that light (shadowFallsOn).
     std::size_t crossShadowPairs = 0;
     std::size_t crossShadowPairsSkipped = 0;
+    // Lit clouds at the last emit(): scene lights (other than the sun) that
+    // reach a cloud's box but do not light it: any for the Roettger model,
+    // past kMaxCloudLights, or of a colour not a multiple of the lights it
+    // took before (a cloud draws one light colour; cloud.hpp). Summed over clouds.
+    std::size_t cloudLightsDropped = 0;
 };
 
 class Scene {
