@@ -20,7 +20,7 @@
 // (EffectKind::lightingDensity: every Effect does; LOD volumes and ground fog
 // do not, their light is part of their data; a Cloud, cloud.hpp, and a ground
 // fog layer, GroundFog::setLighting, follow the scene's first directional light
-// and are relit when it moves, the fog also shadowed by the lit clouds and
+// (a low-albedo Cloud its point and spot lights too) and are relit when it moves, the fog also shadowed by the lit clouds and
 // effects): their splat colours follow Ebert & Parent's low-albedo model with
 // self-shadowing, the light also attenuated through every other lit,
 // shadow-casting volume between them and it (a cloud's shadow on a plume, a
@@ -268,7 +268,9 @@ public:
     EffectId add(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, EffectOptions options = {});
     // A relightable cloud (cloud.hpp). With options.lighting.enabled it
     // follows the scene's first directional light (and, in the low-albedo
-    // model, options.lighting.gas), relit only when those change.
+    // model, options.lighting.gas and the scene's other lights that reach it,
+    // up to kMaxCloudLights of one colour; SceneCounters::cloudLightsDropped
+    // counts the rest), relit only when those change.
     EffectId add(Cloud cloud, EffectOptions options = {});
     // Any other kind (effect_kind.hpp). Expects kind != nullptr.
     EffectId add(std::unique_ptr<EffectKind> kind, EffectOptions options = {});
