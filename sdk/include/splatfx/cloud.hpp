@@ -50,7 +50,9 @@
 // effects through it (scene.hpp).
 //
 //   auto cloud = splatfx::Cloud::create({.cloud = {.dims = {65, 65, 17}}});
-//   cloud->setLight(splatfx::Light::directional({-1, -0.2f, -0.3f}));  // relights once
+//   splatfx::CloudLighting L = cloud->lighting();
+//   L.sun = splatfx::Light::directional({-1, -0.2f, -0.3f});
+//   cloud->setLight(L);                                                 // relights once
 //   cloud->update(camera, {}, frame);                                   // frame.tets
 //
 // Threading: one thread at a time.
