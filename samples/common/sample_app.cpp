@@ -12,6 +12,8 @@
 #include <optional>
 #include <string>
 
+#include <unistd.h>
+
 #include <epoxy/gl.h>
 #include <GLFW/glfw3.h>
 
@@ -111,6 +113,7 @@ int runHeadless(const Options& o, const char* name, const std::function<bool()>&
     }
     splatfx::AnimationWriter gif(outputs->path(std::string(name) + ".gif"), o.fps);
     Notes notes(name);
+    const bool tty = isatty(fileno(stdout)) != 0;
     const auto start = std::chrono::steady_clock::now();
     for (int i = 0; i < o.frames; ++i) {
         FrameContext fc;
@@ -145,12 +148,17 @@ int runHeadless(const Options& o, const char* name, const std::function<bool()>&
             std::fprintf(stderr, "%s: %s\n", name, s.error().c_str());
             return 1;
         }
-        std::printf("\r%s: frame %d/%d", name, i + 1, o.frames);
+        // A terminal gets a live line; a log (CI, a pipe) about ten whole lines.
+        if (tty) {
+            std::printf("\r%s: frame %d/%d", name, i + 1, o.frames);
+            notes.setMidLine(true);
+        } else if ((i + 1) % std::max(1, o.frames / 10) == 0 || i + 1 == o.frames) {
+            std::printf("%s: frame %d/%d\n", name, i + 1, o.frames);
+        }
         std::fflush(stdout);
-        notes.setMidLine(true);
     }
     const double sec = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("\n%s: writing %s/%s.gif\n", name, o.out.c_str(), name);
+    std::printf("%s%s: writing %s/%s.gif\n", tty ? "\n" : "", name, o.out.c_str(), name);
     if (auto s = gif.finish(); !s) {
         std::fprintf(stderr, "%s: %s\n", name, s.error().c_str());
         return 1;
@@ -181,6 +189,7 @@ int runWindowed(const Options& o, const char* name, const std::function<bool()>&
     std::optional<splatfx::gl::Framebuffer> target, resolved;
     describeTarget(o, name);
     Notes notes(name);
+    const bool tty = isatty(fileno(stdout)) != 0;
     const auto start = std::chrono::steady_clock::now();
     for (int i = 0; !window->shouldClose(); ++i) {
         if (glfwGetKey(window->handle(), GLFW_KEY_ESCAPE) == GLFW_PRESS) break;

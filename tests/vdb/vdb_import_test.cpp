@@ -446,6 +446,39 @@ TEST(VdbImport, CorruptedMetadataRefusedBeforeOpenVdbAllocates) {
     EXPECT_LT(seconds, 1.0);
 }
 
+// OpenVDB 10 reads a grid's values as half floats when its metadata "is_saved_as_half_float" says
+// so (GridBase::saveFloatAsHalf after the metadata is read), not when its type name carries
+// "_HalfFloat". A half-float file whose entry is renamed (one byte, found by tools/fuzz.sh) or set
+// to false was walked with the suffix's half floats and passed, then OpenVDB read full floats,
+// threw inside the tree and leaked the node it was reading. Both must be refused by the walk,
+// before OpenVDB reads them, with the grid named; the untouched file loads.
+TEST(VdbImport, HalfFloatFlagIsTheMetadatasAsOpenVdbReadsIt) {
+    const fs::path dir = tempDir();
+    auto d = randomDensity({0, 0, 0}, {11, 11, 11}, 0.1, 3);
+    d->setSaveFloatAsHalf(true);
+    write(dir / "half.vdb", {d});
+    const std::string ok = readBytes(dir / "half.vdb");
+    ASSERT_TRUE(loadVdb((dir / "half.vdb").string(), VdbImportDesc{.temperatureGrid = "", .velocityGrid = ""}));
+    const std::size_t key = ok.find("is_saved_as_half_float");
+    ASSERT_NE(key, std::string::npos);
+    std::string renamed = ok;
+    renamed[key + 2] = '\0';
+    writeBytes(dir / "renamed.vdb", renamed);
+    // Then "bool", its size (1) and the value.
+    const std::size_t type = ok.find("bool", key);
+    ASSERT_NE(type, std::string::npos);
+    std::string off = ok;
+    ASSERT_EQ(off[type + 8], '\1');
+    off[type + 8] = '\0';
+    writeBytes(dir / "false.vdb", off);
+    for (const char* name : {"renamed.vdb", "false.vdb"}) {
+        auto r = loadVdb((dir / name).string(), VdbImportDesc{.temperatureGrid = "", .velocityGrid = ""});
+        ASSERT_FALSE(r) << name;
+        EXPECT_NE(r.error().find(std::string(name) + "' (frame 0): refused before OpenVDB reads it: grid 'density'"), std::string::npos)
+            << r.error();
+    }
+}
+
 // 4-byte windows all over a real file (every 23rd offset: each field is hit
 // by some) set to 2^31 - 1, one at a time: each load ends with a sequence or
 // a message naming the file, and none costs memory to speak of.

@@ -18,6 +18,7 @@
 #include <limits>
 #include <map>
 #include <set>
+#include <sstream>
 #include <utility>
 
 namespace splatfx::vdbfile {
@@ -127,7 +128,12 @@ void walkDelayedLoad(Reader& r, std::uint32_t numBytes, std::uint64_t maxCount, 
 }
 
 // MetaMap::readMeta. `sectionBytes`: the bytes of the file or grid it belongs to.
-void walkMetaMap(Reader& r, const std::string& owner, std::uint64_t sectionBytes) {
+// A grid's tree is read with half floats when its metadata says so: Archive::readGrid takes
+// GridBase::saveFloatAsHalf() (the entry "is_saved_as_half_float" as OpenVDB's asBool reads it,
+// false without it) after MetaMap::readMeta, whatever the type name's "_HalfFloat" suffix says.
+// savedAsHalf (when given) receives that value.
+void walkMetaMap(Reader& r, const std::string& owner, std::uint64_t sectionBytes, bool* savedAsHalf = nullptr) {
+    if (savedAsHalf) *savedAsHalf = false;
     const std::uint32_t count = r.get<std::uint32_t>(owner + "'s metadata count");
     if (count > r.left() / 12) // a name, a type name and a size: 12 bytes at least
         r.fail(owner + "'s metadata claims " + std::to_string(count) + " entries, more than its " + std::to_string(r.left()) +
@@ -139,6 +145,25 @@ void walkMetaMap(Reader& r, const std::string& owner, std::uint64_t sectionBytes
         const std::uint32_t numBytes = r.get<std::uint32_t>(what + "'s size");
         if (!openvdb::Metadata::isRegisteredType(type)) {
             r.skip(numBytes, what); // UnknownMetadata: raw bytes
+        } else if (savedAsHalf && name == openvdb::GridBase::META_SAVE_HALF_FLOAT &&
+                   type != openvdb::io::DelayedLoadMetadata::staticTypeName()) {
+            // Read as OpenVDB reads it (its size checked against the bytes left first), so the flag
+            // the tree is walked with is the one its reader will use.
+            r.need(numBytes, what);
+            std::string raw(sizeof numBytes, '\0');
+            std::memcpy(raw.data(), &numBytes, sizeof numBytes);
+            raw.resize(sizeof numBytes + numBytes);
+            r.bytes(raw.data() + sizeof numBytes, numBytes, what);
+            openvdb::Metadata::Ptr meta = openvdb::Metadata::createMetadata(type);
+            std::istringstream in(raw);
+            try {
+                meta->read(in);
+            } catch (const std::exception& e) {
+                r.fail(what + " cannot be read: " + e.what());
+            }
+            if (!in || in.tellg() != std::streampos(std::streamoff(raw.size())))
+                r.fail(what + " of type " + type + " states " + std::to_string(numBytes) + " bytes; the type holds " + std::to_string(meta->size()));
+            *savedAsHalf = meta->asBool();
         } else if (type == openvdb::io::DelayedLoadMetadata::staticTypeName()) {
             walkDelayedLoad(r, numBytes, sectionBytes / kBytesPerLeafAtLeast, what);
         } else if (type == openvdb::StringMetadata::staticTypeName()) {
@@ -346,7 +371,6 @@ struct TreeWalk {
 
 struct Descriptor {
     std::string uniqueName, gridName, type, parent;
-    bool half = false;
     std::int64_t gridPos = 0, blockPos = 0, endPos = 0;
 };
 
@@ -389,7 +413,7 @@ Result<std::vector<GridLayout>> walk(const std::string& path, const std::vector<
             d.type = r.string("grid '" + d.gridName + "''s type", kMaxName);
             static const std::string kHalf = "_HalfFloat";
             if (d.type.size() >= kHalf.size() && d.type.compare(d.type.size() - kHalf.size(), kHalf.size(), kHalf) == 0)
-                d.half = true, d.type.resize(d.type.size() - kHalf.size());
+                d.type.resize(d.type.size() - kHalf.size()); // GridDescriptor::read strips it; the metadata decides (walkMetaMap)
             d.parent = r.string("grid '" + d.gridName + "''s instance parent", kMaxName);
             if (!openvdb::GridBase::isRegistered(d.type)) r.fail("grid '" + d.gridName + "' has the unknown type '" + d.type + "'");
             d.gridPos = r.get<std::int64_t>("grid '" + d.gridName + "''s offsets");
@@ -412,7 +436,8 @@ Result<std::vector<GridLayout>> walk(const std::string& path, const std::vector<
             r.seek(std::uint64_t(d.gridPos));
             r.limit(std::uint64_t(d.endPos));
             const std::uint32_t compression = r.get<std::uint32_t>(owner + "'s compression");
-            walkMetaMap(r, owner, std::uint64_t(d.endPos - d.gridPos));
+            bool half = false;
+            walkMetaMap(r, owner, std::uint64_t(d.endPos - d.gridPos), &half);
             walkMap(r, owner, 0);
             GridLayout walked;
             bool isWanted = false;
@@ -429,7 +454,7 @@ Result<std::vector<GridLayout>> walk(const std::string& path, const std::vector<
             if (walked.supported) {
                 using FloatRoot = openvdb::FloatTree::RootNodeType;
                 using VecRoot = openvdb::Vec3STree::RootNodeType;
-                TreeWalk t{.r = r, .owner = owner, .compression = compression, .half = d.half, .out = walked, .leafOn = {}};
+                TreeWalk t{.r = r, .owner = owner, .compression = compression, .half = half, .out = walked, .leafOn = {}};
                 t.valueBytes = isFloat ? 4 : 12;
                 t.halfBytes = isFloat ? 2 : 6;
                 t.internal5Bytes = isFloat ? sizeof(FloatRoot::ChildNodeType) : sizeof(VecRoot::ChildNodeType);
