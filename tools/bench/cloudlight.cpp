@@ -6,6 +6,13 @@
 // transmittance against the exact one: the extinction integrated along the
 // ray to the sun through the finest tetrahedral mesh of the same density
 // (LodVolume::integrateRay, double), at sampled grid points with material.
+// The point-light rows (CloudLighting::lights): a low-albedo cloud lit by a
+// lamp circling above it (every grid point traced to it, DensityField's
+// segment integral) against the same cloud under the moving sun; the sun
+// moving with a lamp fixed (the field rescaled, nothing traced); and the
+// per-frame update() with and without the lamp (the per-vertex phases). Their
+// error is the traced transmittance against the exact one through the finest
+// mesh toward the lamp.
 // The receive rows: a lit plume under the cloud in a Scene, its light traced
 // through the cloud's field (scene.hpp) or not; their error is the plume's
 // received transmittance (its splat colour) against the exact one through the
@@ -92,6 +99,99 @@ void transmittanceError(const splatfx::Cloud& cloud, const splatfx::CloudCreateD
         ++count;
     }
     rmse = count ? std::sqrt(sum / double(count)) : 0.0;
+}
+
+// The same for light `i` of CloudLighting::lights (a point or spot light):
+// the ray to its position, through the mesh (zero outside the grid's box).
+void lampError(const splatfx::Cloud& cloud, const splatfx::CloudCreateDesc& desc, std::size_t light, int samples, double& rmse, double& maxErr) {
+    const glm::ivec3 n = cloud.dims();
+    splatfx::ScalarVolume field;
+    field.dims = n;
+    field.scalar = cloud.density();
+    for (float& f : field.scalar) f = f >= desc.transfer.threshold ? f : 0.0f;
+    auto vol = splatfx::LodVolume::create(field, desc.volume);
+    auto tf = splatfx::TransferFunction::create({{0.0f, glm::vec3(0.0f), 0.0f}, {1.0f, glm::vec3(0.0f), desc.transfer.maxExtinctionPerWorld}});
+    if (!vol || !tf) return;
+    std::vector<std::size_t> cloudy;
+    for (std::size_t i = 0; i < field.scalar.size(); ++i)
+        if (field.scalar[i] > 0.0f) cloudy.push_back(i);
+    const std::size_t stride = std::max<std::size_t>(1, cloudy.size() / std::size_t(samples));
+    const glm::dvec3 lamp(cloud.lighting().lights[light].position);
+    double sum = 0.0;
+    std::size_t count = 0;
+    maxErr = 0.0;
+    for (std::size_t k = 0; k < cloudy.size(); k += stride) {
+        const std::size_t i = cloudy[k];
+        const glm::ivec3 g(int(i % std::size_t(n.x)), int((i / std::size_t(n.x)) % std::size_t(n.y)), int(i / (std::size_t(n.x) * std::size_t(n.y))));
+        const glm::dvec3 p = glm::dvec3(vol->originWorld()) + glm::dvec3(g) * double(vol->spacingWorld());
+        const double exact = 1.0 - vol->integrateRay(*tf, p, lamp - p, 0.0, 1.0).a;
+        const double d = double(cloud.lightTransmittance(light)[i]) - exact;
+        sum += d * d;
+        maxErr = std::max(maxErr, std::fabs(d));
+        ++count;
+    }
+    rmse = count ? std::sqrt(sum / double(count)) : 0.0;
+}
+
+// A lamp circling 10 cells above the cloud's top at step s of `steps`.
+splatfx::Light lampAt(const splatfx::CloudCreateDesc& desc, int step, int steps) {
+    const glm::vec3 n(desc.cloud.dims);
+    const float h = desc.volume.spacingWorld, a = 6.2831853f * float(step) / float(std::max(1, steps));
+    const glm::vec3 c = desc.volume.originWorld + 0.5f * (n - 1.0f) * h;
+    const float r = 0.3f * (n.x - 1.0f) * h;
+    return splatfx::Light::point(c + glm::vec3(r * std::cos(a), r * std::sin(a), (0.5f * (n.z - 1.0f) + 10.0f) * h), glm::vec3(1.0f),
+                                 100.0f * h * h);
+}
+
+// Relights with a point light: mode 0 the lamp moves (sun off), 1 the sun
+// moves beside a fixed lamp. Median ms per relight.
+bool measureLamp(const splatfx::CloudCreateDesc& desc, int mode, int steps, int samples, Measure& out, std::uint64_t& traces) {
+    auto cloud = splatfx::Cloud::create(desc);
+    if (!cloud) return std::fprintf(stderr, "cloudlight: %s\n", cloud.error().c_str()), false;
+    std::vector<double> times;
+    splatfx::CloudLighting L = cloud->lighting();
+    if (mode == 0) L.sun.intensity = 0.0f;
+    L.lights = {lampAt(desc, 0, steps)};
+    if (splatfx::Status st = cloud->setLight(L); !st) return std::fprintf(stderr, "cloudlight: %s\n", st.error().c_str()), false;
+    const std::uint64_t traces0 = cloud->lightTraces(), relights0 = cloud->relights();
+    for (int s = 1; s <= steps; ++s) {
+        if (mode == 0) L.lights[0] = lampAt(desc, s, steps);
+        else L.sun = sunAt(s - 1, steps);
+        const auto t0 = Clock::now();
+        if (splatfx::Status st = cloud->setLight(L); !st) return std::fprintf(stderr, "cloudlight: %s\n", st.error().c_str()), false;
+        times.push_back(ms(Clock::now() - t0));
+    }
+    lampError(*cloud, desc, 0, samples, out.rmse, out.maxErr);
+    out.relightMs = bench::percentile(times, 0.5);
+    out.relights = cloud->relights() - relights0;
+    traces = cloud->lightTraces() - traces0;
+    return true;
+}
+
+// CPU ms of one Cloud::update (median of `frames`) for a camera beside the
+// cloud, with the sun alone or with a lamp; and the vertices it wrote.
+bool measureUpdate(const splatfx::CloudCreateDesc& desc, bool lamp, int frames, double& msOut, std::size_t& vertices) {
+    auto cloud = splatfx::Cloud::create(desc);
+    if (!cloud) return false;
+    if (lamp) {
+        splatfx::CloudLighting L = cloud->lighting();
+        L.lights = {lampAt(desc, 0, 1)};
+        if (!cloud->setLight(L)) return false;
+    }
+    const splatfx::Aabb b = cloud->volume().boundsWorld();
+    const glm::vec3 c = 0.5f * (b.lo + b.hi);
+    const splatfx::Camera camera = splatfx::Camera::lookAt(c + glm::vec3(0.0f, -1.2f * (b.hi.y - b.lo.y), 0.3f * (b.hi.x - b.lo.x)), c, {0, 0, 1},
+                                                           glm::radians(60.0f), {640, 480}, 0.1f, 5000.0f);
+    splatfx::LodFrame frame;
+    std::vector<double> times;
+    for (int f = 0; f < frames; ++f) {
+        const auto t0 = Clock::now();
+        if (!cloud->update(camera, {}, frame)) return false;
+        times.push_back(ms(Clock::now() - t0));
+    }
+    msOut = bench::percentile(times, 0.5);
+    vertices = 4 * frame.tets.size();
+    return true;
 }
 
 bool measure(const splatfx::CloudCreateDesc& desc, int steps, int samples, Measure& out) {
@@ -314,6 +414,35 @@ int runCloudLight(int argc, char** argv) {
                         .extra = std::to_string(cloud->relights()) + " | " + dimsText(dims)});
         rows.push_back({.knob = "change", .setting = "sun colour (low-albedo table)", .ms = bench::percentile(colour, 0.5), .rmse = r, .maxErr = m,
                         .extra = std::to_string(cloud->tableBuilds()) + " table builds | " + dimsText(dims)});
+    }
+    // Point lights (low albedo): a lamp moving (every grid point traced), the
+    // sun moving beside a fixed lamp (rescaled only), against the sun alone
+    // (the "low albedo, 2 HG lobes" row above); and update() per frame.
+    for (glm::ivec3 d : {glm::ivec3(65, 65, 17), dims}) {
+        const int lampSteps = std::min(steps, 4);
+        const char* names[] = {"point light moving (traced)", "sun moving, point light fixed"};
+        for (int mode = 0; mode < 2; ++mode) {
+            std::printf("  %s %s ...\n", names[mode], dimsText(d).c_str());
+            std::fflush(stdout);
+            Measure m;
+            std::uint64_t traces = 0;
+            if (!measureLamp(base(d, splatfx::CloudLightModel::LowAlbedo), mode, mode == 0 ? lampSteps : steps, samples, m, traces)) return 1;
+            rows.push_back({.knob = "point light", .setting = names[mode], .ms = m.relightMs, .rmse = m.rmse, .maxErr = m.maxErr,
+                            .extra = std::to_string(m.relights) + " (" + std::to_string(traces) + " traces) | " + dimsText(d)});
+        }
+        if (d != dims) {
+            Measure m;
+            if (!measure(base(d, splatfx::CloudLightModel::LowAlbedo), steps, samples, m)) return 1;
+            rows.push_back({.knob = "point light", .setting = "none: sun moving (low albedo)", .ms = m.relightMs, .rmse = m.rmse, .maxErr = m.maxErr,
+                            .extra = std::to_string(m.relights) + " | " + dimsText(d)});
+        }
+        for (bool lamp : {false, true}) {
+            double t = 0.0;
+            std::size_t v = 0;
+            if (!measureUpdate(base(d, splatfx::CloudLightModel::LowAlbedo), lamp, frames, t, v)) return 1;
+            rows.push_back({.knob = "update()", .setting = lamp ? "sun + point light, per frame" : "sun, per frame", .ms = t,
+                            .extra = std::to_string(v) + " vertices | " + dimsText(d)});
+        }
     }
     // Receiving: the plume's lighting with the cloud's shadow traced, against
     // no cloud and a cloud that does not cast (the receive cost is the difference).

@@ -19,6 +19,21 @@
 // first order in the cell otherwise); LowAlbedo attenuates with the same
 // sigma it draws with, Roettger with CloudDesc::lightExtinctionPerCell.
 //
+// More lights (LowAlbedo only: CloudLighting::lights, up to kMaxCloudLights
+// directional, point or spot lights beside the sun): each has its own
+// transmittance at every grid point (a directional one swept as the sun; a
+// point or spot light's rays converge, so each grid point is traced toward it
+// through the cloud's trilinear extinction, DensityField's exact segment
+// integral, inside the grid's box: light enters at the grid's faces as the
+// sun's does), and the source sums them as lightPoints does (irradiance
+// 1/d^2 capped at max(radiusWorld, spacing / 2), the spot's cone, the HG
+// phase per light, multipleScattering per light). The tetrahedra draw one
+// scalar per vertex, so every lit light (the sun included; one of zero
+// colour or intensity is left out) must share one chromaticity: setLight
+// refuses lights whose colours are not multiples of one another, naming the
+// light. Points a spot's cone leaves dark are not traced, and a light of zero
+// intensity not at all (lightTraces() counts the traced points).
+//
 // Layout (volume.hpp): Roettger is CloudModel::DensityTableLightLength
 // (scalar f, length scale gamma); LowAlbedo is CloudModel::LightTableDensityLength's
 // layout (scalar T, length scale sigma / maxExtinctionPerWorld), drawn with
@@ -27,13 +42,17 @@
 // exact for a colour affine in s, so the per-vertex phase costs no table.
 //
 // It does NOT: draw (the tetrahedra go to the projected-tetrahedra pass), take
-// more than one light (the sun: a directional Light), or receive the shadows
+// lights of different colours (one scalar per vertex draws one light colour),
+// light the Roettger model with anything but the sun (its gamma = ambient +
+// diffuse T is a bounded sun term, not an irradiance), or receive the shadows
 // of other volumes. It casts through densityField(): a Scene puts a lit
 // cloud's field into the scene shadow and traces the light of its lit
 // effects through it (scene.hpp).
 //
 //   auto cloud = splatfx::Cloud::create({.cloud = {.dims = {65, 65, 17}}});
-//   cloud->setLight(splatfx::Light::directional({-1, -0.2f, -0.3f}));  // relights once
+//   splatfx::CloudLighting L = cloud->lighting();
+//   L.sun = splatfx::Light::directional({-1, -0.2f, -0.3f});
+//   cloud->setLight(L);                                                 // relights once
 //   cloud->update(camera, {}, frame);                                   // frame.tets
 //
 // Threading: one thread at a time.
@@ -53,12 +72,21 @@ enum class CloudLightModel {
 };
 
 // How a cloud is lit. Which fields apply depends on the model.
+// How many lights a cloud takes beside its sun (CloudLighting::lights).
+inline constexpr int kMaxCloudLights = 4;
+
 struct CloudLighting {
     CloudLightModel model = CloudLightModel::Roettger; // default Roettger
     // The sun: a directional light; its direction is where the light travels.
     // Default: travelling down (-z) and a little sideways, the direction
     // CloudDesc's default sunDirection points back to.
     Light sun = Light::directional({-0.3f, -0.2f, -1.0f});
+    // LowAlbedo only: up to kMaxCloudLights more lights (directional, point,
+    // spot), summed with the sun. Every light with non-zero colour x
+    // intensity, the sun included, must have a colour that is a multiple of
+    // the others' (set the sun's intensity to 0 to light by these alone).
+    // Default none (the sun alone, as before).
+    std::vector<Light> lights{};
     // Roettger: gamma = ambient + diffuse T, each >= 0, sum <= 1; T through
     // CloudDesc::lightExtinctionPerCell. Defaults as CloudDesc (0.35, 0.65).
     float ambient = 0.35f;
@@ -88,11 +116,18 @@ public:
     // Fails on a bad field in any desc (the message names it) or a sun that
     // is not a valid directional light.
     static Result<Cloud> create(const CloudCreateDesc& desc = {});
+    // What setLight checks, without a cloud: every field, the lights' count
+    // and kind for the model, and their shared colour. The message names the field.
+    static Status validateLighting(const CloudLighting& lighting);
 
     // Relights when the lighting differs from the current one (any field), and
     // rebuilds the transfer table only when the colour terms changed (not for
-    // a new sun direction). Fails, keeping the previous lighting, on a bad
-    // lighting field.
+    // a new sun direction). With lights beside the sun, any change of a light
+    // relights and rebuilds the table (the scalar's scale is the largest
+    // source over the grid); a light's transmittance is traced again only when
+    // its position, direction, type, cone or radius, or the density, changed.
+    // Fails, keeping the previous lighting, on a bad lighting field (the
+    // message names it: "CloudLighting.lights[1].color ...").
     Status setLight(const CloudLighting& lighting);
     // Replaces the density (dims as created, values in [0, 1]) and relights.
     // Fails, changing nothing, on a size mismatch or a bad value.
@@ -101,7 +136,13 @@ public:
     // Refines for the camera into out.tets (LodVolume::update); LowAlbedo
     // writes each vertex's scalar s = T phase(theta) / max phase, theta between
     // the sun's travel and the direction to the eye (for an orthographic
-    // camera: against its forward). Fails as LodVolume::update.
+    // camera: against its forward). With lights beside the sun the stored
+    // field is u = sum_i w_i E_i (4 pi maxPhase T_i + m) / scale (w_i the
+    // light's share of the common colour, E_i its irradiance factor) and each
+    // vertex gets s = u R, R = sum_i w_i E_i (4 pi phase_i T_i + m) / sum_i
+    // w_i E_i (4 pi maxPhase T_i + m) at the vertex (lightPoints, T_i
+    // trilinear between grid points): O(vertices x lights) per frame.
+    // Fails as LodVolume::update.
     Status update(const Camera& camera, const LodRefineDesc& refine, LodFrame& out);
 
     const LodVolume& volume() const { return mVolume; }
@@ -112,6 +153,16 @@ public:
     glm::ivec3 dims() const { return mDims; }
     // The sun's transmittance at each grid point from the last relight (x fastest).
     const std::vector<float>& sunTransmittance() const { return mTrans; }
+    // Towards lighting().lights[i] at each grid point (x fastest), from the
+    // last relight; empty for a light that lights nothing (zero colour or
+    // intensity); 0 where a spot's cone leaves a point dark (not traced).
+    // Expects i < lighting().lights.size().
+    const std::vector<float>& lightTransmittance(std::size_t i) const { return mLightT[i].trans; }
+    // With lights beside the sun: the largest source over the grid that the
+    // scalar's 1 stands for (sum_i w_i E_i (4 pi maxPhase T_i + m)); 0 without.
+    float lightScale() const { return mLightScale; }
+    // Grid points traced toward point and spot lights since creation.
+    std::uint64_t lightTraces() const { return mLightTraces; }
     // The cloud's extinction sigma = maxExtinctionPerWorld f (f >= threshold,
     // else 0) as the field shadow tables read (lighting.hpp): one voxel per
     // grid point, opacity 1 - exp(-sigma spacing), so a ray through it loses
@@ -129,11 +180,22 @@ public:
     // The lighting model's emission per unit extinction at a point with sun
     // transmittance T, seen along toEye (unit, world): what the tetrahedra
     // draw, as a double-precision reference.
+    // For the sun alone (lighting().lights empty).
     glm::dvec3 sourceAt(double sunTransmittance, glm::vec3 toEye) const;
 
 private:
+    // One of CloudLighting::lights: its transmittance and what it was traced for.
+    struct LightState {
+        std::vector<float> trans;
+        Light tracedFor{};
+        bool valid = false;
+    };
     Cloud() = default;
     Status relight();
+    Status traceLights();
+    std::vector<Light> unitLights(float scale, std::vector<const std::vector<float>*>* trans = nullptr) const;
+    Status applyLightPhases(const Camera& camera, LodFrame& out);
+    glm::vec3 gridPoint(glm::ivec3 p) const;
     Status rebuildTable();
     Status rebuildField();
     CloudCreateDesc mDesc;
@@ -145,7 +207,11 @@ private:
     TransferFunction mTransfer;
     PreIntegrationTable mTable;
     float mPhaseMax = 1.0f;
-    std::uint64_t mRelights = 0, mTableBuilds = 0;
+    std::vector<LightState> mLightT;
+    glm::vec3 mLightColour{0.0f}; // the common colour x intensity the weights are shares of
+    float mLightScale = 0.0f;
+    std::vector<glm::vec3> mVertexScratch, mSeenScratch, mBoundScratch; // update(): reused per frame
+    std::uint64_t mRelights = 0, mTableBuilds = 0, mLightTraces = 0;
 };
 
 } // namespace splatfx

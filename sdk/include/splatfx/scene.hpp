@@ -20,7 +20,7 @@
 // (EffectKind::lightingDensity: every Effect does; LOD volumes and ground fog
 // do not, their light is part of their data; a Cloud, cloud.hpp, and a ground
 // fog layer, GroundFog::setLighting, follow the scene's first directional light
-// and are relit when it moves, the fog also shadowed by the lit clouds and
+// (a low-albedo Cloud its point and spot lights too) and are relit when it moves, the fog also shadowed by the lit clouds and
 // effects): their splat colours follow Ebert & Parent's low-albedo model with
 // self-shadowing, the light also attenuated through every other lit,
 // shadow-casting volume between them and it (a cloud's shadow on a plume, a
@@ -246,6 +246,11 @@ struct SceneCounters {
     // the caster's box cannot shadow the receiver's for that light (shadowFallsOn).
     std::size_t crossShadowPairs = 0;
     std::size_t crossShadowPairsSkipped = 0;
+    // Lit clouds at the last emit(): scene lights (other than the sun) that
+    // reach a cloud's box but do not light it: any for the Roettger model,
+    // past kMaxCloudLights, or of a colour not a multiple of the lights it
+    // took before (a cloud draws one light colour; cloud.hpp). Summed over clouds.
+    std::size_t cloudLightsDropped = 0;
 };
 
 class Scene {
@@ -264,7 +269,9 @@ public:
     EffectId add(GroundFog fog, TransferFunction transfer, PreIntegrationTable table, EffectOptions options = {});
     // A relightable cloud (cloud.hpp). With options.lighting.enabled it
     // follows the scene's first directional light (and, in the low-albedo
-    // model, options.lighting.gas), relit only when those change.
+    // model, options.lighting.gas and the scene's other lights that reach it,
+    // up to kMaxCloudLights of one colour; SceneCounters::cloudLightsDropped
+    // counts the rest), relit only when those change.
     EffectId add(Cloud cloud, EffectOptions options = {});
     // Any other kind (effect_kind.hpp). Expects kind != nullptr.
     EffectId add(std::unique_ptr<EffectKind> kind, EffectOptions options = {});

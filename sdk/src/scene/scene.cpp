@@ -183,6 +183,7 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
     // Per-emit lighting counters (scene_lighting.cpp).
     mLightingError.clear();
     mCounters.litEffects = 0;
+    mCounters.cloudLightsDropped = 0;
     mCounters.shadowTableBuilds = mCounters.shadowTableReuses = mCounters.shadowTableSkips = 0;
     mTablesFit = true;
     mEmittedLights.clear();
@@ -202,12 +203,14 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
         Entry& e = mEntries[i];
         auto* cloud = dynamic_cast<detail::CloudKind*>(e.kind.get());
         if (!cloud || !(e.status.needed || e.status.castsIntoView) || !e.options.lighting.enabled) continue;
-        Status s = e.status.needed ? cloud->follow(mLights, e.options.lighting) : Status{};
+        std::size_t dropped = 0;
+        Status s = e.status.needed ? cloud->follow(mLights, e.options.lighting, dropped) : Status{};
         if (!s) {
             mLightingError = "effect '" + e.options.name + "': lighting: " + s.error();
             e.status.castsIntoView = false;
             continue;
         }
+        mCounters.cloudLightsDropped += dropped; // lights reaching the cloud that cannot light it (CloudKind::follow)
         cloudLit[i] = e.status.needed;
         if (!e.lit) e.lit = std::make_unique<LitState>();
         const DensityField& f = cloud->cloud().densityField();

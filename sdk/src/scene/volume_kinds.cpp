@@ -77,16 +77,32 @@ EmitResult CloudKind::emit(const EmitContext& context) {
     return {.tetrahedra = fv.lod.tets.size()};
 }
 
-Status CloudKind::follow(std::span<const Light> lights, const EffectLighting& lighting) {
+Status CloudKind::follow(std::span<const Light> lights, const EffectLighting& lighting, std::size_t& dropped) {
+    dropped = 0;
+    const Light* sun = nullptr;
     for (const Light& l : lights)
         if (l.type == LightType::Directional) {
-            CloudLighting L = mCloud.lighting();
-            L.sun = l;
-            L.gas = lighting.gas;
-            L.gas.colorTable = nullptr;
-            return mCloud.setLight(L);
+            sun = &l;
+            break;
         }
-    return {};
+    CloudLighting L = mCloud.lighting();
+    L.lights.clear();
+    const Aabb box = mCloud.volume().boundsWorld();
+    for (const Light& l : lights) {
+        if (&l == sun || !Scene::lightReaches(l, box)) continue; // one that cannot reach it costs nothing
+        if (L.model != CloudLightModel::LowAlbedo || L.lights.size() == std::size_t(kMaxCloudLights)) {
+            ++dropped;
+            continue;
+        }
+        L.lights.push_back(l);
+        if (sun) L.sun = *sun;
+        if (!Cloud::validateLighting(L)) L.lights.pop_back(), ++dropped; // another colour than the lights before
+    }
+    if (!sun && L.lights.empty() && mCloud.lighting().lights.empty()) return {}; // nothing to follow: keeps its own sun
+    if (sun) L.sun = *sun;
+    L.gas = lighting.gas;
+    L.gas.colorTable = nullptr;
+    return mCloud.setLight(L);
 }
 
 } // namespace splatfx::detail

@@ -114,7 +114,12 @@ public:
     // The scene's sun is its first directional light: the cloud takes it
     // (and, for the low-albedo model, the effect's gas desc) and relights
     // only when that changed. No directional light: the cloud keeps its own.
-    Status follow(std::span<const Light> lights, const EffectLighting& lighting);
+    // A low-albedo cloud also takes the scene's other lights that reach its
+    // box (Scene::lightReaches), in scene order, up to kMaxCloudLights, each
+    // only if its colour is a multiple of the lights taken before
+    // (Cloud::validateLighting); `dropped` counts the reaching lights left
+    // out (over the count, another colour, or any for the Roettger model).
+    Status follow(std::span<const Light> lights, const EffectLighting& lighting, std::size_t& dropped);
     Cloud& cloud() { return mCloud; }
     const Cloud& cloud() const { return mCloud; }
 

@@ -23,7 +23,57 @@ Status checkLighting(const CloudLighting& L) {
     for (int a = 0; a < 3; ++a)
         if (!std::isfinite(g.ambient[a]) || g.ambient[a] < 0.0f)
             return makeError(std::string("CloudLighting.gas.ambient.") + "rgb"[a] + " must be a finite number >= 0");
+    if (L.lights.empty()) return {};
+    // Roettger's gamma = ambient + diffuse T is a bounded sun term scaling the
+    // segment length (sec. 5.2), not an irradiance: a point light's 1/d^2 has no place in it.
+    if (L.model == CloudLightModel::Roettger)
+        return makeError("CloudLighting.lights must be empty with CloudLightModel::Roettger (its light is the sun's alone; use LowAlbedo)");
+    if (L.lights.size() > std::size_t(kMaxCloudLights))
+        return makeError("CloudLighting.lights holds " + std::to_string(L.lights.size()) + " lights; at most kMaxCloudLights = " +
+                         std::to_string(kMaxCloudLights));
+    for (std::size_t i = 0; i < L.lights.size(); ++i)
+        if (Status s = validateLight(L.lights[i], "CloudLighting.lights[" + std::to_string(i) + "]"); !s) return s;
+    // One scalar per vertex draws one light colour: every lit light's colour
+    // must be a multiple of the first lit one's (cross product zero up to
+    // float rounding of the products, 1e-6 relative).
+    const Light* ref = nullptr;
+    std::string refName;
+    for (std::size_t i = 0; i <= L.lights.size(); ++i) {
+        const Light& l = i == 0 ? L.sun : L.lights[i - 1];
+        const std::string name = i == 0 ? std::string("CloudLighting.sun") : "CloudLighting.lights[" + std::to_string(i - 1) + "]";
+        const glm::dvec3 c = glm::dvec3(l.color) * double(l.intensity);
+        if (!(glm::dot(c, c) > 0.0)) continue;
+        if (!ref) {
+            ref = &l;
+            refName = name;
+            continue;
+        }
+        const glm::dvec3 r = glm::dvec3(ref->color);
+        if (glm::length(glm::cross(c, r)) > 1e-6 * glm::length(c) * glm::length(r))
+            return makeError(name + ".color must be a multiple of " + refName +
+                             ".color: a cloud draws one light colour (one scalar per vertex); lights of other colours cannot light it");
+    }
     return {};
+}
+
+bool sameLight(const Light& a, const Light& b) {
+    return a.type == b.type && a.color == b.color && a.intensity == b.intensity && a.direction == b.direction && a.position == b.position &&
+           a.innerConeRad == b.innerConeRad && a.outerConeRad == b.outerConeRad && a.radiusWorld == b.radiusWorld;
+}
+
+// What a light's transmittance depends on (not its colour or intensity).
+bool sameGeometry(const Light& a, const Light& b) {
+    Light x = a;
+    x.color = b.color;
+    x.intensity = b.intensity;
+    return sameLight(x, b);
+}
+
+bool sameLights(const CloudLighting& a, const CloudLighting& b) {
+    if (a.lights.size() != b.lights.size() || !sameLight(a.sun, b.sun)) return false;
+    for (std::size_t i = 0; i < a.lights.size(); ++i)
+        if (!sameLight(a.lights[i], b.lights[i])) return false;
+    return true;
 }
 
 bool samePhase(const PhaseFunction& a, const PhaseFunction& b) {
@@ -50,7 +100,38 @@ bool sameColour(const CloudLighting& a, const CloudLighting& b) {
 // HG lobes are convex in cos theta, so their sum peaks at cos theta = +-1.
 float phaseMax(const PhaseFunction& p) { return std::max(p(1.0f), p(-1.0f)); }
 
+bool multiLight(const CloudLighting& L) { return L.model == CloudLightModel::LowAlbedo && !L.lights.empty(); }
+
+// Transmittance towards each light between grid points: trilinear in the
+// per-point arrays (exact at grid points), clamped onto the grid.
+class GridShadows final : public ShadowProvider {
+public:
+    GridShadows(glm::ivec3 dims, glm::vec3 origin, float spacing, std::vector<const std::vector<float>*> trans)
+        : mDims(dims), mOrigin(origin), mInv(1.0f / spacing), mTrans(std::move(trans)) {}
+    float transmittance(std::size_t light, glm::vec3 world) const override {
+        const std::vector<float>& t = *mTrans[light];
+        const glm::vec3 g = glm::clamp((world - mOrigin) * mInv, glm::vec3(0.0f), glm::vec3(mDims - 1));
+        const glm::ivec3 i0 = glm::min(glm::ivec3(g), glm::max(mDims - 2, glm::ivec3(0)));
+        const glm::vec3 f = g - glm::vec3(i0);
+        float v = 0.0f;
+        for (int c = 0; c < 8; ++c) {
+            const glm::ivec3 k = glm::min(i0 + glm::ivec3(c & 1, (c >> 1) & 1, (c >> 2) & 1), mDims - 1);
+            const float w = ((c & 1) ? f.x : 1.0f - f.x) * ((c & 2) ? f.y : 1.0f - f.y) * ((c & 4) ? f.z : 1.0f - f.z);
+            if (w != 0.0f) v += w * t[std::size_t(k.x) + std::size_t(mDims.x) * (std::size_t(k.y) + std::size_t(mDims.y) * std::size_t(k.z))];
+        }
+        return v;
+    }
+
+private:
+    glm::ivec3 mDims;
+    glm::vec3 mOrigin;
+    float mInv;
+    std::vector<const std::vector<float>*> mTrans;
+};
+
 } // namespace
+
+Status Cloud::validateLighting(const CloudLighting& lighting) { return checkLighting(lighting); }
 
 Result<Cloud> Cloud::create(const CloudCreateDesc& desc) {
     if (Status s = checkLighting(desc.lighting); !s) return makeError(s.error());
@@ -77,9 +158,10 @@ Result<Cloud> Cloud::create(const CloudCreateDesc& desc) {
         c.mDensity = std::move(up);
         c.mDims = {g.x, g.z, g.y};
     }
+    // The field first: a point or spot light is traced through it.
+    if (Status s = c.rebuildField(); !s) return makeError(s.error());
     if (Status s = c.relight(); !s) return makeError(s.error());
     if (Status s = c.rebuildTable(); !s) return makeError(s.error());
-    if (Status s = c.rebuildField(); !s) return makeError(s.error());
     return c;
 }
 
@@ -101,7 +183,35 @@ Status Cloud::relight() {
         for (std::size_t i = 0; i < count; ++i) field.lengthScale[i] = mDensity[i] >= td.threshold ? mDensity[i] : 0.0f;
         detail::sweepSunTransmittance(mDims, field.lengthScale, double(td.maxExtinctionPerWorld) * double(mDesc.volume.spacingWorld), towardSun,
                                       mTrans);
-        field.scalar = mTrans;
+        if (!multiLight(mLighting)) {
+            field.scalar = mTrans;
+            mLightT.clear();
+            mLightScale = 0.0f;
+        } else {
+            // u = sum_i w_i E_i (4 pi maxPhase T_i + m) / scale at every grid
+            // point, by the lighting code's own evaluation (lightPoints with
+            // an isotropic phase: 4 pi phase = 1, each light's colour
+            // w_i 4 pi maxPhase and multipleScattering m / (4 pi maxPhase)).
+            if (Status s = traceLights(); !s) return makeError("Cloud: lights: " + s.error());
+            mPhaseMax = phaseMax(mLighting.gas.phase);
+            std::vector<glm::vec3> points(count), source;
+            for (int z = 0, i = 0; z < mDims.z; ++z)
+                for (int y = 0; y < mDims.y; ++y)
+                    for (int x = 0; x < mDims.x; ++x, ++i) points[std::size_t(i)] = gridPoint({x, y, z});
+            const float fourPiMax = 4.0f * std::numbers::pi_v<float> * mPhaseMax;
+            std::vector<const std::vector<float>*> trans;
+            const std::vector<Light> lights = unitLights(fourPiMax, &trans);
+            const GridShadows shadows(mDims, mDesc.volume.originWorld, mDesc.volume.spacingWorld, std::move(trans));
+            const GasLightingDesc iso{.albedo = 1.0f, .multipleScattering = mLighting.gas.multipleScattering / fourPiMax};
+            if (Status s = lightPoints(points, mDesc.volume.spacingWorld, points[0], lights, &shadows, iso, source); !s)
+                return makeError("Cloud: lights: " + s.error());
+            float scale = 0.0f;
+            for (const glm::vec3& v : source) scale = std::max(scale, v.x);
+            mLightScale = scale;
+            field.scalar.resize(count);
+            const float inv = scale > 0.0f ? 1.0f / scale : 0.0f;
+            for (std::size_t i = 0; i < count; ++i) field.scalar[i] = std::clamp(source[i].x * inv, 0.0f, 1.0f);
+        }
     }
     auto vol = LodVolume::create(field, mDesc.volume);
     if (!vol) return makeError(vol.error());
@@ -123,8 +233,14 @@ Status Cloud::rebuildTable() {
         const glm::vec3 sun = mLighting.sun.color * mLighting.sun.intensity;
         mPhaseMax = phaseMax(g.phase);
         const glm::vec3 base = mDesc.transfer.bright * g.albedo;
-        const glm::vec3 a = base * (g.ambient + sun * g.multipleScattering);
-        const glm::vec3 b = base * sun * (4.0f * std::numbers::pi_v<float> * mPhaseMax);
+        glm::vec3 a = base * (g.ambient + sun * g.multipleScattering);
+        glm::vec3 b = base * sun * (4.0f * std::numbers::pi_v<float> * mPhaseMax);
+        if (multiLight(mLighting)) {
+            // With more lights every light's term is in s (their irradiance
+            // varies over the cloud): kappa(s) = base (ambient + colour scale s).
+            a = base * g.ambient;
+            b = base * mLightColour * mLightScale;
+        }
         const float rho = mDesc.transfer.maxExtinctionPerWorld;
         tf = TransferFunction::create({{0.0f, a, rho}, {1.0f, a + b, rho}});
     }
@@ -173,6 +289,30 @@ Status Cloud::rebuildField() {
 
 Status Cloud::setLight(const CloudLighting& lighting) {
     if (Status s = checkLighting(lighting); !s) return s;
+    if (multiLight(lighting) || multiLight(mLighting)) {
+        // The scale of s is the largest source over the grid: any change of a
+        // light moves it, so the field and the table go together.
+        if (lighting.model == mLighting.model && sameLights(lighting, mLighting) && lighting.gas.albedo == mLighting.gas.albedo &&
+            lighting.gas.ambient == mLighting.gas.ambient && lighting.gas.multipleScattering == mLighting.gas.multipleScattering &&
+            samePhase(lighting.gas.phase, mLighting.gas.phase)) {
+            mLighting = lighting;
+            return {};
+        }
+        const CloudLighting old = mLighting;
+        const std::vector<LightState> oldT = mLightT;
+        mLighting = lighting;
+        Status s = relight();
+        if (s) s = rebuildTable();
+        if (!s) {
+            mLighting = old;
+            mLightT = oldT;
+            // Back to the previous field and table: built before from the same
+            // sizes under the same budget, so they build again.
+            static_cast<void>(relight());
+            static_cast<void>(rebuildTable());
+        }
+        return s;
+    }
     const bool field = !sameField(lighting, mLighting), colour = !sameColour(lighting, mLighting);
     if (!field && !colour) {
         mLighting = lighting; // e.g. a new Roettger gas desc: nothing it draws depends on it
@@ -195,15 +335,28 @@ Status Cloud::setDensity(std::vector<float> density) {
             return makeError("Cloud::setDensity: density[" + std::to_string(i) + "] must be finite and in [0, 1]");
     if (density == mDensity) return {};
     std::swap(mDensity, density);
-    if (Status s = relight(); !s) return std::swap(mDensity, density), s;
-    return rebuildField();
+    // Every light's transmittance is traced again through the new field.
+    for (LightState& l : mLightT) l.valid = false;
+    Status s = rebuildField();
+    if (s) s = relight();
+    if (s && multiLight(mLighting)) s = rebuildTable(); // the scale of s moved
+    if (!s) {
+        // Back to the previous density's fields: built before, so they build again.
+        std::swap(mDensity, density);
+        for (LightState& l : mLightT) l.valid = false;
+        static_cast<void>(rebuildField());
+        static_cast<void>(relight());
+        if (multiLight(mLighting)) static_cast<void>(rebuildTable());
+    }
+    return s;
 }
 
 Status Cloud::update(const Camera& camera, const LodRefineDesc& refine, LodFrame& out) {
     if (Status s = mVolume.update(camera, refine, &mTransfer, out); !s) return s;
     if (mLighting.model != CloudLightModel::LowAlbedo) return {};
     const PhaseFunction& phase = mLighting.gas.phase;
-    if (phase.lobeCount() == 1 && phase.lobe(0).g == 0.0f) return {}; // isotropic: s = T
+    if (phase.lobeCount() == 1 && phase.lobe(0).g == 0.0f) return {}; // isotropic: s = T (with more lights, R = 1)
+    if (multiLight(mLighting)) return applyLightPhases(camera, out);
     const glm::vec3 travel = glm::normalize(mLighting.sun.direction);
     const glm::vec3 eye = camera.eye(), back = -camera.forward();
     const bool persp = camera.perspective();
@@ -214,6 +367,114 @@ Status Cloud::update(const Camera& camera, const LodRefineDesc& refine, LodFrame
             const float len = glm::length(d);
             const glm::vec3 toEye = persp && len > 0.0f ? d / len : back;
             t.scalar[std::size_t(k)] = std::clamp(t.scalar[std::size_t(k)] * phase(travel, toEye) * inv, 0.0f, 1.0f);
+        }
+    return {};
+}
+
+glm::vec3 Cloud::gridPoint(glm::ivec3 p) const { return mDesc.volume.originWorld + glm::vec3(p) * mDesc.volume.spacingWorld; }
+
+std::vector<Light> Cloud::unitLights(float scale, std::vector<const std::vector<float>*>* trans) const {
+    // Each lit light with colour w_i scale (w_i its share of the common
+    // colour mLightColour), paired with its transmittance.
+    std::vector<Light> out;
+    const double ref2 = glm::dot(glm::dvec3(mLightColour), glm::dvec3(mLightColour));
+    for (std::size_t i = 0; i <= mLighting.lights.size(); ++i) {
+        const Light& l = i == 0 ? mLighting.sun : mLighting.lights[i - 1];
+        const glm::dvec3 c = glm::dvec3(l.color) * double(l.intensity);
+        if (!(glm::dot(c, c) > 0.0) || !(ref2 > 0.0)) continue;
+        Light u = l;
+        u.color = glm::vec3(1.0f);
+        u.intensity = float(glm::dot(c, glm::dvec3(mLightColour)) / ref2 * double(scale));
+        out.push_back(u);
+        if (trans) trans->push_back(i == 0 ? &mTrans : &mLightT[i - 1].trans);
+    }
+    return out;
+}
+
+Status Cloud::traceLights() {
+    mLightColour = glm::vec3(0.0f);
+    for (std::size_t i = 0; i <= mLighting.lights.size(); ++i) {
+        const Light& l = i == 0 ? mLighting.sun : mLighting.lights[i - 1];
+        if (glm::dot(l.color * l.intensity, l.color * l.intensity) > 0.0f) {
+            mLightColour = l.color * l.intensity; // the first lit light's: checkLighting made the others multiples of it
+            break;
+        }
+    }
+    mLightT.resize(mLighting.lights.size());
+    const std::size_t count = mDensity.size();
+    const float h = mDesc.volume.spacingWorld;
+    const glm::vec3 lo = mDesc.volume.originWorld, hi = lo + glm::vec3(mDims - 1) * h;
+    std::vector<glm::vec3> points(count), reach;
+    for (int z = 0, i = 0; z < mDims.z; ++z)
+        for (int y = 0; y < mDims.y; ++y)
+            for (int x = 0; x < mDims.x; ++x, ++i) points[std::size_t(i)] = gridPoint({x, y, z});
+    for (std::size_t k = 0; k < mLighting.lights.size(); ++k) {
+        const Light& l = mLighting.lights[k];
+        LightState& st = mLightT[k];
+        if (!(glm::dot(l.color * l.intensity, l.color * l.intensity) > 0.0f)) {
+            st = {}; // lights nothing: costs nothing
+            continue;
+        }
+        if (st.valid && sameGeometry(st.tracedFor, l)) continue;
+        st.tracedFor = l;
+        st.valid = true;
+        if (l.type == LightType::Directional) {
+            // Parallel rays: swept as the sun.
+            std::vector<float> sigma(count);
+            for (std::size_t i = 0; i < count; ++i) sigma[i] = mDensity[i] >= mDesc.transfer.threshold ? mDensity[i] : 0.0f;
+            detail::sweepSunTransmittance(mDims, sigma, double(mDesc.transfer.maxExtinctionPerWorld) * double(h),
+                                          -glm::normalize(glm::dvec3(l.direction)), st.trans);
+            continue;
+        }
+        // Converging rays: which points the light reaches at all (the spot's
+        // cone, by the lighting code's own evaluation), then each traced to
+        // the light through the trilinear field inside the grid's box.
+        Light unit = l;
+        unit.color = glm::vec3(1.0f);
+        unit.intensity = 1.0f;
+        const Light one[] = {unit};
+        if (Status s = lightPoints(points, h, points[0], one, nullptr, GasLightingDesc{.albedo = 1.0f}, reach); !s) return s;
+        st.trans.assign(count, 0.0f);
+        for (std::size_t i = 0; i < count; ++i) {
+            if (!(reach[i].x > 0.0f)) continue;
+            const glm::vec3 p = points[i], d = l.position - p;
+            // Where the segment to the light leaves the box (it starts inside).
+            float t = 1.0f;
+            for (int a = 0; a < 3; ++a) {
+                if (d[a] > 0.0f) t = std::min(t, (hi[a] - p[a]) / d[a]);
+                else if (d[a] < 0.0f) t = std::min(t, (lo[a] - p[a]) / d[a]);
+            }
+            t = std::max(t, 0.0f);
+            st.trans[i] = mField.empty() || t == 0.0f ? 1.0f : std::exp2(-mField.opticalDepth(p, p + t * d));
+            ++mLightTraces;
+        }
+    }
+    return {};
+}
+
+Status Cloud::applyLightPhases(const Camera& camera, LodFrame& out) {
+    // s = u R per vertex: R = sum_i w_i E_i (4 pi phase_i T_i + m) / sum_i
+    // w_i E_i (4 pi maxPhase T_i + m), both by lightPoints at the vertex.
+    mVertexScratch.resize(out.tets.size() * 4);
+    for (std::size_t t = 0; t < out.tets.size(); ++t)
+        for (std::size_t k = 0; k < 4; ++k) mVertexScratch[4 * t + k] = out.tets[t].position[k];
+    // An orthographic camera looks along one direction: the eye is taken
+    // 10^4 box diagonals behind the cloud (directions within 10^-4 rad).
+    const Aabb box = mVolume.boundsWorld();
+    const glm::vec3 eye = camera.perspective() ? camera.eye() : 0.5f * (box.lo + box.hi) - camera.forward() * (1e4f * glm::length(box.hi - box.lo));
+    std::vector<const std::vector<float>*> trans;
+    const float fourPiMax = 4.0f * std::numbers::pi_v<float> * mPhaseMax;
+    const std::vector<Light> bound = unitLights(fourPiMax, &trans), seen = unitLights(1.0f);
+    const GridShadows shadows(mDims, mDesc.volume.originWorld, mDesc.volume.spacingWorld, std::move(trans));
+    GasLightingDesc viewed{.phase = mLighting.gas.phase, .albedo = 1.0f, .multipleScattering = mLighting.gas.multipleScattering};
+    const GasLightingDesc iso{.albedo = 1.0f, .multipleScattering = mLighting.gas.multipleScattering / fourPiMax};
+    if (Status s = lightPoints(mVertexScratch, mDesc.volume.spacingWorld, eye, seen, &shadows, viewed, mSeenScratch); !s) return s;
+    if (Status s = lightPoints(mVertexScratch, mDesc.volume.spacingWorld, eye, bound, &shadows, iso, mBoundScratch); !s) return s;
+    for (std::size_t t = 0; t < out.tets.size(); ++t)
+        for (std::size_t k = 0; k < 4; ++k) {
+            const float n = mSeenScratch[4 * t + k].x, d = mBoundScratch[4 * t + k].x;
+            float& s = out.tets[t].scalar[k];
+            s = d > 0.0f ? std::clamp(s * n / d, 0.0f, 1.0f) : 0.0f;
         }
     return {};
 }
