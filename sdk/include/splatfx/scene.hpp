@@ -20,8 +20,9 @@
 // (EffectKind::lightingDensity: every Effect does; LOD volumes and ground fog
 // do not, their light is part of their data; a Cloud, cloud.hpp, and a ground
 // fog layer, GroundFog::setLighting, follow the scene's first directional light
-// and are relit when it moves, the fog also shadowed by the lit clouds and
-// effects): their splat colours follow Ebert & Parent's low-albedo model with
+// and are relit when it moves, the fog also shadowed by the lit clouds,
+// effects and other layers, and casting like a cloud: GroundFogCaster, its
+// exact optical depth): their splat colours follow Ebert & Parent's low-albedo model with
 // self-shadowing, the light also attenuated through every other lit,
 // shadow-casting volume between them and it (a cloud's shadow on a plume, a
 // plume's on another effect: every effect's field is updated before any is
@@ -100,7 +101,8 @@ struct EffectLighting {
     glm::ivec3 tableDims{32};                  // self-shadowing table entries per axis, each in [1, 1024]; default 32^3
     // Whether the effect's gas is in the frame's shadow on the scene
     // (FrameShadow, Scene::setSceneShadow) and shadows the other lit
-    // effects' splats. Default true.
+    // effects' splats (and lit ground fog layers). For a lit Cloud and a lit
+    // ground fog layer: the same, with their extinction. Default true.
     bool castsShadow = true;
 };
 
