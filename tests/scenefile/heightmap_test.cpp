@@ -235,10 +235,12 @@ TEST(SceneFileHeightmap, GroundFogLightingKeyLightsTheLayer) {
     auto r = t.parse(R"("lights": [{"type": "directional", "direction": [0.3, -1, 0.2]}],
                         "volumes": [{"kind": "groundFog", "name": "lit", "heightmap": "dem.pgm", "fogTop": 0.8, "extinctionPerWorld": 2,
                                      "colour": [0.8, 0.85, 0.9], "lighting": {"enabled": true, "albedo": 0.7}},
-                                    {"kind": "groundFog", "name": "plain", "heightmap": "dem.pgm", "fogTop": 0.8}])",
+                                    {"kind": "groundFog", "name": "plain", "heightmap": "dem.pgm", "fogTop": 0.8},
+                                    {"kind": "groundFog", "name": "quiet", "heightmap": "dem.pgm", "fogTop": 0.8,
+                                     "lighting": {"enabled": true, "castsShadow": false}}])",
                      m);
     ASSERT_TRUE(r) << r.error();
-    ASSERT_EQ(r->volumes.size(), 2u);
+    ASSERT_EQ(r->volumes.size(), 3u);
     const splatfx::EffectId lit = r->volumes[0].id, plain = r->volumes[1].id;
     EXPECT_TRUE(r->scene.options(lit).lighting.enabled);
     EXPECT_FLOAT_EQ(r->scene.options(lit).lighting.gas.albedo, 0.7f);
@@ -253,4 +255,9 @@ TEST(SceneFileHeightmap, GroundFogLightingKeyLightsTheLayer) {
     EXPECT_FLOAT_EQ(fog->lighting().extinctionPerWorld, 2.0f);
     EXPECT_NEAR(fog->lighting().color.g, 0.85f, 1e-6f);
     EXPECT_EQ(fog->lighting().sun.direction, glm::vec3(0.3f, -1.0f, 0.2f));
+    // A lit layer casts by default (into the scene shadow, as a cloud); "castsShadow": false keeps it out.
+    EXPECT_TRUE(r->scene.status(lit).inSceneShadow);
+    EXPECT_TRUE(r->scene.status(r->volumes[2].id).lit);
+    EXPECT_FALSE(r->scene.status(r->volumes[2].id).inSceneShadow);
+    EXPECT_FALSE(r->scene.status(plain).inSceneShadow);
 }

@@ -122,6 +122,37 @@ private:
     int mCount = 1;
 };
 
+// ---------------------------------------------------------------- [SECTION] shadow casters
+
+// A volume that shadows others and the scene, as the shadow code reads it:
+// its extinction (log2 units per world unit, 0 outside its box) and its
+// optical depth along a segment, each exact for the caster's own model.
+// DensityField is one (an effect's or a cloud's trilinear field); a ground
+// fog layer is another (GroundFogCaster, volume.hpp: its continuous layer in
+// closed form). ShadowTable::update and the Scene's volume shadows take either.
+class ShadowCaster {
+public:
+    virtual ~ShadowCaster() = default;
+    // Extinction at a world point, log2 units per world unit (0 outside).
+    virtual float at(glm::vec3 world) const = 0;
+    // Optical depth (log2 units) along the segment.
+    virtual float opticalDepth(glm::vec3 fromWorld, glm::vec3 toWorld) const = 0;
+    // From a world point to the light (to its position, or without end
+    // towards a directional light).
+    virtual float opticalDepthToLight(glm::vec3 world, const Light& light) const = 0;
+    virtual bool empty() const = 0; // no material anywhere
+    // World-space box outside which the extinction is zero.
+    virtual glm::vec3 boundsMin() const = 0;
+    virtual glm::vec3 boundsMax() const = 0;
+    // Hash of everything the extinction depends on; equal casters, equal hashes.
+    virtual std::uint64_t fingerprint() const = 0;
+
+protected:
+    ShadowCaster() = default;
+    ShadowCaster(const ShadowCaster&) = default;
+    ShadowCaster& operator=(const ShadowCaster&) = default;
+};
+
 // ---------------------------------------------------------------- [SECTION] density field
 
 struct DensityFieldDesc {
@@ -137,7 +168,7 @@ struct DensityFieldDesc {
 // beyond the outermost voxels. A ray through a row of equal voxels thus
 // gains the same depth per voxel as the splats drawn for them.
 // Voxels sharing a cell add; voxels with non-finite data are skipped.
-class DensityField {
+class DensityField final : public ShadowCaster {
 public:
     DensityField() = default; // empty: no material anywhere
     // Fails when the cells' bounding box holds more than kMaxVoxels cells
@@ -145,22 +176,22 @@ public:
     static Result<DensityField> fromGrid(const Grid& grid, const DensityFieldDesc& desc = {});
 
     // Extinction at a world point, log2 units per world unit (0 outside).
-    float at(glm::vec3 world) const;
+    float at(glm::vec3 world) const override;
     // Optical depth (log2 units) along the segment, exact for the trilinear
     // field up to float rounding: the segment is split where it crosses
     // lattice planes, and on each piece the field is a cubic in the ray
     // parameter, which Simpson's rule integrates exactly.
-    float opticalDepth(glm::vec3 fromWorld, glm::vec3 toWorld) const;
+    float opticalDepth(glm::vec3 fromWorld, glm::vec3 toWorld) const override;
     // From a world point to the light (to its position, or out of the
     // field for a directional light). The shadow-tracing reference.
-    float opticalDepthToLight(glm::vec3 world, const Light& light) const;
+    float opticalDepthToLight(glm::vec3 world, const Light& light) const override;
 
-    bool empty() const { return mValues.empty(); }
+    bool empty() const override { return mValues.empty(); }
     // World-space box outside which the field is zero (empty: a zero box at the origin).
-    glm::vec3 boundsMin() const { return mBoundsMin; }
-    glm::vec3 boundsMax() const { return mBoundsMax; }
+    glm::vec3 boundsMin() const override { return mBoundsMin; }
+    glm::vec3 boundsMax() const override { return mBoundsMax; }
     // Hash of everything the field's values depend on; equal fields, equal hashes.
-    std::uint64_t fingerprint() const { return mFingerprint; }
+    std::uint64_t fingerprint() const override { return mFingerprint; }
     // Cube root of a voxel's world volume.
     float voxelSizeWorld() const { return mVoxelSize; }
 
@@ -236,6 +267,10 @@ public:
     // every effect of a frame, for shadows on the scene. Fails on a null
     // pointer. The fingerprint combines the fields' in order.
     Status update(std::span<const DensityField* const> fields, const Light& light);
+    // The same for any shadow casters (a ground fog layer among the fields:
+    // GroundFogCaster); the nodes sample each caster's at(), the nodes near a
+    // point light trace its opticalDepth(). Fails on a null pointer.
+    Status update(std::span<const ShadowCaster* const> casters, const Light& light);
 
     // Accumulated optical depth towards the light (log2 units), and exp2(-depth).
     float opticalDepth(glm::vec3 world) const;

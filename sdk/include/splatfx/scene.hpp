@@ -20,8 +20,9 @@
 // (EffectKind::lightingDensity: every Effect does; LOD volumes and ground fog
 // do not, their light is part of their data; a Cloud, cloud.hpp, and a ground
 // fog layer, GroundFog::setLighting, follow the scene's first directional light
-// (a low-albedo Cloud its point and spot lights too) and are relit when it moves, the fog also shadowed by the lit clouds and
-// effects): their splat colours follow Ebert & Parent's low-albedo model with
+// (a low-albedo Cloud its point and spot lights too) and are relit when it moves, the fog also
+// shadowed by the lit clouds, effects and other layers, and casting like a cloud (GroundFogCaster,
+// its exact optical depth): their splat colours follow Ebert & Parent's low-albedo model with
 // self-shadowing, the light also attenuated through every other lit,
 // shadow-casting volume between them and it (a cloud's shadow on a plume, a
 // plume's on another effect: every effect's field is updated before any is
@@ -101,7 +102,8 @@ struct EffectLighting {
     glm::ivec3 tableDims{32};                  // self-shadowing table entries per axis, each in [1, 1024]; default 32^3
     // Whether the effect's gas is in the frame's shadow on the scene
     // (FrameShadow, Scene::setSceneShadow) and shadows the other lit
-    // effects' splats. Default true.
+    // effects' splats (and lit ground fog layers). For a lit Cloud and a lit
+    // ground fog layer: the same, with their extinction. Default true.
     bool castsShadow = true;
 };
 
@@ -409,6 +411,9 @@ private:
         std::vector<glm::vec3> points, factors; // scratch: splat centres and their light factors
         std::vector<bool> reaches;              // scratch: which lights reach the effect (Scene::lightReaches)
         bool fieldReady = false;                // `field` is this emit's (updateEffectCasters)
+        // A ground fog layer that casts this emit: its GroundFogCaster (the
+        // kind's; its extinction stands for the layer), else null.
+        const ShadowCaster* fogCaster = nullptr;
     };
     struct Entry {
         std::unique_ptr<EffectKind> kind; // never null; on the heap, so what a Frame points at stays put
@@ -431,12 +436,15 @@ private:
     // emit, and the shadow-casting ones appended to mVolumeCasters, so each
     // lit effect is shadowed by all the others (scene_lighting.cpp).
     void updateEffectCasters(const Materials& materials, const EmitOptions& options);
+    // Before any volume is lit: every lit, casting ground fog layer needed or
+    // casting into the view joins mVolumeCasters (scene_ground_fog.cpp).
+    void updateFogCasters();
     // mCastersPerLight: per light, the casters other than e's own field whose
     // box can shadow e's (shadowFallsOn).
     void scheduleCasters(const Entry& e);
     void shadeScene(Frame& frame); // fills frame.shadows()
     // Which lights get a scene-shadow table this frame, slot order (scene_lighting.cpp).
-    std::vector<std::size_t> chooseShadowLights(const std::vector<std::vector<const DensityField*>>& casters);
+    std::vector<std::size_t> chooseShadowLights(const std::vector<std::vector<const ShadowCaster*>>& casters);
     std::uint64_t requiredLightingBytes() const;
     // Fits e's emitted lights (EffectOptions::emitsLight) into mEmittedLights.
     void fitLights(Entry& e, const Camera& camera, const Materials& materials, const EmitOptions& draw);
@@ -453,10 +461,12 @@ private:
     std::vector<EmittedLight> mEmittedLights;
     EmittedGrid mEmittedGrid;
     std::size_t mEmittedGridsDropped = 0;
-    // This emit's shadow-casting lit volumes' fields (clouds, then effects):
-    // each lit effect's light is attenuated through the others'.
-    std::vector<const DensityField*> mVolumeCasters;
-    std::vector<std::vector<const DensityField*>> mCastersPerLight; // scratch (scheduleCasters)
+    // This emit's shadow-casting lit volumes (clouds' and effects' fields,
+    // ground fog layers' GroundFogCasters): each lit volume's light is
+    // attenuated through the others'.
+    std::vector<const ShadowCaster*> mVolumeCasters;
+    std::vector<std::vector<const ShadowCaster*>> mCastersPerLight; // scratch (scheduleCasters)
+    std::vector<const ShadowCaster*> mFogCasterScratch;             // scratch: a layer's casters, itself left out (emitLitGroundFogs)
     SplatBuilder mLightScratch{SplatBuilderDesc{.frustumCull = false}}; // an emitter's whole splats, fitted, never drawn
     SceneShadowDesc mSceneShadowDesc;
     bool mHdrLit = false;

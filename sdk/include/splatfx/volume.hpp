@@ -500,6 +500,9 @@ public:
     // Fails, changing nothing, on a bad field (the message names it) or a
     // null caster.
     Status setLighting(const GroundFogLighting& lighting, std::span<const DensityField* const> casters = {});
+    // The same with any shadow casters (another layer's GroundFogCaster among
+    // them; not this layer's own: its self-shadowing is already in T).
+    Status setLighting(const GroundFogLighting& lighting, std::span<const ShadowCaster* const> casters);
     // Back to the unlit layer (the transfer function's colour).
     void clearLighting() { mLit = false; }
     bool lit() const { return mLit; }
@@ -522,8 +525,9 @@ public:
     glm::dvec3 sourceAt(double sunTransmittance, glm::vec3 toEye) const;
 
 private:
+    friend class GroundFogCaster;
     detail::FogFieldView fieldView() const;
-    Status relightFog(std::span<const DensityField* const> casters);
+    Status relightFog(std::span<const ShadowCaster* const> casters);
     Status rebuildLitTable();
     GroundFogDesc mDesc;
     std::uint64_t mPrisms = 0;
@@ -541,6 +545,48 @@ private:
     PreIntegrationTable mLitTable;
     float mPhaseMax = 1.0f;
     std::uint64_t mRelights = 0, mLitTableBuilds = 0;
+};
+
+// A ground fog layer as a shadow caster (lighting.hpp, ShadowCaster): what
+// the layer casts on effects, on other layers and, through the scene shadow
+// table, on the host's surfaces (docs/lighting.md, "Ground fog casts"). Its
+// extinction is extinctionPerWorld x the fog's scalar over the layer's
+// continuous field (integrateGroundFogRay's: terrain and thickness linear in
+// each triangle of the grid, the scalar linear in height or the paper's
+// ratio), in log2 units; optical depths along a segment are integrated in
+// closed form per triangle stretch (exact up to double rounding, returned in
+// float), the same integral the layer's own self-shadowing uses. It does not
+// depend on the camera: the LOD's refinement is not involved.
+//
+//   auto caster = splatfx::GroundFogCaster::create(fog, 0.8f);   // Result<GroundFogCaster>
+//   float depth = caster->opticalDepthToLight(p, sun);           // log2 units
+//
+// Refers to `fog`, which must outlive it and stay where it is (a Scene keeps
+// its layers on the heap). Threading: const members may be called from
+// several threads at once.
+class GroundFogCaster final : public ShadowCaster {
+public:
+    GroundFogCaster() = default; // empty: casts nothing
+    // extinctionPerWorld: natural-log extinction at scalar 1 (the transfer's,
+    // makeGroundFogTransfer), finite and >= 0; fails otherwise, naming it.
+    // O(grid points): the fingerprint hashes the layer's field.
+    static Result<GroundFogCaster> create(const GroundFog& fog, float extinctionPerWorld);
+
+    float at(glm::vec3 world) const override;
+    float opticalDepth(glm::vec3 fromWorld, glm::vec3 toWorld) const override;
+    float opticalDepthToLight(glm::vec3 world, const Light& light) const override;
+    bool empty() const override { return mFog == nullptr; }
+    glm::vec3 boundsMin() const override { return mBounds.lo; }
+    glm::vec3 boundsMax() const override { return mBounds.hi; }
+    std::uint64_t fingerprint() const override { return mFingerprint; }
+    float extinctionPerWorld() const { return mExtinction; }
+    const GroundFog* fog() const { return mFog; }
+
+private:
+    const GroundFog* mFog = nullptr; // null: empty (no fog, or extinction 0)
+    float mExtinction = 0.0f;
+    Aabb mBounds{glm::vec3(0.0f), glm::vec3(0.0f)}; // empty: a zero box at the origin, as DensityField
+    std::uint64_t mFingerprint = 0;
 };
 
 // A fog transfer function: constant colour, extinction linear in the scalar

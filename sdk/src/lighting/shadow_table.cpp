@@ -50,15 +50,15 @@ bool rayBox(glm::vec3 p, glm::vec3 d, float tMax, float& tNear) {
 // outside its support), the support is the union of the non-empty ones, and
 // the fingerprint combines theirs in order (one field: its own).
 struct FieldSum {
-    std::span<const DensityField* const> fields;
+    std::span<const ShadowCaster* const> fields;
     float at(glm::vec3 p) const {
         float sum = 0.0f;
-        for (const DensityField* f : fields) sum += f->at(p);
+        for (const ShadowCaster* f : fields) sum += f->at(p);
         return sum;
     }
     float opticalDepth(glm::vec3 a, glm::vec3 b) const {
         float sum = 0.0f;
-        for (const DensityField* f : fields) sum += f->opticalDepth(a, b);
+        for (const ShadowCaster* f : fields) sum += f->opticalDepth(a, b);
         return sum;
     }
     glm::vec3 boundsMin() const { return bounds(true); }
@@ -66,7 +66,7 @@ struct FieldSum {
     glm::vec3 bounds(bool lo) const {
         glm::vec3 out(0.0f);
         bool any = false;
-        for (const DensityField* f : fields) {
+        for (const ShadowCaster* f : fields) {
             if (f->empty()) continue;
             const glm::vec3 b = lo ? f->boundsMin() : f->boundsMax();
             out = !any ? b : (lo ? glm::min(out, b) : glm::max(out, b));
@@ -77,7 +77,7 @@ struct FieldSum {
     std::uint64_t fingerprint() const {
         if (fields.size() == 1) return fields[0]->fingerprint();
         std::uint64_t h = 0x9e3779b97f4a7c15ull ^ fields.size();
-        for (const DensityField* f : fields) h = (h ^ f->fingerprint()) * 0x100000001b3ull + 0x9e3779b97f4a7c15ull;
+        for (const ShadowCaster* f : fields) h = (h ^ f->fingerprint()) * 0x100000001b3ull + 0x9e3779b97f4a7c15ull;
         return h;
     }
 };
@@ -90,11 +90,18 @@ std::uint64_t ShadowTable::memoryBytes(glm::ivec3 dims) {
 }
 
 Status ShadowTable::update(const DensityField& field, const Light& light) {
-    const DensityField* one = &field;
-    return update(std::span<const DensityField* const>(&one, 1), light);
+    const ShadowCaster* one = &field;
+    return update(std::span<const ShadowCaster* const>(&one, 1), light);
 }
 
 Status ShadowTable::update(std::span<const DensityField* const> fields, const Light& light) {
+    for (std::size_t i = 0; i < fields.size(); ++i)
+        if (!fields[i]) return makeError("ShadowTable::update: fields[" + std::to_string(i) + "] is null");
+    const std::vector<const ShadowCaster*> casters(fields.begin(), fields.end());
+    return update(std::span<const ShadowCaster* const>(casters), light);
+}
+
+Status ShadowTable::update(std::span<const ShadowCaster* const> fields, const Light& light) {
     for (std::size_t i = 0; i < fields.size(); ++i)
         if (!fields[i]) return makeError("ShadowTable::update: fields[" + std::to_string(i) + "] is null");
     const FieldSum field{fields};

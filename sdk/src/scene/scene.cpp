@@ -217,6 +217,7 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
         if (e.lit->field.empty() != f.empty() || e.lit->field.fingerprint() != f.fingerprint()) e.lit->field = f;
         if (e.options.lighting.castsShadow && !e.lit->field.empty()) mVolumeCasters.push_back(&e.lit->field);
     }
+    updateFogCasters();                      // the casting ground fog layers: exact, their extinction only
     updateEffectCasters(materials, options); // every effect's field before any is lit: they shadow one another
     for (std::size_t i = 0; i < mEntries.size(); ++i) {
         Entry& e = mEntries[i];

@@ -33,26 +33,28 @@ std::uint32_t packLit(glm::vec3 c, float* scale) {
 
 // An effect's own shadow (self-shadowing: traced, table or none) times the
 // transmittance through the other volumes between it and the light (the lit
-// clouds and the other lit effects): a product, since optical depths along one ray add. Each other
-// volume is traced through its own trilinear field (DensityField: exact for
-// it up to float rounding); a ray that misses a field's box costs one clip.
+// clouds, the casting ground fog layers and the other lit effects): a
+// product, since optical depths along one ray add. Each other volume is
+// traced through its own model (a trilinear DensityField, or a layer's
+// closed form, GroundFogCaster: each exact up to float rounding); a ray that
+// misses a caster's box costs one clip.
 class VolumeShadows final : public ShadowProvider {
 public:
     // others[i]: the volumes that can shadow the receiver for light i (Scene::scheduleCasters).
-    VolumeShadows(const ShadowProvider* own, std::span<const Light> lights, std::span<const std::vector<const DensityField*>> others)
+    VolumeShadows(const ShadowProvider* own, std::span<const Light> lights, std::span<const std::vector<const ShadowCaster*>> others)
         : mOwn(own), mLights(lights), mOthers(others) {}
     float transmittance(std::size_t light, glm::vec3 world) const override {
         float t = mOwn ? mOwn->transmittance(light, world) : 1.0f;
         if (light >= mLights.size() || light >= mOthers.size()) return t;
         float depth = 0.0f;
-        for (const DensityField* f : mOthers[light]) depth += f->opticalDepthToLight(world, mLights[light]);
+        for (const ShadowCaster* f : mOthers[light]) depth += f->opticalDepthToLight(world, mLights[light]);
         return depth > 0.0f ? t * std::exp2(-depth) : t;
     }
 
 private:
     const ShadowProvider* mOwn;
     std::span<const Light> mLights;
-    std::span<const std::vector<const DensityField*>> mOthers;
+    std::span<const std::vector<const ShadowCaster*>> mOthers;
 };
 
 } // namespace
@@ -121,7 +123,8 @@ void Scene::updateEffectCasters(const Materials& materials, const EmitOptions& o
     mCounters.crossShadowPairs = mCounters.crossShadowPairsSkipped = 0;
     for (Entry& e : mEntries) {
         if (e.lit) e.lit->fieldReady = false;
-        if (dynamic_cast<const detail::CloudKind*>(e.kind.get())) continue; // clouds: their own relight (emitInto)
+        if (dynamic_cast<const detail::CloudKind*>(e.kind.get())) continue;     // clouds: their own relight (emitInto)
+        if (dynamic_cast<const detail::GroundFogKind*>(e.kind.get())) continue; // ground fog: its caster (updateFogCasters)
         const EmitOptions draw{.textured = e.options.draw.textured && options.textured,
                                .opacityScale = e.options.draw.opacityScale * options.opacityScale};
         const bool tableLit = e.options.lighting.selfShadow == SelfShadow::Table;
@@ -143,7 +146,7 @@ void Scene::scheduleCasters(const Entry& e) {
     const Aabb box{own.boundsMin(), own.boundsMax()};
     for (std::size_t i = 0; i < mLights.size(); ++i) {
         mCastersPerLight[i].clear();
-        for (const DensityField* f : mVolumeCasters) {
+        for (const ShadowCaster* f : mVolumeCasters) {
             if (f == &own) continue; // its own shadow is its self-shadowing
             if (shadowFallsOn(Aabb{f->boundsMin(), f->boundsMax()}, mLights[i], box)) {
                 mCastersPerLight[i].push_back(f);
@@ -233,11 +236,11 @@ namespace {
 // closer than the box's bounding radius, so a light inside stays finite),
 // times its brightest colour channel. Spot cones that miss were removed
 // before (Scene::lightReaches).
-double influence(const Light& light, std::span<const DensityField* const> casters) {
+double influence(const Light& light, std::span<const ShadowCaster* const> casters) {
     const double power = double(light.intensity) * double(std::max({light.color.r, light.color.g, light.color.b}));
     if (light.type == LightType::Directional) return power * double(casters.size());
     double sum = 0.0;
-    for (const DensityField* f : casters) {
+    for (const ShadowCaster* f : casters) {
         const glm::dvec3 lo(f->boundsMin()), hi(f->boundsMax()), p(light.position);
         const glm::dvec3 q = glm::clamp(p, lo, hi);
         const double r = 0.5 * glm::length(hi - lo);
@@ -249,7 +252,7 @@ double influence(const Light& light, std::span<const DensityField* const> caster
 
 } // namespace
 
-std::vector<std::size_t> Scene::chooseShadowLights(const std::vector<std::vector<const DensityField*>>& casters) {
+std::vector<std::size_t> Scene::chooseShadowLights(const std::vector<std::vector<const ShadowCaster*>>& casters) {
     const SceneShadowDesc& d = mSceneShadowDesc;
     std::vector<std::size_t> candidates; // lights that reach a caster, except slot 0's
     std::vector<double> weight(mLights.size(), 0.0);
@@ -294,16 +297,20 @@ void Scene::shadeScene(Frame& frame) {
         mLightingError = "sceneShadow.maxLights: expected 1 to " + std::to_string(kMaxShadowLights) + ", got " + std::to_string(d.maxLights);
     const bool on = d.enabled && d.light < mLights.size() && d.maxLights >= 1 && d.maxLights <= kMaxShadowLights && mTablesFit;
     // Casters per light: the drawn lit effects, and those out of view whose
-    // shadow reaches it (castsIntoView); each only where the light reaches it.
-    std::vector<std::vector<const DensityField*>> casters(mLights.size());
+    // shadow reaches it (castsIntoView); the casting ground fog layers
+    // (updateFogCasters); each only where the light reaches it.
+    std::vector<std::vector<const ShadowCaster*>> casters(mLights.size());
     std::vector<std::vector<Entry*>> casterEntries(mLights.size());
     for (Entry& e : mEntries) {
         e.status.inSceneShadow = false;
-        if (!on || !(e.status.lit || e.status.castsIntoView) || !e.options.lighting.castsShadow || !e.lit || e.lit->field.empty()) continue;
-        const Aabb box{e.lit->field.boundsMin(), e.lit->field.boundsMax()};
+        if (!on || !e.lit) continue;
+        const ShadowCaster* c = e.lit->fogCaster;
+        if (!c && (e.status.lit || e.status.castsIntoView) && e.options.lighting.castsShadow && !e.lit->field.empty()) c = &e.lit->field;
+        if (!c) continue;
+        const Aabb box{c->boundsMin(), c->boundsMax()};
         for (std::size_t i = 0; i < mLights.size(); ++i)
             if (lightReaches(mLights[i], box)) {
-                casters[i].push_back(&e.lit->field);
+                casters[i].push_back(c);
                 casterEntries[i].push_back(&e);
             }
     }
@@ -343,7 +350,9 @@ void Scene::shadeScene(Frame& frame) {
         // scene shadow's dims: that table is the scene shadow (the paper's one
         // table serves both), so nothing more is built. Only a drawn effect's
         // self-shadowing tables are current.
-        const Entry* only = casterEntries[li].size() == 1 && casterEntries[li][0]->status.lit ? casterEntries[li][0] : nullptr;
+        const Entry* only = casterEntries[li].size() == 1 && casterEntries[li][0]->status.lit && !casterEntries[li][0]->lit->fogCaster
+                                ? casterEntries[li][0]
+                                : nullptr;
         if (only && only->options.lighting.selfShadow == SelfShadow::Table && only->options.lighting.tableDims == d.dims &&
             li < only->lit->tables.tables().size()) {
             sources[k] = &only->lit->tables.tables()[li];

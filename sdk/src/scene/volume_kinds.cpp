@@ -38,23 +38,43 @@ EmitResult GroundFogKind::emit(const EmitContext& context) {
     return {.tetrahedra = fv.lod.tets.size()};
 }
 
-Status GroundFogKind::follow(std::span<const Light> lights, const EffectLighting& lighting, std::span<const DensityField* const> casters) {
+Result<double> GroundFogKind::fogExtinction() const {
+    // The fog's colour and extinction: sigma = rho s with one colour (makeGroundFogTransfer).
+    const double rho = mTransfer.extinction(1.0);
+    const glm::dvec3 colour = mTransfer.color(1.0);
+    for (const TransferPoint& p : mTransfer.points())
+        if (std::abs(double(p.extinctionPerWorld) - double(p.scalar) * rho) > 1e-6 * rho || glm::length(glm::dvec3(p.color) - colour) > 1e-6)
+            return makeError("a lit ground fog needs a transfer function of makeGroundFogTransfer's form (one colour, extinction linear from 0)");
+    return rho;
+}
+
+Result<const GroundFogCaster*> GroundFogKind::caster() {
+    Result<double> rho = fogExtinction();
+    if (!rho) return makeError(rho.error());
+    if (*rho != mCasterExtinction) {
+        Result<GroundFogCaster> c = GroundFogCaster::create(mVolume, float(*rho));
+        if (!c) return makeError(c.error());
+        mCaster = std::move(*c);
+        mCasterExtinction = *rho;
+    }
+    return &mCaster;
+}
+
+Status GroundFogKind::follow(std::span<const Light> lights, const EffectLighting& lighting, std::span<const ShadowCaster* const> casters) {
     for (const Light& l : lights) {
         if (l.type != LightType::Directional) continue;
-        // The fog's colour and extinction: sigma = rho s with one colour (makeGroundFogTransfer).
-        const double rho = mTransfer.extinction(1.0);
+        Result<double> rho = fogExtinction();
+        if (!rho) {
+            mVolume.clearLighting();
+            return makeError(rho.error());
+        }
         const glm::dvec3 colour = mTransfer.color(1.0);
-        for (const TransferPoint& p : mTransfer.points())
-            if (std::abs(double(p.extinctionPerWorld) - double(p.scalar) * rho) > 1e-6 * rho || glm::length(glm::dvec3(p.color) - colour) > 1e-6) {
-                mVolume.clearLighting();
-                return makeError("a lit ground fog needs a transfer function of makeGroundFogTransfer's form (one colour, extinction linear from 0)");
-            }
         GroundFogLighting L = mVolume.lighting();
         L.sun = l;
         L.gas = lighting.gas;
         L.gas.colorTable = nullptr;
         L.color = glm::vec3(colour);
-        L.extinctionPerWorld = float(rho);
+        L.extinctionPerWorld = float(*rho);
         if (Status s = mVolume.setLighting(L, casters); !s) {
             mVolume.clearLighting();
             return s;

@@ -91,10 +91,19 @@ public:
     // and extinction at scalar 1 the fog's (it must be makeGroundFogTransfer's
     // form), shadowed by `casters`; relit only when those change. No
     // directional light: drawn unlit. On an error the layer is drawn unlit.
-    Status follow(std::span<const Light> lights, const EffectLighting& lighting, std::span<const DensityField* const> casters);
+    Status follow(std::span<const Light> lights, const EffectLighting& lighting, std::span<const ShadowCaster* const> casters);
+    // The layer as a shadow caster with the transfer function's extinction at
+    // scalar 1 (it must be makeGroundFogTransfer's form, else the error);
+    // remade only when that extinction changed (setTransfer). Independent of
+    // the camera and of the sun.
+    Result<const GroundFogCaster*> caster();
 
 private:
+    // The transfer's extinction at scalar 1, or the error when it is not makeGroundFogTransfer's form.
+    Result<double> fogExtinction() const;
     std::vector<glm::vec3> mTerrain;
+    GroundFogCaster mCaster;
+    double mCasterExtinction = -1.0; // what mCaster was made with; < 0: not made
 };
 
 // A relightable cloud (cloud.hpp): static like the other volumes, drawn with

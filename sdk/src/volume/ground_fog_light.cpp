@@ -37,11 +37,11 @@ double ratioIntegral(double a, double b, double c, double e, double L) {
 
 } // namespace
 
-double fogScalarIntegral(const FogFieldView& f, glm::dvec3 p, glm::dvec3 u, std::vector<double>& ts) {
-    if (f.nx < 2 || f.nz < 2) return 0.0;
+double fogScalarIntegral(const FogFieldView& f, glm::dvec3 p, glm::dvec3 u, std::vector<double>& ts, double tMax) {
+    if (f.nx < 2 || f.nz < 2 || !(tMax > 0.0)) return 0.0;
     const double s = f.spacing;
     const double ax = (p.x - f.origin.x) / s, bx = u.x / s, az = (p.z - f.origin.y) / s, bz = u.z / s;
-    double lo = 0.0, hi = 1e30;
+    double lo = 0.0, hi = std::min(tMax, 1e30);
     auto slab = [&](double a, double b, double lower, double upper) {
         if (b == 0.0) {
             if (a < lower || a > upper) hi = lo - 1.0;
@@ -138,6 +138,24 @@ double fogScalarIntegral(const FogFieldView& f, glm::dvec3 p, glm::dvec3 u, std:
     return total;
 }
 
+double fogScalarAt(const FogFieldView& f, glm::dvec3 p) {
+    if (f.nx < 2 || f.nz < 2 || !(p.y >= f.yLo && p.y <= f.yHi)) return 0.0;
+    const double gx = (p.x - f.origin.x) / f.spacing, gz = (p.z - f.origin.y) / f.spacing;
+    if (!(gx >= 0.0 && gx <= double(f.nx - 1) && gz >= 0.0 && gz <= double(f.nz - 1))) return 0.0;
+    const int i = std::min(int(gx), f.nx - 2), j = std::min(int(gz), f.nz - 2);
+    const double uu = gx - i, vv = gz - j;
+    // The triangle of GroundFog's triangulation holding the point (as fogScalarIntegral), terrain and thickness linear on it.
+    auto linear = [&](auto&& value) {
+        const double v00 = value(i, j), v10 = value(i + 1, j), v01 = value(i, j + 1), v11 = value(i + 1, j + 1);
+        if (((i + j) & 1) == 0) return uu >= vv ? v00 + uu * (v10 - v00) + vv * (v11 - v10) : v00 + vv * (v01 - v00) + uu * (v11 - v01);
+        return uu + vv <= 1.0 ? v00 + uu * (v10 - v00) + vv * (v01 - v00) : v11 + (1.0 - uu) * (v01 - v11) + (1.0 - vv) * (v10 - v11);
+    };
+    const double h = linear([&](int x, int z) { return f.h(x, z); }), th = linear([&](int x, int z) { return f.th(x, z); });
+    const double above = p.y - h, below = h + th - p.y; // g1, g2: the layer is where both are >= 0
+    if (!(above >= 0.0 && below >= 0.0 && th > 0.0)) return 0.0;
+    return f.depth > 0.0 ? f.density * below / f.depth : f.density * std::min(below / th, 1.0);
+}
+
 float FogLitView::scalarAt(glm::vec3 world, bool top) const {
     const FogFieldView& f = *field;
     const double gx = std::clamp((double(world.x) - f.origin.x) / f.spacing, 0.0, double(f.nx - 1));
@@ -226,7 +244,7 @@ double GroundFog::opticalDepthToSun(glm::dvec3 p, glm::dvec3 towardSun) const {
     return double(mLighting.extinctionPerWorld) * detail::fogScalarIntegral(fieldView(), p, towardSun / len, scratch);
 }
 
-Status GroundFog::relightFog(std::span<const DensityField* const> casters) {
+Status GroundFog::relightFog(std::span<const ShadowCaster* const> casters) {
     const detail::FogFieldView f = fieldView();
     const int points = mDesc.lod ? mN * mN : mDesc.dims.x * mDesc.dims.y;
     std::vector<float> trans(2 * std::size_t(points), 1.0f);
@@ -242,13 +260,13 @@ Status GroundFog::relightFog(std::span<const DensityField* const> casters) {
                 const glm::vec3 p(x, k ? ht : hb, z);
                 double depth = ext > 0.0 ? ext * detail::fogScalarIntegral(f, glm::dvec3(p), toSun, scratch) : 0.0;
                 double log2Depth = 0.0;
-                for (const DensityField* c : casters) log2Depth += double(c->opticalDepthToLight(p, mLighting.sun));
+                for (const ShadowCaster* c : casters) log2Depth += double(c->opticalDepthToLight(p, mLighting.sun));
                 trans[2 * f.at(i, j) + std::size_t(k)] = float(std::exp(-depth) * std::exp2(-log2Depth));
             }
         }
     mSunT = std::move(trans);
     mCasterPrints.clear();
-    for (const DensityField* c : casters) mCasterPrints.push_back(c->empty() ? 0 : c->fingerprint());
+    for (const ShadowCaster* c : casters) mCasterPrints.push_back(c->empty() ? 0 : c->fingerprint());
     ++mRelights;
     return {};
 }
@@ -277,6 +295,12 @@ Status GroundFog::rebuildLitTable() {
 }
 
 Status GroundFog::setLighting(const GroundFogLighting& lighting, std::span<const DensityField* const> casters) {
+    // Null stays null: the overload below names it, after the lighting's own checks.
+    const std::vector<const ShadowCaster*> all(casters.begin(), casters.end());
+    return setLighting(lighting, std::span<const ShadowCaster* const>(all));
+}
+
+Status GroundFog::setLighting(const GroundFogLighting& lighting, std::span<const ShadowCaster* const> casters) {
     if (Status s = checkFogLighting(lighting); !s) return s;
     for (std::size_t i = 0; i < casters.size(); ++i)
         if (!casters[i]) return makeError("GroundFog::setLighting: casters[" + std::to_string(i) + "] is null");

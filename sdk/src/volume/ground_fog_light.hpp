@@ -33,8 +33,10 @@ struct FogFieldView {
 };
 
 // Integral of the fog's scalar (density at the terrain, 0 at the top) along
-// p + t u, t >= 0 (u unit), through the continuous layer. Double.
-double fogScalarIntegral(const FogFieldView& f, glm::dvec3 p, glm::dvec3 u, std::vector<double>& scratch);
+// p + t u, 0 <= t <= tMax (u unit), through the continuous layer. Double.
+double fogScalarIntegral(const FogFieldView& f, glm::dvec3 p, glm::dvec3 u, std::vector<double>& scratch, double tMax = 1e30);
+// The fog's scalar at a point of the same continuous layer (0 outside it).
+double fogScalarAt(const FogFieldView& f, glm::dvec3 p);
 
 // What update() needs to light each emitted vertex.
 struct FogLitView {
