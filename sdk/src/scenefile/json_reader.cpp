@@ -47,12 +47,6 @@ std::size_t editDistance(const std::string& a, const std::string& b) {
     return row[b.size()];
 }
 
-std::string num(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
-
 std::string range(double lo, double hi) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "[%g, %g]", lo, hi);
@@ -265,6 +259,12 @@ void ObjectReader::finish() {
         for (std::size_t i = 0; i < known.size(); ++i) list += (i ? ", " : "") + known[i];
         mD.error(at(it.key()), "unknown key" + (near.empty() ? std::string() : " (did you mean \"" + near + "\"?)") + "; keys allowed here: " + list);
     }
+}
+
+std::string num(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
 }
 
 } // namespace splatfx::scenefile

@@ -57,6 +57,8 @@ std::string join(const std::string& path, const std::string& key);
 std::string index(const std::string& path, std::size_t i);
 // Closest of `candidates` to `key` by edit distance, or empty when none is close.
 std::string closest(const std::string& key, const std::vector<std::string>& candidates);
+// A number as messages write it ("%g").
+std::string num(double v);
 
 // [SECTION] Value readers (each returns nullopt after reporting)
 

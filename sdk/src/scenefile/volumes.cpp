@@ -57,12 +57,6 @@ ScalarVolume yUp(const ScalarVolume& zUp) {
     return out;
 }
 
-std::string num(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
-
 std::string vec(glm::vec3 v) {
     char buf[96];
     std::snprintf(buf, sizeof buf, "[%g, %g, %g]", double(v.x), double(v.y), double(v.z));
