@@ -8,24 +8,12 @@
 
 #include "splatfx/solver.hpp"
 
+#include "obstacle_helpers.hpp"
+
 using namespace splatfx;
+using namespace obstacle_test;
 
 namespace {
-
-Obstacle boxOverCells(const FluidSolver& s, glm::ivec3 lo, glm::ivec3 hi, Slip slip = Slip::Free, Motion motion = {}) {
-    const glm::vec3 centre = 0.5f * (s.localPosition(lo) + s.localPosition(hi));
-    const glm::vec3 size = glm::vec3(hi - lo + 1) * s.desc().spacing;
-    return {.desc = {.shape = ObstacleShape::Box, .size = size, .transform = glm::translate(glm::mat4(1.0f), centre), .slip = slip},
-            .motion = std::move(motion)};
-}
-
-bool allFinite(const FluidSolver& s) {
-    for (float v : s.density())
-        if (!std::isfinite(v) || v < 0.0f) return false;
-    for (float v : s.temperature())
-        if (!std::isfinite(v)) return false;
-    return std::isfinite(s.maxSpeed());
-}
 
 double planeFlux(const FluidSolver& s, int j) {
     double f = 0.0;

@@ -11,18 +11,12 @@
 #include "splatfx/shapes.hpp"
 #include "splatfx/solver.hpp"
 
+#include "obstacle_helpers.hpp"
+
 using namespace splatfx;
+using namespace obstacle_test;
 
 namespace {
-
-// A box obstacle covering the lattice cells lo..hi (inclusive) of `s`, whose
-// transform is the identity (so grid-local = world).
-Obstacle boxOverCells(const FluidSolver& s, glm::ivec3 lo, glm::ivec3 hi, Slip slip = Slip::Free, Motion motion = {}) {
-    const glm::vec3 centre = 0.5f * (s.localPosition(lo) + s.localPosition(hi));
-    const glm::vec3 size = glm::vec3(hi - lo + 1) * s.desc().spacing;
-    return {.desc = {.shape = ObstacleShape::Box, .size = size, .transform = glm::translate(glm::mat4(1.0f), centre), .slip = slip},
-            .motion = std::move(motion)};
-}
 
 // The 12 triangles of the cube [-h, h]^3.
 std::vector<glm::vec3> cubeTriangles(glm::vec3 h) {

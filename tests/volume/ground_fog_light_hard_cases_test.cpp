@@ -28,26 +28,16 @@
 #include "splatfx/reference.hpp"
 #include "splatfx/volume.hpp"
 
+#include "ground_fog_test_helpers.hpp"
+
 using namespace splatfx;
+using namespace ground_fog_test;
 
 namespace {
 
 constexpr double kFloatT = 6e-8; // a float T in [0, 1]: half an ulp at 1
 
-GroundFogDesc flat(glm::ivec2 dims, float bottom, float top) {
-    GroundFogDesc d;
-    d.dims = dims;
-    d.terrainHeight.assign(std::size_t(dims.x) * std::size_t(dims.y), bottom);
-    d.fogTop.assign(d.terrainHeight.size(), top);
-    return d;
-}
-
-GroundFogLighting sunAlong(glm::vec3 travel, float extinction) {
-    GroundFogLighting L;
-    L.sun = Light::directional(travel);
-    L.extinctionPerWorld = extinction;
-    return L;
-}
+GroundFogDesc flat(glm::ivec2 dims, float bottom, float top) { return slab(dims, 1.0f, bottom, top); }
 
 std::size_t at(const GroundFogDesc& d, int i, int j) { return std::size_t(i) + std::size_t(d.dims.x) * std::size_t(j); }
 

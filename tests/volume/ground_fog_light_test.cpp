@@ -23,7 +23,10 @@
 #include "splatfx/reference.hpp"
 #include "splatfx/volume.hpp"
 
+#include "ground_fog_test_helpers.hpp"
+
 using namespace splatfx;
+using namespace ground_fog_test;
 
 namespace {
 
@@ -44,22 +47,6 @@ GroundFogDesc hills(glm::ivec2 dims, float densityDepth) {
             d.fogTop.push_back(1.0f + 0.4f * std::cos(3.0f * z));
         }
     return d;
-}
-
-GroundFogDesc slab(glm::ivec2 dims, float spacing, float bottom, float top) {
-    GroundFogDesc d;
-    d.dims = dims;
-    d.spacingWorld = spacing;
-    d.terrainHeight.assign(std::size_t(dims.x) * std::size_t(dims.y), bottom);
-    d.fogTop.assign(d.terrainHeight.size(), top);
-    return d;
-}
-
-GroundFogLighting sunAlong(glm::vec3 travel, float extinction) {
-    GroundFogLighting L;
-    L.sun = Light::directional(travel);
-    L.extinctionPerWorld = extinction;
-    return L;
 }
 
 // The reference's transmittance from p toward the sun, and its error bound.

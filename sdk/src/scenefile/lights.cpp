@@ -68,7 +68,6 @@ std::optional<Light> readLight(Context& c, const std::string& path, const Json& 
     });
 }
 
-
 } // namespace
 
 void readLights(Context& c, const std::string& path, const Json& v, SceneFile& out) {

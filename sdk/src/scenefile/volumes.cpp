@@ -26,7 +26,6 @@ constexpr double kMaxVolumePoints = 64.0 * 1024 * 1024;
 // copy of them (tetra_pass.cpp: ten vec4 a tetrahedron).
 constexpr std::uint64_t kFrameBytesPerTetrahedron = 80 + 160 + 160;
 
-
 // Adds a volume's estimate to the scene's and checks the sum against
 // Budgets::volumeBytes; false (reported at `where`) when it is over.
 bool addVolumeBytes(Context& c, const std::string& where, const std::string& what, std::uint64_t bytes) {
