@@ -7,9 +7,12 @@
 #include <string>
 
 #include "volume/cloud_sweep.hpp"
+#include "volume/same_phase.hpp"
 
 namespace splatfx {
 namespace {
+
+using detail::samePhase;
 
 Status checkLighting(const CloudLighting& L) {
     if (Status s = validateLight(L.sun, "CloudLighting.sun"); !s) return s;
@@ -73,13 +76,6 @@ bool sameLights(const CloudLighting& a, const CloudLighting& b) {
     if (a.lights.size() != b.lights.size() || !sameLight(a.sun, b.sun)) return false;
     for (std::size_t i = 0; i < a.lights.size(); ++i)
         if (!sameLight(a.lights[i], b.lights[i])) return false;
-    return true;
-}
-
-bool samePhase(const PhaseFunction& a, const PhaseFunction& b) {
-    if (a.lobeCount() != b.lobeCount()) return false;
-    for (int i = 0; i < a.lobeCount(); ++i)
-        if (a.lobe(i).g != b.lobe(i).g || a.lobe(i).weight != b.lobe(i).weight) return false;
     return true;
 }
 

@@ -8,6 +8,7 @@
 
 #include "splatfx/volume.hpp"
 #include "volume/ground_fog_light.hpp"
+#include "volume/same_phase.hpp"
 
 namespace splatfx {
 namespace detail {
@@ -187,6 +188,8 @@ float FogLitView::scalarAt(glm::vec3 world, bool top) const {
 
 namespace {
 
+using detail::samePhase;
+
 Status checkFogLighting(const GroundFogLighting& L) {
     if (Status s = validateLight(L.sun, "GroundFogLighting.sun"); !s) return s;
     if (L.sun.type != LightType::Directional) return makeError("GroundFogLighting.sun must be a directional light");
@@ -204,13 +207,6 @@ Status checkFogLighting(const GroundFogLighting& L) {
         return makeError("GroundFogLighting.extinctionPerWorld must be finite and >= 0");
     if (L.lengthResolution < 2 || L.lengthResolution > 1024) return makeError("GroundFogLighting.lengthResolution must be in [2, 1024]");
     return {};
-}
-
-bool samePhase(const PhaseFunction& a, const PhaseFunction& b) {
-    if (a.lobeCount() != b.lobeCount()) return false;
-    for (int i = 0; i < a.lobeCount(); ++i)
-        if (a.lobe(i).g != b.lobe(i).g || a.lobe(i).weight != b.lobe(i).weight) return false;
-    return true;
 }
 
 // What the lit transfer function and table depend on.
