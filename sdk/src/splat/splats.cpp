@@ -15,6 +15,14 @@
 namespace splatfx {
 namespace {
 
+// A table colour as the splat's 8-bit RGB (alpha byte 0xff): each channel clamped to [0, 1] and a
+// NaN read as 0, so a bad colour-table entry is dark instead of undefined behaviour (a NaN or
+// negative float converted to an unsigned int) or a channel over 1 carrying into the next byte.
+std::uint32_t packTableColor(glm::vec4 c) {
+    auto byte = [](float v) { return std::uint32_t((v > 0.0f ? std::min(v, 1.0f) : 0.0f) * 255.0f + 0.5f); };
+    return byte(c.r) | byte(c.g) << 8 | byte(c.b) << 16 | 0xff000000u;
+}
+
 // Largest optical depth (log2 units) a voxel may have: opacity 1 - 2^-24,
 // i.e. opaque at 8-bit and half precision, yet exp2(-24 * 0) stays exact at
 // the footprint's zero edge (an infinite depth would give inf * 0 = NaN).
@@ -447,8 +455,7 @@ void SplatBuilder::add(const Grid& grid, const Materials& materials, const Splat
                 // the lattice) and an opacity: reuse the last lookup and logarithm.
                 if (!haveEntry || v.colorCoord != lastCoord) {
                     entry = tableAt(v.colorCoord);
-                    packedColor = std::uint32_t(entry.r * 255.0f + 0.5f) | std::uint32_t(entry.g * 255.0f + 0.5f) << 8 |
-                                  std::uint32_t(entry.b * 255.0f + 0.5f) << 16 | 0xff000000u;
+                    packedColor = packTableColor(entry);
                     lastCoord = v.colorCoord;
                     haveEntry = true;
                 }
@@ -595,8 +602,7 @@ void SplatBuilder::add(std::span<const Particle> particles, const Materials& mat
             const size_t i = std::min(size_t(f), e.size() - 2);
             entry = glm::clamp(glm::mix(e[i], e[i + 1], f - float(i)), glm::vec4(0.0f), glm::vec4(1.0f));
         }
-        const std::uint32_t packed = std::uint32_t(entry.r * 255.0f + 0.5f) | std::uint32_t(entry.g * 255.0f + 0.5f) << 8 |
-                                     std::uint32_t(entry.b * 255.0f + 0.5f) << 16 | 0xff000000u;
+        const std::uint32_t packed = packTableColor(entry);
         const float alpha = opacity * entry.a;
         // As add(Grid): -log2(1 - alpha), log1p for small alphas, capped at kMaxTau.
         const float tau = alpha >= 1.0f ? kMaxTau : std::min(alpha < 0x1p-10f ? -std::log1p(-alpha) * 1.44269504f : -std::log2(1.0f - alpha), kMaxTau);
