@@ -56,4 +56,13 @@ std::string sourcePath(const std::string& relative) {
     return std::string(env && *env ? env : SPLATFX_SOURCE_DIR) + "/" + relative;
 }
 
+Image drawSplats(gl::Renderer& r, const std::vector<Splat>& splats, const Camera& cam, gl::Precision precision, glm::vec4 bg) {
+    auto fb = gl::Framebuffer::create({.width = cam.viewport.x, .height = cam.viewport.y, .color = precision});
+    EXPECT_TRUE(fb) << fb.error();
+    if (!fb) return {};
+    fb->clear(bg);
+    r.draw(splats, cam, {.framebuffer = fb->handle(), .width = cam.viewport.x, .height = cam.viewport.y});
+    return fb->read();
+}
+
 } // namespace splatfx::test

@@ -2,10 +2,13 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "splatfx/context.hpp"
+#include "splatfx/gl/framebuffer.hpp"
+#include "splatfx/gl/renderer.hpp"
 #include "splatfx/splatfx.hpp"
 
 namespace splatfx::test {
@@ -24,5 +27,9 @@ protected:
 std::string outputDir();
 // A file under the source tree (e.g. "tests/golden/campfire.png").
 std::string sourcePath(const std::string& relative);
+
+// `splats` drawn by `r` from `cam` into a new framebuffer of the viewport's
+// size and colour `precision`, cleared to `bg`; the image read back.
+Image drawSplats(gl::Renderer& r, const std::vector<Splat>& splats, const Camera& cam, gl::Precision precision, glm::vec4 bg);
 
 } // namespace splatfx::test

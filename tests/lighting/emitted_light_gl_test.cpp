@@ -41,24 +41,16 @@ constexpr int kW = 32, kH = 24;
 
 class EmittedLightGL : public test::GLTest {};
 
-} // namespace
-
-TEST_F(EmittedLightGL, GlslIrradianceEqualsTheCpuOnTheSameLights) {
-    // Every code path: escape shares below 1 on either side, a light with and
-    // without radius, one below the ground (its light comes from behind some normals).
-    std::vector<EmittedLight> lights;
-    lights.push_back({.position = {0.2f, 0.6f, 0.1f}, .radius = 0.3f, .intensity = {2.0f, 1.2f, 0.4f}, .escapePlus = {0.9f, 0.5f, 0.8f},
-                      .escapeMinus = {0.7f, 0.95f, 0.6f}});
-    lights.push_back({.position = {-1.5f, 1.1f, 0.8f}, .radius = 0.0f, .intensity = {0.5f, 0.3f, 0.1f}});
-    lights.push_back({.position = {1.0f, -0.5f, -1.0f}, .radius = 0.1f, .intensity = {0.3f, 0.2f, 0.6f}, .escapePlus = {0.4f, 1.0f, 0.2f},
-                      .escapeMinus = {1.0f, 0.3f, 0.9f}});
+// One fragment per pixel of a kW x kH RGBA32F target, running shadowGlsl()
+// and `body` with `binding`'s uniforms; the image read back (empty on a link
+// or framebuffer failure, which is reported).
+Image drawEveryPixel(const char* body, const char* label, const gl::ShadowBinding& binding) {
     const std::string include = shadowGlsl();
-    auto prog = gl::linkProgram({kVertex}, {"#version 450 core\n", include.c_str(), kFragmentBody}, "emitted");
-    ASSERT_TRUE(prog) << prog.error();
+    auto prog = gl::linkProgram({kVertex}, {"#version 450 core\n", include.c_str(), body}, label);
+    EXPECT_TRUE(prog) << prog.error();
     auto fb = gl::Framebuffer::create({.width = kW, .height = kH, .color = gl::Precision::F32});
-    ASSERT_TRUE(fb);
-    gl::ShadowBinding binding;
-    binding.emittedLights = lights;
+    EXPECT_TRUE(fb);
+    if (!prog || !fb) return {};
     gl::setShadowUniforms(*prog, binding);
     glProgramUniform2f(*prog, glGetUniformLocation(*prog, "uSize"), float(kW), float(kH));
     GLuint vao = 0;
@@ -75,7 +67,24 @@ TEST_F(EmittedLightGL, GlslIrradianceEqualsTheCpuOnTheSameLights) {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glDeleteVertexArrays(1, &vao);
     glDeleteProgram(*prog);
-    const Image image = fb->read();
+    return fb->read();
+}
+
+} // namespace
+
+TEST_F(EmittedLightGL, GlslIrradianceEqualsTheCpuOnTheSameLights) {
+    // Every code path: escape shares below 1 on either side, a light with and
+    // without radius, one below the ground (its light comes from behind some normals).
+    std::vector<EmittedLight> lights;
+    lights.push_back({.position = {0.2f, 0.6f, 0.1f}, .radius = 0.3f, .intensity = {2.0f, 1.2f, 0.4f}, .escapePlus = {0.9f, 0.5f, 0.8f},
+                      .escapeMinus = {0.7f, 0.95f, 0.6f}});
+    lights.push_back({.position = {-1.5f, 1.1f, 0.8f}, .radius = 0.0f, .intensity = {0.5f, 0.3f, 0.1f}});
+    lights.push_back({.position = {1.0f, -0.5f, -1.0f}, .radius = 0.1f, .intensity = {0.3f, 0.2f, 0.6f}, .escapePlus = {0.4f, 1.0f, 0.2f},
+                      .escapeMinus = {1.0f, 0.3f, 0.9f}});
+    gl::ShadowBinding binding;
+    binding.emittedLights = lights;
+    const Image image = drawEveryPixel(kFragmentBody, "emitted", binding);
+    ASSERT_EQ(image.width, kW);
     // GLSL 4.50 (sec. 4.7.1): +, -, * correctly rounded, division 2.5 ulp,
     // inversesqrt 2 ulp, normalize built from those; about 20 operations per
     // light, three lights summed: under 3 x 20 x 3 ulp = 2^-23 x 180 relative
@@ -160,30 +169,10 @@ TEST_F(EmittedLightGL, GlslGridIrradianceEqualsTheCpuOnTheSameGrid) {
             g.nodes[i][k] = glm::vec3(float((i * 7 + k * 3) % 11) + 0.5f, float((i * 5 + k) % 13) * 0.3f, float((i + k * 11) % 7) * 0.7f + 0.1f);
             largest = std::max(largest, std::max(g.nodes[i][k].x, std::max(g.nodes[i][k].y, g.nodes[i][k].z)));
         }
-    const std::string include = shadowGlsl();
-    auto prog = gl::linkProgram({kVertex}, {"#version 450 core\n", include.c_str(), kGridFragmentBody}, "emitted grid");
-    ASSERT_TRUE(prog) << prog.error();
-    auto fb = gl::Framebuffer::create({.width = kW, .height = kH, .color = gl::Precision::F32});
-    ASSERT_TRUE(fb);
     gl::ShadowBinding binding;
     binding.emittedGrid = g;
-    gl::setShadowUniforms(*prog, binding);
-    glProgramUniform2f(*prog, glGetUniformLocation(*prog, "uSize"), float(kW), float(kH));
-    GLuint vao = 0;
-    glCreateVertexArrays(1, &vao);
-    glBindFramebuffer(GL_FRAMEBUFFER, fb->handle());
-    glViewport(0, 0, kW, kH);
-    glDisable(GL_BLEND);
-    glDisable(GL_DEPTH_TEST);
-    glUseProgram(*prog);
-    glBindVertexArray(vao);
-    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-    glBindVertexArray(0);
-    glUseProgram(0);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glDeleteVertexArrays(1, &vao);
-    glDeleteProgram(*prog);
-    const Image image = fb->read();
+    const Image image = drawEveryPixel(kGridFragmentBody, "emitted grid", binding);
+    ASSERT_EQ(image.width, kW);
     // The value is a convex combination of node values (trilinear weights
     // >= 0 summing to 1, n_a^2 summing to |n|^2 = 1 up to normalize's
     // rounding) times the falloff ratio (<= 1). GLSL 4.50 (sec. 4.7.1): +, -,

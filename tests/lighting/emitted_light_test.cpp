@@ -13,6 +13,7 @@
 #include "splatfx/emitted_light.hpp"
 #include "splatfx/reference.hpp"
 #include "splatfx/scene.hpp"
+#include "test_scenes.hpp"
 
 using namespace splatfx;
 
@@ -405,14 +406,7 @@ TEST(EmittedLight, FitIsDeterministic) {
     const EmittedLightDesc desc{.enabled = true, .lights = 4};
     auto x = fitEmittedLights(splats, fm.m, desc), y = fitEmittedLights(splats, fm.m, desc);
     ASSERT_TRUE(x && y);
-    ASSERT_EQ(x->size(), y->size());
-    for (std::size_t i = 0; i < x->size(); ++i) {
-        EXPECT_EQ((*x)[i].position, (*y)[i].position);
-        EXPECT_EQ((*x)[i].intensity, (*y)[i].intensity);
-        EXPECT_EQ((*x)[i].radius, (*y)[i].radius);
-        EXPECT_EQ((*x)[i].escapePlus, (*y)[i].escapePlus);
-        EXPECT_EQ((*x)[i].escapeMinus, (*y)[i].escapeMinus);
-    }
+    EXPECT_TRUE(test::sameLights(*x, *y));
 }
 
 // Bad descs and inputs: named errors, never a crash or a NaN light.

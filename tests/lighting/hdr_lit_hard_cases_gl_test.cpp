@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include <epoxy/gl.h>
@@ -13,6 +14,7 @@
 
 #include "../reference/gl_bounds.hpp"
 #include "gl_fixture.hpp"
+#include "image_stats.hpp"
 #include "scenes.hpp"
 #include "splatfx/gl/frame_renderer.hpp"
 #include "splatfx/gl/renderer.hpp"
@@ -45,13 +47,6 @@ struct Fire {
     }
 };
 
-Image draw(gl::Renderer& r, const std::vector<Splat>& splats, const Camera& cam, gl::Precision precision, glm::vec4 bg) {
-    auto fb = gl::Framebuffer::create({.width = cam.viewport.x, .height = cam.viewport.y, .color = precision});
-    EXPECT_TRUE(fb) << fb.error();
-    fb->clear(bg);
-    r.draw(splats, cam, {.framebuffer = fb->handle(), .width = cam.viewport.x, .height = cam.viewport.y});
-    return fb->read();
-}
 
 class HdrLitHardCasesGL : public test::GLTest {};
 
@@ -85,7 +80,7 @@ TEST_F(HdrLitHardCasesGL, EdgeEncodingsReadTheSameInTheGlslAsOnTheCpu) {
         splats[0].colorCoord = e.colorCoord;
         splats[0].color = (splats[0].color & 0xff000000u) | e.rgb;
         const double m = e.colorCoord < 0.0f ? -double(e.colorCoord) : 1.0;
-        const Image got = draw(*r, splats, fire.cam, gl::Precision::F32, bg);
+        const Image got = test::drawSplats(*r, splats, fire.cam, gl::Precision::F32, bg);
         SplatExactDesc rd;
         rd.host.background = bg;
         rd.packedColor = true;
@@ -129,7 +124,7 @@ TEST_F(HdrLitHardCasesGL, AnOpaqueSplatOverAnOverflowedHalfFloatPixelIsNotNaN) {
     splats.push_back(front);
     auto r = gl::Renderer::create({.sampling = gl::TextureSampling::Bilinear});
     ASSERT_TRUE(r && r->upload(fire.m));
-    const Image got = draw(*r, splats, fire.cam, gl::Precision::F16, {0.0f, 0.0f, 0.0f, 1.0f});
+    const Image got = test::drawSplats(*r, splats, fire.cam, gl::Precision::F16, {0.0f, 0.0f, 0.0f, 1.0f});
     int nan = 0, front8 = 0;
     for (int y = 0; y < got.height; ++y)
         for (int x = 0; x < got.width; ++x) {
@@ -193,6 +188,39 @@ TEST_F(HdrLitHardCasesGL, ReducedResolutionKeepsValuesAboveOne) {
         const double peak = hdrOverLdr({.resolutionScale = scale}, 3.0 * kHalfUlp, scale == 2 ? "half resolution" : "quarter resolution");
         EXPECT_GT(peak, 1.5) << "scale " << scale << ": values above 1 must reach the target";
     }
+}
+
+TEST_F(HdrLitHardCasesGL, AnEightBitReducedLayerOnAFloatHostClampsAndSaysSo) {
+    // The host asks for an 8-bit reduced layer (reducedPrecision U8) under an
+    // RGBA32F target: the values above 1 are clamped there, and the frame's
+    // notes say so; with the default RGBA16F layer they reach the target and
+    // nothing is noted. On an 8-bit host the U8 layer loses nothing more: no note.
+    Fire hdr(true);
+    auto draw = [&](gl::Precision layer, gl::Precision host, std::vector<std::string>& notes) {
+        auto fr = gl::FrameRenderer::create({.resolutionScale = 2, .reducedPrecision = layer});
+        EXPECT_TRUE(fr && fr->upload(hdr.m));
+        if (!fr) return 0.0;
+        auto fb = gl::Framebuffer::create({.width = hdr.cam.viewport.x, .height = hdr.cam.viewport.y, .color = host});
+        EXPECT_TRUE(fb) << fb.error();
+        fr->render(hdr.frame, {.framebuffer = fb->handle(), .drawOpaque = [] {
+                                   glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+                                   glClearDepth(1.0);
+                                   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+                               }});
+        notes = fr->stats().notes;
+        return test::maxRgb(fb->read());
+    };
+    const std::string said = "reducedPrecision U8 on a floating-point host: the reduced layer clamps the volumes' colours to [0, 1]";
+    auto noted = [&](const std::vector<std::string>& notes) {
+        return std::any_of(notes.begin(), notes.end(), [&](const std::string& n) { return n.rfind(said, 0) == 0; });
+    };
+    std::vector<std::string> notes;
+    EXPECT_LE(draw(gl::Precision::U8, gl::Precision::F32, notes), 1.0) << "the U8 layer clamps";
+    EXPECT_TRUE(noted(notes)) << "the clamp must be noted";
+    EXPECT_GT(draw(gl::Precision::F16, gl::Precision::F32, notes), 1.5) << "the default layer keeps values above 1";
+    EXPECT_FALSE(noted(notes));
+    draw(gl::Precision::U8, gl::Precision::U8, notes);
+    EXPECT_FALSE(noted(notes)) << "an 8-bit host loses nothing more to an 8-bit layer";
 }
 
 TEST_F(HdrLitHardCasesGL, FullResolutionThroughTheHostDepthKeepsValuesAboveOne) {

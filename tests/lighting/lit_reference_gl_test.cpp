@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "gl_fixture.hpp"
+#include "image_stats.hpp"
 #include "splatfx/gl/renderer.hpp"
 #include "splatfx/reference.hpp"
 #include "splatfx/scene.hpp"
@@ -35,19 +36,6 @@ std::uint32_t pack(glm::vec3 c) { // scene_lighting.cpp's packLit for colours <=
 }
 glm::vec3 unpack(std::uint32_t c) { return glm::vec3(float(c & 255u), float((c >> 8) & 255u), float((c >> 16) & 255u)) / 255.0f; }
 
-double maxDiff(const Image& a, const Image& b, int channels = 3) {
-    double m = 0.0;
-    for (int y = 0; y < a.height; ++y)
-        for (int x = 0; x < a.width; ++x)
-            for (int c = 0; c < channels; ++c) m = std::max(m, double(std::abs(a.at(x, y, c) - b.at(x, y, c))));
-    return m;
-}
-double maxAlpha(const Image& img) {
-    double m = 0.0;
-    for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x) m = std::max(m, double(img.at(x, y, 3)));
-    return m;
-}
 
 class LitReferenceGL : public test::GLTest {};
 
@@ -127,7 +115,7 @@ TEST_F(LitReferenceGL, ALitFrameDecomposesIntoTableLightFieldLobeSplattingEightB
     // depends on the alphas alone, and the weights sum to the pixel's alpha. So a GL term is at
     // most the frame's largest alpha times the largest change of an 8-bit splat colour, plus the
     // F32 target's rounding (27 blends of values <= 1: < 1e-5).
-    const double glAlpha = maxAlpha(gTable);
+    const double glAlpha = test::maxAlpha(gTable);
     ASSERT_GT(glAlpha, 0.5);
     auto glTerm = [&](const char* name, const Image& a, const Image& b, const std::vector<glm::vec3>& ca, const std::vector<glm::vec3>& cb) {
         double dc = 0.0;
@@ -135,7 +123,7 @@ TEST_F(LitReferenceGL, ALitFrameDecomposesIntoTableLightFieldLobeSplattingEightB
             const glm::vec3 d = glm::abs(unpack(pack(ca[v])) - unpack(pack(cb[v])));
             dc = std::max(dc, double(std::max({d.r, d.g, d.b})));
         }
-        const double e = maxDiff(a, b);
+        const double e = test::maxDiff(a, b);
         EXPECT_LE(e, glAlpha * dc + 1e-5) << name;
         std::printf("  %-34s GL image %.3f/255 (bound %.3f)\n", name, 255.0 * e, 255.0 * (glAlpha * dc + 1e-5));
         return e;
@@ -160,11 +148,11 @@ TEST_F(LitReferenceGL, ALitFrameDecomposesIntoTableLightFieldLobeSplattingEightB
     auto exact = renderVolumeExact(field, cam, {.tolerance = 1e-6, .lighting = &lit}, &st);
     auto volFc = renderVolumeExact(vf, cam, {.tolerance = 1e-6});
     ASSERT_TRUE(vol8 && volF && exact && volFc);
-    const double splatting = maxDiff(gKernel, *vol8, 4), eight = maxDiff(*vol8, *volF), perVoxel = maxDiff(*volFc, *exact);
-    const double volAlpha = maxAlpha(*exact);
+    const double splatting = test::maxDiff(gKernel, *vol8, 4), eight = test::maxDiff(*vol8, *volF), perVoxel = test::maxDiff(*volFc, *exact);
+    const double volAlpha = test::maxAlpha(*exact);
     EXPECT_LE(eight, volAlpha * 0.5 / 255.0 + 1e-7);
     EXPECT_GT(perVoxel, 100.0 * st.maxErrorEstimate) << "the reference must resolve the per-voxel term";
-    const double total = maxDiff(gTable, *exact);
+    const double total = test::maxDiff(gTable, *exact);
     std::printf("  %-34s %.3f/255 (RGBA, measured)\n  %-34s %.3f/255 (bound %.3f)\n  %-34s %.3f/255 (reference error %.1e)\n"
                 "  GL frame vs the lit reference: %.3f/255\n",
                 "splatting (GL vs volume)", 255.0 * splatting, "8-bit lit colour", 255.0 * eight, volAlpha * 0.5,

@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include "image_stats.hpp"
 #include "splatfx/reference.hpp"
 #include "test_scenes.hpp"
 
@@ -69,11 +70,6 @@ glm::vec3 eightBit(glm::vec3 c) {
     return c;
 }
 
-double maxDiff(const Image& a, const Image& b) {
-    double m = 0.0;
-    for (std::size_t i = 0; i < a.pixels.size(); ++i) m = std::max(m, double(std::abs(a.pixels[i] - b.pixels[i])));
-    return m;
-}
 double maxVoxelDiff(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b) {
     double m = 0.0;
     for (std::size_t i = 0; i < a.size(); ++i)
@@ -83,12 +79,6 @@ double maxVoxelDiff(const std::vector<glm::vec3>& a, const std::vector<glm::vec3
 // Largest pixel opacity (1 - T): every per-voxel colour term is at most this times the largest
 // change of a voxel colour, because the pixel is sum_steps w_s * (colour mean) with weights
 // w_s >= 0 summing to 1 - T that do not depend on the colours (a fixed step makes them identical).
-double maxAlpha(const Image& img) {
-    double m = 0.0;
-    for (int y = 0; y < img.height; ++y)
-        for (int x = 0; x < img.width; ++x) m = std::max(m, double(img.at(x, y, 3)));
-    return m;
-}
 
 // sup over each kernel's support of |base (f(x) - f(c_j))|: what replacing the lit factor at
 // every sample point by its value at the voxel centre can change a colour by (the image changes by
@@ -158,7 +148,7 @@ TEST(LitReference, EmissionOnlyReproducesTheUnlitVolumeReferenceBitForBit) {
     auto lit1 = renderVolumeExact(f, s.camera, {.threads = 1, .lighting = &lit});
     ASSERT_TRUE(unlit && lit1);
     EXPECT_EQ(unlit->pixels, lit1->pixels);
-    EXPECT_GT(maxAlpha(*unlit), 0.5);
+    EXPECT_GT(test::maxAlpha(*unlit), 0.5);
 }
 
 TEST(LitReference, TheFactorIsTheModelOfLightingHppAtEveryPoint) {
@@ -199,9 +189,9 @@ TEST(LitReference, ErrorDecomposesIntoPerVoxelLightFieldTableLobeAndEightBitTerm
     VolumeExactStats voxStats;
     auto perVoxel = renderVolumeExact(s.field(voxel), s.camera, {.tolerance = 1e-6}, &voxStats);
     ASSERT_TRUE(perVoxel);
-    const double alpha = maxAlpha(*exact);
+    const double alpha = test::maxAlpha(*exact);
     const double quad = refStats.maxErrorEstimate + voxStats.maxErrorEstimate;
-    const double perVoxelTerm = maxDiff(*exact, *perVoxel);
+    const double perVoxelTerm = test::maxDiff(*exact, *perVoxel);
     const double perVoxelLimit = alpha * perVoxelBound(s, f, s.lit, voxel) + quad;
     EXPECT_LE(perVoxelTerm, perVoxelLimit);
     // Resolved: the term stands well above the reference's own error (else it would not "show").
@@ -213,7 +203,7 @@ TEST(LitReference, ErrorDecomposesIntoPerVoxelLightFieldTableLobeAndEightBitTerm
     auto image = [&](const std::vector<glm::vec3>& c) { return *renderVolumeExact(s.field(c), s.camera, {.fixedStep = h}); };
     const Image base = image(voxel);
     auto term = [&](const char* name, const std::vector<glm::vec3>& c, double voxelBound) {
-        const double v = maxVoxelDiff(c, voxel), img = maxDiff(image(c), base);
+        const double v = maxVoxelDiff(c, voxel), img = test::maxDiff(image(c), base);
         EXPECT_LE(v, voxelBound) << name;
         EXPECT_LE(img, alpha * v * (1.0 + 1e-6) + 1e-7) << name; // float image rounding
         std::printf("  %-38s voxels %.3f/255, image %.3f/255\n", name, 255.0 * v, 255.0 * img);
@@ -337,8 +327,8 @@ TEST(LitReferenceHardCases, ASpotConeEdgeThroughTheVolumeKeepsThePerVoxelErrorWi
     auto exact = renderVolumeExact(f, s.camera, {.tolerance = 1e-6, .lighting = &s.lit}, &a);
     auto perVoxel = renderVolumeExact(s.field(voxel), s.camera, {.tolerance = 1e-6}, &b);
     ASSERT_TRUE(exact && perVoxel);
-    const double term = maxDiff(*exact, *perVoxel);
-    EXPECT_LE(term, maxAlpha(*exact) * perVoxelBound(s, f, s.lit, voxel) + a.maxErrorEstimate + b.maxErrorEstimate);
+    const double term = test::maxDiff(*exact, *perVoxel);
+    EXPECT_LE(term, test::maxAlpha(*exact) * perVoxelBound(s, f, s.lit, voxel) + a.maxErrorEstimate + b.maxErrorEstimate);
     EXPECT_GT(term, 1.0 / 255.0) << "a hard cone edge must show as per-voxel error";
 }
 

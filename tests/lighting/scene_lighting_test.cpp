@@ -6,8 +6,10 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
 
+#include "splatfx/cloud.hpp"
 #include "splatfx/reference.hpp"
 #include "splatfx/scene.hpp"
+#include "splatfx/volume.hpp"
 #include "test_scenes.hpp"
 
 using namespace splatfx;
@@ -216,6 +218,37 @@ TEST(SceneLighting, TablesOverTheLightingBudgetAreNeverBuiltAndTheErrorNamesTheF
     EXPECT_EQ(s.scene.lightingError(), "");
     EXPECT_EQ(s.frame.counters().litEffects, 1u);
     EXPECT_TRUE(s.frame.shadow().valid);
+}
+
+TEST(SceneLighting, TheLightingBudgetCountsOnlyTheTablesThatAreBuilt) {
+    // A lit ground fog and a lit cloud keep the default options (SelfShadow::Table, 32^3) but
+    // build no self-shadow tables (the fog's light is a closed form, the cloud's its relight):
+    // a budget that holds exactly the effect's four tables and the scene shadow still holds
+    // with them in the scene, and the error counts one table-lit effect.
+    LitScene s({.enabled = true, .selfShadow = SelfShadow::Table, .tableDims = glm::ivec3(128)});
+    for (int i = 0; i < 4; ++i) ASSERT_TRUE(s.scene.addLight(Light::directional({0.1f * float(i), -1.0f, 0.0f})));
+    const TransferFunction fogTransfer = *makeGroundFogTransfer({0.9f, 0.92f, 0.95f}, 1.2f);
+    GroundFogDesc fog;
+    fog.dims = {9, 9};
+    fog.terrainHeight.assign(81, 0.0f);
+    fog.fogTop.assign(81, 1.5f);
+    s.scene.add(*GroundFog::create(fog), fogTransfer, *PreIntegrationTable::create(fogTransfer, {.scalarResolution = 4, .lengthResolution = 4}),
+                {.name = "fog", .lighting = {.enabled = true}});
+    CloudLighting cloudLight;
+    cloudLight.model = CloudLightModel::LowAlbedo;
+    s.scene.add(*Cloud::create({.cloud = {.dims = {9, 9, 5}}, .lighting = cloudLight}), {.name = "cloud", .lighting = {.enabled = true}});
+    const std::uint64_t needed = 147062784; // 4 x 128^3 x 17 bytes + the 64^3 scene shadow (the test above)
+    Budgets b;
+    b.lightingBytes = needed;
+    s.scene.setBudgets(b);
+    s.prepare(0.0);
+    EXPECT_EQ(s.scene.lightingError(), "");
+    EXPECT_TRUE(s.frame.shadow().valid);
+    b.lightingBytes = needed - 1;
+    s.scene.setBudgets(b);
+    s.prepare(0.1);
+    EXPECT_NE(s.scene.lightingError().find("4 light(s) x 1 table-lit effect(s) and the scene shadow needs 147062784 bytes"), std::string::npos)
+        << s.scene.lightingError();
 }
 
 TEST(SceneLighting, ASceneShadowLightPastTheLightsIsAnErrorNotNoShadow) {

@@ -3,14 +3,23 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "splatfx/emitted_light.hpp"
 #include "splatfx/grid.hpp"
 #include "splatfx/lighting.hpp"
 #include "splatfx/scene.hpp"
 
 namespace splatfx::test {
+
+// Two fits' lights, equal field for field and bit for bit.
+inline bool sameLights(const std::vector<EmittedLight>& a, const std::vector<EmittedLight>& b) {
+    auto fields = [](const EmittedLight& l) { return std::tie(l.position, l.radius, l.intensity, l.escapePlus, l.escapeMinus); };
+    return std::equal(a.begin(), a.end(), b.begin(), b.end(), [&](const EmittedLight& x, const EmittedLight& y) { return fields(x) == fields(y); });
+}
 
 // A smooth Gaussian blob of opacity (peak `peak` at the centre), n^3 cells of `spacing`.
 inline Grid gaussianBlob(int n, float spacing, float peak = 0.6f) {

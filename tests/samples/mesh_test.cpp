@@ -184,12 +184,12 @@ TEST(SceneHostHeightmap, SamplesBecomeGridPointsFacingUp) {
 // a few bytes claiming 8192^2 samples (6.5-8 GB as a mesh) are refused, and
 // a lowered budget refuses a real image by the same rule.
 TEST(SceneHostHeightmap, AHeightmapOverItsVertexBudgetIsRefusedFromItsHeader) {
-    auto huge = scenehost::heightmapMesh(writeFile("heightmap_huge.pgm", "P5\n8192 8192\n255\n" + std::string(8192, '\1')), 1.0f, 1.0f);
+    auto huge = scenehost::heightmapMesh(writeFile("heightmap_huge.pgm", std::string("P5\n8192 8192\n255\n").append(8192, '\1')), 1.0f, 1.0f);
     ASSERT_FALSE(huge);
     EXPECT_NE(huge.error().find("(8192x8192) as a mesh needs 67108864 vertices, over the budget of 20000000 (raise Budgets::heightmapVertices)"),
               std::string::npos)
         << huge.error();
-    const std::string small = writeFile("heightmap_3x2.pgm", "P5\n3 2\n255\n" + std::string(6, '\7'));
+    const std::string small = writeFile("heightmap_3x2.pgm", std::string("P5\n3 2\n255\n").append(6, '\7'));
     ASSERT_TRUE(scenehost::heightmapMesh(small, 1.0f, 1.0f));
     splatfx::Budgets low;
     low.heightmapVertices = 5;

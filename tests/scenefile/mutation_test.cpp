@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "sanitized.hpp"
 #include "splatfx/scene_file.hpp"
 
 namespace {
@@ -68,8 +69,9 @@ TEST(SceneFileCorpus, MutationsNeverCrashAndAlwaysExplain) {
     int rejected = 0, accepted = 0;
     for (const fs::path& p : seeds()) {
         const std::string text = read(p);
-        // Solver-heavy samples cost more per parse; 60 variants each keeps the test to a few seconds.
-        for (int i = 0; i < 60; ++i) {
+        // Solver-heavy samples cost more per parse; 60 variants each keeps the test to a few seconds
+        // (12 sanitized, where fuzz_scene_file runs 10000 under the same sanitizers).
+        for (int i = 0; i < splatfx::test::count(60, 12); ++i) {
             const std::string m = mutate(text, rng);
             splatfx::Materials materials(splatfx::Footprint{});
             auto r = splatfx::parseSceneFile(m, p.string(), materials);

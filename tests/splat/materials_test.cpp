@@ -138,9 +138,9 @@ TEST(Presets, EffectsWithDifferentSeedsShareTheirTextureSets) {
 }
 
 TEST(Presets, AGivenSetIsSharedByContent) {
-    auto folder = loadTextureSet(std::string(SPLATFX_SOURCE_DIR) + "/textures/turbulence-8x32");
+    auto folder = loadTextureSet(std::string(SPLATFX_SOURCE_DIR "/textures/turbulence-8x32"));
     ASSERT_TRUE(folder) << folder.error();
-    auto again = loadTextureSet(std::string(SPLATFX_SOURCE_DIR) + "/textures/turbulence-8x32/"); // spelled differently
+    auto again = loadTextureSet(std::string(SPLATFX_SOURCE_DIR "/textures/turbulence-8x32/")); // spelled differently
     ASSERT_TRUE(again) << again.error();
     Materials m{Footprint{}};
     auto a = presets::steam(m, {.textureSet = *folder});

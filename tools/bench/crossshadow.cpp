@@ -15,6 +15,7 @@
 #include <ctime>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,24 @@ struct Measured {
     double ms = 0.0, rmse = 0.0, maxErr = 0.0;
     std::size_t splats = 0, pairs = 0, skipped = 0;
 };
+
+// Each splat's red channel (8-bit, grey base) against exact(splat), an
+// optional: empty stops with false. Fills out's splats, rmse and maxErr.
+template <class Exact>
+bool splatErrors(const std::vector<splatfx::Splat>& splats, Exact exact, Measured& out) {
+    double sum = 0.0, maxErr = 0.0;
+    for (const splatfx::Splat& sp : splats) {
+        const std::optional<double> e = exact(sp);
+        if (!e) return false;
+        const double d = double(sp.color & 255u) / 255.0 - *e;
+        sum += d * d;
+        maxErr = std::max(maxErr, std::fabs(d));
+    }
+    out.splats = splats.size();
+    out.rmse = splats.empty() ? 0.0 : std::sqrt(sum / double(splats.size()));
+    out.maxErr = maxErr;
+    return true;
+}
 
 // n plumes, stacked 8 units apart along the sun (column) or 10 apart along x (side by side).
 bool measure(int n, bool column, bool casts, int frames, Measured& out) {
@@ -113,20 +132,15 @@ bool measure(int n, bool column, bool casts, int frames, Measured& out) {
             if (j != k) others.back().addMedium(plumeMedium(grids[std::size_t(j)]));
     }
     const LitVolumeDesc lit{.lights = {sun}, .gas = {.albedo = 1.0f}};
-    double sum = 0.0, maxErr = 0.0;
-    std::size_t count = 0;
-    for (const Splat& sp : frame.splats()) {
-        const int k = owner(sp.center);
-        if (k < 0) return std::fprintf(stderr, "crossshadow: a splat outside every plume\n"), false;
-        const double exact = double(kGrey) * litFactor(others[std::size_t(k)], glm::dvec3(sp.center), glm::dvec3(camera.eye()), lit).x;
-        const double d = double(sp.color & 255u) / 255.0 - exact;
-        sum += d * d;
-        maxErr = std::max(maxErr, std::fabs(d));
-        ++count;
-    }
-    out.splats = count;
-    out.rmse = count ? std::sqrt(sum / double(count)) : 0.0;
-    out.maxErr = maxErr;
+    const bool inPlumes = splatErrors(
+        frame.splats(),
+        [&](const Splat& sp) -> std::optional<double> {
+            const int k = owner(sp.center);
+            if (k < 0) return std::nullopt;
+            return double(kGrey) * litFactor(others[std::size_t(k)], glm::dvec3(sp.center), glm::dvec3(camera.eye()), lit).x;
+        },
+        out);
+    if (!inPlumes) return std::fprintf(stderr, "crossshadow: a splat outside every plume\n"), false;
     out.ms = bench::percentile(times, 0.5);
     return true;
 }
@@ -196,17 +210,7 @@ bool measureFog(bool casts, bool sceneShadow, int frames, Measured& out, double*
         integrateGroundFogRay(fd, tf, p, toSun, 0.0, 1e4, 1e-10, 20, &st);
         return st.transmittance;
     };
-    double sum = 0.0, maxErr = 0.0;
-    std::size_t count = 0;
-    for (const Splat& sp : frame.splats()) {
-        const double d = double(sp.color & 255u) / 255.0 - double(kGrey) * fogT(glm::dvec3(sp.center));
-        sum += d * d;
-        maxErr = std::max(maxErr, std::fabs(d));
-        ++count;
-    }
-    out.splats = count;
-    out.rmse = count ? std::sqrt(sum / double(count)) : 0.0;
-    out.maxErr = maxErr;
+    splatErrors(frame.splats(), [&](const Splat& sp) { return std::optional<double>(double(kGrey) * fogT(glm::dvec3(sp.center))); }, out);
     out.ms = bench::percentile(times, 0.5);
     if (tableRmse && sceneShadow && frame.shadow().valid && scene.status(fogId).inSceneShadow) {
         // The table at the terrain under the fog (trilinear in the table's box), every 4th grid point, against the layer's T.

@@ -73,13 +73,24 @@ Status Scene::setLight(std::size_t i, const Light& light) {
     return {};
 }
 
+namespace {
+
+// An effect that builds self-shadow tables: lit with SelfShadow::Table and of a
+// kind lit through splats. Clouds (their relight) and the tetrahedra kinds (a
+// ground fog's closed form; LOD volumes are unlit) build none, whatever their
+// options say.
+bool buildsShadowTables(const EffectKind& kind, const EffectOptions& options) {
+    if (!options.enabled || !options.lighting.enabled || options.lighting.selfShadow != SelfShadow::Table) return false;
+    return !dynamic_cast<const detail::CloudKind*>(&kind) && !dynamic_cast<const detail::TetraKind*>(&kind);
+}
+
+} // namespace
+
 std::uint64_t Scene::requiredLightingBytes() const {
     std::uint64_t total = 0;
-    for (const Entry& e : mEntries) {
-        const EffectLighting& L = e.options.lighting;
-        if (!e.options.enabled || !L.enabled || L.selfShadow != SelfShadow::Table) continue;
-        total += ShadowTable::memoryBytes(L.tableDims) * mLights.size(); // one table per light
-    }
+    for (const Entry& e : mEntries)
+        if (buildsShadowTables(*e.kind, e.options))
+            total += ShadowTable::memoryBytes(e.options.lighting.tableDims) * mLights.size(); // one table per light
     if (mSceneShadowDesc.enabled) total += ShadowTable::memoryBytes(mSceneShadowDesc.dims); // slot 0's
     return total;
 }
@@ -87,10 +98,7 @@ std::uint64_t Scene::requiredLightingBytes() const {
 Status Scene::checkLightingBudget() const {
     if (mLights.empty()) return {};
     std::size_t tableLit = 0;
-    for (const Entry& e : mEntries) {
-        const EffectLighting& L = e.options.lighting;
-        if (e.options.enabled && L.enabled && L.selfShadow == SelfShadow::Table) ++tableLit;
-    }
+    for (const Entry& e : mEntries) tableLit += buildsShadowTables(*e.kind, e.options) ? 1 : 0;
     return checkBudget("lighting: the shadow tables of " + std::to_string(mLights.size()) + " light(s) x " + std::to_string(tableLit) +
                            " table-lit effect(s)" + (mSceneShadowDesc.enabled ? " and the scene shadow" : ""),
                        requiredLightingBytes(), "bytes", mBudgets.lightingBytes, "lightingBytes");

@@ -23,28 +23,46 @@ namespace splatfx::gl {
 
 namespace {
 
-// Whether the host's colour buffer (its draw buffer 0) stores 32-bit floats:
-// blending into it rounds no more than the volume layer would, so the layer is
-// not used. RGBA16F rounds each blend to 11 bits: that one takes the layer.
-bool hostColorIsFloat32(unsigned framebuffer) {
+// The host's colour buffer (its draw buffer 0): floating point or not, and
+// its red channel's bits. One of 32-bit floats takes the volumes straight:
+// blending into it rounds no more than the volume layer would. RGBA16F rounds
+// each blend to 11 bits: that one takes the layer.
+struct HostColor {
+    bool isFloat = false;
+    int redBits = 0;
+};
+
+HostColor hostColor(unsigned framebuffer) {
     GLint bound = 0, buffer = GL_NONE;
     glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &bound);
     if (GLuint(bound) != framebuffer) glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer);
     glGetIntegerv(GL_DRAW_BUFFER0, &buffer);
     if (GLuint(bound) != framebuffer) glBindFramebuffer(GL_DRAW_FRAMEBUFFER, GLuint(bound));
     if (framebuffer == 0) buffer = buffer == GL_FRONT ? GL_FRONT_LEFT : buffer == GL_BACK ? GL_BACK_LEFT : buffer;
-    if (buffer == GL_NONE) return false;
+    if (buffer == GL_NONE) return {};
     GLint object = GL_NONE, type = GL_NONE;
     glGetNamedFramebufferAttachmentParameteriv(framebuffer, GLenum(buffer), GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE, &object);
     // A context without a default framebuffer (surfaceless) answers with an
     // error: the layer is used, and the error must not reach a later pass's own check.
     if (framebuffer == 0)
         while (glGetError() != GL_NO_ERROR) {}
-    if (object == GL_NONE) return false; // asking more of an empty attachment is an error
+    if (object == GL_NONE) return {}; // asking more of an empty attachment is an error
     GLint red = 0;
     glGetNamedFramebufferAttachmentParameteriv(framebuffer, GLenum(buffer), GL_FRAMEBUFFER_ATTACHMENT_COMPONENT_TYPE, &type);
     glGetNamedFramebufferAttachmentParameteriv(framebuffer, GLenum(buffer), GL_FRAMEBUFFER_ATTACHMENT_RED_SIZE, &red);
-    return type == GL_FLOAT && red >= 32;
+    return {.isFloat = type == GL_FLOAT, .redBits = red};
+}
+
+// An 8-bit intermediate image the volumes go through on a floating-point host
+// clamps their colours at 1 (HDR lit colour, emission above 1): said, not done
+// silently, since the host asked for that precision.
+std::string clampingLayerNote(const FramePlan& plan, const FrameRendererDesc& desc, bool volumeLayer, HostColor host) {
+    if (!host.isFloat) return {};
+    if (plan.reduced && desc.reducedPrecision == Precision::U8)
+        return "reducedPrecision U8 on a floating-point host: the reduced layer clamps the volumes' colours to [0, 1] and rounds them to 8 bits";
+    if (!plan.reduced && plan.tetrahedra && volumeLayer && desc.volumeLayerPrecision == Precision::U8)
+        return "volumeLayerPrecision U8 on a floating-point host: the volume layer clamps the volumes' colours to [0, 1] and rounds them to 8 bits";
+    return {};
 }
 
 // The per-sample runs of a multisampled host that draw the volumes into the
@@ -92,7 +110,8 @@ struct FrameRenderer::Impl {
     const void* context = nullptr; // the context create() ran in: its GL objects are names in that context only
     FramePlan plan;
     FrameRenderStats stats;
-    std::string depthNote; // the camera's depth convention against the context and its projection
+    std::string depthNote;     // the camera's depth convention against the context and its projection
+    std::string clampingNote;  // an 8-bit layer on a floating-point host (clampingLayerNote)
     bool layerPerSample = false; // the last frame's per-sample runs drew the volume layer per sample (layerCameras)
     detail::ShadowPass shadow;
     detail::HostPass host;
@@ -200,8 +219,10 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
     r.host.addSampleTexture(depth, target.x + frame.camera().viewport.x, target.y + frame.camera().viewport.y);
     FrameRendererDesc planDesc = r.desc;
     if (!r.splats.layerError().empty()) planDesc.volumeLayer = false; // noted in report()
-    else if (planDesc.volumeLayer && planDesc.resolutionScale == 1 && hostColorIsFloat32(target.framebuffer)) planDesc.volumeLayer = false;
+    const HostColor hostColorBuffer = hostColor(target.framebuffer);
+    if (planDesc.volumeLayer && planDesc.resolutionScale == 1 && hostColorBuffer.isFloat && hostColorBuffer.redBits >= 32) planDesc.volumeLayer = false;
     r.plan = planFrame(frame, target, planDesc, depth);
+    r.clampingNote = clampingLayerNote(r.plan, planDesc, planDesc.volumeLayer, hostColorBuffer);
     for (detail::Pass* p : r.passes()) p->prepare(r.plan, frame);
     detail::StepContext context{.frame = frame, .host = target, .plan = r.plan, .splatLayers = r.splats.renderer().layerTexture()};
     const std::vector<Camera> sampleCameras = layerCameras(frame.camera(), target.framebuffer, r.plan);
@@ -247,6 +268,7 @@ void FrameRenderer::Impl::report(const Frame& frame, const detail::StepContext& 
         if (!line.empty() && std::find(s.notes.begin(), s.notes.end(), line) == s.notes.end()) s.notes.push_back(line);
     };
     note(depthNote);
+    note(clampingNote);
     note(s.fog.error);
     for (const PlanStep& step : plan.steps)
         if (step.range != StepRange::ListsBehindAndBetween) note(step.note); // that one is noted with its count, when it applies
