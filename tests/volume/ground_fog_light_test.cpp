@@ -49,15 +49,6 @@ GroundFogDesc hills(glm::ivec2 dims, float densityDepth) {
     return d;
 }
 
-// The reference's transmittance from p toward the sun, and its error bound.
-std::pair<double, double> referenceT(const GroundFogDesc& d, float extinction, glm::vec3 p, glm::vec3 travel) {
-    const TransferFunction tf = *makeGroundFogTransfer(glm::vec3(1.0f), extinction);
-    GroundFogRayStats st;
-    integrateGroundFogRay(d, tf, glm::dvec3(p), -glm::normalize(glm::dvec3(travel)), 0.0, 1e4, 1e-11, 20, &st);
-    EXPECT_TRUE(st.converged);
-    return {st.transmittance, st.errorEstimate};
-}
-
 void expectSelfShadowIsTheReference(const GroundFogDesc& d, glm::vec3 travel, float extinction) {
     auto fog = GroundFog::create(d);
     ASSERT_TRUE(fog) << fog.error();
@@ -73,7 +64,7 @@ void expectSelfShadowIsTheReference(const GroundFogDesc& d, glm::vec3 travel, fl
             for (int top = 0; top < 2; ++top) {
                 const auto [want, err] = referenceT(d, extinction, {x, top ? ht : hb, z}, travel);
                 EXPECT_NEAR(T[2 * k + std::size_t(top)], want, kFloatT + 2.0 * err) << i << ", " << j << (top ? " top" : " terrain");
-                lowest = std::min(lowest, want);
+                if (want > 0.0) lowest = std::min(lowest, want); // 0: the terrain hides the sun
             }
         }
     EXPECT_LT(lowest, 0.9); // the layer does shadow itself
@@ -104,6 +95,44 @@ TEST(GroundFogLight, SunStraightDownThroughAFlatLayer) {
         EXPECT_NEAR(fog->sunTransmittance()[2 * k], want, kFloatT) << k;
         EXPECT_EQ(fog->sunTransmittance()[2 * k + 1], 1.0f) << k;
     }
+}
+
+// A ridge across the layer under a low sun: the fog in its lee gets no
+// direct light (T = 0 at every point whose ray to the sun passes under the
+// terrain), the sunward side and the points above the crest's line are as
+// before (the layer's own transmittance); a sun below the horizon lights
+// nothing (the ground goes on past the grid). Both against the reference's
+// brute-force test over every triangle (terrainHides).
+TEST(GroundFogLight, TheTerrainHidesTheSunFromTheFogInItsLee) {
+    GroundFogDesc d = slab({12, 4}, 0.5f, 0.0f, 1.2f);
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 12; ++i) {
+            const float h = std::max(0.0f, 2.5f - 1.5f * std::abs(float(i) - 4.0f)); // a ridge 2.5 high at i = 4
+            d.terrainHeight[std::size_t(i) + 12u * std::size_t(j)] = h;
+            d.fogTop[std::size_t(i) + 12u * std::size_t(j)] = h + 1.2f;
+        }
+    auto fog = GroundFog::create(d);
+    ASSERT_TRUE(fog) << fog.error();
+    const glm::vec3 travel{0.9f, -0.35f, 0.1f}; // the sun low at -x: the lee is at i > 4
+    ASSERT_TRUE(fog->setLighting(sunAlong(travel, 0.8f)));
+    int hidden = 0, lit = 0;
+    for (int j = 0; j < 4; ++j)
+        for (int i = 0; i < 12; ++i)
+            for (int top = 0; top < 2; ++top) {
+                const std::size_t k = std::size_t(i) + 12u * std::size_t(j);
+                const glm::vec3 p(d.originWorld.x + float(i) * d.spacingWorld, top ? d.fogTop[k] : d.terrainHeight[k], d.originWorld.z + float(j) * d.spacingWorld);
+                const auto [want, err] = referenceT(d, 0.8f, p, travel);
+                EXPECT_NEAR(fog->sunTransmittance()[2 * k + std::size_t(top)], want, kFloatT + 2.0 * err) << i << ", " << j << (top ? " top" : " terrain");
+                (want == 0.0 ? hidden : lit) += 1;
+                if (i <= 3) {
+                    EXPECT_GT(want, 0.0) << "the sunward side is lit";
+                }
+            }
+    EXPECT_GT(hidden, 8) << "the lee must be in the ridge's shadow";
+    EXPECT_GT(lit, 40);
+    // Below the horizon: no direct light anywhere.
+    ASSERT_TRUE(fog->setLighting(sunAlong({0.9f, 0.05f, 0.1f}, 0.8f)));
+    for (float T : fog->sunTransmittance()) EXPECT_EQ(T, 0.0f);
 }
 
 // The sun at the horizon grazes the terrain: a terrain point's ray runs along

@@ -38,24 +38,16 @@ double ratioIntegral(double a, double b, double c, double e, double L) {
 
 } // namespace
 
-double fogScalarIntegral(const FogFieldView& f, glm::dvec3 p, glm::dvec3 u, std::vector<double>& ts, double tMax) {
-    if (f.nx < 2 || f.nz < 2 || !(tMax > 0.0)) return 0.0;
+namespace {
+
+// Walks p + t u, t in [lo, hi] (inside the grid's domain), over the layer's
+// triangulation: visit(t0, t1, h0, h1, th0, th1) for each piece over one
+// triangle, with the terrain h and thickness th at its ends (both linear on
+// it). Returns false as soon as visit does (the walk stops).
+template <class Visit>
+bool walkTriangles(const FogFieldView& f, glm::dvec3 p, glm::dvec3 u, double lo, double hi, std::vector<double>& ts, Visit&& visit) {
     const double s = f.spacing;
     const double ax = (p.x - f.origin.x) / s, bx = u.x / s, az = (p.z - f.origin.y) / s, bz = u.z / s;
-    double lo = 0.0, hi = std::min(tMax, 1e30);
-    auto slab = [&](double a, double b, double lower, double upper) {
-        if (b == 0.0) {
-            if (a < lower || a > upper) hi = lo - 1.0;
-            return;
-        }
-        double t0 = (lower - a) / b, t1 = (upper - a) / b;
-        if (t0 > t1) std::swap(t0, t1);
-        lo = std::max(lo, t0), hi = std::min(hi, t1);
-    };
-    slab(ax, bx, 0.0, double(f.nx - 1));
-    slab(az, bz, 0.0, double(f.nz - 1));
-    slab(p.y, u.y, f.yLo, f.yHi);
-    if (!(hi > lo)) return 0.0;
     ts.clear();
     ts.push_back(lo), ts.push_back(hi);
     auto lines = [&](double a, double b, int count) {
@@ -70,7 +62,6 @@ double fogScalarIntegral(const FogFieldView& f, glm::dvec3 p, glm::dvec3 u, std:
     lines(ax, bx, f.nx);
     lines(az, bz, f.nz);
     std::sort(ts.begin(), ts.end());
-    double total = 0.0;
     for (std::size_t c = 0; c + 1 < ts.size(); ++c) {
         const double ta = ts[c], tb = ts[c + 1];
         if (!(tb > ta)) continue;
@@ -113,30 +104,80 @@ double fogScalarIntegral(const FogFieldView& f, glm::dvec3 p, glm::dvec3 u, std:
             };
             auto hAt = [&](int x, int z) { return f.h(x, z); };
             auto thAt = [&](int x, int z) { return f.th(x, z); };
-            const double h0 = linear(hAt, t0), h1 = linear(hAt, t1), th0 = linear(thAt, t0), th1 = linear(thAt, t1);
-            const double y0 = p.y + u.y * t0, y1 = p.y + u.y * t1;
-            // g1 = y - terrain, g2 = top - y: linear in t; the layer is where both are >= 0.
-            const double g1a = y0 - h0, g1b = y1 - h1, g2a = h0 + th0 - y0, g2b = h1 + th1 - y1;
-            double l0 = t0, l1 = t1;
-            for (const auto& g : {std::make_pair(g1a, g1b), std::make_pair(g2a, g2b)}) {
-                const double fa = g.first, fb = g.second;
-                if (fa < 0.0 && fb < 0.0) l1 = l0 - 1.0;
-                else if (fa < 0.0) l0 = std::max(l0, t0 + (t1 - t0) * fa / (fa - fb));
-                else if (fb < 0.0) l1 = std::min(l1, t0 + (t1 - t0) * fa / (fa - fb));
-            }
-            if (!(l1 > l0)) continue;
-            const double L = l1 - l0;
-            auto at = [&](double fa, double fb, double t) { return fa + (fb - fa) * (t - t0) / (t1 - t0); };
-            const double g2l0 = std::max(at(g2a, g2b, l0), 0.0), g2l1 = std::max(at(g2a, g2b, l1), 0.0);
-            if (f.depth > 0.0) {
-                total += f.density / f.depth * 0.5 * (g2l0 + g2l1) * L; // affine scalar: the trapezoid is exact
-            } else {
-                const double c0 = std::max(at(th0, th1, l0), 0.0), c1 = std::max(at(th0, th1, l1), 0.0);
-                total += f.density * ratioIntegral(g2l0, (g2l1 - g2l0) / L, c0, (c1 - c0) / L, L);
-            }
+            if (!visit(t0, t1, linear(hAt, t0), linear(hAt, t1), linear(thAt, t0), linear(thAt, t1))) return false;
         }
     }
+    return true;
+}
+
+// Clips [0, tMax] of p + t u to the grid's domain in x and z and to [yLo, yHi]
+// in y; false when nothing is left.
+bool clipToLayer(const FogFieldView& f, glm::dvec3 p, glm::dvec3 u, double yLo, double yHi, double tMax, double& lo, double& hi) {
+    const double s = f.spacing;
+    lo = 0.0, hi = std::min(tMax, 1e30);
+    auto slab = [&](double a, double b, double lower, double upper) {
+        if (b == 0.0) {
+            if (a < lower || a > upper) hi = lo - 1.0;
+            return;
+        }
+        double t0 = (lower - a) / b, t1 = (upper - a) / b;
+        if (t0 > t1) std::swap(t0, t1);
+        lo = std::max(lo, t0), hi = std::min(hi, t1);
+    };
+    slab((p.x - f.origin.x) / s, u.x / s, 0.0, double(f.nx - 1));
+    slab((p.z - f.origin.y) / s, u.z / s, 0.0, double(f.nz - 1));
+    slab(p.y, u.y, yLo, yHi);
+    return hi > lo;
+}
+
+} // namespace
+
+double fogScalarIntegral(const FogFieldView& f, glm::dvec3 p, glm::dvec3 u, std::vector<double>& ts, double tMax) {
+    double lo = 0.0, hi = 0.0;
+    if (f.nx < 2 || f.nz < 2 || !(tMax > 0.0) || !clipToLayer(f, p, u, f.yLo, f.yHi, tMax, lo, hi)) return 0.0;
+    double total = 0.0;
+    walkTriangles(f, p, u, lo, hi, ts, [&](double t0, double t1, double h0, double h1, double th0, double th1) {
+        const double y0 = p.y + u.y * t0, y1 = p.y + u.y * t1;
+        // g1 = y - terrain, g2 = top - y: linear in t; the layer is where both are >= 0.
+        const double g1a = y0 - h0, g1b = y1 - h1, g2a = h0 + th0 - y0, g2b = h1 + th1 - y1;
+        double l0 = t0, l1 = t1;
+        for (const auto& g : {std::make_pair(g1a, g1b), std::make_pair(g2a, g2b)}) {
+            const double fa = g.first, fb = g.second;
+            if (fa < 0.0 && fb < 0.0) l1 = l0 - 1.0;
+            else if (fa < 0.0) l0 = std::max(l0, t0 + (t1 - t0) * fa / (fa - fb));
+            else if (fb < 0.0) l1 = std::min(l1, t0 + (t1 - t0) * fa / (fa - fb));
+        }
+        if (!(l1 > l0)) return true;
+        const double L = l1 - l0;
+        auto at = [&](double fa, double fb, double t) { return fa + (fb - fa) * (t - t0) / (t1 - t0); };
+        const double g2l0 = std::max(at(g2a, g2b, l0), 0.0), g2l1 = std::max(at(g2a, g2b, l1), 0.0);
+        if (f.depth > 0.0) {
+            total += f.density / f.depth * 0.5 * (g2l0 + g2l1) * L; // affine scalar: the trapezoid is exact
+        } else {
+            const double c0 = std::max(at(th0, th1, l0), 0.0), c1 = std::max(at(th0, th1, l1), 0.0);
+            total += f.density * ratioIntegral(g2l0, (g2l1 - g2l0) / L, c0, (c1 - c0) / L, L);
+        }
+        return true;
+    });
     return total;
+}
+
+bool terrainBlocks(const FogFieldView& f, glm::dvec3 p, glm::dvec3 u, std::vector<double>& ts) {
+    // The ground goes on past the grid: a light below the horizon is behind it.
+    if (u.y < 0.0) return true;
+    if (f.nx < 2 || f.nz < 2) return false;
+    // Only the terrain can block, so the walk ends where the ray rises above the
+    // highest terrain point or leaves the grid.
+    double lo = 0.0, hi = 0.0;
+    if (!clipToLayer(f, p, u, -1e30, std::min(f.hMax, 1e30), 1e30, lo, hi)) return false;
+    // Below the terrain by more than the rounding of the terrain's linear
+    // interpolation (double, of floats of at most this size) is blocked; a ray
+    // along the surface (a vertex's own slope, a sun on the horizon over flat
+    // ground) is not.
+    const double eps = 1e-9 * (1.0 + std::abs(f.yHi) + std::abs(f.yLo) + f.spacing);
+    return !walkTriangles(f, p, u, lo, hi, ts, [&](double t0, double t1, double h0, double h1, double, double) {
+        return !(p.y + u.y * t0 - h0 < -eps || p.y + u.y * t1 - h1 < -eps);
+    });
 }
 
 double fogScalarAt(const FogFieldView& f, glm::dvec3 p) {
@@ -241,7 +282,10 @@ double GroundFog::opticalDepthToSun(glm::dvec3 p, glm::dvec3 towardSun) const {
 }
 
 Status GroundFog::relightFog(std::span<const ShadowCaster* const> casters) {
-    const detail::FogFieldView f = fieldView();
+    detail::FogFieldView f = fieldView();
+    f.hMax = -1e30;
+    for (int j = 0; j < f.nz; ++j)
+        for (int i = 0; i < f.nx; ++i) f.hMax = std::max(f.hMax, f.h(i, j));
     const int points = mDesc.lod ? mN * mN : mDesc.dims.x * mDesc.dims.y;
     std::vector<float> trans(2 * std::size_t(points), 1.0f);
     const glm::dvec3 toSun = -glm::normalize(glm::dvec3(mLighting.sun.direction));
@@ -254,6 +298,14 @@ Status GroundFog::relightFog(std::span<const ShadowCaster* const> casters) {
             const float hb = float(f.h(i, j)), ht = hb + float(f.th(i, j));
             for (int k = 0; k < 2; ++k) {
                 const glm::vec3 p(x, k ? ht : hb, z);
+                // A hill between the point and the sun: no direct light (ambient and multiple scattering
+                // remain). Asked at the exact grid point (double): the float position is off the grid line
+                // by its rounding, which on a steep slope would put the point below its own terrain.
+                const glm::dvec3 exact(f.origin.x + double(i) * f.spacing, k ? double(ht) : double(hb), f.origin.y + double(j) * f.spacing);
+                if (detail::terrainBlocks(f, exact, toSun, scratch)) {
+                    trans[2 * f.at(i, j) + std::size_t(k)] = 0.0f;
+                    continue;
+                }
                 double depth = ext > 0.0 ? ext * detail::fogScalarIntegral(f, glm::dvec3(p), toSun, scratch) : 0.0;
                 double log2Depth = 0.0;
                 for (const ShadowCaster* c : casters) log2Depth += double(c->opticalDepthToLight(p, mLighting.sun));

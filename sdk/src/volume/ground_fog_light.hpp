@@ -24,6 +24,7 @@ struct FogFieldView {
     const float* thickness = nullptr; // thickness (LOD), or null
     double density = 1.0, depth = 0.0; // GroundFogDesc::density, densityDepthWorld
     double yLo = 0.0, yHi = 0.0;       // the layer's lowest terrain and highest top
+    double hMax = 1e30;                // the highest terrain point, where known (terrainBlocks' walk ends above it)
 
     std::size_t at(int i, int j) const { return std::size_t(i) + std::size_t(stride) * std::size_t(j); }
     double h(int i, int j) const { return double(height[at(i, j)]); }
@@ -37,6 +38,11 @@ struct FogFieldView {
 double fogScalarIntegral(const FogFieldView& f, glm::dvec3 p, glm::dvec3 u, std::vector<double>& scratch, double tMax = 1e30);
 // The fog's scalar at a point of the same continuous layer (0 outside it).
 double fogScalarAt(const FogFieldView& f, glm::dvec3 p);
+// Whether the terrain stands between p and a light toward u (unit): the ray
+// passes below the terrain's triangulation inside the grid, or the light is
+// below the horizon (u.y < 0: the ground goes on past the grid). A ray along
+// the surface is not blocked.
+bool terrainBlocks(const FogFieldView& f, glm::dvec3 p, glm::dvec3 u, std::vector<double>& scratch);
 
 // What update() needs to light each emitted vertex.
 struct FogLitView {
