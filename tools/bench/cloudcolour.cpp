@@ -98,19 +98,20 @@ int runCloudColour(int argc, char** argv) {
             const auto e = Clock::now();
             if (f >= 0) m.updateMs.push_back(ms(b - a)), m.passMs.push_back(ms(e - c));
         }
-    std::printf("cloudcolour: cloud %dx%dx%d, detailC %.1f, %dx%d RGBA16F, %d frames per mode, interleaved (medians)\n", size, size, nz, detailC, width,
-                height, frames);
+    std::printf("cloudcolour: cloud %dx%dx%d, detailC %.1f, %dx%d RGBA16F, %d frames per mode, interleaved (medians)\n", size, size, nz, detailC,
+                width, height, frames);
     for (const Mode& m : modes) {
         const splatfx::LodFrame& lod = m.frame.volumes()[0].lod;
         const auto& st = m.renderer->stats();
         const std::size_t frameBytes = lod.tets.size() * sizeof(splatfx::Tetrahedron) + lod.rgb.size() * sizeof(lod.rgb[0]);
         const std::size_t recordBytes = std::size_t(st.tetrahedra.drawn) * (lod.rgb.empty() ? 10u : 12u) * 16u;
-        std::printf("  %-45s %7zu tetrahedra (%llu drawn, %llu RGB)  update ms %8.2f  pass ms %8.2f  LodFrame %6.2f MB  records %6.2f MB%s%s\n", m.name,
-                    lod.tets.size(), static_cast<unsigned long long>(st.tetrahedra.drawn), static_cast<unsigned long long>(st.tetrahedra.rgb),
+        std::printf("  %-45s %7zu tetrahedra (%llu drawn, %llu RGB)  update ms %8.2f  pass ms %8.2f  LodFrame %6.2f MB  records %6.2f MB%s%s\n",
+                    m.name, lod.tets.size(), static_cast<unsigned long long>(st.tetrahedra.drawn), static_cast<unsigned long long>(st.tetrahedra.rgb),
                     bench::median(m.updateMs), bench::median(m.passMs), double(frameBytes) / 1e6, double(recordBytes) / 1e6,
                     st.notes.empty() ? "" : "  note: ", st.notes.empty() ? "" : st.notes[0].c_str());
     }
-    std::printf("  ratio two colours / one colour: update %.2fx, pass %.2fx\n", bench::median(modes[1].updateMs) / std::max(bench::median(modes[0].updateMs), 1e-9),
+    std::printf("  ratio two colours / one colour: update %.2fx, pass %.2fx\n",
+                bench::median(modes[1].updateMs) / std::max(bench::median(modes[0].updateMs), 1e-9),
                 bench::median(modes[1].passMs) / std::max(bench::median(modes[0].passMs), 1e-9));
     return 0;
 }
