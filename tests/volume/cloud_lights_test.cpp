@@ -9,13 +9,19 @@
 // The cloud: 17x17x9 grid points of spacing 0.5 (box [0, 8] x [0, 8] x [0, 4]),
 // density 0.4 everywhere, maxExtinctionPerWorld 1.5: sigma = 0.6 per unit.
 //
+// Lights of different colours (a white sun and a torch's orange): each
+// vertex carries an RGB source s_c = u R_c (LodFrame::rgb), drawn per channel
+// as kappa_c(s_c); the same model and tolerance per channel.
+//
 // Tolerances. Transmittance: the trace is DensityField's segment integral in
 // float over at most ~40 lattice pieces, of a depth <= 4 nats whose per-voxel
 // value is itself a float conversion (relative ~1e-7): |T - exact| <= 1e-5
 // (as cloud_light_test.cpp's sweep). Vertex source: the LOD stores the scalar
 // u in 8 bits (rounded: half a code, 0.5 / 255), each vertex draws s = u R
 // with R in [0, 1], and kappa(s) = A + B s: so |source - model| <= B (0.5 /
-// 255 + 1e-5), the 1e-5 covering T and the float phase and irradiance.
+// 255 + 1e-5), the 1e-5 covering T and the float phase and irradiance. With
+// an RGB source s_c = u R_c, R_c in [0, 1] likewise (a light's channel is at
+// most its largest, w_i): the same bound per channel, B_c (0.5 / 255 + 1e-5).
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -112,21 +118,30 @@ glm::dvec3 model(glm::dvec3 terms) { return 0.9 * (glm::dvec3(0.1, 0.12, 0.15) +
 
 const Camera kCamera = Camera::lookAt({4.0f, -12.0f, 6.0f}, {4.0f, 4.0f, 2.0f}, {0.0f, 0.0f, 1.0f}, 0.8f, {64, 48});
 
-// Every vertex of the fully refined mesh (a grid point) against `want`.
+// Every vertex of the fully refined mesh (a grid point) against `want`:
+// one scalar per vertex (frame.rgb empty), or with `rgb` an RGB source
+// (channel c drawn as kappa_c(rgb_c), the scalar its largest channel).
 template <class Want>
-void checkVertices(Cloud& cloud, Want want) {
+void checkVertices(Cloud& cloud, Want want, bool rgb = false) {
     LodFrame frame;
     ASSERT_TRUE(cloud.update(kCamera, {.detailC = 1e6f, .zeroOpacityTest = false, .clipNear = false}, frame));
     ASSERT_FALSE(frame.tets.empty());
+    ASSERT_EQ(frame.rgb.size(), rgb ? frame.tets.size() : 0u);
     const glm::dvec3 B = cloud.transfer().color(1.0) - cloud.transfer().color(0.0);
     int checked = 0;
-    for (const Tetrahedron& t : frame.tets)
+    for (std::size_t i = 0; i < frame.tets.size(); ++i)
         for (int k = 0; k < 4; ++k) {
+            const Tetrahedron& t = frame.tets[i];
             const glm::vec3 p = t.position[std::size_t(k)];
             const glm::ivec3 g = glm::ivec3(glm::round(p / kH));
             ASSERT_LT(glm::length(p - glm::vec3(g) * kH), 1e-4f) << "fully refined vertices are grid points";
             const glm::dvec3 w = want(g, glm::dvec3(p));
-            const glm::dvec3 got = cloud.transfer().color(t.scalar[std::size_t(k)]);
+            glm::dvec3 got = cloud.transfer().color(t.scalar[std::size_t(k)]);
+            if (rgb) {
+                const glm::vec3 s = frame.rgb[i][std::size_t(k)];
+                for (int c = 0; c < 3; ++c) got[c] = cloud.transfer().color(s[c])[c];
+                EXPECT_EQ(t.scalar[std::size_t(k)], std::max({s.x, s.y, s.z}));
+            }
             for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], w[c], B[c] * (0.5 / 255.0 + 1e-5)) << g.x << " " << g.y << " " << g.z;
             ++checked;
         }
@@ -232,6 +247,59 @@ TEST(CloudLights, SunAndPointLightSummed) {
     });
 }
 
+// The typical case of lights of different colours: a torch's orange under a
+// white sun. Each vertex's RGB source against the model per channel; the
+// cloud's colour is no multiple of either light's (its red-to-blue ratio
+// varies over the cloud: the torch's share falls with distance).
+TEST(CloudLights, WhiteSunAndOrangeTorchGiveAnRgbSourcePerVertex) {
+    CloudLighting L;
+    L.sun = Light::directional({0.3f, 0.2f, -1.0f}, glm::vec3(1.0f), 1.2f);
+    const Light torch = Light::point({1.5f, 2.0f, 3.0f}, {1.0f, 0.45f, 0.1f}, 6.0f);
+    L.lights = {torch};
+    Cloud cloud = uniformCloud(L, true);
+    checkVertices(
+        cloud,
+        [&](glm::ivec3, glm::dvec3 p) {
+            // The sun's T in closed form: its ray to the box's face, the sun as a light far along -direction.
+            const double sunT = closedT(p, p - 1e4 * glm::normalize(glm::dvec3(L.sun.direction)));
+            return model(lightTerm(L.sun, p, glm::dvec3(kCamera.eye()), sunT) +
+                         lightTerm(torch, p, glm::dvec3(kCamera.eye()), closedT(p, glm::dvec3(torch.position))));
+        },
+        true);
+    // The drawn colour does vary in chromaticity: red over blue near the torch against far from it.
+    LodFrame frame;
+    ASSERT_TRUE(cloud.update(kCamera, {.detailC = 1e6f, .zeroOpacityTest = false, .clipNear = false}, frame));
+    double lo = 1e30, hi = 0.0;
+    for (std::size_t i = 0; i < frame.tets.size(); ++i)
+        for (std::size_t k = 0; k < 4; ++k) {
+            const glm::dvec3 c(cloud.transfer().color(frame.rgb[i][k].r).r, 0.0, cloud.transfer().color(frame.rgb[i][k].b).b);
+            lo = std::min(lo, c.x / c.z), hi = std::max(hi, c.x / c.z);
+        }
+    EXPECT_GT(hi, 1.5 * lo);
+}
+
+// The same cloud under lights sharing one colour keeps one scalar per vertex
+// (frame.rgb empty: the pass draws it as before, the same records and program).
+TEST(CloudLights, LightsOfOneColourKeepOneScalarPerVertex) {
+    CloudLighting L;
+    L.sun = Light::directional({0.3f, 0.2f, -1.0f}, {1.0f, 0.45f, 0.1f}, 1.2f);
+    L.lights = {Light::point({1.5f, 2.0f, 3.0f}, {2.0f, 0.9f, 0.2f}, 3.0f)};
+    Cloud cloud = uniformCloud(L, true);
+    LodFrame frame;
+    ASSERT_TRUE(cloud.update(kCamera, {.detailC = 1e6f, .zeroOpacityTest = false, .clipNear = false}, frame));
+    ASSERT_FALSE(frame.tets.empty());
+    EXPECT_TRUE(frame.rgb.empty());
+    // A new colour for the torch: RGB from the next update on; back to one colour: empty again.
+    L.lights[0].color = {0.2f, 0.9f, 1.0f};
+    ASSERT_TRUE(cloud.setLight({.model = CloudLightModel::LowAlbedo, .sun = L.sun, .lights = L.lights, .gas = cloud.lighting().gas}));
+    ASSERT_TRUE(cloud.update(kCamera, {.detailC = 1e6f, .zeroOpacityTest = false, .clipNear = false}, frame));
+    EXPECT_EQ(frame.rgb.size(), frame.tets.size());
+    L.lights[0].color = {2.0f, 0.9f, 0.2f};
+    ASSERT_TRUE(cloud.setLight({.model = CloudLightModel::LowAlbedo, .sun = L.sun, .lights = L.lights, .gas = cloud.lighting().gas}));
+    ASSERT_TRUE(cloud.update(kCamera, {.detailC = 1e6f, .zeroOpacityTest = false, .clipNear = false}, frame));
+    EXPECT_TRUE(frame.rgb.empty());
+}
+
 // A light that moves relights (and traces again); the same light does
 // neither; a new intensity relights (the scale moves) without tracing; a new
 // density traces again.
@@ -269,18 +337,9 @@ TEST(CloudLights, BadLightsAreRefusedNamingTheField) {
     const std::uint64_t relights = cloud->relights();
     CloudLighting L = cloud->lighting();
     L.lights = {Light::point({0.0f, 0.0f, 10.0f}), Light::point({1.0f, 0.0f, 10.0f}, {1.0f, 0.5f, 0.2f})};
-    Status s = cloud->setLight(L);
-    ASSERT_FALSE(s);
-    EXPECT_EQ(s.error(), "CloudLighting.lights[1].color must be a multiple of CloudLighting.sun.color: a cloud draws one light colour (one scalar "
-                         "per vertex); lights of other colours cannot light it");
-    L.sun.intensity = 0.0f; // the sun unlit: lights[0] is the colour to match
-    s = cloud->setLight(L);
-    ASSERT_FALSE(s);
-    EXPECT_NE(s.error().find("must be a multiple of CloudLighting.lights[0].color"), std::string::npos) << s.error();
-    L.lights[1].color = {3.0f, 3.0f, 3.0f}; // white x 3: a multiple
-    EXPECT_TRUE(Cloud::validateLighting(L));
+    EXPECT_TRUE(Cloud::validateLighting(L)); // lights of different colours are taken (row 317: no longer refused)
     L.lights[1].position.y = std::numeric_limits<float>::quiet_NaN();
-    s = cloud->setLight(L);
+    Status s = cloud->setLight(L);
     ASSERT_FALSE(s);
     EXPECT_EQ(s.error(), "CloudLighting.lights[1].position must be finite");
     L.lights.assign(std::size_t(kMaxCloudLights) + 1, Light::point({0.0f, 0.0f, 10.0f}));
@@ -297,8 +356,9 @@ TEST(CloudLights, BadLightsAreRefusedNamingTheField) {
 }
 
 // In a Scene: a low-albedo cloud takes the scene's sun and its point light;
-// a spot aimed away is not taken (it cannot reach the cloud), a light of
-// another colour is left out and counted (SceneCounters::cloudLightsDropped).
+// a spot aimed away is not taken (it cannot reach the cloud); a light of
+// another colour is taken too (an RGB source per vertex), and only lights past
+// kMaxCloudLights are left out and counted (SceneCounters::cloudLightsDropped).
 TEST(CloudLights, SceneLightsTheCloudWithItsPointLights) {
     CloudCreateDesc d = uniformDesc();
     d.cloud.dims = {9, 9, 5};
@@ -318,7 +378,13 @@ TEST(CloudLights, SceneLightsTheCloudWithItsPointLights) {
     EXPECT_EQ(scene.counters().cloudLightsDropped, 0u);
     ASSERT_TRUE(scene.addLight(Light::point({1.0f, 1.0f, 6.0f}, {1.0f, 0.4f, 0.1f}, 10.0f))); // a torch's orange
     ASSERT_TRUE(scene.prepare(0.0, cam, materials, frame));
-    EXPECT_EQ(scene.findCloud(id)->lighting().lights.size(), 1u);
-    EXPECT_EQ(scene.counters().cloudLightsDropped, 1u);
+    EXPECT_EQ(scene.findCloud(id)->lighting().lights.size(), 2u);
+    EXPECT_EQ(scene.counters().cloudLightsDropped, 0u);
     EXPECT_TRUE(scene.lightingError().empty()) << scene.lightingError();
+    ASSERT_EQ(frame.volumes().size(), 1u);
+    EXPECT_EQ(frame.volumes()[0].lod.rgb.size(), frame.volumes()[0].lod.tets.size()); // drawn with an RGB source
+    for (int k = 0; k < 3; ++k) ASSERT_TRUE(scene.addLight(Light::point({1.0f + float(k), 3.0f, 6.0f}, {0.2f, 0.4f, 1.0f}, 5.0f)));
+    ASSERT_TRUE(scene.prepare(0.0, cam, materials, frame));
+    EXPECT_EQ(scene.findCloud(id)->lighting().lights.size(), std::size_t(kMaxCloudLights));
+    EXPECT_EQ(scene.counters().cloudLightsDropped, 1u); // the fifth: past the cap
 }

@@ -34,6 +34,7 @@ int runDevice(int argc, char** argv);       // device.cpp: the GL context the be
 int runEmitted(int argc, char** argv);      // emitted.cpp: a campfire as light: fitted lights vs the exact irradiance, fit and GLSL cost (issue 27.3)
 int runCrossShadow(int argc, char** argv); // crossshadow.cpp: lit effects shadowing one another in a Scene, 1/2/4 effects, cost and error (issue 27.2)
 int runHdr(int argc, char** argv);          // hdr.cpp: HDR lit colour and RGBA16F/32F targets against the 8-bit path (issues 26, 27)
+int runCloudColour(int argc, char** argv);  // cloudcolour.cpp: a cloud under lights of different colours (RGB per vertex) vs one colour (issue 27)
 
 // cloud_knobs.cpp, run by accuracy (--clouds-only alone): the LOD clouds' table size, c, C and
 // max vs average Delta against the finest level integrated exactly (issue 17). Needs a current GL context.
@@ -65,6 +66,7 @@ inline constexpr BenchCommand kCommands[] = {
     {"vdb", "OpenVDB import: voxels per cell and splat filter against the file's voxels at full resolution; Pareto plot", runVdb},
     {"particles", "splats at particle positions (host, emitter) vs the same number of grid splats: CPU frame, GL pass, error vs the exact reference", runParticles},
     {"cloudlight", "LOD cloud relit as the sun moves: ms per relight per model and size, skipped relight, table rebuild; transmittance vs exact", runCloudLight},
+    {"cloudcolour", "a low-albedo cloud under lights of different colours (RGB per vertex) vs one colour: update and tetrahedra pass ms, ratio, bytes", runCloudColour},
     {"crossshadow", "lit effects shadowing one another in a Scene: 1, 2, 4 plumes with and without the cross-shadow, ms per frame, colour vs exact", runCrossShadow},
     {"obstacles", "solver step cost with obstacles (a bridge, a moving locomotive, as boxes or meshes, free or no slip) against none", runObstacles},
     {"device", "the OpenGL context the benches get (SPLATFX_EGL_DEVICE selects an EGL device): vendor, renderer, sample limits", runDevice},

@@ -27,12 +27,14 @@
 // integral, inside the grid's box: light enters at the grid's faces as the
 // sun's does), and the source sums them as lightPoints does (irradiance
 // 1/d^2 capped at max(radiusWorld, spacing / 2), the spot's cone, the HG
-// phase per light, multipleScattering per light). The tetrahedra draw one
-// scalar per vertex, so every lit light (the sun included; one of zero
-// colour or intensity is left out) must share one chromaticity: setLight
-// refuses lights whose colours are not multiples of one another, naming the
-// light. Points a spot's cone leaves dark are not traced, and a light of zero
-// intensity not at all (lightTraces() counts the traced points).
+// phase per light, multipleScattering per light). When every lit light (the
+// sun included; one of zero colour or intensity is left out) shares one
+// chromaticity the tetrahedra carry one scalar per vertex; lights of
+// different colours (a torch's orange under a white sun) give each vertex an
+// RGB source instead (LodFrame::rgb, drawn per channel by the tetrahedra
+// pass: 48 more bytes per tetrahedron, three table lookups a segment). Points
+// a spot's cone leaves dark are not traced, and a light of zero intensity not
+// at all (lightTraces() counts the traced points).
 //
 // Layout (volume.hpp): Roettger is CloudModel::DensityTableLightLength
 // (scalar f, length scale gamma); LowAlbedo is CloudModel::LightTableDensityLength's
@@ -41,8 +43,7 @@
 // writes s = T phase(theta) / max phase at each vertex: pre-integration is
 // exact for a colour affine in s, so the per-vertex phase costs no table.
 //
-// It does NOT: draw (the tetrahedra go to the projected-tetrahedra pass), take
-// lights of different colours (one scalar per vertex draws one light colour),
+// It does NOT: draw (the tetrahedra go to the projected-tetrahedra pass),
 // light the Roettger model with anything but the sun (its gamma = ambient +
 // diffuse T is a bounded sun term, not an irradiance), or receive the shadows
 // of other volumes. It casts through densityField(): a Scene puts a lit
@@ -82,10 +83,10 @@ struct CloudLighting {
     // CloudDesc's default sunDirection points back to.
     Light sun = Light::directional({-0.3f, -0.2f, -1.0f});
     // LowAlbedo only: up to kMaxCloudLights more lights (directional, point,
-    // spot), summed with the sun. Every light with non-zero colour x
-    // intensity, the sun included, must have a colour that is a multiple of
-    // the others' (set the sun's intensity to 0 to light by these alone).
-    // Default none (the sun alone, as before).
+    // spot), summed with the sun, of any colours (set the sun's intensity to
+    // 0 to light by these alone). Lights whose colours are multiples of one
+    // another draw one scalar per vertex; others an RGB source per vertex
+    // (update()). Default none (the sun alone, as before).
     std::vector<Light> lights{};
     // Roettger: gamma = ambient + diffuse T, each >= 0, sum <= 1; T through
     // CloudDesc::lightExtinctionPerCell. Defaults as CloudDesc (0.35, 0.65).
@@ -116,8 +117,8 @@ public:
     // Fails on a bad field in any desc (the message names it) or a sun that
     // is not a valid directional light.
     static Result<Cloud> create(const CloudCreateDesc& desc = {});
-    // What setLight checks, without a cloud: every field, the lights' count
-    // and kind for the model, and their shared colour. The message names the field.
+    // What setLight checks, without a cloud: every field, and the lights' count
+    // and kind for the model. The message names the field.
     static Status validateLighting(const CloudLighting& lighting);
 
     // Relights when the lighting differs from the current one (any field), and
@@ -141,8 +142,12 @@ public:
     // light's share of the common colour, E_i its irradiance factor) and each
     // vertex gets s = u R, R = sum_i w_i E_i (4 pi phase_i T_i + m) / sum_i
     // w_i E_i (4 pi maxPhase T_i + m) at the vertex (lightPoints, T_i
-    // trilinear between grid points): O(vertices x lights) per frame.
-    // Fails as LodVolume::update.
+    // trilinear between grid points): O(vertices x lights) per frame. With
+    // lights of different colours (w_i then the light's largest channel) it
+    // also writes out.rgb, s_c = u R_c with R_c = sum_i c_i,c E_i (4 pi
+    // phase_i T_i + m) / the same denominator (c_i the light's colour x
+    // intensity), drawn per channel as kappa_c(s_c), and the scalar max_c s_c;
+    // otherwise out.rgb is left empty. Fails as LodVolume::update.
     Status update(const Camera& camera, const LodRefineDesc& refine, LodFrame& out);
 
     const LodVolume& volume() const { return mVolume; }
@@ -160,6 +165,8 @@ public:
     const std::vector<float>& lightTransmittance(std::size_t i) const { return mLightT[i].trans; }
     // With lights beside the sun: the largest source over the grid that the
     // scalar's 1 stands for (sum_i w_i E_i (4 pi maxPhase T_i + m)); 0 without.
+    // w_i: the light's share of the common colour, or its largest channel
+    // when the lights' colours differ (the colour scale is then white).
     float lightScale() const { return mLightScale; }
     // Grid points traced toward point and spot lights since creation.
     std::uint64_t lightTraces() const { return mLightTraces; }
@@ -193,7 +200,7 @@ private:
     Cloud() = default;
     Status relight();
     Status traceLights();
-    std::vector<Light> unitLights(float scale, std::vector<const std::vector<float>*>* trans = nullptr) const;
+    std::vector<Light> unitLights(float scale, std::vector<const std::vector<float>*>* trans = nullptr, bool coloured = false) const;
     Status applyLightPhases(const Camera& camera, LodFrame& out);
     glm::vec3 gridPoint(glm::ivec3 p) const;
     Status rebuildTable();
@@ -210,6 +217,7 @@ private:
     std::vector<LightState> mLightT;
     glm::vec3 mLightColour{0.0f}; // the common colour x intensity the weights are shares of
     float mLightScale = 0.0f;
+    bool mRgb = false; // lights of different colours: an RGB source per vertex (LodFrame::rgb)
     std::vector<glm::vec3> mVertexScratch, mSeenScratch, mBoundScratch; // update(): reused per frame
     std::uint64_t mRelights = 0, mTableBuilds = 0, mLightTraces = 0;
 };

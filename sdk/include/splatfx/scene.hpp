@@ -249,9 +249,8 @@ struct SceneCounters {
     std::size_t crossShadowPairs = 0;
     std::size_t crossShadowPairsSkipped = 0;
     // Lit clouds at the last emit(): scene lights (other than the sun) that
-    // reach a cloud's box but do not light it: any for the Roettger model,
-    // past kMaxCloudLights, or of a colour not a multiple of the lights it
-    // took before (a cloud draws one light colour; cloud.hpp). Summed over clouds.
+    // reach a cloud's box but do not light it: any for the Roettger model, or
+    // past kMaxCloudLights (lights of any colour are taken: cloud.hpp). Summed over clouds.
     std::size_t cloudLightsDropped = 0;
 };
 
@@ -272,7 +271,7 @@ public:
     // A relightable cloud (cloud.hpp). With options.lighting.enabled it
     // follows the scene's first directional light (and, in the low-albedo
     // model, options.lighting.gas and the scene's other lights that reach it,
-    // up to kMaxCloudLights of one colour; SceneCounters::cloudLightsDropped
+    // up to kMaxCloudLights of any colour; SceneCounters::cloudLightsDropped
     // counts the rest), relit only when those change.
     EffectId add(Cloud cloud, EffectOptions options = {});
     // Any other kind (effect_kind.hpp). Expects kind != nullptr.

@@ -193,6 +193,14 @@ struct LodFrameStats {
 struct LodFrame {
     std::vector<Tetrahedron> tets; // back to front for the camera of the update
     LodFrameStats stats;
+    // A source colour per vertex, for a transfer kappa(s) = A + B s whose
+    // extinction does not depend on s (a LowAlbedo Cloud lit by lights of
+    // different colours, cloud.hpp): empty (one scalar, the default), or one
+    // entry per tets entry, channel c of vertex k drawn as kappa_c(rgb[i][k][c])
+    // (pre-integration stays exact: affine per channel). 48 bytes a
+    // tetrahedron beside its 80; tets[i].scalar then holds each vertex's
+    // largest channel. Producers that write one scalar clear it.
+    std::vector<std::array<glm::vec3, 4>> rgb;
 };
 
 // The octree over a grid of (R.x 2^n + 1) x (R.y 2^n + 1) x (R.z 2^n + 1)

@@ -131,7 +131,7 @@ enum Define { MODE };
 enum Uniform { Ray, DepthAxis, HostDepthMap, Origin, Size, FogParams, FogColour, FogFar, FogSize, Threshold, UniformCount };
 } // namespace fog_pass
 namespace tetra {
-enum Define { PERSPECTIVE, HAS_DEPTH, FOG };
+enum Define { PERSPECTIVE, HAS_DEPTH, FOG, RGB };
 enum Uniform { ViewProjRel, First, Forward, HostDepthMap, TexScale, TexOffset, MaxLength, FogParams, FogColour, FogFar, SampleRay, InvViewProjRel, Viewport, NdcZ, UniformCount };
 } // namespace tetra
 namespace section {

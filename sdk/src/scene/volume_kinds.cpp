@@ -116,7 +116,9 @@ Status CloudKind::follow(std::span<const Light> lights, const EffectLighting& li
         }
         L.lights.push_back(l);
         if (sun) L.sun = *sun;
-        if (!Cloud::validateLighting(L)) L.lights.pop_back(), ++dropped; // another colour than the lights before
+        // Lights of any colour are taken (an RGB source per vertex when they
+        // differ); a light the cloud refuses all the same is left out and counted.
+        if (!Cloud::validateLighting(L)) L.lights.pop_back(), ++dropped;
     }
     if (!sun && L.lights.empty() && mCloud.lighting().lights.empty()) return {}; // nothing to follow: keeps its own sun
     if (sun) L.sun = *sun;

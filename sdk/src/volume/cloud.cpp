@@ -36,26 +36,6 @@ Status checkLighting(const CloudLighting& L) {
                          std::to_string(kMaxCloudLights));
     for (std::size_t i = 0; i < L.lights.size(); ++i)
         if (Status s = validateLight(L.lights[i], "CloudLighting.lights[" + std::to_string(i) + "]"); !s) return s;
-    // One scalar per vertex draws one light colour: every lit light's colour
-    // must be a multiple of the first lit one's (cross product zero up to
-    // float rounding of the products, 1e-6 relative).
-    const Light* ref = nullptr;
-    std::string refName;
-    for (std::size_t i = 0; i <= L.lights.size(); ++i) {
-        const Light& l = i == 0 ? L.sun : L.lights[i - 1];
-        const std::string name = i == 0 ? std::string("CloudLighting.sun") : "CloudLighting.lights[" + std::to_string(i - 1) + "]";
-        const glm::dvec3 c = glm::dvec3(l.color) * double(l.intensity);
-        if (!(glm::dot(c, c) > 0.0)) continue;
-        if (!ref) {
-            ref = &l;
-            refName = name;
-            continue;
-        }
-        const glm::dvec3 r = glm::dvec3(ref->color);
-        if (glm::length(glm::cross(c, r)) > 1e-6 * glm::length(c) * glm::length(r))
-            return makeError(name + ".color must be a multiple of " + refName +
-                             ".color: a cloud draws one light colour (one scalar per vertex); lights of other colours cannot light it");
-    }
     return {};
 }
 
@@ -97,6 +77,28 @@ bool sameColour(const CloudLighting& a, const CloudLighting& b) {
 float phaseMax(const PhaseFunction& p) { return std::max(p(1.0f), p(-1.0f)); }
 
 bool multiLight(const CloudLighting& L) { return L.model == CloudLightModel::LowAlbedo && !L.lights.empty(); }
+
+// Whether every lit light's colour (the sun's included; one of zero colour or
+// intensity lights nothing) is a multiple of the first lit one's: cross
+// product zero up to float rounding of the products, 1e-6 relative. Then one
+// scalar per vertex draws them (the one-scalar path); otherwise each vertex
+// carries an RGB source (LodFrame::rgb).
+bool sharedColour(const CloudLighting& L) {
+    glm::dvec3 ref(0.0);
+    bool first = true;
+    for (std::size_t i = 0; i <= L.lights.size(); ++i) {
+        const Light& l = i == 0 ? L.sun : L.lights[i - 1];
+        const glm::dvec3 c = glm::dvec3(l.color) * double(l.intensity);
+        if (!(glm::dot(c, c) > 0.0)) continue;
+        if (first) {
+            ref = glm::dvec3(l.color);
+            first = false;
+            continue;
+        }
+        if (glm::length(glm::cross(c, ref)) > 1e-6 * glm::length(c) * glm::length(ref)) return false;
+    }
+    return true;
+}
 
 // Transmittance towards each light between grid points: trilinear in the
 // per-point arrays (exact at grid points), clamped onto the grid.
@@ -170,6 +172,7 @@ Status Cloud::relight() {
     if (mLighting.model == CloudLightModel::Roettger) {
         detail::sweepSunTransmittance(mDims, mDensity, double(mDesc.cloud.lightExtinctionPerCell), towardSun, mTrans);
         field.scalar = mDensity;
+        mRgb = false;
         field.lengthScale.resize(count);
         for (std::size_t i = 0; i < count; ++i) field.lengthScale[i] = std::min(1.0f, mLighting.ambient + mLighting.diffuse * mTrans[i]);
     } else {
@@ -183,11 +186,15 @@ Status Cloud::relight() {
             field.scalar = mTrans;
             mLightT.clear();
             mLightScale = 0.0f;
+            mRgb = false;
         } else {
             // u = sum_i w_i E_i (4 pi maxPhase T_i + m) / scale at every grid
             // point, by the lighting code's own evaluation (lightPoints with
             // an isotropic phase: 4 pi phase = 1, each light's colour
             // w_i 4 pi maxPhase and multipleScattering m / (4 pi maxPhase)).
+            // w_i: the light's share of the common colour, or with lights of
+            // different colours its largest channel (unitLights).
+            mRgb = !sharedColour(mLighting);
             if (Status s = traceLights(); !s) return makeError("Cloud: lights: " + s.error());
             mPhaseMax = phaseMax(mLighting.gas.phase);
             std::vector<glm::vec3> points(count), source;
@@ -350,6 +357,8 @@ Status Cloud::setDensity(std::vector<float> density) {
 Status Cloud::update(const Camera& camera, const LodRefineDesc& refine, LodFrame& out) {
     if (Status s = mVolume.update(camera, refine, &mTransfer, out); !s) return s;
     if (mLighting.model != CloudLightModel::LowAlbedo) return {};
+    // Lights of different colours: an RGB source per vertex, whatever the phase.
+    if (multiLight(mLighting) && mRgb) return applyLightPhases(camera, out);
     const PhaseFunction& phase = mLighting.gas.phase;
     if (phase.lobeCount() == 1 && phase.lobe(0).g == 0.0f) return {}; // isotropic: s = T (with more lights, R = 1)
     if (multiLight(mLighting)) return applyLightPhases(camera, out);
@@ -369,9 +378,11 @@ Status Cloud::update(const Camera& camera, const LodRefineDesc& refine, LodFrame
 
 glm::vec3 Cloud::gridPoint(glm::ivec3 p) const { return mDesc.volume.originWorld + glm::vec3(p) * mDesc.volume.spacingWorld; }
 
-std::vector<Light> Cloud::unitLights(float scale, std::vector<const std::vector<float>*>* trans) const {
+std::vector<Light> Cloud::unitLights(float scale, std::vector<const std::vector<float>*>* trans, bool coloured) const {
     // Each lit light with colour w_i scale (w_i its share of the common
-    // colour mLightColour), paired with its transmittance.
+    // colour mLightColour; with lights of different colours, mLightColour is
+    // white and w_i the light's largest channel), paired with its
+    // transmittance. `coloured`: each light's own colour x intensity x scale instead.
     std::vector<Light> out;
     const double ref2 = glm::dot(glm::dvec3(mLightColour), glm::dvec3(mLightColour));
     for (std::size_t i = 0; i <= mLighting.lights.size(); ++i) {
@@ -380,7 +391,14 @@ std::vector<Light> Cloud::unitLights(float scale, std::vector<const std::vector<
         if (!(glm::dot(c, c) > 0.0) || !(ref2 > 0.0)) continue;
         Light u = l;
         u.color = glm::vec3(1.0f);
-        u.intensity = float(glm::dot(c, glm::dvec3(mLightColour)) / ref2 * double(scale));
+        if (coloured) {
+            u.color = l.color;
+            u.intensity = l.intensity * scale;
+        } else if (mRgb) {
+            u.intensity = float(std::max({c.x, c.y, c.z}) * double(scale));
+        } else {
+            u.intensity = float(glm::dot(c, glm::dvec3(mLightColour)) / ref2 * double(scale));
+        }
         out.push_back(u);
         if (trans) trans->push_back(i == 0 ? &mTrans : &mLightT[i - 1].trans);
     }
@@ -389,13 +407,14 @@ std::vector<Light> Cloud::unitLights(float scale, std::vector<const std::vector<
 
 Status Cloud::traceLights() {
     mLightColour = glm::vec3(0.0f);
-    for (std::size_t i = 0; i <= mLighting.lights.size(); ++i) {
+    for (std::size_t i = 0; i <= mLighting.lights.size() && !mRgb; ++i) {
         const Light& l = i == 0 ? mLighting.sun : mLighting.lights[i - 1];
         if (glm::dot(l.color * l.intensity, l.color * l.intensity) > 0.0f) {
-            mLightColour = l.color * l.intensity; // the first lit light's: checkLighting made the others multiples of it
+            mLightColour = l.color * l.intensity; // the first lit light's: this path has the others multiples of it (sharedColour)
             break;
         }
     }
+    if (mRgb) mLightColour = glm::vec3(1.0f); // the weights are the lights' largest channels (unitLights)
     mLightT.resize(mLighting.lights.size());
     const std::size_t count = mDensity.size();
     const float h = mDesc.volume.spacingWorld;
@@ -451,6 +470,9 @@ Status Cloud::traceLights() {
 Status Cloud::applyLightPhases(const Camera& camera, LodFrame& out) {
     // s = u R per vertex: R = sum_i w_i E_i (4 pi phase_i T_i + m) / sum_i
     // w_i E_i (4 pi maxPhase T_i + m), both by lightPoints at the vertex.
+    // Lights of different colours: s_c = u R_c per channel, R_c = sum_i c_i,c
+    // E_i (4 pi phase_i T_i + m) / the same denominator (w_i = max_c c_i,c,
+    // so R_c <= 1), written to out.rgb; the scalar keeps max_c s_c.
     mVertexScratch.resize(out.tets.size() * 4);
     for (std::size_t t = 0; t < out.tets.size(); ++t)
         for (std::size_t k = 0; k < 4; ++k) mVertexScratch[4 * t + k] = out.tets[t].position[k];
@@ -460,12 +482,25 @@ Status Cloud::applyLightPhases(const Camera& camera, LodFrame& out) {
     const glm::vec3 eye = camera.perspective() ? camera.eye() : 0.5f * (box.lo + box.hi) - camera.forward() * (1e4f * glm::length(box.hi - box.lo));
     std::vector<const std::vector<float>*> trans;
     const float fourPiMax = 4.0f * std::numbers::pi_v<float> * mPhaseMax;
-    const std::vector<Light> bound = unitLights(fourPiMax, &trans), seen = unitLights(1.0f);
+    const std::vector<Light> bound = unitLights(fourPiMax, &trans), seen = unitLights(1.0f, nullptr, mRgb);
     const GridShadows shadows(mDims, mDesc.volume.originWorld, mDesc.volume.spacingWorld, std::move(trans));
     GasLightingDesc viewed{.phase = mLighting.gas.phase, .albedo = 1.0f, .multipleScattering = mLighting.gas.multipleScattering};
     const GasLightingDesc iso{.albedo = 1.0f, .multipleScattering = mLighting.gas.multipleScattering / fourPiMax};
     if (Status s = lightPoints(mVertexScratch, mDesc.volume.spacingWorld, eye, seen, &shadows, viewed, mSeenScratch); !s) return s;
     if (Status s = lightPoints(mVertexScratch, mDesc.volume.spacingWorld, eye, bound, &shadows, iso, mBoundScratch); !s) return s;
+    if (mRgb) {
+        out.rgb.resize(out.tets.size());
+        for (std::size_t t = 0; t < out.tets.size(); ++t)
+            for (std::size_t k = 0; k < 4; ++k) {
+                const glm::vec3 n = mSeenScratch[4 * t + k];
+                const float d = mBoundScratch[4 * t + k].x;
+                float& s = out.tets[t].scalar[k];
+                glm::vec3& c = out.rgb[t][k];
+                c = d > 0.0f ? glm::clamp(s * n / d, 0.0f, 1.0f) : glm::vec3(0.0f);
+                s = std::max({c.x, c.y, c.z});
+            }
+        return {};
+    }
     for (std::size_t t = 0; t < out.tets.size(); ++t)
         for (std::size_t k = 0; k < 4; ++k) {
             const float n = mSeenScratch[4 * t + k].x, d = mBoundScratch[4 * t + k].x;

@@ -624,6 +624,7 @@ Status GroundFog::update(const Camera& camera, LodFrame& out) const { return upd
 
 Status GroundFog::update(const Camera& camera, const LodRefineDesc& refine, LodFrame& out, std::vector<glm::vec3>* terrainTriangles) const {
     out.tets.clear();
+    out.rgb.clear();
     out.stats = {};
     if (terrainTriangles) terrainTriangles->clear();
     const glm::vec3 e = camera.eye(), f = camera.forward();

@@ -621,6 +621,7 @@ struct LodTraversal {
 
 Status LodVolume::update(const Camera& camera, const LodRefineDesc& refine, const TransferFunction* transfer, LodFrame& out) {
     out.tets.clear();
+    out.rgb.clear();
     out.stats = LodFrameStats{};
     for (int c = 0; c < 4; ++c)
         for (int r = 0; r < 4; ++r)

@@ -240,6 +240,8 @@ struct FrameRenderStats {
         std::uint64_t transparent = 0; // skipped by the table's zero-opacity test
         std::uint64_t batches = 0;     // runs of the interleaved splat/tetrahedron sequence
         std::size_t tableBytes = 0;    // GPU bytes of the uploaded pre-integration tables
+        std::uint64_t rgb = 0;         // of those drawn, with an RGB source per vertex (LodFrame::rgb: 3 table lookups a segment)
+        std::string error;             // empty, or why an RGB source was not drawn as given (its program failed to build: not drawn; LodFrame::rgb's length not the tetrahedra's: drawn with the scalar)
     } tetrahedra;
     // Order-exact transparency (HostTarget::transparentToLists).
     struct Lists {

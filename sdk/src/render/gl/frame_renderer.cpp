@@ -270,6 +270,7 @@ void FrameRenderer::Impl::report(const Frame& frame, const detail::StepContext& 
     note(depthNote);
     note(clampingNote);
     note(s.fog.error);
+    note(s.tetrahedra.error);
     for (const PlanStep& step : plan.steps)
         if (step.range != StepRange::ListsBehindAndBetween) note(step.note); // that one is noted with its count, when it applies
     note(s.lists.note);

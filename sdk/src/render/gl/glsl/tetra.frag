@@ -1,4 +1,4 @@
-// Tetrahedra (TetraPass), pre-integrated. Defines: PERSPECTIVE, HAS_DEPTH, FOG.
+// Tetrahedra (TetraPass), pre-integrated. Defines: PERSPECTIVE, HAS_DEPTH, FOG, RGB.
 layout(binding = 1) uniform sampler2D uHostDepth;
 layout(binding = 2) uniform sampler3D uTable;
 uniform vec3 uForward;      // unit view direction
@@ -26,6 +26,10 @@ in vec3 vRel;
 flat in vec4 vPlane[4];
 flat in vec4 vScalar;
 flat in vec4 vLength;
+#if RGB
+flat in vec4 vScalarG;
+flat in vec4 vScalarB;
+#endif
 layout(location = 0) out vec4 oColor;
 
 #if FOG
@@ -53,6 +57,17 @@ vec4 fogSegment(vec4 c, vec3 pf, vec3 pb) {
 vec4 table(float sf, float sb, float l) {
     return texture(uTable, vec3(clamp(sf, 0.0, 1.0), clamp(sb, 0.0, 1.0), l / uMaxLength) * uTexScale + uTexOffset);
 }
+
+#if RGB
+// An RGB source per vertex (kappa_c(s_c) = A_c + B_c s_c, constant
+// extinction): channel c is the table's channel c at that channel's scalars;
+// alpha does not depend on the scalars.
+vec4 segment(vec3 sf, vec3 sb, float l) {
+    return vec4(table(sf.r, sb.r, l).r, table(sf.g, sb.g, l).g, table(sf.b, sb.b, l).ba);
+}
+#else
+vec4 segment(float sf, float sb, float l) { return table(sf, sb, l); }
+#endif
 
 void main() {
     // Compiled per camera kind and host depth (#defines), so no lane pays for
@@ -100,13 +115,18 @@ void main() {
     if (!(tOut > tIn)) discard;
     vec4 S = vScalar, M = vLength;
     vec3 pf = o + tIn * d, pb = o + tOut * d;
+#if RGB
+    vec3 sf = vec3(dot(S.xyz, pf) + S.w, dot(vScalarG.xyz, pf) + vScalarG.w, dot(vScalarB.xyz, pf) + vScalarB.w);
+    vec3 sb = vec3(dot(S.xyz, pb) + S.w, dot(vScalarG.xyz, pb) + vScalarG.w, dot(vScalarB.xyz, pb) + vScalarB.w);
+#else
     float sf = dot(S.xyz, pf) + S.w, sb = dot(S.xyz, pb) + S.w;
+#endif
     float mf = dot(M.xyz, pf) + M.w, mb = dot(M.xyz, pb) + M.w;
     // The table assumes a constant length scale along the segment (eq. 9):
     // the mean of the ends, exact for constant m (docs/volume.md).
     float l = (tOut - tIn) * max(0.5 * (mf + mb), 0.0);
     if (l <= uMaxLength) {
-        oColor = FOGGED(table(sf, sb, l));
+        oColor = FOGGED(segment(sf, sb, l));
         return;
     }
     // Longer than the table: equal pieces (the scalar is linear, so each is
@@ -115,7 +135,7 @@ void main() {
     float piece = l / float(n);
     vec4 acc = vec4(0.0);
     for (int k = 0; k < n && acc.a < 0.99999; ++k) {
-        vec4 c = table(mix(sf, sb, float(k) / float(n)), mix(sf, sb, float(k + 1) / float(n)), piece);
+        vec4 c = segment(mix(sf, sb, float(k) / float(n)), mix(sf, sb, float(k + 1) / float(n)), piece);
         acc += (1.0 - acc.a) * c;
     }
     oColor = FOGGED(acc);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <epoxy/gl.h>
@@ -26,8 +27,10 @@ namespace {
 // Per tetrahedron, 10 vec4 (std430): the four vertices relative to the eye,
 // the four barycentric planes lambda_i(x) = dot(B_i.xyz, x) + B_i.w (x
 // relative to the eye, lambda_i = 1 at vertex i, 0 on the opposite face),
-// and the scalar and length scale as linear functions of x.
-constexpr int kVec4PerTet = 10;
+// and the scalar and length scale as linear functions of x. A volume with an
+// RGB source per vertex (LodFrame::rgb) has 12: the scalar's slot holds the
+// red source, the green and blue ones follow the length scale.
+constexpr int kVec4PerTet = 10, kVec4PerRgbTet = 12;
 
 // The faces wound counter-clockwise seen from outside a positively oriented
 // tetrahedron (dot(p1-p0, cross(p2-p0, p3-p0)) > 0): opposite 0, 1, 2, 3.
@@ -42,6 +45,7 @@ struct TetraPass::Impl {
     // The fog variants, built for the structure of the last fog seen (Fog::glslKey).
     const Program* fogPrograms[4] = {};
     std::uint64_t fogKey = 0;
+    std::string fogSource; // the fog's GLSL the fog variants were built from (the RGB ones are built on first use)
     const Fog* fog = nullptr;
     double fogTimeSec = 0.0;
     GLuint vao = 0, ssbo = 0;
@@ -61,7 +65,8 @@ struct TetraPass::Impl {
     };
     std::vector<Table> tables;
     std::vector<int> tableOfVolume;                      // per frame volume: index into tables (-1: not drawn)
-    std::vector<std::size_t> recordBase;                 // per frame volume: first record
+    std::vector<std::size_t> recordBase;                 // per frame volume: its first vec4
+    std::vector<bool> rgbOfVolume;                       // per frame volume: an RGB source per vertex (kVec4PerRgbTet)
     std::vector<std::vector<std::uint32_t>> firstRecord; // per volume: records before tet i (size tets + 1)
     std::vector<glm::vec4> records;
     glm::vec3 eye{0.0f};
@@ -88,7 +93,7 @@ Result<TetraPass> TetraPass::create(Programs programs) {
     Impl& r = *impl;
     r.library = std::move(programs);
     for (int v = 0; v < 4; ++v) {
-        auto p = r.library->get({glsl::ProgramId::Tetra, {(v & 2) ? 1 : 0, v & 1, 0}});
+        auto p = r.library->get({glsl::ProgramId::Tetra, {(v & 2) ? 1 : 0, v & 1, 0, 0}});
         if (!p) return makeError(p.error());
         r.programs[v] = *p;
     }
@@ -107,8 +112,9 @@ Status TetraPass::setFog(const Fog* fog, double timeSec) {
     r.library->release(glsl::ProgramId::Tetra, [](const glsl::ProgramKey& k) { return k.values[glsl::tetra::FOG] != 0; });
     for (auto& p : r.fogPrograms) p = nullptr;
     r.fogKey = 0;
+    r.fogSource.clear();
     for (int v = 0; v < 4; ++v) {
-        auto p = r.library->get({glsl::ProgramId::Tetra, {(v & 2) ? 1 : 0, v & 1, 1}, r.fog->glslKey()}, {.fog = *change->rebuild});
+        auto p = r.library->get({glsl::ProgramId::Tetra, {(v & 2) ? 1 : 0, v & 1, 1, 0}, r.fog->glslKey()}, {.fog = *change->rebuild});
         if (!p) {
             r.library->release(glsl::ProgramId::Tetra, [](const glsl::ProgramKey& k) { return k.values[glsl::tetra::FOG] != 0; });
             for (auto& q : r.fogPrograms) q = nullptr;
@@ -118,6 +124,7 @@ Status TetraPass::setFog(const Fog* fog, double timeSec) {
         r.fogPrograms[v] = *p;
     }
     r.fogKey = r.fog->glslKey();
+    r.fogSource = *change->rebuild;
     return {};
 }
 
@@ -174,12 +181,20 @@ void TetraPass::uploadTables(const Frame& frame) {
     const glm::dvec3 eye(r.eye);
     r.records.clear();
     r.recordBase.assign(volumes.size(), 0);
+    r.rgbOfVolume.assign(volumes.size(), false);
     r.firstRecord.resize(volumes.size());
     for (std::size_t v = 0; v < volumes.size(); ++v) {
         auto& first = r.firstRecord[v];
         const auto& tets = volumes[v].lod.tets;
+        const auto& rgb = volumes[v].lod.rgb;
+        // An RGB list of another length than the tetrahedra's is not one (LodFrame::rgb): the scalar is drawn, and noted.
+        const bool coloured = !rgb.empty() && rgb.size() == tets.size();
+        if (!rgb.empty() && !coloured)
+            r.stats.rgbError = "frame volume " + std::to_string(v) + ": LodFrame::rgb holds " + std::to_string(rgb.size()) + " entries for " +
+                               std::to_string(tets.size()) + " tetrahedra: drawn with their scalar";
+        r.rgbOfVolume[v] = coloured;
         first.assign(tets.size() + 1, 0);
-        r.recordBase[v] = r.records.size() / kVec4PerTet;
+        r.recordBase[v] = r.records.size();
         const PreIntegrationTable* table = r.tableOfVolume[v] >= 0 ? volumes[v].table : nullptr;
         std::uint32_t count = 0;
         for (std::size_t i = 0; i < tets.size(); ++i) {
@@ -209,15 +224,24 @@ void TetraPass::uploadTables(const Frame& frame) {
                 g0 -= g;
             }
             b[0] = glm::dvec4(g0, 1.0 - glm::dot(g0, p[0]));
-            glm::dvec4 s(0.0), ls(0.0);
+            glm::dvec4 s(0.0), ls(0.0), sg(0.0), sb(0.0);
             for (int k = 0; k < 4; ++k) {
-                s += double(t.scalar[std::size_t(k)]) * b[k];
-                ls += double(t.lengthScale[std::size_t(k)]) * b[k];
+                const std::size_t kk = std::size_t(k);
+                s += double(coloured ? rgb[i][kk].r : t.scalar[kk]) * b[k];
+                ls += double(t.lengthScale[kk]) * b[k];
+                if (coloured) {
+                    sg += double(rgb[i][kk].g) * b[k];
+                    sb += double(rgb[i][kk].b) * b[k];
+                }
             }
             for (int k = 0; k < 4; ++k) r.records.emplace_back(glm::vec3(p[k]), 0.0f);
             for (int k = 0; k < 4; ++k) r.records.emplace_back(b[k]);
             r.records.emplace_back(s);
             r.records.emplace_back(ls);
+            if (coloured) {
+                r.records.emplace_back(sg);
+                r.records.emplace_back(sb);
+            }
             ++count;
         }
         first[tets.size()] = count;
@@ -256,6 +280,23 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     const glm::vec2 pa = ndc(c), pb = ndc(c + camera.right()), pc = ndc(c + camera.up());
     const float area = (pb.x - pa.x) * (pc.y - pa.y) - (pb.y - pa.y) * (pc.x - pa.x);
 
+    const bool coloured = r.rgbOfVolume[volume];
+    const int variant = (camera.perspective() ? 2 : 0) + (hostDepth ? 1 : 0);
+    const bool fogged = r.fog && r.fogPrograms[variant];
+    const Impl::Program* program = fogged ? r.fogPrograms[variant] : r.programs[variant];
+    if (coloured) {
+        // Built on first use (the library keeps it): most frames have no RGB volume.
+        auto q = r.library->get({glsl::ProgramId::Tetra, {camera.perspective() ? 1 : 0, hostDepth ? 1 : 0, fogged ? 1 : 0, 1}, fogged ? r.fogKey : 0},
+                                {.fog = fogged ? std::string_view(r.fogSource) : std::string_view()});
+        if (!q) {
+            r.stats.rgbError = "tetrahedra with an RGB source per vertex not drawn: " + q.error();
+            return;
+        }
+        program = *q;
+        r.stats.rgb += b - a;
+    }
+    const Impl::Program& p = *program;
+
     SavedState saved;
     saved.save({.texture2DUnits = 2, .scissor = false});
     GLint prevTex3D = 0, prevSsbo = 0, prevCullMode = 0, prevFrontFace = 0;
@@ -275,9 +316,6 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     glFrontFace(area >= 0.0f ? GL_CCW : GL_CW);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 
-    const int variant = (camera.perspective() ? 2 : 0) + (hostDepth ? 1 : 0);
-    const bool fogged = r.fog && r.fogPrograms[variant];
-    const Impl::Program& p = fogged ? *r.fogPrograms[variant] : *r.programs[variant];
     glUseProgram(p.id);
     if (fogged) {
         // Parameters in double relative to the eye the records are relative to (docs/fog.md, GLSL).
@@ -290,7 +328,8 @@ void TetraPass::draw(const Frame& frame, std::uint32_t volume, std::uint32_t beg
     }
     const glm::mat4 vpRel = vp * glm::translate(glm::mat4(1.0f), r.eye);
     glUniformMatrix4fv(p.uniform(glsl::tetra::ViewProjRel), 1, GL_FALSE, glm::value_ptr(vpRel));
-    glUniform1i(p.uniform(glsl::tetra::First), GLint(r.recordBase[volume] + a));
+    // The first vec4 of the draw's first tetrahedron.
+    glUniform1i(p.uniform(glsl::tetra::First), GLint(r.recordBase[volume] + std::size_t(a) * std::size_t(coloured ? kVec4PerRgbTet : kVec4PerTet)));
     const glm::vec3 f = camera.forward();
     glUniform3f(p.uniform(glsl::tetra::Forward), f.x, f.y, f.z);
     const glm::vec3 depthMap = hostDepthMap(camera);
@@ -369,6 +408,8 @@ void TetraPass::report(FrameRenderStats& stats) const {
     stats.drawCalls += ts.drawCalls;
     stats.tetrahedra.drawn = ts.tetrahedra;
     stats.tetrahedra.transparent = ts.transparent;
+    stats.tetrahedra.rgb = ts.rgb;
+    stats.tetrahedra.error = ts.rgbError;
     stats.fog.tetrahedra = mFogged;
     if (!mFogError.empty()) stats.fog.error = mFogError;
 }

@@ -14,6 +14,14 @@
 // clipping is switched off (depth clamp) so a face lying in the near plane is
 // never lost to rounding. No CPU projection (Shirley-Tuchman classes) needed.
 //
+// A volume whose LodFrame carries an RGB source per vertex (a LowAlbedo cloud
+// lit by lights of different colours) is drawn by the RGB variants (built on
+// first use): three linear source functions per tetrahedron instead of one,
+// and three lookups per segment, channel c read at (s_c front, s_c back,
+// length). Exact for a transfer kappa(s) = A + B s of constant extinction
+// (the table's entries are then affine in each scalar, per channel, and its
+// alpha does not depend on s): the one-scalar variants are untouched.
+//
 // With a fog (setFog, issue 14) a second set of variants fogs each segment's
 // colour as the splats do, f from the eye (also for orthographic cameras,
 // like the splats) to the segment's opacity centroid (docs/fog.md).
@@ -43,6 +51,8 @@ struct TetraStats {
     std::uint64_t tableUploads = 0; // since creation
     std::size_t tableBytes = 0;     // GPU bytes held by uploaded tables
     std::uint64_t foggedDraws = 0;  // draws with the fog variant this frame
+    std::uint64_t rgb = 0;          // drawn with an RGB source per vertex this frame
+    std::string rgbError;           // this frame: an RGB source not drawn as given (a program that failed to build, a list of the wrong length)
 };
 
 class TetraPass final : public Pass {
