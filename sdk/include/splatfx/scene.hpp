@@ -466,7 +466,7 @@ private:
     // attenuated through the others'.
     std::vector<const ShadowCaster*> mVolumeCasters;
     std::vector<std::vector<const ShadowCaster*>> mCastersPerLight; // scratch (scheduleCasters)
-    std::vector<const ShadowCaster*> mFogCasterScratch;             // scratch: a layer's casters, itself left out (emitLitGroundFogs)
+    std::vector<const ShadowCaster*> mFogCasterScratch;             // scratch: a layer's or a cloud's casters, itself left out (emitLitGroundFogs, emitInto)
     SplatBuilder mLightScratch{SplatBuilderDesc{.frustumCull = false}}; // an emitter's whole splats, fitted, never drawn
     SceneShadowDesc mSceneShadowDesc;
     bool mHdrLit = false;
