@@ -213,13 +213,16 @@ TEST(CloudReceive, AVoxelBlockAboveDarkensTheColumnsUnderIt) {
 // scale): the restricted relight (only the points under the old and new
 // boxes traced again) leaves the transmittances, the received depths, the
 // scale and the LOD fields bit for bit as a full relight of a fresh cloud
-// under the same casters, traces fewer points than the grid holds, and does
-// no sweep; a second cloud taken through the same calls is identical
+// under the same casters, traces fewer points than the full relight, and does
+// no sweep, for a slanted and a horizontal sun; a second cloud taken through the same calls is identical
 // (determinism).
 TEST(CloudReceive, ARestrictedRelightEqualsAFullOneBitForBit) {
+  // A slanted sun, and a horizontal one (its rays never leave a z plane).
+  for (glm::vec3 sunTravel : {glm::vec3(0.3f, 0.2f, -1.0f), glm::vec3(-1.0f, -0.3f, 0.0f)}) {
+    SCOPED_TRACE(sunTravel.z);
     CloudLighting L;
     L.model = CloudLightModel::LowAlbedo;
-    L.sun = Light::directional({0.3f, 0.2f, -1.0f});
+    L.sun = Light::directional(sunTravel);
     L.lights = {Light::point({10.0f, 4.0f, 16.0f}, glm::vec3(1.0f), 300.0f)};
     L.gas.phase = *PhaseFunction::create(std::vector<HgLobe>{{0.6f, 1.0f}});
     CloudCreateDesc cd = uniformDesc(L);
@@ -227,8 +230,11 @@ TEST(CloudReceive, ARestrictedRelightEqualsAFullOneBitForBit) {
     cd.cloud.coverage = 0.7f;
     cd.volume.originWorld = {0.37f, -1.3f, 0.11f}; // grid points off the float lattice: GridShadows' weights round
     cd.volume.spacingWorld = 0.93f;
-    const DensityField still = voxelBlock({12.0f, 2.0f, 11.0f}, 3, 0.5f);
-    const DensityField before = voxelBlock({2.0f, 3.0f, 10.0f}, 4, 0.6f), after = voxelBlock({4.5f, 5.0f, 10.5f}, 4, 0.6f);
+    // Above the cloud for the slanted sun, beside it (toward +x) for the horizontal one.
+    const bool flat = sunTravel.z == 0.0f;
+    const DensityField still = flat ? voxelBlock({18.0f, 9.0f, 1.0f}, 3, 0.5f) : voxelBlock({12.0f, 2.0f, 11.0f}, 3, 0.5f);
+    const DensityField before = flat ? voxelBlock({18.0f, 3.0f, 2.0f}, 4, 0.6f) : voxelBlock({2.0f, 3.0f, 10.0f}, 4, 0.6f);
+    const DensityField after = flat ? voxelBlock({19.5f, 5.0f, 3.5f}, 4, 0.6f) : voxelBlock({4.5f, 5.0f, 10.5f}, 4, 0.6f);
     const ShadowCaster* first[] = {&before, &still};
     const ShadowCaster* second[] = {&after, &still};
     CloudCreateDesc fresh = cd;
@@ -236,7 +242,7 @@ TEST(CloudReceive, ARestrictedRelightEqualsAFullOneBitForBit) {
     Cloud full = *Cloud::create(fresh);
     ASSERT_TRUE(full.setLight(L, second));
     EXPECT_GT(full.relights(), 1u);
-    EXPECT_EQ(full.receivePoints(), 2 * full.density().size()); // every point, for each light
+    EXPECT_GE(full.receivePoints(), full.density().size()); // every point, for each light a caster can shadow it from
     auto run = [&](Cloud& c) {
         ASSERT_TRUE(c.setLight(L, first));
         const std::uint64_t relights = c.relights(), points = c.receivePoints(), restricted = c.restrictedRelights();
@@ -262,6 +268,7 @@ TEST(CloudReceive, ARestrictedRelightEqualsAFullOneBitForBit) {
     float most = 0.0f;
     for (float d : full.receivedDepth(0)) most = std::max(most, d);
     EXPECT_GT(most, 2.0f);
+  }
 }
 
 // A caster whose box cannot shadow the cloud for any light (beside it and

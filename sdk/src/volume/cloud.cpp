@@ -159,6 +159,43 @@ bool rayMeetsBox(glm::dvec3 p, const Light& light, const PaddedBox& b) {
     return true;
 }
 
+// A conservative bound, in world x and y, of the points in the plane z = c
+// whose ray toward the light meets the box: false when none can. A
+// directional light (u toward it): p = b - t u, t >= 0, so in the plane t
+// spans the box's z extent's [t0, t1] and x, y the box's shifted by -t u. A
+// point or spot light at q: p = q + s (b - q), s >= 1, so each coordinate
+// stays on the far side of the box from q (or anywhere with q across it).
+bool sliceBound(const PaddedBox& b, const Light& light, double c, glm::dvec2& lo, glm::dvec2& hi) {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    lo = glm::dvec2(-inf), hi = glm::dvec2(inf);
+    if (light.type == LightType::Directional) {
+        const glm::dvec3 u = -glm::normalize(glm::dvec3(light.direction));
+        const double ta = u.z != 0.0 ? (b.lo.z - c) / u.z : 0.0, tb = u.z != 0.0 ? (b.hi.z - c) / u.z : 0.0;
+        if (u.z != 0.0 && std::isfinite(ta) && std::isfinite(tb)) {
+            const double t0 = std::max(0.0, std::min(ta, tb)), t1 = std::max(ta, tb);
+            if (t1 < 0.0) return false;
+            for (int a = 0; a < 2; ++a) {
+                lo[a] = b.lo[a] - std::max(t0 * u[a], t1 * u[a]);
+                hi[a] = b.hi[a] - std::min(t0 * u[a], t1 * u[a]);
+            }
+            return true;
+        }
+        if (u.z == 0.0 && (c < b.lo.z || c > b.hi.z)) return false;
+        for (int a = 0; a < 2; ++a) {
+            if (u[a] >= 0.0) hi[a] = b.hi[a];
+            if (u[a] <= 0.0) lo[a] = b.lo[a];
+        }
+        return true;
+    }
+    const glm::dvec3 q(light.position);
+    if ((q.z > b.hi.z && c > b.hi.z) || (q.z < b.lo.z && c < b.lo.z)) return false;
+    for (int a = 0; a < 2; ++a) {
+        if (q[a] > b.hi[a]) hi[a] = b.hi[a];
+        if (q[a] < b.lo[a]) lo[a] = b.lo[a];
+    }
+    return true;
+}
+
 // Marks the 26 neighbours of every marked point too (separable: x, y, z).
 void dilate(glm::ivec3 dims, std::vector<std::uint8_t>& mask) {
     const std::size_t stride[3] = {1, std::size_t(dims.x), std::size_t(dims.x) * std::size_t(dims.y)};
@@ -297,9 +334,30 @@ bool Cloud::receive(std::span<const ShadowCaster* const> casters, std::vector<st
             r.tracedFor = light;
             r.valid = true;
         }
-        for (int z = 0, i = 0; z < mDims.z; ++z)
-            for (int y = 0; y < mDims.y; ++y)
-                for (int x = 0; x < mDims.x; ++x, ++i) {
+        const glm::vec3 origin = mDesc.volume.originWorld;
+        // World to grid index along axis a, rounded outward with a point to
+        // spare (the bound is only a pre-filter: each point's own test decides).
+        auto index = [&](int a, double w, bool upper) {
+            const double v = (w - double(origin[a])) / double(h);
+            if (!(v == v)) return upper ? mDims[a] - 1 : 0; // NaN: the whole axis
+            const double r = std::clamp(upper ? std::ceil(v) + 1.0 : std::floor(v) - 1.0, 0.0, double(mDims[a] - 1));
+            return int(r);
+        };
+        for (int z = 0; z < mDims.z; ++z) {
+            glm::ivec2 i0(0), i1(mDims.x - 1, mDims.y - 1);
+            if (!full) {
+                // Only the rows the changed boxes' shadows can reach in this plane.
+                i0 = glm::ivec2(mDims.x, mDims.y), i1 = glm::ivec2(-1);
+                const double c = double(gridPoint({0, 0, z}).z);
+                for (const PaddedBox& b : dirty) {
+                    glm::dvec2 lo, hi;
+                    if (!sliceBound(b, light, c, lo, hi)) continue;
+                    for (int a = 0; a < 2; ++a) i0[a] = std::min(i0[a], index(a, lo[a], false)), i1[a] = std::max(i1[a], index(a, hi[a], true));
+                }
+            }
+            for (int y = i0.y; y <= i1.y; ++y)
+                for (int x = i0.x; x <= i1.x; ++x) {
+                    const std::size_t i = std::size_t(x) + std::size_t(mDims.x) * (std::size_t(y) + std::size_t(mDims.y) * std::size_t(z));
                     const glm::vec3 p = gridPoint({x, y, z});
                     const glm::dvec3 pd(p);
                     if (!full && std::none_of(dirty.begin(), dirty.end(), [&](const PaddedBox& b) { return rayMeetsBox(pd, light, b); })) continue;
@@ -311,12 +369,13 @@ bool Cloud::receive(std::span<const ShadowCaster* const> casters, std::vector<st
                             ++mReceiveTraces;
                         }
                     if (!full || !active.empty()) ++mReceivePoints;
-                    float& d = r.depth[std::size_t(i)];
+                    float& d = r.depth[i];
                     if (d == depth) continue;
                     d = depth;
-                    changed[std::size_t(i)] = 1;
+                    changed[i] = 1;
                     any = true;
                 }
+        }
     }
     mCasters = std::move(now);
     return any;
