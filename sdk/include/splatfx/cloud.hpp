@@ -189,9 +189,11 @@ public:
     // towards light `slot` (0 the sun, 1 + i lighting().lights[i]); empty for
     // a light that lights nothing or a slot beyond the lights.
     const std::vector<float>& receivedDepth(std::size_t slot) const;
-    // Grid points whose received depth was traced again with at least one
-    // caster able to shadow them, per light, since creation; and the casters'
-    // opticalDepthToLight calls those made.
+    // Grid points whose received depth was computed again, per light, since
+    // creation (a light's first or new depths with no caster able to shadow
+    // the cloud count none: they are zero); and the casters'
+    // opticalDepthToLight calls those made (only casters whose box the
+    // point's ray meets are traced).
     std::uint64_t receivePoints() const { return mReceivePoints; }
     std::uint64_t receiveTraces() const { return mReceiveTraces; }
     // setLight calls that only the casters changed and that traced at least

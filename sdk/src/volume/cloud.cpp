@@ -127,8 +127,9 @@ private:
     std::vector<const std::vector<float>*> mTrans;
 };
 
-// A caster's box grown as Scene::shadowFallsOn grows it (a relative 1e-5),
-// so the per-point test below never says no where that test said yes.
+// A caster's box grown as Scene::shadowFallsOn grows it (a relative 1e-5):
+// a point whose ray meets it lies in a grid that test lets through, so
+// gating the casters by that test drops none the points would trace.
 struct PaddedBox {
     glm::dvec3 lo, hi;
 };
