@@ -43,12 +43,26 @@
 // writes s = T phase(theta) / max phase at each vertex: pre-integration is
 // exact for a colour affine in s, so the per-vertex phase costs no table.
 //
-// It does NOT: draw (the tetrahedra go to the projected-tetrahedra pass),
+// Shadows of other volumes (setLight's casters: effects' DensityFields,
+// other clouds' fields, GroundFogCasters): each grid point's transmittance
+// towards each light, the sun's included, is its own one times
+// exp2(-depth), depth the sum of the casters' opticalDepthToLight from the
+// point (to the light's position, or without end toward a directional one),
+// summed over the casters whose box the point's ray to the light meets; a
+// caster whose box cannot shadow the grid for a light (Scene::shadowFallsOn)
+// is never traced for it. When only the casters change (a plume simulated,
+// moved), only the grid points whose ray meets a changed caster's old or new
+// box are traced again (receivePoints(), receiveTraces() count them), with
+// the same sum, so the result equals a full relight bit for bit; the LOD
+// fields are then rebuilt whole (LodVolume has no partial rebuild; see
+// docs/BENCHMARKS.md "Cloud relighting" for what that costs). The Roettger
+// model receives through its T as well (gamma = ambient + diffuse T).
+//
+// It does NOT: draw (the tetrahedra go to the projected-tetrahedra pass), or
 // light the Roettger model with anything but the sun (its gamma = ambient +
-// diffuse T is a bounded sun term, not an irradiance), or receive the shadows
-// of other volumes. It casts through densityField(): a Scene puts a lit
-// cloud's field into the scene shadow and traces the light of its lit
-// effects through it (scene.hpp).
+// diffuse T is a bounded sun term, not an irradiance). It casts through
+// densityField(): a Scene puts a lit cloud's field into the scene shadow and
+// traces the light of its lit effects and other lit clouds through it (scene.hpp).
 //
 //   auto cloud = splatfx::Cloud::create({.cloud = {.dims = {65, 65, 17}}});
 //   splatfx::CloudLighting L = cloud->lighting();
@@ -60,6 +74,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "splatfx/lighting.hpp"
@@ -127,11 +142,22 @@ public:
     // relights and rebuilds the table (the scalar's scale is the largest
     // source over the grid); a light's transmittance is traced again only when
     // its position, direction, type, cone or radius, or the density, changed.
+    // `casters` are the other volumes that shadow the cloud (not its own
+    // densityField(): its self-shadowing is its own); the cloud keeps their
+    // fingerprints and boxes, not the pointers, so every call names them all
+    // (none: the cloud receives no shadow). When only the casters changed,
+    // only the grid points under a changed caster's old or new box are traced
+    // again (restrictedRelights(), receivePoints()); a changed caster whose
+    // box cannot shadow the cloud costs nothing.
     // Fails, keeping the previous lighting, on a bad lighting field (the
-    // message names it: "CloudLighting.lights[1].color ...").
-    Status setLight(const CloudLighting& lighting);
+    // message names it: "CloudLighting.lights[1].color ..."), a null caster
+    // or the cloud's own field among the casters ("Cloud::setLight: casters[0] ...").
+    // A failure after the checks (none is known) forgets the casters: the
+    // next call traces them all again.
+    Status setLight(const CloudLighting& lighting, std::span<const ShadowCaster* const> casters = {});
     // Replaces the density (dims as created, values in [0, 1]) and relights.
-    // Fails, changing nothing, on a size mismatch or a bad value.
+    // The casters' shadows of the last setLight are kept (they do not depend
+    // on the cloud's density). Fails, changing nothing, on a size mismatch or a bad value.
     Status setDensity(std::vector<float> density);
 
     // Refines for the camera into out.tets (LodVolume::update); LowAlbedo
@@ -156,13 +182,28 @@ public:
     const CloudLighting& lighting() const { return mLighting; }
     const std::vector<float>& density() const { return mDensity; }
     glm::ivec3 dims() const { return mDims; }
-    // The sun's transmittance at each grid point from the last relight (x fastest).
+    // The sun's transmittance at each grid point from the last relight (x
+    // fastest): through the cloud's own density times exp2(-receivedDepth(0)).
     const std::vector<float>& sunTransmittance() const { return mTrans; }
     // Towards lighting().lights[i] at each grid point (x fastest), from the
-    // last relight; empty for a light that lights nothing (zero colour or
-    // intensity); 0 where a spot's cone leaves a point dark (not traced).
-    // Expects i < lighting().lights.size().
+    // last relight (times exp2(-receivedDepth(i + 1))); empty for a light that
+    // lights nothing (zero colour or intensity); 0 where a spot's cone leaves
+    // a point dark (not traced). Expects i < lighting().lights.size().
     const std::vector<float>& lightTransmittance(std::size_t i) const { return mLightT[i].trans; }
+    // The casters' optical depth (log2 units) at each grid point (x fastest)
+    // towards light `slot` (0 the sun, 1 + i lighting().lights[i]); empty for
+    // a light that lights nothing or a slot beyond the lights.
+    const std::vector<float>& receivedDepth(std::size_t slot) const;
+    // Grid points whose received depth was computed again, per light, since
+    // creation (a light's first or new depths with no caster able to shadow
+    // the cloud count none: they are zero); and the casters'
+    // opticalDepthToLight calls those made (only casters whose box the
+    // point's ray meets are traced).
+    std::uint64_t receivePoints() const { return mReceivePoints; }
+    std::uint64_t receiveTraces() const { return mReceiveTraces; }
+    // setLight calls that only the casters changed and that traced at least
+    // one point again (each rebuilds the LOD fields, not the sweep).
+    std::uint64_t restrictedRelights() const { return mRestrictedRelights; }
     // With lights beside the sun: the largest source over the grid that the
     // scalar's 1 stands for (sum_i w_i E_i (4 pi maxPhase T_i + m)); 0 without.
     // w_i: the light's share of the common colour, or its largest channel
@@ -193,12 +234,32 @@ public:
 private:
     // One of CloudLighting::lights: its transmittance and what it was traced for.
     struct LightState {
-        std::vector<float> trans;
+        std::vector<float> own, trans; // through the cloud alone; times the casters' shadow
         Light tracedFor{};
         bool valid = false;
     };
+    // The casters' depth towards one light (Cloud::receive), and what it was traced for.
+    struct Received {
+        std::vector<float> depth;
+        Light tracedFor{};
+        bool valid = false;
+    };
+    // What the received depths were traced for: one per caster of the last setLight.
+    struct CasterRecord {
+        std::uint64_t print = 0;
+        glm::vec3 lo{0.0f}, hi{0.0f};
+        bool empty = true;
+        bool operator==(const CasterRecord&) const = default;
+    };
     Cloud() = default;
-    Status relight();
+    // own: the cloud's own transmittances again (the sweep, traceLights);
+    // casters: the received depths for them (null: kept as they are).
+    Status relight(bool own = true, const std::span<const ShadowCaster* const>* casters = nullptr);
+    bool receive(std::span<const ShadowCaster* const> casters, std::vector<std::uint8_t>& changed);
+    void compose(const std::vector<std::uint8_t>* changed);
+    Status buildField(const std::vector<std::uint8_t>* changed);
+    bool sameCasters(std::span<const ShadowCaster* const> casters) const;
+    void forgetCasters();
     Status traceLights();
     std::vector<Light> unitLights(float scale, std::vector<const std::vector<float>*>* trans = nullptr, bool coloured = false) const;
     Status applyLightPhases(const Camera& camera, LodFrame& out);
@@ -208,7 +269,10 @@ private:
     CloudCreateDesc mDesc;
     CloudLighting mLighting;
     glm::ivec3 mDims{0};
-    std::vector<float> mDensity, mTrans;
+    std::vector<float> mDensity, mTrans, mSunOwn; // mTrans = mSunOwn x the casters' shadow
+    std::vector<Received> mRecv;                  // 0 the sun, 1 + i lights[i]
+    std::vector<CasterRecord> mCasters;
+    std::vector<float> mSource;                   // with lights beside the sun: the source per grid point before scaling
     LodVolume mVolume;
     DensityField mField;
     TransferFunction mTransfer;
@@ -220,6 +284,7 @@ private:
     bool mRgb = false; // lights of different colours: an RGB source per vertex (LodFrame::rgb)
     std::vector<glm::vec3> mVertexScratch, mSeenScratch, mBoundScratch; // update(): reused per frame
     std::uint64_t mRelights = 0, mTableBuilds = 0, mLightTraces = 0;
+    std::uint64_t mReceivePoints = 0, mReceiveTraces = 0, mRestrictedRelights = 0;
 };
 
 } // namespace splatfx

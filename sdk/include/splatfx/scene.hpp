@@ -20,8 +20,9 @@
 // (EffectKind::lightingDensity: every Effect does; LOD volumes and ground fog
 // do not, their light is part of their data; a Cloud, cloud.hpp, and a ground
 // fog layer, GroundFog::setLighting, follow the scene's first directional light
-// (a low-albedo Cloud its point and spot lights too) and are relit when it moves, the fog also
-// shadowed by the lit clouds, effects and other layers, and casting like a cloud (GroundFogCaster,
+// (a low-albedo Cloud its point and spot lights too) and are relit when it moves, both also
+// shadowed by the other lit clouds, effects and layers (a cloud relit only under the casters
+// that changed), the fog casting like a cloud (GroundFogCaster,
 // its exact optical depth): their splat colours follow Ebert & Parent's low-albedo model with
 // self-shadowing, the light also attenuated through every other lit,
 // shadow-casting volume between them and it (a cloud's shadow on a plume, a
@@ -272,7 +273,9 @@ public:
     // follows the scene's first directional light (and, in the low-albedo
     // model, options.lighting.gas and the scene's other lights that reach it,
     // up to kMaxCloudLights of any colour; SceneCounters::cloudLightsDropped
-    // counts the rest), relit only when those change.
+    // counts the rest), and is shadowed by the frame's other lit,
+    // shadow-casting volumes (Cloud::setLight's casters); relit only when
+    // those change, under a changed caster only where its shadow falls.
     EffectId add(Cloud cloud, EffectOptions options = {});
     // Any other kind (effect_kind.hpp). Expects kind != nullptr.
     EffectId add(std::unique_ptr<EffectKind> kind, EffectOptions options = {});
@@ -465,7 +468,7 @@ private:
     // attenuated through the others'.
     std::vector<const ShadowCaster*> mVolumeCasters;
     std::vector<std::vector<const ShadowCaster*>> mCastersPerLight; // scratch (scheduleCasters)
-    std::vector<const ShadowCaster*> mFogCasterScratch;             // scratch: a layer's casters, itself left out (emitLitGroundFogs)
+    std::vector<const ShadowCaster*> mFogCasterScratch;             // scratch: a layer's or a cloud's casters, itself left out (emitLitGroundFogs, emitInto)
     SplatBuilder mLightScratch{SplatBuilderDesc{.frustumCull = false}}; // an emitter's whole splats, fitted, never drawn
     SceneShadowDesc mSceneShadowDesc;
     bool mHdrLit = false;

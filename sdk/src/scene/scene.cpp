@@ -193,25 +193,15 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
         mLightingError = s.error();
         mTablesFit = false;
     }
-    // Lit clouds first: each takes the scene's sun before it refines (relit
-    // only when it changed), and its extinction joins the scene's shadow
-    // casters (shadeScene reads e.lit->field; copied only when the density
-    // changed) and shadows the effects lit below (mVolumeCasters).
+    // Lit clouds' extinction first: it depends on their density only, joins
+    // the scene's shadow casters (shadeScene reads e.lit->field; copied only
+    // when the density changed) and shadows the effects lit below and the
+    // other lit volumes (mVolumeCasters).
     mVolumeCasters.clear();
     std::vector<char> cloudLit(mEntries.size(), 0);
-    for (std::size_t i = 0; i < mEntries.size(); ++i) {
-        Entry& e = mEntries[i];
+    for (Entry& e : mEntries) {
         auto* cloud = dynamic_cast<detail::CloudKind*>(e.kind.get());
         if (!cloud || !(e.status.needed || e.status.castsIntoView) || !e.options.lighting.enabled) continue;
-        std::size_t dropped = 0;
-        Status s = e.status.needed ? cloud->follow(mLights, e.options.lighting, dropped) : Status{};
-        if (!s) {
-            mLightingError = "effect '" + e.options.name + "': lighting: " + s.error();
-            e.status.castsIntoView = false;
-            continue;
-        }
-        mCounters.cloudLightsDropped += dropped; // lights reaching the cloud that cannot light it (CloudKind::follow)
-        cloudLit[i] = e.status.needed;
         if (!e.lit) e.lit = std::make_unique<LitState>();
         const DensityField& f = cloud->cloud().densityField();
         if (e.lit->field.empty() != f.empty() || e.lit->field.fingerprint() != f.fingerprint()) e.lit->field = f;
@@ -219,6 +209,24 @@ std::size_t Scene::emitInto(SplatBuilder& builder, std::vector<FrameVolume>* vol
     }
     updateFogCasters();                      // the casting ground fog layers: exact, their extinction only
     updateEffectCasters(materials, options); // every effect's field before any is lit: they shadow one another
+    // Then each lit cloud in view takes the scene's lights and the shadows of
+    // every other caster of this emit (not its own field: its self-shadowing
+    // is its own sweep) before it refines; relit only when a light or a
+    // caster changed, and then only under the changed casters (Cloud::setLight).
+    for (std::size_t i = 0; i < mEntries.size(); ++i) {
+        Entry& e = mEntries[i];
+        auto* cloud = dynamic_cast<detail::CloudKind*>(e.kind.get());
+        if (!cloud || !e.status.needed || !e.options.lighting.enabled) continue;
+        mFogCasterScratch.assign(mVolumeCasters.begin(), mVolumeCasters.end());
+        std::erase(mFogCasterScratch, static_cast<const ShadowCaster*>(&e.lit->field));
+        std::size_t dropped = 0;
+        if (Status s = cloud->follow(mLights, e.options.lighting, dropped, mFogCasterScratch); !s) {
+            mLightingError = "effect '" + e.options.name + "': lighting: " + s.error();
+            continue;
+        }
+        mCounters.cloudLightsDropped += dropped; // lights reaching the cloud that cannot light it (CloudKind::follow)
+        cloudLit[i] = 1;
+    }
     for (std::size_t i = 0; i < mEntries.size(); ++i) {
         Entry& e = mEntries[i];
         const EmitOptions draw{.textured = e.options.draw.textured && options.textured,

@@ -97,7 +97,8 @@ EmitResult CloudKind::emit(const EmitContext& context) {
     return {.tetrahedra = fv.lod.tets.size()};
 }
 
-Status CloudKind::follow(std::span<const Light> lights, const EffectLighting& lighting, std::size_t& dropped) {
+Status CloudKind::follow(std::span<const Light> lights, const EffectLighting& lighting, std::size_t& dropped,
+                         std::span<const ShadowCaster* const> casters) {
     dropped = 0;
     const Light* sun = nullptr;
     for (const Light& l : lights)
@@ -120,11 +121,12 @@ Status CloudKind::follow(std::span<const Light> lights, const EffectLighting& li
         // differ); a light the cloud refuses all the same is left out and counted.
         if (!Cloud::validateLighting(L)) L.lights.pop_back(), ++dropped;
     }
-    if (!sun && L.lights.empty() && mCloud.lighting().lights.empty()) return {}; // nothing to follow: keeps its own sun
+    if (!sun && L.lights.empty() && mCloud.lighting().lights.empty())
+        return mCloud.setLight(mCloud.lighting(), casters); // nothing to follow: keeps its own sun, shadowed by the casters
     if (sun) L.sun = *sun;
     L.gas = lighting.gas;
     L.gas.colorTable = nullptr;
-    return mCloud.setLight(L);
+    return mCloud.setLight(L, casters);
 }
 
 } // namespace splatfx::detail

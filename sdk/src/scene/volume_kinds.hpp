@@ -128,7 +128,8 @@ public:
     // only if its colour is a multiple of the lights taken before
     // (Cloud::validateLighting); `dropped` counts the reaching lights left
     // out (over the count, another colour, or any for the Roettger model).
-    Status follow(std::span<const Light> lights, const EffectLighting& lighting, std::size_t& dropped);
+    // `casters` shadow it (Cloud::setLight; not its own field).
+    Status follow(std::span<const Light> lights, const EffectLighting& lighting, std::size_t& dropped, std::span<const ShadowCaster* const> casters);
     Cloud& cloud() { return mCloud; }
     const Cloud& cloud() const { return mCloud; }
 

@@ -3,9 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <string>
 
+#include "splatfx/scene.hpp"
 #include "volume/cloud_sweep.hpp"
 #include "volume/same_phase.hpp"
 
@@ -127,6 +129,92 @@ private:
     std::vector<const std::vector<float>*> mTrans;
 };
 
+// A caster's box grown as Scene::shadowFallsOn grows it (a relative 1e-5):
+// a point whose ray meets it lies in a grid that test lets through, so
+// gating the casters by that test drops none the points would trace.
+struct PaddedBox {
+    glm::dvec3 lo, hi;
+};
+
+PaddedBox padded(glm::vec3 lo, glm::vec3 hi) {
+    glm::dvec3 c0(lo), c1(hi);
+    const double pad = 1e-5 * (1.0 + std::max({glm::length(c1 - c0), glm::length(c0), glm::length(c1)}));
+    return {c0 - pad, c1 + pad};
+}
+
+// Whether the ray from p toward the light (without end toward a directional
+// one, to its position for a point or spot) meets the box (slab test).
+bool rayMeetsBox(glm::dvec3 p, const Light& light, const PaddedBox& b) {
+    const bool directional = light.type == LightType::Directional;
+    const glm::dvec3 d = directional ? -glm::normalize(glm::dvec3(light.direction)) : glm::dvec3(light.position) - p;
+    double t0 = 0.0, t1 = directional ? std::numeric_limits<double>::infinity() : 1.0;
+    for (int a = 0; a < 3; ++a) {
+        if (d[a] == 0.0) {
+            if (p[a] < b.lo[a] || p[a] > b.hi[a]) return false;
+            continue;
+        }
+        double ta = (b.lo[a] - p[a]) / d[a], tb = (b.hi[a] - p[a]) / d[a];
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+        if (t0 > t1) return false;
+    }
+    return true;
+}
+
+// A conservative bound, in world x and y, of the points in the plane z = c
+// whose ray toward the light meets the box: false when none can. A
+// directional light (u toward it): p = b - t u, t >= 0, so in the plane t
+// spans the box's z extent's [t0, t1] and x, y the box's shifted by -t u. A
+// point or spot light at q: p = q + s (b - q), s >= 1, so each coordinate
+// stays on the far side of the box from q (or anywhere with q across it).
+bool sliceBound(const PaddedBox& b, const Light& light, double c, glm::dvec2& lo, glm::dvec2& hi) {
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    lo = glm::dvec2(-inf), hi = glm::dvec2(inf);
+    if (light.type == LightType::Directional) {
+        const glm::dvec3 u = -glm::normalize(glm::dvec3(light.direction));
+        const double ta = u.z != 0.0 ? (b.lo.z - c) / u.z : 0.0, tb = u.z != 0.0 ? (b.hi.z - c) / u.z : 0.0;
+        if (u.z != 0.0 && std::isfinite(ta) && std::isfinite(tb)) {
+            const double t0 = std::max(0.0, std::min(ta, tb)), t1 = std::max(ta, tb);
+            if (t1 < 0.0) return false;
+            for (int a = 0; a < 2; ++a) {
+                lo[a] = b.lo[a] - std::max(t0 * u[a], t1 * u[a]);
+                hi[a] = b.hi[a] - std::min(t0 * u[a], t1 * u[a]);
+            }
+            return true;
+        }
+        if (u.z == 0.0 && (c < b.lo.z || c > b.hi.z)) return false;
+        for (int a = 0; a < 2; ++a) {
+            if (u[a] >= 0.0) hi[a] = b.hi[a];
+            if (u[a] <= 0.0) lo[a] = b.lo[a];
+        }
+        return true;
+    }
+    const glm::dvec3 q(light.position);
+    if ((q.z > b.hi.z && c > b.hi.z) || (q.z < b.lo.z && c < b.lo.z)) return false;
+    for (int a = 0; a < 2; ++a) {
+        if (q[a] > b.hi[a]) hi[a] = b.hi[a];
+        if (q[a] < b.lo[a]) lo[a] = b.lo[a];
+    }
+    return true;
+}
+
+// Marks the 26 neighbours of every marked point too (separable: x, y, z).
+void dilate(glm::ivec3 dims, std::vector<std::uint8_t>& mask) {
+    const std::size_t stride[3] = {1, std::size_t(dims.x), std::size_t(dims.x) * std::size_t(dims.y)};
+    std::vector<std::uint8_t> src;
+    for (int a = 0; a < 3; ++a) {
+        src = mask;
+        for (int z = 0, i = 0; z < dims.z; ++z)
+            for (int y = 0; y < dims.y; ++y)
+                for (int x = 0; x < dims.x; ++x, ++i) {
+                    if (src[std::size_t(i)]) continue;
+                    const int c = a == 0 ? x : a == 1 ? y : z, n = dims[a];
+                    if ((c > 0 && src[std::size_t(i) - stride[a]]) || (c + 1 < n && src[std::size_t(i) + stride[a]])) mask[std::size_t(i)] = 1;
+                }
+    }
+}
+
 } // namespace
 
 Status Cloud::validateLighting(const CloudLighting& lighting) { return checkLighting(lighting); }
@@ -163,30 +251,174 @@ Result<Cloud> Cloud::create(const CloudCreateDesc& desc) {
     return c;
 }
 
-Status Cloud::relight() {
+Status Cloud::relight(bool own, const std::span<const ShadowCaster* const>* casters) {
     const std::size_t count = mDensity.size();
     const CloudTransferDesc& td = mDesc.transfer;
-    const glm::dvec3 towardSun = -glm::normalize(glm::dvec3(mLighting.sun.direction));
+    if (own) {
+        const glm::dvec3 towardSun = -glm::normalize(glm::dvec3(mLighting.sun.direction));
+        if (mLighting.model == CloudLightModel::Roettger) {
+            detail::sweepSunTransmittance(mDims, mDensity, double(mDesc.cloud.lightExtinctionPerCell), towardSun, mSunOwn);
+            mRgb = false;
+        } else {
+            // The extinction drawn (sigma = maxExtinction f above the threshold) is
+            // the one the sun is attenuated by: one cell is spacingWorld long.
+            std::vector<float> sigma(count);
+            for (std::size_t i = 0; i < count; ++i) sigma[i] = mDensity[i] >= td.threshold ? mDensity[i] : 0.0f;
+            detail::sweepSunTransmittance(mDims, sigma, double(td.maxExtinctionPerWorld) * double(mDesc.volume.spacingWorld), towardSun, mSunOwn);
+            if (!multiLight(mLighting)) {
+                mLightT.clear();
+                mLightScale = 0.0f;
+                mRgb = false;
+            } else {
+                mRgb = !sharedColour(mLighting); // before traceLights: it picks the colour the weights are shares of
+                if (Status s = traceLights(); !s) return makeError("Cloud: lights: " + s.error());
+            }
+        }
+    }
+    std::vector<std::uint8_t> changed;
+    bool any = own;
+    if (casters) {
+        changed.assign(count, 0);
+        any = receive(*casters, changed) || any;
+    }
+    if (!any) return {}; // no point's light changed: nothing to rebuild
+    const std::vector<std::uint8_t>* only = own ? nullptr : &changed;
+    compose(only);
+    if (Status s = buildField(only); !s) return s;
+    if (own) ++mRelights;
+    else ++mRestrictedRelights;
+    return {};
+}
+
+bool Cloud::receive(std::span<const ShadowCaster* const> casters, std::vector<std::uint8_t>& changed) {
+    const std::size_t count = mDensity.size();
+    std::vector<CasterRecord> now(casters.size());
+    for (std::size_t i = 0; i < casters.size(); ++i) {
+        const ShadowCaster& c = *casters[i];
+        if (c.empty()) continue; // casts nothing: the default record
+        now[i] = {c.fingerprint(), c.boundsMin(), c.boundsMax(), false};
+    }
+    // The boxes whose shadow may have changed: a changed caster's old and new one.
+    std::vector<const CasterRecord*> moved;
+    for (std::size_t i = 0; i < std::max(now.size(), mCasters.size()); ++i) {
+        const CasterRecord* was = i < mCasters.size() ? &mCasters[i] : nullptr;
+        const CasterRecord* is = i < now.size() ? &now[i] : nullptr;
+        if (was && is && *was == *is) continue;
+        if (was && !was->empty) moved.push_back(was);
+        if (is && !is->empty) moved.push_back(is);
+    }
+    const float h = mDesc.volume.spacingWorld;
+    const Aabb grid{mDesc.volume.originWorld, mDesc.volume.originWorld + glm::vec3(mDims - 1) * h};
+    const std::size_t slots = 1 + mLighting.lights.size();
+    mRecv.resize(slots);
+    bool any = false;
+    std::vector<std::size_t> active;
+    std::vector<PaddedBox> activeBox, dirty;
+    for (std::size_t slot = 0; slot < slots; ++slot) {
+        const Light& light = slot == 0 ? mLighting.sun : mLighting.lights[slot - 1];
+        Received& r = mRecv[slot];
+        if (slot > 0 && (slot - 1 >= mLightT.size() || mLightT[slot - 1].own.empty())) {
+            r = {}; // lights nothing: nothing to shadow
+            continue;
+        }
+        // The casters that can shadow the grid for this light; the others are never traced.
+        active.clear(), activeBox.clear(), dirty.clear();
+        for (std::size_t i = 0; i < now.size(); ++i)
+            if (!now[i].empty && Scene::shadowFallsOn(Aabb{now[i].lo, now[i].hi}, light, grid)) {
+                active.push_back(i);
+                activeBox.push_back(padded(now[i].lo, now[i].hi));
+            }
+        const bool full = !r.valid || !sameGeometry(r.tracedFor, light) || r.depth.size() != count;
+        if (!full)
+            for (const CasterRecord* m : moved)
+                if (Scene::shadowFallsOn(Aabb{m->lo, m->hi}, light, grid)) dirty.push_back(padded(m->lo, m->hi));
+        if (!full && dirty.empty()) continue; // no changed caster can shadow the grid for this light: costs nothing
+        if (full) {
+            // A new light (or the first casters): every point, each marked
+            // changed only where its depth differs (none with no caster).
+            if (!r.valid || r.depth.size() != count) r.depth.assign(count, 0.0f);
+            r.tracedFor = light;
+            r.valid = true;
+        }
+        const glm::vec3 origin = mDesc.volume.originWorld;
+        // World to grid index along axis a, rounded outward with a point to
+        // spare (the bound is only a pre-filter: each point's own test decides).
+        auto index = [&](int a, double w, bool upper) {
+            const double v = (w - double(origin[a])) / double(h);
+            if (!(v == v)) return upper ? mDims[a] - 1 : 0; // NaN: the whole axis
+            const double r = std::clamp(upper ? std::ceil(v) + 1.0 : std::floor(v) - 1.0, 0.0, double(mDims[a] - 1));
+            return int(r);
+        };
+        for (int z = 0; z < mDims.z; ++z) {
+            glm::ivec2 i0(0), i1(mDims.x - 1, mDims.y - 1);
+            if (!full) {
+                // Only the rows the changed boxes' shadows can reach in this plane.
+                i0 = glm::ivec2(mDims.x, mDims.y), i1 = glm::ivec2(-1);
+                const double c = double(gridPoint({0, 0, z}).z);
+                for (const PaddedBox& b : dirty) {
+                    glm::dvec2 lo, hi;
+                    if (!sliceBound(b, light, c, lo, hi)) continue;
+                    for (int a = 0; a < 2; ++a) i0[a] = std::min(i0[a], index(a, lo[a], false)), i1[a] = std::max(i1[a], index(a, hi[a], true));
+                }
+            }
+            for (int y = i0.y; y <= i1.y; ++y)
+                for (int x = i0.x; x <= i1.x; ++x) {
+                    const std::size_t i = std::size_t(x) + std::size_t(mDims.x) * (std::size_t(y) + std::size_t(mDims.y) * std::size_t(z));
+                    const glm::vec3 p = gridPoint({x, y, z});
+                    const glm::dvec3 pd(p);
+                    if (!full && std::none_of(dirty.begin(), dirty.end(), [&](const PaddedBox& b) { return rayMeetsBox(pd, light, b); })) continue;
+                    // Every caster the ray meets, in the casters' order: the same sum a full relight makes.
+                    float depth = 0.0f;
+                    for (std::size_t k = 0; k < active.size(); ++k)
+                        if (rayMeetsBox(pd, light, activeBox[k])) {
+                            depth += casters[active[k]]->opticalDepthToLight(p, light);
+                            ++mReceiveTraces;
+                        }
+                    if (!full || !active.empty()) ++mReceivePoints;
+                    float& d = r.depth[i];
+                    if (d == depth) continue;
+                    d = depth;
+                    changed[i] = 1;
+                    any = true;
+                }
+        }
+    }
+    mCasters = std::move(now);
+    return any;
+}
+
+void Cloud::compose(const std::vector<std::uint8_t>* changed) {
+    const std::size_t count = mDensity.size();
+    for (std::size_t slot = 0; slot <= mLightT.size(); ++slot) {
+        const std::vector<float>& own = slot == 0 ? mSunOwn : mLightT[slot - 1].own;
+        std::vector<float>& trans = slot == 0 ? mTrans : mLightT[slot - 1].trans;
+        if (own.empty()) {
+            trans.clear();
+            continue;
+        }
+        trans.resize(count);
+        const Received* r = slot < mRecv.size() && mRecv[slot].valid ? &mRecv[slot] : nullptr;
+        for (std::size_t i = 0; i < count; ++i) {
+            if (changed && !(*changed)[i]) continue;
+            const float d = r ? r->depth[i] : 0.0f;
+            trans[i] = d > 0.0f ? own[i] * std::exp2(-d) : own[i];
+        }
+    }
+}
+
+Status Cloud::buildField(const std::vector<std::uint8_t>* changed) {
+    const std::size_t count = mDensity.size();
+    const CloudTransferDesc& td = mDesc.transfer;
     ScalarVolume field;
     field.dims = mDims;
+    field.lengthScale.resize(count);
     if (mLighting.model == CloudLightModel::Roettger) {
-        detail::sweepSunTransmittance(mDims, mDensity, double(mDesc.cloud.lightExtinctionPerCell), towardSun, mTrans);
         field.scalar = mDensity;
-        mRgb = false;
-        field.lengthScale.resize(count);
         for (std::size_t i = 0; i < count; ++i) field.lengthScale[i] = std::min(1.0f, mLighting.ambient + mLighting.diffuse * mTrans[i]);
     } else {
-        // The extinction drawn (sigma = maxExtinction f above the threshold) is
-        // the one the sun is attenuated by: one cell is spacingWorld long.
-        field.lengthScale.resize(count);
         for (std::size_t i = 0; i < count; ++i) field.lengthScale[i] = mDensity[i] >= td.threshold ? mDensity[i] : 0.0f;
-        detail::sweepSunTransmittance(mDims, field.lengthScale, double(td.maxExtinctionPerWorld) * double(mDesc.volume.spacingWorld), towardSun,
-                                      mTrans);
         if (!multiLight(mLighting)) {
             field.scalar = mTrans;
-            mLightT.clear();
-            mLightScale = 0.0f;
-            mRgb = false;
         } else {
             // u = sum_i w_i E_i (4 pi maxPhase T_i + m) / scale at every grid
             // point, by the lighting code's own evaluation (lightPoints with
@@ -194,32 +426,46 @@ Status Cloud::relight() {
             // w_i 4 pi maxPhase and multipleScattering m / (4 pi maxPhase)).
             // w_i: the light's share of the common colour, or with lights of
             // different colours its largest channel (unitLights).
-            mRgb = !sharedColour(mLighting);
-            if (Status s = traceLights(); !s) return makeError("Cloud: lights: " + s.error());
+            // After a caster moved, only the points whose transmittance
+            // changed and their neighbours (GridShadows interpolates between
+            // grid points, and a grid point's float position may sit a
+            // rounding off its node) are evaluated again.
             mPhaseMax = phaseMax(mLighting.gas.phase);
-            std::vector<glm::vec3> points(count), source;
+            std::vector<std::size_t> index;
+            std::vector<glm::vec3> points, source;
+            std::vector<std::uint8_t> near;
+            if (changed) {
+                near = *changed;
+                dilate(mDims, near);
+            }
+            if (mSource.size() != count) mSource.assign(count, 0.0f), near.clear();
             for (int z = 0, i = 0; z < mDims.z; ++z)
                 for (int y = 0; y < mDims.y; ++y)
-                    for (int x = 0; x < mDims.x; ++x, ++i) points[std::size_t(i)] = gridPoint({x, y, z});
+                    for (int x = 0; x < mDims.x; ++x, ++i)
+                        if (near.empty() || near[std::size_t(i)]) {
+                            index.push_back(std::size_t(i));
+                            points.push_back(gridPoint({x, y, z}));
+                        }
             const float fourPiMax = 4.0f * std::numbers::pi_v<float> * mPhaseMax;
             std::vector<const std::vector<float>*> trans;
             const std::vector<Light> lights = unitLights(fourPiMax, &trans);
             const GridShadows shadows(mDims, mDesc.volume.originWorld, mDesc.volume.spacingWorld, std::move(trans));
             const GasLightingDesc iso{.albedo = 1.0f, .multipleScattering = mLighting.gas.multipleScattering / fourPiMax};
-            if (Status s = lightPoints(points, mDesc.volume.spacingWorld, points[0], lights, &shadows, iso, source); !s)
-                return makeError("Cloud: lights: " + s.error());
+            if (!points.empty())
+                if (Status s = lightPoints(points, mDesc.volume.spacingWorld, gridPoint({0, 0, 0}), lights, &shadows, iso, source); !s)
+                    return makeError("Cloud: lights: " + s.error());
+            for (std::size_t k = 0; k < index.size(); ++k) mSource[index[k]] = source[k].x;
             float scale = 0.0f;
-            for (const glm::vec3& v : source) scale = std::max(scale, v.x);
+            for (float v : mSource) scale = std::max(scale, v);
             mLightScale = scale;
             field.scalar.resize(count);
             const float inv = scale > 0.0f ? 1.0f / scale : 0.0f;
-            for (std::size_t i = 0; i < count; ++i) field.scalar[i] = std::clamp(source[i].x * inv, 0.0f, 1.0f);
+            for (std::size_t i = 0; i < count; ++i) field.scalar[i] = std::clamp(mSource[i] * inv, 0.0f, 1.0f);
         }
     }
     auto vol = LodVolume::create(field, mDesc.volume);
     if (!vol) return makeError(vol.error());
     mVolume = std::move(*vol);
-    ++mRelights;
     return {};
 }
 
@@ -290,8 +536,49 @@ Status Cloud::rebuildField() {
     return {};
 }
 
-Status Cloud::setLight(const CloudLighting& lighting) {
+bool Cloud::sameCasters(std::span<const ShadowCaster* const> casters) const {
+    if (casters.size() != mCasters.size()) return false;
+    for (std::size_t i = 0; i < casters.size(); ++i) {
+        const ShadowCaster& c = *casters[i];
+        const CasterRecord r = c.empty() ? CasterRecord{} : CasterRecord{c.fingerprint(), c.boundsMin(), c.boundsMax(), false};
+        if (!(r == mCasters[i])) return false;
+    }
+    return true;
+}
+
+void Cloud::forgetCasters() {
+    mRecv.clear();
+    mCasters.clear();
+}
+
+const std::vector<float>& Cloud::receivedDepth(std::size_t slot) const {
+    static const std::vector<float> none;
+    return slot < mRecv.size() && mRecv[slot].valid ? mRecv[slot].depth : none;
+}
+
+Status Cloud::setLight(const CloudLighting& lighting, std::span<const ShadowCaster* const> casters) {
     if (Status s = checkLighting(lighting); !s) return s;
+    for (std::size_t i = 0; i < casters.size(); ++i) {
+        if (!casters[i]) return makeError("Cloud::setLight: casters[" + std::to_string(i) + "] is null");
+        if (casters[i] == &mField)
+            return makeError("Cloud::setLight: casters[" + std::to_string(i) +
+                             "] is this cloud's own densityField() (its self-shadowing is its own; pass the other volumes)");
+    }
+    const bool castersSame = sameCasters(casters);
+    // Only the casters changed: the points under their old and new boxes.
+    auto relightCasters = [&]() -> Status {
+        if (castersSame) return {};
+        const float scale = mLightScale;
+        Status s = relight(false, &casters);
+        if (s && multiLight(mLighting) && mLightScale != scale) s = rebuildTable(); // the scale of s moved
+        if (!s) {
+            // Not known to happen (the sizes and lights built before): traced again from scratch next time.
+            forgetCasters();
+            static_cast<void>(relight());
+            if (multiLight(mLighting)) static_cast<void>(rebuildTable());
+        }
+        return s;
+    };
     if (multiLight(lighting) || multiLight(mLighting)) {
         // The scale of s is the largest source over the grid: any change of a
         // light moves it, so the field and the table go together.
@@ -299,16 +586,17 @@ Status Cloud::setLight(const CloudLighting& lighting) {
             lighting.gas.ambient == mLighting.gas.ambient && lighting.gas.multipleScattering == mLighting.gas.multipleScattering &&
             samePhase(lighting.gas.phase, mLighting.gas.phase)) {
             mLighting = lighting;
-            return {};
+            return relightCasters();
         }
         const CloudLighting old = mLighting;
         const std::vector<LightState> oldT = mLightT;
         mLighting = lighting;
-        Status s = relight();
+        Status s = relight(true, &casters);
         if (s) s = rebuildTable();
         if (!s) {
             mLighting = old;
             mLightT = oldT;
+            forgetCasters();
             // Back to the previous field and table: built before from the same
             // sizes under the same budget, so they build again.
             static_cast<void>(relight());
@@ -319,12 +607,15 @@ Status Cloud::setLight(const CloudLighting& lighting) {
     const bool field = !sameField(lighting, mLighting), colour = !sameColour(lighting, mLighting);
     if (!field && !colour) {
         mLighting = lighting; // e.g. a new Roettger gas desc: nothing it draws depends on it
-        return {};
+        return relightCasters();
     }
     const CloudLighting old = mLighting;
     mLighting = lighting;
-    if (field)
-        if (Status s = relight(); !s) return mLighting = old, s;
+    if (field) {
+        if (Status s = relight(true, &casters); !s) return mLighting = old, forgetCasters(), s;
+    } else if (Status s = relightCasters(); !s) {
+        return mLighting = old, s;
+    }
     if (colour)
         if (Status s = rebuildTable(); !s) return mLighting = old, s;
     return {};
@@ -438,7 +729,7 @@ Status Cloud::traceLights() {
             std::vector<float> sigma(count);
             for (std::size_t i = 0; i < count; ++i) sigma[i] = mDensity[i] >= mDesc.transfer.threshold ? mDensity[i] : 0.0f;
             detail::sweepSunTransmittance(mDims, sigma, double(mDesc.transfer.maxExtinctionPerWorld) * double(h),
-                                          -glm::normalize(glm::dvec3(l.direction)), st.trans);
+                                          -glm::normalize(glm::dvec3(l.direction)), st.own);
             continue;
         }
         // Converging rays: which points the light reaches at all (the spot's
@@ -449,7 +740,7 @@ Status Cloud::traceLights() {
         unit.intensity = 1.0f;
         const Light one[] = {unit};
         if (Status s = lightPoints(points, h, points[0], one, nullptr, GasLightingDesc{.albedo = 1.0f}, reach); !s) return s;
-        st.trans.assign(count, 0.0f);
+        st.own.assign(count, 0.0f);
         for (std::size_t i = 0; i < count; ++i) {
             if (!(reach[i].x > 0.0f)) continue;
             const glm::vec3 p = points[i], d = l.position - p;
@@ -460,7 +751,7 @@ Status Cloud::traceLights() {
                 else if (d[a] < 0.0f) t = std::min(t, (lo[a] - p[a]) / d[a]);
             }
             t = std::max(t, 0.0f);
-            st.trans[i] = mField.empty() || t == 0.0f ? 1.0f : std::exp2(-mField.opticalDepth(p, p + t * d));
+            st.own[i] = mField.empty() || t == 0.0f ? 1.0f : std::exp2(-mField.opticalDepth(p, p + t * d));
             ++mLightTraces;
         }
     }
