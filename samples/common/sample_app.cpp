@@ -189,7 +189,6 @@ int runWindowed(const Options& o, const char* name, const std::function<bool()>&
     std::optional<splatfx::gl::Framebuffer> target, resolved;
     describeTarget(o, name);
     Notes notes(name);
-    const bool tty = isatty(fileno(stdout)) != 0;
     const auto start = std::chrono::steady_clock::now();
     for (int i = 0; !window->shouldClose(); ++i) {
         if (glfwGetKey(window->handle(), GLFW_KEY_ESCAPE) == GLFW_PRESS) break;

@@ -37,10 +37,11 @@ TEST(GlslFiles, EveryVariantAssemblesWithItsIncludesResolved) {
             ++variants;
         });
     // splat 3 fog states (none, per fragment, per splat) x 7 cut states x 2 cross-fade = 42; sections
-    // 6 kinds x 3 section counts = 18; tetrahedra 8; fog pass 3; resolve: every K a budget of 1 to
+    // 6 kinds x 3 section counts = 18; tetrahedra 16 (perspective, host depth, fog, an RGB source per
+    // vertex); fog pass 3; resolve: every K a budget of 1 to
     // 128 fragments per pixel can ask for x 2 programs = 256; the eight programs without defines 8
     // (the host depth sample one among them).
-    EXPECT_EQ(variants, 42 + 18 + 8 + 3 + 256 + 8);
+    EXPECT_EQ(variants, 42 + 18 + 16 + 3 + 256 + 8);
 }
 
 TEST(GlslFiles, AnIncludeAppearsOncePerExpansion) {
@@ -79,7 +80,7 @@ TEST(GlslFiles, AVariantTheBuildDoesNotCheckIsRefused) {
             EXPECT_TRUE(glsl::isCheckedVariant({glsl::ProgramId(p), values, 0}));
             ++listed;
         });
-    EXPECT_EQ(listed, 42 + 18 + 8 + 3 + 256 + 8);
+    EXPECT_EQ(listed, 42 + 18 + 16 + 3 + 256 + 8);
 }
 
 TEST(GlslFiles, SubstituteReplacesWholeWordsOnly) { EXPECT_EQ(glsl::substitute("A A_B xA A", {{"A", "1"}}), "1 A_B xA 1"); }

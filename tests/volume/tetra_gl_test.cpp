@@ -274,6 +274,23 @@ TEST_F(TetraPassGL, PaperEquation9ModelMatchesTheReferenceWithinTheSameBound) {
     expectPassMatchesTheReference(TestCloud{CloudModel::LightTableDensityLength});
 }
 
+namespace {
+
+// The lit-cloud tests' cloud: 17x17x9 (seed 5), LowAlbedo under a white sun
+// from (0.6, -0.3, 1) of `sunIntensity`, two HG lobes, ambient 0.03.
+splatfx::CloudCreateDesc lowAlbedoTestCloud(float sunIntensity) {
+    splatfx::CloudCreateDesc d;
+    d.cloud = {.dims = {17, 17, 9}, .seed = 5, .featureCells = 6.0f, .coverage = 0.6f};
+    d.lighting.model = CloudLightModel::LowAlbedo;
+    d.lighting.sun = Light::directional({-0.6f, 0.3f, -1.0f}, glm::vec3(1.0f), sunIntensity);
+    const HgLobe lobes[] = {{0.6f, 0.7f}, {-0.3f, 0.3f}};
+    d.lighting.gas.phase = *PhaseFunction::create(lobes);
+    d.lighting.gas.ambient = glm::vec3(0.03f);
+    return d;
+}
+
+} // namespace
+
 // A Cloud in the low-albedo model (cloud.hpp) with two HG lobes: the source
 // per vertex s = T phase / max phase written by Cloud::update, drawn with
 // the cloud's own affine transfer and table, against the exact integral of
@@ -281,13 +298,7 @@ TEST_F(TetraPassGL, PaperEquation9ModelMatchesTheReferenceWithinTheSameBound) {
 // bound. The sun (intensity 0.15) keeps the peak source A + B below 1, as
 // the bound's "colours <= 1" needs.
 TEST_F(TetraPassGL, LowAlbedoCloudMatchesTheReferenceWithinTheSameBound) {
-    splatfx::CloudCreateDesc d;
-    d.cloud = {.dims = {17, 17, 9}, .seed = 5, .featureCells = 6.0f, .coverage = 0.6f};
-    d.lighting.model = CloudLightModel::LowAlbedo;
-    d.lighting.sun = Light::directional({-0.6f, 0.3f, -1.0f}, glm::vec3(1.0f), 0.15f);
-    const HgLobe lobes[] = {{0.6f, 0.7f}, {-0.3f, 0.3f}};
-    d.lighting.gas.phase = *PhaseFunction::create(lobes);
-    d.lighting.gas.ambient = glm::vec3(0.03f);
+    splatfx::CloudCreateDesc d = lowAlbedoTestCloud(0.15f);
     d.table = {.scalarResolution = 32, .lengthResolution = 64};
     auto cloud = splatfx::Cloud::create(d);
     ASSERT_TRUE(cloud) << cloud.error();
@@ -1109,14 +1120,8 @@ TEST_F(TetraPassGL, FogAttenuatesEveryTetrahedronAsOneMedium) {
 // RGB integral is channel c of that scalar integral, alpha the same for all):
 // within the same derived bound as the one-scalar tests, channel by channel.
 TEST_F(TetraPassGL, CloudUnderLightsOfTwoColoursMatchesTheReferencePerChannel) {
-    splatfx::CloudCreateDesc d;
-    d.cloud = {.dims = {17, 17, 9}, .seed = 5, .featureCells = 6.0f, .coverage = 0.6f};
-    d.lighting.model = CloudLightModel::LowAlbedo;
-    d.lighting.sun = Light::directional({-0.6f, 0.3f, -1.0f}, glm::vec3(1.0f), 0.02f);
+    splatfx::CloudCreateDesc d = lowAlbedoTestCloud(0.02f);
     d.lighting.lights = {Light::point({26.0f, 9.0f, 6.0f}, {1.0f, 0.45f, 0.1f}, 10.0f)};
-    const HgLobe lobes[] = {{0.6f, 0.7f}, {-0.3f, 0.3f}};
-    d.lighting.gas.phase = *PhaseFunction::create(lobes);
-    d.lighting.gas.ambient = glm::vec3(0.03f);
     // 256 length samples: the bound's texel spread along the length small enough beside the
     // colour the two lights' difference makes (see `tinted`). The torch is behind the cloud
     // (seen from the camera), lighting its far side in the forward lobe.
