@@ -219,7 +219,10 @@ void FrameRenderer::render(const Frame& frame, const HostTarget& target) {
     r.host.addSampleTexture(depth, target.x + frame.camera().viewport.x, target.y + frame.camera().viewport.y);
     FrameRendererDesc planDesc = r.desc;
     if (!r.splats.layerError().empty()) planDesc.volumeLayer = false; // noted in report()
-    const HostColor hostColorBuffer = hostColor(target.framebuffer);
+    // The host's colour format matters to the volume layer's choice and to an 8-bit layer's clamp; asked only then.
+    const bool readsHostColor = (planDesc.volumeLayer && planDesc.resolutionScale == 1) || planDesc.reducedPrecision == Precision::U8 ||
+                                planDesc.volumeLayerPrecision == Precision::U8;
+    const HostColor hostColorBuffer = readsHostColor ? hostColor(target.framebuffer) : HostColor{};
     if (planDesc.volumeLayer && planDesc.resolutionScale == 1 && hostColorBuffer.isFloat && hostColorBuffer.redBits >= 32) planDesc.volumeLayer = false;
     r.plan = planFrame(frame, target, planDesc, depth);
     r.clampingNote = clampingLayerNote(r.plan, planDesc, planDesc.volumeLayer, hostColorBuffer);
